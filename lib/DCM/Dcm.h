@@ -1,0 +1,99 @@
+// Fixed-step Direction Cosine Matrix attitude estimator with drift correction,
+// after W. Premerlani and P. Bizard, "Direction Cosine Matrix IMU: Theory" (2009).
+//
+// Frames: body x forward, y right, z down; earth north-east-down, referenced to
+// MAGNETIC north (the declination is added only when a heading is reported, so
+// changing it moves the output at once). The matrix R maps body to earth; its rows
+// are the earth axes seen in body coordinates.
+//
+// Units: gyro rad/s, specific force m/s^2 (level at rest reads z = -9.81), field in
+// any consistent unit (uT), time in seconds. Gains are per second and scaled by the
+// step, so the step rate can change without retuning.
+//
+// Plain C++ with no Arduino include: the host tests, the host replay tool and the
+// firmware run this very code.
+#pragma once
+
+#include <stdint.h>
+
+#include "Euler.h"
+#include "LinAlg.h"
+
+namespace dcm {
+
+struct DcmSettings {
+    float step_s;                    // fixed update step, s (200 Hz: 0.005)
+    float kp_rp_1_s;                 // roll/pitch proportional gain, 1/s
+    float ki_rp_1_s2;                // roll/pitch integral gain (gyro-bias estimate), 1/s^2
+    float kp_yaw_1_s;                // yaw proportional gain, 1/s
+    float ki_yaw_1_s2;               // yaw integral gain, 1/s^2
+    float kp_startup_1_s;            // roll/pitch/yaw P gain during the start-up ramp, 1/s
+    float startup_s;                 // length of the start-up ramp, s
+    float accel_reject_g;            // |1 - |a|/g| at which gravity's weight reaches 0, g
+    float integrator_hold_rate_rad_s;// |gyro| above which the bias integrator is held, rad/s
+    float bias_limit_rad_s;          // bound on each axis of the gyro-bias estimate, rad/s
+    float mag_reject_rad;            // heading error beyond which a mag sample counts as disturbed, rad
+    float mag_recover_s;             // a heading error that persists this long is accepted, s
+};
+
+extern const DcmSettings kDefaultDcmSettings;
+
+// Bits of Dcm::status().
+enum StatusFlags : uint8_t {
+    kStatusInitialised = 0x01,
+    kStatusAccelIgnored = 0x02,   // last step gave gravity no weight (|a| far from 1 g or NaN)
+    kStatusMagIgnored = 0x04,     // last mag sample rejected (disturbed, NaN, or too vertical)
+    kStatusBiasHeld = 0x08,       // integrator held: rotating fast
+    kStatusRecovered = 0x10,      // the matrix was rebuilt since start (sticky)
+    kStatusNoHeading = 0x20,      // no magnetometer sample yet: yaw is gyro-only
+};
+
+class Dcm {
+public:
+    explicit Dcm(const DcmSettings& settings = kDefaultDcmSettings);
+
+    // Start-up attitude from one gravity and one field sample (TRIAD):
+    // K = -a/|a| (earth down in body), I = (K x m) x K normalised (north), J = K x I.
+    // With a zero or unusable field, yaw starts at 0 and kStatusNoHeading is set.
+    // Returns false (and stays uninitialised) when gravity is unusable.
+    bool init(const linalg::Vector3f& accel_m_s2, const linalg::Vector3f& mag_field);
+
+    // One fixed step: integrate the gyro (R <- R (I + [w x] dt)), renormalise, and
+    // apply the roll/pitch drift correction from gravity. A non-finite gyro sample is
+    // rejected (not integrated); a non-finite or absurd accel sample gets no weight.
+    void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2);
+
+    // Yaw drift correction from a new magnetometer sample (call when one arrives,
+    // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down.
+    void correct_heading(const linalg::Vector3f& mag_field);
+
+    bool initialised() const { return (status_ & kStatusInitialised) != 0; }
+    uint8_t status() const { return status_; }
+    uint16_t recoveries() const { return recoveries_; }
+    const linalg::Matrix3f& matrix() const { return r_; }
+    // Current gyro-bias estimate, rad/s (what the integrator has learned).
+    linalg::Vector3f gyro_bias_rad_s() const { return bias_rad_s_; }
+    // Seed for the bias estimate, e.g. from a start-up calibration at rest.
+    void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
+    const DcmSettings& settings() const { return settings_; }
+    // Euler angles of R (yaw relative to magnetic north); see Euler.h.
+    EulerAngles euler() const { return euler_from_dcm(r_); }
+
+private:
+    bool renormalise();
+    float startup_blend() const;
+
+    DcmSettings settings_;
+    linalg::Matrix3f r_;
+    linalg::Vector3f bias_rad_s_;        // integrator: gyro-bias estimate
+    linalg::Vector3f omega_p_rad_s_;     // proportional correction from gravity, applied each step
+    linalg::Vector3f omega_yaw_rad_s_;   // proportional correction from the field, held between samples
+    linalg::Vector3f last_accel_m_s2_;   // for a rebuild if the matrix degenerates
+    linalg::Vector3f last_mag_field_;
+    float mag_disturbed_s_;
+    uint32_t steps_;
+    uint16_t recoveries_;
+    uint8_t status_;
+};
+
+}  // namespace dcm

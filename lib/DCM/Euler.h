@@ -1,0 +1,34 @@
+// Euler angles from a body->earth rotation matrix, aerospace Z-Y-X (yaw psi, pitch
+// theta, roll phi): R = Rz(psi) Ry(theta) Rx(phi), earth = north-east-down.
+//
+//   theta = -asin(R31), phi = atan2(R32, R33), psi = atan2(R21, R11)
+//
+// Gimbal lock (|R31| -> 1, pitch +-90 deg): roll and yaw are not separable there.
+// Convention: when cos(theta) is below kGimbalLockCos the whole remaining rotation
+// is reported as yaw and roll is 0: psi = atan2(-R12, R22) (exact for phi = 0).
+// Away from the lock the ordinary formulas are used; the switch happens where both
+// give the same rotation to within float precision, so the output stays finite and
+// the matrix rebuilt from the angles matches R everywhere.
+#pragma once
+
+#include "LinAlg.h"
+
+namespace dcm {
+
+struct EulerAngles {
+    float roll_rad;
+    float pitch_rad;
+    float yaw_rad;  // -pi..pi
+};
+
+// Below this cos(pitch) (pitch within ~0.06 deg of +-90) roll is folded into yaw.
+constexpr float kGimbalLockCos = 1e-3f;
+
+EulerAngles euler_from_dcm(const linalg::Matrix3f& r);
+linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
+
+// Heading in degrees, 0 <= h < 360, from a yaw angle in radians and a declination
+// (east positive) in degrees: the firmware's output convention.
+float heading_deg(float yaw_rad, float declination_deg);
+
+}  // namespace dcm

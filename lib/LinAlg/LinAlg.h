@@ -1,0 +1,115 @@
+// LinAlg: small float value types for 3-vectors and 3x3 matrices.
+//
+// Plain C++11, no Arduino include: the same code builds for the host tests and the
+// ATmega2560 (where float and double are both 32-bit; we use float everywhere so
+// both targets compute the same thing). No heap, no virtuals, no exceptions.
+//
+// Matrix3f stores ROWS: m.a is row 1, m.b row 2, m.c row 3. For the DCM the rows are
+// the earth axes (north, east, down) expressed in body coordinates, so
+// m * v_body = v_earth and m.mul_transpose(v_earth) = v_body.
+#pragma once
+
+#include <math.h>
+
+namespace linalg {
+
+// True if x is neither NaN nor infinite. Written without isfinite() because
+// avr-libc and the host libc disagree on where it lives.
+inline bool is_finite(float x) { return (x == x) && (x - x == 0.0f); }
+
+// Clamp x to [lo, hi]; a NaN becomes lo so that it never propagates.
+inline float constrain(float x, float lo, float hi) {
+    if (!(x >= lo)) return lo;
+    if (x > hi) return hi;
+    return x;
+}
+
+// asin defined for every input: |x| > 1 (rounding) is clamped, NaN gives 0.
+inline float safe_asin(float x) {
+    if (!is_finite(x)) return 0.0f;
+    return asinf(constrain(x, -1.0f, 1.0f));
+}
+
+// sqrt defined for every input: negatives and NaN give 0.
+inline float safe_sqrt(float x) { return (x > 0.0f && is_finite(x)) ? sqrtf(x) : 0.0f; }
+
+constexpr float kPi = 3.14159265358979f;
+constexpr float kDegPerRad = 57.2957795130823f;
+constexpr float kRadPerDeg = 0.0174532925199433f;
+
+struct Vector3f {
+    float x, y, z;
+
+    Vector3f() : x(0.0f), y(0.0f), z(0.0f) {}
+    Vector3f(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
+
+    Vector3f operator+(const Vector3f& v) const { return Vector3f(x + v.x, y + v.y, z + v.z); }
+    Vector3f operator-(const Vector3f& v) const { return Vector3f(x - v.x, y - v.y, z - v.z); }
+    Vector3f operator-() const { return Vector3f(-x, -y, -z); }
+    Vector3f operator*(float s) const { return Vector3f(x * s, y * s, z * s); }
+    Vector3f& operator+=(const Vector3f& v) { x += v.x; y += v.y; z += v.z; return *this; }
+    Vector3f& operator-=(const Vector3f& v) { x -= v.x; y -= v.y; z -= v.z; return *this; }
+    Vector3f& operator*=(float s) { x *= s; y *= s; z *= s; return *this; }
+    bool operator==(const Vector3f& v) const { return x == v.x && y == v.y && z == v.z; }
+
+    float dot(const Vector3f& v) const { return x * v.x + y * v.y + z * v.z; }
+    Vector3f cross(const Vector3f& v) const {
+        return Vector3f(y * v.z - z * v.y, z * v.x - x * v.z, x * v.y - y * v.x);
+    }
+    float length_squared() const { return dot(*this); }
+    float length() const { return safe_sqrt(length_squared()); }
+    bool is_finite() const { return linalg::is_finite(x) && linalg::is_finite(y) && linalg::is_finite(z); }
+    bool is_zero() const { return x == 0.0f && y == 0.0f && z == 0.0f; }
+
+    // Unit vector in the same direction; a zero, tiny or non-finite vector has no
+    // direction and gives the zero vector (never NaN). Callers test is_zero().
+    Vector3f normalized() const {
+        const float len_sq = length_squared();
+        if (!(len_sq > 1e-30f) || !linalg::is_finite(len_sq)) return Vector3f();
+        return *this * (1.0f / sqrtf(len_sq));
+    }
+    // In-place form of normalized(); returns false (and leaves zero) when impossible.
+    bool normalize() {
+        *this = normalized();
+        return !is_zero();
+    }
+};
+
+inline Vector3f operator*(float s, const Vector3f& v) { return v * s; }
+
+struct Matrix3f {
+    Vector3f a, b, c;  // rows
+
+    Matrix3f() : a(1.0f, 0.0f, 0.0f), b(0.0f, 1.0f, 0.0f), c(0.0f, 0.0f, 1.0f) {}
+    Matrix3f(const Vector3f& row1, const Vector3f& row2, const Vector3f& row3)
+        : a(row1), b(row2), c(row3) {}
+
+    static Matrix3f identity() { return Matrix3f(); }
+    static Matrix3f zero() { return Matrix3f(Vector3f(), Vector3f(), Vector3f()); }
+    // The matrix [v x] such that [v x] * u = v x u.
+    static Matrix3f skew(const Vector3f& v) {
+        return Matrix3f(Vector3f(0.0f, -v.z, v.y), Vector3f(v.z, 0.0f, -v.x), Vector3f(-v.y, v.x, 0.0f));
+    }
+
+    Vector3f col_x() const { return Vector3f(a.x, b.x, c.x); }
+    Vector3f col_y() const { return Vector3f(a.y, b.y, c.y); }
+    Vector3f col_z() const { return Vector3f(a.z, b.z, c.z); }
+
+    Matrix3f operator+(const Matrix3f& m) const { return Matrix3f(a + m.a, b + m.b, c + m.c); }
+    Matrix3f operator-(const Matrix3f& m) const { return Matrix3f(a - m.a, b - m.b, c - m.c); }
+    Matrix3f operator*(float s) const { return Matrix3f(a * s, b * s, c * s); }
+
+    // M v
+    Vector3f operator*(const Vector3f& v) const { return Vector3f(a.dot(v), b.dot(v), c.dot(v)); }
+    // M^T v, without forming the transpose (earth -> body for a DCM).
+    Vector3f mul_transpose(const Vector3f& v) const { return a * v.x + b * v.y + c * v.z; }
+    // M N
+    Matrix3f operator*(const Matrix3f& n) const {
+        return Matrix3f(n.mul_transpose(a), n.mul_transpose(b), n.mul_transpose(c));
+    }
+    Matrix3f transposed() const { return Matrix3f(col_x(), col_y(), col_z()); }
+    float determinant() const { return a.dot(b.cross(c)); }
+    bool is_finite() const { return a.is_finite() && b.is_finite() && c.is_finite(); }
+};
+
+}  // namespace linalg

@@ -1,0 +1,86 @@
+// MPU6000 register map and decoding (InvenSense MPU-6000 Register Map rev 4.2).
+//
+// Pure: no bus access, no Arduino include. The bus driver (Mpu6000.h) moves bytes;
+// everything that gives those bytes a meaning is here, so it is host-tested and
+// shared with the simulator's register model (sim/).
+//
+// Body frame: x forward (the arrow on the APM case), y right, z down. Units SI.
+#pragma once
+
+#include <stdint.h>
+
+#include "Bytes.h"
+#include "LinAlg.h"
+
+namespace mpu6000 {
+
+// Register addresses (Register Map section 3). Bit 7 of the address byte = read.
+constexpr uint8_t kReadFlag = 0x80;
+constexpr uint8_t REG_SMPLRT_DIV = 0x19;
+constexpr uint8_t REG_CONFIG = 0x1A;
+constexpr uint8_t REG_GYRO_CONFIG = 0x1B;
+constexpr uint8_t REG_ACCEL_CONFIG = 0x1C;
+constexpr uint8_t REG_INT_PIN_CFG = 0x37;
+constexpr uint8_t REG_INT_ENABLE = 0x38;
+constexpr uint8_t REG_INT_STATUS = 0x3A;
+constexpr uint8_t REG_ACCEL_XOUT_H = 0x3B;  // first of the 14-byte burst
+constexpr uint8_t REG_USER_CTRL = 0x6A;
+constexpr uint8_t REG_PWR_MGMT_1 = 0x6B;
+constexpr uint8_t REG_WHO_AM_I = 0x75;
+
+constexpr uint8_t kWhoAmIValue = 0x68;
+constexpr uint8_t kPwrDeviceReset = 0x80;    // PWR_MGMT_1 bit 7; the reset takes <= 100 ms
+constexpr uint8_t kPwrClockPllGyroZ = 0x03;  // PWR_MGMT_1 CLKSEL = 3
+constexpr uint8_t kUserCtrlI2cIfDis = 0x10;  // USER_CTRL: SPI only
+constexpr uint8_t kIntPinCfgClearOnRead = 0x10;
+constexpr uint8_t kIntEnableDataReady = 0x01;
+constexpr uint8_t kIntStatusDataReady = 0x01;
+constexpr uint8_t kBurstLength = 14;         // accel xyz, temp, gyro xyz, big-endian int16
+
+// DLPF_CFG values (CONFIG bits 2:0). With the DLPF on, the internal rate is 1 kHz.
+enum class Dlpf : uint8_t { Hz188 = 1, Hz98 = 2, Hz42 = 3, Hz20 = 4, Hz10 = 5, Hz5 = 6 };
+// FS_SEL values, already shifted into GYRO_CONFIG bits 4:3.
+enum class GyroRange : uint8_t { Dps250 = 0x00, Dps500 = 0x08, Dps1000 = 0x10, Dps2000 = 0x18 };
+// AFS_SEL values, already shifted into ACCEL_CONFIG bits 4:3.
+enum class AccelRange : uint8_t { G2 = 0x00, G4 = 0x08, G8 = 0x10, G16 = 0x18 };
+
+// Sample rate = 1 kHz / (1 + SMPLRT_DIV) with the DLPF on (Register Map 4.2).
+constexpr uint8_t smplrt_div_for_hz(uint16_t rate_hz) { return (uint8_t)(1000u / rate_hz - 1u); }
+
+// Sensitivity per configured range (Product Specification 6.1 and 6.2).
+float gyro_lsb_per_dps(GyroRange range);
+float accel_lsb_per_g(AccelRange range);
+
+// Temperature in degrees C from the TEMP_OUT register (Register Map 4.18).
+inline float temperature_c_from_raw(int16_t raw) { return (float)raw * (1.0f / 340.0f) + 36.53f; }
+
+// Chip axes <-> body axes on the APM 2.5 (ArduPilot's APM2 mapping, what flew):
+// body = (+chip_y, +chip_x, -chip_z). Written once here; the simulator uses the inverse.
+inline linalg::Vector3f chip_to_body(const linalg::Vector3f& chip) {
+    return linalg::Vector3f(chip.y, chip.x, -chip.z);
+}
+inline linalg::Vector3f body_to_chip(const linalg::Vector3f& body) {
+    return linalg::Vector3f(body.y, body.x, -body.z);
+}
+
+enum class BurstStatus : uint8_t {
+    Ok,
+    NoSensor,  // all 0x00 or all 0xFF: nobody drove MISO
+};
+
+struct Sample {
+    linalg::Vector3f gyro_rad_s;   // body frame
+    linalg::Vector3f accel_m_s2;   // body frame, specific force (level at rest: z = -9.81)
+    float temperature_c;
+    bool gyro_saturated;           // an axis at the end of its range: the rate is at least that
+    bool accel_saturated;
+};
+
+// Decodes one 14-byte burst read from ACCEL_XOUT_H, in the configured ranges.
+// On NoSensor `out` is left untouched.
+BurstStatus decode_burst(const uint8_t raw[kBurstLength], GyroRange gyro_range,
+                         AccelRange accel_range, Sample& out);
+
+constexpr float kStandardGravity_m_s2 = 9.80665f;
+
+}  // namespace mpu6000

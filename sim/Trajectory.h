@@ -1,0 +1,44 @@
+// Trajectory files (../shared/SIM.md): CSV, optionally gzip-compressed, header
+// `t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz[,movement]`, body frame x forward,
+// y right, z down; rad/s, m/s^2, uT; quaternion body->earth (NED), scalar first.
+// Host-only (simulator, replay, scorer); read once into memory.
+#pragma once
+
+#include <stddef.h>
+#include <string>
+#include <vector>
+
+namespace sim {
+
+struct TrajectorySample {
+    double t_s;
+    double gyro_rad_s[3];
+    double accel_m_s2[3];
+    double mag_uT[3];
+    double quat[4];   // w, x, y, z; NaN where unknown
+    bool movement;    // counts in error metrics
+};
+
+class Trajectory {
+public:
+    // Loads FILE (.csv or .csv.gz, detected by content). On failure returns false and
+    // sets error() to a sentence naming the file and the line.
+    bool load(const std::string& path);
+    const std::string& error() const { return error_; }
+    size_t size() const { return samples_.size(); }
+    const TrajectorySample& operator[](size_t i) const { return samples_[i]; }
+    double duration_s() const { return samples_.empty() ? 0.0 : samples_.back().t_s; }
+
+    // Linear interpolation of the physical values at time t (held at both ends).
+    // The quaternion is taken from the nearest sample (not interpolated).
+    TrajectorySample at(double t_s) const;
+
+    std::vector<TrajectorySample>& samples() { return samples_; }
+
+private:
+    std::vector<TrajectorySample> samples_;
+    std::string error_;
+    mutable size_t cursor_ = 0;  // speeds up monotonic at() calls
+};
+
+}  // namespace sim
