@@ -101,7 +101,7 @@ tools: $(HOST_BUILD)/Makefile
 	@$(MAKE) --no-print-directory -C $(HOST_BUILD) -j2
 
 $(HOST_BUILD)/Makefile: CMakeLists.txt
-	cmake -S . -B $(HOST_BUILD) -DCMAKE_BUILD_TYPE=Release > /dev/null
+	cmake -S . -B $(HOST_BUILD) -DCMAKE_BUILD_TYPE=Release -DTOOLS_DIR=$(abspath $(BUILD)) > /dev/null
 
 sim: deps firmware tools
 	@mkdir -p $(BUILD)/scenarios
