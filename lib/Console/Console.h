@@ -1,0 +1,102 @@
+// The serial console: one command per line, answered with "# " lines.
+//
+//   help                 the command list
+//   rate <Hz>            output lines per second, whole number 1..100
+//   decl <degrees>       magnetic declination, east positive, -180..180 (2 decimals kept)
+//   mode plot|csv|quiet  output format (csv prints its header "t_ms,roll,pitch,yaw" first)
+//   status               sensor health, loop load, overruns, gyro bias, temperature, uptime
+//   cal gyro             measure the gyro bias again (keep the board still ~1 s)
+//   cal mag              hard iron + scale: turn the board every way for 30 s
+//   save                 write settings and calibration to EEPROM
+//   defaults             back to the defaults (not saved until `save`)
+//
+// Anything else (unknown words, bad or out-of-range numbers, extra arguments, a line
+// over kLineCapacity characters, control or non-ASCII bytes) is answered with
+// "# error: ..." and changes nothing. Commands are case-insensitive; '\r', '\n' or
+// "\r\n" end a line; backspace (0x08 or 0x7F) deletes the last character.
+//
+// Pure C++: the firmware feeds received bytes and executes what comes back; the
+// commands that only change settings are executed here (apply_setting) so that the
+// host tests cover them.
+#pragma once
+
+#include <stdint.h>
+
+#include "Format.h"
+#include "Settings.h"
+#include "Text.h"
+
+namespace console {
+
+constexpr uint8_t kLineCapacity = 40;  // longest accepted line, characters
+
+enum class CommandId : uint8_t {
+    None,      // nothing complete yet (or an empty line)
+    Error,     // Command::error says what
+    Help,
+    Rate,      // value = Hz
+    Decl,      // value = hundredths of a degree
+    Mode,      // mode
+    Status,
+    CalGyro,
+    CalMag,
+    Save,
+    Defaults,
+};
+
+enum class Error : uint8_t {
+    None,
+    Unknown,          // not a command
+    TooLong,          // line over kLineCapacity
+    Garbage,          // control or non-ASCII bytes
+    MissingArgument,
+    ExtraArgument,
+    BadNumber,        // not a number of the expected form
+    RateRange,        // not 1..100 or not whole
+    DeclRange,        // outside -180..180
+    BadMode,          // not plot|csv|quiet
+    BadCalTarget,     // cal without gyro|mag
+};
+
+struct Command {
+    CommandId id;
+    Error error;
+    int32_t value;
+    fmt::OutputMode mode;
+};
+
+// Parses one complete line (NUL-terminated, without the line ending).
+Command parse_line(const char* line);
+
+// Parses a decimal number "[+-]digits[.digits]" into hundredths, rounding half away
+// from zero on the third decimal. False for anything else (empty, letters, "1e3",
+// "nan", two points, more than 7 integer digits).
+bool parse_centi(const char* s, int32_t& out);
+
+// Collects bytes into lines and parses them.
+class LineReader {
+public:
+    // Feeds one received byte; returns the command when it ended a line, else None.
+    Command feed(uint8_t byte);
+
+private:
+    char buf_[kLineCapacity + 1] = {};
+    uint8_t len_ = 0;
+    bool too_long_ = false;
+    bool garbage_ = false;
+    bool last_was_cr_ = false;
+};
+
+// Writes "# error: <why>\n" for a parse error.
+void print_error(const Command& c, const text::Sink* out);
+void print_help(const text::Sink* out);
+
+// Executes Rate, Decl, Mode and Defaults on `s` and writes the reply; returns false
+// (and touches nothing) for every other command. Defaults keeps nothing: calibration
+// too returns to zero bias and unit scale.
+bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* out);
+
+// "plot", "csv" or "quiet".
+text::Flash mode_name(fmt::OutputMode m);
+
+}  // namespace console

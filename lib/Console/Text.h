@@ -1,0 +1,59 @@
+// Text output seam: a tiny function-pointer sink plus a writer that formats integers
+// and fixed-point numbers without printf or float printing.
+//
+// On AVR a string literal lives in SRAM unless it is put in flash (PROGMEM), and the
+// firmware has < 2 KB of static RAM to spend: every message is written TXT("...")
+// (flash on AVR, an ordinary literal on the host) and handed to the sink's
+// write_flash. No Arduino include: the firmware implements the sink with Serial, the
+// host tests with a std::string, the replay tool with nothing (a null sink is silent).
+#pragma once
+
+#include <stdint.h>
+
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define TXT(s) (::text::Flash{PSTR(s)})
+#else
+#define TXT(s) (::text::Flash{s})
+#endif
+
+namespace text {
+
+// A NUL-terminated string in program memory on AVR (ordinary memory on the host).
+struct Flash {
+    const char* p;
+};
+
+struct Sink {
+    void* ctx;
+    void (*write)(void* ctx, const char* data, uint8_t len);  // bytes in RAM
+    void (*write_flash)(void* ctx, const char* flash_str);    // NUL-terminated, program memory on AVR
+};
+
+// Decimal digits of v into buf (no NUL); returns the count (<= 11).
+uint8_t format_int(char* buf, int32_t v);
+// v/100 with exactly two decimals ("-1.23", "0.05"); returns the count (<= 14).
+uint8_t format_centi(char* buf, int32_t centi);
+// Nearest hundredth of x, rounding half away from zero. False (out untouched) when x
+// is NaN, infinite or beyond +-2e7, so nothing non-finite ever reaches the text.
+bool to_centi(float x, int32_t& out);
+
+// Chained writes to a sink; every call is a no-op when the sink is null.
+class Writer {
+public:
+    explicit Writer(const Sink* sink) : sink_(sink) {}
+    Writer& str(Flash s);
+    Writer& str(const char* ram, uint8_t len);
+    Writer& chr(char c) { return str(&c, 1); }
+    Writer& i32(int32_t v);
+    Writer& u32(uint32_t v);
+    // Two decimals; a non-finite value prints as "?" (never "nan").
+    Writer& fixed2(float v);
+    Writer& hex8(uint8_t v);  // two upper-case hex digits, no prefix
+    Writer& end() { return chr('\n'); }
+
+private:
+    const Sink* sink_;
+};
+
+}  // namespace text

@@ -1,0 +1,157 @@
+// Gyro-bias and magnetometer calibration (lib/Calibration).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "Calibration.h"
+
+using calib::GyroCalibrator;
+using calib::MagCalibrator;
+using linalg::Vector3f;
+
+namespace {
+const Vector3f kLevel(0.0f, 0.0f, -9.80665f);
+const Vector3f kBias(0.02f, -0.01f, 0.005f);
+
+// Small deterministic noise in [-a, a].
+float noise(uint32_t& s, float a) {
+    s = s * 1664525u + 1013904223u;
+    return a * ((float)(s >> 8) / 8388608.0f - 1.0f);
+}
+}  // namespace
+
+TEST(Calibration, ApplyInOnePlace) {
+    calib::Calibration c = calib::default_calibration();
+    EXPECT_TRUE(calib::apply_gyro(c, kBias) == kBias);
+    c.gyro_bias_rad_s = kBias;
+    EXPECT_TRUE(calib::apply_gyro(c, kBias) == Vector3f());
+    c.mag_offset_uT = Vector3f(10.0f, 0.0f, -5.0f);
+    c.mag_scale = Vector3f(2.0f, 1.0f, 0.5f);
+    EXPECT_TRUE(calib::apply_mag(c, Vector3f(11.0f, 3.0f, -1.0f)) == Vector3f(2.0f, 3.0f, 2.0f));
+    EXPECT_TRUE(calib::is_plausible(c));
+    c.mag_scale.x = 5.0f;
+    EXPECT_FALSE(calib::is_plausible(c));
+}
+
+TEST(Calibration, GyroBiasAtRestTakesOneSecond) {
+    GyroCalibrator g;
+    uint32_t s = 1;
+    GyroCalibrator::Result r = GyroCalibrator::Result::Collecting;
+    int n = 0;
+    while (r != GyroCalibrator::Result::Done && n < 1000) {
+        const Vector3f gyro = kBias + Vector3f(noise(s, 0.004f), noise(s, 0.004f), noise(s, 0.004f));
+        const Vector3f acc = kLevel + Vector3f(noise(s, 0.05f), noise(s, 0.05f), noise(s, 0.05f));
+        r = g.add(gyro, acc);
+        ASSERT_NE(r, GyroCalibrator::Result::Moved);
+        ++n;
+    }
+    EXPECT_EQ(n, calib::kGyroWindow);
+    EXPECT_NEAR(g.bias().x, kBias.x, 0.001f);
+    EXPECT_NEAR(g.bias().y, kBias.y, 0.001f);
+    EXPECT_NEAR(g.bias().z, kBias.z, 0.001f);
+    EXPECT_NEAR(g.mean_accel_m_s2().z, -9.80665f, 0.02f);
+    EXPECT_EQ(g.restarts(), 0);
+}
+
+TEST(Calibration, GyroRestartsWhenTheBoardMoves) {
+    GyroCalibrator g;
+    for (int i = 0; i < 100; ++i) ASSERT_EQ(g.add(kBias, kLevel), GyroCalibrator::Result::Collecting);
+    // A 10 deg/s twitch.
+    EXPECT_EQ(g.add(kBias + Vector3f(0.0f, 0.0f, 0.17f), kLevel), GyroCalibrator::Result::Moved);
+    EXPECT_EQ(g.restarts(), 1);
+    EXPECT_EQ(g.count(), 0);
+    // Then a full still second completes.
+    GyroCalibrator::Result r = GyroCalibrator::Result::Collecting;
+    for (int i = 0; i < calib::kGyroWindow; ++i) r = g.add(kBias, kLevel);
+    EXPECT_EQ(r, GyroCalibrator::Result::Done);
+}
+
+TEST(Calibration, GyroRestartsOnAccelChange) {
+    GyroCalibrator g;
+    for (int i = 0; i < 50; ++i) g.add(kBias, kLevel);
+    // Shaken: |a| 1.3 g.
+    EXPECT_EQ(g.add(kBias, kLevel * 1.3f), GyroCalibrator::Result::Moved);
+    for (int i = 0; i < 50; ++i) g.add(kBias, kLevel);
+    // Slowly tilting: |a| stays 1 g but an axis moves by 0.5 m/s^2.
+    EXPECT_EQ(g.add(kBias, Vector3f(0.5f, 0.0f, -9.79f)), GyroCalibrator::Result::Moved);
+    // NaN counts as movement, never as data.
+    for (int i = 0; i < 50; ++i) g.add(kBias, kLevel);
+    EXPECT_EQ(g.add(Vector3f(std::nanf(""), 0.0f, 0.0f), kLevel), GyroCalibrator::Result::Moved);
+}
+
+TEST(Calibration, SteadySpinIsNotABias) {
+    GyroCalibrator g;
+    GyroCalibrator::Result r = GyroCalibrator::Result::Collecting;
+    for (int i = 0; i < calib::kGyroWindow; ++i) r = g.add(Vector3f(0.0f, 0.0f, 1.0f), kLevel);
+    EXPECT_EQ(r, GyroCalibrator::Result::Moved);
+    EXPECT_FALSE(g.done());
+}
+
+namespace {
+// Feeds a rotation through every orientation of a field `b` seen through an offset and
+// per-axis gains.
+void feed_sphere(MagCalibrator& m, const Vector3f& offset, const Vector3f& gain, float b_uT) {
+    for (int i = 0; i < 36; ++i) {
+        for (int j = 0; j < 18; ++j) {
+            const float az = (float)i * 10.0f * linalg::kRadPerDeg;
+            const float el = ((float)j * 10.0f - 85.0f) * linalg::kRadPerDeg;
+            const Vector3f f(b_uT * cosf(el) * cosf(az), b_uT * cosf(el) * sinf(az), b_uT * sinf(el));
+            m.add(Vector3f(f.x * gain.x, f.y * gain.y, f.z * gain.z) + offset);
+        }
+    }
+}
+}  // namespace
+
+TEST(Calibration, MagHardIronAndScale) {
+    MagCalibrator m;
+    const Vector3f offset(20.0f, -15.0f, 40.0f);
+    const Vector3f gain(1.1f, 0.9f, 1.0f);
+    feed_sphere(m, offset, gain, 50.0f);
+    calib::Calibration c = calib::default_calibration();
+    c.gyro_bias_rad_s = kBias;
+    ASSERT_EQ(m.finish(c), MagCalibrator::Quality::Ok);
+    EXPECT_NEAR(c.mag_offset_uT.x, 20.0f, 0.5f);
+    EXPECT_NEAR(c.mag_offset_uT.y, -15.0f, 0.5f);
+    EXPECT_NEAR(c.mag_offset_uT.z, 40.0f, 0.5f);
+    // After calibration the axes have equal spans.
+    EXPECT_NEAR(c.mag_scale.x * 1.1f, c.mag_scale.y * 0.9f, 0.02f);
+    EXPECT_NEAR(c.mag_scale.y * 0.9f, c.mag_scale.z * 1.0f, 0.02f);
+    EXPECT_TRUE(c.gyro_bias_rad_s == kBias);  // untouched
+    const Vector3f corrected = calib::apply_mag(c, Vector3f(50.0f * 1.1f, 0.0f, 0.0f) + offset);
+    EXPECT_NEAR(corrected.length(), 50.0f, 1.5f);
+}
+
+TEST(Calibration, MagQualityChecks) {
+    calib::Calibration c = calib::default_calibration();
+    const calib::Calibration before = c;
+    MagCalibrator m;
+    for (int i = 0; i < 10; ++i) m.add(Vector3f((float)i, 0.0f, 0.0f));
+    EXPECT_EQ(m.finish(c), MagCalibrator::Quality::TooFewSamples);
+
+    // Only turned about z: the z axis never changes.
+    m.restart();
+    for (int i = 0; i < 360; ++i) {
+        const float a = (float)i * linalg::kRadPerDeg;
+        m.add(Vector3f(30.0f * cosf(a), 30.0f * sinf(a), 40.0f));
+    }
+    EXPECT_EQ(m.finish(c), MagCalibrator::Quality::AxisNotTurned);
+    EXPECT_EQ(m.axis(), 2);
+
+    // A magnet nearby.
+    m.restart();
+    feed_sphere(m, Vector3f(), Vector3f(1.0f, 1.0f, 1.0f), 400.0f);
+    EXPECT_EQ(m.finish(c), MagCalibrator::Quality::SpanTooLarge);
+
+    // Axes that disagree by 2x.
+    m.restart();
+    feed_sphere(m, Vector3f(), Vector3f(2.0f, 1.0f, 1.0f), 30.0f);
+    EXPECT_EQ(m.finish(c), MagCalibrator::Quality::AxesDisagree);
+
+    EXPECT_TRUE(c.mag_offset_uT == before.mag_offset_uT);
+    EXPECT_TRUE(c.mag_scale == before.mag_scale);
+
+    // Non-finite samples are ignored.
+    m.restart();
+    m.add(Vector3f(std::nanf(""), 0.0f, 0.0f));
+    EXPECT_EQ(m.count(), 0);
+}

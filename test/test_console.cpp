@@ -1,0 +1,236 @@
+// The serial console parser and the settings commands (lib/Console/Console).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include "Console.h"
+
+using console::Command;
+using console::CommandId;
+using console::Error;
+
+namespace {
+
+void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
+void sink_flash(void* ctx, const char* s) { static_cast<std::string*>(ctx)->append(s); }
+
+Command parse(const char* s) { return console::parse_line(s); }
+
+// Feeds bytes through a LineReader and returns the last non-None command.
+Command feed(console::LineReader& r, const std::string& bytes) {
+    Command last{CommandId::None, Error::None, 0, fmt::OutputMode::Plot};
+    for (char c : bytes) {
+        const Command cmd = r.feed((uint8_t)c);
+        if (cmd.id != CommandId::None) last = cmd;
+    }
+    return last;
+}
+
+bool same(const settings::Settings& a, const settings::Settings& b) {
+    return a.rate_hz == b.rate_hz && a.declination_centideg == b.declination_centideg && a.mode == b.mode &&
+           a.flags == b.flags && a.cal.mag_offset_uT == b.cal.mag_offset_uT;
+}
+
+}  // namespace
+
+TEST(Console, PlainCommands) {
+    EXPECT_EQ(parse("help").id, CommandId::Help);
+    EXPECT_EQ(parse("?").id, CommandId::Help);
+    EXPECT_EQ(parse("status").id, CommandId::Status);
+    EXPECT_EQ(parse("save").id, CommandId::Save);
+    EXPECT_EQ(parse("defaults").id, CommandId::Defaults);
+    EXPECT_EQ(parse("cal gyro").id, CommandId::CalGyro);
+    EXPECT_EQ(parse("cal mag").id, CommandId::CalMag);
+    EXPECT_EQ(parse("  STATUS\t ").id, CommandId::Status);  // case and blanks do not matter
+    EXPECT_EQ(parse("").id, CommandId::None);
+    EXPECT_EQ(parse("   ").id, CommandId::None);
+}
+
+TEST(Console, Rate) {
+    Command c = parse("rate 10");
+    EXPECT_EQ(c.id, CommandId::Rate);
+    EXPECT_EQ(c.value, 10);
+    EXPECT_EQ(parse("rate 1").value, 1);
+    EXPECT_EQ(parse("rate 100").value, 100);
+    EXPECT_EQ(parse("rate 25.0").value, 25);
+    EXPECT_EQ(parse("rate 0").error, Error::RateRange);
+    EXPECT_EQ(parse("rate 101").error, Error::RateRange);
+    EXPECT_EQ(parse("rate -5").error, Error::RateRange);
+    EXPECT_EQ(parse("rate 2.5").error, Error::RateRange);
+    EXPECT_EQ(parse("rate abc").error, Error::BadNumber);
+    EXPECT_EQ(parse("rate 5x").error, Error::BadNumber);
+    EXPECT_EQ(parse("rate 1e2").error, Error::BadNumber);
+    EXPECT_EQ(parse("rate 99999999999").error, Error::BadNumber);
+    EXPECT_EQ(parse("rate").error, Error::MissingArgument);
+    EXPECT_EQ(parse("rate 5 6").error, Error::ExtraArgument);
+}
+
+TEST(Console, Decl) {
+    Command c = parse("decl -12.34");
+    EXPECT_EQ(c.id, CommandId::Decl);
+    EXPECT_EQ(c.value, -1234);
+    EXPECT_EQ(parse("decl 2").value, 200);
+    EXPECT_EQ(parse("decl +2.5").value, 250);
+    EXPECT_EQ(parse("decl .5").value, 50);
+    EXPECT_EQ(parse("decl 1.005").value, 101);  // third decimal rounds
+    EXPECT_EQ(parse("decl -1.005").value, -101);
+    EXPECT_EQ(parse("decl 180").value, 18000);
+    EXPECT_EQ(parse("decl -180").value, -18000);
+    EXPECT_EQ(parse("decl 180.01").error, Error::DeclRange);
+    EXPECT_EQ(parse("decl -200").error, Error::DeclRange);
+    EXPECT_EQ(parse("decl nan").error, Error::BadNumber);
+    EXPECT_EQ(parse("decl inf").error, Error::BadNumber);
+    EXPECT_EQ(parse("decl -").error, Error::BadNumber);
+    EXPECT_EQ(parse("decl .").error, Error::BadNumber);
+    EXPECT_EQ(parse("decl 1.2.3").error, Error::BadNumber);
+    EXPECT_EQ(parse("decl 0x10").error, Error::BadNumber);
+    EXPECT_EQ(parse("decl").error, Error::MissingArgument);
+}
+
+TEST(Console, Mode) {
+    EXPECT_EQ(parse("mode plot").mode, fmt::OutputMode::Plot);
+    EXPECT_EQ(parse("mode CSV").mode, fmt::OutputMode::Csv);
+    EXPECT_EQ(parse("mode quiet").mode, fmt::OutputMode::Quiet);
+    EXPECT_EQ(parse("mode loud").error, Error::BadMode);
+    EXPECT_EQ(parse("mode").error, Error::MissingArgument);
+}
+
+TEST(Console, UnknownAndMalformed) {
+    EXPECT_EQ(parse("hello").error, Error::Unknown);
+    EXPECT_EQ(parse("help me").error, Error::ExtraArgument);
+    EXPECT_EQ(parse("status now").error, Error::ExtraArgument);
+    EXPECT_EQ(parse("cal").error, Error::MissingArgument);
+    EXPECT_EQ(parse("cal accel").error, Error::BadCalTarget);
+    EXPECT_EQ(parse("cal gyro mag").error, Error::ExtraArgument);
+    EXPECT_EQ(parse("a b c d e").error, Error::ExtraArgument);
+    EXPECT_EQ(parse("ratee 5").error, Error::Unknown);
+}
+
+TEST(Console, LineReaderEndings) {
+    console::LineReader r;
+    EXPECT_EQ(feed(r, "status\n").id, CommandId::Status);
+    EXPECT_EQ(feed(r, "status\r").id, CommandId::Status);
+    // "\r\n" is one line ending: exactly one command.
+    int commands = 0;
+    for (char c : std::string("rate 5\r\nrate 6\r\n")) {
+        if (r.feed((uint8_t)c).id != CommandId::None) ++commands;
+    }
+    EXPECT_EQ(commands, 2);
+    EXPECT_EQ(feed(r, "\n\n\r\n").id, CommandId::None);  // empty lines: nothing
+}
+
+TEST(Console, Backspace) {
+    console::LineReader r;
+    EXPECT_EQ(feed(r, "ratx\x08" "e 7\n").value, 7);
+    EXPECT_EQ(feed(r, "\x7f\x7f" "help\n").id, CommandId::Help);
+}
+
+TEST(Console, OverLongLineIsRejectedWhole) {
+    console::LineReader r;
+    const std::string longline = "rate " + std::string(60, '5') + "\n";
+    Command c = feed(r, longline);
+    EXPECT_EQ(c.id, CommandId::Error);
+    EXPECT_EQ(c.error, Error::TooLong);
+    // The reader recovers at the next line.
+    EXPECT_EQ(feed(r, "rate 5\n").value, 5);
+    // Exactly the capacity is fine.
+    const std::string fits = "decl " + std::string(console::kLineCapacity - 7, ' ') + "12";
+    ASSERT_EQ(fits.size(), console::kLineCapacity);
+    EXPECT_EQ(feed(r, fits + "\n").value, 1200);
+    EXPECT_EQ(feed(r, fits + "3\n").error, Error::TooLong);
+}
+
+TEST(Console, BinaryGarbage) {
+    console::LineReader r;
+    std::string garbage;
+    for (int i = 0; i < 256; ++i)
+        if (i != '\n' && i != '\r' && i != 0x08 && i != 0x7F) garbage.push_back((char)i);
+    Command c = feed(r, garbage + "\n");
+    EXPECT_EQ(c.error, Error::Garbage);
+    EXPECT_EQ(feed(r, std::string("rate\0 5\n", 8)).error, Error::Garbage);
+    EXPECT_EQ(feed(r, "mode csv\xff\n").error, Error::Garbage);
+    EXPECT_EQ(feed(r, "mode csv\n").mode, fmt::OutputMode::Csv);
+}
+
+TEST(Console, PseudoRandomBytesNeverChangeSettings) {
+    // Every line of random bytes containing a non-text byte is rejected whole.
+    console::LineReader r;
+    uint32_t x = 12345;
+    std::string out;
+    const text::Sink sink{&out, sink_write, sink_flash};
+    settings::Settings s = settings::defaults();
+    const settings::Settings before = s;
+    for (int i = 0; i < 20000; ++i) {
+        x = x * 1103515245u + 12345u;
+        uint8_t b = (uint8_t)(x >> 16);
+        if (i % 37 == 36) b = '\n';
+        else if (b >= 0x20 && b < 0x7F) b = 0x80;  // keep every line binary
+        const Command c = r.feed(b);
+        if (c.id != CommandId::None) {
+            EXPECT_EQ(c.id, CommandId::Error);
+            console::apply_setting(c, s, &sink);
+        }
+    }
+    EXPECT_TRUE(same(s, before));
+}
+
+TEST(Console, ApplySettingsAndReplies) {
+    std::string out;
+    const text::Sink sink{&out, sink_write, sink_flash};
+    settings::Settings s = settings::defaults();
+
+    EXPECT_TRUE(console::apply_setting(parse("rate 20"), s, &sink));
+    EXPECT_EQ(s.rate_hz, 20);
+    EXPECT_EQ(out, "# rate 20 Hz\n");
+
+    out.clear();
+    EXPECT_TRUE(console::apply_setting(parse("decl -3.5"), s, &sink));
+    EXPECT_EQ(s.declination_centideg, -350);
+    EXPECT_EQ(out, "# decl -3.50 deg\n");
+
+    out.clear();
+    EXPECT_TRUE(console::apply_setting(parse("mode csv"), s, &sink));
+    EXPECT_EQ(s.mode, fmt::OutputMode::Csv);
+    EXPECT_EQ(out, "# mode csv\nt_ms,roll,pitch,yaw\n");
+
+    out.clear();
+    s.cal.mag_offset_uT = linalg::Vector3f(1.0f, 2.0f, 3.0f);
+    EXPECT_TRUE(console::apply_setting(parse("defaults"), s, &sink));
+    EXPECT_TRUE(same(s, settings::defaults()));
+    EXPECT_EQ(out.rfind("# defaults", 0), 0u);
+
+    // Commands that are not settings are left to the firmware; errors change nothing.
+    const settings::Settings before = s;
+    EXPECT_FALSE(console::apply_setting(parse("status"), s, &sink));
+    EXPECT_FALSE(console::apply_setting(parse("rate 500"), s, &sink));
+    EXPECT_FALSE(console::apply_setting(parse("decl x"), s, &sink));
+    EXPECT_TRUE(same(s, before));
+}
+
+TEST(Console, ErrorMessagesAreHashLines) {
+    const char* bad[] = {"bogus", "rate", "rate 1 2", "rate x", "rate 0", "decl 999", "mode x", "cal x"};
+    for (const char* line : bad) {
+        std::string out;
+        const text::Sink sink{&out, sink_write, sink_flash};
+        const Command c = parse(line);
+        ASSERT_EQ(c.id, CommandId::Error) << line;
+        console::print_error(c, &sink);
+        EXPECT_EQ(out.rfind("# error: ", 0), 0u) << out;
+        EXPECT_EQ(out.back(), '\n');
+        EXPECT_EQ(out.find('\n'), out.size() - 1) << "one line";
+    }
+}
+
+TEST(Console, HelpListsEveryCommandOnHashLines) {
+    std::string out;
+    const text::Sink sink{&out, sink_write, sink_flash};
+    console::print_help(&sink);
+    for (const char* word : {"rate", "decl", "mode", "status", "cal gyro", "cal mag", "save", "defaults"})
+        EXPECT_NE(out.find(word), std::string::npos) << word;
+    size_t start = 0;
+    while (start < out.size()) {
+        EXPECT_EQ(out.compare(start, 2, "# "), 0) << out.substr(start);
+        start = out.find('\n', start) + 1;
+    }
+}

@@ -1,0 +1,102 @@
+// Fixed-point formatting of the output lines (lib/Console/Format, Text).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "Format.h"
+#include "Text.h"
+
+namespace {
+
+std::string plot(float r, float p, float y) {
+    char buf[fmt::kLineMax];
+    const uint8_t n = fmt::format_plot_line(buf, r, p, y);
+    return std::string(buf, n);
+}
+
+std::string csv(uint32_t t, float r, float p, float y) {
+    char buf[fmt::kLineMax];
+    const uint8_t n = fmt::format_csv_line(buf, t, r, p, y);
+    return std::string(buf, n);
+}
+
+std::string centi(int32_t c) {
+    char buf[16];
+    return std::string(buf, text::format_centi(buf, c));
+}
+
+}  // namespace
+
+TEST(Format, PlotLineMatchesTheContract) {
+    EXPECT_EQ(plot(-1.23f, 4.56f, 271.8f), "roll:-1.23 pitch:4.56 yaw:271.80\n");
+    EXPECT_EQ(plot(0.0f, 0.0f, 0.0f), "roll:0.00 pitch:0.00 yaw:0.00\n");
+    EXPECT_EQ(plot(-180.0f, -90.0f, 359.99f), "roll:-180.00 pitch:-90.00 yaw:359.99\n");
+}
+
+TEST(Format, RoundsHalfAwayFromZeroAndNeverPrintsMinusZero) {
+    EXPECT_EQ(plot(0.004f, -0.004f, 1.006f), "roll:0.00 pitch:0.00 yaw:1.01\n");
+    EXPECT_EQ(plot(-0.006f, 0.996f, 10.0f), "roll:-0.01 pitch:1.00 yaw:10.00\n");
+    EXPECT_EQ(plot(-0.05f, 0.05f, 0.5f), "roll:-0.05 pitch:0.05 yaw:0.50\n");
+}
+
+TEST(Format, HeadingThatRoundsTo360IsZero) {
+    EXPECT_EQ(plot(0.0f, 0.0f, 359.996f), "roll:0.00 pitch:0.00 yaw:0.00\n");
+}
+
+TEST(Format, NonFiniteOrAbsurdAnglesAreNotPrinted) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(plot(nan, 0.0f, 0.0f), "");
+    EXPECT_EQ(plot(0.0f, inf, 0.0f), "");
+    EXPECT_EQ(plot(0.0f, 0.0f, -inf), "");
+    EXPECT_EQ(plot(1000.0f, 0.0f, 0.0f), "");
+    EXPECT_EQ(csv(5, 0.0f, 0.0f, nan), "");
+}
+
+TEST(Format, CsvRow) {
+    EXPECT_EQ(csv(0, 1.0f, -2.5f, 90.125f), "0,1.00,-2.50,90.13\n");
+    EXPECT_EQ(csv(123456, -179.999f, 89.999f, 0.0f), "123456,-180.00,90.00,0.00\n");
+    EXPECT_EQ(csv(4294967295u, 0.0f, 0.0f, 0.0f), "4294967295,0.00,0.00,0.00\n");
+    EXPECT_EQ(csv(1000000000u, 0.0f, 0.0f, 0.0f), "1000000000,0.00,0.00,0.00\n");
+}
+
+TEST(Format, LongestLinesFit) {
+    EXPECT_LE(plot(-179.99f, -89.99f, 359.99f).size(), fmt::kLineMax);
+    EXPECT_LE(csv(4294967295u, -179.99f, -89.99f, 359.99f).size(), fmt::kLineMax);
+}
+
+TEST(Format, CentiAndInt) {
+    EXPECT_EQ(centi(0), "0.00");
+    EXPECT_EQ(centi(5), "0.05");
+    EXPECT_EQ(centi(-5), "-0.05");
+    EXPECT_EQ(centi(-123456), "-1234.56");
+    EXPECT_EQ(centi(INT32_MIN), "-21474836.48");
+    char buf[12];
+    EXPECT_EQ(std::string(buf, text::format_int(buf, INT32_MIN)), "-2147483648");
+    EXPECT_EQ(std::string(buf, text::format_int(buf, 7)), "7");
+}
+
+TEST(Format, ToCentiRejectsNonFinite) {
+    int32_t c = 42;
+    EXPECT_FALSE(text::to_centi(std::numeric_limits<float>::quiet_NaN(), c));
+    EXPECT_FALSE(text::to_centi(3e7f, c));
+    EXPECT_EQ(c, 42);
+    EXPECT_TRUE(text::to_centi(-2.345f, c));
+    EXPECT_EQ(c, -235);  // -234.5 (float: -234.49997) rounds to nearest
+}
+
+namespace {
+void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
+void sink_flash(void* ctx, const char* s) { static_cast<std::string*>(ctx)->append(s); }
+}  // namespace
+
+TEST(Format, WriterChains) {
+    std::string s;
+    const text::Sink sink{&s, sink_write, sink_flash};
+    text::Writer(&sink).str(TXT("# x=")).i32(-12).chr(' ').u32(4000000000u).chr(' ').hex8(0x6A)
+        .chr(' ').fixed2(3.14159f).chr(' ').fixed2(std::nanf("")).end();
+    EXPECT_EQ(s, "# x=-12 4000000000 6A 3.14 ?\n");
+    text::Writer(nullptr).str(TXT("silent")).i32(3).end();  // a null sink is a no-op
+}
