@@ -46,6 +46,7 @@ enum StatusFlags : uint8_t {
     kStatusBiasHeld = 0x08,       // integrator held: rotating fast
     kStatusRecovered = 0x10,      // the matrix was rebuilt since start (sticky)
     kStatusNoHeading = 0x20,      // no magnetometer sample yet: yaw is gyro-only
+    kStatusGyroRejected = 0x40,   // last gyro sample non-finite or beyond any range: not integrated
 };
 
 class Dcm {
@@ -81,19 +82,25 @@ public:
 
 private:
     bool renormalise();
-    float startup_blend() const;
+    static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
+    void recover();
+    void clamp_bias();
+    float proportional_gain(float steady_gain_1_s) const;
 
     DcmSettings settings_;
     linalg::Matrix3f r_;
     linalg::Vector3f bias_rad_s_;        // integrator: gyro-bias estimate
-    linalg::Vector3f omega_p_rad_s_;     // proportional correction from gravity, applied each step
     linalg::Vector3f omega_yaw_rad_s_;   // proportional correction from the field, held between samples
     linalg::Vector3f last_accel_m_s2_;   // for a rebuild if the matrix degenerates
     linalg::Vector3f last_mag_field_;
-    float mag_disturbed_s_;
-    uint32_t steps_;
+    float mag_ref_norm_ = 0.0f;          // learned field strength
+    float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
+    float mag_disturbed_s_;              // how long the field has been rejected
+    uint32_t steps_;                     // since init
+    uint16_t steps_since_mag_;
     uint16_t recoveries_;
     uint8_t status_;
+    bool rotating_fast_ = false;
 };
 
 }  // namespace dcm

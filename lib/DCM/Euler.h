@@ -7,8 +7,11 @@
 // Convention: when cos(theta) is below kGimbalLockCos the whole remaining rotation
 // is reported as yaw and roll is 0: psi = atan2(-R12, R22) (exact for phi = 0).
 // Away from the lock the ordinary formulas are used; the switch happens where both
-// give the same rotation to within float precision, so the output stays finite and
-// the matrix rebuilt from the angles matches R everywhere.
+// give the same rotation to within ~2e-5, so the output stays finite and the matrix
+// rebuilt from the angles matches R everywhere. (Passing over the top, pitch turns
+// back from 90 deg and roll and yaw flip by 180 deg: that is Euler angles, not noise.)
+// Pitch is atan2(-R31, sqrt(R32^2 + R33^2)), which equals -asin(R31) for an
+// orthonormal R and keeps its precision near +-90 deg.
 #pragma once
 
 #include "LinAlg.h"
@@ -21,8 +24,10 @@ struct EulerAngles {
     float yaw_rad;  // -pi..pi
 };
 
-// Below this cos(pitch) (pitch within ~0.06 deg of +-90) roll is folded into yaw.
-constexpr float kGimbalLockCos = 1e-3f;
+// Below this cos(pitch) (pitch within ~0.001 deg of +-90) roll is folded into yaw.
+// Small enough that the folded angles rebuild R to ~2e-5, large enough that roll
+// is still well-conditioned just above it.
+constexpr float kGimbalLockCos = 2e-5f;
 
 EulerAngles euler_from_dcm(const linalg::Matrix3f& r);
 linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);

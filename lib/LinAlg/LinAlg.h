@@ -37,6 +37,12 @@ constexpr float kPi = 3.14159265358979f;
 constexpr float kDegPerRad = 57.2957795130823f;
 constexpr float kRadPerDeg = 0.0174532925199433f;
 
+// atan2 to within 1.2e-5 rad (0.0007 deg) for any finite input, in about a third
+// of avr-libc's atan2f cycles (~2 960 on the 2560): one division and an odd
+// degree-9 polynomial fitted (least maximum error) to atan on [0, 1], with the
+// octant folded in by symmetry. atan2(0, 0) = 0; NaN in gives 0 out.
+float fast_atan2(float y, float x);
+
 struct Vector3f {
     float x, y, z;
 

@@ -1,0 +1,47 @@
+#include "Euler.h"
+
+namespace dcm {
+
+using linalg::Matrix3f;
+using linalg::Vector3f;
+using linalg::fast_atan2;
+
+EulerAngles euler_from_dcm(const Matrix3f& r) {
+    // R31 = r.c.x, R32 = r.c.y, R33 = r.c.z, R21 = r.b.x, R11 = r.a.x (rows a, b, c).
+    EulerAngles e;
+    // cos(theta) from the other two entries of the last row: pitch by atan2 is
+    // accurate near +-90 deg, where asin(R31) loses all its digits.
+    const float cos_pitch = linalg::safe_sqrt(r.c.y * r.c.y + r.c.z * r.c.z);
+    e.pitch_rad = fast_atan2(-r.c.x, cos_pitch);
+    if (cos_pitch > kGimbalLockCos) {
+        e.roll_rad = fast_atan2(r.c.y, r.c.z);
+        e.yaw_rad = fast_atan2(r.b.x, r.a.x);
+    } else {
+        // Gimbal lock: roll := 0, all of the heading in yaw. With phi = 0,
+        // R12 = -sin(psi) and R22 = cos(psi) exactly.
+        e.roll_rad = 0.0f;
+        e.yaw_rad = fast_atan2(-r.a.y, r.b.y);
+    }
+    return e;
+}
+
+Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad) {
+    const float cr = cosf(roll_rad), sr = sinf(roll_rad);
+    const float cp = cosf(pitch_rad), sp = sinf(pitch_rad);
+    const float cy = cosf(yaw_rad), sy = sinf(yaw_rad);
+    // R = Rz(yaw) Ry(pitch) Rx(roll), body -> earth (NED).
+    return Matrix3f(Vector3f(cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy),
+                    Vector3f(cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy),
+                    Vector3f(-sp, sr * cp, cr * cp));
+}
+
+float heading_deg(float yaw_rad, float declination_deg) {
+    float h = yaw_rad * linalg::kDegPerRad + declination_deg;
+    if (!linalg::is_finite(h)) return 0.0f;
+    h = fmodf(h, 360.0f);
+    if (h < 0.0f) h += 360.0f;
+    if (h >= 360.0f) h = 0.0f;  // -1e-9 + 360 rounds to 360
+    return h;
+}
+
+}  // namespace dcm

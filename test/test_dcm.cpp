@@ -1,0 +1,201 @@
+// Properties of the DCM estimator: orthonormality, drift correction of a gyro
+// bias, TRIAD start-up, and robustness to absurd input.
+#include <gtest/gtest.h>
+
+#include "dcm_test_support.h"
+
+using namespace dcm_test;
+
+namespace {
+
+// Feeds a board at the fixed attitude `truth` with gyro = true rate (0) + bias for
+// `seconds`, magnetometer at 75 Hz as the HMC5883L delivers it.
+struct RestRun {
+    dcm::Dcm filter;
+    Matrix3f truth;
+    float t_s = 0.0f;
+    float next_mag_s = 0.0f;
+
+    explicit RestRun(const Matrix3f& r) : truth(r) { EXPECT_TRUE(filter.init(accel_for(r), mag_for(r))); }
+
+    void run(float seconds, const Vector3f& gyro_bias_rad_s) {
+        const float dt = filter.settings().step_s;
+        const int steps = (int)(seconds / dt + 0.5f);
+        for (int i = 0; i < steps; ++i) {
+            t_s += dt;
+            if (t_s >= next_mag_s) {
+                filter.correct_heading(mag_for(truth));
+                next_mag_s += 1.0f / 75.0f;
+            }
+            filter.update(gyro_bias_rad_s, accel_for(truth));
+        }
+    }
+    float yaw_error_deg() const {
+        return wrap_deg((filter.euler().yaw_rad - dcm::euler_from_dcm(truth).yaw_rad) * linalg::kDegPerRad);
+    }
+};
+
+}  // namespace
+
+TEST(Dcm, StaysOrthonormalOverManyRandomRateSteps) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(Vector3f(0, 0, -kG), earth_field_uT()));
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> rate(-10.0f, 10.0f);  // up to ~570 deg/s per axis
+    float worst = 0.0f;
+    for (int i = 0; i < 100000; ++i) {
+        // Accel far from 1 g (no gravity weight) so only integration and renormalisation act.
+        filter.update(Vector3f(rate(rng), rate(rng), rate(rng)), Vector3f(0, 0, -3.0f * kG));
+        const float e = orthonormality_error(filter.matrix());
+        worst = e > worst ? e : worst;
+    }
+    EXPECT_LT(worst, 1e-5f);
+    EXPECT_EQ(filter.recoveries(), 0);
+}
+
+TEST(Dcm, RemovesAConstantGyroBiasAtRest) {
+    std::mt19937 rng(4);
+    const float bias_deg_s = 2.0f;
+    const Vector3f bias = Vector3f(1, 1, 1) * (bias_deg_s * linalg::kRadPerDeg);
+    for (int trial = 0; trial < 3; ++trial) {
+        const Matrix3f truth = trial == 0 ? Matrix3f::identity()
+                                          : dcm::dcm_from_euler(0.4f * (float)trial, -0.3f, 2.0f * (float)trial);
+        RestRun run(truth);
+        run.run(30.0f, bias);
+        EXPECT_LT(tilt_error_deg(truth, run.filter.matrix()), 0.5f) << "trial " << trial;
+        run.run(90.0f, bias);
+        const Vector3f learned = run.filter.gyro_bias_rad_s() * linalg::kDegPerRad;
+        EXPECT_NEAR(learned.x, bias_deg_s, 0.1f) << "trial " << trial;
+        EXPECT_NEAR(learned.y, bias_deg_s, 0.1f) << "trial " << trial;
+        EXPECT_NEAR(learned.z, bias_deg_s, 0.1f) << "trial " << trial;
+        EXPECT_LT(std::fabs(run.yaw_error_deg()), 1.0f) << "trial " << trial;
+        EXPECT_LT(tilt_error_deg(truth, run.filter.matrix()), 0.1f) << "trial " << trial;
+    }
+}
+
+TEST(Dcm, WithoutDriftCorrectionTheBiasRunsAway) {
+    // The thesis's failure, reproduced to show the test above can fail: the same
+    // bias with every gain at zero drifts by bias x time.
+    dcm::DcmSettings no_correction = dcm::kDefaultDcmSettings;
+    no_correction.kp_rp_1_s = no_correction.ki_rp_1_s2 = 0.0f;
+    no_correction.kp_yaw_1_s = no_correction.ki_yaw_1_s2 = no_correction.kp_startup_1_s = 0.0f;
+    dcm::Dcm filter(no_correction);
+    ASSERT_TRUE(filter.init(Vector3f(0, 0, -kG), earth_field_uT()));
+    for (int i = 0; i < 2000; ++i) filter.update(Vector3f(0, 2.0f * linalg::kRadPerDeg, 0), Vector3f(0, 0, -kG));
+    EXPECT_NEAR(filter.euler().pitch_rad * linalg::kDegPerRad, 20.0f, 0.5f);
+}
+
+TEST(Dcm, TriadStartUpMatchesTheTruth) {
+    std::mt19937 rng(5);
+    for (int i = 0; i < 100; ++i) {
+        const Matrix3f truth = random_rotation(rng);
+        dcm::Dcm filter;
+        ASSERT_TRUE(filter.init(accel_for(truth), mag_for(truth)));
+        EXPECT_LT(angle_between_deg(truth, filter.matrix()), 0.5f) << "orientation " << i;
+        EXPECT_FALSE(filter.status() & dcm::kStatusNoHeading);
+    }
+}
+
+TEST(Dcm, StartsLevelWithoutFieldAndTakesTheFirstField) {
+    const Matrix3f truth = dcm::dcm_from_euler(0.2f, -0.1f, 1.0f);
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(truth), Vector3f()));
+    EXPECT_TRUE(filter.status() & dcm::kStatusNoHeading);
+    EXPECT_LT(tilt_error_deg(truth, filter.matrix()), 0.5f);
+    filter.correct_heading(mag_for(truth));
+    EXPECT_FALSE(filter.status() & dcm::kStatusNoHeading);
+    EXPECT_LT(angle_between_deg(truth, filter.matrix()), 0.5f);
+}
+
+TEST(Dcm, RefusesToStartWithoutGravity) {
+    dcm::Dcm filter;
+    EXPECT_FALSE(filter.init(Vector3f(), earth_field_uT()));
+    EXPECT_FALSE(filter.init(Vector3f(NAN, 0, 0), earth_field_uT()));
+    EXPECT_FALSE(filter.initialised());
+}
+
+TEST(Dcm, NoNaNFromZeroHugeOrNaNInput) {
+    const float big = 3.0e38f;
+    const Vector3f inputs[] = {
+        Vector3f(), Vector3f(NAN, NAN, NAN), Vector3f(INFINITY, 0, 0), Vector3f(-INFINITY, 1, 2),
+        Vector3f(big, big, big), Vector3f(1e6f, -1e6f, 1e6f), Vector3f(0, 0, -kG), Vector3f(0.1f, -0.2f, 0.3f),
+    };
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(Vector3f(0, 0, -kG), earth_field_uT()));
+    for (const Vector3f& gyro : inputs) {
+        for (const Vector3f& accel : inputs) {
+            for (const Vector3f& mag : inputs) {
+                filter.update(gyro, accel);
+                filter.correct_heading(mag);
+                filter.update(gyro, accel);
+                ASSERT_TRUE(filter.matrix().is_finite());
+                ASSERT_TRUE(filter.gyro_bias_rad_s().is_finite());
+                const dcm::EulerAngles e = filter.euler();
+                ASSERT_TRUE(linalg::is_finite(e.roll_rad) && linalg::is_finite(e.pitch_rad) &&
+                            linalg::is_finite(e.yaw_rad));
+                ASSERT_LT(orthonormality_error(filter.matrix()), 1e-3f);
+            }
+        }
+    }
+}
+
+TEST(Dcm, NaNGyroIsRejectedNotIntegrated) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(Vector3f(0, 0, -kG), earth_field_uT()));
+    const Matrix3f before = filter.matrix();
+    filter.update(Vector3f(NAN, 0, 0), Vector3f(0, 0, -kG));
+    EXPECT_TRUE(filter.status() & dcm::kStatusGyroRejected);
+    EXPECT_LT(angle_between_deg(before, filter.matrix()), 1e-3f);
+    filter.update(Vector3f(1000.0f, 0, 0), Vector3f(0, 0, -kG));  // 57 000 deg/s: garbage
+    EXPECT_TRUE(filter.status() & dcm::kStatusGyroRejected);
+    EXPECT_LT(angle_between_deg(before, filter.matrix()), 1e-3f);
+    filter.update(Vector3f(0, 0, 0), Vector3f(0, 0, -kG));
+    EXPECT_FALSE(filter.status() & dcm::kStatusGyroRejected);
+}
+
+TEST(Dcm, AccelFarFromOneGIsIgnored) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(Vector3f(0, 0, -kG), earth_field_uT()));
+    // A 2 g push sideways: not gravity, so the tilt must not follow it.
+    for (int i = 0; i < 400; ++i) filter.update(Vector3f(), Vector3f(2.0f * kG, 0, -kG));
+    EXPECT_TRUE(filter.status() & dcm::kStatusAccelIgnored);
+    EXPECT_LT(tilt_error_deg(Matrix3f::identity(), filter.matrix()), 0.1f);
+}
+
+TEST(Dcm, TracksARotationAndHoldsTheIntegratorWhileFast) {
+    dcm::Dcm filter;
+    Matrix3f truth = Matrix3f::identity();
+    ASSERT_TRUE(filter.init(accel_for(truth), mag_for(truth)));
+    const float dt = filter.settings().step_s;
+    const Vector3f rate(0.0f, 0.0f, 1.0f);  // 57 deg/s yaw
+    for (int i = 0; i < 600; ++i) {
+        truth = truth * dcm::dcm_from_euler(0, 0, rate.z * dt);
+        if (i % 3 == 0) filter.correct_heading(mag_for(truth));
+        filter.update(rate, accel_for(truth));
+        EXPECT_TRUE(filter.status() & dcm::kStatusBiasHeld);
+    }
+    EXPECT_LT(angle_between_deg(truth, filter.matrix()), 1.0f);
+    EXPECT_LT(filter.gyro_bias_rad_s().length(), 1e-4f);
+}
+
+TEST(Dcm, RejectsAMagneticDisturbanceAndRecoversFromALastingOne) {
+    const Matrix3f truth = Matrix3f::identity();
+    RestRun run(truth);
+    run.run(5.0f, Vector3f());
+    // A magnet beside the board: the field turns 60 deg and grows. Ignored at first.
+    const Vector3f disturbed = dcm::dcm_from_euler(0, 0, 1.05f).mul_transpose(earth_field_uT()) * 1.5f;
+    for (int i = 0; i < 75 * 3; ++i) {
+        run.filter.correct_heading(disturbed);
+        run.filter.update(Vector3f(), accel_for(truth));
+        run.filter.update(Vector3f(), accel_for(truth));
+    }
+    EXPECT_TRUE(run.filter.status() & dcm::kStatusMagIgnored);
+    EXPECT_LT(std::fabs(run.yaw_error_deg()), 1.0f);
+    // The same field for long enough is taken as the truth.
+    for (int i = 0; i < 75 * 30; ++i) {
+        run.filter.correct_heading(disturbed);
+        for (int k = 0; k < 3; ++k) run.filter.update(Vector3f(), accel_for(truth));
+    }
+    EXPECT_FALSE(run.filter.status() & dcm::kStatusMagIgnored);
+    EXPECT_GT(std::fabs(run.yaw_error_deg()), 50.0f);
+}
