@@ -1,0 +1,71 @@
+#include "Mpu6000.h"
+
+namespace mpu6000 {
+
+uint8_t Mpu6000::read_register(uint8_t reg, uint32_t clock_hz) {
+    dev_.select(dev_.ctx, true, clock_hz);
+    dev_.transfer(dev_.ctx, (uint8_t)(reg | kReadFlag));
+    const uint8_t v = dev_.transfer(dev_.ctx, 0x00);
+    dev_.select(dev_.ctx, false, clock_hz);
+    return v;
+}
+
+void Mpu6000::write_register(uint8_t reg, uint8_t value) {
+    dev_.select(dev_.ctx, true, kConfigClockHz);
+    dev_.transfer(dev_.ctx, (uint8_t)(reg & (uint8_t)~kReadFlag));
+    dev_.transfer(dev_.ctx, value);
+    dev_.select(dev_.ctx, false, kConfigClockHz);
+}
+
+bool Mpu6000::probe(uint8_t& who) {
+    who = read_register(REG_WHO_AM_I);
+    return who == kWhoAmIValue;
+}
+
+InitResult Mpu6000::begin() {
+    uint8_t who = 0;
+    if (!probe(who)) return InitResult{InitStatus::WrongIdentity, REG_WHO_AM_I, kWhoAmIValue, who};
+
+    write_register(REG_PWR_MGMT_1, kPwrDeviceReset);
+    dev_.delay_ms(dev_.ctx, kResetWaitMs);  // the reset takes up to 100 ms
+    write_register(REG_PWR_MGMT_1, kPwrClockPllGyroZ);
+    dev_.delay_ms(dev_.ctx, 5);             // PLL settles
+    // After a reset the I2C interface is back on: SPI only again before anything else.
+    write_register(REG_USER_CTRL, kUserCtrlI2cIfDis);
+
+    struct Write { uint8_t reg, value; };
+    const Write kConfig[] = {
+        {REG_PWR_MGMT_1, kPwrClockPllGyroZ},
+        {REG_USER_CTRL, kUserCtrlI2cIfDis},
+        {REG_SMPLRT_DIV, smplrt_div_for_hz(kRateHz)},
+        {REG_CONFIG, (uint8_t)kDlpf},
+        {REG_GYRO_CONFIG, (uint8_t)kGyroRange},
+        {REG_ACCEL_CONFIG, (uint8_t)kAccelRange},
+        {REG_INT_PIN_CFG, kIntPinCfgLatchClearOnRead},
+        {REG_INT_ENABLE, kIntEnableDataReady},
+    };
+    for (const Write& w : kConfig) write_register(w.reg, w.value);
+    for (const Write& w : kConfig) {
+        const uint8_t got = read_register(w.reg);
+        if (got != w.value) return InitResult{InitStatus::ReadbackMismatch, w.reg, w.value, got};
+    }
+    read_register(REG_INT_STATUS);  // clear a stale interrupt
+    return InitResult{InitStatus::Ok, REG_WHO_AM_I, kWhoAmIValue, who};
+}
+
+bool Mpu6000::data_ready() {
+    return (read_register(REG_INT_STATUS, kReadClockHz) & kIntStatusDataReady) != 0;
+}
+
+BurstStatus Mpu6000::read(Sample& out, uint8_t* raw) {
+    uint8_t buf[kBurstLength];
+    dev_.select(dev_.ctx, true, kReadClockHz);
+    dev_.transfer(dev_.ctx, (uint8_t)(REG_ACCEL_XOUT_H | kReadFlag));
+    for (uint8_t i = 0; i < kBurstLength; ++i) buf[i] = dev_.transfer(dev_.ctx, 0x00);
+    dev_.select(dev_.ctx, false, kReadClockHz);
+    if (raw != nullptr)
+        for (uint8_t i = 0; i < kBurstLength; ++i) raw[i] = buf[i];
+    return decode_burst(buf, kGyroRange, kAccelRange, out);
+}
+
+}  // namespace mpu6000

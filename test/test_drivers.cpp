@@ -1,0 +1,281 @@
+// The MPU6000 and HMC5883L bus drivers against fake buses (lib/MPU6000/Mpu6000,
+// lib/HMC5883/Hmc5883): the same seam the firmware fills with SPI/Wire and the replay
+// tool with the simulator's register models.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "Hmc5883.h"
+#include "Mpu6000.h"
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// A register-level MPU6000 on SPI: first byte = address (bit 7 read), then auto-increment.
+struct FakeMpu {
+    uint8_t reg[128] = {};
+    bool present = true;
+    bool selected = false;
+    bool have_addr = false;
+    bool reading = false;
+    uint8_t addr = 0;
+    uint32_t clock = 0;
+    std::vector<uint32_t> write_clocks, burst_clocks;
+    uint16_t delayed_ms = 0;
+    uint8_t ignore_reg = 0xFF;  // a register that does not keep writes (read-back test)
+
+    FakeMpu() { power_on(); }
+    void power_on() {
+        std::memset(reg, 0, sizeof reg);
+        reg[mpu6000::REG_WHO_AM_I] = 0x68;
+        reg[mpu6000::REG_PWR_MGMT_1] = 0x40;  // sleeping
+    }
+    static void select(void* ctx, bool on, uint32_t hz) {
+        FakeMpu* m = static_cast<FakeMpu*>(ctx);
+        m->selected = on;
+        m->have_addr = false;
+        m->clock = hz;
+    }
+    static uint8_t transfer(void* ctx, uint8_t out) {
+        FakeMpu* m = static_cast<FakeMpu*>(ctx);
+        EXPECT_TRUE(m->selected);
+        if (!m->present) return 0x00;
+        if (!m->have_addr) {
+            m->have_addr = true;
+            m->reading = (out & 0x80) != 0;
+            m->addr = out & 0x7F;
+            if (m->reading && m->addr == mpu6000::REG_ACCEL_XOUT_H) m->burst_clocks.push_back(m->clock);
+            if (!m->reading) m->write_clocks.push_back(m->clock);
+            return 0;
+        }
+        const uint8_t a = m->addr++;
+        if (m->reading) {
+            const uint8_t v = m->reg[a];
+            if (a == mpu6000::REG_INT_STATUS) m->reg[a] = 0;  // clear on read
+            return v;
+        }
+        if (a == mpu6000::REG_PWR_MGMT_1 && (out & 0x80)) {
+            m->power_on();
+            return 0;
+        }
+        if (a != m->ignore_reg && a != mpu6000::REG_WHO_AM_I) m->reg[a] = out;
+        return 0;
+    }
+    static void delay(void* ctx, uint16_t ms) { static_cast<FakeMpu*>(ctx)->delayed_ms += ms; }
+    mpu6000::SpiDevice device() { return mpu6000::SpiDevice{this, select, transfer, delay}; }
+
+    void set_sample(int16_t ax, int16_t ay, int16_t az, int16_t t, int16_t gx, int16_t gy, int16_t gz) {
+        const int16_t v[7] = {ax, ay, az, t, gx, gy, gz};
+        for (int i = 0; i < 7; ++i) {
+            reg[0x3B + 2 * i] = (uint8_t)((uint16_t)v[i] >> 8);
+            reg[0x3B + 2 * i + 1] = (uint8_t)(v[i] & 0xFF);
+        }
+        reg[mpu6000::REG_INT_STATUS] = 0x01;
+    }
+};
+
+}  // namespace
+
+TEST(Mpu6000Driver, BeginConfiguresAndReadsBack) {
+    FakeMpu chip;
+    mpu6000::Mpu6000 mpu(chip.device());
+    const mpu6000::InitResult r = mpu.begin();
+    ASSERT_EQ(r.status, mpu6000::InitStatus::Ok);
+    EXPECT_GE(chip.delayed_ms, 100);  // waited for the reset
+    EXPECT_EQ(chip.reg[mpu6000::REG_PWR_MGMT_1], 0x03);
+    EXPECT_EQ(chip.reg[mpu6000::REG_USER_CTRL], 0x10);
+    EXPECT_EQ(chip.reg[mpu6000::REG_SMPLRT_DIV], 4);   // 1 kHz / 5 = 200 Hz
+    EXPECT_EQ(chip.reg[mpu6000::REG_CONFIG], 0x03);    // DLPF 42 Hz
+    EXPECT_EQ(chip.reg[mpu6000::REG_GYRO_CONFIG], 0x18);
+    EXPECT_EQ(chip.reg[mpu6000::REG_ACCEL_CONFIG], 0x10);
+    EXPECT_EQ(chip.reg[mpu6000::REG_INT_ENABLE], 0x01);
+    EXPECT_EQ(chip.reg[mpu6000::REG_INT_PIN_CFG], 0x30);
+    for (uint32_t hz : chip.write_clocks) EXPECT_LE(hz, 1000000u);  // writes at <= 1 MHz
+}
+
+TEST(Mpu6000Driver, AbsentOrWrongIdentity) {
+    FakeMpu chip;
+    chip.present = false;
+    mpu6000::Mpu6000 mpu(chip.device());
+    mpu6000::InitResult r = mpu.begin();
+    EXPECT_EQ(r.status, mpu6000::InitStatus::WrongIdentity);
+    EXPECT_EQ(r.read, 0x00);
+    EXPECT_EQ(r.wrote, 0x68);
+    EXPECT_EQ(chip.delayed_ms, 0);  // no reset wait when nobody answers
+
+    FakeMpu other;
+    other.reg[mpu6000::REG_WHO_AM_I] = 0x70;  // an MPU6500
+    mpu6000::Mpu6000 mpu2(other.device());
+    uint8_t who = 0;
+    EXPECT_FALSE(mpu2.probe(who));
+    EXPECT_EQ(who, 0x70);
+}
+
+TEST(Mpu6000Driver, ReadbackMismatchIsReported) {
+    FakeMpu chip;
+    chip.ignore_reg = mpu6000::REG_GYRO_CONFIG;
+    mpu6000::Mpu6000 mpu(chip.device());
+    const mpu6000::InitResult r = mpu.begin();
+    EXPECT_EQ(r.status, mpu6000::InitStatus::ReadbackMismatch);
+    EXPECT_EQ(r.reg, mpu6000::REG_GYRO_CONFIG);
+    EXPECT_EQ(r.wrote, 0x18);
+    EXPECT_EQ(r.read, 0x00);
+}
+
+TEST(Mpu6000Driver, BurstAt8MHzDecodesToBodyFrame) {
+    FakeMpu chip;
+    mpu6000::Mpu6000 mpu(chip.device());
+    ASSERT_EQ(mpu.begin().status, mpu6000::InitStatus::Ok);
+    // Level, at rest: chip z reads +1 g (body z = -chip z = -1 g). Gyro chip x = 16.4 LSB = 1 deg/s.
+    chip.set_sample(0, 0, 4096, 0, 164, 0, -328);
+    EXPECT_TRUE(mpu.data_ready());
+    EXPECT_FALSE(mpu.data_ready());  // cleared by the read
+    mpu6000::Sample s{};
+    uint8_t raw[14];
+    ASSERT_EQ(mpu.read(s, raw), mpu6000::BurstStatus::Ok);
+    ASSERT_EQ(chip.burst_clocks.size(), 1u);
+    EXPECT_EQ(chip.burst_clocks[0], 8000000u);
+    EXPECT_EQ(raw[4], 0x10);
+    EXPECT_NEAR(s.accel_m_s2.z, -9.80665f, 1e-3f);
+    EXPECT_NEAR(s.accel_m_s2.x, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.gyro_rad_s.y, 10.0f * linalg::kRadPerDeg, 1e-4f);   // body y = chip x
+    EXPECT_NEAR(s.gyro_rad_s.z, 20.0f * linalg::kRadPerDeg, 1e-4f);   // body z = -chip z
+    EXPECT_NEAR(s.temperature_c, 36.53f, 1e-3f);
+    EXPECT_FALSE(s.gyro_saturated);
+}
+
+TEST(Mpu6000Driver, SilentBusIsNoSensor) {
+    FakeMpu chip;
+    mpu6000::Mpu6000 mpu(chip.device());
+    ASSERT_EQ(mpu.begin().status, mpu6000::InitStatus::Ok);
+    chip.present = false;
+    mpu6000::Sample s{};
+    s.temperature_c = 99.0f;
+    EXPECT_EQ(mpu.read(s), mpu6000::BurstStatus::NoSensor);
+    EXPECT_EQ(s.temperature_c, 99.0f);  // untouched
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// A register-level HMC5883L: ambient field + positive bias in self-test, single and
+// continuous modes, RDY in the status register.
+struct FakeHmc {
+    uint8_t reg[16] = {};
+    bool present = true;
+    bool ready_works = true;
+    int16_t ambient[3] = {100, -50, 200};  // chip x, y, z counts at the current gain
+    int16_t bias[3] = {740, 700, 690};     // positive bias counts at gain 0x60
+    int reads = 0;
+
+    FakeHmc() {
+        reg[0x0A] = 'H';
+        reg[0x0B] = '4';
+        reg[0x0C] = '3';
+        reg[hmc5883::REG_MODE] = 0x01;
+    }
+    void measure() {
+        int16_t v[3];
+        const bool positive = (reg[0] & 0x03) == 0x01;
+        for (int i = 0; i < 3; ++i) v[i] = (int16_t)(ambient[i] + (positive ? bias[i] : 0));
+        // Data order X, Z, Y.
+        const int16_t order[3] = {v[0], v[2], v[1]};
+        for (int i = 0; i < 3; ++i) {
+            reg[3 + 2 * i] = (uint8_t)((uint16_t)order[i] >> 8);
+            reg[4 + 2 * i] = (uint8_t)(order[i] & 0xFF);
+        }
+        if (ready_works) reg[hmc5883::REG_STATUS] |= 0x01;
+    }
+    static bool write_reg(void* ctx, uint8_t addr7, uint8_t r, uint8_t v) {
+        FakeHmc* h = static_cast<FakeHmc*>(ctx);
+        if (!h->present || addr7 != 0x1E) return false;
+        if (r <= 2) h->reg[r] = v;
+        if (r == hmc5883::REG_MODE && (v & 0x03) == hmc5883::kModeSingle) h->measure();
+        if (r == hmc5883::REG_MODE && (v & 0x03) == hmc5883::kModeContinuous) h->measure();
+        return true;
+    }
+    static bool read_regs(void* ctx, uint8_t addr7, uint8_t r, uint8_t* d, uint8_t n) {
+        FakeHmc* h = static_cast<FakeHmc*>(ctx);
+        if (!h->present || addr7 != 0x1E) return false;
+        for (uint8_t i = 0; i < n; ++i) d[i] = h->reg[(r + i) & 0x0F];
+        if (r == hmc5883::REG_DATA_X_MSB) {
+            h->reg[hmc5883::REG_STATUS] &= (uint8_t)~0x01;
+            ++h->reads;
+        }
+        return true;
+    }
+    static void delay(void*, uint16_t) {}
+    hmc5883::I2cBus bus() { return hmc5883::I2cBus{this, write_reg, read_regs, delay}; }
+};
+
+}  // namespace
+
+TEST(Hmc5883Driver, SelfTestScaleAndContinuousConfig) {
+    FakeHmc chip;
+    hmc5883::Hmc5883 mag(chip.bus());
+    const hmc5883::InitResult r = mag.begin(true);
+    ASSERT_EQ(r.status, hmc5883::InitStatus::Ok);
+    EXPECT_TRUE(mag.self_test_passed());
+    // The ambient field is subtracted: scale = expected / bias alone.
+    EXPECT_NEAR(mag.self_test_scale().x, 766.0f / 740.0f, 1e-4f);
+    EXPECT_NEAR(mag.self_test_scale().y, 713.0f / 700.0f, 1e-4f);
+    EXPECT_NEAR(mag.self_test_scale().z, 713.0f / 690.0f, 1e-4f);
+    EXPECT_EQ(chip.reg[hmc5883::REG_CONFIG_A], 0x78);
+    EXPECT_EQ(chip.reg[hmc5883::REG_CONFIG_B], 0x20);
+    EXPECT_EQ(chip.reg[hmc5883::REG_MODE], 0x00);
+}
+
+TEST(Hmc5883Driver, ImplausibleSelfTestFallsBackToUnitScale) {
+    FakeHmc chip;
+    chip.bias[1] = 200;  // y far too weak: ratio 3.6
+    hmc5883::Hmc5883 mag(chip.bus());
+    ASSERT_EQ(mag.begin(true).status, hmc5883::InitStatus::Ok);
+    EXPECT_FALSE(mag.self_test_passed());
+    EXPECT_TRUE(mag.self_test_scale() == linalg::Vector3f(1.0f, 1.0f, 1.0f));
+
+    FakeHmc no_ready;
+    no_ready.ready_works = false;  // never says ready: bounded, then unit scale
+    hmc5883::Hmc5883 mag2(no_ready.bus());
+    ASSERT_EQ(mag2.begin(true).status, hmc5883::InitStatus::Ok);
+    EXPECT_FALSE(mag2.self_test_passed());
+}
+
+TEST(Hmc5883Driver, AbsentAndWrongIdentity) {
+    FakeHmc chip;
+    chip.present = false;
+    hmc5883::Hmc5883 mag(chip.bus());
+    EXPECT_EQ(mag.begin(true).status, hmc5883::InitStatus::NoAnswer);
+    linalg::Vector3f f;
+    EXPECT_EQ(mag.read(f), hmc5883::ReadStatus::BusError);
+
+    FakeHmc other;
+    other.reg[0x0B] = '5';
+    hmc5883::Hmc5883 mag2(other.bus());
+    const hmc5883::InitResult r = mag2.begin(true);
+    EXPECT_EQ(r.status, hmc5883::InitStatus::WrongIdentity);
+    EXPECT_EQ(r.id[1], '5');
+}
+
+TEST(Hmc5883Driver, ReadsBodyFrameDropsFirstAndOverflow) {
+    FakeHmc chip;
+    hmc5883::Hmc5883 mag(chip.bus());
+    ASSERT_EQ(mag.begin(false).status, hmc5883::InitStatus::Ok);
+    linalg::Vector3f f(7.0f, 7.0f, 7.0f);
+    EXPECT_EQ(mag.read(f), hmc5883::ReadStatus::Skipped);  // first sample after the gain change
+    chip.ambient[0] = 109;  // 0.1 Ga = 10 uT on chip x at 1090 LSB/Ga
+    chip.ambient[1] = 218;
+    chip.ambient[2] = -545;
+    chip.measure();
+    ASSERT_EQ(mag.read(f), hmc5883::ReadStatus::Ok);
+    // body = (-chip_y, -chip_x, -chip_z)
+    EXPECT_NEAR(f.x, -20.0f, 1e-3f);
+    EXPECT_NEAR(f.y, -10.0f, 1e-3f);
+    EXPECT_NEAR(f.z, 50.0f, 1e-3f);
+    chip.ambient[2] = -4096;
+    chip.measure();
+    const linalg::Vector3f before = f;
+    EXPECT_EQ(mag.read(f), hmc5883::ReadStatus::Overflow);
+    EXPECT_TRUE(f == before);
+}
