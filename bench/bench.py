@@ -1,0 +1,659 @@
+#!/usr/bin/env python3
+"""`make bench`: cycles, size and accuracy of the firmware, with the peers beside it.
+
+    python3 bench/bench.py [--build DIR] [--data DIR] [--jobs N] [--no-peers] [--seconds S]
+
+The build directory is --build, else $BENCH_BUILD, else $BUILD (make passes command-line
+variables on), else `build`. It needs DIR/firmware.elf and the tools DIR/apm25sim,
+DIR/replay, DIR/scenario, DIR/score (`make all`); a missing one skips its part with a
+message. The real recordings are read from ../shared/data/broad beside the repository
+(skipped with a message when absent).
+
+It runs itself in its own virtual environment, DIR/bench/venv, which it creates and fills
+from PyPI on first use (numpy, matplotlib and the peers vqf, ahrs, imufusion).
+
+Writes DIR/bench/report.md, DIR/bench/figures.json, DIR/bench/*.png; peer results are
+cached by file hash in DIR/bench/cache so that reruns are fast.
+"""
+import argparse
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
+
+# The virtualenv's packages. ahrs 0.4.0 works with numpy 2 (checked); imufusion's API
+# changed between 1.2 and 1.3, so it is pinned with the peers.
+REQUIREMENTS = ["numpy>=1.24", "matplotlib>=3.6", "vqf==2.1.2", "ahrs==0.4.0", "imufusion==1.3.3"]
+
+FIGURE_KEYS = ["step_cycles_avg", "euler_cycles_avg", "line_cycles_avg", "loop_load_pct",
+               "flash_bytes", "ram_bytes", "broad_total_deg", "broad_incl_deg", "broad_heading_deg"]
+
+# Profile sections written by apm25sim --profile (numbers, or names matched by keyword).
+SECTIONS = [
+    (1, "step", "estimator step", ("step", "estimator", "dcm")),
+    (2, "euler", "Euler extraction", ("euler",)),
+    (3, "line", "format one output line", ("line", "format", "print", "output")),
+    (4, "mpu", "MPU6000 burst read", ("mpu",)),
+    (5, "hmc", "HMC5883L read", ("hmc", "compass", "mag")),
+    (6, "loop", "one loop iteration's work", ("loop",)),
+]
+
+# Targets of issue 5: (key, label, limit, unit).
+CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 16000, ""),
+                 ("euler_cycles_avg", "Euler extraction, avg cycles", 6000, ""),
+                 ("line_cycles_avg", "one output line, avg cycles", 3000, ""),
+                 ("loop_load_pct", "loop CPU load at 200 Hz", 40.0, "%"),
+                 ("flash_bytes", "flash", 24 * 1024, " B"),
+                 ("ram_bytes", "static RAM", 2 * 1024, " B")]
+TARGET_BROAD_TOTAL = 4.5
+TARGET_BROAD_WORST = 15.0
+TARGET_REST = 0.5
+
+OURS = "ours: DCM (replay)"
+
+
+def log(msg):
+    print("[bench] " + msg, flush=True)
+
+
+# ---------------------------------------------------------------------------
+# The virtual environment
+
+def ensure_venv(build):
+    venv = os.path.join(build, "bench", "venv")
+    if os.path.realpath(sys.prefix) == os.path.realpath(venv):
+        return
+    py = os.path.join(venv, "bin", "python")
+    stamp = os.path.join(venv, ".bench-requirements")
+    wanted = "\n".join(REQUIREMENTS) + "\n"
+    if not os.path.exists(py):
+        log("creating the virtual environment " + os.path.relpath(venv, REPO))
+        os.makedirs(os.path.dirname(venv), exist_ok=True)
+        r = subprocess.run([sys.executable, "-m", "venv", venv])
+        if r.returncode != 0 or not os.path.exists(py):
+            sys.exit("bench: could not create a virtualenv with '%s -m venv' (Debian: apt-get install "
+                     "python3-venv, or run `make deps`)" % sys.executable)
+    have = open(stamp).read() if os.path.exists(stamp) else ""
+    if have != wanted:
+        log("installing into the virtualenv: " + " ".join(REQUIREMENTS) + " (once)")
+        r = subprocess.run([py, "-m", "pip", "install", "--quiet", "--disable-pip-version-check"]
+                           + REQUIREMENTS)
+        if r.returncode != 0:
+            sys.exit("bench: pip install failed (PyPI must be reachable); rerun `make bench` to retry")
+        with open(stamp, "w") as f:
+            f.write(wanted)
+    os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:])
+
+
+# ---------------------------------------------------------------------------
+# Small helpers
+
+def tool(build, name):
+    p = os.path.join(build, name)
+    return p if os.path.isfile(p) and os.access(p, os.X_OK) else None
+
+
+def file_hash(path):
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()[:16]
+
+
+def trial_name(path):
+    base = os.path.basename(path)
+    for ext in (".csv.gz", ".csv"):
+        if base.endswith(ext):
+            return base[: -len(ext)]
+    return base
+
+
+def slug(s):
+    return "".join(c if c.isalnum() else "_" for c in s).strip("_")
+
+
+def parse_score_csv(text):
+    lines = [l for l in text.strip().splitlines() if l and not l.startswith("#")]
+    keys = lines[0].split(",")
+    vals = lines[1].split(",")
+    d = dict(zip(keys, vals))
+    return dict(total=float(d["total_rmse_deg"]), incl=float(d["incl_rmse_deg"]),
+                heading=float(d["heading_rmse_deg"]), samples=int(d["samples"]),
+                max_total=float(d["max_total_deg"]))
+
+
+def fmt(v, nd=2):
+    if v is None:
+        return "–"
+    if isinstance(v, float) and v != v:
+        return "nan"
+    if isinstance(v, int):
+        return "{:,}".format(v).replace(",", " ")
+    return "%.*f" % (nd, v)
+
+
+def verdict(value, limit):
+    if value is None:
+        return "N/A"
+    return "PASS" if value <= limit else "MISS"
+
+
+def md_table(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------
+# Size and cycles
+
+def measure_size(build):
+    elf = os.path.join(build, "firmware.elf")
+    if not os.path.exists(elf):
+        log("no %s: flash and RAM not measured (make firmware)" % os.path.relpath(elf, REPO))
+        return None
+    try:
+        out = subprocess.run(["avr-size", "-A", elf], capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError) as e:
+        log("avr-size failed: %s" % e)
+        return None
+    sec = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and parts[0].startswith(".") and parts[1].isdigit():
+            sec[parts[0]] = int(parts[1])
+    return dict(flash=sec.get(".text", 0) + sec.get(".data", 0),
+                ram=sec.get(".data", 0) + sec.get(".bss", 0), sections=sec)
+
+
+def section_id(name):
+    name = name.strip().lower()
+    if name.isdigit():
+        return int(name)
+    for num, _, _, keys in SECTIONS:
+        if any(k in name for k in keys):
+            return num
+    return None
+
+
+def measure_cycles(build, out_dir, seconds):
+    sim = tool(build, "apm25sim")
+    scen = tool(build, "scenario")
+    elf = os.path.join(build, "firmware.elf")
+    if not sim or not scen or not os.path.exists(elf):
+        missing = [n for n, ok in (("apm25sim", sim), ("scenario", scen), ("firmware.elf", os.path.exists(elf)))
+                   if not ok]
+        log("cycles not measured: missing %s (make all)" % ", ".join(missing))
+        return None
+    traj = os.path.join(out_dir, "scenarios", "tilt_tour.csv")
+    os.makedirs(os.path.dirname(traj), exist_ok=True)
+    with open(traj, "w") as f:
+        r = subprocess.run([scen, "tilt_tour"], stdout=f, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        log("scenario tilt_tour failed: %s" % r.stderr.strip())
+        return None
+    prof = os.path.join(out_dir, "profile.csv")
+    if os.path.exists(prof):
+        os.remove(prof)
+    cmd = [sim, "--elf", elf, "--trajectory", traj, "--seconds", str(seconds), "--profile", prof]
+    log("cycles: %s (simavr, %g simulated s)" % (" ".join(os.path.relpath(c, REPO) if os.sep in c else c
+                                                            for c in cmd), seconds))
+    t0 = time.time()
+    r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=1800)
+    if r.returncode != 0 or not os.path.exists(prof):
+        log("apm25sim --profile failed (exit %d): %s" % (r.returncode, r.stderr.strip()[-500:]))
+        return None
+    log("cycles: simavr took %.0f s" % (time.time() - t0))
+    rows = {}
+    run_window = None
+    with open(prof) as f:
+        header = f.readline().strip().split(",")
+        col = {h.strip(): i for i, h in enumerate(header)}
+        for line in f:
+            p = [x.strip() for x in line.strip().split(",")]
+            if len(p) < len(header):
+                continue
+            vals = dict(count=int(float(p[col["count"]])), avg=float(p[col["avg_cycles"]]),
+                        min=float(p[col["min_cycles"]]), max=float(p[col["max_cycles"]]),
+                        total=float(p[col["total_cycles"]]), name=p[col["section"]])
+            if p[col["section"]].lower() == "run":
+                run_window = vals["total"]
+                continue
+            sid = section_id(p[col["section"]])
+            if sid is not None:
+                rows[sid] = vals
+    load = None
+    if run_window and 6 in rows:
+        load = 100.0 * rows[6]["total"] / run_window
+    if 1 in rows and rows[1]["count"] < 500:
+        log("warning: only %d estimator steps profiled (issue 5 asks for >= 500): raise --seconds"
+            % rows[1]["count"])
+    return dict(sections=rows, window=run_window, load=load, seconds=seconds)
+
+
+# ---------------------------------------------------------------------------
+# Accuracy: tasks run in a pool
+
+def task_replay(args):
+    """Our estimator through build/replay on one trajectory, scored by build/score."""
+    label, traj, est_path, replay, score = args
+    t0 = time.time()
+    with open(est_path, "w") as f:
+        r = subprocess.run([replay, "--trajectory", traj], stdout=f, stderr=subprocess.PIPE, text=True,
+                           timeout=1800)
+    if r.returncode != 0:
+        return ("replay", label, None, "replay failed (exit %d): %s" % (r.returncode, r.stderr.strip()[-300:]),
+                time.time() - t0)
+    s = subprocess.run([score, "--trajectory", traj, "--estimate", est_path, "--csv"], capture_output=True,
+                       text=True)
+    if s.returncode != 0:
+        return ("replay", label, None, "score failed (exit %d): %s" % (s.returncode, s.stderr.strip()),
+                time.time() - t0)
+    return ("replay", label, parse_score_csv(s.stdout), None, time.time() - t0)
+
+
+def task_peers(args):
+    """The peers missing from the cache, on one trajectory; returns their scores."""
+    label, traj, names, cache_dir, key = args
+    sys.path.insert(0, BENCH_DIR)
+    import numpy as np
+    import peers
+    t0 = time.time()
+    tr = peers.load_trajectory(traj)
+    step = max(1, int(round(0.02 / peers.sample_period(tr["t"]))))  # keep ~50 Hz for plots
+    out = {}
+    for name in names:
+        try:
+            q = peers.PEERS[name](tr)
+        except Exception as e:  # a peer that breaks is reported, the bench goes on
+            out[name] = dict(error="%s: %s" % (type(e).__name__, e))
+            continue
+        s = peers.score(tr["quat"], q, tr["movement"])
+        path = os.path.join(cache_dir, "%s-%s.npz" % (key, slug(name)))
+        np.savez_compressed(path, t=tr["t"][::step], q=q[::step].astype(np.float32),
+                            score=json.dumps(s))
+        out[name] = s
+    return ("peers", label, out, None, time.time() - t0)
+
+
+def peer_cache_key(traj_hash):
+    """File hash + the peer code and package versions, so any change reruns the peers."""
+    h = hashlib.sha256(traj_hash.encode())
+    h.update(open(os.path.join(BENCH_DIR, "peers.py"), "rb").read())
+    h.update(" ".join(REQUIREMENTS).encode())
+    return h.hexdigest()[:20]
+
+
+def load_cached_peer(cache_dir, key, name):
+    import numpy as np
+    path = os.path.join(cache_dir, "%s-%s.npz" % (key, slug(name)))
+    if not os.path.exists(path):
+        return None
+    try:
+        with np.load(path) as z:
+            return json.loads(str(z["score"]))
+    except Exception:
+        return None
+
+
+def cached_peer_series(cache_dir, key, name):
+    import numpy as np
+    path = os.path.join(cache_dir, "%s-%s.npz" % (key, slug(name)))
+    if not os.path.exists(path):
+        return None
+    with np.load(path) as z:
+        return z["t"].astype(float), z["q"].astype(float)
+
+
+def list_scenarios(build):
+    scen = tool(build, "scenario")
+    if not scen:
+        log("no scenario tool: scenarios skipped (make tools)")
+        return []
+    r = subprocess.run([scen, "--list"], capture_output=True, text=True)
+    if r.returncode != 0:
+        log("scenario --list failed: %s" % r.stderr.strip())
+        return []
+    names = []
+    for line in r.stdout.splitlines():
+        line = line.strip()
+        if line and not line.startswith("#"):
+            names.append(line.split()[0].rstrip(":"))
+    return names
+
+
+def write_scenarios(build, out_dir, names):
+    scen = tool(build, "scenario")
+    paths = {}
+    d = os.path.join(out_dir, "scenarios")
+    os.makedirs(d, exist_ok=True)
+    for n in names:
+        p = os.path.join(d, n + ".csv")
+        with open(p, "w") as f:
+            r = subprocess.run([scen, n], stdout=f, stderr=subprocess.PIPE, text=True)
+        if r.returncode != 0:
+            log("scenario %s failed: %s" % (n, r.stderr.strip()))
+            continue
+        paths[n] = p
+    return paths
+
+
+def metric_cross_check(traj, score_tool, out_dir):
+    """build/score and the numpy metric must agree: VQF on one recording through both."""
+    sys.path.insert(0, BENCH_DIR)
+    import numpy as np
+    import peers
+    tr = peers.load_trajectory(traj)
+    q = peers.run_vqf(tr)
+    r, p, y = peers.euler_from_quat(q)
+    est = os.path.join(out_dir, "crosscheck_vqf.csv")
+    np.savetxt(est, np.column_stack([tr["t"], r, p, y]), delimiter=",", fmt="%.6f",
+               header="t,roll,pitch,yaw", comments="")
+    s = subprocess.run([score_tool, "--trajectory", traj, "--estimate", est, "--csv"], capture_output=True,
+                       text=True)
+    if s.returncode != 0:
+        return "build/score failed: " + s.stderr.strip()
+    a = parse_score_csv(s.stdout)
+    b = peers.score(tr["quat"], q, tr["movement"])
+    diff = max(abs(a[k] - b[k]) for k in ("total", "incl", "heading"))
+    ok = diff < 0.01 and a["samples"] == b["samples"]
+    return "%s: build/score %.3f/%.3f/%.3f (n=%d), numpy %.3f/%.3f/%.3f (n=%d), max diff %.4f deg" % (
+        "agree" if ok else "DISAGREE", a["total"], a["incl"], a["heading"], a["samples"],
+        b["total"], b["incl"], b["heading"], b["samples"], diff)
+
+
+# ---------------------------------------------------------------------------
+
+def mean_of(results, trials, key):
+    vals = [results[t][key] for t in trials if t in results and results[t] is not None]
+    return (sum(vals) / len(vals)) if vals else None
+
+
+def worst_of(results, trials):
+    vals = [(results[t]["total"], t) for t in trials if t in results and results[t] is not None]
+    return max(vals) if vals else (None, None)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=os.environ.get("BENCH_BUILD") or os.environ.get("BUILD") or "build")
+    ap.add_argument("--data", default=os.path.join(os.path.dirname(REPO), "shared", "data", "broad"))
+    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
+    ap.add_argument("--no-peers", action="store_true", help="only our estimator")
+    ap.add_argument("--seconds", type=float, default=12.0, help="simulated seconds profiled in simavr")
+    ap.add_argument("--no-venv", action="store_true", help="use the current interpreter as it is")
+    args = ap.parse_args()
+    build = os.path.abspath(os.path.join(REPO, args.build))
+    if not args.no_venv:
+        ensure_venv(build)
+
+    sys.path.insert(0, BENCH_DIR)
+    import multiprocessing
+    import numpy as np
+    import peers
+    import plots
+
+    out_dir = os.path.join(build, "bench")
+    cache_dir = os.path.join(out_dir, "cache")
+    est_dir = os.path.join(out_dir, "estimates")
+    for d in (out_dir, cache_dir, est_dir):
+        os.makedirs(d, exist_ok=True)
+    t_start = time.time()
+    log("build directory %s, output %s" % (os.path.relpath(build, REPO), os.path.relpath(out_dir, REPO)))
+
+    # 1. size and cycles
+    size = measure_size(build)
+    cycles = measure_cycles(build, out_dir, args.seconds)
+
+    # 2. accuracy
+    replay = tool(build, "replay")
+    score_tool = tool(build, "score")
+    if not replay:
+        log("no %s: our estimator not scored (make all)" % os.path.relpath(os.path.join(build, "replay"), REPO))
+    if not score_tool:
+        log("no %s: our estimator not scored (make tools)" % os.path.relpath(os.path.join(build, "score"), REPO))
+    recordings = []
+    if os.path.isdir(args.data):
+        recordings = sorted(os.path.join(args.data, f) for f in os.listdir(args.data)
+                            if f.endswith(".csv.gz") or f.endswith(".csv"))
+    if not recordings:
+        log("no recordings in %s: the BROAD part is skipped (it needs ../shared/data/broad)" % args.data)
+    else:
+        log("%d recordings in %s" % (len(recordings), os.path.relpath(args.data, REPO)))
+    scen_paths = write_scenarios(build, out_dir, list_scenarios(build)) if tool(build, "scenario") else {}
+    if scen_paths:
+        log("%d scenarios: %s" % (len(scen_paths), ", ".join(scen_paths)))
+
+    files = [(trial_name(p), p, "broad") for p in recordings] + [(n, p, "scenario") for n, p in scen_paths.items()]
+    peer_names = [] if args.no_peers else list(peers.PEERS)
+    results = {OURS: {}}
+    for n in peer_names:
+        results[n] = {}
+    keys = {}
+    tasks = []
+    for label, path, kind in files:
+        if replay and score_tool:
+            tasks.append((task_replay, (label, path, os.path.join(est_dir, label + ".csv"), replay, score_tool),
+                          "replay %s" % label))
+        if peer_names:
+            keys[label] = peer_cache_key(file_hash(path))
+            missing = []
+            for n in peer_names:
+                s = load_cached_peer(cache_dir, keys[label], n)
+                if s is None:
+                    missing.append(n)
+                else:
+                    results[n][label] = s
+            if missing:
+                tasks.append((task_peers, (label, path, missing, cache_dir, keys[label]),
+                              "peers on %s (%s)" % (label, ", ".join(missing))))
+    cached = sum(len(v) for k, v in results.items() if k != OURS)
+    if cached:
+        log("%d peer results from the cache" % cached)
+    errors = []
+    if tasks:
+        log("running %d tasks on %d processes" % (len(tasks), args.jobs))
+        # Slow tasks (peers in Python) first so that both processes stay busy.
+        tasks.sort(key=lambda t: t[0] is not task_peers)
+        with multiprocessing.Pool(args.jobs) as pool:
+            pending = [(desc, pool.apply_async(fn, (a,))) for fn, a, desc in tasks]
+            done = 0
+            for desc, res in pending:
+                kind, label, value, err, dt = res.get()
+                done += 1
+                if err:
+                    errors.append("%s: %s" % (desc, err))
+                    log("[%d/%d] %s: ERROR %s" % (done, len(tasks), desc, err))
+                    continue
+                if kind == "replay":
+                    results[OURS][label] = value
+                    log("[%d/%d] %s: total %.2f incl %.2f heading %.2f deg (%.1f s)" % (
+                        done, len(tasks), desc, value["total"], value["incl"], value["heading"], dt))
+                else:
+                    for n, s in value.items():
+                        if "error" in s:
+                            errors.append("%s on %s: %s" % (n, label, s["error"]))
+                        else:
+                            results[n][label] = s
+                    log("[%d/%d] %s (%.1f s)" % (done, len(tasks), desc, dt))
+
+    trials = [trial_name(p) for p in recordings]
+    scen_names = list(scen_paths)
+    check = None
+    if recordings and score_tool:
+        check = metric_cross_check(recordings[0], score_tool, out_dir)
+        log("metric cross-check (VQF on %s): %s" % (trials[0], check))
+
+    # 3. plots
+    pngs = []
+    plot_trials = [t for t in trials if t.split("_")[0] in ("01", "21", "30")] or trials[:3]
+    for label, path, kind in files:
+        if label not in scen_names and label not in plot_trials:
+            continue
+        est_path = os.path.join(est_dir, label + ".csv")
+        if label not in results[OURS] or not os.path.exists(est_path):
+            continue
+        try:
+            est = np.genfromtxt(est_path, delimiter=",", names=True)
+            tr = peers.load_trajectory(path)
+            others = {}
+            if "VQF" in peer_names and label in keys:
+                ser = cached_peer_series(cache_dir, keys[label], "VQF")
+                if ser is not None:
+                    others["VQF"] = ser
+            png = os.path.join(out_dir, "plot_%s.png" % slug(label))
+            s = results[OURS][label]
+            plots.plot_run(png, "%s: ours total %.2f, incl %.2f, heading %.2f deg RMSE" % (
+                label, s["total"], s["incl"], s["heading"]), tr,
+                dict(t=est["t"], roll=est["roll"], pitch=est["pitch"], yaw=est["yaw"]), others)
+            pngs.append(png)
+        except Exception as e:
+            log("plot %s failed: %s" % (label, e))
+    if pngs:
+        log("%d plots written" % len(pngs))
+
+    # 4. figures and report
+    sec = cycles["sections"] if cycles else {}
+    ours_broad = results[OURS]
+    have_all = trials and all(t in ours_broad for t in trials)
+    figures = {
+        "step_cycles_avg": sec[1]["avg"] if 1 in sec else None,
+        "euler_cycles_avg": sec[2]["avg"] if 2 in sec else None,
+        "line_cycles_avg": sec[3]["avg"] if 3 in sec else None,
+        "loop_load_pct": cycles["load"] if cycles else None,
+        "flash_bytes": size["flash"] if size else None,
+        "ram_bytes": size["ram"] if size else None,
+        "broad_total_deg": mean_of(ours_broad, trials, "total") if have_all else None,
+        "broad_incl_deg": mean_of(ours_broad, trials, "incl") if have_all else None,
+        "broad_heading_deg": mean_of(ours_broad, trials, "heading") if have_all else None,
+    }
+    for k, v in figures.items():
+        if isinstance(v, float):
+            figures[k] = round(v, 3)
+    with open(os.path.join(out_dir, "figures.json"), "w") as f:
+        json.dump({k: figures[k] for k in FIGURE_KEYS}, f, indent=2)
+        f.write("\n")
+
+    rep = ["# Benchmark: cycles, size and accuracy", "",
+           "Generated by `make bench` (bench/bench.py) from `%s`; %s." % (
+               os.path.relpath(build, REPO), time.strftime("%Y-%m-%d %H:%M")), ""]
+    # cycles
+    rep += ["## Cycles on the ATmega2560 (simavr, 16 MHz)", ""]
+    if cycles:
+        rows = []
+        for num, _, label, _ in SECTIONS:
+            s = sec.get(num)
+            rows.append([label] + ([fmt(s["count"]), fmt(s["avg"], 0), fmt(s["min"], 0), fmt(s["max"], 0)]
+                                   if s else ["–"] * 4))
+        rep.append("Scenario `tilt_tour`, %g simulated seconds through `apm25sim --profile`." % cycles["seconds"])
+        rep.append("")
+        rep.append(md_table(["section", "count", "avg", "min", "max"], rows))
+        rep.append("")
+        if cycles["load"] is not None:
+            rep.append("Loop CPU load at 200 Hz: %.1f %% (section 6 cycles / run window of %s cycles)." % (
+                cycles["load"], fmt(int(cycles["window"]))))
+    else:
+        rep.append("Not measured (apm25sim, scenario or firmware.elf missing, or the run failed).")
+    rep.append("")
+    if size:
+        rep.append("Flash %s bytes (.text + .data), static RAM %s bytes (.data + .bss)." % (
+            fmt(size["flash"]), fmt(size["ram"])))
+        rep.append("")
+
+    # accuracy
+    rep += ["## Accuracy on the BROAD recordings", ""]
+    if trials:
+        rep += ["The dataset's metric (`build/score`): RMSE over the samples with movement = 1 of the total, "
+                   "inclination and heading error, mean over the %d trials. Ours runs through `replay` "
+                   "(the sensor models, drivers and DCM, 50 Hz output); the peers run on the recordings "
+                   "as they are (each at the file's own rate). *published*: the figures in "
+                   "../shared/data/broad/README.md and issue 5." % len(trials), ""]
+        rows = []
+        for name in [OURS] + peer_names:
+            res = results[name]
+            n = sum(1 for t in trials if t in res)
+            if not n:
+                rows.append([name, "–", "–", "–", "–", "0/%d" % len(trials), "–"])
+                continue
+            w, wt = worst_of(res, trials)
+            pub = peers.PUBLISHED.get(name)
+            rows.append([name, fmt(mean_of(res, trials, "total")), fmt(mean_of(res, trials, "incl")),
+                         fmt(mean_of(res, trials, "heading")), "%s (%s)" % (fmt(w), wt.split("_")[0]),
+                         "%d/%d" % (n, len(trials)),
+                         "%.2f / %.2f / %.2f" % pub if pub else "–"])
+        rep.append(md_table(["filter", "total °", "inclination °", "heading °", "worst trial total °",
+                             "trials", "published total / incl / heading"], rows))
+        rep.append("")
+        if check:
+            rep.append("Metric cross-check (VQF on %s through build/score and through numpy): %s." % (
+                trials[0], check))
+            rep.append("")
+        rep += ["### Per trial (total RMSE °; ours: total / inclination / heading)", ""]
+        rows = []
+        for t in trials:
+            o = results[OURS].get(t)
+            row = [t, "%s / %s / %s" % (fmt(o["total"]), fmt(o["incl"]), fmt(o["heading"])) if o else "–"]
+            row += [fmt(results[n][t]["total"]) if t in results[n] else "–" for n in peer_names]
+            rows.append(row)
+        rep.append(md_table(["trial", "ours"] + peer_names, rows))
+        rep.append("")
+    else:
+        rep.append("Skipped: no recordings (../shared/data/broad is not beside the repository).")
+        rep.append("")
+    if scen_names:
+        rep += ["## The project's scenarios (total / inclination / heading RMSE °)", ""]
+        rows = []
+        for sname in scen_names:
+            row = [sname]
+            for name in [OURS] + peer_names:
+                s = results[name].get(sname)
+                row.append("%s / %s / %s" % (fmt(s["total"]), fmt(s["incl"]), fmt(s["heading"])) if s else "–")
+            rows.append(row)
+        rep.append(md_table(["scenario", "ours"] + peer_names, rows))
+        rep.append("")
+
+    # targets
+    rep += ["## Targets (issue 5)", ""]
+    rows = []
+    for key, label, limit, unit in CYCLE_TARGETS:
+        v = figures[key]
+        rows.append([label, "≤ %s%s" % (fmt(limit) if isinstance(limit, int) else fmt(limit, 1), unit),
+                     (fmt(v, 1) if isinstance(v, float) else fmt(v)) if v is not None else "–",
+                     verdict(v, limit)])
+    w, wt = worst_of(results[OURS], trials) if trials else (None, None)
+    rows.append(["BROAD mean total RMSE (15 trials)", "≤ %.1f°" % TARGET_BROAD_TOTAL,
+                 fmt(figures["broad_total_deg"]), verdict(figures["broad_total_deg"], TARGET_BROAD_TOTAL)])
+    rows.append(["BROAD worst trial total RMSE", "≤ %.0f°" % TARGET_BROAD_WORST,
+                 "%s (%s)" % (fmt(w), wt) if w is not None else "–",
+                 verdict(w if have_all else None, TARGET_BROAD_WORST)])
+    rest = [n for n in scen_names if "rest" in n]
+    for n in rest:
+        s = results[OURS].get(n)
+        rows.append(["scenario %s total RMSE" % n, "≤ %.1f°" % TARGET_REST, fmt(s["total"]) if s else "–",
+                     verdict(s["total"] if s else None, TARGET_REST)])
+    if not rest:
+        rows.append(["rest scenario total RMSE", "≤ %.1f°" % TARGET_REST, "–", "N/A"])
+    rep.append(md_table(["target", "limit", "now", ""], rows))
+    rep.append("")
+    if errors:
+        rep += ["## Errors", ""] + ["- " + e for e in errors] + [""]
+    if pngs:
+        rep += ["## Plots", ""] + ["![%s](%s)" % (os.path.basename(p), os.path.basename(p)) for p in pngs] + [""]
+    report = "\n".join(rep)
+    with open(os.path.join(out_dir, "report.md"), "w") as f:
+        f.write(report)
+    print()
+    print(report)
+    log("wrote %s, figures.json and %d plots in %.0f s" % (
+        os.path.relpath(os.path.join(out_dir, "report.md"), REPO), len(pngs), time.time() - t_start))
+    return 1 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
