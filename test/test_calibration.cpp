@@ -155,3 +155,125 @@ TEST(Calibration, MagQualityChecks) {
     m.add(Vector3f(std::nanf(""), 0.0f, 0.0f));
     EXPECT_EQ(m.count(), 0);
 }
+
+// ---------------------------------------------------------------------------
+// The start-up calibration as the firmware and the replay tool run it (lib/Pipeline).
+#include <string>
+
+#include "Pipeline.h"
+
+namespace {
+
+void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
+void sink_flash(void* ctx, const char* s) { static_cast<std::string*>(ctx)->append(s); }
+
+mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) {
+    return mpu6000::Sample{gyro, accel, 25.0f, false, false};
+}
+
+// North-facing level board: field north and down (dip ~60 deg).
+const Vector3f kFieldNorthDown(20.0f, 0.0f, 40.0f);
+
+}  // namespace
+
+TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
+    std::string log;
+    const text::Sink sink{&log, sink_write, sink_flash};
+    pipeline::AttitudePipeline p(&sink);
+    p.set_mag_present(true);
+    int first_output = -1;
+    for (int i = 0; i < 400; ++i) {
+        if (i % 3 == 0) p.on_mag_sample(kFieldNorthDown);
+        p.on_imu_sample(imu(kBias, kLevel));
+        if (p.output_due() && first_output < 0) first_output = i;
+    }
+    EXPECT_EQ(first_output, calib::kGyroWindow - 1);  // the step that finished the calibration
+    EXPECT_EQ(p.phase(), pipeline::Phase::Running);
+    EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, kBias.x, 1e-6f);
+    const pipeline::Angles a = p.angles();
+    EXPECT_NEAR(a.roll_deg, 0.0f, 0.1f);
+    EXPECT_NEAR(a.pitch_deg, 0.0f, 0.1f);
+    EXPECT_TRUE(a.heading_deg < 0.5f || a.heading_deg > 359.5f) << a.heading_deg;
+    EXPECT_NE(log.find("# gyro bias: "), std::string::npos) << log;
+    p.settings().declination_centideg = 250;
+    EXPECT_NEAR(p.angles().heading_deg, 2.5f, 0.5f);
+}
+
+TEST(Pipeline, RolledAndPitchedBoardFromGravity) {
+    // 90 deg roll right: body y points down, the accelerometer reads -g on body y.
+    pipeline::AttitudePipeline p;
+    for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(Vector3f(), Vector3f(0.0f, -9.80665f, 0.0f)));
+    EXPECT_NEAR(p.angles().roll_deg, 90.0f, 0.5f);
+    // 30 deg nose up: body x tilts up, specific force along +x is g sin 30.
+    pipeline::AttitudePipeline q;
+    for (int i = 0; i < 300; ++i) q.on_imu_sample(imu(Vector3f(), Vector3f(4.903f, 0.0f, -8.4926f)));
+    EXPECT_NEAR(q.angles().pitch_deg, 30.0f, 0.5f);
+}
+
+TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
+    std::string log;
+    const text::Sink sink{&log, sink_write, sink_flash};
+    pipeline::AttitudePipeline p(&sink);
+    int first_output = -1;
+    for (int i = 0; i < 400 && first_output < 0; ++i) {
+        const float wobble = (i % 20 < 10) ? 0.2f : -0.2f;  // +-11 deg/s
+        p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
+        if (p.output_due()) first_output = i;
+    }
+    EXPECT_EQ(first_output, pipeline::kStartupDeadlineSteps - 1);
+    EXPECT_NE(log.find("# calibrating gyro: board moved, retrying"), std::string::npos);
+    EXPECT_NE(log.find("# warn: board not still"), std::string::npos);
+    EXPECT_TRUE(p.gyro_calibrating());  // measuring on in the background
+}
+
+TEST(Pipeline, OutputRateFollowsTheSetting) {
+    pipeline::AttitudePipeline p;
+    for (int i = 0; i < calib::kGyroWindow; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    for (uint8_t rate : {50, 1, 7, 100}) {
+        p.settings().rate_hz = rate;
+        int lines = 0;
+        for (int i = 0; i < 2000; ++i) {  // 10 s
+            p.on_imu_sample(imu(kBias, kLevel));
+            if (p.output_due()) ++lines;
+        }
+        EXPECT_NEAR(lines, rate * 10, 1) << int(rate);
+    }
+}
+
+TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
+    std::string log;
+    const text::Sink sink{&log, sink_write, sink_flash};
+    pipeline::AttitudePipeline p(&sink);
+    for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    log.clear();
+    p.on_imu_sample(imu(Vector3f(30.0f, -30.0f, 30.0f), kLevel * 6.0f));
+    p.on_imu_sample(imu(Vector3f(30.0f, -30.0f, 30.0f), kLevel * 6.0f));
+    for (int i = 0; i < 10; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    EXPECT_EQ(p.spikes(), 2u);
+    EXPECT_NEAR(p.angles().roll_deg, 0.0f, 0.2f);  // the spike never reached the estimator
+    size_t first = log.find("# warn: MPU6000 spike");
+    EXPECT_NE(first, std::string::npos) << log;
+    EXPECT_EQ(log.find("# warn: MPU6000 spike", first + 1), std::string::npos) << "rate-limited";
+}
+
+TEST(Pipeline, MagCalibrationCommand) {
+    std::string log;
+    const text::Sink sink{&log, sink_write, sink_flash};
+    pipeline::AttitudePipeline p(&sink);
+    p.set_mag_present(true);
+    for (int i = 0; i < 250; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    ASSERT_TRUE(p.handle(console::parse_line("cal mag")));
+    EXPECT_TRUE(p.mag_calibrating());
+    // Only turned about z: the check must fail and keep the old calibration.
+    for (int i = 0; i < calib::kMagCalSeconds * 200; ++i) {
+        const float a = (float)i * 0.01f;
+        if (i % 3 == 0) p.on_mag_sample(Vector3f(30.0f * cosf(a), 30.0f * sinf(a), 40.0f));
+        p.on_imu_sample(imu(kBias, kLevel));
+    }
+    EXPECT_FALSE(p.mag_calibrating());
+    EXPECT_NE(log.find("# error: cal mag failed: z axis not turned enough"), std::string::npos) << log;
+    EXPECT_TRUE(p.settings().cal.mag_scale == Vector3f(1.0f, 1.0f, 1.0f));
+    // Defaults keep the gyro bias measured at this start.
+    p.handle(console::parse_line("defaults"));
+    EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, kBias.x, 1e-6f);
+}

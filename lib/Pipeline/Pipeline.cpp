@@ -1,0 +1,254 @@
+#include "Pipeline.h"
+
+namespace pipeline {
+
+using linalg::Vector3f;
+using text::Writer;
+
+namespace {
+constexpr float kG = mpu6000::kStandardGravity_m_s2;
+float absf(float v) { return v < 0.0f ? -v : v; }
+}  // namespace
+
+bool RateLimiter::allow(uint32_t now, uint16_t interval) {
+    if (ever_ && now - last_ < interval) {
+        if (suppressed_ < 0xFFFFu) ++suppressed_;
+        return false;
+    }
+    ever_ = true;
+    last_ = now;
+    return true;
+}
+
+AttitudePipeline::AttitudePipeline(const text::Sink* log)
+    : log_(log), settings_(settings::defaults()), dcm_(dcm::kDefaultDcmSettings) {
+    last_ = mpu6000::Sample{Vector3f(), Vector3f(0.0f, 0.0f, -kG), 0.0f, false, false};
+}
+
+void AttitudePipeline::set_mag_present(bool present) {
+    mag_present_ = present;
+    if (!present) mag_pending_ = false;
+}
+
+void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
+    if (!field_uT.is_finite()) return;
+    if (mag_cal_active_) mag_cal_.add(field_uT);
+    const Vector3f f = calib::apply_mag(settings_.cal, field_uT);
+    const float n = f.length();
+    if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
+        if (warn_mag_.allow(steps_, kWarnIntervalSteps)) {
+            Writer(log_).str(TXT("# warn: HMC5883L field ")).fixed2(n)
+                .str(TXT(" uT is not the Earth's (10..200), sample not used")).end();
+        }
+        return;
+    }
+    mag_cal_uT_ = f;
+    mag_pending_ = true;
+    have_mag_ = true;
+}
+
+// Spikes and non-finite values are replaced by the previous sample; saturation is
+// reported but used (the true rate is at least the full scale).
+mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
+    mpu6000::Sample out = s;
+    bool spike = !s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite();
+    if (!spike && have_last_) {
+        const Vector3f d = s.gyro_rad_s - last_.gyro_rad_s;
+        spike = absf(d.x) > kSpikeGyroJump_rad_s || absf(d.y) > kSpikeGyroJump_rad_s ||
+                absf(d.z) > kSpikeGyroJump_rad_s;
+        const float a2 = s.accel_m_s2.length_squared(), last2 = last_.accel_m_s2.length_squared();
+        spike = spike || (a2 > (kSpikeAccel_g * kG) * (kSpikeAccel_g * kG) &&
+                          last2 < (kNormalAccel_g * kG) * (kNormalAccel_g * kG));
+    }
+    if (spike && have_last_ && spike_run_ < kMaxSpikeRun) {
+        ++spike_run_;
+        ++spikes_;
+        if (warn_spike_.allow(steps_, kWarnIntervalSteps)) {
+            Writer(log_).str(TXT("# warn: MPU6000 spike: sample replaced by the previous one ("))
+                .u32(spikes_).str(TXT(" so far)")).end();
+        }
+        out = last_;
+        out.temperature_c = s.temperature_c;
+        return out;
+    }
+    if (!out.gyro_rad_s.is_finite() || !out.accel_m_s2.is_finite()) return last_;  // never pass NaN on
+    spike_run_ = 0;
+    if (s.gyro_saturated && warn_gyro_sat_.allow(steps_, kWarnIntervalSteps))
+        Writer(log_).str(TXT("# warn: MPU6000 gyro saturated (beyond 2000 deg/s)")).end();
+    if (s.accel_saturated && warn_accel_sat_.allow(steps_, kWarnIntervalSteps))
+        Writer(log_).str(TXT("# warn: MPU6000 accel saturated (beyond 8 g)")).end();
+    last_ = out;
+    have_last_ = true;
+    return out;
+}
+
+void AttitudePipeline::print_bias(text::Flash prefix) {
+    const Vector3f b = settings_.cal.gyro_bias_rad_s * linalg::kDegPerRad;
+    Writer(log_).str(prefix).fixed2(b.x).chr(' ').fixed2(b.y).chr(' ').fixed2(b.z).str(TXT(" deg/s")).end();
+}
+
+void AttitudePipeline::start_estimator(const Vector3f& gravity) {
+    dcm_ = dcm::Dcm(dcm::kDefaultDcmSettings);
+    dcm_.init(gravity, have_mag_ && mag_present_ ? mag_cal_uT_ : Vector3f());
+    mag_pending_ = false;
+    phase_ = Phase::Running;
+    output_acc_ = kRateHz;  // the first line comes with the first step
+}
+
+void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
+    const calib::GyroCalibrator::Result r = gyro_cal_.add(raw.gyro_rad_s, raw.accel_m_s2);
+    ++gyro_cal_steps_;
+    if (r == calib::GyroCalibrator::Result::Done) {
+        gyro_cal_active_ = false;
+        settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
+        settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
+        print_bias(TXT("# gyro bias: "));
+        if (phase_ == Phase::Calibrating) {
+            start_estimator(gyro_cal_.mean_accel_m_s2());
+        } else {
+            dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
+        }
+        return;
+    }
+    if (r == calib::GyroCalibrator::Result::Moved && warn_moved_.allow(steps_, kRateHz))
+        Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
+    if (phase_ == Phase::Calibrating && gyro_cal_steps_ >= kStartupDeadlineSteps) {
+        // Never still long enough: run with what we have, keep measuring in the background.
+        Writer(log_).str((settings_.flags & settings::kFlagGyroCalibrated)
+                             ? TXT("# warn: board not still: starting with the saved gyro bias")
+                             : TXT("# warn: board not still: starting with zero gyro bias"))
+            .str(TXT(", measuring on")).end();
+        start_estimator(raw.accel_m_s2);
+        return;
+    }
+    if (phase_ == Phase::Running && gyro_cal_steps_ >= kGyroCalTimeoutSteps) {
+        gyro_cal_active_ = false;
+        Writer(log_).str(TXT("# error: cal gyro: board never still for 1 s; bias unchanged")).end();
+    }
+}
+
+void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
+    output_due_ = false;
+    ++steps_;
+    const mpu6000::Sample s = guard(raw);
+    if (phase_ == Phase::WaitImu) {
+        phase_ = Phase::Calibrating;
+        Writer(log_).str(TXT("# calibrating gyro: keep the board still")).end();
+        start_gyro_calibration();
+    }
+    if (gyro_cal_active_) step_calibration(s);
+    if (phase_ != Phase::Running) return;
+
+    dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s), s.accel_m_s2);
+    if (mag_pending_ && mag_present_) dcm_.correct_heading(mag_cal_uT_);
+    mag_pending_ = false;
+
+    if (mag_cal_active_) {
+        ++mag_cal_steps_;
+        if (mag_cal_steps_ % (5u * kRateHz) == 0u && mag_cal_steps_ < calib::kMagCalSeconds * kRateHz) {
+            Writer(log_).str(TXT("# cal mag: "))
+                .u32(calib::kMagCalSeconds - mag_cal_steps_ / kRateHz)
+                .str(TXT(" s left, keep turning ("))
+                .u32(mag_cal_.count()).str(TXT(" samples)")).end();
+        }
+        if (mag_cal_steps_ >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
+    }
+
+    output_acc_ = (uint16_t)(output_acc_ + settings_.rate_hz);
+    if (output_acc_ >= kRateHz) {
+        output_acc_ = (uint16_t)(output_acc_ - kRateHz);
+        if (output_acc_ >= kRateHz) output_acc_ = 0;  // rate lowered: no burst of lines
+        output_due_ = true;
+    }
+}
+
+Angles AttitudePipeline::angles() const {
+    const dcm::EulerAngles e = dcm_.euler();
+    return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad,
+                  dcm::heading_deg(e.yaw_rad, settings_.declination_deg())};
+}
+
+Vector3f AttitudePipeline::gyro_bias_rad_s() const {
+    return settings_.cal.gyro_bias_rad_s + dcm_.gyro_bias_rad_s();
+}
+
+void AttitudePipeline::start_gyro_calibration() {
+    gyro_cal_.restart();
+    gyro_cal_steps_ = 0;
+    gyro_cal_active_ = true;
+    if (phase_ == Phase::Running)
+        Writer(log_).str(TXT("# cal gyro: keep the board still for 1 s")).end();
+}
+
+void AttitudePipeline::start_mag_calibration() {
+    if (!mag_present_) {
+        Writer(log_).str(TXT("# error: cal mag: HMC5883L absent")).end();
+        return;
+    }
+    mag_cal_.restart();
+    mag_cal_steps_ = 0;
+    mag_cal_active_ = true;
+    Writer(log_).str(TXT("# cal mag: turn the board through every orientation for 30 s")).end();
+}
+
+void AttitudePipeline::finish_mag_calibration() {
+    mag_cal_active_ = false;
+    calib::Calibration c = settings_.cal;
+    const calib::MagCalibrator::Quality q = mag_cal_.finish(c);
+    if (q == calib::MagCalibrator::Quality::Ok) {
+        settings_.cal = c;
+        settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
+        Writer w(log_);
+        w.str(TXT("# cal mag: offset ")).fixed2(c.mag_offset_uT.x).chr(' ').fixed2(c.mag_offset_uT.y)
+            .chr(' ').fixed2(c.mag_offset_uT.z).str(TXT(" uT, scale ")).fixed2(c.mag_scale.x).chr(' ')
+            .fixed2(c.mag_scale.y).chr(' ').fixed2(c.mag_scale.z).str(TXT(" (save to keep)")).end();
+        return;
+    }
+    const Vector3f half = (mag_cal_.max_uT() - mag_cal_.min_uT()) * 0.5f;
+    Writer w(log_);
+    w.str(TXT("# error: cal mag failed: "));
+    switch (q) {
+        case calib::MagCalibrator::Quality::TooFewSamples:
+            w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
+            break;
+        case calib::MagCalibrator::Quality::AxisNotTurned:
+        case calib::MagCalibrator::Quality::SpanTooLarge:
+            w.chr((char)('x' + mag_cal_.axis()))
+                .str(q == calib::MagCalibrator::Quality::AxisNotTurned ? TXT(" axis not turned enough")
+                                                                       : TXT(" axis span too large (magnet near?)"));
+            break;
+        default:
+            w.str(TXT("axes disagree"));
+            break;
+    }
+    w.str(TXT("; half spans ")).fixed2(half.x).chr(' ').fixed2(half.y).chr(' ').fixed2(half.z)
+        .str(TXT(" uT; calibration unchanged")).end();
+}
+
+bool AttitudePipeline::handle(const console::Command& c) {
+    switch (c.id) {
+        case console::CommandId::Defaults: {
+            // The gyro bias measured at this start is a measurement, not a setting: keep it.
+            const Vector3f bias = settings_.cal.gyro_bias_rad_s;
+            const uint8_t gyro_flag = (uint8_t)(settings_.flags & settings::kFlagGyroCalibrated);
+            console::apply_setting(c, settings_, log_);
+            settings_.cal.gyro_bias_rad_s = bias;
+            settings_.flags = (uint8_t)(settings_.flags | gyro_flag);
+            return true;
+        }
+        case console::CommandId::Rate:
+        case console::CommandId::Decl:
+        case console::CommandId::Mode:
+            return console::apply_setting(c, settings_, log_);
+        case console::CommandId::CalGyro:
+            start_gyro_calibration();
+            return true;
+        case console::CommandId::CalMag:
+            start_mag_calibration();
+            return true;
+        default:
+            return false;
+    }
+}
+
+}  // namespace pipeline

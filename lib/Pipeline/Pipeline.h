@@ -1,0 +1,149 @@
+// AttitudePipeline: decoded sensor samples in, estimator state and output timing out.
+// The firmware and the host replay tool run exactly this; the firmware adds only the
+// Arduino set-up, the buses, the data-ready pacing, serial I/O, LEDs and EEPROM.
+//
+// Use (one call per MPU6000 data-ready, 200 Hz):
+//
+//   pipeline::AttitudePipeline pipe(sink_or_nullptr);   // null sink: silent
+//   pipe.settings() = settings_from_eeprom_or_defaults;  // rate, declination, calibration
+//   pipe.set_mag_present(true);                          // false: yaw is gyro-only
+//   loop:
+//     if (magnetometer delivered)  pipe.on_mag_sample(field_uT);   // body frame, before calibration
+//     pipe.on_imu_sample(sample);                                  // decoded burst, body frame
+//     if (pipe.output_due()) { pipeline::Angles a = pipe.angles(); ... }
+//
+// Start-up: the gyro bias is measured at rest (kGyroWindow samples, restarting when the
+// board moves); then the DCM starts from the mean gravity and the latest field (TRIAD).
+// If the board is never still for kStartupDeadlineSteps the estimator starts anyway
+// with the saved bias (or zero) and the measurement goes on in the background.
+// Each step: calibration applied (calib::apply_*), spikes and non-finite samples
+// replaced by the previous sample, Dcm::update at the fixed 5 ms step, then
+// Dcm::correct_heading if a field sample came in since the previous step.
+//
+// Messages (to the sink, each a "# " line): gyro calibration progress and result,
+// "# warn: MPU6000 ..." for spikes and saturation (at most one per kWarnIntervalSteps
+// per kind, with the count), "# warn: HMC5883L ..." for absurd fields, the `cal mag`
+// progress and verdict.
+#pragma once
+
+#include <stdint.h>
+
+#include "Calibration.h"
+#include "Console.h"
+#include "Dcm.h"
+#include "LinAlg.h"
+#include "Mpu6000Registers.h"
+#include "Settings.h"
+#include "Text.h"
+
+namespace pipeline {
+
+constexpr uint16_t kRateHz = 200;               // the MPU6000's sample rate = the estimator step
+constexpr float kStep_s = 0.005f;
+constexpr uint16_t kStartupDeadlineSteps = 260; // 1.3 s: the first line must be out within 2 s of reset
+constexpr uint16_t kGyroCalTimeoutSteps = 2000; // `cal gyro` gives up after 10 s without a still second
+constexpr uint16_t kWarnIntervalSteps = 400;    // rate limit of each warning kind: 2 s
+constexpr float kSpikeGyroJump_rad_s = 17.45f;  // 1000 deg/s in one 5 ms step: not a rotation
+constexpr float kSpikeAccel_g = 4.0f;           // |a| above this right after a normal sample
+constexpr float kNormalAccel_g = 2.0f;
+constexpr uint8_t kMaxSpikeRun = 3;             // more in a row: it is real, use it
+constexpr float kMagMin_uT = 10.0f;             // Earth: 25..65 uT; outside 10..200 = not the Earth
+constexpr float kMagMax_uT = 200.0f;
+
+enum class Phase : uint8_t {
+    WaitImu,      // no sample yet
+    Calibrating,  // measuring the gyro bias; nothing estimated yet
+    Running,      // estimating
+};
+
+struct Angles {
+    float roll_deg;
+    float pitch_deg;
+    float heading_deg;  // 0 <= h < 360, declination applied
+};
+
+// A per-kind rate limiter for warnings: allow() is true at most once per interval,
+// suppressed() tells how many were held back since the last allowed one.
+class RateLimiter {
+public:
+    bool allow(uint32_t now_steps, uint16_t interval_steps);
+    uint16_t suppressed() const { return suppressed_; }
+
+private:
+    uint32_t last_ = 0;
+    uint16_t suppressed_ = 0;
+    bool ever_ = false;
+};
+
+class AttitudePipeline {
+public:
+    explicit AttitudePipeline(const text::Sink* log = nullptr);
+
+    // Rate, declination, mode and calibration; change them freely (console commands).
+    settings::Settings& settings() { return settings_; }
+    const settings::Settings& settings() const { return settings_; }
+
+    // Whether a magnetometer is delivering. false: yaw is gyro-only, heading not corrected.
+    void set_mag_present(bool present);
+    bool mag_present() const { return mag_present_; }
+
+    // One MPU6000 sample at the fixed 200 Hz step.
+    void on_imu_sample(const mpu6000::Sample& s);
+    // One magnetometer sample (body frame, uT, self-test scale applied, before the
+    // calibration): used by the next on_imu_sample.
+    void on_mag_sample(const linalg::Vector3f& field_uT);
+    // True once per output period after on_imu_sample (only while Running).
+    bool output_due() const { return output_due_; }
+    // Current angles (Euler extraction: ~5 ksteps of float work on AVR; call when due).
+    Angles angles() const;
+
+    // Console commands that act on the pipeline: rate, decl, mode, defaults (settings),
+    // cal gyro, cal mag. Returns false for the others (help, status, save: the firmware's).
+    bool handle(const console::Command& c);
+    void start_gyro_calibration();
+    void start_mag_calibration();
+
+    Phase phase() const { return phase_; }
+    bool gyro_calibrating() const { return gyro_cal_active_; }
+    bool mag_calibrating() const { return mag_cal_active_; }
+    uint32_t steps() const { return steps_; }
+    uint32_t time_ms() const { return steps_ * 5u; }
+    const dcm::Dcm& estimator() const { return dcm_; }
+    // Calibrated bias plus what the estimator has learned since, rad/s.
+    linalg::Vector3f gyro_bias_rad_s() const;
+    float temperature_c() const { return last_.temperature_c; }
+    uint32_t spikes() const { return spikes_; }
+
+private:
+    void step_calibration(const mpu6000::Sample& raw);
+    void start_estimator(const linalg::Vector3f& gravity);
+    mpu6000::Sample guard(const mpu6000::Sample& s);
+    void finish_mag_calibration();
+    void print_bias(text::Flash prefix);
+
+    const text::Sink* log_;
+    settings::Settings settings_;
+    dcm::Dcm dcm_;
+    calib::GyroCalibrator gyro_cal_;
+    calib::MagCalibrator mag_cal_;
+    mpu6000::Sample last_;            // previous accepted sample (spike substitute)
+    linalg::Vector3f mag_cal_uT_;     // latest calibrated field
+    linalg::Vector3f accel_for_init_;
+    RateLimiter warn_spike_, warn_gyro_sat_, warn_accel_sat_, warn_mag_, warn_moved_;
+    uint32_t steps_ = 0;
+    uint32_t spikes_ = 0;
+    uint16_t gyro_cal_steps_ = 0;
+    uint16_t mag_cal_steps_ = 0;
+    uint16_t output_acc_ = 0;
+    Phase phase_ = Phase::WaitImu;
+    uint8_t spike_run_ = 0;
+    bool have_last_ = false;
+    bool mag_present_ = false;
+    bool mag_pending_ = false;
+    bool have_mag_ = false;
+    bool gyro_cal_active_ = false;
+    bool mag_cal_active_ = false;
+    bool output_due_ = false;
+};
+
+}  // namespace pipeline
