@@ -1,0 +1,144 @@
+// build/apm25sim: the firmware ELF on a simulated APM 2.5 (simavr ATmega2560 at 16 MHz,
+// MPU6000 on SPI, HMC5883L on I2C), sensors fed from a trajectory file. The command
+// line and output are the contract in ../shared/SIM.md; --help lists the extensions.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "Board.h"
+#include "FaultSpec.h"
+#include "Trajectory.h"
+
+namespace {
+
+const char* const kUsage =
+    "usage: apm25sim --elf FILE.elf --trajectory FILE.csv[.gz] [--seconds S] [--stamp]\n"
+    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--profile FILE] [--verbose]\n"
+    "\n"
+    "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
+    "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
+    "(held at its last sample after its end). stdout: exactly the bytes the firmware sends on UART0.\n"
+    "\n"
+    "  --seconds S      stop after S simulated seconds (default: the trajectory's length)\n"
+    "  --stamp          prefix each line with the simulated time (s) its newline left the UART\n"
+    "  --fault SPEC     inject a fault (repeatable; grammar below)\n"
+    "  --input FILE     type FILE's bytes into UART0 RX, one character per 10 bit times at the\n"
+    "                   baud rate the firmware set (87 us at 115200), starting at the firmware's\n"
+    "                   first angle line (first line not beginning with '#') or at t = 2.5 s,\n"
+    "                   whichever comes first\n"
+    "  --input-at S     latest start of the input instead of 2.5 s\n"
+    "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..15 written\n"
+    "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
+    "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
+    "                   run,1,C,C,C,C with C = cycles from the first start to the last end of section 6\n"
+    "  --verbose        print the sensor models' protocol counters on stderr at the end\n"
+    "\n"
+    "Bus check: the barometer chip select (pin 40 = PG1, PORTG bit 1) must be high whenever the\n"
+    "MPU6000 chip select (pin 53) is low, checked when pin 53 goes low and at every SPI byte.\n"
+    "A violation is printed on stderr and the exit status is 3.\n"
+    "Timing: an SPI byte takes 8 SCK periods at the divider SPCR/SPSR set; an I2C bit takes\n"
+    "16 + 2*TWBR*4^TWPS CPU cycles (simavr 1.6's fixed times corrected).\n"
+    "Exit status: 0 run completed, 1 usage or file error, 2 the core crashed, 3 bus violation.\n"
+    "\n";
+
+bool read_file(const std::string& path, std::string& out) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return false;
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    out = ss.str();
+    return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    sim::BoardOptions options;
+    std::string trajectory_path, input_path, profile_path;
+    std::vector<std::string> faults;
+    double seconds = -1.0;
+    bool verbose = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        auto value = [&](const char* name) -> const char* {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "apm25sim: %s needs a value\n", name);
+                std::exit(1);
+            }
+            return argv[++i];
+        };
+        if (arg == "--help" || arg == "-h") {
+            std::fputs(kUsage, stdout);
+            std::fputs(sim::kFaultHelp, stdout);
+            return 0;
+        } else if (arg == "--elf") {
+            options.elf_path = value("--elf");
+        } else if (arg == "--trajectory") {
+            trajectory_path = value("--trajectory");
+        } else if (arg == "--seconds") {
+            seconds = std::atof(value("--seconds"));
+        } else if (arg == "--stamp") {
+            options.stamp = true;
+        } else if (arg == "--fault") {
+            faults.push_back(value("--fault"));
+        } else if (arg == "--input") {
+            input_path = value("--input");
+        } else if (arg == "--input-at") {
+            options.input_start_s = std::atof(value("--input-at"));
+        } else if (arg == "--profile") {
+            profile_path = value("--profile");
+        } else if (arg == "--verbose") {
+            verbose = true;
+        } else {
+            std::fprintf(stderr, "apm25sim: unknown argument '%s'\n%s", arg.c_str(), kUsage);
+            return 1;
+        }
+    }
+    if (options.elf_path.empty() || trajectory_path.empty()) {
+        std::fprintf(stderr, "apm25sim: --elf and --trajectory are required\n%s", kUsage);
+        return 1;
+    }
+    sim::Trajectory trajectory;
+    if (!trajectory.load(trajectory_path)) {
+        std::fprintf(stderr, "apm25sim: %s\n", trajectory.error().c_str());
+        return 1;
+    }
+    if (!input_path.empty() && !read_file(input_path, options.input)) {
+        std::fprintf(stderr, "apm25sim: cannot read the input file '%s'\n", input_path.c_str());
+        return 1;
+    }
+    options.profile = !profile_path.empty();
+    if (seconds < 0.0) seconds = trajectory.duration_s();
+
+    sim::Board board(trajectory, options);
+    for (const std::string& spec : faults) {
+        std::string error;
+        if (!sim::apply_fault_spec(spec, board.mpu(), board.mag(), board.bus_faults(), error)) {
+            std::fprintf(stderr, "apm25sim: %s\n", error.c_str());
+            return 1;
+        }
+    }
+    if (!board.init()) {
+        std::fprintf(stderr, "apm25sim: %s\n", board.error().c_str());
+        return 1;
+    }
+    const bool ran = board.run(seconds);
+    board.finish_output();
+    if (!ran) std::fprintf(stderr, "apm25sim: %s\n", board.error().c_str());
+    if (verbose) board.print_counters(stderr);
+    if (options.profile && !board.write_profile(profile_path)) {
+        std::fprintf(stderr, "apm25sim: cannot write the profile '%s'\n", profile_path.c_str());
+        return 1;
+    }
+    if (!ran) return 2;
+    if (board.bus_violations() > 0) {
+        std::fprintf(stderr, "apm25sim: %u bus violation(s): pin 40 must be high while pin 53 is low\n",
+                     board.bus_violations());
+        return 3;
+    }
+    return 0;
+}

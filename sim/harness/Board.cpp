@@ -1,0 +1,475 @@
+#include "Board.h"
+#include "Hmc5883Registers.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstring>
+
+#include "avr_ioport.h"
+#include "avr_spi.h"
+#include "avr_twi.h"
+#include "avr_uart.h"
+#include "sim_avr.h"
+#include "sim_elf.h"
+#include "sim_interrupts.h"
+#include "sim_irq.h"
+#include "sim_regbit.h"
+
+namespace sim {
+
+namespace {
+
+// ATmega2560 data-space addresses (datasheet "Register Summary"; I/O address + 0x20).
+constexpr uint16_t kSpdr = 0x4E;
+constexpr uint16_t kTwbr = 0xB8;
+constexpr uint16_t kTwsr = 0xB9;
+constexpr uint16_t kTwcr = 0xBC;
+constexpr uint16_t kUcsr0a = 0xC0;
+constexpr uint16_t kUbrr0l = 0xC4;
+constexpr uint16_t kUbrr0h = 0xC5;
+constexpr uint16_t kGpior0 = 0x3E;  // profiling: section start
+constexpr uint16_t kGpior1 = 0x4A;  // profiling: section end
+constexpr uint8_t kMpuCsBit = 0;    // PB0, Arduino pin 53
+constexpr uint8_t kBaroCsBit = 1;   // PG1, Arduino pin 40
+constexpr int kMaxViolationsPrinted = 10;
+
+Board* g_board = nullptr;  // simavr's logger has no context pointer
+
+void log_to_stderr(avr_t*, const int level, const char* format, va_list args) {
+    if (level <= LOG_WARNING) vfprintf(stderr, format, args);
+}
+
+void no_sleep(avr_t*, avr_cycle_count_t) {}
+
+void spdr_write_hook(avr_t*, avr_io_addr_t, uint8_t v, void* param) {
+    static_cast<Board*>(param)->on_spdr_write(v);
+}
+avr_cycle_count_t spi_done_timer(avr_t*, avr_cycle_count_t, void* param) {
+    static_cast<Board*>(param)->on_spi_byte_done();
+    return 0;
+}
+void twcr_write_hook(avr_t*, avr_io_addr_t addr, uint8_t v, void* param) {
+    static_cast<Board*>(param)->on_twcr_write(addr, v);
+}
+void twi_output_hook(avr_irq_t*, uint32_t value, void* param) {
+    static_cast<Board*>(param)->on_twi_message(value);
+}
+void uart_output_hook(avr_irq_t*, uint32_t value, void* param) {
+    static_cast<Board*>(param)->on_uart_byte((uint8_t)value);
+}
+avr_cycle_count_t sensor_timer(avr_t*, avr_cycle_count_t, void* param) {
+    return static_cast<Board*>(param)->on_sensor_tick();
+}
+avr_cycle_count_t uart_input_timer(avr_t*, avr_cycle_count_t, void* param) {
+    return static_cast<Board*>(param)->on_uart_input_tick();
+}
+avr_cycle_count_t uart_input_start_timer(avr_t*, avr_cycle_count_t, void* param) {
+    static_cast<Board*>(param)->on_uart_input_tick();  // starts the input if not yet
+    return 0;
+}
+void gpior_write_hook(avr_t* avr, avr_io_addr_t addr, uint8_t v, void* param) {
+    avr->data[addr] = v;
+    static_cast<Board*>(param)->on_gpior_write(addr == kGpior1, v);
+}
+
+struct PortHook {
+    Board* board;
+    char port;
+    bool direction;
+};
+PortHook g_port_hooks[4];
+void port_hook(avr_irq_t*, uint32_t value, void* param) {
+    const PortHook* hook = static_cast<PortHook*>(param);
+    hook->board->on_port_change(hook->port, hook->direction, (uint8_t)value);
+}
+
+}  // namespace
+
+Board::Board(const Trajectory& trajectory, const BoardOptions& options)
+    : mpu_(trajectory), mag_(trajectory), options_(options) {}
+
+Board::~Board() {
+    if (avr_) avr_terminate(avr_);
+    if (g_board == this) g_board = nullptr;
+}
+
+double Board::time_s() const { return avr_ ? (double)avr_->cycle / (double)kCpuHz : 0.0; }
+
+bool Board::init() {
+    g_board = this;
+    avr_global_logger_set(log_to_stderr);
+    elf_firmware_t firmware;
+    std::memset(&firmware, 0, sizeof firmware);
+    if (elf_read_firmware(options_.elf_path.c_str(), &firmware) != 0) {
+        error_ = "cannot read the ELF '" + options_.elf_path + "'";
+        return false;
+    }
+    // Arduino ELFs carry no .mmcu section (SIM.md): the board is fixed.
+    std::strcpy(firmware.mmcu, "atmega2560");
+    firmware.frequency = kCpuHz;
+
+    // simavr 1.6 prints part-init chatter on stdout: keep stdout for the firmware's bytes.
+    fflush(stdout);
+    const int saved_stdout = dup(1);
+    dup2(2, 1);
+    avr_ = avr_make_mcu_by_name(firmware.mmcu);
+    if (avr_) {
+        avr_init(avr_);
+        avr_load_firmware(avr_, &firmware);
+    }
+    fflush(stdout);
+    dup2(saved_stdout, 1);
+    close(saved_stdout);
+    if (!avr_) {
+        error_ = "simavr does not know the atmega2560";
+        return false;
+    }
+    avr_->frequency = kCpuHz;
+    avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
+    avr_->log = LOG_WARNING;
+
+    // UART0: no stdio echo, no sleep on RX poll (SIM.md).
+    uint32_t uart_flags = 0;
+    avr_ioctl(avr_, AVR_IOCTL_UART_GET_FLAGS('0'), &uart_flags);
+    uart_flags &= ~(uint32_t)(AVR_UART_FLAG_STDIO | AVR_UART_FLAG_POLL_SLEEP);
+    avr_ioctl(avr_, AVR_IOCTL_UART_SET_FLAGS('0'), &uart_flags);
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT), uart_output_hook,
+                            this);
+    uart_input_irq_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+
+    // SPI: take over the SPDR write so a byte lasts what the configured clock says.
+    spi_ = static_cast<avr_spi_t*>(avr_->io[AVR_DATA_TO_IO(kSpdr)].w.param);
+    if (!spi_ || spi_->r_spdr != kSpdr) {
+        error_ = "simavr's SPI is not where this harness expects it (SPDR hook)";
+        return false;
+    }
+    avr_->io[AVR_DATA_TO_IO(kSpdr)].w.c = spdr_write_hook;
+    avr_->io[AVR_DATA_TO_IO(kSpdr)].w.param = this;
+
+    // TWI: the HMC5883L answers simavr's TWI messages; TWCR writes get the bit time fixed.
+    twi_input_irq_ = avr_io_getirq(avr_, AVR_IOCTL_TWI_GETIRQ(0), TWI_IRQ_INPUT);
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_TWI_GETIRQ(0), TWI_IRQ_OUTPUT), twi_output_hook, this);
+    twcr_original_ = avr_->io[AVR_DATA_TO_IO(kTwcr)].w.c;
+    twcr_original_param_ = avr_->io[AVR_DATA_TO_IO(kTwcr)].w.param;
+    twi_ = twcr_original_param_;
+    if (twcr_original_) {
+        avr_->io[AVR_DATA_TO_IO(kTwcr)].w.c = twcr_write_hook;
+        avr_->io[AVR_DATA_TO_IO(kTwcr)].w.param = this;
+    }
+
+    // Chip selects: PORTB/DDRB and PORTG/DDRG register writes.
+    const char ports[2] = {'B', 'G'};
+    for (int i = 0; i < 2; ++i) {
+        g_port_hooks[2 * i] = PortHook{this, ports[i], false};
+        g_port_hooks[2 * i + 1] = PortHook{this, ports[i], true};
+        avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(ports[i]), IOPORT_IRQ_REG_PORT),
+                                port_hook, &g_port_hooks[2 * i]);
+        avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(ports[i]), IOPORT_IRQ_DIRECTION_ALL),
+                                port_hook, &g_port_hooks[2 * i + 1]);
+    }
+    mpu_int_irq_ = avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ('E'), 6);
+    mag_drdy_irq_ = avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ('C'), 6);
+
+    if (options_.profile) {
+        avr_register_io_write(avr_, kGpior0, gpior_write_hook, this);
+        avr_register_io_write(avr_, kGpior1, gpior_write_hook, this);
+    }
+
+    avr_cycle_timer_register(avr_, 1, sensor_timer, this);
+    if (!options_.input.empty()) {
+        avr_cycle_timer_register(avr_, (avr_cycle_count_t)(options_.input_start_s * kCpuHz), uart_input_start_timer,
+                                 this);
+    }
+    update_pins();
+    return true;
+}
+
+bool Board::run(double seconds) {
+    const avr_cycle_count_t end = (avr_cycle_count_t)std::llround(seconds * kCpuHz);
+    while (avr_->cycle < end) {
+        const int state = avr_run(avr_);
+        if (state == cpu_Done || state == cpu_Crashed) {
+            error_ = state == cpu_Crashed ? "the AVR core crashed" : "the AVR core stopped";
+            char where[64];
+            std::snprintf(where, sizeof where, " at t=%.6f s, PC=0x%05x", time_s(), (unsigned)avr_->pc);
+            error_ += where;
+            return false;
+        }
+    }
+    return true;
+}
+
+// --- time and pins ------------------------------------------------------------
+
+void Board::advance_models() {
+    const double t_s = time_s();
+    mpu_.advance_to(t_s);
+    mag_.advance_to(t_s);
+}
+
+void Board::update_pins() {
+    const int int_level = mpu_.int_pin_high() ? 1 : 0;
+    if (int_level != int_level_) {
+        int_level_ = int_level;
+        avr_raise_irq(mpu_int_irq_, (uint32_t)int_level);
+    }
+    const int drdy_level = mag_.drdy_pin_high() ? 1 : 0;
+    if (drdy_level != drdy_level_) {
+        drdy_level_ = drdy_level;
+        avr_raise_irq(mag_drdy_irq_, (uint32_t)drdy_level);
+    }
+}
+
+uint64_t Board::on_sensor_tick() {
+    advance_models();
+    update_pins();
+    // Next: the earliest model event, at least every 1 ms (fault windows, pulse ends).
+    const double now_s = time_s();
+    double next_s = now_s + 1e-3;
+    if (mpu_.next_event_s() < next_s) next_s = mpu_.next_event_s();
+    if (mag_.next_event_s() < next_s) next_s = mag_.next_event_s();
+    uint64_t next_cycle = (uint64_t)std::ceil(next_s * kCpuHz);
+    if (next_cycle <= avr_->cycle) next_cycle = avr_->cycle + 1;
+    return next_cycle;
+}
+
+// --- SPI ----------------------------------------------------------------------
+
+double Board::sck_hz() const {
+    static const unsigned kDivider[4] = {4, 16, 64, 128};  // SPR1:SPR0 (datasheet 21.5.1)
+    const unsigned spr = (unsigned)avr_regbit_get(avr_, spi_->spr[0]) | ((unsigned)avr_regbit_get(avr_, spi_->spr[1]) << 1);
+    unsigned divider = kDivider[spr];
+    if (avr_regbit_get(avr_, spi_->spr[2])) divider /= 2;  // SPI2X
+    return (double)kCpuHz / divider;
+}
+
+void Board::on_spdr_write(uint8_t value) {
+    // As the hardware: writing SPDR clears SPIF and starts shifting 8 bits at SCK.
+    avr_core_watch_write(avr_, kSpdr, value);
+    avr_regbit_clear(avr_, spi_->spi.raised);
+    if (!avr_regbit_get(avr_, spi_->spe) || !avr_regbit_get(avr_, spi_->mstr)) return;
+    spi_out_byte_ = value;
+    const avr_cycle_count_t cycles = (avr_cycle_count_t)std::llround(8.0 * kCpuHz / sck_hz());
+    avr_cycle_timer_register(avr_, cycles, spi_done_timer, this);
+}
+
+void Board::on_spi_byte_done() {
+    advance_models();
+    check_bus("during an SPI transfer");
+    uint8_t miso = 0x00;  // nobody drives MISO
+    if (mpu_cs_low_) miso = mpu_.transfer(spi_out_byte_, sck_hz());
+    // simavr's SPI input sets the received byte and raises SPIF (as its own completion).
+    avr_raise_irq(spi_->io.irq + SPI_IRQ_INPUT, miso);
+    update_pins();
+}
+
+bool Board::mpu_selected() const { return (ddr_b_ & (1u << kMpuCsBit)) && !(port_b_ & (1u << kMpuCsBit)); }
+
+// Pin 40 high: driven high, or (input) held by the pull-up the PORT bit enables.
+bool Board::baro_deselected() const { return (port_g_ & (1u << kBaroCsBit)) != 0; }
+
+void Board::check_bus(const char* when) {
+    if (!mpu_cs_low_ || baro_deselected()) return;
+    ++bus_violations_;
+    if (bus_violations_ <= (uint32_t)kMaxViolationsPrinted) {
+        std::fprintf(stderr,
+                     "apm25sim: bus violation at t=%.6f s (PC=0x%05x): MPU6000 chip select (pin 53) low "
+                     "while the barometer chip select (pin 40) is not high, %s\n",
+                     time_s(), (unsigned)avr_->pc, when);
+    }
+}
+
+void Board::on_port_change(char port, bool direction, uint8_t value) {
+    if (port == 'B') (direction ? ddr_b_ : port_b_) = value;
+    if (port == 'G') (direction ? ddr_g_ : port_g_) = value;
+    const bool selected = mpu_selected();
+    if (selected != mpu_cs_low_) {
+        advance_models();
+        mpu_cs_low_ = selected;
+        mpu_.set_chip_select(selected);
+        if (selected) check_bus("when pin 53 went low");
+        update_pins();
+    } else if (port == 'G' && mpu_cs_low_) {
+        check_bus("when pin 40 changed");
+    }
+}
+
+// --- TWI ----------------------------------------------------------------------
+
+void Board::on_twcr_write(uint16_t addr, uint8_t value) {
+    // Timers simavr's TWI already had pending, so only the new one is re-timed.
+    std::vector<avr_cycle_count_t> before;
+    for (avr_cycle_timer_slot_p slot = avr_->cycle_timers.timer; slot; slot = slot->next)
+        if (slot->param == twi_) before.push_back(slot->when);
+    twcr_original_(avr_, addr, value, twcr_original_param_);
+
+    // simavr 1.6 arms the next TWI state after N "bits" of 1 us; the bus takes
+    // N x (16 + 2 TWBR 4^TWPS) CPU cycles (ATmega2560 datasheet 24.5.2).
+    const unsigned prescaler = avr_->data[kTwsr] & 0x03;
+    const uint64_t cycles_per_bit = 16u + 2u * (uint64_t)avr_->data[kTwbr] * (1u << (2 * prescaler));
+    struct Pending {
+        avr_cycle_timer_t timer;
+        avr_cycle_count_t when;
+    };
+    std::vector<Pending> fresh;
+    for (avr_cycle_timer_slot_p slot = avr_->cycle_timers.timer; slot; slot = slot->next) {
+        if (slot->param != twi_) continue;
+        bool old = false;
+        for (avr_cycle_count_t w : before) old = old || w == slot->when;
+        if (!old) fresh.push_back(Pending{slot->timer, slot->when});
+    }
+    for (const Pending& p : fresh) {
+        const uint64_t delay = p.when > avr_->cycle ? p.when - avr_->cycle : 0;
+        const uint64_t bits = (delay + kCpuHz / 2000000) / (kCpuHz / 1000000);
+        if (bits == 0) continue;
+        avr_cycle_timer_cancel(avr_, p.timer, twi_);
+        avr_cycle_timer_register(avr_, bits * cycles_per_bit, p.timer, twi_);
+    }
+}
+
+void Board::on_twi_message(uint32_t value) {
+    avr_twi_msg_irq_t msg;
+    msg.u.v = value;
+    const uint8_t cond = msg.u.twi.msg;
+    const uint8_t addr = msg.u.twi.addr;
+    advance_models();
+    if (cond & TWI_COND_STOP) {
+        if (twi_selected_) mag_.stop();
+        twi_selected_ = false;
+    }
+    if (cond & TWI_COND_START) {
+        if (twi_selected_) mag_.stop();  // repeated start
+        twi_selected_ = false;
+        const bool bus_ok = !bus_faults_.i2c_sda_low.active(time_s());
+        if (bus_ok && (addr >> 1) == hmc5883::kAddress7 && mag_.start((addr & 1) != 0)) {
+            twi_selected_ = true;
+            avr_raise_irq(twi_input_irq_, avr_twi_irq_msg(TWI_COND_ACK, addr, 1));
+        }
+    }
+    if (twi_selected_ && (cond & TWI_COND_WRITE)) {
+        if (mag_.write(msg.u.twi.data)) avr_raise_irq(twi_input_irq_, avr_twi_irq_msg(TWI_COND_ACK, addr, 1));
+    }
+    if (twi_selected_ && (cond & TWI_COND_READ)) {
+        const uint8_t byte = mag_.read();
+        avr_raise_irq(twi_input_irq_, avr_twi_irq_msg(TWI_COND_READ, addr, byte));
+    }
+    update_pins();
+}
+
+// --- UART ---------------------------------------------------------------------
+
+void Board::on_uart_byte(uint8_t byte) {
+    if (!options_.stamp) std::fputc(byte, stdout);
+    if (byte == '\n') {
+        if (options_.stamp) {
+            std::printf("%.6f ", time_s());
+            std::fwrite(line_.data(), 1, line_.size(), stdout);
+            std::fputc('\n', stdout);
+        }
+        const bool angle_line = !line_.empty() && line_[0] != '#' && line_[0] != '\r';
+        line_.clear();
+        if (angle_line && !first_angle_line_seen_) {
+            first_angle_line_seen_ = true;
+            start_input();
+        }
+        return;
+    }
+    line_.push_back((char)byte);
+}
+
+void Board::finish_output() {
+    if (options_.stamp && !line_.empty()) {
+        std::printf("%.6f ", time_s());
+        std::fwrite(line_.data(), 1, line_.size(), stdout);
+        line_.clear();
+    }
+    std::fflush(stdout);
+}
+
+void Board::start_input() {
+    if (input_started_ || options_.input.empty()) return;
+    input_started_ = true;
+    avr_cycle_timer_register(avr_, 1, uart_input_timer, this);
+}
+
+uint64_t Board::on_uart_input_tick() {
+    if (!input_started_) {  // called by the start timer
+        start_input();
+        return 0;
+    }
+    if (input_pos_ >= options_.input.size()) return 0;
+    avr_raise_irq(uart_input_irq_, (uint8_t)options_.input[input_pos_++]);
+    // One character = 10 bits at the baud rate UBRR0 sets (datasheet 22.3.1).
+    const unsigned ubrr = (unsigned)avr_->data[kUbrr0l] | ((unsigned)(avr_->data[kUbrr0h] & 0x0F) << 8);
+    const unsigned divisor = (avr_->data[kUcsr0a] & 0x02) ? 8u : 16u;  // U2X0
+    const uint64_t cycles_per_char = 10u * (uint64_t)divisor * (ubrr + 1u);
+    return avr_->cycle + cycles_per_char;
+}
+
+// --- profiling ----------------------------------------------------------------
+
+void Board::on_gpior_write(bool end, uint8_t value) {
+    if (value == 0 || value > 15) return;
+    SectionProfile& s = sections_[value];
+    const uint64_t now = avr_->cycle;
+    if (!end) {
+        if (s.open) ++profile_errors_;
+        s.open = true;
+        s.started_at = now;
+        if (value == 6 && !run_started_) {
+            run_started_ = true;
+            run_first_start_ = now;
+        }
+        return;
+    }
+    if (!s.open) {
+        ++profile_errors_;
+        return;
+    }
+    s.open = false;
+    const uint64_t cycles = now - s.started_at;
+    ++s.count;
+    s.total += cycles;
+    if (cycles < s.min) s.min = cycles;
+    if (cycles > s.max) s.max = cycles;
+    if (value == 6) run_last_end_ = now;
+}
+
+bool Board::write_profile(const std::string& path) const {
+    FILE* f = std::fopen(path.c_str(), "w");
+    if (!f) return false;
+    std::fprintf(f, "section,count,avg_cycles,min_cycles,max_cycles,total_cycles\n");
+    for (int id = 1; id <= 15; ++id) {
+        const SectionProfile& s = sections_[id];
+        if (s.count == 0) continue;
+        std::fprintf(f, "%d,%llu,%llu,%llu,%llu,%llu\n", id, (unsigned long long)s.count,
+                     (unsigned long long)(s.total / s.count), (unsigned long long)s.min,
+                     (unsigned long long)s.max, (unsigned long long)s.total);
+    }
+    const unsigned long long window = run_started_ && run_last_end_ > run_first_start_
+                                          ? (unsigned long long)(run_last_end_ - run_first_start_)
+                                          : 0ull;
+    std::fprintf(f, "run,1,%llu,%llu,%llu,%llu\n", window, window, window, window);
+    return std::fclose(f) == 0;
+}
+
+void Board::print_counters(FILE* out) const {
+    const Mpu6000Counters& m = mpu_.counters();
+    const Hmc5883Counters& h = mag_.counters();
+    std::fprintf(out,
+                 "# apm25sim: t=%.3f s; MPU6000 transactions=%u bytes=%u writes=%u samples=%u not_read=%u "
+                 "absent_bytes=%u reset_bytes=%u asleep_reads=%u ro_writes=%u fast_writes=%u\n",
+                 time_s(), m.transactions, m.bytes, m.register_writes, m.samples, m.samples_not_read,
+                 m.access_while_absent, m.access_during_reset, m.data_read_while_asleep, m.writes_to_read_only,
+                 m.writes_above_1mhz);
+    std::fprintf(out,
+                 "# apm25sim: HMC5883L transactions=%u written=%u read=%u samples=%u lock_dropped=%u nacked=%u "
+                 "ro_writes=%u invalid_reads=%u; bus violations=%u; profile marker errors=%u\n",
+                 h.transactions, h.bytes_written, h.bytes_read, h.samples, h.samples_dropped_by_lock,
+                 h.nacked_while_absent, h.writes_to_read_only, h.reads_of_invalid_register, bus_violations_,
+                 profile_errors_);
+}
+
+}  // namespace sim

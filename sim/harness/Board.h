@@ -1,0 +1,124 @@
+// The APM 2.5 board around a simavr ATmega2560 (../shared/SIM.md, ../shared/APM25.md):
+// MPU6000 on SPI (CS pin 53 = PB0, INT on PE6), HMC5883L on TWI (7-bit 0x1E, DRDY on
+// pin 31 = PC6), the barometer chip select (pin 40 = PG1) watched, UART0 to a sink.
+//
+// simavr 1.6 corrections made here:
+// - SPI: the SPDR write hook is replaced so a byte takes 8 x the configured SCK divider
+//   in CPU cycles (simavr 1.6 charges a fixed 100 us).
+// - TWI: after each TWCR write, simavr's pending TWI state timer (1 us per bit in 1.6)
+//   is re-armed at the bit time TWBR/TWPS give: 16 + 2 * TWBR * 4^TWPS cycles per bit.
+// - Time is avr->cycle / 16 MHz; the sensor models are advanced to it before every
+//   bus byte and by a cycle timer at each of their events (at least every 1 ms).
+#pragma once
+
+#include <stdint.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "FaultSpec.h"
+#include "Hmc5883Model.h"
+#include "Mpu6000Model.h"
+#include "Trajectory.h"
+
+struct avr_t;
+struct avr_spi_t;
+struct avr_irq_t;
+
+namespace sim {
+
+constexpr uint32_t kCpuHz = 16000000;
+
+struct BoardOptions {
+    std::string elf_path;
+    bool stamp = false;             // prefix each output line with the simulated time
+    std::string input;              // bytes for UART0 RX
+    double input_start_s = 2.5;     // latest start of the input (earlier: first angle line)
+    bool profile = false;
+};
+
+// Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
+struct SectionProfile {
+    uint64_t count = 0, total = 0, min = UINT64_MAX, max = 0;
+    uint64_t started_at = 0;
+    bool open = false;
+};
+
+class Board {
+public:
+    Board(const Trajectory& trajectory, const BoardOptions& options);
+    ~Board();
+
+    // Loads the ELF and wires the parts; false with error() set on failure.
+    bool init();
+    const std::string& error() const { return error_; }
+
+    // Runs until `seconds` of simulated time; false if the core crashed or stopped.
+    bool run(double seconds);
+
+    double time_s() const;
+    Mpu6000Model& mpu() { return mpu_; }
+    Hmc5883Model& mag() { return mag_; }
+    BusFaults& bus_faults() { return bus_faults_; }
+
+    uint32_t bus_violations() const { return bus_violations_; }
+    bool write_profile(const std::string& path) const;
+    void print_counters(FILE* out) const;
+    void finish_output();  // flushes a partial last line
+
+    // simavr callbacks (static trampolines call these).
+    void on_spdr_write(uint8_t value);
+    void on_spi_byte_done();
+    void on_port_change(char port, bool direction, uint8_t value);
+    void on_twi_message(uint32_t value);
+    void on_twcr_write(uint16_t addr, uint8_t value);
+    void on_uart_byte(uint8_t byte);
+    uint64_t on_sensor_tick();
+    uint64_t on_uart_input_tick();
+    void on_gpior_write(bool end, uint8_t value);
+
+private:
+    void advance_models();
+    void update_pins();
+    bool mpu_selected() const;
+    bool baro_deselected() const;
+    void check_bus(const char* when);
+    void start_input();
+    double sck_hz() const;
+
+    Mpu6000Model mpu_;
+    Hmc5883Model mag_;
+    BusFaults bus_faults_;
+    BoardOptions options_;
+    std::string error_;
+
+    avr_t* avr_ = nullptr;
+    avr_spi_t* spi_ = nullptr;
+    void* twi_ = nullptr;
+    avr_irq_t* twi_input_irq_ = nullptr;
+    avr_irq_t* uart_input_irq_ = nullptr;
+    avr_irq_t* mpu_int_irq_ = nullptr;
+    avr_irq_t* mag_drdy_irq_ = nullptr;
+    void (*twcr_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
+    void* twcr_original_param_ = nullptr;
+
+    uint8_t spi_out_byte_ = 0;
+    uint8_t port_b_ = 0, ddr_b_ = 0, port_g_ = 0, ddr_g_ = 0;
+    bool mpu_cs_low_ = false;
+    bool twi_selected_ = false;
+    int int_level_ = -1, drdy_level_ = -1;
+    uint32_t bus_violations_ = 0;
+
+    std::string line_;
+    bool first_angle_line_seen_ = false;
+    bool input_started_ = false;
+    size_t input_pos_ = 0;
+
+    SectionProfile sections_[16];
+    uint64_t run_first_start_ = 0, run_last_end_ = 0;
+    bool run_started_ = false;
+    uint32_t profile_errors_ = 0;
+};
+
+}  // namespace sim
