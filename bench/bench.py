@@ -509,10 +509,16 @@ def main():
                     others["VQF"] = ser
             png = os.path.join(out_dir, "plot_%s.png" % slug(label))
             s = results[OURS][label]
-            plots.plot_run(png, "%s: ours total %.2f, incl %.2f, heading %.2f deg RMSE" % (
-                label, s["total"], s["incl"], s["heading"]), tr,
-                dict(t=est["t"], roll=est["roll"], pitch=est["pitch"], yaw=est["yaw"]), others)
+            ours = dict(t=est["t"], roll=est["roll"], pitch=est["pitch"], yaw=est["yaw"])
+            title = "%s: ours total %.2f, incl %.2f, heading %.2f deg RMSE" % (
+                label, s["total"], s["incl"], s["heading"])
+            t_worst = plots.plot_run(png, title, tr, ours, others)
             pngs.append(png)
+            if label not in scen_names and t_worst is not None:  # 20 s around our worst moment
+                png = os.path.join(out_dir, "plot_%s_zoom.png" % slug(label))
+                plots.plot_run(png, title + " (zoom on the largest error)", tr, ours, others,
+                               window=(t_worst - 10.0, t_worst + 10.0))
+                pngs.append(png)
         except Exception as e:
             log("plot %s failed: %s" % (label, e))
     if pngs:

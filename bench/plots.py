@@ -23,9 +23,10 @@ def truth_at(tr, t):
     return tr["quat"][i], tr["movement"][i]
 
 
-def plot_run(png, title, tr, est, others=None):
+def plot_run(png, title, tr, est, others=None, window=None):
     """est: dict t, roll, pitch, yaw (degrees) of our estimator; others: {label: (t, q_ned)}
-    drawn thin for comparison. Writes a 4-panel PNG."""
+    drawn thin for comparison; window: (t0, t1) to zoom in. Writes a 4-panel PNG and returns
+    the time of our largest total error among the scored samples (None if none)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -71,6 +72,19 @@ def plot_run(png, title, tr, est, others=None):
     ax[3].set_xlabel("time (s)")
     ax[3].grid(True, alpha=0.3)
     ax[3].legend(loc="upper right", fontsize=8)
+    if window:
+        ax[3].set_xlim(*window)
+        for k, series in enumerate((roll_t, pitch_t)):
+            inside = (t >= window[0]) & (t <= window[1])
+            vals = np.concatenate([series[inside], np.asarray(est[["roll", "pitch"][k]], float)[inside]])
+            vals = vals[np.isfinite(vals)]
+            if len(vals):
+                ax[k].set_ylim(vals.min() - 5, vals.max() + 5)
+        inside = (t >= window[0]) & (t <= window[1]) & np.isfinite(tot)
+        if inside.any():
+            ax[3].set_ylim(0, np.nanmax(tot[inside]) * 1.1 + 0.1)
     fig.tight_layout()
     fig.savefig(png, dpi=90)
     plt.close(fig)
+    scored = moving & np.isfinite(tot)
+    return float(t[scored][np.argmax(tot[scored])]) if scored.any() else None
