@@ -30,7 +30,7 @@ const char* const kUsage =
     "                   baud rate the firmware set (87 us at 115200), starting at the firmware's\n"
     "                   first angle line (first line not beginning with '#') or at t = 2.5 s,\n"
     "                   whichever comes first\n"
-    "  --input-at S     latest start of the input instead of 2.5 s\n"
+    "  --input-at S     start the input at exactly S simulated seconds instead\n"
     "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..15 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
@@ -89,6 +89,7 @@ int main(int argc, char** argv) {
             input_path = value("--input");
         } else if (arg == "--input-at") {
             options.input_start_s = std::atof(value("--input-at"));
+            options.input_start_fixed = true;
         } else if (arg == "--profile") {
             profile_path = value("--profile");
         } else if (arg == "--verbose") {

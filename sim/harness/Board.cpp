@@ -372,7 +372,7 @@ void Board::on_uart_byte(uint8_t byte) {
         line_.clear();
         if (angle_line && !first_angle_line_seen_) {
             first_angle_line_seen_ = true;
-            start_input();
+            if (!options_.input_start_fixed) start_input();
         }
         return;
     }

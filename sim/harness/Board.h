@@ -35,6 +35,7 @@ struct BoardOptions {
     bool stamp = false;             // prefix each output line with the simulated time
     std::string input;              // bytes for UART0 RX
     double input_start_s = 2.5;     // latest start of the input (earlier: first angle line)
+    bool input_start_fixed = false; // start exactly at input_start_s (--input-at)
     bool profile = false;
 };
 

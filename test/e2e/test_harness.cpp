@@ -1,0 +1,144 @@
+// The simulated board itself, checked with a probe AVR program (test/e2e/avr/probe.cpp)
+// rather than the firmware: sensors answer on the real buses, faults reach the bus,
+// bus timing is the board's, the chip-select rule is enforced, console input arrives.
+#include "e2e_support.h"
+
+namespace {
+
+// Builds the probe ELFs once (flock: ctest may run these tests in parallel).
+std::string probe_dir() {
+    const std::string dir = e2e::work_dir() + "/probe";
+    const std::string cmd = "flock " + e2e::work_dir() + "/probe.lock " + e2e::project_dir() +
+                            "/test/e2e/avr/build.sh " + dir;
+    const e2e::CommandResult r = e2e::run_command(cmd);
+    if (r.exit_code != 0) return "";
+    return dir;
+}
+
+#define REQUIRE_PROBE(dir)                                                              \
+    E2E_REQUIRE_TOOLS("apm25sim", "scenario");                                          \
+    const std::string dir = probe_dir();                                                \
+    if (dir.empty() || !e2e::file_exists(dir + "/probe.elf"))                           \
+        GTEST_SKIP() << "cannot build the probe (avr-gcc and the Arduino core needed)"
+
+const e2e::Line* find_text(const std::vector<e2e::Line>& lines, const std::string& text) {
+    for (const e2e::Line& l : lines)
+        if (l.text.find(text) != std::string::npos) return &l;
+    return nullptr;
+}
+
+TEST(Harness, HelpDocumentsTheFaultLanguage) {
+    E2E_REQUIRE_TOOLS("apm25sim");
+    const e2e::CommandResult r = e2e::run_command(e2e::tool("apm25sim") + " --help");
+    EXPECT_EQ(r.exit_code, 0);
+    for (const char* spec : {"mpu:absent", "mpu:whoami=", "mag:absent", "mag:drdy-stuck-low", "mag:overflow",
+                             "gyro:saturate", "accel:saturate", "imu:spike", "i2c:sda-low", "--profile", "--input"})
+        EXPECT_NE(r.out.find(spec), std::string::npos) << spec;
+    const e2e::CommandResult bad = e2e::run_command(e2e::tool("apm25sim") + " --elf x --trajectory " +
+                                                    e2e::scenario_csv("rest", 1) + " --fault mpu:melted");
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_NE(bad.err.find("mpu:melted"), std::string::npos) << bad.err;
+}
+
+TEST(Harness, SensorsAnswerOnSpiAndI2cWithDataReadyLines) {
+    REQUIRE_PROBE(dir);
+    const e2e::SimRun run = e2e::run_sim(dir + "/probe.elf", "rest", 1.0);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    EXPECT_TRUE(find_text(run.lines, "# whoami 0x68")) << e2e::dump(run);
+    EXPECT_TRUE(find_text(run.lines, "# magid 3 H43")) << e2e::dump(run);
+    // Level at rest, +-4 g: accel chip z = +1 g = 8192 counts; 200 Hz data-ready on INT;
+    // DRDY seen and the field's chip z (-45 uT at 1090 LSB/Ga) about -490.
+    const e2e::Line* last = nullptr;
+    for (const e2e::Line& l : run.lines)
+        if (l.text.rfind("ax:", 0) == 0) last = &l;
+    ASSERT_TRUE(last) << e2e::dump(run);
+    EXPECT_NEAR(e2e::field(last->text, "az"), 8192, 60) << last->text;
+    EXPECT_NEAR(e2e::field(last->text, "mz"), -490, 15) << last->text;
+    const double ints = e2e::field(last->text, "ints");
+    EXPECT_NEAR(ints / (last->t_s - 0.11), 200.0, 15.0) << last->text;
+}
+
+TEST(Harness, FaultsReachTheBus) {
+    REQUIRE_PROBE(dir);
+    const e2e::SimRun whoami = e2e::run_sim(dir + "/probe.elf", "rest", 0.3, "--fault mpu:whoami=0x70");
+    EXPECT_TRUE(find_text(whoami.lines, "# whoami 0x70")) << e2e::dump(whoami);
+    const e2e::SimRun absent = e2e::run_sim(dir + "/probe.elf", "rest", 0.3, "--fault mag:absent --fault mpu:absent");
+    EXPECT_TRUE(find_text(absent.lines, "# magid 0")) << e2e::dump(absent);
+    EXPECT_TRUE(find_text(absent.lines, "# whoami 0x0")) << e2e::dump(absent);
+    const e2e::SimRun sda = e2e::run_sim(dir + "/probe.elf", "rest", 0.3, "--fault i2c:sda-low@0-1");
+    EXPECT_TRUE(find_text(sda.lines, "# magid 0")) << e2e::dump(sda);
+    const e2e::SimRun sat = e2e::run_sim(dir + "/probe.elf", "rest", 0.35, "--fault gyro:saturate@0.2-1");
+    // Every gyro axis at an end of the int16 range (the sign of the true rate), from 0.2 s.
+    const e2e::Line* line = nullptr;
+    for (const e2e::Line& l : sat.lines) {
+        if (l.text.rfind("ax:", 0) != 0) continue;
+        bool all_ends = true;
+        for (const char* axis : {"gx", "gy", "gz"}) {
+            const double v = e2e::field(l.text, axis);
+            all_ends = all_ends && (v == 32767 || v == -32768);
+        }
+        if (all_ends) {
+            line = &l;
+            break;
+        }
+    }
+    ASSERT_TRUE(line) << e2e::dump(sat);
+    EXPECT_GE(line->t_s, 0.2);
+}
+
+TEST(Harness, BaroChipSelectLowWhileMpuSelectedFailsTheRun) {
+    REQUIRE_PROBE(dir);
+    const e2e::SimRun bad = e2e::run_sim(dir + "/probe_violation.elf", "rest", 0.8);
+    EXPECT_EQ(bad.result.exit_code, 3) << e2e::dump(bad);
+    EXPECT_NE(bad.result.err.find("bus violation"), std::string::npos) << bad.result.err;
+    const e2e::SimRun good = e2e::run_sim(dir + "/probe.elf", "rest", 0.8);
+    EXPECT_EQ(good.result.exit_code, 0) << e2e::dump(good);
+    EXPECT_EQ(good.result.err.find("bus violation"), std::string::npos) << good.result.err;
+}
+
+TEST(Harness, BusTransfersTakeTheBoardsTime) {
+    REQUIRE_PROBE(dir);
+    const std::string profile = e2e::work_dir() + "/probe_profile." + std::to_string(getpid()) + ".csv";
+    const e2e::SimRun run = e2e::run_sim(dir + "/probe.elf", "rest", 1.0, "--profile " + profile);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    const std::string csv = e2e::read_text(profile);
+    std::istringstream in(csv);
+    std::string row;
+    double spi_avg = 0, twi_avg = 0;
+    while (std::getline(in, row)) {
+        unsigned id = 0;
+        unsigned long long count = 0, avg = 0;
+        if (std::sscanf(row.c_str(), "%u,%llu,%llu", &id, &count, &avg) == 3) {
+            if (id == 4) spi_avg = (double)avg;
+            if (id == 5) twi_avg = (double)avg;
+        }
+    }
+    // 15 SPI bytes at 8 MHz: ~735 cycles on the board (APM25.md); simavr 1.6 alone: 24000.
+    EXPECT_GT(spi_avg, 600);
+    EXPECT_LT(spi_avg, 1000);
+    // Pointer write + 6-byte read at 400 kHz: ~11 bytes x 9 bits x 40 cycles plus Wire's work.
+    EXPECT_GT(twi_avg, 3500);
+    EXPECT_LT(twi_avg, 7000);
+    EXPECT_NE(csv.find("\nrun,1,"), std::string::npos) << csv;
+    unlink(profile.c_str());
+}
+
+TEST(Harness, InputReachesTheUartAfterTheFirstDataLine) {
+    REQUIRE_PROBE(dir);
+    const std::string input = e2e::input_file("probe_input", "hi\n");
+    const e2e::SimRun run = e2e::run_sim(dir + "/probe.elf", "rest", 0.5, "--input " + input);
+    unlink(input.c_str());
+    // The probe echoes what it reads (maybe a few characters at a time).
+    std::string echoed;
+    for (const e2e::Line& l : run.lines) {
+        size_t pos = 0;
+        while ((pos = l.text.find("# echo ", pos)) != std::string::npos) {
+            pos += 7;
+            while (pos < l.text.size() && l.text[pos] != '#') echoed += l.text[pos++];
+        }
+    }
+    EXPECT_NE(echoed.find('h'), std::string::npos) << e2e::dump(run);
+    EXPECT_NE(echoed.find('i'), std::string::npos) << e2e::dump(run);
+}
+
+}  // namespace

@@ -1,0 +1,82 @@
+// The host replay tool and the scorer on scenarios and (when ../shared/data is present) a
+// real recording, and the simavr run scored with the same metric.
+#include "e2e_support.h"
+
+namespace {
+
+// total_rmse_deg=... in build/score's one-line output; NaN if absent.
+double score_field(const std::string& out, const std::string& key) {
+    const size_t pos = out.find(key + "=");
+    if (pos == std::string::npos) return NAN;
+    return std::atof(out.c_str() + pos + key.size() + 1);
+}
+
+TEST(Replay, LevelRestWithinHalfADegree) {
+    E2E_REQUIRE_TOOLS("replay", "scenario");
+    const std::string csv = e2e::scenario_csv("rest", 60);
+    const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::istringstream in(r.out);
+    std::string row;
+    ASSERT_TRUE(std::getline(in, row));
+    EXPECT_EQ(row.rfind("t,roll,pitch,yaw", 0), 0u) << row;
+    size_t rows = 0;
+    while (std::getline(in, row)) {
+        double t, roll, pitch, yaw;
+        ASSERT_EQ(std::sscanf(row.c_str(), "%lf,%lf,%lf,%lf", &t, &roll, &pitch, &yaw), 4) << row;
+        ASSERT_TRUE(std::isfinite(roll) && std::isfinite(pitch) && std::isfinite(yaw)) << row;
+        if (t < 2.0) continue;
+        ++rows;
+        ASSERT_LT(std::fabs(roll), 0.5) << row;
+        ASSERT_LT(std::fabs(pitch), 0.5) << row;
+    }
+    EXPECT_GT(rows, 2500u);
+}
+
+TEST(Replay, TiltTourScoresWithinBounds) {
+    E2E_REQUIRE_TOOLS("replay", "scenario", "score");
+    const std::string csv = e2e::scenario_csv("tilt_tour", 40);
+    const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " | " +
+                                                  e2e::tool("score") + " --trajectory " + csv + " --estimate -");
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const double total = score_field(r.out, "total_rmse_deg");
+    ASSERT_TRUE(std::isfinite(total)) << r.out;
+    EXPECT_LT(total, 3.0) << r.out;
+}
+
+TEST(Replay, RealRecordingScoresWithinBounds) {
+    E2E_REQUIRE_TOOLS("replay", "score");
+    const std::string recording = std::string(SHARED_DIR) + "/data/broad/01_undisturbed_slow_rotation_A.csv.gz";
+    if (!e2e::file_exists(recording)) GTEST_SKIP() << recording << " is absent (a clone without ../shared)";
+    const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + recording + " | " +
+                                                  e2e::tool("score") + " --trajectory " + recording +
+                                                  " --estimate -");
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const double total = score_field(r.out, "total_rmse_deg");
+    ASSERT_TRUE(std::isfinite(total)) << r.out;
+    EXPECT_LT(total, 10.0) << r.out;
+}
+
+// The firmware in simavr on tilt_tour, its serial angle lines scored like replay's output.
+TEST(Simavr, TiltTourScoresWithinBounds) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario", "score");
+    const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "tilt_tour", 40.0);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    EXPECT_FALSE(e2e::has_non_finite(run.lines));
+    const std::string estimate = e2e::work_dir() + "/tilt_tour_sim." + std::to_string(getpid()) + ".csv";
+    {
+        std::ofstream out(estimate);
+        out << "t,roll,pitch,yaw\n";
+        for (const e2e::Line& l : e2e::angle_lines(run.lines))
+            out << l.t_s << "," << l.roll << "," << l.pitch << "," << l.yaw << "\n";
+    }
+    const e2e::CommandResult r = e2e::run_command(e2e::tool("score") + " --trajectory " +
+                                                  e2e::scenario_csv("tilt_tour", 40.0) + " --estimate " + estimate);
+    unlink(estimate.c_str());
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const double total = score_field(r.out, "total_rmse_deg");
+    ASSERT_TRUE(std::isfinite(total)) << r.out;
+    EXPECT_LT(total, 3.0) << r.out;
+}
+
+}  // namespace
