@@ -7,13 +7,14 @@ using linalg::Vector3f;
 
 namespace {
 constexpr float kGravity_m_s2 = 9.80665f;
-constexpr float kInvGravity_s2_m = 1.0f / kGravity_m_s2;
 // Beyond any MEMS gyro's range (the MPU6000 stops at 2000 deg/s = 35 rad/s): such a
 // sample is garbage, not a rotation, and is not integrated.
 constexpr float kMaxCredibleRate_rad_s = 50.0f;
 // A mag correction stands for the time since the previous sample, but never more
 // than this (after an outage the first sample must not make a jump).
 constexpr float kMaxMagInterval_s = 0.1f;
+// The accel low-pass during start-up: a 0.25 s time constant at 200 Hz.
+constexpr float kStartupAccelAlpha = 0.02f;
 }  // namespace
 
 // Gains tuned on the BROAD recordings through the replay tool (see README,
@@ -25,12 +26,14 @@ const DcmSettings kDefaultDcmSettings = {
     1.0f,                           // kp_yaw_1_s
     0.1f,                           // ki_yaw_1_s2
     5.0f,                           // kp_startup_1_s
-    1.0f,                           // startup_s
-    0.15f,                          // accel_reject_g
+    3.0f,                           // startup_s
+    16.0f,                          // accel_max_g
+    3.0f,                           // accel_lowpass_s
     20.0f * linalg::kRadPerDeg,     // integrator_hold_rate_rad_s (ArduPilot's 20 deg/s)
     10.0f * linalg::kRadPerDeg,     // bias_limit_rad_s
-    30.0f * linalg::kRadPerDeg,     // mag_reject_rad
-    10.0f,                          // mag_recover_s
+    0.2f,                           // mag_norm_tolerance
+    0.1f,                           // mag_dip_tolerance
+    20.0f,                          // mag_recover_s
 };
 
 Dcm::Dcm(const DcmSettings& settings)
@@ -70,9 +73,13 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
         last_mag_field_ = mag_field;
         mag_ref_norm_ = mag_field.length();
         mag_ref_down_ = mag_field.dot(down) / mag_ref_norm_;
+        mag_candidate_norm_ = mag_ref_norm_;
+        mag_candidate_down_ = mag_ref_down_;
     }
     const Vector3f east = down.cross(north);
     r_ = Matrix3f(north, east, down);
+    accel_lp_ef_ = Vector3f(0.0f, 0.0f, -kGravity_m_s2);
+    accel_alpha_ = settings_.step_s / (settings_.accel_lowpass_s + settings_.step_s);
     omega_yaw_rad_s_ = Vector3f();
     mag_disturbed_s_ = 0.0f;
     steps_ = 0;
@@ -80,14 +87,16 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     return true;
 }
 
-float Dcm::proportional_gain(float steady_gain_1_s) const {
-    // Start-up: a higher gain that ramps down linearly to the steady one, so a
-    // poor first sample is forgotten within startup_s (Fusion does the same).
+// Start-up: a faster response that ramps down linearly to the steady one over
+// startup_s, so a poor first sample is forgotten quickly (Fusion does the same).
+float Dcm::startup_boost(float steady, float boosted) const {
     const float startup_steps = settings_.startup_s / settings_.step_s;
-    if ((float)steps_ >= startup_steps) return steady_gain_1_s;
-    const float left = 1.0f - (float)steps_ / startup_steps;
-    const float boosted = settings_.kp_startup_1_s > steady_gain_1_s ? settings_.kp_startup_1_s : steady_gain_1_s;
-    return steady_gain_1_s + (boosted - steady_gain_1_s) * left;
+    if ((float)steps_ >= startup_steps || boosted <= steady) return steady;
+    return steady + (boosted - steady) * (1.0f - (float)steps_ / startup_steps);
+}
+
+float Dcm::proportional_gain(float steady_gain_1_s) const {
+    return startup_boost(steady_gain_1_s, settings_.kp_startup_1_s);
 }
 
 void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
@@ -103,43 +112,63 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
                          gyro_rad_s.length_squared() < kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s;
     if (!gyro_ok) status_ |= kStatusGyroRejected;
     const float hold2 = settings_.integrator_hold_rate_rad_s * settings_.integrator_hold_rate_rad_s;
-    const bool hold_integrator = !gyro_ok || gyro_rad_s.length_squared() > hold2;
+    // The bias is not learned from start-up transients nor while rotating fast
+    // (where gyro scale errors look like bias: ArduPilot's rule).
+    const bool starting = (float)steps_ < settings_.startup_s / dt;
+    const bool hold_integrator = !gyro_ok || starting || gyro_rad_s.length_squared() > hold2;
     if (hold_integrator) status_ |= kStatusBiasHeld;
     rotating_fast_ = hold_integrator;
 
     // Roll/pitch error (Premerlani & Bizard eq. 27): measured down x estimated down.
-    // |a|^2 against g^2 gives the weight without a square root: gravity counts fully
-    // at 1 g and not at all accel_reject_g away from it (linear accelerations and
-    // vibration make |a| differ from 1 g, and then a is not gravity).
+    // The measurement is the specific force low-passed in the (estimated) earth
+    // frame, as VQF does: there a linear acceleration averages out over the filter's
+    // time, since velocity stays bounded, while in body axes it does not. Samples
+    // are not weighted by how close |a| is to 1 g: dropping the large ones biases
+    // that average (BROAD's fast translation, up to 10 g, shows it: 16 deg RMSE with
+    // weighting, 0.7 without). Only a sample beyond any accelerometer's range is
+    // garbage and skipped.
     Vector3f correction_rad_s;
-    if (accel_m_s2.is_finite()) {
-        const float ratio2 = accel_m_s2.length_squared() * (kInvGravity_s2_m * kInvGravity_s2_m);
-        const float deviation = 0.5f * (ratio2 > 1.0f ? ratio2 - 1.0f : 1.0f - ratio2);  // ~ | |a|/g - 1 |
-        const float weight = 1.0f - deviation / settings_.accel_reject_g;
-        if (weight > 0.0f) {
-            last_accel_m_s2_ = accel_m_s2;
-            // -a/g is the measured down direction (unit length to within the weight's
-            // tolerance, so no normalisation is needed).
-            const Vector3f error = (accel_m_s2 * -kInvGravity_s2_m).cross(r_.c);
-            correction_rad_s = error * (proportional_gain(settings_.kp_rp_1_s) * weight);
-            if (!hold_integrator) bias_rad_s_ -= error * (settings_.ki_rp_1_s2 * weight * dt);
-        } else {
-            status_ |= kStatusAccelIgnored;
-        }
+    const float accel_max_m_s2 = settings_.accel_max_g * kGravity_m_s2;
+    if (accel_m_s2.is_finite() && accel_m_s2.length_squared() < accel_max_m_s2 * accel_max_m_s2) {
+        last_accel_m_s2_ = accel_m_s2;
+        accel_lp_ef_ += (r_ * accel_m_s2 - accel_lp_ef_) * startup_boost(accel_alpha_, kStartupAccelAlpha);
     } else {
         status_ |= kStatusAccelIgnored;
+    }
+    {
+        // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
+        const float lp2 = accel_lp_ef_.length_squared();
+        if (lp2 > 0.25f * kGravity_m_s2 * kGravity_m_s2) {
+            const float inv = 1.0f / sqrtf(lp2);
+            const Vector3f error_ef(-accel_lp_ef_.y * inv, accel_lp_ef_.x * inv, 0.0f);
+            const Vector3f error = r_.mul_transpose(error_ef);
+            const float kp = proportional_gain(settings_.kp_rp_1_s);
+            correction_rad_s = error * kp;
+            if (!hold_integrator) bias_rad_s_ -= error * (settings_.ki_rp_1_s2 * dt);
+            // The correction turns the estimated earth frame by kp dt error_ef: the
+            // filter state, kept in that frame, turns with it.
+            accel_lp_ef_ += (error_ef * (kp * dt)).cross(accel_lp_ef_);
+        }
     }
     // Yaw correction from the last magnetometer sample, applied once.
     correction_rad_s += omega_yaw_rad_s_;
     omega_yaw_rad_s_ = Vector3f();
     clamp_bias();
 
-    // Gyro integration (eq. 17): R <- R (I + [w x] dt); row_i [w x] = row_i x w.
+    // Gyro integration (eq. 17, to second order): R <- R exp([theta x]), theta = w dt,
+    // row_i [theta x] = row_i x theta. The paper's first-order R (I + [theta x]) is not
+    // a rotation: renormalising it shrinks each row's component along the axis by
+    // theta^2/2 a step, which at 640 deg/s tilts the matrix by 50 deg in 10 s at
+    // 200 Hz. The second-order term (row x theta) x theta / 2 and the first term's
+    // (1 - |theta|^2/6) make the step exact to O(theta^4). Row c need not be
+    // integrated: renormalisation rebuilds it as a x b.
     if (gyro_ok) {
-        const Vector3f omega_dt = (gyro_rad_s - bias_rad_s_ + correction_rad_s) * dt;
-        r_.a += r_.a.cross(omega_dt);
-        r_.b += r_.b.cross(omega_dt);
-        r_.c += r_.c.cross(omega_dt);
+        const Vector3f theta = (gyro_rad_s - bias_rad_s_ + correction_rad_s) * dt;
+        const float first_order = 1.0f - (1.0f / 6.0f) * theta.length_squared();
+        const Vector3f da = r_.a.cross(theta);
+        const Vector3f db = r_.b.cross(theta);
+        r_.a += da * first_order + da.cross(theta) * 0.5f;
+        r_.b += db * first_order + db.cross(theta) * 0.5f;
     }
     // One pass leaves ~(X.Y)^2: a second one, needed only at high rates (a step of
     // more than ~3 deg), keeps the matrix orthonormal to 1e-5 up to the gyro's range.
@@ -175,24 +204,25 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     const float sin_error = field_ef.y * inv_horizontal;
     const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
 
-    // Disturbance rejection: a field whose strength or dip differs from the one
-    // learned, or that disagrees with the gyro-propagated heading, is not the
-    // earth's. A disagreement that lasts mag_recover_s is accepted (the heading
-    // was wrong, not the field), as Fusion's recovery trigger does.
+    // Disturbance rejection (as VQF does): a field whose strength or dip differs
+    // from the learned earth field is a magnet or iron nearby, not north, and is not
+    // used; the heading then runs on the gyro. A different field that stays the same
+    // for mag_recover_s is a new environment (the board was moved): it becomes the
+    // reference, and its heading is taken at once. A magnet fixed to a rotating
+    // board never looks the same twice, so it never gets in.
     const float norm = norm2 * inv_norm;
     const float down_component = field_ef.z * inv_norm;
-    const bool odd_field = norm > 1.25f * mag_ref_norm_ || norm < 0.8f * mag_ref_norm_ ||
-                           (down_component - mag_ref_down_) > 0.1f || (mag_ref_down_ - down_component) > 0.1f;
-    const float reject_sin = sinf(settings_.mag_reject_rad);
-    const bool disagrees = heading_error > reject_sin || heading_error < -reject_sin;
-    if ((odd_field || disagrees) && mag_disturbed_s_ < settings_.mag_recover_s) {
-        mag_disturbed_s_ += interval_s;
-        return;
-    }
-    if (mag_disturbed_s_ >= settings_.mag_recover_s) {
-        // Recovery: the field has been steady in its new form for mag_recover_s.
-        // Learn it and take its heading at once (R <- Rz(-error) R, the rotation
-        // that puts the field's horizontal part on north; no trigonometry needed).
+    if (!field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
+        if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
+            mag_disturbed_s_ += interval_s;
+        } else {
+            mag_disturbed_s_ = 0.0f;
+        }
+        mag_candidate_norm_ += 0.2f * (norm - mag_candidate_norm_);
+        mag_candidate_down_ += 0.2f * (down_component - mag_candidate_down_);
+        if (mag_disturbed_s_ < settings_.mag_recover_s) return;
+        // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
+        // (the rotation that puts the field's horizontal part on north).
         mag_ref_norm_ = norm;
         mag_ref_down_ = down_component;
         mag_disturbed_s_ = 0.0f;
@@ -205,8 +235,10 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         return;
     }
     mag_disturbed_s_ = 0.0f;
+    mag_candidate_norm_ = norm;
+    mag_candidate_down_ = down_component;
     status_ &= (uint8_t)~kStatusMagIgnored;
-    // Track slow changes of the local field (temperature, location) 1 %/sample.
+    // Track slow changes of the local field (temperature, location): ~2 s at 75 Hz.
     mag_ref_norm_ += 0.01f * (norm - mag_ref_norm_);
     mag_ref_down_ += 0.01f * (down_component - mag_ref_down_);
 
@@ -217,6 +249,16 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     omega_yaw_rad_s_ = error * (proportional_gain(settings_.kp_yaw_1_s) * interval / settings_.step_s);
     if (!rotating_fast_) bias_rad_s_ -= error * (settings_.ki_yaw_1_s2 * interval);
     clamp_bias();
+}
+
+bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,
+                        float tolerance_scale) const {
+    const float norm_tolerance = settings_.mag_norm_tolerance * tolerance_scale * ref_norm;
+    const float dip_tolerance = settings_.mag_dip_tolerance * tolerance_scale;
+    const float norm_error = norm - ref_norm;
+    const float dip_error = down_component - ref_down;
+    return norm_error < norm_tolerance && norm_error > -norm_tolerance && dip_error < dip_tolerance &&
+           dip_error > -dip_tolerance;
 }
 
 void Dcm::clamp_bias() {

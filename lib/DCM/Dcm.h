@@ -27,13 +27,15 @@ struct DcmSettings {
     float ki_rp_1_s2;                // roll/pitch integral gain (gyro-bias estimate), 1/s^2
     float kp_yaw_1_s;                // yaw proportional gain, 1/s
     float ki_yaw_1_s2;               // yaw integral gain, 1/s^2
-    float kp_startup_1_s;            // roll/pitch/yaw P gain during the start-up ramp, 1/s
-    float startup_s;                 // length of the start-up ramp, s
-    float accel_reject_g;            // |1 - |a|/g| at which gravity's weight reaches 0, g
+    float kp_startup_1_s;            // roll/pitch/yaw P gain at start, ramping down to the steady ones, 1/s
+    float startup_s;                 // length of the start-up ramp (also speeds up the accel low-pass), s
+    float accel_max_g;               // beyond any accelerometer's range: such a sample is garbage, g
+    float accel_lowpass_s;           // time constant of the earth-frame accel low-pass, s
     float integrator_hold_rate_rad_s;// |gyro| above which the bias integrator is held, rad/s
     float bias_limit_rad_s;          // bound on each axis of the gyro-bias estimate, rad/s
-    float mag_reject_rad;            // heading error beyond which a mag sample counts as disturbed, rad
-    float mag_recover_s;             // a heading error that persists this long is accepted, s
+    float mag_norm_tolerance;        // |field| may differ from the learned one by this fraction
+    float mag_dip_tolerance;         // field.down/|field| may differ from the learned one by this
+    float mag_recover_s;             // a different field steady this long becomes the reference, s
 };
 
 extern const DcmSettings kDefaultDcmSettings;
@@ -85,7 +87,10 @@ private:
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
     void recover();
     void clamp_bias();
+    bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
+                       float tolerance_scale) const;
     float proportional_gain(float steady_gain_1_s) const;
+    float startup_boost(float steady, float boosted) const;
 
     DcmSettings settings_;
     linalg::Matrix3f r_;
@@ -93,8 +98,12 @@ private:
     linalg::Vector3f omega_yaw_rad_s_;   // proportional correction from the field, held between samples
     linalg::Vector3f last_accel_m_s2_;   // for a rebuild if the matrix degenerates
     linalg::Vector3f last_mag_field_;
+    linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
+    float accel_alpha_ = 0.0f;
     float mag_ref_norm_ = 0.0f;          // learned field strength
     float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
+    float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
+    float mag_candidate_down_ = 0.0f;
     float mag_disturbed_s_;              // how long the field has been rejected
     uint32_t steps_;                     // since init
     uint16_t steps_since_mag_;
