@@ -12,9 +12,12 @@
 
 #ifdef __AVR__
 #include <avr/pgmspace.h>
-#define TXT(s) (::text::Flash{PSTR(s)})
+// Through a function, not Flash{PSTR(s)}: avr-gcc 5.4's LTO crashes (internal compiler
+// error in lto_output_varpool_node) on PSTR's statement expression inside a braced
+// initialiser.
+#define TXT(s) (::text::flash(PSTR(s)))
 #else
-#define TXT(s) (::text::Flash{s})
+#define TXT(s) (::text::flash(s))
 #endif
 
 namespace text {
@@ -23,6 +26,7 @@ namespace text {
 struct Flash {
     const char* p;
 };
+inline Flash flash(const char* p) { return Flash{p}; }
 
 struct Sink {
     void* ctx;

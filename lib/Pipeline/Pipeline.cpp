@@ -138,6 +138,10 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
     if (gyro_cal_active_) step_calibration(s);
     if (phase_ != Phase::Running) return;
+    if (reinit_pending_) {
+        reinit_pending_ = false;
+        start_estimator(s.accel_m_s2);
+    }
 
     dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s), s.accel_m_s2);
     if (mag_pending_ && mag_present_) dcm_.correct_heading(mag_cal_uT_);
@@ -178,6 +182,12 @@ void AttitudePipeline::start_gyro_calibration() {
     gyro_cal_active_ = true;
     if (phase_ == Phase::Running)
         Writer(log_).str(TXT("# cal gyro: keep the board still for 1 s")).end();
+}
+
+void AttitudePipeline::restart_estimator() {
+    reinit_pending_ = (phase_ == Phase::Running);
+    have_last_ = false;  // the previous sample is too old to judge spikes by
+    spike_run_ = 0;
 }
 
 void AttitudePipeline::start_mag_calibration() {

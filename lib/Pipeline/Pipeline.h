@@ -102,6 +102,9 @@ public:
     bool handle(const console::Command& c);
     void start_gyro_calibration();
     void start_mag_calibration();
+    // After a sensor outage: the next sample restarts the DCM from gravity and the latest
+    // field, keeping the gyro bias (before the first start it just goes on calibrating).
+    void restart_estimator();
 
     Phase phase() const { return phase_; }
     bool gyro_calibrating() const { return gyro_cal_active_; }
@@ -144,6 +147,7 @@ private:
     bool gyro_cal_active_ = false;
     bool mag_cal_active_ = false;
     bool output_due_ = false;
+    bool reinit_pending_ = false;
 };
 
 }  // namespace pipeline
