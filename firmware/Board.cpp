@@ -21,15 +21,15 @@ void set_leds(bool calibrating, bool running, bool fault) {
 }
 
 // ---------------------------------------------------------------------------
-// SPI: mode 0, MSB first; two prebuilt settings (SPISettings computes the divider).
-static const SPISettings kSpiSlow(mpu6000::kConfigClockHz, MSBFIRST, SPI_MODE0);
-static const SPISettings kSpiFast(mpu6000::kReadClockHz, MSBFIRST, SPI_MODE0);
+// SPI: mode 0, MSB first. SPISettings built in place from constants folds to two
+// register values; as global objects they cost a ~1 KB run-time constructor.
 
 void spi_begin() { SPI.begin(); }
 
 static void spi_select(void*, bool on, uint32_t clock_hz) {
     if (on) {
-        SPI.beginTransaction(clock_hz >= mpu6000::kReadClockHz ? kSpiFast : kSpiSlow);
+        if (clock_hz >= mpu6000::kReadClockHz) SPI.beginTransaction(SPISettings(mpu6000::kReadClockHz, MSBFIRST, SPI_MODE0));
+        else SPI.beginTransaction(SPISettings(mpu6000::kConfigClockHz, MSBFIRST, SPI_MODE0));
         PORTB &= (uint8_t)~_BV(PB0);  // pin 53 low; pin 40 (barometer) is never touched
     } else {
         PORTB |= _BV(PB0);
