@@ -1,0 +1,163 @@
+// build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
+//
+//   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log]
+//
+// The same pipeline as the board, minus the AVR: the simulator's register models
+// (sim/models) answer the very drivers the firmware runs (lib/MPU6000, lib/HMC5883)
+// through their bus seams, the bytes are decoded by the same code, and the same
+// AttitudePipeline (lib/Pipeline: gyro calibration at rest, DCM at the fixed 5 ms
+// step, mag folded in when DRDY says so) produces the angles. Time is the models':
+// each step waits for the MPU6000's data-ready, as the firmware's loop does.
+//
+// stdout: CSV `t,roll,pitch,yaw` (s, degrees; yaw = heading 0..360 with the default
+// declination) at the firmware's output rate. --log sends the pipeline's "# " lines
+// (calibration, warnings) to stderr.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "Hmc5883.h"
+#include "Hmc5883Model.h"
+#include "Mpu6000.h"
+#include "Mpu6000Model.h"
+#include "Pipeline.h"
+#include "Trajectory.h"
+
+namespace {
+
+void usage(FILE* out) {
+    fprintf(out,
+            "usage: replay --trajectory FILE.csv[.gz] [--seconds S] [--log]\n"
+            "  Runs the firmware's drivers, calibration and DCM on the host against the\n"
+            "  simulated MPU6000 and HMC5883L, and prints CSV t,roll,pitch,yaw (degrees)\n"
+            "  at the firmware's output rate.\n"
+            "  --seconds S  stop after S simulated seconds (default: the trajectory's length)\n"
+            "  --log        the pipeline's messages (calibration, warnings) on stderr\n");
+}
+
+// Simulated time shared by both sensor models; the drivers' waits move it on.
+struct Board {
+    sim::Mpu6000Model* mpu;
+    sim::Hmc5883Model* mag;
+    double t_s;
+    uint32_t spi_clock_hz;
+
+    void advance(double to_s) {
+        if (to_s < t_s) return;
+        t_s = to_s;
+        mpu->advance_to(t_s);
+        mag->advance_to(t_s);
+    }
+};
+
+void spi_select(void* ctx, bool selected, uint32_t clock_hz) {
+    Board* b = static_cast<Board*>(ctx);
+    b->spi_clock_hz = clock_hz;
+    b->mpu->set_chip_select(selected);
+}
+uint8_t spi_transfer(void* ctx, uint8_t out) {
+    Board* b = static_cast<Board*>(ctx);
+    return b->mpu->transfer(out, (double)b->spi_clock_hz);
+}
+void delay_ms(void* ctx, uint16_t ms) {
+    Board* b = static_cast<Board*>(ctx);
+    b->advance(b->t_s + ms * 1e-3);
+}
+bool i2c_write_reg(void* ctx, uint8_t addr7, uint8_t reg, uint8_t value) {
+    Board* b = static_cast<Board*>(ctx);
+    return addr7 == hmc5883::kAddress7 && b->mag->write_register(reg, value);
+}
+bool i2c_read_regs(void* ctx, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t len) {
+    Board* b = static_cast<Board*>(ctx);
+    return addr7 == hmc5883::kAddress7 && b->mag->read_registers(reg, data, len);
+}
+
+void log_write(void*, const char* data, uint8_t len) { fwrite(data, 1, len, stderr); }
+void log_write_flash(void*, const char* s) { fputs(s, stderr); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string path;
+    double seconds = -1.0;
+    bool log = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--trajectory" && i + 1 < argc) {
+            path = argv[++i];
+        } else if (a == "--seconds" && i + 1 < argc) {
+            char* end = nullptr;
+            seconds = strtod(argv[++i], &end);
+            if (!end || *end || !(seconds > 0.0)) {
+                fprintf(stderr, "replay: --seconds needs a positive number, not '%s'\n", argv[i]);
+                return 1;
+            }
+        } else if (a == "--log") {
+            log = true;
+        } else if (a == "--help" || a == "-h") {
+            usage(stdout);
+            return 0;
+        } else {
+            fprintf(stderr, "replay: unknown argument '%s'\n", a.c_str());
+            usage(stderr);
+            return 1;
+        }
+    }
+    if (path.empty()) {
+        usage(stderr);
+        return 1;
+    }
+    sim::Trajectory trajectory;
+    if (!trajectory.load(path)) {
+        fprintf(stderr, "replay: %s\n", trajectory.error().c_str());
+        return 2;
+    }
+    const double end_s = seconds > 0.0 ? seconds : trajectory.duration_s();
+
+    sim::Mpu6000Model mpu_model(trajectory);
+    sim::Hmc5883Model mag_model(trajectory);
+    Board board{&mpu_model, &mag_model, 0.0, mpu6000::kConfigClockHz};
+    const mpu6000::SpiDevice spi{&board, spi_select, spi_transfer, delay_ms};
+    const hmc5883::I2cBus i2c{&board, i2c_write_reg, i2c_read_regs, delay_ms};
+    const text::Sink log_sink{nullptr, log_write, log_write_flash};
+
+    // Set-up, in the firmware's order (firmware/main.cpp setup()).
+    mpu6000::Mpu6000 mpu(spi);
+    hmc5883::Hmc5883 mag(i2c);
+    pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr);
+    const mpu6000::InitResult mpu_init = mpu.begin();
+    if (mpu_init.status != mpu6000::InitStatus::Ok) {
+        fprintf(stderr, "replay: the MPU6000 model did not come up (status %d)\n", (int)mpu_init.status);
+        return 2;
+    }
+    const bool mag_ok = mag.begin(true).status == hmc5883::InitStatus::Ok;
+    pipe.set_mag_present(mag_ok);
+    if (!mag_ok) fprintf(stderr, "replay: the HMC5883L model did not come up: yaw is gyro-only\n");
+
+    printf("t,roll,pitch,yaw\n");
+    const double kMagReadMin_s = 0.010;  // the firmware's kMagReadMinMs
+    double last_mag_read_s = -1.0;
+    while (board.t_s < end_s) {
+        // Wait for the data-ready line, as the loop does.
+        while (!mpu_model.int_pin_high() && board.t_s < end_s) board.advance(mpu_model.next_event_s());
+        if (board.t_s >= end_s) break;
+        mpu6000::Sample sample;
+        if (mpu.read(sample) != mpu6000::BurstStatus::Ok) {
+            fprintf(stderr, "replay: MPU6000 burst read failed at t=%.3f s\n", board.t_s);
+            return 2;
+        }
+        if (mag_ok && mag_model.drdy_pin_high() && board.t_s - last_mag_read_s >= kMagReadMin_s) {
+            linalg::Vector3f field_uT;
+            if (mag.read(field_uT) == hmc5883::ReadStatus::Ok) pipe.on_mag_sample(field_uT);
+            last_mag_read_s = board.t_s;
+        }
+        pipe.on_imu_sample(sample);
+        if (pipe.output_due()) {
+            const pipeline::Angles a = pipe.angles();
+            printf("%.4f,%.2f,%.2f,%.2f\n", board.t_s, (double)a.roll_deg, (double)a.pitch_deg,
+                   (double)a.heading_deg);
+        }
+    }
+    return 0;
+}
