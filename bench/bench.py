@@ -630,7 +630,7 @@ def main():
     for key, label, limit, unit in CYCLE_TARGETS:
         v = figures[key]
         rows.append([label, "≤ %s%s" % (fmt(limit) if isinstance(limit, int) else fmt(limit, 1), unit),
-                     (fmt(v, 1) if isinstance(v, float) else fmt(v)) if v is not None else "–",
+                     (fmt(v, 1) if unit == "%" else fmt(int(round(v)))) if v is not None else "–",
                      verdict(v, limit)])
     w, wt = worst_of(results[OURS], trials) if trials else (None, None)
     rows.append(["BROAD mean total RMSE (15 trials)", "≤ %.1f°" % TARGET_BROAD_TOTAL,

@@ -14,6 +14,24 @@ def _break_wraps(t, deg, jump=180.0):
     return np.insert(t, cut, np.nan), np.insert(deg, cut, np.nan)
 
 
+def _wrap180(deg):
+    return np.mod(np.asarray(deg, float) + 180.0, 360.0) - 180.0
+
+
+def _heading_display(truth, ours):
+    """Headings for plotting: the truth within +-180 deg of its circular mean (so a board facing
+    north does not flip between 0 and 360), ours drawn beside the truth (truth + the wrapped
+    difference, the same angle modulo 360)."""
+    ok = np.isfinite(truth)
+    centre = 0.0
+    if ok.any():
+        r = np.radians(truth[ok])
+        centre = float(np.degrees(np.arctan2(np.mean(np.sin(r)), np.mean(np.cos(r)))))
+    head_t = centre + _wrap180(truth - centre)
+    head_o = np.where(ok, head_t + _wrap180(ours - truth), centre + _wrap180(ours - centre))
+    return head_t, head_o, centre
+
+
 def truth_at(tr, t):
     """The trajectory's nearest true quaternion and movement flag at times t (as build/score does)."""
     ts = tr["t"]
@@ -44,9 +62,10 @@ def plot_run(png, title, tr, est, others=None, window=None):
 
     fig, ax = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
     fig.suptitle(title)
+    head_t, head_o, centre = _heading_display(yaw_t, np.asarray(est["yaw"], float))
     panels = [("roll (deg)", roll_t, np.asarray(est["roll"], float), 0),
               ("pitch (deg)", pitch_t, np.asarray(est["pitch"], float), 1),
-              ("heading (deg)", np.mod(yaw_t, 360.0), np.mod(np.asarray(est["yaw"], float), 360.0), 2)]
+              ("heading (deg)", head_t, head_o, 2)]
     for label, truth, ours, k in panels:
         wrap = k == 2
         tt, tv = _break_wraps(t, truth) if wrap else (t, truth)
@@ -55,7 +74,7 @@ def plot_run(png, title, tr, est, others=None, window=None):
         ax[k].plot(te, ev, color="tab:red", lw=0.9, label="ours (replay)")
         for name, (to, qo) in (others or {}).items():
             r, p, y = peers.euler_from_quat(qo)
-            v = [r, p, np.mod(y, 360.0)][k]
+            v = [r, p, centre + _wrap180(y - centre)][k]
             tp, vp = _break_wraps(to, v) if wrap else (to, v)
             ax[k].plot(tp, vp, lw=0.6, alpha=0.7, label=name)
         ax[k].set_ylabel(label)
