@@ -11,19 +11,19 @@ constexpr float kGravity_m_s2 = 9.80665f;
 // sample is garbage, not a rotation, and is not integrated.
 constexpr float kMaxCredibleRate_rad_s = 50.0f;
 // A mag correction stands for the time since the previous sample, but never more
-// than this (after an outage the first sample must not make a jump).
-constexpr float kMaxMagInterval_s = 0.1f;
+// than this many steps (after an outage the first sample must not make a jump).
+constexpr uint16_t kMaxMagIntervalSteps = 20;
 // The accel low-pass during start-up: a 0.25 s time constant at 200 Hz.
 constexpr float kStartupAccelAlpha = 0.02f;
 }  // namespace
 
-// Gains tuned on the BROAD recordings through the replay tool (see README,
-// "Performance"): one set for every recording and scenario.
+// Gains tuned on the BROAD recordings through the replay tool (README, "Performance"):
+// one set for every recording and scenario.
 const DcmSettings kDefaultDcmSettings = {
     0.005f,                         // step_s: 200 Hz
     1.0f,                           // kp_rp_1_s
     0.1f,                           // ki_rp_1_s2
-    1.0f,                           // kp_yaw_1_s
+    0.3f,                           // kp_yaw_1_s
     0.1f,                           // ki_yaw_1_s2
     5.0f,                           // kp_startup_1_s
     3.0f,                           // startup_s
@@ -36,20 +36,31 @@ const DcmSettings kDefaultDcmSettings = {
     20.0f,                          // mag_recover_s
 };
 
+// Everything the step needs that depends only on the settings is worked out once
+// here: a float division costs ~480 cycles on the 2560.
 Dcm::Dcm(const DcmSettings& settings)
     : settings_(settings),
-      mag_disturbed_s_(0.0f),
-      steps_(0),
-      steps_since_mag_(0),
-      recoveries_(0),
-      status_(kStatusNoHeading) {}
+      startup_steps_((uint16_t)(settings.startup_s / settings.step_s)),
+      inv_startup_steps_(settings.step_s / settings.startup_s),
+      max_rate2_(kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s),
+      hold_rate2_(settings.integrator_hold_rate_rad_s * settings.integrator_hold_rate_rad_s),
+      accel_max_m_s2_(settings.accel_max_g * kGravity_m_s2),
+      accel_alpha_(settings.step_s / (settings.accel_lowpass_s + settings.step_s)),
+      correction_dt_(settings.step_s * (float)kCorrectionDivider),
+      mag_recover_steps_(settings.mag_recover_s / settings.step_s) {}
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    const float limit = settings_.bias_limit_rad_s;
-    bias_rad_s_ = Vector3f(linalg::constrain(bias.x, -limit, limit),
-                           linalg::constrain(bias.y, -limit, limit),
-                           linalg::constrain(bias.z, -limit, limit));
+    bias_rad_s_ = bias;
+    clamp_bias();
+    offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
+}
+
+// Each axis within the range of any accelerometer (16 g): three comparisons where
+// |a|^2 would cost five float operations. NaN fails them too.
+bool Dcm::accel_plausible(const Vector3f& a) const {
+    const float m = accel_max_m_s2_;
+    return a.x < m && a.x > -m && a.y < m && a.y > -m && a.z < m && a.z > -m;
 }
 
 // TRIAD (Shuster & Oh 1981, as in the thesis): the rows of R are the earth axes
@@ -71,32 +82,22 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     } else {
         status_ &= (uint8_t)~kStatusNoHeading;
         last_mag_field_ = mag_field;
-        mag_ref_norm_ = mag_field.length();
-        mag_ref_down_ = mag_field.dot(down) / mag_ref_norm_;
-        mag_candidate_norm_ = mag_ref_norm_;
-        mag_candidate_down_ = mag_ref_down_;
+        learn_field(mag_field.length(), down.dot(mag_field.normalized()));
     }
-    const Vector3f east = down.cross(north);
-    r_ = Matrix3f(north, east, down);
+    r_ = Matrix3f(north, down.cross(north), down);
     accel_lp_ef_ = Vector3f(0.0f, 0.0f, -kGravity_m_s2);
-    accel_alpha_ = settings_.step_s / (settings_.accel_lowpass_s + settings_.step_s);
-    omega_yaw_rad_s_ = Vector3f();
-    mag_disturbed_s_ = 0.0f;
+    correction_rad_s_ = Vector3f();
+    offset_rad_s_ = bias_rad_s_;
+    yaw_pending_ = false;
+    mag_steady_steps_ = 0;
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
 }
 
-// Start-up: a faster response that ramps down linearly to the steady one over
-// startup_s, so a poor first sample is forgotten quickly (Fusion does the same).
-float Dcm::startup_boost(float steady, float boosted) const {
-    const float startup_steps = settings_.startup_s / settings_.step_s;
-    if ((float)steps_ >= startup_steps || boosted <= steady) return steady;
-    return steady + (boosted - steady) * (1.0f - (float)steps_ / startup_steps);
-}
-
-float Dcm::proportional_gain(float steady_gain_1_s) const {
-    return startup_boost(steady_gain_1_s, settings_.kp_startup_1_s);
+void Dcm::learn_field(float norm, float down_component) {
+    mag_ref_norm_ = mag_candidate_norm_ = norm;
+    mag_ref_down_ = mag_candidate_down_ = down_component;
 }
 
 void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
@@ -107,69 +108,64 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
     const float dt = settings_.step_s;
+    // Start-up: a faster response that ramps down linearly to the steady one over
+    // startup_s, so a poor first sample is forgotten quickly (Fusion does the same);
+    // the bias is not learned from those transients.
+    const bool starting = steps_ < startup_steps_;
+    const float startup_left = starting ? 1.0f - (float)steps_ * inv_startup_steps_ : 0.0f;
 
-    const bool gyro_ok = gyro_rad_s.is_finite() &&
-                         gyro_rad_s.length_squared() < kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s;
+    // NaN and infinity fail these comparisons too: such samples are rejected.
+    const float rate2 = gyro_rad_s.length_squared();
+    const bool gyro_ok = rate2 < max_rate2_;
     if (!gyro_ok) status_ |= kStatusGyroRejected;
-    const float hold2 = settings_.integrator_hold_rate_rad_s * settings_.integrator_hold_rate_rad_s;
-    // The bias is not learned from start-up transients nor while rotating fast
-    // (where gyro scale errors look like bias: ArduPilot's rule).
-    const bool starting = (float)steps_ < settings_.startup_s / dt;
-    const bool hold_integrator = !gyro_ok || starting || gyro_rad_s.length_squared() > hold2;
+    // No bias learning while rotating fast either: gyro scale errors look like bias
+    // there (ArduPilot's rule).
+    rotating_fast_ = !gyro_ok || rate2 > hold_rate2_;
+    const bool hold_integrator = rotating_fast_ || starting;
     if (hold_integrator) status_ |= kStatusBiasHeld;
-    rotating_fast_ = hold_integrator;
 
-    // Roll/pitch error (Premerlani & Bizard eq. 27): measured down x estimated down.
-    // The measurement is the specific force low-passed in the (estimated) earth
-    // frame, as VQF does: there a linear acceleration averages out over the filter's
-    // time, since velocity stays bounded, while in body axes it does not. Samples
-    // are not weighted by how close |a| is to 1 g: dropping the large ones biases
-    // that average (BROAD's fast translation, up to 10 g, shows it: 16 deg RMSE with
+    // Gravity. The specific force is low-passed in the (estimated) earth frame, as
+    // VQF does: there a linear acceleration averages out over the filter's time,
+    // since velocity stays bounded, while in body axes it does not. Samples are
+    // not weighted by how close |a| is to 1 g: dropping the large ones biases that
+    // average (BROAD's fast translation, up to 10 g, shows it: 16 deg RMSE with
     // weighting, 0.7 without). Only a sample beyond any accelerometer's range is
     // garbage and skipped.
-    Vector3f correction_rad_s;
-    const float accel_max_m_s2 = settings_.accel_max_g * kGravity_m_s2;
-    if (accel_m_s2.is_finite() && accel_m_s2.length_squared() < accel_max_m_s2 * accel_max_m_s2) {
+    if (accel_plausible(accel_m_s2)) {
         last_accel_m_s2_ = accel_m_s2;
-        accel_lp_ef_ += (r_ * accel_m_s2 - accel_lp_ef_) * startup_boost(accel_alpha_, kStartupAccelAlpha);
+        const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
+        accel_lp_ef_ += (r_ * accel_m_s2 - accel_lp_ef_) * alpha;
     } else {
         status_ |= kStatusAccelIgnored;
     }
-    {
-        // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
-        const float lp2 = accel_lp_ef_.length_squared();
-        if (lp2 > 0.25f * kGravity_m_s2 * kGravity_m_s2) {
-            const float inv = 1.0f / sqrtf(lp2);
-            const Vector3f error_ef(-accel_lp_ef_.y * inv, accel_lp_ef_.x * inv, 0.0f);
-            const Vector3f error = r_.mul_transpose(error_ef);
-            const float kp = proportional_gain(settings_.kp_rp_1_s);
-            correction_rad_s = error * kp;
-            if (!hold_integrator) bias_rad_s_ -= error * (settings_.ki_rp_1_s2 * dt);
-            // The correction turns the estimated earth frame by kp dt error_ef: the
-            // filter state, kept in that frame, turns with it.
-            accel_lp_ef_ += (error_ef * (kp * dt)).cross(accel_lp_ef_);
-        }
+    // The roll/pitch error (Premerlani & Bizard eq. 27, measured down x estimated
+    // down) moves slowly once low-passed: it is worked out every kCorrectionDivider
+    // steps and applied at every step in between.
+    if (++correction_phase_ >= kCorrectionDivider) {
+        correction_phase_ = 0;
+        correct_tilt(startup_left, hold_integrator);
+        offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
     }
-    // Yaw correction from the last magnetometer sample, applied once.
-    correction_rad_s += omega_yaw_rad_s_;
-    omega_yaw_rad_s_ = Vector3f();
-    clamp_bias();
 
-    // Gyro integration (eq. 17, to second order): R <- R exp([theta x]), theta = w dt,
-    // row_i [theta x] = row_i x theta. The paper's first-order R (I + [theta x]) is not
-    // a rotation: renormalising it shrinks each row's component along the axis by
-    // theta^2/2 a step, which at 640 deg/s tilts the matrix by 50 deg in 10 s at
-    // 200 Hz. The second-order term (row x theta) x theta / 2 and the first term's
-    // (1 - |theta|^2/6) make the step exact to O(theta^4). Row c need not be
-    // integrated: renormalisation rebuilds it as a x b.
+    // Gyro integration (eq. 17, to second order): R <- R exp([theta x]), theta = w dt.
+    // For a row r, r exp([theta x]) = r + (1 + |theta|^2/3)(r x theta)
+    //                                   + theta (r . theta) / 2 + (a length change),
+    // to O(theta^4) once renormalised. The paper's first-order R (I + [theta x]) is
+    // not a rotation: renormalising it shrinks each row's component along the axis
+    // by theta^2/2 a step, which at 640 deg/s tilts the matrix by 50 deg in 10 s at
+    // 200 Hz. The (1 + |theta|^2/3) undoes the atan|theta| that renormalising
+    // r + r x theta turns the angle into. Row c is not integrated: renormalisation
+    // rebuilds it as a x b.
     if (gyro_ok) {
-        const Vector3f theta = (gyro_rad_s - bias_rad_s_ + correction_rad_s) * dt;
-        const float first_order = 1.0f - (1.0f / 6.0f) * theta.length_squared();
-        const Vector3f da = r_.a.cross(theta);
-        const Vector3f db = r_.b.cross(theta);
-        r_.a += da * first_order + da.cross(theta) * 0.5f;
-        r_.b += db * first_order + db.cross(theta) * 0.5f;
+        Vector3f rate_rad_s = gyro_rad_s - offset_rad_s_;
+        if (yaw_pending_) rate_rad_s += omega_yaw_rad_s_;  // a mag correction is applied once
+        const Vector3f theta = rate_rad_s * dt;
+        const Vector3f half_theta = theta * 0.5f;
+        const Vector3f stretched = theta * (1.0f + (1.0f / 3.0f) * theta.length_squared());
+        r_.a += r_.a.cross(stretched) + theta * r_.a.dot(half_theta);
+        r_.b += r_.b.cross(stretched) + theta * r_.b.dot(half_theta);
     }
+    yaw_pending_ = false;
     // One pass leaves ~(X.Y)^2: a second one, needed only at high rates (a step of
     // more than ~3 deg), keeps the matrix orthonormal to 1e-5 up to the gyro's range.
     const float skew_before = r_.a.dot(r_.b);
@@ -179,11 +175,38 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     if (steps_ < 0xFFFFFFFFu) ++steps_;
 }
 
+void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
+    // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
+    const float lp2 = accel_lp_ef_.length_squared();
+    if (!(lp2 > 0.25f * kGravity_m_s2 * kGravity_m_s2)) {
+        correction_rad_s_ = Vector3f();
+        return;
+    }
+    const float inv_lp = 1.0f / sqrtf(lp2);
+    const float error_n = -accel_lp_ef_.y * inv_lp;
+    const float error_e = accel_lp_ef_.x * inv_lp;
+    // In body axes: R^T (error_n, error_e, 0).
+    const Vector3f error = r_.a * error_n + r_.b * error_e;
+    const float kp = settings_.kp_rp_1_s + (settings_.kp_startup_1_s - settings_.kp_rp_1_s) * startup_left;
+    correction_rad_s_ = error * kp;
+    if (!hold_integrator) {
+        bias_rad_s_ -= error * (settings_.ki_rp_1_s2 * correction_dt_);
+        clamp_bias();
+    }
+    // The correction turns the estimated earth frame by kp dt error_ef over the
+    // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
+    // with it ((e_n, e_e, 0) x lp, scaled).
+    const float turn = kp * correction_dt_;
+    const Vector3f lp = accel_lp_ef_;
+    accel_lp_ef_ += Vector3f(error_e * lp.z, -error_n * lp.z, error_n * lp.y - error_e * lp.x) * turn;
+}
+
 void Dcm::correct_heading(const Vector3f& mag_field) {
-    const float interval_s = (float)steps_since_mag_ * settings_.step_s;
+    uint16_t interval_steps = steps_since_mag_;
     steps_since_mag_ = 0;
     status_ |= kStatusMagIgnored;
-    if (!mag_field.is_finite() || mag_field.is_zero()) return;
+    const float norm2 = mag_field.length_squared();
+    if (!(norm2 > 0.0f) || !linalg::is_finite(norm2)) return;
     last_mag_field_ = mag_field;
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
@@ -195,14 +218,12 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
     const Vector3f field_ef = r_ * mag_field;
-    const float norm2 = mag_field.length_squared();
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
-    const float inv_norm = 1.0f / sqrtf(norm2);
+    const float norm = sqrtf(norm2);
+    const float down_component = field_ef.z / norm;
     const float inv_horizontal = 1.0f / sqrtf(horizontal2);
-    // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
     const float sin_error = field_ef.y * inv_horizontal;
-    const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
 
     // Disturbance rejection (as VQF does): a field whose strength or dip differs
     // from the learned earth field is a magnet or iron nearby, not north, and is not
@@ -210,45 +231,50 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // for mag_recover_s is a new environment (the board was moved): it becomes the
     // reference, and its heading is taken at once. A magnet fixed to a rotating
     // board never looks the same twice, so it never gets in.
-    const float norm = norm2 * inv_norm;
-    const float down_component = field_ef.z * inv_norm;
     if (!field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
-            mag_disturbed_s_ += interval_s;
+            mag_steady_steps_ += interval_steps;
         } else {
-            mag_disturbed_s_ = 0.0f;
+            mag_steady_steps_ = 0;
         }
         mag_candidate_norm_ += 0.2f * (norm - mag_candidate_norm_);
         mag_candidate_down_ += 0.2f * (down_component - mag_candidate_down_);
-        if (mag_disturbed_s_ < settings_.mag_recover_s) return;
+        if ((float)mag_steady_steps_ < mag_recover_steps_) return;
         // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
         // (the rotation that puts the field's horizontal part on north).
-        mag_ref_norm_ = norm;
-        mag_ref_down_ = down_component;
-        mag_disturbed_s_ = 0.0f;
+        learn_field(norm, down_component);
+        mag_steady_steps_ = 0;
         const float cos_error = field_ef.x * inv_horizontal;
         const Vector3f north = r_.a * cos_error + r_.b * sin_error;
-        const Vector3f east = r_.b * cos_error - r_.a * sin_error;
+        r_.b = r_.b * cos_error - r_.a * sin_error;
         r_.a = north;
-        r_.b = east;
         status_ &= (uint8_t)~kStatusMagIgnored;
         return;
     }
-    mag_disturbed_s_ = 0.0f;
+    mag_steady_steps_ = 0;
     mag_candidate_norm_ = norm;
     mag_candidate_down_ = down_component;
     status_ &= (uint8_t)~kStatusMagIgnored;
-    // Track slow changes of the local field (temperature, location): ~2 s at 75 Hz.
+    // Track slow changes of the local field (temperature, location): ~1.3 s at 75 Hz.
     mag_ref_norm_ += 0.01f * (norm - mag_ref_norm_);
     mag_ref_down_ += 0.01f * (down_component - mag_ref_down_);
 
+    // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
+    const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
     // The correction is a rotation about earth down by -error: in body axes that
-    // is the third row of R. It stands for the whole interval since the last sample.
-    const float interval = interval_s > kMaxMagInterval_s ? kMaxMagInterval_s : interval_s;
+    // is the third row of R. It stands for the whole interval since the last sample
+    // and is applied in the next step, so its rate is scaled by interval / step.
+    if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
+    const float steps = (float)interval_steps;
     const Vector3f error = r_.c * -heading_error;
-    omega_yaw_rad_s_ = error * (proportional_gain(settings_.kp_yaw_1_s) * interval / settings_.step_s);
-    if (!rotating_fast_) bias_rad_s_ -= error * (settings_.ki_yaw_1_s2 * interval);
-    clamp_bias();
+    const bool starting = steps_ < startup_steps_;
+    omega_yaw_rad_s_ = error * ((starting ? settings_.kp_startup_1_s : settings_.kp_yaw_1_s) * steps);
+    yaw_pending_ = true;
+    if (!rotating_fast_ && !starting) {
+        bias_rad_s_ -= error * (settings_.ki_yaw_1_s2 * settings_.step_s * steps);
+        clamp_bias();
+        offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
+    }
 }
 
 bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,
@@ -268,22 +294,24 @@ void Dcm::clamp_bias() {
     bias_rad_s_.z = linalg::constrain(bias_rad_s_.z, -limit, limit);
 }
 
-// Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, make
-// Z their cross product, then bring each row to unit length. Near unit length the
-// first-order Taylor factor (3 - r.r)/2 replaces a square root and a division.
+// Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, bring
+// each to unit length, and make Z their cross product (unit to within the square
+// of the remaining error, so it needs no scaling of its own).
 bool Dcm::renormalise() {
-    const float error = r_.a.dot(r_.b);
-    const Vector3f x = r_.a - r_.b * (0.5f * error);
-    const Vector3f y = r_.b - r_.a * (0.5f * error);
-    const Vector3f z = x.cross(y);
-    return rescale(x, r_.a) && rescale(y, r_.b) && rescale(z, r_.c);
+    const float half_error = 0.5f * r_.a.dot(r_.b);
+    const Vector3f x = r_.a - r_.b * half_error;
+    const Vector3f y = r_.b - r_.a * half_error;
+    if (!rescale(x, r_.a) || !rescale(y, r_.b)) return false;
+    r_.c = r_.a.cross(r_.b);
+    return true;
 }
 
+// Near unit length the first-order Taylor factor (3 - r.r)/2 replaces a square root
+// and a division; its residual is 3/8 (r.r - 1)^2, below 2e-6 in this window.
 bool Dcm::rescale(const Vector3f& row, Vector3f& out) {
     const float length2 = row.length_squared();
-    // Taylor's residual is 3/8 (r.r - 1)^2: below 2e-6 in this window.
     if (length2 > 0.998f && length2 < 1.002f) {
-        out = row * (0.5f * (3.0f - length2));
+        out = row * (1.5f - 0.5f * length2);
         return true;
     }
     // Far from unit length: the exact factor, unless the matrix is hopeless.

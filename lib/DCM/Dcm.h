@@ -82,34 +82,53 @@ public:
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const { return euler_from_dcm(r_); }
 
+    // The roll/pitch correction is worked out every this many steps (50 Hz at the
+    // default 200 Hz step) and applied at every step: it moves at the 3 s pace of
+    // the accel low-pass, and the work saved is a quarter of the step.
+    static constexpr uint8_t kCorrectionDivider = 4;
+
 private:
+    void correct_tilt(float startup_left, bool hold_integrator);
     bool renormalise();
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
     void recover();
     void clamp_bias();
+    bool accel_plausible(const linalg::Vector3f& a) const;
+    void learn_field(float norm, float down_component);
     bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
                        float tolerance_scale) const;
-    float proportional_gain(float steady_gain_1_s) const;
-    float startup_boost(float steady, float boosted) const;
 
+    // From the settings, once.
     DcmSettings settings_;
+    uint16_t startup_steps_;
+    float inv_startup_steps_;
+    float max_rate2_;                    // (rad/s)^2
+    float hold_rate2_;                   // (rad/s)^2
+    float accel_max_m_s2_;
+    float accel_alpha_;                  // low-pass factor per step
+    float correction_dt_;                // s between two roll/pitch corrections
+    float mag_recover_steps_;
+
     linalg::Matrix3f r_;
     linalg::Vector3f bias_rad_s_;        // integrator: gyro-bias estimate
-    linalg::Vector3f omega_yaw_rad_s_;   // proportional correction from the field, held between samples
+    linalg::Vector3f correction_rad_s_;  // roll/pitch correction, held between corrections
+    linalg::Vector3f offset_rad_s_;      // bias - correction: what the step subtracts from the gyro
+    linalg::Vector3f omega_yaw_rad_s_;   // yaw correction from the last field sample, applied once
+    linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
     linalg::Vector3f last_accel_m_s2_;   // for a rebuild if the matrix degenerates
     linalg::Vector3f last_mag_field_;
-    linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
-    float accel_alpha_ = 0.0f;
     float mag_ref_norm_ = 0.0f;          // learned field strength
     float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
     float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
     float mag_candidate_down_ = 0.0f;
-    float mag_disturbed_s_;              // how long the field has been rejected
-    uint32_t steps_;                     // since init
-    uint16_t steps_since_mag_;
-    uint16_t recoveries_;
-    uint8_t status_;
+    uint32_t steps_ = 0;                 // since init
+    uint16_t steps_since_mag_ = 0;
+    uint16_t mag_steady_steps_ = 0;      // how long a different field has stayed the same
+    uint16_t recoveries_ = 0;
+    uint8_t correction_phase_ = 0;
+    uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
+    bool yaw_pending_ = false;
 };
 
 }  // namespace dcm

@@ -19,4 +19,40 @@ float fast_atan2(float y, float x) {
     return y < 0.0f ? -a : a;
 }
 
+Vector3f Vector3f::operator+(const Vector3f& v) const { return Vector3f(x + v.x, y + v.y, z + v.z); }
+Vector3f Vector3f::operator-(const Vector3f& v) const { return Vector3f(x - v.x, y - v.y, z - v.z); }
+Vector3f Vector3f::operator-() const { return Vector3f(-x, -y, -z); }
+Vector3f Vector3f::operator*(float s) const { return Vector3f(x * s, y * s, z * s); }
+Vector3f& Vector3f::operator+=(const Vector3f& v) {
+    x += v.x;
+    y += v.y;
+    z += v.z;
+    return *this;
+}
+Vector3f& Vector3f::operator-=(const Vector3f& v) {
+    x -= v.x;
+    y -= v.y;
+    z -= v.z;
+    return *this;
+}
+Vector3f& Vector3f::operator*=(float s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+}
+float Vector3f::dot(const Vector3f& v) const { return x * v.x + y * v.y + z * v.z; }
+Vector3f Vector3f::cross(const Vector3f& v) const {
+    return Vector3f(y * v.z - z * v.y, z * v.x - x * v.z, x * v.y - y * v.x);
+}
+bool Vector3f::is_finite() const { return linalg::is_finite(x) && linalg::is_finite(y) && linalg::is_finite(z); }
+Vector3f Vector3f::normalized() const {
+    const float len_sq = length_squared();
+    if (!(len_sq > 1e-30f) || !linalg::is_finite(len_sq)) return Vector3f();
+    return *this * (1.0f / sqrtf(len_sq));
+}
+
+Vector3f Matrix3f::operator*(const Vector3f& v) const { return Vector3f(a.dot(v), b.dot(v), c.dot(v)); }
+Vector3f Matrix3f::mul_transpose(const Vector3f& v) const { return a * v.x + b * v.y + c * v.z; }
+
 }  // namespace linalg

@@ -43,37 +43,33 @@ constexpr float kRadPerDeg = 0.0174532925199433f;
 // octant folded in by symmetry. atan2(0, 0) = 0; NaN in gives 0 out.
 float fast_atan2(float y, float x);
 
+// Operations are out of line (LinAlg.cpp): inlined, each float operation is a
+// call with its own register shuffling, and the estimator grew to 9 KB of flash.
 struct Vector3f {
     float x, y, z;
 
     Vector3f() : x(0.0f), y(0.0f), z(0.0f) {}
     Vector3f(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
 
-    Vector3f operator+(const Vector3f& v) const { return Vector3f(x + v.x, y + v.y, z + v.z); }
-    Vector3f operator-(const Vector3f& v) const { return Vector3f(x - v.x, y - v.y, z - v.z); }
-    Vector3f operator-() const { return Vector3f(-x, -y, -z); }
-    Vector3f operator*(float s) const { return Vector3f(x * s, y * s, z * s); }
-    Vector3f& operator+=(const Vector3f& v) { x += v.x; y += v.y; z += v.z; return *this; }
-    Vector3f& operator-=(const Vector3f& v) { x -= v.x; y -= v.y; z -= v.z; return *this; }
-    Vector3f& operator*=(float s) { x *= s; y *= s; z *= s; return *this; }
+    Vector3f operator+(const Vector3f& v) const;
+    Vector3f operator-(const Vector3f& v) const;
+    Vector3f operator-() const;
+    Vector3f operator*(float s) const;
+    Vector3f& operator+=(const Vector3f& v);
+    Vector3f& operator-=(const Vector3f& v);
+    Vector3f& operator*=(float s);
     bool operator==(const Vector3f& v) const { return x == v.x && y == v.y && z == v.z; }
 
-    float dot(const Vector3f& v) const { return x * v.x + y * v.y + z * v.z; }
-    Vector3f cross(const Vector3f& v) const {
-        return Vector3f(y * v.z - z * v.y, z * v.x - x * v.z, x * v.y - y * v.x);
-    }
+    float dot(const Vector3f& v) const;
+    Vector3f cross(const Vector3f& v) const;
     float length_squared() const { return dot(*this); }
     float length() const { return safe_sqrt(length_squared()); }
-    bool is_finite() const { return linalg::is_finite(x) && linalg::is_finite(y) && linalg::is_finite(z); }
+    bool is_finite() const;
     bool is_zero() const { return x == 0.0f && y == 0.0f && z == 0.0f; }
 
     // Unit vector in the same direction; a zero, tiny or non-finite vector has no
     // direction and gives the zero vector (never NaN). Callers test is_zero().
-    Vector3f normalized() const {
-        const float len_sq = length_squared();
-        if (!(len_sq > 1e-30f) || !linalg::is_finite(len_sq)) return Vector3f();
-        return *this * (1.0f / sqrtf(len_sq));
-    }
+    Vector3f normalized() const;
     // In-place form of normalized(); returns false (and leaves zero) when impossible.
     bool normalize() {
         *this = normalized();
@@ -106,9 +102,9 @@ struct Matrix3f {
     Matrix3f operator*(float s) const { return Matrix3f(a * s, b * s, c * s); }
 
     // M v
-    Vector3f operator*(const Vector3f& v) const { return Vector3f(a.dot(v), b.dot(v), c.dot(v)); }
+    Vector3f operator*(const Vector3f& v) const;
     // M^T v, without forming the transpose (earth -> body for a DCM).
-    Vector3f mul_transpose(const Vector3f& v) const { return a * v.x + b * v.y + c * v.z; }
+    Vector3f mul_transpose(const Vector3f& v) const;
     // M N
     Matrix3f operator*(const Matrix3f& n) const {
         return Matrix3f(n.mul_transpose(a), n.mul_transpose(b), n.mul_transpose(c));
