@@ -1,48 +1,66 @@
 #include "Board.h"
 
+#include <avr/interrupt.h>
+#include <util/atomic.h>
 
 namespace board {
 
 void init_pins() {
     // Outputs written high before they are outputs: no low glitch on a chip select.
-    const uint8_t high_outputs[] = {kPinLedA, kPinLedB, kPinLedC, kPinMpuCs, kPinBaroCs};
-    for (uint8_t pin : high_outputs) {
-        digitalWrite(pin, HIGH);
-        pinMode(pin, OUTPUT);
-    }
-    pinMode(kPinMagDrdy, INPUT);
-    DDRE &= (uint8_t)~_BV(PE6);  // MPU6000 INT
+    PORTA |= _BV(PA5) | _BV(PA4) | _BV(PA3);  // LEDs off
+    DDRA |= _BV(PA5) | _BV(PA4) | _BV(PA3);
+    PORTB |= _BV(PB0);                          // MPU6000 CS (pin 53) first,
+    DDRB |= _BV(PB0);
+    PORTG |= _BV(PG1);                          // then the barometer's (pin 40)
+    DDRG |= _BV(PG1);
+    DDRC &= (uint8_t)~_BV(PC6);                 // HMC5883L DRDY
+    DDRE &= (uint8_t)~_BV(PE6);                 // MPU6000 INT
 }
 
 void set_leds(bool calibrating, bool running, bool fault) {
-    digitalWrite(kPinLedA, calibrating ? LOW : HIGH);
-    digitalWrite(kPinLedB, running ? LOW : HIGH);
-    digitalWrite(kPinLedC, fault ? LOW : HIGH);
+    uint8_t on = 0;  // active low: a set bit here drives the LED's pin low
+    if (calibrating) on |= _BV(PA5);
+    if (running) on |= _BV(PA4);
+    if (fault) on |= _BV(PA3);
+    PORTA = (uint8_t)((PORTA | (_BV(PA5) | _BV(PA4) | _BV(PA3))) & ~on);
 }
 
 // ---------------------------------------------------------------------------
-// SPI: mode 0, MSB first. SPISettings built in place from constants folds to two
-// register values; as global objects they cost a ~1 KB run-time constructor.
-
-void spi_begin() { SPI.begin(); }
+// SPI master, mode 0, MSB first. 8 MHz = fosc/2 (SPI2X) for sensor reads, 1 MHz =
+// fosc/16 for the MPU6000's register writes (datasheet limit).
+void spi_begin() {
+    DDRB |= _BV(PB1) | _BV(PB2);  // SCK, MOSI out; MISO (PB3) in; SS (PB0) already an output
+    SPCR = _BV(SPE) | _BV(MSTR) | _BV(SPR0);
+}
 
 static void spi_select(void*, bool on, uint32_t clock_hz) {
     if (on) {
-        if (clock_hz >= mpu6000::kReadClockHz) SPI.beginTransaction(SPISettings(mpu6000::kReadClockHz, MSBFIRST, SPI_MODE0));
-        else SPI.beginTransaction(SPISettings(mpu6000::kConfigClockHz, MSBFIRST, SPI_MODE0));
+        if (clock_hz >= mpu6000::kReadClockHz) {
+            SPCR = _BV(SPE) | _BV(MSTR);
+            SPSR = _BV(SPI2X);
+        } else {
+            SPCR = _BV(SPE) | _BV(MSTR) | _BV(SPR0);
+            SPSR = 0;
+        }
         PORTB &= (uint8_t)~_BV(PB0);  // pin 53 low; pin 40 (barometer) is never touched
     } else {
         PORTB |= _BV(PB0);
-        SPI.endTransaction();
     }
 }
-static uint8_t spi_transfer(void*, uint8_t out) { return SPI.transfer(out); }
+static uint8_t spi_transfer(void*, uint8_t out) {
+    SPDR = out;
+    while (!(SPSR & _BV(SPIF))) {}  // a master transfer always completes (16..128 cycles)
+    return SPDR;
+}
 static void wait_ms(void*, uint16_t ms) { delay(ms); }
 
-mpu6000::SpiDevice spi_device() { return mpu6000::SpiDevice{nullptr, spi_select, spi_transfer, wait_ms}; }
+const mpu6000::SpiDevice kSpi = {nullptr, spi_select, spi_transfer, wait_ms};
 
 // ---------------------------------------------------------------------------
-// I2C through Wire: every call bounded by Wire's timeout.
+// I2C through Wire, every call bounded by its timeout. (A polled TWI driver of our own
+// would save ~1.5 KB, but simavr 1.6 does not complete a polled SLA+R: tests first.)
+static constexpr uint32_t kI2cTimeoutUs = 3000;  // any Wire call returns within ~3 ms
+
 void wire_begin() {
     Wire.begin();
     Wire.setClock(kI2cClockHz);
@@ -53,27 +71,6 @@ bool i2c_timed_out() {
     if (!Wire.getWireTimeoutFlag()) return false;
     Wire.clearWireTimeoutFlag();
     return true;
-}
-
-void i2c_recover() {
-    Wire.end();
-    pinMode(kPinSda, INPUT_PULLUP);
-    pinMode(kPinScl, INPUT_PULLUP);
-    delayMicroseconds(5);
-    for (uint8_t i = 0; i < 16 && digitalRead(kPinSda) == LOW; ++i) {
-        digitalWrite(kPinScl, LOW);  // open drain: drive low, release to the pull-up
-        pinMode(kPinScl, OUTPUT);
-        delayMicroseconds(5);
-        pinMode(kPinScl, INPUT_PULLUP);
-        delayMicroseconds(5);
-    }
-    // STOP: SDA rises while SCL is high.
-    digitalWrite(kPinSda, LOW);
-    pinMode(kPinSda, OUTPUT);
-    delayMicroseconds(5);
-    pinMode(kPinSda, INPUT_PULLUP);
-    delayMicroseconds(5);
-    wire_begin();
 }
 
 static bool i2c_write_reg(void*, uint8_t addr7, uint8_t reg, uint8_t value) {
@@ -92,50 +89,102 @@ static bool i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint
     return true;
 }
 
-hmc5883::I2cBus i2c_bus() { return hmc5883::I2cBus{nullptr, i2c_write_reg, i2c_read_regs, wait_ms}; }
+const hmc5883::I2cBus kI2c = {nullptr, i2c_write_reg, i2c_read_regs, wait_ms};
 
-// ---------------------------------------------------------------------------
-// Serial output ring: the angle lines and messages queue here and leave as the UART
-// has room, so a status or help reply does not stall the 200 Hz loop.
-static constexpr uint16_t kRingSize = 256;
-static char ring[kRingSize];
-static uint16_t ring_head = 0, ring_tail = 0;  // head: next write, tail: next read
-
-static uint16_t ring_used() { return (uint16_t)((ring_head - ring_tail) & (kRingSize - 1u)); }
-
-void serial_pump() {
-    int room = Serial.availableForWrite();
-    while (room-- > 0 && ring_tail != ring_head) {
-        Serial.write((uint8_t)ring[ring_tail]);
-        ring_tail = (uint16_t)((ring_tail + 1u) & (kRingSize - 1u));
+void i2c_recover() {
+    Wire.end();  // the pins back to the port
+    DDRD &= (uint8_t)~(_BV(PD0) | _BV(PD1));
+    PORTD |= _BV(PD0) | _BV(PD1);
+    delayMicroseconds(5);
+    for (uint8_t i = 0; i < 16 && sda_low(); ++i) {
+        PORTD &= (uint8_t)~_BV(PD0);  // open drain: drive SCL low, release to the pull-up
+        DDRD |= _BV(PD0);
+        delayMicroseconds(5);
+        DDRD &= (uint8_t)~_BV(PD0);
+        PORTD |= _BV(PD0);
+        delayMicroseconds(5);
     }
+    // STOP: SDA rises while SCL is high.
+    PORTD &= (uint8_t)~_BV(PD1);
+    DDRD |= _BV(PD1);
+    delayMicroseconds(5);
+    DDRD &= (uint8_t)~_BV(PD1);
+    PORTD |= _BV(PD1);
+    delayMicroseconds(5);
+    wire_begin();
 }
 
-void serial_drain() {
-    while (ring_tail != ring_head) serial_pump();
+// ---------------------------------------------------------------------------
+// USART0. Indices are uint8_t: a 256-byte ring wraps by itself, and a one-byte index
+// is read and written atomically by the loop and the interrupt.
+static char tx_ring[256];
+static volatile uint8_t tx_head = 0, tx_tail = 0;  // head: next write (loop), tail: next send (ISR)
+static constexpr uint8_t kRxMask = 31;
+static char rx_ring[kRxMask + 1];
+static volatile uint8_t rx_head = 0, rx_tail = 0;
+
+void serial_begin() {
+    UCSR0A = _BV(U2X0);
+    UBRR0 = (uint16_t)((F_CPU / 4u / 115200u - 1u) / 2u);  // 16: 115200 at 16 MHz (-0.8 %)
+    UCSR0C = _BV(UCSZ01) | _BV(UCSZ00);                    // 8N1
+    UCSR0B = _BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0);
+}
+
+ISR(USART0_UDRE_vect) {
+    const uint8_t t = tx_tail;
+    if (t == tx_head) {
+        UCSR0B &= (uint8_t)~_BV(UDRIE0);
+        return;
+    }
+    UDR0 = (uint8_t)tx_ring[t];
+    tx_tail = (uint8_t)(t + 1u);
+}
+
+ISR(USART0_RX_vect) {
+    const uint8_t c = UDR0;
+    const uint8_t h = rx_head, next = (uint8_t)((h + 1u) & kRxMask);
+    if (next != rx_tail) {  // full: the byte is lost (the console says the line is garbage)
+        rx_ring[h] = (char)c;
+        rx_head = next;
+    }
 }
 
 static void ring_put(char c) {
-    while (ring_used() >= kRingSize - 1u) {  // full: wait for the UART (bounded: 87 us a byte)
-        Serial.write((uint8_t)ring[ring_tail]);
-        ring_tail = (uint16_t)((ring_tail + 1u) & (kRingSize - 1u));
+    const uint8_t h = tx_head, next = (uint8_t)(h + 1u);
+    while (next == tx_tail) {  // full: wait for the UART (interrupts on: the ISR drains)
+        UCSR0B |= _BV(UDRIE0);
     }
-    ring[ring_head] = c;
-    ring_head = (uint16_t)((ring_head + 1u) & (kRingSize - 1u));
+    tx_ring[h] = c;
+    __asm__ __volatile__("" ::: "memory");  // the byte is in the ring before the ISR may send it
+    tx_head = next;
+}
+
+static inline void tx_kick() { UCSR0B |= _BV(UDRIE0); }
+
+void serial_drain() {
+    tx_kick();
+    while (tx_tail != tx_head) {}
 }
 
 void serial_write(const char* data, uint8_t len) {
     for (uint8_t i = 0; i < len; ++i) ring_put(data[i]);
+    tx_kick();
+}
+
+int16_t serial_read() {
+    const uint8_t t = rx_tail;
+    if (t == rx_head) return -1;
+    const uint8_t c = (uint8_t)rx_ring[t];
+    rx_tail = (uint8_t)((t + 1u) & kRxMask);
+    return c;
 }
 
 static void sink_write(void*, const char* data, uint8_t len) { serial_write(data, len); }
 static void sink_write_flash(void*, const char* p) {
     for (char c = (char)pgm_read_byte(p); c != '\0'; c = (char)pgm_read_byte(++p)) ring_put(c);
+    tx_kick();
 }
 
-static const text::Sink kSerialSink = {nullptr, sink_write, sink_write_flash};
-
-void serial_begin(uint32_t baud) { Serial.begin(baud); }
-const text::Sink* serial_sink() { return &kSerialSink; }
+const text::Sink kSerialSink = {nullptr, sink_write, sink_write_flash};
 
 }  // namespace board

@@ -1,6 +1,8 @@
-// The APM 2.5 board seen by the firmware: pins, the bus seams filled with the Arduino
-// core's SPI and Wire, the serial output ring, the LEDs and the benchmark markers.
-// The only place (with main.cpp) that includes Arduino.h.
+// The APM 2.5 board seen by the firmware: pins, the bus seams filled with the AVR's
+// own SPI and USART0 at register level (the Arduino SPI and HardwareSerial cost ~1.5 KB
+// of flash and 160 B of RAM for what this board needs) and with Wire for I2C, the LEDs
+// and the benchmark markers. The only place (with main.cpp) that includes Arduino.h;
+// the Arduino core is also used for init(), millis(), micros() and delay().
 #pragma once
 
 #include "ArduinoCore.h"
@@ -11,22 +13,16 @@
 
 namespace board {
 
-// Pins (../shared/APM25.md).
-constexpr uint8_t kPinMpuCs = 53;    // PB0, also the AVR's SS: an output keeps SPI master
-constexpr uint8_t kPinBaroCs = 40;   // PG1, MS5611: high forever
-constexpr uint8_t kPinSda = 20;      // PD1
-constexpr uint8_t kPinScl = 21;      // PD0
-constexpr uint8_t kPinMagDrdy = 31;  // PC6, HMC5883L DRDY (no interrupt: polled)
-constexpr uint8_t kPinLedA = 27;     // PA5, active low: calibrating
-constexpr uint8_t kPinLedB = 26;     // PA4, active low: running
-constexpr uint8_t kPinLedC = 25;     // PA3, active low: sensor fault
+// Pins (../shared/APM25.md): MPU6000 CS = pin 53 = PB0 (also the AVR's SS: an output
+// keeps SPI master), barometer CS = pin 40 = PG1 (high forever), SDA/SCL = pins 20/21 =
+// PD1/PD0, HMC5883L DRDY = pin 31 = PC6 (no interrupt: polled), MPU6000 INT = PE6,
+// LEDs A/B/C = pins 27/26/25 = PA5/PA4/PA3, active low (calibrating / running / fault).
 constexpr uint32_t kI2cClockHz = 400000;
-constexpr uint32_t kI2cTimeoutUs = 3000;  // any Wire call returns within ~3 ms
 
 // Cycle markers read by the simulator's benchmark: a section id written to GPIOR0 when
 // it starts and to GPIOR1 when it ends (one OUT instruction each).
 enum Section : uint8_t {
-    kSecEstimator = 1,  // Dcm::update (+ correct_heading when a field sample came in)
+    kSecEstimator = 1,  // the pipeline's step: guard, calibration, Dcm::update (+ heading)
     kSecEuler = 2,
     kSecFormat = 3,     // one output line, not the UART send
     kSecMpuRead = 4,
@@ -36,29 +32,32 @@ enum Section : uint8_t {
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }
 
-// MPU6000 INT (data ready) on PE6, not an Arduino pin: read the port directly.
 inline bool mpu_int_high() { return (PINE & _BV(PE6)) != 0; }
 inline bool mag_drdy_high() { return (PINC & _BV(PC6)) != 0; }
+inline bool sda_low() { return (PIND & _BV(PD1)) == 0; }
 
-void init_pins();           // LEDs off, every SPI chip select high (53 then 40), DRDY input
+void init_pins();           // LEDs off, every SPI chip select high (53 then 40), inputs
 void set_leds(bool calibrating, bool running, bool fault);
-void spi_begin();           // after init_pins
-void wire_begin();          // Wire at 400 kHz with the timeout
+void spi_begin();           // after init_pins: SPI master, mode 0
+void wire_begin();          // Wire at 400 kHz with a 3 ms timeout
 // Frees the I2C bus when a slave holds SDA low: up to 16 SCL pulses until SDA is
-// released (>= 9 clocks finish any byte), then a STOP, then Wire again.
+// released (>= 9 clocks finish any byte), then a STOP, then the TWI again.
 void i2c_recover();
 // True (and clears it) if a Wire call timed out since the last call.
 bool i2c_timed_out();
 
-mpu6000::SpiDevice spi_device();
-hmc5883::I2cBus i2c_bus();
+extern const mpu6000::SpiDevice kSpi;
+extern const hmc5883::I2cBus kI2c;
 
-// Serial output through a ring drained without blocking (pump() each loop); a full
-// ring blocks until the UART makes room, so text is never lost.
-void serial_begin(uint32_t baud);
-const text::Sink* serial_sink();
-void serial_pump();
+// Serial: USART0 at 115200 (U2X, as the Arduino core sets it). Output goes through a
+// 256-byte ring drained by the data-register-empty interrupt; a full ring waits for
+// the UART (87 us a byte), so text is never lost. Input: a 32-byte ring filled by the
+// receive interrupt.
+void serial_begin();
+extern const text::Sink kSerialSink;
 void serial_drain();  // blocks until the ring is empty (set-up only)
 void serial_write(const char* data, uint8_t len);
+// The next received byte, or -1.
+int16_t serial_read();
 
 }  // namespace board

@@ -1,9 +1,9 @@
 // apm25-attitude: attitude (roll, pitch, heading) on the ArduPilot Mega 2.5.
 //
-// This file is the board's side only: Arduino set-up, the 200 Hz loop paced by the
-// MPU6000 data-ready, sensor health (report once, retry at 1 Hz, report recovery),
-// the serial console, LEDs and EEPROM. Everything that turns samples into angles is
-// lib/Pipeline (AttitudePipeline), which the host replay tool runs too.
+// This file is the board's side only: set-up, the 200 Hz loop paced by the MPU6000
+// data-ready, sensor health (report once, retry at 1 Hz, report recovery), the serial
+// console, LEDs and EEPROM. Everything that turns samples into angles is lib/Pipeline
+// (AttitudePipeline), which the host replay tool runs too.
 //
 // Serial: 115200 baud; angle lines per ../shared/SIM.md; every other line begins "# ".
 #include "ArduinoCore.h"
@@ -17,39 +17,45 @@
 
 namespace {
 
+using text::Flash;
 using text::Writer;
 
-constexpr uint32_t kBaud = 115200;
-constexpr uint32_t kPeriodUs = 1000000u / pipeline::kRateHz;  // 5 000
-constexpr uint32_t kStatusPollAfterUs = 4000;   // pin still low this late: ask INT_STATUS
-constexpr uint32_t kTimerFallbackUs = 12000;    // neither: pace on the timer and say so
-constexpr uint16_t kRetryMs = 1000;             // a failed sensor is tried again this often
-constexpr uint16_t kWarnMs = 2000;              // rate limit of the firmware's warnings
-constexpr uint8_t kMagReadMinMs = 10;           // 75 Hz = 13.3 ms; DRDY stuck high: <= 100 Hz
-constexpr uint8_t kMagDrdySilentMs = 50;        // DRDY low this long: ask the status register
-constexpr uint16_t kMagDeadMs = 1000;           // no good sample this long: stopped answering
+constexpr uint16_t kPeriodUs = 1000000u / pipeline::kRateHz;  // 5 000
+// Reading INT_STATUS clears the data-ready flag and the latched pin: a poll that races
+// a new sample loses it (the early overrun seen at ~0.27 s). So INT_STATUS is asked
+// only when the pin is overdue (it is silent), and every loop from 4 ms on once the pin
+// has been found silent.
+constexpr uint16_t kStatusPollOverdueUs = 7000;
+constexpr uint16_t kStatusPollAfterUs = 4000;
+constexpr uint16_t kTimerFallbackUs = 12000;   // neither: pace on the timer and say so
+constexpr uint16_t kRetryMs = 1000;            // a failed sensor is tried again this often
+constexpr uint16_t kWarnMs = 2000;             // rate limit of the firmware's warnings
+constexpr uint8_t kMagReadMinMs = 10;          // 75 Hz = 13.3 ms; DRDY stuck high: <= 100 Hz
+constexpr uint8_t kMagDrdySilentMs = 50;       // DRDY low this long: ask the status register
+constexpr uint16_t kMagDeadMs = 1000;          // no good sample this long: stopped answering
 constexpr uint8_t kConsoleBytesPerLoop = 16;
 
-const text::Sink* const out = board::serial_sink();
-pipeline::AttitudePipeline pipe(board::serial_sink());
-mpu6000::Mpu6000 mpu(board::spi_device());
-hmc5883::Hmc5883 mag(board::i2c_bus());
+const text::Sink* const out = &board::kSerialSink;
+pipeline::AttitudePipeline pipe(&board::kSerialSink);
+mpu6000::Mpu6000 mpu(board::kSpi);
+hmc5883::Hmc5883 mag(board::kI2c);
 console::LineReader reader;
 
 // Sensor health.
 bool mpu_ok = false;
-bool mpu_reported = false;       // the current failure has been reported
+bool mpu_reported = false;  // the current failure has been reported
 bool mag_ok = false;
 bool mag_reported = false;
+bool mag_drdy_warned = false;
+uint8_t mag_failures = 0;
 uint32_t mpu_retry_ms = 0, mag_retry_ms = 0;
 uint32_t last_mag_read_ms = 0, last_mag_ok_ms = 0;
-uint8_t mag_failures = 0;
-bool mag_drdy_warned = false;
 
 // Loop timing.
 uint32_t last_sample_us = 0;
 bool have_sample_time = false;
 bool timer_pacing = false;
+bool int_pin_ok = true;  // the INT pin paces the loop (else INT_STATUS polling)
 uint32_t overruns = 0;
 uint32_t work_us = 0, window_start_us = 0;
 uint8_t load_pct = 0;
@@ -60,72 +66,62 @@ uint8_t save_buf[settings::kRecordSize];
 uint8_t save_index = settings::kRecordSize;
 bool save_verify = false;
 
-settings::LoadResult load_result = settings::LoadResult::Blank;
+// "<a>\n": most messages are one flash string.
+void say(Flash a) { Writer(out).str(a).end(); }
 
-// ---------------------------------------------------------------------------
-void print_mpu_init_error(const mpu6000::InitResult& r) {
-    Writer w(out);
-    if (r.status == mpu6000::InitStatus::WrongIdentity) {
-        w.str(TXT("# error: MPU6000 not found (WHO_AM_I=0x")).hex8(r.read).str(TXT(", expected 0x"))
-            .hex8(r.wrote).chr(')').end();
-    } else {
-        w.str(TXT("# error: MPU6000 did not keep its configuration (reg 0x")).hex8(r.reg)
-            .str(TXT(" wrote 0x")).hex8(r.wrote).str(TXT(" read 0x")).hex8(r.read).chr(')').end();
-    }
+// "... (reg 0xRR wrote 0xWW read 0xVV)": a register that did not keep its value.
+void print_readback(Flash part, uint8_t reg, uint8_t wrote, uint8_t read) {
+    Writer(out).str(TXT("# error: ")).str(part).str(TXT(" did not keep its configuration (reg 0x")).hex8(reg)
+        .str(TXT(" wrote 0x")).hex8(wrote).str(TXT(" read 0x")).hex8(read).chr(')').end();
 }
 
+// ---------------------------------------------------------------------------
 bool mpu_start() {
     const mpu6000::InitResult r = mpu.begin();
     if (r.status == mpu6000::InitStatus::Ok) return true;
-    if (!mpu_reported) print_mpu_init_error(r);
+    if (!mpu_reported) {
+        if (r.status == mpu6000::InitStatus::WrongIdentity)
+            Writer(out).str(TXT("# error: MPU6000 not found (WHO_AM_I=0x")).hex8(r.read)
+                .str(TXT(", expected 0x68)")).end();
+        else
+            print_readback(TXT("MPU6000"), r.reg, r.wrote, r.read);
+    }
     mpu_reported = true;
     return false;
 }
 
-void mpu_failed(text::Flash why) {
-    mpu_ok = false;
-    if (!mpu_reported) Writer(out).str(TXT("# error: MPU6000 ")).str(why).end();
-    mpu_reported = true;
-    mpu_retry_ms = millis();
-}
-
-void print_mag_init_error(const hmc5883::InitResult& r) {
-    Writer w(out);
-    switch (r.status) {
-        case hmc5883::InitStatus::NoAnswer:
-            w.str(TXT("# error: HMC5883L not found (no answer at 0x1E)")).end();
-            break;
-        case hmc5883::InitStatus::WrongIdentity:
-            w.str(TXT("# error: HMC5883L wrong identity (ID=")).hex8(r.id[0]).chr(' ').hex8(r.id[1]).chr(' ')
-                .hex8(r.id[2]).str(TXT(", expected 48 34 33 'H43')")).end();
-            break;
-        default:
-            w.str(TXT("# error: HMC5883L did not keep its configuration (reg 0x")).hex8(r.reg)
-                .str(TXT(" wrote 0x")).hex8(r.wrote).str(TXT(" read 0x")).hex8(r.read).chr(')').end();
-            break;
+// The first report of a compass failure (`why` null: already said), then what it
+// means for yaw; the compass is then retried every second.
+void mag_failed(Flash why) {
+    if (!mag_reported) {
+        if (why.p != nullptr) Writer(out).str(TXT("# error: HMC5883L ")).str(why).end();
+        say(TXT("# warn: HMC5883L absent: yaw is gyro-only"));
     }
-}
-
-void mag_gone() {
+    mag_reported = true;
     mag_ok = false;
     pipe.set_mag_present(false);
     mag_retry_ms = millis();
-    Writer(out).str(TXT("# warn: HMC5883L absent: yaw is gyro-only")).end();
 }
 
 bool mag_start(bool self_test) {
     const hmc5883::InitResult r = mag.begin(self_test);
     if (r.status != hmc5883::InitStatus::Ok) {
-        if (!mag_reported) {
-            print_mag_init_error(r);
-            mag_gone();
+        Flash why = TXT("not found (no answer at 0x1E)");
+        if (!mag_reported && r.status != hmc5883::InitStatus::NoAnswer) {
+            why.p = nullptr;
+            if (r.status == hmc5883::InitStatus::WrongIdentity) {
+                Writer(out).str(TXT("# error: HMC5883L wrong identity (ID=")).hex8(r.id[0]).chr(' ')
+                    .hex8(r.id[1]).chr(' ').hex8(r.id[2]).str(TXT(", expected 48 34 33 'H43')")).end();
+            } else {
+                print_readback(TXT("HMC5883L"), r.reg, r.wrote, r.read);
+            }
         }
-        mag_reported = true;
+        mag_failed(why);
         return false;
     }
     if (self_test) {
-        const linalg::Vector3f s = mag.self_test_scale();
         if (mag.self_test_passed()) {
+            const linalg::Vector3f s = mag.self_test_scale();
             Writer(out).str(TXT("# HMC5883L self-test: scale ")).fixed2(s.x).chr(' ').fixed2(s.y).chr(' ')
                 .fixed2(s.z).end();
         } else {
@@ -133,24 +129,11 @@ bool mag_start(bool self_test) {
                 .str(TXT(" of 5 good samples): scale 1.0")).end();
         }
     }
-    const uint32_t now = millis();
-    last_mag_read_ms = last_mag_ok_ms = now;
+    last_mag_read_ms = last_mag_ok_ms = millis();
     mag_failures = 0;
     mag_ok = true;
     pipe.set_mag_present(true);
     return true;
-}
-
-void mag_failed(text::Flash why) {
-    if (!mag_reported) {
-        Writer(out).str(TXT("# error: HMC5883L ")).str(why).end();
-        mag_gone();
-    } else {
-        mag_ok = false;
-        pipe.set_mag_present(false);
-    }
-    mag_reported = true;
-    board::i2c_recover();
 }
 
 // ---------------------------------------------------------------------------
@@ -163,25 +146,23 @@ void print_settings_line() {
         .str((s.flags & settings::kFlagMagCalibrated) ? TXT("yes") : TXT("none")).end();
 }
 
+Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
+
 void print_status() {
-    const uint32_t ms = millis();
     Writer w(out);
-    w.str(TXT("# status: MPU6000 ")).str(mpu_ok ? TXT("ok") : TXT("FAILED"))
-        .str(TXT(", HMC5883L ")).str(mag_ok ? TXT("ok") : TXT("FAILED (yaw gyro-only)"))
-        .str(TXT(", estimator "));
-    switch (pipe.phase()) {
-        case pipeline::Phase::Running: w.str(TXT("running")); break;
-        case pipeline::Phase::Calibrating: w.str(TXT("calibrating")); break;
-        case pipeline::Phase::WaitImu: w.str(TXT("waiting for MPU6000")); break;
-    }
-    w.end();
+    w.str(TXT("# status: MPU6000 ")).str(ok_or_failed(mpu_ok)).str(TXT(", HMC5883L ")).str(ok_or_failed(mag_ok));
+    if (!mag_ok) w.str(TXT(" (yaw gyro-only)"));
+    const pipeline::Phase ph = pipe.phase();
+    w.str(TXT(", estimator "))
+        .str(ph == pipeline::Phase::Running       ? TXT("running")
+             : ph == pipeline::Phase::Calibrating ? TXT("calibrating")
+                                                  : TXT("waiting for MPU6000"))
+        .end();
     char buf[14];
     w.str(TXT("# load ")).u32(load_pct).str(TXT("%, overruns ")).u32(overruns)
         .str(TXT(", spikes ")).u32(pipe.spikes()).str(TXT(", uptime "))
-        .str(buf, text::format_centi(buf, (int32_t)(ms / 10u))).str(TXT(" s")).end();
-    const linalg::Vector3f b = pipe.gyro_bias_rad_s() * linalg::kDegPerRad;
-    w.str(TXT("# gyro bias ")).fixed2(b.x).chr(' ').fixed2(b.y).chr(' ').fixed2(b.z)
-        .str(TXT(" deg/s, temperature ")).fixed2(pipe.temperature_c()).str(TXT(" C")).end();
+        .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s")).end();
+    pipe.print_bias(TXT("# gyro bias "), true);
     print_settings_line();
 }
 
@@ -189,44 +170,44 @@ void start_save() {
     settings::encode(pipe.settings(), save_buf);
     save_index = 0;
     save_verify = true;
-    Writer(out).str(TXT("# saving to EEPROM...")).end();
+    say(TXT("# saving to EEPROM..."));
 }
 
 void service_save() {
+    if (!eeprom_is_ready()) return;
     if (save_index < settings::kRecordSize) {
-        if (!eeprom_is_ready()) return;
         eeprom_update_byte((uint8_t*)(settings::kEepromAddress + save_index), save_buf[save_index]);
         ++save_index;
         return;
     }
-    if (!save_verify || !eeprom_is_ready()) return;
+    if (!save_verify) return;
     save_verify = false;
     bool same = true;
     for (uint8_t i = 0; i < settings::kRecordSize; ++i)
         same = same && eeprom_read_byte((const uint8_t*)(settings::kEepromAddress + i)) == save_buf[i];
-    if (same) Writer(out).str(TXT("# saved")).end();
-    else Writer(out).str(TXT("# error: EEPROM write did not verify; settings not saved")).end();
+    say(same ? TXT("# saved") : TXT("# error: EEPROM write did not verify; settings not saved"));
 }
 
 void load_settings() {
     uint8_t rec[settings::kRecordSize];
     eeprom_read_block(rec, (const void*)settings::kEepromAddress, settings::kRecordSize);
-    load_result = settings::decode(rec, pipe.settings());
-    Writer w(out);
-    switch (load_result) {
-        case settings::LoadResult::Ok: w.str(TXT("# settings loaded from EEPROM")).end(); return;
-        case settings::LoadResult::Blank: w.str(TXT("# EEPROM blank: default settings")).end(); return;
-        case settings::LoadResult::BadMagic: w.str(TXT("# warn: EEPROM holds something else: default settings")); break;
-        case settings::LoadResult::OldVersion: w.str(TXT("# warn: EEPROM settings from another version: default settings")); break;
-        case settings::LoadResult::BadCrc: w.str(TXT("# warn: EEPROM settings corrupted (CRC): default settings")); break;
-        case settings::LoadResult::BadValue: w.str(TXT("# warn: EEPROM settings out of range: default settings")); break;
+    Flash m;
+    switch (settings::decode(rec, pipe.settings())) {
+        case settings::LoadResult::Ok: m = TXT("# settings loaded from EEPROM"); break;
+        case settings::LoadResult::Blank: m = TXT("# EEPROM blank: default settings"); break;
+        case settings::LoadResult::BadMagic: m = TXT("# warn: EEPROM holds something else: default settings"); break;
+        case settings::LoadResult::OldVersion: m = TXT("# warn: EEPROM settings from another version: default settings"); break;
+        case settings::LoadResult::BadCrc: m = TXT("# warn: EEPROM settings corrupted (CRC): default settings"); break;
+        default: m = TXT("# warn: EEPROM settings out of range: default settings"); break;
     }
-    w.end();
+    say(m);
 }
 
 void poll_console() {
-    for (uint8_t n = 0; n < kConsoleBytesPerLoop && Serial.available() > 0; ++n) {
-        const console::Command c = reader.feed((uint8_t)Serial.read());
+    for (uint8_t n = 0; n < kConsoleBytesPerLoop; ++n) {
+        const int16_t b = board::serial_read();
+        if (b < 0) return;
+        const console::Command c = reader.feed((uint8_t)b);
         switch (c.id) {
             case console::CommandId::None: break;
             case console::CommandId::Error: console::print_error(c, out); break;
@@ -242,15 +223,16 @@ void poll_console() {
 void service_mag(uint32_t now_ms) {
     if (!mag_ok) return;
     const uint32_t since = now_ms - last_mag_read_ms;
+    const bool by_pin = board::mag_drdy_high();
     bool due = false;
-    if (board::mag_drdy_high()) {
+    if (by_pin) {
         due = since >= kMagReadMinMs;
     } else if (since >= kMagDrdySilentMs) {
         bool ready = false;
         if (!mag.ready_by_status(ready)) ++mag_failures;
         if (ready) {
             due = true;
-            if (!mag_drdy_warned) Writer(out).str(TXT("# warn: HMC5883L DRDY pin silent: polling its status register")).end();
+            if (!mag_drdy_warned) say(TXT("# warn: HMC5883L DRDY pin silent: polling its status register"));
             mag_drdy_warned = true;
         }
     }
@@ -260,38 +242,35 @@ void service_mag(uint32_t now_ms) {
         const hmc5883::ReadStatus st = mag.read(field);
         board::mark_end(board::kSecMagRead);
         last_mag_read_ms = now_ms;
-        switch (st) {
-            case hmc5883::ReadStatus::Ok:
-                pipe.on_mag_sample(field);
-                last_mag_ok_ms = now_ms;
-                mag_failures = 0;
-                break;
-            case hmc5883::ReadStatus::Overflow:
-                last_mag_ok_ms = now_ms;  // it answers; the field is just out of range
-                if (warn_mag_overflow.allow(now_ms, kWarnMs))
-                    Writer(out).str(TXT("# warn: HMC5883L overflow (-4096): sample dropped")).end();
-                break;
-            case hmc5883::ReadStatus::Skipped: break;
-            case hmc5883::ReadStatus::NoSensor:
-            case hmc5883::ReadStatus::BusError: ++mag_failures; break;
+        if (st == hmc5883::ReadStatus::Ok) {
+            pipe.on_mag_sample(field);
+            last_mag_ok_ms = now_ms;
+            mag_failures = 0;
+            if (by_pin) mag_drdy_warned = false;  // the pin works (again): a new silence is news
+        } else if (st == hmc5883::ReadStatus::Overflow) {
+            last_mag_ok_ms = now_ms;  // it answers; the field is just out of range
+            if (warn_mag_overflow.allow(now_ms, kWarnMs))
+                say(TXT("# warn: HMC5883L overflow (-4096): sample dropped"));
+        } else if (st != hmc5883::ReadStatus::Skipped) {
+            ++mag_failures;
         }
     }
     const bool timed_out = board::i2c_timed_out();  // read every time: it clears the flag
-    if (mag_failures >= 3 || (timed_out && mag_failures > 0)) {
-        mag_failed(TXT("stopped answering"));
-    } else if (now_ms - last_mag_ok_ms > kMagDeadMs) {
-        mag_failed(TXT("stopped delivering samples"));
-    }
+    Flash why;
+    if (mag_failures >= 3 || (timed_out && mag_failures > 0)) why = TXT("stopped answering");
+    else if (now_ms - last_mag_ok_ms > kMagDeadMs) why = TXT("stopped delivering samples");
+    else return;
+    mag_failed(why);
+    board::i2c_recover();
 }
 
 void retry_sensors(uint32_t now_ms) {
     if (!mpu_ok && now_ms - mpu_retry_ms >= kRetryMs) {
         mpu_retry_ms = now_ms;
-        if (pipe.phase() != pipeline::Phase::Running || mpu_reported)
-            Writer(out).str(TXT("# no attitude: MPU6000 absent, retrying every 1 s")).end();
+        say(TXT("# no attitude: MPU6000 absent, retrying every 1 s"));
         uint8_t who = 0;
         if (mpu.probe(who) && mpu_start()) {
-            Writer(out).str(TXT("# recovered: MPU6000 (WHO_AM_I=0x68)")).end();
+            say(TXT("# recovered: MPU6000 (WHO_AM_I=0x68)"));
             mpu_ok = true;
             mpu_reported = false;
             have_sample_time = false;
@@ -300,20 +279,22 @@ void retry_sensors(uint32_t now_ms) {
     }
     if (!mag_ok && now_ms - mag_retry_ms >= kRetryMs) {
         mag_retry_ms = now_ms;
+        if (board::sda_low()) board::i2c_recover();
         if (mag_start(false)) {
-            Writer(out).str(TXT("# recovered: HMC5883L (ID H43)")).end();
+            say(TXT("# recovered: HMC5883L (ID H43)"));
             mag_reported = false;
         }
     }
 }
 
 void update_leds() {
-    const bool calibrating = pipe.phase() == pipeline::Phase::Calibrating || pipe.gyro_calibrating() ||
-                             pipe.mag_calibrating();
-    board::set_leds(calibrating, mpu_ok && pipe.phase() == pipeline::Phase::Running, !mpu_ok || !mag_ok);
+    const pipeline::Phase ph = pipe.phase();
+    board::set_leds(ph == pipeline::Phase::Calibrating || pipe.gyro_calibrating() || pipe.mag_calibrating(),
+                    mpu_ok && ph == pipeline::Phase::Running,
+                    !mpu_ok || !mag_ok);
 }
 
-void emit_output() {
+void emit_output(uint32_t now_ms) {
     const settings::Settings& s = pipe.settings();
     if (s.mode == fmt::OutputMode::Quiet) return;
     board::mark_begin(board::kSecEuler);
@@ -322,23 +303,23 @@ void emit_output() {
     char line[fmt::kLineMax];
     board::mark_begin(board::kSecFormat);
     const uint8_t n = s.mode == fmt::OutputMode::Csv
-                          ? fmt::format_csv_line(line, millis(), a.roll_deg, a.pitch_deg, a.heading_deg)
+                          ? fmt::format_csv_line(line, now_ms, a.roll_deg, a.pitch_deg, a.heading_deg)
                           : fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
     board::mark_end(board::kSecFormat);
     if (n > 0) board::serial_write(line, n);
-    else if (warn_angle.allow(millis(), kWarnMs))
-        Writer(out).str(TXT("# warn: angle not finite: line skipped")).end();
+    else if (warn_angle.allow(now_ms, kWarnMs)) say(TXT("# warn: angle not finite: line skipped"));
 }
 
 // One 200 Hz step once the MPU6000 has a sample.
 void step(uint32_t now_us) {
     board::mark_begin(board::kSecLoop);
+    const uint32_t now_ms = millis();
     if (have_sample_time) {
         const uint32_t gap = now_us - last_sample_us;
         if (gap > kPeriodUs + kPeriodUs / 2u) {
-            const uint32_t missed = (gap + kPeriodUs / 2u) / kPeriodUs - 1u;
+            const uint16_t missed = (uint16_t)((gap + kPeriodUs / 2u) / kPeriodUs - 1u);
             overruns += missed;
-            if (warn_overrun.allow(millis(), kWarnMs))
+            if (warn_overrun.allow(now_ms, kWarnMs))
                 Writer(out).str(TXT("# warn: loop overrun: ")).u32(missed).str(TXT(" sample(s) missed, "))
                     .u32(overruns).str(TXT(" in all")).end();
         }
@@ -351,15 +332,17 @@ void step(uint32_t now_us) {
     const mpu6000::BurstStatus st = mpu.read(sample);
     board::mark_end(board::kSecMpuRead);
     if (st != mpu6000::BurstStatus::Ok) {
-        mpu_failed(TXT("stopped answering (burst all 0x00 or 0xFF)"));
-        board::mark_end(board::kSecLoop);
-        return;
+        mpu_ok = false;
+        if (!mpu_reported) say(TXT("# error: MPU6000 stopped answering (burst all 0x00 or 0xFF)"));
+        mpu_reported = true;
+        mpu_retry_ms = now_ms;
+    } else {
+        service_mag(now_ms);
+        board::mark_begin(board::kSecEstimator);
+        pipe.on_imu_sample(sample);
+        board::mark_end(board::kSecEstimator);
+        if (pipe.output_due()) emit_output(now_ms);
     }
-    service_mag(millis());
-    board::mark_begin(board::kSecEstimator);
-    pipe.on_imu_sample(sample);
-    board::mark_end(board::kSecEstimator);
-    if (pipe.output_due()) emit_output();
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
 }
@@ -369,22 +352,21 @@ void step(uint32_t now_us) {
 void setup() {
     board::init_pins();  // every chip select high before any SPI traffic
     board::set_leds(true, false, false);
-    board::serial_begin(kBaud);
-    Writer(out).str(TXT("# apm25-attitude 0.1.0")).end();
-    Writer(out).str(TXT("# board: APM 2.5, ATmega2560 16 MHz, serial 115200, 200 Hz loop")).end();
-    Writer(out).str(TXT("# MPU6000: 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; HMC5883L: 75 Hz, 8-sample average, 1.3 Ga")).end();
+    board::serial_begin();
+    say(TXT("# apm25-attitude 0.1.0\n"
+            "# board: APM 2.5, ATmega2560 16 MHz, serial 115200, 200 Hz loop\n"
+            "# MPU6000: 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; HMC5883L: 75 Hz, 8-sample average, 1.3 Ga"));
     load_settings();
     print_settings_line();
-    board::serial_pump();
 
     board::spi_begin();
     mpu_ok = mpu_start();
-    if (!mpu_ok) mpu_retry_ms = millis();
+    mpu_retry_ms = millis();
 
     board::wire_begin();
-    if (digitalRead(board::kPinSda) == LOW) board::i2c_recover();
+    if (board::sda_low()) board::i2c_recover();
     mag_start(true);
-    Writer(out).str(TXT("# type help for commands")).end();
+    say(TXT("# type help for commands"));
     if (pipe.settings().mode == fmt::OutputMode::Csv) Writer(out).str(TXT("t_ms,roll,pitch,yaw\n"));
     board::serial_drain();  // the banner out before the 200 Hz loop starts: no overrun
     window_start_us = micros();
@@ -392,15 +374,13 @@ void setup() {
 }
 
 void loop() {
-    board::serial_pump();
     poll_console();
     service_save();
-    const uint32_t now_ms = millis();
-    retry_sensors(now_ms);
+    retry_sensors(millis());
 
     const uint32_t now_us = micros();
     if (now_us - window_start_us >= 1000000u) {  // load over the last second
-        load_pct = (uint8_t)((work_us / ((now_us - window_start_us) / 100u)) & 0xFFu);
+        load_pct = (uint8_t)(work_us / ((now_us - window_start_us) / 100u));
         work_us = 0;
         window_start_us = now_us;
         update_leds();
@@ -411,12 +391,21 @@ void loop() {
     // sample is due, else the timer (said once): the loop never waits forever.
     const uint32_t since = now_us - last_sample_us;
     bool ready = board::mpu_int_high();
-    if (!ready && (since >= kStatusPollAfterUs || !have_sample_time)) ready = mpu.data_ready();
+    if (ready) {
+        int_pin_ok = true;
+    } else if (since >= (int_pin_ok ? kStatusPollOverdueUs : kStatusPollAfterUs) || !have_sample_time) {
+        ready = mpu.data_ready();
+        if (ready && have_sample_time && int_pin_ok) {
+            int_pin_ok = false;
+            have_sample_time = false;  // this gap is not an overrun
+            say(TXT("# warn: MPU6000 INT pin silent: polling INT_STATUS"));
+        }
+    }
     if (ready) {
         timer_pacing = false;
     } else if (have_sample_time && since >= (timer_pacing ? kPeriodUs : kTimerFallbackUs)) {
         if (!timer_pacing) {
-            Writer(out).str(TXT("# warn: MPU6000 data-ready not seen: pacing on the timer")).end();
+            say(TXT("# warn: MPU6000 data-ready not seen: pacing on the timer"));
             have_sample_time = false;  // this gap is not an overrun
         }
         timer_pacing = true;

@@ -6,21 +6,56 @@ namespace fmt {
 
 namespace {
 
-// Hundredths of the three angles; false if any is not representable.
+// Hundredths of an angle, rounded half away from zero: one float multiply, one add and
+// one conversion (~400 cycles on the 2560). False for NaN, infinities and anything
+// beyond a full turn (|c| > 36000), which is not an attitude angle.
+bool centi_angle(float deg, int32_t& out) {
+    if (!(deg > -360.005f && deg < 360.005f)) return false;  // NaN fails both
+    const float s = deg * 100.0f;
+    out = (int32_t)(s >= 0.0f ? s + 0.5f : s - 0.5f);
+    return out >= -36000 && out <= 36000;
+}
+
 bool angles_centi(float roll_deg, float pitch_deg, float heading_deg, int32_t c[3]) {
-    if (!text::to_centi(roll_deg, c[0]) || !text::to_centi(pitch_deg, c[1]) ||
-        !text::to_centi(heading_deg, c[2]))
+    if (!centi_angle(roll_deg, c[0]) || !centi_angle(pitch_deg, c[1]) || !centi_angle(heading_deg, c[2]))
         return false;
-    // Attitude angles never exceed a full turn; anything else is not an angle.
-    for (uint8_t i = 0; i < 3; ++i)
-        if (c[i] > 36000 || c[i] < -36000) return false;
     if (c[2] == 36000) c[2] = 0;  // 359.996 rounds to 360.00: the same heading as 0.00
     return true;
 }
 
-uint8_t put(char* buf, uint8_t at, const char* s) {
-    while (*s != '\0') buf[at++] = *s++;
-    return at;
+// One decimal digit of m at the power `pw` by subtraction (no division on the AVR).
+char digit(uint16_t& m, uint16_t pw) {
+    char d = '0';
+    while (m >= pw) {
+        m = (uint16_t)(m - pw);
+        ++d;
+    }
+    return d;
+}
+
+// |c| <= 36000 hundredths as "[-]d.dd" (no leading zeros); returns the end.
+char* put_centi(char* p, int32_t c) {
+    if (c < 0) {
+        *p++ = '-';
+        c = -c;
+    }
+    uint16_t m = (uint16_t)c;  // <= 36000: 16-bit arithmetic from here
+    char d = digit(m, 10000);
+    bool lead = d != '0';
+    if (lead) *p++ = d;
+    d = digit(m, 1000);
+    lead = lead || d != '0';
+    if (lead) *p++ = d;
+    *p++ = digit(m, 100);
+    *p++ = '.';
+    *p++ = digit(m, 10);
+    *p++ = (char)('0' + m);
+    return p;
+}
+
+char* put(char* p, const char* s) {
+    while (*s != '\0') *p++ = *s++;
+    return p;
 }
 
 }  // namespace
@@ -28,35 +63,27 @@ uint8_t put(char* buf, uint8_t at, const char* s) {
 uint8_t format_plot_line(char buf[kLineMax], float roll_deg, float pitch_deg, float heading_deg) {
     int32_t c[3];
     if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
-    uint8_t n = put(buf, 0, "roll:");
-    n = (uint8_t)(n + text::format_centi(buf + n, c[0]));
-    n = put(buf, n, " pitch:");
-    n = (uint8_t)(n + text::format_centi(buf + n, c[1]));
-    n = put(buf, n, " yaw:");
-    n = (uint8_t)(n + text::format_centi(buf + n, c[2]));
-    buf[n++] = '\n';
-    return n;
+    char* p = put(buf, "roll:");
+    p = put_centi(p, c[0]);
+    p = put(p, " pitch:");
+    p = put_centi(p, c[1]);
+    p = put(p, " yaw:");
+    p = put_centi(p, c[2]);
+    *p++ = '\n';
+    return (uint8_t)(p - buf);
 }
 
 uint8_t format_csv_line(char buf[kLineMax], uint32_t t_ms, float roll_deg, float pitch_deg,
                         float heading_deg) {
     int32_t c[3];
     if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
-    // t_ms as unsigned: split so that the int32 formatter never sees a wrapped value.
-    uint8_t n = 0;
-    if (t_ms >= 1000000000u) {
-        n = text::format_int(buf, (int32_t)(t_ms / 1000000000u));
-        const uint32_t rest = t_ms % 1000000000u;
-        for (uint32_t p = 100000000u; p > 0u; p /= 10u) buf[n++] = (char)('0' + (uint8_t)((rest / p) % 10u));
-    } else {
-        n = text::format_int(buf, (int32_t)t_ms);
-    }
+    char* p = buf + text::format_u32(buf, t_ms);
     for (uint8_t i = 0; i < 3; ++i) {
-        buf[n++] = ',';
-        n = (uint8_t)(n + text::format_centi(buf + n, c[i]));
+        *p++ = ',';
+        p = put_centi(p, c[i]);
     }
-    buf[n++] = '\n';
-    return n;
+    *p++ = '\n';
+    return (uint8_t)(p - buf);
 }
 
 }  // namespace fmt

@@ -4,26 +4,30 @@
 
 namespace text {
 
-uint8_t format_int(char* buf, int32_t v) {
-    // Work on the magnitude as uint32 so INT32_MIN does not overflow.
-    uint32_t mag = v < 0 ? (uint32_t)0 - (uint32_t)v : (uint32_t)v;
+uint8_t format_u32(char* buf, uint32_t v) {
     char tmp[10];
     uint8_t n = 0;
     do {
-        tmp[n++] = (char)('0' + (uint8_t)(mag % 10u));
-        mag /= 10u;
-    } while (mag != 0u);
-    uint8_t len = 0;
-    if (v < 0) buf[len++] = '-';
-    while (n > 0) buf[len++] = tmp[--n];
-    return len;
+        const uint32_t q = v / 10u;  // one __udivmodsi4 gives both
+        tmp[n++] = (char)('0' + (uint8_t)(v - q * 10u));
+        v = q;
+    } while (v != 0u);
+    for (uint8_t i = 0; i < n; ++i) buf[i] = tmp[n - 1u - i];
+    return n;
+}
+
+uint8_t format_int(char* buf, int32_t v) {
+    // The magnitude as uint32 so INT32_MIN does not overflow.
+    if (v >= 0) return format_u32(buf, (uint32_t)v);
+    buf[0] = '-';
+    return (uint8_t)(1u + format_u32(buf + 1, (uint32_t)0 - (uint32_t)v));
 }
 
 uint8_t format_centi(char* buf, int32_t centi) {
-    uint32_t mag = centi < 0 ? (uint32_t)0 - (uint32_t)centi : (uint32_t)centi;
+    const uint32_t mag = centi < 0 ? (uint32_t)0 - (uint32_t)centi : (uint32_t)centi;
     uint8_t len = 0;
     if (centi < 0) buf[len++] = '-';
-    len = (uint8_t)(len + format_int(buf + len, (int32_t)(mag / 100u)));
+    len = (uint8_t)(len + format_u32(buf + len, mag / 100u));
     const uint8_t frac = (uint8_t)(mag % 100u);
     buf[len++] = '.';
     buf[len++] = (char)('0' + frac / 10u);
@@ -54,15 +58,8 @@ Writer& Writer::i32(int32_t v) {
 }
 
 Writer& Writer::u32(uint32_t v) {
-    char tmp[10];
-    uint8_t n = 0;
-    do {
-        tmp[n++] = (char)('0' + (uint8_t)(v % 10u));
-        v /= 10u;
-    } while (v != 0u);
     char buf[10];
-    for (uint8_t i = 0; i < n; ++i) buf[i] = tmp[n - 1u - i];
-    return str(buf, n);
+    return str(buf, format_u32(buf, v));
 }
 
 Writer& Writer::fixed2(float v) {
@@ -70,6 +67,10 @@ Writer& Writer::fixed2(float v) {
     if (!to_centi(v, c)) return chr('?');
     char buf[14];
     return str(buf, format_centi(buf, c));
+}
+
+Writer& Writer::vec(const linalg::Vector3f& v, float scale) {
+    return fixed2(v.x * scale).chr(' ').fixed2(v.y * scale).chr(' ').fixed2(v.z * scale);
 }
 
 Writer& Writer::hex8(uint8_t v) {

@@ -10,6 +10,8 @@
 
 #include <stdint.h>
 
+#include "LinAlg.h"
+
 #ifdef __AVR__
 #include <avr/pgmspace.h>
 // Through a function, not Flash{PSTR(s)}: avr-gcc 5.4's LTO crashes (internal compiler
@@ -34,6 +36,8 @@ struct Sink {
     void (*write_flash)(void* ctx, const char* flash_str);    // NUL-terminated, program memory on AVR
 };
 
+// Decimal digits of v into buf (no NUL); returns the count (<= 10).
+uint8_t format_u32(char* buf, uint32_t v);
 // Decimal digits of v into buf (no NUL); returns the count (<= 11).
 uint8_t format_int(char* buf, int32_t v);
 // v/100 with exactly two decimals ("-1.23", "0.05"); returns the count (<= 14).
@@ -53,6 +57,8 @@ public:
     Writer& u32(uint32_t v);
     // Two decimals; a non-finite value prints as "?" (never "nan").
     Writer& fixed2(float v);
+    // "x y z", each times `scale` with two decimals (fixed2).
+    Writer& vec(const linalg::Vector3f& v, float scale = 1.0f);
     Writer& hex8(uint8_t v);  // two upper-case hex digits, no prefix
     Writer& end() { return chr('\n'); }
 

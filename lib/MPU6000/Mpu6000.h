@@ -58,7 +58,7 @@ struct InitResult {
 
 class Mpu6000 {
 public:
-    explicit Mpu6000(const SpiDevice& dev) : dev_(dev) {}
+    constexpr explicit Mpu6000(const SpiDevice& dev) : dev_(dev) {}
 
     // WHO_AM_I at the configuration clock; `who` receives what the chip answered.
     bool probe(uint8_t& who);

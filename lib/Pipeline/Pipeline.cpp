@@ -50,15 +50,13 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
 // Spikes and non-finite values are replaced by the previous sample; saturation is
 // reported but used (the true rate is at least the full scale).
 mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
-    mpu6000::Sample out = s;
     bool spike = !s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite();
     if (!spike && have_last_) {
-        const Vector3f d = s.gyro_rad_s - last_.gyro_rad_s;
-        spike = absf(d.x) > kSpikeGyroJump_rad_s || absf(d.y) > kSpikeGyroJump_rad_s ||
-                absf(d.z) > kSpikeGyroJump_rad_s;
-        const float a2 = s.accel_m_s2.length_squared(), last2 = last_.accel_m_s2.length_squared();
-        spike = spike || (a2 > (kSpikeAccel_g * kG) * (kSpikeAccel_g * kG) &&
-                          last2 < (kNormalAccel_g * kG) * (kNormalAccel_g * kG));
+        const float* g = &s.gyro_rad_s.x;  // Vector3f is three packed floats
+        const float* h = &last_.gyro_rad_s.x;
+        for (uint8_t i = 0; i < 3; ++i) spike = spike || absf(g[i] - h[i]) > kSpikeGyroJump_rad_s;
+        spike = spike || (s.accel_m_s2.length_squared() > (kSpikeAccel_g * kG) * (kSpikeAccel_g * kG) &&
+                          last_.accel_m_s2.length_squared() < (kNormalAccel_g * kG) * (kNormalAccel_g * kG));
     }
     if (spike && have_last_ && spike_run_ < kMaxSpikeRun) {
         ++spike_run_;
@@ -67,24 +65,27 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
             Writer(log_).str(TXT("# warn: MPU6000 spike: sample replaced by the previous one ("))
                 .u32(spikes_).str(TXT(" so far)")).end();
         }
-        out = last_;
+        mpu6000::Sample out = last_;
         out.temperature_c = s.temperature_c;
         return out;
     }
-    if (!out.gyro_rad_s.is_finite() || !out.accel_m_s2.is_finite()) return last_;  // never pass NaN on
+    if (spike) return last_;  // non-finite with nothing to replace it by: never pass NaN on
     spike_run_ = 0;
     if (s.gyro_saturated && warn_gyro_sat_.allow(steps_, kWarnIntervalSteps))
         Writer(log_).str(TXT("# warn: MPU6000 gyro saturated (beyond 2000 deg/s)")).end();
     if (s.accel_saturated && warn_accel_sat_.allow(steps_, kWarnIntervalSteps))
         Writer(log_).str(TXT("# warn: MPU6000 accel saturated (beyond 8 g)")).end();
-    last_ = out;
+    last_ = s;
     have_last_ = true;
-    return out;
+    return s;
 }
 
-void AttitudePipeline::print_bias(text::Flash prefix) {
-    const Vector3f b = settings_.cal.gyro_bias_rad_s * linalg::kDegPerRad;
-    Writer(log_).str(prefix).fixed2(b.x).chr(' ').fixed2(b.y).chr(' ').fixed2(b.z).str(TXT(" deg/s")).end();
+void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
+    Writer w(log_);
+    w.str(prefix).vec(status ? gyro_bias_rad_s() : settings_.cal.gyro_bias_rad_s, linalg::kDegPerRad)
+        .str(TXT(" deg/s"));
+    if (status) w.str(TXT(", temperature ")).fixed2(last_.temperature_c).str(TXT(" C"));
+    w.end();
 }
 
 void AttitudePipeline::start_estimator(const Vector3f& gravity) {
@@ -102,7 +103,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         gyro_cal_active_ = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
-        print_bias(TXT("# gyro bias: "));
+        print_bias(TXT("# gyro bias: "), false);
         if (phase_ == Phase::Calibrating) {
             start_estimator(gyro_cal_.mean_accel_m_s2());
         } else {
@@ -205,33 +206,25 @@ void AttitudePipeline::finish_mag_calibration() {
     mag_cal_active_ = false;
     calib::Calibration c = settings_.cal;
     const calib::MagCalibrator::Quality q = mag_cal_.finish(c);
+    Writer w(log_);
     if (q == calib::MagCalibrator::Quality::Ok) {
         settings_.cal = c;
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
-        Writer w(log_);
-        w.str(TXT("# cal mag: offset ")).fixed2(c.mag_offset_uT.x).chr(' ').fixed2(c.mag_offset_uT.y)
-            .chr(' ').fixed2(c.mag_offset_uT.z).str(TXT(" uT, scale ")).fixed2(c.mag_scale.x).chr(' ')
-            .fixed2(c.mag_scale.y).chr(' ').fixed2(c.mag_scale.z).str(TXT(" (save to keep)")).end();
+        w.str(TXT("# cal mag: offset ")).vec(c.mag_offset_uT).str(TXT(" uT, scale ")).vec(c.mag_scale)
+            .str(TXT(" (save to keep)")).end();
         return;
     }
-    const Vector3f half = (mag_cal_.max_uT() - mag_cal_.min_uT()) * 0.5f;
-    Writer w(log_);
     w.str(TXT("# error: cal mag failed: "));
-    switch (q) {
-        case calib::MagCalibrator::Quality::TooFewSamples:
-            w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
-            break;
-        case calib::MagCalibrator::Quality::AxisNotTurned:
-        case calib::MagCalibrator::Quality::SpanTooLarge:
-            w.chr((char)('x' + mag_cal_.axis()))
-                .str(q == calib::MagCalibrator::Quality::AxisNotTurned ? TXT(" axis not turned enough")
-                                                                       : TXT(" axis span too large (magnet near?)"));
-            break;
-        default:
-            w.str(TXT("axes disagree"));
-            break;
+    if (q == calib::MagCalibrator::Quality::TooFewSamples) {
+        w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
+    } else if (q == calib::MagCalibrator::Quality::AxesDisagree) {
+        w.str(TXT("axes disagree"));
+    } else {
+        w.chr((char)('x' + mag_cal_.axis()))
+            .str(q == calib::MagCalibrator::Quality::AxisNotTurned ? TXT(" axis not turned enough")
+                                                                   : TXT(" axis span too large (magnet near?)"));
     }
-    w.str(TXT("; half spans ")).fixed2(half.x).chr(' ').fixed2(half.y).chr(' ').fixed2(half.z)
+    w.str(TXT("; half spans ")).vec(mag_cal_.max_uT() - mag_cal_.min_uT(), 0.5f)
         .str(TXT(" uT; calibration unchanged")).end();
 }
 

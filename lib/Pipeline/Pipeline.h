@@ -116,13 +116,15 @@ public:
     linalg::Vector3f gyro_bias_rad_s() const;
     float temperature_c() const { return last_.temperature_c; }
     uint32_t spikes() const { return spikes_; }
+    // "<prefix>x y z deg/s": the calibrated bias, or (status) the calibrated bias plus the
+    // estimator's, followed by ", temperature T C".
+    void print_bias(text::Flash prefix, bool status) const;
 
 private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
-    void print_bias(text::Flash prefix);
 
     const text::Sink* log_;
     settings::Settings settings_;
@@ -131,7 +133,6 @@ private:
     calib::MagCalibrator mag_cal_;
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
-    linalg::Vector3f accel_for_init_;
     RateLimiter warn_spike_, warn_gyro_sat_, warn_accel_sat_, warn_mag_, warn_moved_;
     uint32_t steps_ = 0;
     uint32_t spikes_ = 0;
