@@ -47,6 +47,8 @@ bool mpu_reported = false;  // the current failure has been reported
 bool mag_ok = false;
 bool mag_reported = false;
 bool mag_drdy_warned = false;
+bool mag_overflow_warned = false;
+uint8_t mag_drdy_high_reads = 0;  // reads after which DRDY stayed high (3: stuck, said)
 uint8_t mag_failures = 0;
 uint32_t mpu_retry_ms = 0, mag_retry_ms = 0;
 uint32_t last_mag_read_ms = 0, last_mag_ok_ms = 0;
@@ -56,10 +58,11 @@ uint32_t last_sample_us = 0;
 bool have_sample_time = false;
 bool timer_pacing = false;
 bool int_pin_ok = true;  // the INT pin paces the loop (else INT_STATUS polling)
+bool pacing_warned = false;
 uint32_t overruns = 0;
 uint32_t work_us = 0, window_start_us = 0;
 uint8_t load_pct = 0;
-pipeline::RateLimiter warn_overrun, warn_mag_overflow, warn_angle;
+pipeline::RateLimiter warn_overrun, warn_angle;
 
 // EEPROM save, one byte per loop while the EEPROM is ready (no 150 ms stall).
 uint8_t save_buf[settings::kRecordSize];
@@ -242,15 +245,24 @@ void service_mag(uint32_t now_ms) {
         const hmc5883::ReadStatus st = mag.read(field);
         board::mark_end(board::kSecMagRead);
         last_mag_read_ms = now_ms;
+        // DRDY falls when the data are read: still high afterwards, three reads in a row,
+        // means the pin is stuck and the 10 ms minimum spacing is what paces the reads.
+        if (by_pin && board::mag_drdy_high()) {
+            if (mag_drdy_high_reads < 3 && ++mag_drdy_high_reads == 3)
+                say(TXT("# warn: HMC5883L DRDY pin stuck high: reading every 10 ms"));
+        } else {
+            mag_drdy_high_reads = 0;
+        }
         if (st == hmc5883::ReadStatus::Ok) {
             pipe.on_mag_sample(field);
             last_mag_ok_ms = now_ms;
             mag_failures = 0;
+            mag_overflow_warned = false;
             if (by_pin) mag_drdy_warned = false;  // the pin works (again): a new silence is news
         } else if (st == hmc5883::ReadStatus::Overflow) {
             last_mag_ok_ms = now_ms;  // it answers; the field is just out of range
-            if (warn_mag_overflow.allow(now_ms, kWarnMs))
-                say(TXT("# warn: HMC5883L overflow (-4096): sample dropped"));
+            if (!mag_overflow_warned) say(TXT("# warn: HMC5883L overflow (-4096): samples dropped"));
+            mag_overflow_warned = true;  // once until a good sample
         } else if (st != hmc5883::ReadStatus::Skipped) {
             ++mag_failures;
         }
@@ -393,6 +405,7 @@ void loop() {
     bool ready = board::mpu_int_high();
     if (ready) {
         int_pin_ok = true;
+        pacing_warned = false;
     } else if (since >= (int_pin_ok ? kStatusPollOverdueUs : kStatusPollAfterUs) || !have_sample_time) {
         ready = mpu.data_ready();
         if (ready && have_sample_time && int_pin_ok) {
@@ -405,7 +418,8 @@ void loop() {
         timer_pacing = false;
     } else if (have_sample_time && since >= (timer_pacing ? kPeriodUs : kTimerFallbackUs)) {
         if (!timer_pacing) {
-            say(TXT("# warn: MPU6000 data-ready not seen: pacing on the timer"));
+            if (!pacing_warned) say(TXT("# warn: MPU6000 data-ready not seen: pacing on the timer"));
+            pacing_warned = true;      // once until the INT pin works again
             have_sample_time = false;  // this gap is not an overrun
         }
         timer_pacing = true;

@@ -69,7 +69,9 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
         out.temperature_c = s.temperature_c;
         return out;
     }
-    if (spike) return last_;  // non-finite with nothing to replace it by: never pass NaN on
+    // A run longer than kMaxSpikeRun is real (saturation, a crash) and used; a non-finite
+    // sample never is, with or without a previous one to stand in.
+    if (!s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite()) return last_;
     spike_run_ = 0;
     if (s.gyro_saturated && warn_gyro_sat_.allow(steps_, kWarnIntervalSteps))
         Writer(log_).str(TXT("# warn: MPU6000 gyro saturated (beyond 2000 deg/s)")).end();
