@@ -23,17 +23,18 @@ const DcmSettings kDefaultDcmSettings = {
     0.005f,                         // step_s: 200 Hz
     1.0f,                           // kp_rp_1_s
     0.1f,                           // ki_rp_1_s2
-    0.3f,                           // kp_yaw_1_s
-    0.1f,                           // ki_yaw_1_s2
+    0.1f,                           // kp_yaw_1_s
+    0.01f,                           // ki_yaw_1_s2
     5.0f,                           // kp_startup_1_s
     3.0f,                           // startup_s
     16.0f,                          // accel_max_g
     3.0f,                           // accel_lowpass_s
     20.0f * linalg::kRadPerDeg,     // integrator_hold_rate_rad_s (ArduPilot's 20 deg/s)
     10.0f * linalg::kRadPerDeg,     // bias_limit_rad_s
-    0.2f,                           // mag_norm_tolerance
+    0.1f,                           // mag_norm_tolerance
     0.1f,                           // mag_dip_tolerance
     20.0f,                          // mag_recover_s
+    0.012f,                         // mag_latency_s
 };
 
 // Everything the step needs that depends only on the settings is worked out once
@@ -159,6 +160,7 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     if (gyro_ok) {
         Vector3f rate_rad_s = gyro_rad_s - offset_rad_s_;
         if (yaw_pending_) rate_rad_s += omega_yaw_rad_s_;  // a mag correction is applied once
+        last_rate_rad_s_ = rate_rad_s;
         const Vector3f theta = rate_rad_s * dt;
         const Vector3f half_theta = theta * 0.5f;
         const Vector3f stretched = theta * (1.0f + (1.0f / 3.0f) * theta.length_squared());
@@ -215,9 +217,13 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         return;
     }
 
+    // The sample is older than the gyro-propagated attitude (the chip's averaging
+    // and the wait for the next step): turn it forward by the rotation since, as a
+    // fixed earth vector seen from the body moves, dm/dt = m x w.
+    const Vector3f field_now = mag_field + mag_field.cross(last_rate_rad_s_) * settings_.mag_latency_s;
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
-    const Vector3f field_ef = r_ * mag_field;
+    const Vector3f field_ef = r_ * field_now;
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
     const float norm = sqrtf(norm2);

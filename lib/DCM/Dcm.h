@@ -36,6 +36,7 @@ struct DcmSettings {
     float mag_norm_tolerance;        // |field| may differ from the learned one by this fraction
     float mag_dip_tolerance;         // field.down/|field| may differ from the learned one by this
     float mag_recover_s;             // a different field steady this long becomes the reference, s
+    float mag_latency_s;             // age of a field sample against the gyro-propagated attitude, s
 };
 
 extern const DcmSettings kDefaultDcmSettings;
@@ -117,6 +118,7 @@ private:
     linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
     linalg::Vector3f last_accel_m_s2_;   // for a rebuild if the matrix degenerates
     linalg::Vector3f last_mag_field_;
+    linalg::Vector3f last_rate_rad_s_;   // the last corrected rate, to bring field samples up to date
     float mag_ref_norm_ = 0.0f;          // learned field strength
     float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
     float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
