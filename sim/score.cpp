@@ -1,6 +1,6 @@
 // build/score: the BROAD dataset's orientation error metric for one estimate file.
 //
-//   build/score --trajectory FILE.csv[.gz] --estimate EST.csv [--skip S] [--csv]
+//   build/score --trajectory FILE.csv[.gz] --estimate EST.csv [--skip S] [--all] [--csv]
 //               [--series OUT.csv]
 //
 // EST.csv: header naming at least the columns t, roll, pitch, yaw (any order, more
@@ -38,6 +38,7 @@ void usage(FILE* out) {
             "  body->earth NED) against the trajectory's true orientation with the BROAD metric:\n"
             "  total, inclination and heading RMSE over the rows with movement = 1 and finite truth.\n"
             "  --skip S     ignore rows with t < S seconds\n"
+            "  --all        count rows whatever their movement flag (still needs a finite truth)\n"
             "  --csv        print a CSV header and one row instead of key=value\n"
             "  --series F   write per-row errors (t,total_deg,incl_deg,heading_deg) to F\n");
 }
@@ -66,6 +67,7 @@ struct Options {
     std::string trajectory, estimate, series;
     double skip_s = 0.0;
     bool csv = false;
+    bool all_rows = false;  // --all: ignore the movement flag
 };
 
 // Returns 0 when the command line is usable, otherwise the exit status to use.
@@ -98,6 +100,8 @@ int parse_args(int argc, char** argv, Options& o) {
                 fprintf(stderr, "score: --skip needs a number of seconds, got '%s'\n", v);
                 return 1;
             }
+        } else if (a == "--all") {
+            o.all_rows = true;
         } else if (a == "--csv") {
             o.csv = true;
         } else if (a == "--help" || a == "-h") {
@@ -194,7 +198,7 @@ int main(int argc, char** argv) {
         if (t < opt.skip_s || t < t_first || t > t_last) continue;
         const sim::TrajectorySample truth = traj.at(t);
         const score::Quat q_true{truth.quat[0], truth.quat[1], truth.quat[2], truth.quat[3]};
-        if (!truth.movement || !score::quat_finite(q_true)) continue;
+        if ((!truth.movement && !opt.all_rows) || !score::quat_finite(q_true)) continue;
         const score::ErrorAngles e =
             score::error_angles(q_true, score::quat_from_euler_deg(roll, pitch, yaw));
         acc.add(e);
