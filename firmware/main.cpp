@@ -30,7 +30,9 @@ constexpr uint16_t kStatusPollAfterUs = 4000;
 constexpr uint16_t kTimerFallbackUs = 12000;   // neither: pace on the timer and say so
 constexpr uint16_t kRetryMs = 1000;            // a failed sensor is tried again this often
 constexpr uint16_t kWarnMs = 2000;             // rate limit of the firmware's warnings
-constexpr uint8_t kMagReadMinMs = 10;          // 75 Hz = 13.3 ms; DRDY stuck high: <= 100 Hz
+// 75 Hz = 13.3 ms; DRDY stuck high: <= 100 Hz. Counted in estimator steps, not
+// millis(), so the reads fall on the same steps as in the host replay tool.
+constexpr uint8_t kMagReadMinSteps = 2;
 constexpr uint8_t kMagDrdySilentMs = 50;       // DRDY low this long: ask the status register
 constexpr uint16_t kMagDeadMs = 1000;          // no good sample this long: stopped answering
 constexpr uint8_t kConsoleBytesPerLoop = 16;
@@ -52,6 +54,7 @@ uint8_t mag_drdy_high_reads = 0;  // reads after which DRDY stayed high (3: stuc
 uint8_t mag_failures = 0;
 uint32_t mpu_retry_ms = 0, mag_retry_ms = 0;
 uint32_t last_mag_read_ms = 0, last_mag_ok_ms = 0;
+uint32_t last_mag_read_step = 0;
 
 // Loop timing.
 uint32_t last_sample_us = 0;
@@ -229,7 +232,7 @@ void service_mag(uint32_t now_ms) {
     const bool by_pin = board::mag_drdy_high();
     bool due = false;
     if (by_pin) {
-        due = since >= kMagReadMinMs;
+        due = pipe.steps() - last_mag_read_step >= kMagReadMinSteps;
     } else if (since >= kMagDrdySilentMs) {
         bool ready = false;
         if (!mag.ready_by_status(ready)) ++mag_failures;
@@ -245,6 +248,7 @@ void service_mag(uint32_t now_ms) {
         const hmc5883::ReadStatus st = mag.read(field);
         board::mark_end(board::kSecMagRead);
         last_mag_read_ms = now_ms;
+        last_mag_read_step = pipe.steps();
         // DRDY falls when the data are read: still high afterwards, three reads in a row,
         // means the pin is stuck and the 10 ms minimum spacing is what paces the reads.
         if (by_pin && board::mag_drdy_high()) {
@@ -361,6 +365,13 @@ void step(uint32_t now_us) {
 
 }  // namespace
 
+// The set-up runs on a fixed timeline (pipeline::kMpuStartMs ...): the same
+// instants of a trajectory are sampled here and in the host replay tool.
+static void wait_until_ms(uint16_t ms) {
+    while (millis() < ms) {
+    }
+}
+
 void setup() {
     board::init_pins();  // every chip select high before any SPI traffic
     board::set_leds(true, false, false);
@@ -372,15 +383,18 @@ void setup() {
     print_settings_line();
 
     board::spi_begin();
+    wait_until_ms(pipeline::kMpuStartMs);
     mpu_ok = mpu_start();
     mpu_retry_ms = millis();
 
     board::wire_begin();
     if (board::sda_low()) board::i2c_recover();
+    wait_until_ms(pipeline::kMagStartMs);
     mag_start(true);
     say(TXT("# type help for commands"));
     if (pipe.settings().mode == fmt::OutputMode::Csv) Writer(out).str(TXT("t_ms,roll,pitch,yaw\n"));
     board::serial_drain();  // the banner out before the 200 Hz loop starts: no overrun
+    wait_until_ms(pipeline::kLoopStartMs);
     window_start_us = micros();
     update_leds();
 }

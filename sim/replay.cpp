@@ -122,22 +122,25 @@ int main(int argc, char** argv) {
     const hmc5883::I2cBus i2c{&board, i2c_write_reg, i2c_read_regs, delay_ms};
     const text::Sink log_sink{nullptr, log_write, log_write_flash};
 
-    // Set-up, in the firmware's order (firmware/main.cpp setup()).
+    // Set-up, in the firmware's order and on its timeline (firmware/main.cpp setup()).
     mpu6000::Mpu6000 mpu(spi);
     hmc5883::Hmc5883 mag(i2c);
     pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr);
+    board.advance(pipeline::kMpuStartMs * 1e-3);
     const mpu6000::InitResult mpu_init = mpu.begin();
     if (mpu_init.status != mpu6000::InitStatus::Ok) {
         fprintf(stderr, "replay: the MPU6000 model did not come up (status %d)\n", (int)mpu_init.status);
         return 2;
     }
+    board.advance(pipeline::kMagStartMs * 1e-3);
     const bool mag_ok = mag.begin(true).status == hmc5883::InitStatus::Ok;
     pipe.set_mag_present(mag_ok);
     if (!mag_ok) fprintf(stderr, "replay: the HMC5883L model did not come up: yaw is gyro-only\n");
 
+    board.advance(pipeline::kLoopStartMs * 1e-3);
     printf("t,roll,pitch,yaw\n");
-    const double kMagReadMin_s = 0.010;  // the firmware's kMagReadMinMs
-    double last_mag_read_s = -1.0;
+    const uint32_t kMagReadMinSteps = 2;  // the firmware's
+    uint32_t last_mag_read_step = 0;
     while (board.t_s < end_s) {
         // Wait for the data-ready line, as the loop does.
         while (!mpu_model.int_pin_high() && board.t_s < end_s) board.advance(mpu_model.next_event_s());
@@ -147,10 +150,10 @@ int main(int argc, char** argv) {
             fprintf(stderr, "replay: MPU6000 burst read failed at t=%.3f s\n", board.t_s);
             return 2;
         }
-        if (mag_ok && mag_model.drdy_pin_high() && board.t_s - last_mag_read_s >= kMagReadMin_s) {
+        if (mag_ok && mag_model.drdy_pin_high() && pipe.steps() - last_mag_read_step >= kMagReadMinSteps) {
             linalg::Vector3f field_uT;
             if (mag.read(field_uT) == hmc5883::ReadStatus::Ok) pipe.on_mag_sample(field_uT);
-            last_mag_read_s = board.t_s;
+            last_mag_read_step = pipe.steps();
         }
         pipe.on_imu_sample(sample);
         if (pipe.output_due()) {

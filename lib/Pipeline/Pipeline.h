@@ -38,6 +38,14 @@
 
 namespace pipeline {
 
+// The set-up timeline, fixed so that a run is reproducible: each stage starts at
+// this time after reset (or as soon after as the one before it is done). The host
+// replay tool follows the same timeline, so both sample the same instants of a
+// trajectory and their angles can be compared one for one.
+constexpr uint16_t kMpuStartMs = 50;    // after the banner
+constexpr uint16_t kMagStartMs = 200;   // after the MPU6000's 100 ms reset and wake
+constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the banner's drain
+
 constexpr uint16_t kRateHz = 200;               // the MPU6000's sample rate = the estimator step
 constexpr float kStep_s = 0.005f;
 constexpr uint16_t kStartupDeadlineSteps = 260; // 1.3 s: the first line must be out within 2 s of reset

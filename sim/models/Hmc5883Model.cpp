@@ -49,9 +49,7 @@ void Hmc5883Model::advance_to(double t_s) {
         const double t_m = next_measurement_s_;
         const uint8_t mode = regs_[hmc5883::REG_MODE] & kModeMask;
         if (mode == hmc5883::kModeContinuous) {
-            float rate_hz = hmc5883::output_rate_hz(regs_[hmc5883::REG_CONFIG_A]);
-            if (!(rate_hz > 0.0f)) rate_hz = 75.0f;  // reserved DO code: fastest listed rate
-            next_measurement_s_ = t_m + 1.0 / rate_hz;
+            next_measurement_s_ = t_m + 1.0 / continuous_rate_hz();
         } else {
             next_measurement_s_ = kNever_s;
             regs_[hmc5883::REG_MODE] = (uint8_t)((regs_[hmc5883::REG_MODE] & ~kModeMask) | kModeIdle);
@@ -62,6 +60,11 @@ void Hmc5883Model::advance_to(double t_s) {
 }
 
 double Hmc5883Model::next_event_s() const { return next_measurement_s_; }
+
+double Hmc5883Model::continuous_rate_hz() const {
+    const float rate_hz = hmc5883::output_rate_hz(regs_[hmc5883::REG_CONFIG_A]);
+    return rate_hz > 0.0f ? rate_hz : 75.0;  // reserved DO code: the fastest listed rate
+}
 
 void Hmc5883Model::measure(double t_s) {
     // Data lock: part of the last sample was read, not all of it.
@@ -106,8 +109,15 @@ void Hmc5883Model::measure(double t_s) {
 void Hmc5883Model::schedule_after_mode_write() {
     data_read_mask_ = 0;  // a mode write releases the lock
     const uint8_t mode = regs_[hmc5883::REG_MODE] & kModeMask;
-    if (mode == hmc5883::kModeContinuous || mode == hmc5883::kModeSingle)
+    if (mode == hmc5883::kModeSingle) {
         next_measurement_s_ = time_s_ + kMeasurementDelay_s;
+    } else if (mode == hmc5883::kModeContinuous) {
+        // The first measurement lands ~6 ms after the mode write, on the output rate's
+        // grid anchored at t = 0 (a model choice, as the MPU6000 model's: simavr runs
+        // and the host replay then sample the same instants).
+        const double rate_hz = continuous_rate_hz();
+        next_measurement_s_ = std::ceil((time_s_ + kMeasurementDelay_s) * rate_hz) / rate_hz;
+    }
     else
         next_measurement_s_ = kNever_s;
 }

@@ -87,6 +87,7 @@ public:
 private:
     void measure(double t_s);
     void schedule_after_mode_write();
+    double continuous_rate_hz() const;
     uint8_t register_value(uint8_t reg) const;
 
     Trajectory trajectory_;

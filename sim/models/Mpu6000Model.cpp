@@ -48,7 +48,6 @@ void Mpu6000Model::reset_registers() {
     regs_[mpu6000::REG_WHO_AM_I] = mpu6000::kWhoAmIValue;
     data_ready_ = false;
     filter_primed_ = false;
-    samples_since_output_ = 0;
     int_pulse_end_s_ = -1.0;
 }
 
@@ -63,10 +62,12 @@ void Mpu6000Model::advance_to(double t_s) {
     if (t_s < time_s_) return;
     while (next_internal_s_ <= t_s) {
         const double t_sample_s = next_internal_s_;
-        next_internal_s_ += 1.0 / internal_rate_hz();
+        // The next point of the internal rate's grid (anchored at t = 0; the rate
+        // changes from 8 to 1 kHz when the DLPF is switched on).
+        const double rate_hz = internal_rate_hz();
+        next_internal_s_ = (std::floor(t_sample_s * rate_hz + 0.5) + 1.0) / rate_hz;
         if (t_sample_s < reset_until_s_ || asleep()) {
             filter_primed_ = false;
-            samples_since_output_ = 0;
             continue;
         }
         internal_sample(t_sample_s);
@@ -105,10 +106,10 @@ void Mpu6000Model::internal_sample(double t_s) {
     }
     filter_primed_ = true;
 
-    if (++samples_since_output_ >= 1u + regs_[mpu6000::REG_SMPLRT_DIV]) {
-        samples_since_output_ = 0;
-        publish_sample(t_s);
-    }
+    // Output every (1 + SMPLRT_DIV)-th internal sample, counted on the absolute grid
+    // (see advance_to): the same instants whenever the chip was configured.
+    const long index = std::lround(t_s * rate_hz);
+    if (index % (1L + regs_[mpu6000::REG_SMPLRT_DIV]) == 0) publish_sample(t_s);
 }
 
 void Mpu6000Model::publish_sample(double t_s) {
@@ -230,8 +231,10 @@ void Mpu6000Model::write_register_from_spi(uint8_t reg, uint8_t value, double sc
     }
     regs_[reg] = value;
     if (reg == mpu6000::REG_PWR_MGMT_1 && !(value & kPwrSleep)) {
-        // Waking: the sample grid restarts from now at the internal rate.
-        if (next_internal_s_ < time_s_) next_internal_s_ = time_s_;
+        // Waking: sampling resumes at the next point of the internal rate's grid,
+        // anchored at t = 0 (a model choice: the chip's own phase is arbitrary, and
+        // a fixed one makes simavr runs and the host replay sample the same instants).
+        if (next_internal_s_ < time_s_) next_internal_s_ = std::ceil(time_s_ * internal_rate_hz()) / internal_rate_hz();
     }
 }
 

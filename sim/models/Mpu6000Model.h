@@ -112,7 +112,6 @@ private:
 
     double time_s_ = 0.0;
     double next_internal_s_ = 0.0;
-    unsigned samples_since_output_ = 0;
     double reset_until_s_ = -1.0;
     bool filter_primed_ = false;
     float gyro_dps_filtered_[3] = {0, 0, 0};   // chip axes

@@ -5,7 +5,7 @@
 //   30 s of two of them, scored with the dataset's metric. The bounds are regression
 //   guards with a margin over today's figures; `make bench` prints the figures.
 // Recordings absent (a clone without ../shared): those tests skip with a message.
-#include <map>
+#include <algorithm>
 
 #include "e2e_support.h"
 
