@@ -256,6 +256,26 @@ TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
     EXPECT_EQ(log.find("# warn: MPU6000 spike", first + 1), std::string::npos) << "rate-limited";
 }
 
+TEST(Pipeline, SaturatedAccelIsNotGravityButGyroIsIntegrated) {
+    std::string log;
+    const text::Sink sink{&log, sink_write, sink_flash};
+    pipeline::AttitudePipeline p(&sink);
+    for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));  // past the start-up ramp
+    log.clear();
+    // 1 s of clipped accel pointing sideways (8 g on body y): with the flag set it must
+    // not tilt the estimate.
+    mpu6000::Sample clipped = imu(kBias, Vector3f(0.0f, 78.45f, -9.80665f));
+    clipped.accel_saturated = true;
+    for (int i = 0; i < 200; ++i) p.on_imu_sample(clipped);
+    EXPECT_NEAR(p.angles().roll_deg, 0.0f, 0.05f);
+    EXPECT_NE(log.find("# warn: MPU6000 accel saturated"), std::string::npos) << log;
+    // The gyro still counts: 0.5 s at 20 deg/s about x with a saturated accel rolls 10 deg.
+    mpu6000::Sample turning = clipped;
+    turning.gyro_rad_s = kBias + Vector3f(20.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    for (int i = 0; i < 100; ++i) p.on_imu_sample(turning);
+    EXPECT_NEAR(p.angles().roll_deg, 10.0f, 0.3f);
+}
+
 TEST(Pipeline, MagCalibrationCommand) {
     std::string log;
     const text::Sink sink{&log, sink_write, sink_flash};

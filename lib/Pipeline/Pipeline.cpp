@@ -48,7 +48,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
 }
 
 // Spikes and non-finite values are replaced by the previous sample; saturation is
-// reported but used (the true rate is at least the full scale).
+// reported (a saturated gyro is used: the true rate is at least the full scale; a
+// saturated accel is withheld from the DCM by on_imu_sample).
 mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
     bool spike = !s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite();
     if (!spike && have_last_) {
@@ -146,7 +147,12 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         start_estimator(s.accel_m_s2);
     }
 
-    dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s), s.accel_m_s2);
+    // A clipped accelerometer sample is not the specific force: the DCM gets NaN for it
+    // and gives gravity no weight this step (Dcm::update); the gyro is still integrated
+    // (a saturated gyro is a lower bound of the rate, closer to the truth than nothing).
+    const float nan = __builtin_nanf("");
+    dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s),
+                s.accel_saturated ? Vector3f(nan, nan, nan) : s.accel_m_s2);
     if (mag_pending_ && mag_present_) dcm_.correct_heading(mag_cal_uT_);
     mag_pending_ = false;
 

@@ -17,7 +17,8 @@
 // If the board is never still for kStartupDeadlineSteps the estimator starts anyway
 // with the saved bias (or zero) and the measurement goes on in the background.
 // Each step: calibration applied (calib::apply_*), spikes and non-finite samples
-// replaced by the previous sample, Dcm::update at the fixed 5 ms step, then
+// replaced by the previous sample, Dcm::update at the fixed 5 ms step (a saturated
+// accelerometer sample goes in as NaN: no gravity weight that step), then
 // Dcm::correct_heading if a field sample came in since the previous step.
 //
 // Messages (to the sink, each a "# " line): gyro calibration progress and result,
