@@ -1,10 +1,9 @@
-// Arduino.h and Wire, then the core's function-like macros removed: Arduino.h
+// Arduino.h, then the core's function-like macros removed: Arduino.h
 // #defines constrain/min/max/abs/round/sq/radians/degrees, which would rewrite the
 // project's own functions (linalg::constrain) in every header included after it.
 #pragma once
 
 #include <Arduino.h>
-#include <Wire.h>
 
 #undef constrain
 #undef min

@@ -57,42 +57,110 @@ static void wait_ms(void*, uint16_t ms) { delay(ms); }
 const mpu6000::SpiDevice kSpi = {nullptr, spi_select, spi_transfer, wait_ms};
 
 // ---------------------------------------------------------------------------
-// I2C through Wire, every call bounded by its timeout. (A polled TWI driver of our own
-// would save ~1.5 KB, but simavr 1.6 does not complete a polled SLA+R: tests first.)
-static constexpr uint32_t kI2cTimeoutUs = 3000;  // any Wire call returns within ~3 ms
+// I2C master on the TWI at register level, interrupt-driven like the Arduino Wire
+// (simavr 1.6 completes an SLA+R only through the interrupt), in ~1/4 of Wire's flash
+// (Wire, its Stream/Print vtable and digitalWrite cost ~2.4 KB). One transaction at a
+// time: START, SLA, the bytes, STOP. The caller waits with a 3 ms bound; on a timeout
+// the TWI is reset and i2c_timed_out() says so once.
+static constexpr uint32_t kI2cTimeoutUs = 3000;  // any bus call returns within ~3 ms
+static constexpr uint8_t kTwiGo = _BV(TWINT) | _BV(TWEN) | _BV(TWIE);
+static constexpr uint8_t kTwiStop = _BV(TWINT) | _BV(TWEN) | _BV(TWSTO);
+
+static uint8_t twi_sla;                // address byte with R/W
+static uint8_t* twi_buf;               // bytes to send / received
+static volatile uint8_t twi_len, twi_index;
+static volatile int8_t twi_result;     // 0 running, 1 done, -1 failed
+static bool twi_timeout_flag = false;
+
+static void twi_enable() {
+    TWSR = 0;                                                    // prescaler 1
+    TWBR = (uint8_t)((F_CPU / kI2cClockHz - 16u) / 2u);         // 12: 400 kHz
+    TWCR = _BV(TWEN);
+}
 
 void wire_begin() {
-    Wire.begin();
-    Wire.setClock(kI2cClockHz);
-    Wire.setWireTimeout(kI2cTimeoutUs, true);
+    PORTD |= _BV(PD0) | _BV(PD1);  // internal pull-ups, as Wire.begin() sets them
+    twi_enable();
 }
 
 bool i2c_timed_out() {
-    if (!Wire.getWireTimeoutFlag()) return false;
-    Wire.clearWireTimeoutFlag();
-    return true;
+    const bool t = twi_timeout_flag;
+    twi_timeout_flag = false;
+    return t;
+}
+
+ISR(TWI_vect) {
+    const uint8_t st = TWSR & 0xF8u;
+    const uint8_t i = twi_index;
+    switch (st) {
+        case 0x08:  // START
+        case 0x10:  // repeated START
+            TWDR = twi_sla;
+            TWCR = kTwiGo;
+            return;
+        case 0x18:  // SLA+W acknowledged
+        case 0x28:  // data byte acknowledged
+            if (i < twi_len) {
+                TWDR = twi_buf[i];
+                twi_index = (uint8_t)(i + 1u);
+                TWCR = kTwiGo;
+                return;
+            }
+            break;  // all sent: STOP, done
+        case 0x50:  // byte received, ACK returned
+            twi_buf[i] = TWDR;
+            twi_index = (uint8_t)(i + 1u);
+            // fall through: ask for the next byte
+        case 0x40:  // SLA+R acknowledged
+            // ACK every byte but the last.
+            TWCR = (uint8_t)(kTwiGo | ((uint8_t)(twi_index + 1u) < twi_len ? _BV(TWEA) : 0));
+            return;
+        case 0x58:  // last byte received, NACK returned
+            twi_buf[i] = TWDR;
+            twi_index = (uint8_t)(i + 1u);
+            break;
+        default:    // NACK on address or data, arbitration lost, bus error
+            TWCR = kTwiStop;
+            twi_result = -1;
+            return;
+    }
+    TWCR = kTwiStop;
+    twi_result = 1;
+}
+
+// One transaction, bounded: true when every byte went (or came) with an ACK.
+static bool twi_transfer(uint8_t addr7, bool read, uint8_t* data, uint8_t len) {
+    twi_sla = (uint8_t)((uint8_t)(addr7 << 1) | (read ? 1u : 0u));
+    twi_buf = data;
+    twi_len = len;
+    twi_index = 0;
+    twi_result = 0;
+    const uint32_t start = micros();
+    TWCR = (uint8_t)(kTwiGo | _BV(TWSTA));
+    while (twi_result == 0 || (TWCR & _BV(TWSTO))) {  // done, and the STOP is out
+        if (micros() - start > kI2cTimeoutUs) {
+            TWCR = 0;  // release the bus and reset the TWI
+            twi_enable();
+            twi_timeout_flag = true;
+            return false;
+        }
+    }
+    return twi_result > 0;
 }
 
 static bool i2c_write_reg(void*, uint8_t addr7, uint8_t reg, uint8_t value) {
-    Wire.beginTransmission(addr7);
-    Wire.write(reg);
-    Wire.write(value);
-    return Wire.endTransmission() == 0;
+    uint8_t b[2] = {reg, value};
+    return twi_transfer(addr7, false, b, 2);
 }
 
 static bool i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t len) {
-    Wire.beginTransmission(addr7);
-    Wire.write(reg);
-    if (Wire.endTransmission() != 0) return false;
-    if (Wire.requestFrom(addr7, len) != len) return false;
-    for (uint8_t i = 0; i < len; ++i) data[i] = (uint8_t)Wire.read();
-    return true;
+    return twi_transfer(addr7, false, &reg, 1) && twi_transfer(addr7, true, data, len);
 }
 
 const hmc5883::I2cBus kI2c = {nullptr, i2c_write_reg, i2c_read_regs, wait_ms};
 
 void i2c_recover() {
-    Wire.end();  // the pins back to the port
+    TWCR = 0;  // the pins back to the port
     DDRD &= (uint8_t)~(_BV(PD0) | _BV(PD1));
     PORTD |= _BV(PD0) | _BV(PD1);
     delayMicroseconds(5);

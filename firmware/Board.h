@@ -1,6 +1,6 @@
 // The APM 2.5 board seen by the firmware: pins, the bus seams filled with the AVR's
-// own SPI and USART0 at register level (the Arduino SPI and HardwareSerial cost ~1.5 KB
-// of flash and 160 B of RAM for what this board needs) and with Wire for I2C, the LEDs
+// own SPI, TWI and USART0 at register level (the Arduino SPI, Wire and HardwareSerial
+// cost ~4 KB of flash and 370 B of RAM for what this board needs), the LEDs
 // and the benchmark markers. The only place (with main.cpp) that includes Arduino.h;
 // the Arduino core is also used for init(), millis(), micros() and delay().
 #pragma once
@@ -39,11 +39,11 @@ inline bool sda_low() { return (PIND & _BV(PD1)) == 0; }
 void init_pins();           // LEDs off, every SPI chip select high (53 then 40), inputs
 void set_leds(bool calibrating, bool running, bool fault);
 void spi_begin();           // after init_pins: SPI master, mode 0
-void wire_begin();          // Wire at 400 kHz with a 3 ms timeout
+void wire_begin();          // the TWI at 400 kHz, pull-ups on; every call bounded by 3 ms
 // Frees the I2C bus when a slave holds SDA low: up to 16 SCL pulses until SDA is
 // released (>= 9 clocks finish any byte), then a STOP, then the TWI again.
 void i2c_recover();
-// True (and clears it) if a Wire call timed out since the last call.
+// True (and clears it) if an I2C call timed out since the last call.
 bool i2c_timed_out();
 
 extern const mpu6000::SpiDevice kSpi;
