@@ -160,8 +160,9 @@ TEST(Mpu6000Driver, SilentBusIsNoSensor) {
 namespace {
 
 // ---------------------------------------------------------------------------
-// A register-level HMC5883L: ambient field + positive bias in self-test, single and
-// continuous modes, RDY in the status register.
+// A register-level HMC5883L: the ambient field, or the bias field alone in self-test
+// (the chip subtracts the ambient itself), single and continuous modes, RDY in the
+// status register.
 struct FakeHmc {
     uint8_t reg[16] = {};
     bool present = true;
@@ -179,7 +180,7 @@ struct FakeHmc {
     void measure() {
         int16_t v[3];
         const bool positive = (reg[0] & 0x03) == 0x01;
-        for (int i = 0; i < 3; ++i) v[i] = (int16_t)(ambient[i] + (positive ? bias[i] : 0));
+        for (int i = 0; i < 3; ++i) v[i] = positive ? bias[i] : ambient[i];
         // Data order X, Z, Y.
         const int16_t order[3] = {v[0], v[2], v[1]};
         for (int i = 0; i < 3; ++i) {
@@ -218,10 +219,10 @@ TEST(Hmc5883Driver, SelfTestScaleAndContinuousConfig) {
     const hmc5883::InitResult r = mag.begin(true);
     ASSERT_EQ(r.status, hmc5883::InitStatus::Ok);
     EXPECT_TRUE(mag.self_test_passed());
-    // The ambient field is subtracted: scale = expected / bias alone.
-    EXPECT_NEAR(mag.self_test_scale().x, 766.0f / 740.0f, 1e-4f);
-    EXPECT_NEAR(mag.self_test_scale().y, 713.0f / 700.0f, 1e-4f);
-    EXPECT_NEAR(mag.self_test_scale().z, 713.0f / 690.0f, 1e-4f);
+    // scale = expected (datasheet bias field at 660 LSB/Ga) / measured.
+    EXPECT_NEAR(mag.self_test_scale().x, 1.16f * 660.0f / 740.0f, 1e-4f);
+    EXPECT_NEAR(mag.self_test_scale().y, 1.16f * 660.0f / 700.0f, 1e-4f);
+    EXPECT_NEAR(mag.self_test_scale().z, 1.08f * 660.0f / 690.0f, 1e-4f);
     EXPECT_EQ(chip.reg[hmc5883::REG_CONFIG_A], 0x78);
     EXPECT_EQ(chip.reg[hmc5883::REG_CONFIG_B], 0x20);
     EXPECT_EQ(chip.reg[hmc5883::REG_MODE], 0x00);

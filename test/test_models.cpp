@@ -302,10 +302,16 @@ TEST(Hmc5883Model, DrdyRisesAbout6msAfterAModeWriteAndFallsOnRead) {
     uint8_t raw[hmc5883::kDataLength];
     ASSERT_TRUE(mag.read_registers(hmc5883::REG_DATA_X_MSB, raw, sizeof raw));
     EXPECT_FALSE(mag.drdy_pin_high());
-    // 75 Hz: the next sample 13.3 ms later.
-    mag.advance_to(1.0065 + 0.0125);
+    // Then 75 Hz on the grid anchored at t = 0 (k / 75 s), at least half a period on:
+    // 76/75 = 1.01333 s, then 77/75 = 1.02667 s.
+    mag.advance_to(1.0130);
     EXPECT_FALSE(mag.drdy_pin_high());
-    mag.advance_to(1.0065 + 0.0140);
+    mag.advance_to(1.0134);
+    EXPECT_TRUE(mag.drdy_pin_high());
+    ASSERT_TRUE(mag.read_registers(hmc5883::REG_DATA_X_MSB, raw, sizeof raw));
+    mag.advance_to(1.0265);
+    EXPECT_FALSE(mag.drdy_pin_high());
+    mag.advance_to(1.0267);
     EXPECT_TRUE(mag.drdy_pin_high());
 }
 
@@ -326,9 +332,9 @@ TEST(Hmc5883Model, PointerReturnsTo3AfterRegister8) {
     for (int i = 0; i < 6; ++i) EXPECT_EQ(twelve[i], twelve[i + 6]) << i;
 }
 
-TEST(Hmc5883Model, PositiveBiasAddsTheSelfTestField) {
-    const double no_field_uT[3] = {0.0, 0.0, 0.0};
-    sim::Hmc5883Model mag(constant_trajectory(kGyro_rad_s, kAccel_m_s2, no_field_uT));
+TEST(Hmc5883Model, PositiveBiasReadsTheSelfTestFieldAlone) {
+    // The external field does not show: the chip subtracts it (datasheet).
+    sim::Hmc5883Model mag(constant_trajectory(kGyro_rad_s, kAccel_m_s2, kMag_uT));
     ASSERT_TRUE(mag.write_register(hmc5883::REG_CONFIG_A, 0x70 | hmc5883::kConfigA_PositiveBias));
     ASSERT_TRUE(mag.write_register(hmc5883::REG_CONFIG_B, (uint8_t)hmc5883::kSelfTestGain));
     ASSERT_TRUE(mag.write_register(hmc5883::REG_MODE, hmc5883::kModeSingle));
@@ -336,11 +342,16 @@ TEST(Hmc5883Model, PositiveBiasAddsTheSelfTestField) {
     uint8_t raw[hmc5883::kDataLength];
     ASSERT_TRUE(mag.read_registers(hmc5883::REG_DATA_X_MSB, raw, sizeof raw));
     const hmc5883::Counts counts = hmc5883::counts_from_data(raw);
-    EXPECT_NEAR(counts.x, 1.1 * 660, 1);
-    EXPECT_NEAR(counts.y, 1.1 * 660, 1);
+    EXPECT_NEAR(counts.x, 1.16 * 660, 1);
+    EXPECT_NEAR(counts.y, 1.16 * 660, 1);
     EXPECT_NEAR(counts.z, 1.08 * 660, 1);
+    // A perfect chip's self-test gives unit scale on every axis.
     hmc5883::SelfTest self_test;
-    EXPECT_TRUE(self_test.add_sample(counts));
+    for (int i = 0; i < 5; ++i) EXPECT_TRUE(self_test.add_sample(counts));
+    ASSERT_TRUE(self_test.done());
+    EXPECT_NEAR(self_test.scale().x, 1.0f, 0.002f);
+    EXPECT_NEAR(self_test.scale().y, 1.0f, 0.002f);
+    EXPECT_NEAR(self_test.scale().z, 1.0f, 0.002f);
 }
 
 TEST(Hmc5883Model, FaultsAbsentOverflowDrdyStuck) {

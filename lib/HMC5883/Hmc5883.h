@@ -8,9 +8,10 @@
 //                              for hard iron before overflow, at 0.09 uT resolution.
 //   75 Hz, 8-sample average    the fastest continuous rate, averaged against noise; the
 //                              estimator folds each sample in as it comes.
-// Self-test: positive bias at gain 2.5 Ga in single-measurement mode, minus an unbiased
-// measurement taken just before (so the Earth's field does not pollute the ratio),
-// checked by hmc5883::SelfTest; per-axis scale = expected / measured, 1.0 on failure.
+// Self-test: positive bias at gain 2.5 Ga in single-measurement mode; the chip
+// subtracts the external field itself (datasheet "Self Test Operation"), so each
+// reading is the bias field, checked by hmc5883::SelfTest against the datasheet's
+// 1.16 / 1.16 / 1.08 Ga; per-axis scale = expected / measured, 1.0 on failure.
 #pragma once
 
 #include <stdint.h>

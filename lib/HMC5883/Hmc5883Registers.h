@@ -68,12 +68,17 @@ DataStatus decode_data(const uint8_t raw[kDataLength], Gain gain, linalg::Vector
 
 bool id_matches(const uint8_t id[kIdLength]);
 
-// Self-test with the positive bias (datasheet "Self Test Operation"), at gain 2.5 Ga:
-// the bias field gives about 1.1 Ga on X and Y, 1.08 Ga on Z. Counts expected at
-// gain 0x60 (ArduPilot's figures); a sample is plausible when expected/measured is
-// within 0.7..1.3 on every axis. Five good samples of at most twenty tries make the scale.
+// Self-test with the positive bias (datasheet "Self Test Operation"): the offset
+// straps add 1.16 Ga on X and Y and 1.08 Ga on Z, and the chip itself subtracts a
+// measurement of the external field, so the data registers hold the bias field
+// alone. A sample is plausible when expected/measured is within 0.7..1.3 on every
+// axis; five good samples of at most twenty tries make the scale. (ArduPilot
+// expected 713 counts on Y like Z; the datasheet gives Y the same 1.16 Ga as X, and
+// with 713 a perfect chip would be "corrected" 7 % off between X and Y, which turns
+// into ~2 deg of heading error. The register model uses the same field.)
 constexpr Gain kSelfTestGain = Gain::Ga2_5;
-constexpr float kSelfTestExpected[3] = {766.0f, 713.0f, 713.0f};
+constexpr float kSelfTestField_Ga[3] = {1.16f, 1.16f, 1.08f};
+constexpr float kSelfTestExpected[3] = {1.16f * 660.0f, 1.16f * 660.0f, 1.08f * 660.0f};  // counts at 2.5 Ga
 constexpr uint8_t kSelfTestSamplesNeeded = 5;
 constexpr uint8_t kSelfTestMaxTries = 20;
 

@@ -20,7 +20,6 @@ constexpr uint8_t kStatusLock = 0x02;
 constexpr uint8_t kLastRegister = 12;
 constexpr uint8_t kLastDataRegister = 8;
 // Datasheet "Self Test Operation": positive bias field per chip axis, gauss.
-constexpr float kBiasField_Ga[3] = {1.1f, 1.1f, 1.08f};
 
 int16_t counts_or_overflow(float gauss, float lsb_per_gauss) {
     const int16_t counts = linalg::saturate_int16(gauss * lsb_per_gauss);
@@ -49,7 +48,10 @@ void Hmc5883Model::advance_to(double t_s) {
         const double t_m = next_measurement_s_;
         const uint8_t mode = regs_[hmc5883::REG_MODE] & kModeMask;
         if (mode == hmc5883::kModeContinuous) {
-            next_measurement_s_ = t_m + 1.0 / continuous_rate_hz();
+            // The output rate's grid anchored at t = 0 (a model choice: simavr runs and
+            // the host replay then sample the same instants), at least half a period on.
+            const double rate_hz = continuous_rate_hz();
+            next_measurement_s_ = std::ceil((t_m + 0.5 / rate_hz) * rate_hz) / rate_hz;
         } else {
             next_measurement_s_ = kNever_s;
             regs_[hmc5883::REG_MODE] = (uint8_t)((regs_[hmc5883::REG_MODE] & ~kModeMask) | kModeIdle);
@@ -80,10 +82,13 @@ void Hmc5883Model::measure(double t_s) {
     }
     const Vector3f chip_Ga = hmc5883::body_to_chip(sum_uT * (1.0f / (float)averaged)) * 0.01f;
     float field_Ga[3] = {chip_Ga.x, chip_Ga.y, chip_Ga.z};
+    // Self-test (datasheet "Self Test Operation"): the chip measures the external
+    // field, then the field with the offset straps on, and outputs the difference:
+    // the bias field alone, whatever the external field.
     const uint8_t bias = regs_[hmc5883::REG_CONFIG_A] & hmc5883::kConfigA_BiasMask;
-    for (int i = 0; i < 3; ++i) {
-        if (bias == hmc5883::kConfigA_PositiveBias) field_Ga[i] += kBiasField_Ga[i];
-        if (bias == hmc5883::kConfigA_NegativeBias) field_Ga[i] -= kBiasField_Ga[i];
+    if (bias == hmc5883::kConfigA_PositiveBias || bias == hmc5883::kConfigA_NegativeBias) {
+        const float sign = bias == hmc5883::kConfigA_PositiveBias ? 1.0f : -1.0f;
+        for (int i = 0; i < 3; ++i) field_Ga[i] = sign * hmc5883::kSelfTestField_Ga[i];
     }
     const float lsb = hmc5883::lsb_per_gauss((hmc5883::Gain)(regs_[hmc5883::REG_CONFIG_B] & 0xE0));
     int16_t x = counts_or_overflow(field_Ga[0], lsb);
@@ -109,15 +114,8 @@ void Hmc5883Model::measure(double t_s) {
 void Hmc5883Model::schedule_after_mode_write() {
     data_read_mask_ = 0;  // a mode write releases the lock
     const uint8_t mode = regs_[hmc5883::REG_MODE] & kModeMask;
-    if (mode == hmc5883::kModeSingle) {
+    if (mode == hmc5883::kModeContinuous || mode == hmc5883::kModeSingle)
         next_measurement_s_ = time_s_ + kMeasurementDelay_s;
-    } else if (mode == hmc5883::kModeContinuous) {
-        // The first measurement lands ~6 ms after the mode write, on the output rate's
-        // grid anchored at t = 0 (a model choice, as the MPU6000 model's: simavr runs
-        // and the host replay then sample the same instants).
-        const double rate_hz = continuous_rate_hz();
-        next_measurement_s_ = std::ceil((time_s_ + kMeasurementDelay_s) * rate_hz) / rate_hz;
-    }
     else
         next_measurement_s_ = kNever_s;
 }

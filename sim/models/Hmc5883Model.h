@@ -10,8 +10,9 @@
 //   written bytes go to Config A, Config B, Mode (others are read-only and ignored).
 //   Reads auto-increment; after register 8 the pointer returns to 3, after 12 to 0.
 // - Config A: averaging 1/2/4/8 (bits 6:5), output rate (bits 4:2), measurement bias
-//   (bits 1:0; positive self-test bias adds 1.1 Ga on X and Y, 1.08 Ga on Z: datasheet
-//   "Self Test Operation"; the ambient field stays in the reading).
+//   (bits 1:0; with the positive self-test bias the reading is the bias field alone,
+//   1.16 Ga on X and Y, 1.08 Ga on Z: datasheet "Self Test Operation", the chip
+//   subtracts the external field itself).
 // - Config B gain (bits 7:5) and its LSB/Ga (datasheet table 9); a channel outside
 //   [-2048, 2047] counts reads -4096.
 // - Mode: continuous (first sample ~6 ms after the write, then at the output rate),
