@@ -15,39 +15,22 @@ Calibration default_calibration() {
 static bool within(float v, float lo, float hi) { return v >= lo && v <= hi; }  // false for NaN
 
 bool is_plausible(const Calibration& c) {
-    const float g[3] = {c.gyro_bias_rad_s.x, c.gyro_bias_rad_s.y, c.gyro_bias_rad_s.z};
-    const float o[3] = {c.mag_offset_uT.x, c.mag_offset_uT.y, c.mag_offset_uT.z};
-    const float s[3] = {c.mag_scale.x, c.mag_scale.y, c.mag_scale.z};
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (!within(g[i], -kGyroBiasMax_rad_s, kGyroBiasMax_rad_s)) return false;
-        if (!within(o[i], -200.0f, 200.0f)) return false;
-        if (!within(s[i], 0.5f, 2.0f)) return false;
+    // Bias, offset and scale are nine packed floats (three Vector3f).
+    static_assert(sizeof(Calibration) == 9 * sizeof(float), "Calibration is nine floats");
+    const float* v = &c.gyro_bias_rad_s.x;
+    for (uint8_t i = 0; i < 9; ++i) {
+        const uint8_t k = (uint8_t)(i / 3u);
+        const float lo = k == 0 ? -kGyroBiasMax_rad_s : k == 1 ? -200.0f : 0.5f;
+        const float hi = k == 0 ? kGyroBiasMax_rad_s : k == 1 ? 200.0f : 2.0f;
+        if (!within(v[i], lo, hi)) return false;
     }
     return true;
 }
 
 // ---------------------------------------------------------------------------
-static void widen(Vector3f& lo, Vector3f& hi, const Vector3f& v) {
-    if (v.x < lo.x) lo.x = v.x;
-    if (v.y < lo.y) lo.y = v.y;
-    if (v.z < lo.z) lo.z = v.z;
-    if (v.x > hi.x) hi.x = v.x;
-    if (v.y > hi.y) hi.y = v.y;
-    if (v.z > hi.z) hi.z = v.z;
-}
-
-static float max_spread(const Vector3f& lo, const Vector3f& hi) {
-    const Vector3f d = hi - lo;
-    float m = d.x;
-    if (d.y > m) m = d.y;
-    if (d.z > m) m = d.z;
-    return m;
-}
-
 void GyroCalibrator::restart() {
-    n_ = 0;
+    n_ = 0;  // add() starts the sums and extremes afresh at n_ == 0
     done_ = false;
-    gyro_sum_ = accel_sum_ = Vector3f();
 }
 
 GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
@@ -56,12 +39,12 @@ GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vec
     const float a_norm = accel_m_s2.length();
     bool still = gyro_rad_s.is_finite() && accel_m_s2.is_finite() &&
                  a_norm > g * (1.0f - kAccelNormTol_g) && a_norm < g * (1.0f + kAccelNormTol_g);
-    if (still && n_ > 0) {
-        Vector3f glo = gyro_min_, ghi = gyro_max_, alo = accel_min_, ahi = accel_max_;
-        widen(glo, ghi, gyro_rad_s);
-        widen(alo, ahi, accel_m_s2);
-        still = max_spread(glo, ghi) <= kGyroSpreadMax_rad_s && max_spread(alo, ahi) <= kAccelSpreadMax_m_s2;
-        gyro_min_ = glo; gyro_max_ = ghi; accel_min_ = alo; accel_max_ = ahi;
+    const float v[6] = {gyro_rad_s.x, gyro_rad_s.y, gyro_rad_s.z, accel_m_s2.x, accel_m_s2.y, accel_m_s2.z};
+    // The spread (max - min) of every channel over the window so far.
+    for (uint8_t i = 0; i < 6 && still; ++i) {
+        if (n_ == 0 || v[i] < lo_[i]) lo_[i] = v[i];
+        if (n_ == 0 || v[i] > hi_[i]) hi_[i] = v[i];
+        still = hi_[i] - lo_[i] <= (i < 3 ? kGyroSpreadMax_rad_s : kAccelSpreadMax_m_s2);
     }
     if (!still) {
         const bool had_samples = n_ > 0;
@@ -69,23 +52,20 @@ GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vec
         if (had_samples) ++restarts_;
         return had_samples ? Result::Moved : Result::Collecting;
     }
-    if (n_ == 0) {
-        gyro_min_ = gyro_max_ = gyro_rad_s;
-        accel_min_ = accel_max_ = accel_m_s2;
-    }
-    gyro_sum_ += gyro_rad_s;
-    accel_sum_ += accel_m_s2;
+    for (uint8_t i = 0; i < 6; ++i) sum_[i] = (n_ == 0 ? 0.0f : sum_[i]) + v[i];
     ++n_;
     if (n_ < kGyroWindow) return Result::Collecting;
     const float inv = 1.0f / (float)n_;
-    const Vector3f mean = gyro_sum_ * inv;
-    mean_accel_ = accel_sum_ * inv;
-    if (!(mean.length() <= kGyroBiasMax_rad_s * 1.7320508f)) {  // steady spin: not a bias
+    float mean[6];
+    for (uint8_t i = 0; i < 6; ++i) mean[i] = sum_[i] * inv;
+    for (uint8_t i = 3; i < 6; ++i) bias_[i] = mean[i];  // the mean accel, kept either way
+    const float len2 = mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2];
+    if (!(len2 <= 3.0f * kGyroBiasMax_rad_s * kGyroBiasMax_rad_s)) {  // steady spin: not a bias
         restart();
         ++restarts_;
         return Result::Moved;
     }
-    bias_ = mean;
+    for (uint8_t i = 0; i < 3; ++i) bias_[i] = mean[i];
     done_ = true;
     return Result::Done;
 }
@@ -98,35 +78,35 @@ void MagCalibrator::restart() {
 
 void MagCalibrator::add(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
-    if (n_ == 0) {
-        min_ = max_ = field_uT;
-    } else {
-        widen(min_, max_, field_uT);
+    const float* v = &field_uT.x;
+    for (uint8_t i = 0; i < 3; ++i) {
+        if (n_ == 0 || v[i] < min_[i]) min_[i] = v[i];
+        if (n_ == 0 || v[i] > max_[i]) max_[i] = v[i];
     }
     if (n_ < 0xFFFFu) ++n_;
 }
 
 MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
     if (n_ < kMagCalMinSamples) return Quality::TooFewSamples;
-    const Vector3f half = (max_ - min_) * 0.5f;
-    const float h[3] = {half.x, half.y, half.z};
-    float lo = h[0], hi = h[0];
+    float h[3];
+    float lo = 0.0f, hi = 0.0f, sum = 0.0f;
     for (uint8_t i = 0; i < 3; ++i) {
-        if (h[i] < kMagMinHalfSpan_uT) {
-            axis_ = i;
-            return Quality::AxisNotTurned;
-        }
-        if (h[i] > kMagMaxHalfSpan_uT) {
-            axis_ = i;
-            return Quality::SpanTooLarge;
-        }
-        if (h[i] < lo) lo = h[i];
-        if (h[i] > hi) hi = h[i];
+        h[i] = (max_[i] - min_[i]) * 0.5f;
+        axis_ = i;
+        if (h[i] < kMagMinHalfSpan_uT) return Quality::AxisNotTurned;
+        if (h[i] > kMagMaxHalfSpan_uT) return Quality::SpanTooLarge;
+        if (i == 0 || h[i] < lo) lo = h[i];
+        if (i == 0 || h[i] > hi) hi = h[i];
+        sum += h[i];
     }
     if (hi > lo * kMagMaxSpanRatio) return Quality::AxesDisagree;
-    const float mean = (h[0] + h[1] + h[2]) * (1.0f / 3.0f);
-    cal.mag_offset_uT = (max_ + min_) * 0.5f;
-    cal.mag_scale = Vector3f(mean / h[0], mean / h[1], mean / h[2]);
+    const float mean = sum * (1.0f / 3.0f);
+    float* offset = &cal.mag_offset_uT.x;
+    float* scale = &cal.mag_scale.x;
+    for (uint8_t i = 0; i < 3; ++i) {
+        offset[i] = (max_[i] + min_[i]) * 0.5f;
+        scale[i] = mean / h[i];
+    }
     return Quality::Ok;
 }
 

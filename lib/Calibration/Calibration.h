@@ -59,16 +59,19 @@ public:
     // Feeds one sample (raw gyro, raw accel); returns what happened.
     Result add(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2);
     bool done() const { return done_; }
-    linalg::Vector3f bias() const { return bias_; }
+    linalg::Vector3f bias() const { return linalg::Vector3f(bias_[0], bias_[1], bias_[2]); }
     // Mean specific force over the last complete still window (gravity for the DCM init).
-    linalg::Vector3f mean_accel_m_s2() const { return mean_accel_; }
+    linalg::Vector3f mean_accel_m_s2() const { return linalg::Vector3f(bias_[3], bias_[4], bias_[5]); }
     uint16_t count() const { return n_; }
     uint16_t restarts() const { return restarts_; }
 
 private:
-    linalg::Vector3f gyro_sum_, accel_sum_;
-    linalg::Vector3f gyro_min_, gyro_max_, accel_min_, accel_max_;
-    linalg::Vector3f bias_, mean_accel_;
+    // Plain arrays, gyro x y z then accel x y z: one loop does all six channels, and
+    // the object needs no constructor code. Valid from the first add() of a window
+    // (n_ == 0 starts them); bias_ once done().
+    float sum_[6];
+    float lo_[6], hi_[6];
+    float bias_[6] = {};  // mean gyro (the bias), then mean accel
     uint16_t n_ = 0;
     uint16_t restarts_ = 0;
     bool done_ = false;
@@ -103,11 +106,11 @@ public:
     Quality finish(Calibration& cal);
     // The axis (0 = x, 1 = y, 2 = z) that failed AxisNotTurned / SpanTooLarge.
     uint8_t axis() const { return axis_; }
-    linalg::Vector3f min_uT() const { return min_; }
-    linalg::Vector3f max_uT() const { return max_; }
+    linalg::Vector3f min_uT() const { return linalg::Vector3f(min_[0], min_[1], min_[2]); }
+    linalg::Vector3f max_uT() const { return linalg::Vector3f(max_[0], max_[1], max_[2]); }
 
 private:
-    linalg::Vector3f min_, max_;
+    float min_[3], max_[3];  // valid once count() > 0
     uint16_t n_ = 0;
     uint8_t axis_ = 0;
 };
