@@ -4,8 +4,6 @@
 
 namespace settings {
 
-using linalg::Vector3f;
-
 Settings defaults() {
     Settings s;
     s.rate_hz = kRateDefaultHz;
@@ -27,50 +25,24 @@ uint16_t crc16(const uint8_t* data, uint16_t len) {
     return crc;
 }
 
-namespace {
-
-struct Out {
-    uint8_t* p;
-    void u8(uint8_t v) { *p++ = v; }
-    void u16(uint16_t v) { u8((uint8_t)(v & 0xFFu)); u8((uint8_t)(v >> 8)); }
-    void f32(float v) {
-        uint8_t b[4];
-        memcpy(b, &v, 4);  // IEEE-754 little-endian on both the AVR and x86/ARM hosts
-        for (uint8_t i = 0; i < 4; ++i) u8(b[i]);
-    }
-    void vec(const Vector3f& v) { f32(v.x); f32(v.y); f32(v.z); }
-};
-
-struct In {
-    const uint8_t* p;
-    uint8_t u8() { return *p++; }
-    uint16_t u16() { const uint8_t lo = u8(); return (uint16_t)(lo | (uint16_t)((uint16_t)u8() << 8)); }
-    float f32() {
-        uint8_t b[4];
-        for (uint8_t i = 0; i < 4; ++i) b[i] = u8();
-        float v;
-        memcpy(&v, b, 4);
-        return v;
-    }
-    Vector3f vec() { const float x = f32(); const float y = f32(); return Vector3f(x, y, f32()); }
-};
-
-}  // namespace
+// The payload: rate, declination (2), mode, flags, then the calibration's nine floats
+// (IEEE-754, little-endian on both the AVR and x86/ARM hosts: memcpy is the layout).
+static_assert(sizeof(calib::Calibration) == 36, "Calibration is nine packed floats");
 
 void encode(const Settings& s, uint8_t out[kRecordSize]) {
-    Out o{out};
-    o.u8(kMagic0);
-    o.u8(kMagic1);
-    o.u8(kSettingsVersion);
-    o.u8(kPayloadLength);
-    o.u8(s.rate_hz);
-    o.u16((uint16_t)s.declination_centideg);
-    o.u8((uint8_t)s.mode);
-    o.u8(s.flags);
-    o.vec(s.cal.gyro_bias_rad_s);
-    o.vec(s.cal.mag_offset_uT);
-    o.vec(s.cal.mag_scale);
-    o.u16(crc16(out, (uint16_t)(4u + kPayloadLength)));
+    out[0] = kMagic0;
+    out[1] = kMagic1;
+    out[2] = kSettingsVersion;
+    out[3] = kPayloadLength;
+    out[4] = s.rate_hz;
+    out[5] = (uint8_t)((uint16_t)s.declination_centideg & 0xFFu);
+    out[6] = (uint8_t)((uint16_t)s.declination_centideg >> 8);
+    out[7] = (uint8_t)s.mode;
+    out[8] = s.flags;
+    memcpy(out + 9, &s.cal, sizeof s.cal);
+    const uint16_t crc = crc16(out, (uint16_t)(4u + kPayloadLength));
+    out[4 + kPayloadLength] = (uint8_t)(crc & 0xFFu);
+    out[5 + kPayloadLength] = (uint8_t)(crc >> 8);
 }
 
 bool is_valid(const Settings& s) {
@@ -87,17 +59,14 @@ LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     if (blank) return LoadResult::Blank;
     if (in[0] != kMagic0 || in[1] != kMagic1) return LoadResult::BadMagic;
     if (in[2] != kSettingsVersion || in[3] != kPayloadLength) return LoadResult::OldVersion;
-    In r{in + 4 + kPayloadLength};
-    if (r.u16() != crc16(in, (uint16_t)(4u + kPayloadLength))) return LoadResult::BadCrc;
-    In p{in + 4};
+    const uint16_t crc = (uint16_t)(in[4 + kPayloadLength] | (uint16_t)((uint16_t)in[5 + kPayloadLength] << 8));
+    if (crc != crc16(in, (uint16_t)(4u + kPayloadLength))) return LoadResult::BadCrc;
     Settings s;
-    s.rate_hz = p.u8();
-    s.declination_centideg = (int16_t)p.u16();
-    s.mode = (fmt::OutputMode)p.u8();
-    s.flags = p.u8();
-    s.cal.gyro_bias_rad_s = p.vec();
-    s.cal.mag_offset_uT = p.vec();
-    s.cal.mag_scale = p.vec();
+    s.rate_hz = in[4];
+    s.declination_centideg = (int16_t)(uint16_t)(in[5] | (uint16_t)((uint16_t)in[6] << 8));
+    s.mode = (fmt::OutputMode)in[7];
+    s.flags = in[8];
+    memcpy(&s.cal, in + 9, sizeof s.cal);
     if (!is_valid(s)) return LoadResult::BadValue;
     out = s;
     return LoadResult::Ok;
