@@ -256,24 +256,45 @@ TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
     EXPECT_EQ(log.find("# warn: MPU6000 spike", first + 1), std::string::npos) << "rate-limited";
 }
 
-TEST(Pipeline, SaturatedAccelIsNotGravityButGyroIsIntegrated) {
+TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
     std::string log;
     const text::Sink sink{&log, sink_write, sink_flash};
     pipeline::AttitudePipeline p(&sink);
     for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));  // past the start-up ramp
     log.clear();
-    // 1 s of clipped accel pointing sideways (8 g on body y): with the flag set it must
+    // 1 s of accel stuck at full scale on every axis (a broken sensor, 14 g): it must
     // not tilt the estimate.
-    mpu6000::Sample clipped = imu(kBias, Vector3f(0.0f, 78.45f, -9.80665f));
+    const float fs = 8.0f * 9.80665f;
+    mpu6000::Sample clipped = imu(kBias, Vector3f(fs, fs, -fs));
     clipped.accel_saturated = true;
     for (int i = 0; i < 200; ++i) p.on_imu_sample(clipped);
     EXPECT_NEAR(p.angles().roll_deg, 0.0f, 0.05f);
+    EXPECT_NEAR(p.angles().pitch_deg, 0.0f, 0.05f);
     EXPECT_NE(log.find("# warn: MPU6000 accel saturated"), std::string::npos) << log;
-    // The gyro still counts: 0.5 s at 20 deg/s about x with a saturated accel rolls 10 deg.
+    // The gyro still counts: 0.5 s at 20 deg/s about x with a stuck accel rolls 10 deg.
     mpu6000::Sample turning = clipped;
     turning.gyro_rad_s = kBias + Vector3f(20.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
     for (int i = 0; i < 100; ++i) p.on_imu_sample(turning);
     EXPECT_NEAR(p.angles().roll_deg, 10.0f, 0.3f);
+}
+
+TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
+    // A shake that clips one axis for 40 ms at each swing: the clipped samples are
+    // used, so the shake averages out as it does unclipped (withholding the clipped
+    // half of each swing would leave the other half and tilt the estimate).
+    pipeline::AttitudePipeline p(nullptr);
+    for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    const float fs = 8.0f * 9.80665f;
+    for (int cycle = 0; cycle < 20; ++cycle) {
+        for (int i = 0; i < 8; ++i) {  // 40 ms of +x clipped
+            mpu6000::Sample s = imu(kBias, Vector3f(fs, 0.0f, -9.80665f));
+            s.accel_saturated = true;
+            p.on_imu_sample(s);
+        }
+        for (int i = 0; i < 8; ++i) p.on_imu_sample(imu(kBias, Vector3f(-fs + 0.5f, 0.0f, -9.80665f)));
+    }
+    for (int i = 0; i < 20; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    EXPECT_LT(std::fabs(p.angles().pitch_deg), 1.0f);
 }
 
 TEST(Pipeline, MagCalibrationCommand) {

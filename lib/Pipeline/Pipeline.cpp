@@ -131,6 +131,14 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     }
 }
 
+// How many axes sit at the accelerometer's full scale (8 g, 32767/4096 counts).
+static uint8_t clipped_axes(const Vector3f& a_m_s2) {
+    const float full_scale_m_s2 = 7.99f * mpu6000::kStandardGravity_m_s2;
+    return (uint8_t)((a_m_s2.x >= full_scale_m_s2 || a_m_s2.x <= -full_scale_m_s2) +
+                     (a_m_s2.y >= full_scale_m_s2 || a_m_s2.y <= -full_scale_m_s2) +
+                     (a_m_s2.z >= full_scale_m_s2 || a_m_s2.z <= -full_scale_m_s2));
+}
+
 void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     output_due_ = false;
     ++steps_;
@@ -147,12 +155,19 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         start_estimator(s.accel_m_s2);
     }
 
-    // A clipped accelerometer sample is not the specific force: the DCM gets NaN for it
-    // and gives gravity no weight this step (Dcm::update); the gyro is still integrated
-    // (a saturated gyro is a lower bound of the rate, closer to the truth than nothing).
+    // A clipped accelerometer sample still points roughly the right way: in a violent
+    // motion one axis clips for a few ms, and dropping those samples would bias the
+    // estimator's low-passed gravity (BROAD's 10 g fast translation: 1.7 -> 5.2 deg
+    // RMSE; its clipped samples never have two axes clipped at once). Two or more
+    // axes at full scale (at least 11 g) is not a motion but a stuck or broken sensor,
+    // and so is one axis clipped for longer than kAccelSaturationFaultSteps: then the
+    // DCM gets NaN and gives gravity no weight that step (Dcm::update). The gyro is
+    // always integrated (saturated, it is a lower bound of the rate).
+    accel_saturated_steps_ = s.accel_saturated ? (uint8_t)(accel_saturated_steps_ < 255 ? accel_saturated_steps_ + 1 : 255) : 0;
+    const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel_m_s2) >= 2 ||
+                                                   accel_saturated_steps_ > kAccelSaturationFaultSteps);
     const float nan = __builtin_nanf("");
-    dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s),
-                s.accel_saturated ? Vector3f(nan, nan, nan) : s.accel_m_s2);
+    dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s), accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2);
     if (mag_pending_ && mag_present_) dcm_.correct_heading(mag_cal_uT_);
     mag_pending_ = false;
 

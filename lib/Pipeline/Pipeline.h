@@ -56,6 +56,7 @@ constexpr float kSpikeGyroJump_rad_s = 17.45f;  // 1000 deg/s in one 5 ms step: 
 constexpr float kSpikeAccel_g = 4.0f;           // |a| above this right after a normal sample
 constexpr float kNormalAccel_g = 2.0f;
 constexpr uint8_t kMaxSpikeRun = 3;             // more in a row: it is real, use it
+constexpr uint8_t kAccelSaturationFaultSteps = 20;  // 100 ms of clipped accel: a stuck sensor, not a motion
 constexpr float kMagMin_uT = 10.0f;             // Earth: 25..65 uT; outside 10..200 = not the Earth
 constexpr float kMagMax_uT = 200.0f;
 
@@ -150,6 +151,7 @@ private:
     uint16_t output_acc_ = 0;
     Phase phase_ = Phase::WaitImu;
     uint8_t spike_run_ = 0;
+    uint8_t accel_saturated_steps_ = 0;  // consecutive saturated accel samples
     bool have_last_ = false;
     bool mag_present_ = false;
     bool mag_pending_ = false;
