@@ -295,9 +295,8 @@ bool Dcm::field_matches(float norm, float down_component, float ref_norm, float 
 
 void Dcm::clamp_bias() {
     const float limit = settings_.bias_limit_rad_s;
-    bias_rad_s_.x = linalg::constrain(bias_rad_s_.x, -limit, limit);
-    bias_rad_s_.y = linalg::constrain(bias_rad_s_.y, -limit, limit);
-    bias_rad_s_.z = linalg::constrain(bias_rad_s_.z, -limit, limit);
+    float* axis[3] = {&bias_rad_s_.x, &bias_rad_s_.y, &bias_rad_s_.z};
+    for (uint8_t i = 0; i < 3; ++i) *axis[i] = linalg::constrain(*axis[i], -limit, limit);
 }
 
 // Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, bring
