@@ -37,6 +37,7 @@ struct DcmSettings {
     float mag_dip_tolerance;         // field.down/|field| may differ from the learned one by this
     float mag_recover_s;             // a different field steady this long becomes the reference, s
     float mag_latency_s;             // age of a field sample against the gyro-propagated attitude, s
+    float output_lead_s;             // the output is R carried forward by this, s
 };
 
 extern const DcmSettings kDefaultDcmSettings;
@@ -82,6 +83,11 @@ public:
     const DcmSettings& settings() const { return settings_; }
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const { return euler_from_dcm(r_); }
+    // Euler angles of R carried forward by output_lead_s at the last corrected rate:
+    // the attitude now rather than when the (low-passed, hence delayed) gyro sample
+    // was taken. R (I + [w lead x]), first order: the lead is a few ms. What the
+    // firmware prints.
+    EulerAngles euler_now() const;
 
     // The roll/pitch correction is worked out every this many steps (50 Hz at the
     // default 200 Hz step) and applied at every step: it moves at the 3 s pace of

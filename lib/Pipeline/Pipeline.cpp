@@ -191,7 +191,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
 }
 
 Angles AttitudePipeline::angles() const {
-    const dcm::EulerAngles e = dcm_.euler();
+    const dcm::EulerAngles e = dcm_.euler_now();
     // yaw is within +-180 deg and the declination within +-180 (settings range): two
     // folds reach 0 <= h < 360, where dcm::heading_deg's fmodf would cost ~300 B of flash.
     float h = e.yaw_rad * linalg::kDegPerRad + settings_.declination_deg();
