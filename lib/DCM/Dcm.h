@@ -45,9 +45,9 @@ extern const DcmSettings kDefaultDcmSettings;
 // Bits of Dcm::status().
 enum StatusFlags : uint8_t {
     kStatusInitialised = 0x01,
-    kStatusAccelIgnored = 0x02,   // last step gave gravity no weight (|a| far from 1 g or NaN)
+    kStatusAccelIgnored = 0x02,   // last step gave gravity no weight (NaN or beyond any range)
     kStatusMagIgnored = 0x04,     // last mag sample rejected (disturbed, NaN, or too vertical)
-    kStatusBiasHeld = 0x08,       // integrator held: rotating fast
+    kStatusBiasHeld = 0x08,       // integrator held: rotating fast, or starting up
     kStatusRecovered = 0x10,      // the matrix was rebuilt since start (sticky)
     kStatusNoHeading = 0x20,      // no magnetometer sample yet: yaw is gyro-only
     kStatusGyroRejected = 0x40,   // last gyro sample non-finite or beyond any range: not integrated
@@ -63,13 +63,17 @@ public:
     // Returns false (and stays uninitialised) when gravity is unusable.
     bool init(const linalg::Vector3f& accel_m_s2, const linalg::Vector3f& mag_field);
 
-    // One fixed step: integrate the gyro (R <- R (I + [w x] dt)), renormalise, and
-    // apply the roll/pitch drift correction from gravity. A non-finite gyro sample is
-    // rejected (not integrated); a non-finite or absurd accel sample gets no weight.
+    // One fixed step: integrate the gyro (R <- R exp([w dt x]), to second order),
+    // renormalise, and feed gravity to the roll/pitch drift correction (worked out
+    // every kCorrectionDivider steps, applied at every step). A non-finite gyro
+    // sample is rejected (not integrated); a non-finite or absurd accel sample gets
+    // no weight.
     void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2);
 
     // Yaw drift correction from a new magnetometer sample (call when one arrives,
-    // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down.
+    // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down,
+    // applied in the next step. Samples whose strength or dip differ from the
+    // learned earth field are rejected (kStatusMagIgnored).
     void correct_heading(const linalg::Vector3f& mag_field);
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
