@@ -5,6 +5,13 @@
 
 namespace board {
 
+void start_clock() {
+    TCCR0A = _BV(WGM01) | _BV(WGM00);
+    TCCR0B = _BV(CS01) | _BV(CS00);
+    TIMSK0 = _BV(TOIE0);
+    sei();
+}
+
 void init_pins() {
     // Outputs written high before they are outputs: no low glitch on a chip select.
     PORTA |= _BV(PA5) | _BV(PA4) | _BV(PA3);  // LEDs off

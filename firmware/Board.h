@@ -2,7 +2,8 @@
 // own SPI, TWI and USART0 at register level (the Arduino SPI, Wire and HardwareSerial
 // cost ~4 KB of flash and 370 B of RAM for what this board needs), the LEDs
 // and the benchmark markers. The only place (with main.cpp) that includes Arduino.h;
-// the Arduino core is also used for init(), millis(), micros() and delay().
+// the Arduino core is used for millis(), micros() and delay() only (its init() sets up
+// every timer and the ADC for PWM and analogRead: start_clock() does what we use).
 #pragma once
 
 #include "ArduinoCore.h"
@@ -36,6 +37,9 @@ inline bool mpu_int_high() { return (PINE & _BV(PE6)) != 0; }
 inline bool mag_drdy_high() { return (PINC & _BV(PC6)) != 0; }
 inline bool sda_low() { return (PIND & _BV(PD1)) == 0; }
 
+// Timer 0 as the Arduino core's init() sets it (fast PWM, clock/64, overflow interrupt:
+// what millis(), micros() and delay() count), then interrupts on.
+void start_clock();
 void init_pins();           // LEDs off, every SPI chip select high (53 then 40), inputs
 void set_leds(bool calibrating, bool running, bool fault);
 void spi_begin();           // after init_pins: SPI master, mode 0

@@ -443,3 +443,11 @@ void loop() {
     step(now_us);
     if (pipe.steps() % 50u == 0u) update_leds();
 }
+
+// Our own entry point instead of the core's main(): its init() also starts timers 1..5
+// for PWM and the ADC, which this board does not use.
+int main() {
+    board::start_clock();
+    setup();
+    for (;;) loop();
+}
