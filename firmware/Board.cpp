@@ -255,11 +255,6 @@ int16_t serial_read() {
 }
 
 static void sink_write(void*, const char* data, uint8_t len) { serial_write(data, len); }
-static void sink_write_flash(void*, const char* p) {
-    for (char c = (char)pgm_read_byte(p); c != '\0'; c = (char)pgm_read_byte(++p)) ring_put(c);
-    tx_kick();
-}
-
-const text::Sink kSerialSink = {nullptr, sink_write, sink_write_flash};
+const text::Sink kSerialSink = {nullptr, sink_write, nullptr};  // Writer reads the flash itself
 
 }  // namespace board

@@ -77,8 +77,8 @@ void say(Flash a) { Writer(out).str(a).end(); }
 
 // "... (reg 0xRR wrote 0xWW read 0xVV)": a register that did not keep its value.
 void print_readback(Flash part, uint8_t reg, uint8_t wrote, uint8_t read) {
-    Writer(out).str(TXT("# error: ")).str(part).str(TXT(" did not keep its configuration (reg 0x")).hex8(reg)
-        .str(TXT(" wrote 0x")).hex8(wrote).str(TXT(" read 0x")).hex8(read).chr(')').end();
+    Writer(out).str(TXT(TXT_ERROR)).str(part).str(TXT(" did not keep its configuration: reg 0x")).hex8(reg)
+        .str(TXT(" wrote 0x")).hex8(wrote).str(TXT(" read 0x")).hex8(read).end();
 }
 
 // ---------------------------------------------------------------------------
@@ -87,10 +87,10 @@ bool mpu_start() {
     if (r.status == mpu6000::InitStatus::Ok) return true;
     if (!mpu_reported) {
         if (r.status == mpu6000::InitStatus::WrongIdentity)
-            Writer(out).str(TXT("# error: MPU6000 not found (WHO_AM_I=0x")).hex8(r.read)
+            Writer(out).str(TXT(TXT_ERROR TXT_MPU " not found (WHO_AM_I=0x")).hex8(r.read)
                 .str(TXT(", expected 0x68)")).end();
         else
-            print_readback(TXT("MPU6000"), r.reg, r.wrote, r.read);
+            print_readback(TXT(TXT_MPU), r.reg, r.wrote, r.read);
     }
     mpu_reported = true;
     return false;
@@ -100,8 +100,8 @@ bool mpu_start() {
 // means for yaw; the compass is then retried every second.
 void mag_failed(Flash why) {
     if (!mag_reported) {
-        if (why.p != nullptr) Writer(out).str(TXT("# error: HMC5883L ")).str(why).end();
-        say(TXT("# warn: HMC5883L absent: yaw is gyro-only"));
+        if (why.p != nullptr) Writer(out).str(TXT(TXT_ERROR TXT_HMC " ")).str(why).end();
+        say(TXT(TXT_WARN TXT_HMC " absent: yaw is gyro-only"));
     }
     mag_reported = true;
     mag_ok = false;
@@ -116,10 +116,10 @@ bool mag_start(bool self_test) {
         if (!mag_reported && r.status != hmc5883::InitStatus::NoAnswer) {
             why.p = nullptr;
             if (r.status == hmc5883::InitStatus::WrongIdentity) {
-                Writer(out).str(TXT("# error: HMC5883L wrong identity (ID=")).hex8(r.id[0]).chr(' ')
-                    .hex8(r.id[1]).chr(' ').hex8(r.id[2]).str(TXT(", expected 48 34 33 'H43')")).end();
+                Writer(out).str(TXT(TXT_ERROR TXT_HMC " wrong ID ")).hex8(r.id[0]).chr(' ')
+                    .hex8(r.id[1]).chr(' ').hex8(r.id[2]).str(TXT(", expected 48 34 33 (H43)")).end();
             } else {
-                print_readback(TXT("HMC5883L"), r.reg, r.wrote, r.read);
+                print_readback(TXT(TXT_HMC), r.reg, r.wrote, r.read);
             }
         }
         mag_failed(why);
@@ -128,11 +128,11 @@ bool mag_start(bool self_test) {
     if (self_test) {
         if (mag.self_test_passed()) {
             const linalg::Vector3f s = mag.self_test_scale();
-            Writer(out).str(TXT("# HMC5883L self-test: scale ")).fixed2(s.x).chr(' ').fixed2(s.y).chr(' ')
+            Writer(out).str(TXT("# " TXT_HMC " self-test: scale ")).fixed2(s.x).chr(' ').fixed2(s.y).chr(' ')
                 .fixed2(s.z).end();
         } else {
-            Writer(out).str(TXT("# warn: HMC5883L self-test implausible (")).u32(mag.self_test_good_samples())
-                .str(TXT(" of 5 good samples): scale 1.0")).end();
+            Writer(out).str(TXT(TXT_WARN TXT_HMC " self-test implausible (")).u32(mag.self_test_good_samples())
+                .str(TXT("/5 good): scale 1.0")).end();
         }
     }
     last_mag_read_ms = last_mag_ok_ms = millis();
@@ -148,7 +148,7 @@ void print_settings_line() {
     char buf[14];
     Writer(out).str(TXT("# settings: rate ")).u32(s.rate_hz).str(TXT(" Hz, decl "))
         .str(buf, text::format_centi(buf, s.declination_centideg)).str(TXT(" deg, mode "))
-        .str(console::mode_name(s.mode)).str(TXT(", compass calibration "))
+        .str(console::mode_name(s.mode)).str(TXT(", compass cal "))
         .str((s.flags & settings::kFlagMagCalibrated) ? TXT("yes") : TXT("none")).end();
 }
 
@@ -156,13 +156,13 @@ Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
 
 void print_status() {
     Writer w(out);
-    w.str(TXT("# status: MPU6000 ")).str(ok_or_failed(mpu_ok)).str(TXT(", HMC5883L ")).str(ok_or_failed(mag_ok));
+    w.str(TXT("# status: " TXT_MPU " ")).str(ok_or_failed(mpu_ok)).str(TXT(", " TXT_HMC " ")).str(ok_or_failed(mag_ok));
     if (!mag_ok) w.str(TXT(" (yaw gyro-only)"));
     const pipeline::Phase ph = pipe.phase();
     w.str(TXT(", estimator "))
         .str(ph == pipeline::Phase::Running       ? TXT("running")
              : ph == pipeline::Phase::Calibrating ? TXT("calibrating")
-                                                  : TXT("waiting for MPU6000"))
+                                                  : TXT("waiting for " TXT_MPU))
         .end();
     char buf[14];
     w.str(TXT("# load ")).u32(load_pct).str(TXT("%, overruns ")).u32(overruns)
@@ -176,7 +176,7 @@ void start_save() {
     settings::encode(pipe.settings(), save_buf);
     save_index = 0;
     save_verify = true;
-    say(TXT("# saving to EEPROM..."));
+    say(TXT("# saving to " TXT_EEPROM));
 }
 
 void service_save() {
@@ -191,7 +191,7 @@ void service_save() {
     bool same = true;
     for (uint8_t i = 0; i < settings::kRecordSize; ++i)
         same = same && eeprom_read_byte((const uint8_t*)(settings::kEepromAddress + i)) == save_buf[i];
-    say(same ? TXT("# saved") : TXT("# error: EEPROM write did not verify; settings not saved"));
+    say(same ? TXT("# saved") : TXT(TXT_ERROR TXT_EEPROM " write did not verify: not saved"));
 }
 
 void load_settings() {
@@ -199,12 +199,12 @@ void load_settings() {
     eeprom_read_block(rec, (const void*)settings::kEepromAddress, settings::kRecordSize);
     Flash m;
     switch (settings::decode(rec, pipe.settings())) {
-        case settings::LoadResult::Ok: m = TXT("# settings loaded from EEPROM"); break;
-        case settings::LoadResult::Blank: m = TXT("# EEPROM blank: default settings"); break;
-        case settings::LoadResult::BadMagic: m = TXT("# warn: EEPROM holds something else: default settings"); break;
-        case settings::LoadResult::OldVersion: m = TXT("# warn: EEPROM settings from another version: default settings"); break;
-        case settings::LoadResult::BadCrc: m = TXT("# warn: EEPROM settings corrupted (CRC): default settings"); break;
-        default: m = TXT("# warn: EEPROM settings out of range: default settings"); break;
+        case settings::LoadResult::Ok: m = TXT("# settings loaded from " TXT_EEPROM); break;
+        case settings::LoadResult::Blank: m = TXT("# " TXT_EEPROM " blank" TXT_DEFAULTS); break;
+        case settings::LoadResult::BadMagic: m = TXT(TXT_WARN TXT_EEPROM " holds something else" TXT_DEFAULTS); break;
+        case settings::LoadResult::OldVersion: m = TXT(TXT_WARN TXT_EEPROM " from another version" TXT_DEFAULTS); break;
+        case settings::LoadResult::BadCrc: m = TXT(TXT_WARN TXT_EEPROM " corrupted (CRC)" TXT_DEFAULTS); break;
+        default: m = TXT(TXT_WARN TXT_EEPROM " values out of range" TXT_DEFAULTS); break;
     }
     say(m);
 }
@@ -238,7 +238,7 @@ void service_mag(uint32_t now_ms) {
         if (!mag.ready_by_status(ready)) ++mag_failures;
         if (ready) {
             due = true;
-            if (!mag_drdy_warned) say(TXT("# warn: HMC5883L DRDY pin silent: polling its status register"));
+            if (!mag_drdy_warned) say(TXT(TXT_WARN TXT_HMC " DRDY pin silent: polling status"));
             mag_drdy_warned = true;
         }
     }
@@ -253,7 +253,7 @@ void service_mag(uint32_t now_ms) {
         // means the pin is stuck and the 10 ms minimum spacing is what paces the reads.
         if (by_pin && board::mag_drdy_high()) {
             if (mag_drdy_high_reads < 3 && ++mag_drdy_high_reads == 3)
-                say(TXT("# warn: HMC5883L DRDY pin stuck high: reading every 10 ms"));
+                say(TXT(TXT_WARN TXT_HMC " DRDY pin stuck high: reading every 10 ms"));
         } else {
             mag_drdy_high_reads = 0;
         }
@@ -265,7 +265,7 @@ void service_mag(uint32_t now_ms) {
             if (by_pin) mag_drdy_warned = false;  // the pin works (again): a new silence is news
         } else if (st == hmc5883::ReadStatus::Overflow) {
             last_mag_ok_ms = now_ms;  // it answers; the field is just out of range
-            if (!mag_overflow_warned) say(TXT("# warn: HMC5883L overflow (-4096): samples dropped"));
+            if (!mag_overflow_warned) say(TXT(TXT_WARN TXT_HMC " overflow (-4096): samples dropped"));
             mag_overflow_warned = true;  // once until a good sample
         } else if (st != hmc5883::ReadStatus::Skipped) {
             ++mag_failures;
@@ -283,10 +283,10 @@ void service_mag(uint32_t now_ms) {
 void retry_sensors(uint32_t now_ms) {
     if (!mpu_ok && now_ms - mpu_retry_ms >= kRetryMs) {
         mpu_retry_ms = now_ms;
-        say(TXT("# no attitude: MPU6000 absent, retrying every 1 s"));
+        say(TXT("# no attitude: " TXT_MPU " absent, retrying every 1 s"));
         uint8_t who = 0;
         if (mpu.probe(who) && mpu_start()) {
-            say(TXT("# recovered: MPU6000 (WHO_AM_I=0x68)"));
+            say(TXT("# recovered: " TXT_MPU));
             mpu_ok = true;
             mpu_reported = false;
             have_sample_time = false;
@@ -297,7 +297,7 @@ void retry_sensors(uint32_t now_ms) {
         mag_retry_ms = now_ms;
         if (board::sda_low()) board::i2c_recover();
         if (mag_start(false)) {
-            say(TXT("# recovered: HMC5883L (ID H43)"));
+            say(TXT("# recovered: " TXT_HMC));
             mag_reported = false;
         }
     }
@@ -323,7 +323,7 @@ void emit_output(uint32_t now_ms) {
                           : fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
     board::mark_end(board::kSecFormat);
     if (n > 0) board::serial_write(line, n);
-    else if (warn_angle.allow(now_ms, kWarnMs)) say(TXT("# warn: angle not finite: line skipped"));
+    else if (warn_angle.allow(now_ms, kWarnMs)) say(TXT(TXT_WARN "angle not finite: line skipped"));
 }
 
 // One 200 Hz step once the MPU6000 has a sample.
@@ -336,7 +336,7 @@ void step(uint32_t now_us) {
             const uint16_t missed = (uint16_t)((gap + kPeriodUs / 2u) / kPeriodUs - 1u);
             overruns += missed;
             if (warn_overrun.allow(now_ms, kWarnMs))
-                Writer(out).str(TXT("# warn: loop overrun: ")).u32(missed).str(TXT(" sample(s) missed, "))
+                Writer(out).str(TXT(TXT_WARN "loop overrun: ")).u32(missed).str(TXT(" sample(s) missed, "))
                     .u32(overruns).str(TXT(" in all")).end();
         }
     }
@@ -349,7 +349,7 @@ void step(uint32_t now_us) {
     board::mark_end(board::kSecMpuRead);
     if (st != mpu6000::BurstStatus::Ok) {
         mpu_ok = false;
-        if (!mpu_reported) say(TXT("# error: MPU6000 stopped answering (burst all 0x00 or 0xFF)"));
+        if (!mpu_reported) say(TXT(TXT_ERROR TXT_MPU " stopped answering (burst all 0x00 or 0xFF)"));
         mpu_reported = true;
         mpu_retry_ms = now_ms;
     } else {
@@ -376,9 +376,8 @@ void setup() {
     board::init_pins();  // every chip select high before any SPI traffic
     board::set_leds(true, false, false);
     board::serial_begin();
-    say(TXT("# apm25-attitude 0.1.0\n"
-            "# board: APM 2.5, ATmega2560 16 MHz, serial 115200, 200 Hz loop\n"
-            "# MPU6000: 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; HMC5883L: 75 Hz, 8-sample average, 1.3 Ga"));
+    say(TXT("# apm25-attitude 0.1.0: APM 2.5, 200 Hz loop\n"
+            "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     load_settings();
     print_settings_line();
 
@@ -392,7 +391,7 @@ void setup() {
     wait_until_ms(pipeline::kMagStartMs);
     mag_start(true);
     say(TXT("# type help for commands"));
-    if (pipe.settings().mode == fmt::OutputMode::Csv) Writer(out).str(TXT("t_ms,roll,pitch,yaw\n"));
+    if (pipe.settings().mode == fmt::OutputMode::Csv) Writer(out).str(console::csv_header());
     board::serial_drain();  // the banner out before the 200 Hz loop starts: no overrun
     wait_until_ms(pipeline::kLoopStartMs);
     window_start_us = micros();
@@ -425,14 +424,14 @@ void loop() {
         if (ready && have_sample_time && int_pin_ok) {
             int_pin_ok = false;
             have_sample_time = false;  // this gap is not an overrun
-            say(TXT("# warn: MPU6000 INT pin silent: polling INT_STATUS"));
+            say(TXT(TXT_WARN TXT_MPU " INT pin silent: polling INT_STATUS"));
         }
     }
     if (ready) {
         timer_pacing = false;
     } else if (have_sample_time && since >= (timer_pacing ? kPeriodUs : kTimerFallbackUs)) {
         if (!timer_pacing) {
-            if (!pacing_warned) say(TXT("# warn: MPU6000 data-ready not seen: pacing on the timer"));
+            if (!pacing_warned) say(TXT(TXT_WARN TXT_MPU " data-ready not seen: pacing on the timer"));
             pacing_warned = true;      // once until the INT pin works again
             have_sample_time = false;  // this gap is not an overrun
         }

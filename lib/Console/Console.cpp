@@ -153,6 +153,8 @@ Command LineReader::feed(uint8_t byte) {
     return make(CommandId::None);
 }
 
+text::Flash csv_header() { return TXT("t_ms,roll,pitch,yaw\n"); }
+
 text::Flash mode_name(fmt::OutputMode m) {
     switch (m) {
         case fmt::OutputMode::Csv: return TXT("csv");
@@ -164,13 +166,13 @@ text::Flash mode_name(fmt::OutputMode m) {
 
 void print_error(const Command& c, const text::Sink* out) {
     Writer w(out);
-    w.str(TXT("# error: "));
+    w.str(TXT(TXT_ERROR));
     switch (c.error) {
-        case Error::Unknown: w.str(TXT("unknown command (type help)")); break;
-        case Error::TooLong: w.str(TXT("line too long (max 40 characters), ignored")); break;
-        case Error::Garbage: w.str(TXT("non-text bytes in line, ignored")); break;
-        case Error::MissingArgument: w.str(TXT("missing argument (type help)")); break;
-        case Error::ExtraArgument: w.str(TXT("too many arguments (type help)")); break;
+        case Error::Unknown: w.str(TXT("unknown command" TXT_HELP)); break;
+        case Error::TooLong: w.str(TXT("line over 40 characters")); break;
+        case Error::Garbage: w.str(TXT("non-text bytes in line")); break;
+        case Error::MissingArgument: w.str(TXT("missing argument" TXT_HELP)); break;
+        case Error::ExtraArgument: w.str(TXT("too many arguments" TXT_HELP)); break;
         case Error::BadNumber: w.str(TXT("not a number (e.g. 50 or -2.5)")); break;
         case Error::RateRange: w.str(TXT("rate must be a whole number 1..100 Hz")); break;
         case Error::DeclRange: w.str(TXT("decl must be -180..180 degrees")); break;
@@ -183,14 +185,13 @@ void print_error(const Command& c, const text::Sink* out) {
 
 void print_help(const text::Sink* out) {
     Writer(out).str(TXT(
-        "# commands:\n"
-        "#   rate <Hz>            output rate 1..100 (now and after save)\n"
-        "#   decl <deg>           declination -180..180, east positive\n"
-        "#   mode plot|csv|quiet  output format\n"
-        "#   status               health, load, bias, temperature, uptime\n"
-        "#   cal gyro             gyro bias: keep still ~1 s\n"
-        "#   cal mag              compass: turn every way for 30 s\n"
-        "#   save | defaults      store settings / back to defaults\n"));
+        "# rate <Hz>: output rate 1..100\n"
+        "# decl <deg>: declination -180..180, east +\n"
+        "# mode plot|csv|quiet: output format\n"
+        "# status: health, load, bias, temperature, uptime\n"
+        "# cal gyro: gyro bias (keep still 1 s)\n"
+        "# cal mag: compass (turn every way for 30 s)\n"
+        "# save | defaults: store settings / back to defaults\n"));
 }
 
 bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* out) {
@@ -209,11 +210,11 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
         case CommandId::Mode:
             s.mode = c.mode;
             w.str(TXT("# mode ")).str(mode_name(c.mode)).end();
-            if (c.mode == fmt::OutputMode::Csv) w.str(TXT("t_ms,roll,pitch,yaw\n"));
+            if (c.mode == fmt::OutputMode::Csv) w.str(csv_header());
             return true;
         case CommandId::Defaults:
             s = settings::defaults();
-            w.str(TXT("# defaults: rate 50 Hz, decl 0.00, mode plot, compass calibration cleared (save to keep)")).end();
+            w.str(TXT("# defaults: rate 50 Hz, decl 0.00, mode plot, no compass cal (save to keep)")).end();
             return true;
         default:
             return false;

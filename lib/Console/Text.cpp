@@ -42,9 +42,41 @@ bool to_centi(float x, int32_t& out) {
     return true;
 }
 
+namespace {
+#ifdef __AVR__
+uint8_t flash_byte(const char* p) { return pgm_read_byte(p); }
+#define TEXT_PROGMEM PROGMEM
+#else
+uint8_t flash_byte(const char* p) { return (uint8_t)*p; }
+#define TEXT_PROGMEM
+#endif
+// The fragments of Text.h, NUL-separated, in flash: code k is the k-th.
+constexpr uint8_t kFragmentCount = 7;
+const char kFragments[] TEXT_PROGMEM =
+    "# warn: \0# error: \0MPU6000\0HMC5883L\0EEPROM\0: default settings\0 (type help)";
+}  // namespace
+
 Writer& Writer::str(Flash s) {
-    if (sink_ != nullptr && s.p != nullptr) sink_->write_flash(sink_->ctx, s.p);
-    return *this;
+    if (sink_ == nullptr || s.p == nullptr) return *this;
+    char buf[16];  // runs of plain text go to the sink in pieces of up to 16 bytes
+    uint8_t n = 0;
+    for (const char* p = s.p;; ++p) {
+        const uint8_t c = flash_byte(p);
+        const bool fragment = c != 0u && c <= kFragmentCount;
+        if (c == 0u || fragment || n == sizeof buf) {
+            str(buf, n);
+            n = 0;
+        }
+        if (c == 0u) return *this;
+        if (fragment) {
+            const char* f = kFragments;
+            for (uint8_t k = c; --k != 0u;)
+                while (flash_byte(f++) != 0u) {}
+            str(Flash{f});
+        } else {
+            buf[n++] = (char)c;
+        }
+    }
 }
 
 Writer& Writer::str(const char* ram, uint8_t len) {

@@ -3,8 +3,8 @@
 //
 // On AVR a string literal lives in SRAM unless it is put in flash (PROGMEM), and the
 // firmware has < 2 KB of static RAM to spend: every message is written TXT("...")
-// (flash on AVR, an ordinary literal on the host) and handed to the sink's
-// write_flash. No Arduino include: the firmware implements the sink with Serial, the
+// (flash on AVR, an ordinary literal on the host); Writer::str reads it byte by byte,
+// expands the shared fragments (TXT_WARN ...) and hands the text to the sink's write. No Arduino include: the firmware implements the sink with Serial, the
 // host tests with a std::string, the replay tool with nothing (a null sink is silent).
 #pragma once
 
@@ -22,6 +22,18 @@
 #define TXT(s) (::text::flash(s))
 #endif
 
+// Fragments that many messages share, each one control byte inside a TXT string and
+// expanded by Writer::str (flash spent once, not in every message). Write them as
+// separate literals, TXT(TXT_WARN TXT_MPU " spike"): "\x03" "spike" cannot swallow the
+// following hex digits. Codes 1..8 only: '\t' and '\n' are text.
+#define TXT_WARN "\x01"    // "# warn: "
+#define TXT_ERROR "\x02"   // "# error: "
+#define TXT_MPU "\x03"     // "MPU6000"
+#define TXT_HMC "\x04"     // "HMC5883L"
+#define TXT_EEPROM "\x05"    // "EEPROM"
+#define TXT_DEFAULTS "\x06"  // ": default settings"
+#define TXT_HELP "\x07"      // " (type help)"
+
 namespace text {
 
 // A NUL-terminated string in program memory on AVR (ordinary memory on the host).
@@ -33,7 +45,9 @@ inline Flash flash(const char* p) { return Flash{p}; }
 struct Sink {
     void* ctx;
     void (*write)(void* ctx, const char* data, uint8_t len);  // bytes in RAM
-    void (*write_flash)(void* ctx, const char* flash_str);    // NUL-terminated, program memory on AVR
+    // Not used by Writer any more (it expands the fragments itself and hands runs to
+    // write); kept so that existing sinks still compile. May be null.
+    void (*write_flash)(void* ctx, const char* flash_str);
 };
 
 // Decimal digits of v into buf (no NUL); returns the count (<= 10).
@@ -50,6 +64,7 @@ bool to_centi(float x, int32_t& out);
 class Writer {
 public:
     explicit Writer(const Sink* sink) : sink_(sink) {}
+    // A TXT string, its fragment codes expanded.
     Writer& str(Flash s);
     Writer& str(const char* ram, uint8_t len);
     Writer& chr(char c) { return str(&c, 1); }

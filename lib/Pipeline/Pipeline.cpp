@@ -37,8 +37,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
         if (warn_mag_.allow(steps_, kWarnIntervalSteps)) {
-            Writer(log_).str(TXT("# warn: HMC5883L field ")).fixed2(n)
-                .str(TXT(" uT is not the Earth's (10..200), sample not used")).end();
+            Writer(log_).str(TXT(TXT_WARN TXT_HMC " field ")).fixed2(n)
+                .str(TXT(" uT is not the Earth's (10..200): sample dropped")).end();
         }
         return;
     }
@@ -63,7 +63,7 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
         ++spike_run_;
         ++spikes_;
         if (warn_spike_.allow(steps_, kWarnIntervalSteps)) {
-            Writer(log_).str(TXT("# warn: MPU6000 spike: sample replaced by the previous one ("))
+            Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: previous sample used instead ("))
                 .u32(spikes_).str(TXT(" so far)")).end();
         }
         mpu6000::Sample out = last_;
@@ -75,9 +75,9 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
     if (!s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite()) return last_;
     spike_run_ = 0;
     if (s.gyro_saturated && warn_gyro_sat_.allow(steps_, kWarnIntervalSteps))
-        Writer(log_).str(TXT("# warn: MPU6000 gyro saturated (beyond 2000 deg/s)")).end();
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated (beyond 2000 deg/s)")).end();
     if (s.accel_saturated && warn_accel_sat_.allow(steps_, kWarnIntervalSteps))
-        Writer(log_).str(TXT("# warn: MPU6000 accel saturated (beyond 8 g)")).end();
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated (beyond 8 g)")).end();
     last_ = s;
     have_last_ = true;
     return s;
@@ -118,16 +118,15 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
     if (phase_ == Phase::Calibrating && gyro_cal_steps_ >= kStartupDeadlineSteps) {
         // Never still long enough: run with what we have, keep measuring in the background.
-        Writer(log_).str((settings_.flags & settings::kFlagGyroCalibrated)
-                             ? TXT("# warn: board not still: starting with the saved gyro bias")
-                             : TXT("# warn: board not still: starting with zero gyro bias"))
-            .str(TXT(", measuring on")).end();
+        Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
+            .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
+            .str(TXT(" gyro bias, measuring on")).end();
         start_estimator(raw.accel_m_s2);
         return;
     }
     if (phase_ == Phase::Running && gyro_cal_steps_ >= kGyroCalTimeoutSteps) {
         gyro_cal_active_ = false;
-        Writer(log_).str(TXT("# error: cal gyro: board never still for 1 s; bias unchanged")).end();
+        Writer(log_).str(TXT(TXT_ERROR "cal gyro: board never still for 1 s; bias unchanged")).end();
     }
 }
 
@@ -223,13 +222,13 @@ void AttitudePipeline::restart_estimator() {
 
 void AttitudePipeline::start_mag_calibration() {
     if (!mag_present_) {
-        Writer(log_).str(TXT("# error: cal mag: HMC5883L absent")).end();
+        Writer(log_).str(TXT(TXT_ERROR "cal mag: " TXT_HMC " absent")).end();
         return;
     }
     mag_cal_.restart();
     mag_cal_steps_ = 0;
     mag_cal_active_ = true;
-    Writer(log_).str(TXT("# cal mag: turn the board through every orientation for 30 s")).end();
+    Writer(log_).str(TXT("# cal mag: turn the board every way for 30 s")).end();
 }
 
 void AttitudePipeline::finish_mag_calibration() {
@@ -244,7 +243,7 @@ void AttitudePipeline::finish_mag_calibration() {
             .str(TXT(" (save to keep)")).end();
         return;
     }
-    w.str(TXT("# error: cal mag failed: "));
+    w.str(TXT(TXT_ERROR "cal mag failed: "));
     if (q == calib::MagCalibrator::Quality::TooFewSamples) {
         w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
     } else if (q == calib::MagCalibrator::Quality::AxesDisagree) {
