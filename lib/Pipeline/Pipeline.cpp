@@ -11,40 +11,40 @@ float absf(float v) { return v < 0.0f ? -v : v; }
 }  // namespace
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
-    if (ever_ && now - last_ < interval) {
-        if (suppressed_ < 0xFFFFu) ++suppressed_;
+    if (ever && now - last < interval) {
+        if (held < 0xFFFFu) ++held;
         return false;
     }
-    ever_ = true;
-    last_ = now;
+    ever = true;
+    last = now;
     return true;
 }
 
 AttitudePipeline::AttitudePipeline(const text::Sink* log)
-    : log_(log), settings_(settings::defaults()), dcm_(dcm::kDefaultDcmSettings) {
+    : log_(log), settings_(settings::defaults()), dcm_(dcm::kDefaultDcmSettings), st_() {
     last_ = mpu6000::Sample{Vector3f(), Vector3f(0.0f, 0.0f, -kG), 0.0f, false, false};
 }
 
 void AttitudePipeline::set_mag_present(bool present) {
-    mag_present_ = present;
-    if (!present) mag_pending_ = false;
+    st_.mag_present = present;
+    if (!present) st_.mag_pending = false;
 }
 
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
-    if (mag_cal_active_) mag_cal_.add(field_uT);
+    if (st_.mag_cal_active) mag_cal_.add(field_uT);
     const Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
-        if (warn_mag_.allow(steps_, kWarnIntervalSteps)) {
+        if (st_.warn_mag.allow(st_.steps, kWarnIntervalSteps)) {
             Writer(log_).str(TXT(TXT_WARN TXT_HMC " field ")).fixed2(n)
                 .str(TXT(" uT is not the Earth's (10..200): sample dropped")).end();
         }
         return;
     }
     mag_cal_uT_ = f;
-    mag_pending_ = true;
-    have_mag_ = true;
+    st_.mag_pending = true;
+    st_.have_mag = true;
 }
 
 // Spikes and non-finite values are replaced by the previous sample; saturation is
@@ -52,19 +52,19 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
 // saturated accel is withheld from the DCM by on_imu_sample).
 mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
     bool spike = !s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite();
-    if (!spike && have_last_) {
+    if (!spike && st_.have_last) {
         const float* g = &s.gyro_rad_s.x;  // Vector3f is three packed floats
         const float* h = &last_.gyro_rad_s.x;
         for (uint8_t i = 0; i < 3; ++i) spike = spike || absf(g[i] - h[i]) > kSpikeGyroJump_rad_s;
         spike = spike || (s.accel_m_s2.length_squared() > (kSpikeAccel_g * kG) * (kSpikeAccel_g * kG) &&
                           last_.accel_m_s2.length_squared() < (kNormalAccel_g * kG) * (kNormalAccel_g * kG));
     }
-    if (spike && have_last_ && spike_run_ < kMaxSpikeRun) {
-        ++spike_run_;
-        ++spikes_;
-        if (warn_spike_.allow(steps_, kWarnIntervalSteps)) {
+    if (spike && st_.have_last && st_.spike_run < kMaxSpikeRun) {
+        ++st_.spike_run;
+        ++st_.spikes;
+        if (st_.warn_spike.allow(st_.steps, kWarnIntervalSteps)) {
             Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: previous sample used instead ("))
-                .u32(spikes_).str(TXT(" so far)")).end();
+                .u32(st_.spikes).str(TXT(" so far)")).end();
         }
         mpu6000::Sample out = last_;
         out.temperature_c = s.temperature_c;
@@ -73,13 +73,13 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
     // A run longer than kMaxSpikeRun is real (saturation, a crash) and used; a non-finite
     // sample never is, with or without a previous one to stand in.
     if (!s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite()) return last_;
-    spike_run_ = 0;
-    if (s.gyro_saturated && warn_gyro_sat_.allow(steps_, kWarnIntervalSteps))
+    st_.spike_run = 0;
+    if (s.gyro_saturated && st_.warn_gyro_sat.allow(st_.steps, kWarnIntervalSteps))
         Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated (beyond 2000 deg/s)")).end();
-    if (s.accel_saturated && warn_accel_sat_.allow(steps_, kWarnIntervalSteps))
+    if (s.accel_saturated && st_.warn_accel_sat.allow(st_.steps, kWarnIntervalSteps))
         Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated (beyond 8 g)")).end();
     last_ = s;
-    have_last_ = true;
+    st_.have_last = true;
     return s;
 }
 
@@ -93,30 +93,30 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
 
 void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     dcm_ = dcm::Dcm(dcm::kDefaultDcmSettings);
-    dcm_.init(gravity, have_mag_ && mag_present_ ? mag_cal_uT_ : Vector3f());
-    mag_pending_ = false;
-    phase_ = Phase::Running;
-    output_acc_ = kRateHz;  // the first line comes with the first step
+    dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
+    st_.mag_pending = false;
+    st_.phase = Phase::Running;
+    st_.output_acc = kRateHz;  // the first line comes with the first step
 }
 
 void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     const calib::GyroCalibrator::Result r = gyro_cal_.add(raw.gyro_rad_s, raw.accel_m_s2);
-    ++gyro_cal_steps_;
+    ++st_.gyro_cal_steps;
     if (r == calib::GyroCalibrator::Result::Done) {
-        gyro_cal_active_ = false;
+        st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
         print_bias(TXT("# gyro bias: "), false);
-        if (phase_ == Phase::Calibrating) {
+        if (st_.phase == Phase::Calibrating) {
             start_estimator(gyro_cal_.mean_accel_m_s2());
         } else {
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
         }
         return;
     }
-    if (r == calib::GyroCalibrator::Result::Moved && warn_moved_.allow(steps_, kRateHz))
+    if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz))
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
-    if (phase_ == Phase::Calibrating && gyro_cal_steps_ >= kStartupDeadlineSteps) {
+    if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
         // Never still long enough: run with what we have, keep measuring in the background.
         Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
             .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
@@ -124,8 +124,8 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         start_estimator(raw.accel_m_s2);
         return;
     }
-    if (phase_ == Phase::Running && gyro_cal_steps_ >= kGyroCalTimeoutSteps) {
-        gyro_cal_active_ = false;
+    if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
+        st_.gyro_cal_active = false;
         Writer(log_).str(TXT(TXT_ERROR "cal gyro: board never still for 1 s; bias unchanged")).end();
     }
 }
@@ -139,18 +139,18 @@ static uint8_t clipped_axes(const Vector3f& a_m_s2) {
 }
 
 void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
-    output_due_ = false;
-    ++steps_;
+    st_.output_due = false;
+    ++st_.steps;
     const mpu6000::Sample s = guard(raw);
-    if (phase_ == Phase::WaitImu) {
-        phase_ = Phase::Calibrating;
+    if (st_.phase == Phase::WaitImu) {
+        st_.phase = Phase::Calibrating;
         Writer(log_).str(TXT("# calibrating gyro: keep the board still")).end();
         start_gyro_calibration();
     }
-    if (gyro_cal_active_) step_calibration(s);
-    if (phase_ != Phase::Running) return;
-    if (reinit_pending_) {
-        reinit_pending_ = false;
+    if (st_.gyro_cal_active) step_calibration(s);
+    if (st_.phase != Phase::Running) return;
+    if (st_.reinit_pending) {
+        st_.reinit_pending = false;
         start_estimator(s.accel_m_s2);
     }
 
@@ -162,30 +162,30 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // and so is one axis clipped for longer than kAccelSaturationFaultSteps: then the
     // DCM gets NaN and gives gravity no weight that step (Dcm::update). The gyro is
     // always integrated (saturated, it is a lower bound of the rate).
-    accel_saturated_steps_ = s.accel_saturated ? (uint8_t)(accel_saturated_steps_ < 255 ? accel_saturated_steps_ + 1 : 255) : 0;
+    st_.accel_saturated_steps = s.accel_saturated ? (uint8_t)(st_.accel_saturated_steps < 255 ? st_.accel_saturated_steps + 1 : 255) : 0;
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel_m_s2) >= 2 ||
-                                                   accel_saturated_steps_ > kAccelSaturationFaultSteps);
+                                                   st_.accel_saturated_steps > kAccelSaturationFaultSteps);
     const float nan = __builtin_nanf("");
     dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s), accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2);
-    if (mag_pending_ && mag_present_) dcm_.correct_heading(mag_cal_uT_);
-    mag_pending_ = false;
+    if (st_.mag_pending && st_.mag_present) dcm_.correct_heading(mag_cal_uT_);
+    st_.mag_pending = false;
 
-    if (mag_cal_active_) {
-        ++mag_cal_steps_;
-        if (mag_cal_steps_ % (5u * kRateHz) == 0u && mag_cal_steps_ < calib::kMagCalSeconds * kRateHz) {
+    if (st_.mag_cal_active) {
+        ++st_.mag_cal_steps;
+        if (st_.mag_cal_steps % (5u * kRateHz) == 0u && st_.mag_cal_steps < calib::kMagCalSeconds * kRateHz) {
             Writer(log_).str(TXT("# cal mag: "))
-                .u32(calib::kMagCalSeconds - mag_cal_steps_ / kRateHz)
+                .u32(calib::kMagCalSeconds - st_.mag_cal_steps / kRateHz)
                 .str(TXT(" s left, keep turning ("))
                 .u32(mag_cal_.count()).str(TXT(" samples)")).end();
         }
-        if (mag_cal_steps_ >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
+        if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
     }
 
-    output_acc_ = (uint16_t)(output_acc_ + settings_.rate_hz);
-    if (output_acc_ >= kRateHz) {
-        output_acc_ = (uint16_t)(output_acc_ - kRateHz);
-        if (output_acc_ >= kRateHz) output_acc_ = 0;  // rate lowered: no burst of lines
-        output_due_ = true;
+    st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
+    if (st_.output_acc >= kRateHz) {
+        st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
+        if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
+        st_.output_due = true;
     }
 }
 
@@ -208,31 +208,31 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
 
 void AttitudePipeline::start_gyro_calibration() {
     gyro_cal_.restart();
-    gyro_cal_steps_ = 0;
-    gyro_cal_active_ = true;
-    if (phase_ == Phase::Running)
+    st_.gyro_cal_steps = 0;
+    st_.gyro_cal_active = true;
+    if (st_.phase == Phase::Running)
         Writer(log_).str(TXT("# cal gyro: keep the board still for 1 s")).end();
 }
 
 void AttitudePipeline::restart_estimator() {
-    reinit_pending_ = (phase_ == Phase::Running);
-    have_last_ = false;  // the previous sample is too old to judge spikes by
-    spike_run_ = 0;
+    st_.reinit_pending = (st_.phase == Phase::Running);
+    st_.have_last = false;  // the previous sample is too old to judge spikes by
+    st_.spike_run = 0;
 }
 
 void AttitudePipeline::start_mag_calibration() {
-    if (!mag_present_) {
+    if (!st_.mag_present) {
         Writer(log_).str(TXT(TXT_ERROR "cal mag: " TXT_HMC " absent")).end();
         return;
     }
     mag_cal_.restart();
-    mag_cal_steps_ = 0;
-    mag_cal_active_ = true;
+    st_.mag_cal_steps = 0;
+    st_.mag_cal_active = true;
     Writer(log_).str(TXT("# cal mag: turn the board every way for 30 s")).end();
 }
 
 void AttitudePipeline::finish_mag_calibration() {
-    mag_cal_active_ = false;
+    st_.mag_cal_active = false;
     calib::Calibration c = settings_.cal;
     const calib::MagCalibrator::Quality q = mag_cal_.finish(c);
     Writer w(log_);

@@ -73,16 +73,15 @@ struct Angles {
 };
 
 // A per-kind rate limiter for warnings: allow() is true at most once per interval,
-// suppressed() tells how many were held back since the last allowed one.
-class RateLimiter {
-public:
+// suppressed() tells how many were held back in all. A plain struct that starts
+// zeroed: declare it static or value-initialise it (`RateLimiter r{};`).
+struct RateLimiter {
     bool allow(uint32_t now_steps, uint16_t interval_steps);
-    uint16_t suppressed() const { return suppressed_; }
+    uint16_t suppressed() const { return held; }
 
-private:
-    uint32_t last_ = 0;
-    uint16_t suppressed_ = 0;
-    bool ever_ = false;
+    uint32_t last;  // when allow() last said yes
+    uint16_t held;  // how many were suppressed (saturates)
+    bool ever;      // allow() has said yes before
 };
 
 class AttitudePipeline {
@@ -95,7 +94,7 @@ public:
 
     // Whether a magnetometer is delivering. false: yaw is gyro-only, heading not corrected.
     void set_mag_present(bool present);
-    bool mag_present() const { return mag_present_; }
+    bool mag_present() const { return st_.mag_present; }
 
     // One MPU6000 sample at the fixed 200 Hz step.
     void on_imu_sample(const mpu6000::Sample& s);
@@ -103,7 +102,7 @@ public:
     // calibration): used by the next on_imu_sample.
     void on_mag_sample(const linalg::Vector3f& field_uT);
     // True once per output period after on_imu_sample (only while Running).
-    bool output_due() const { return output_due_; }
+    bool output_due() const { return st_.output_due; }
     // Current angles (Euler extraction: ~5 ksteps of float work on AVR; call when due).
     Angles angles() const;
 
@@ -116,16 +115,16 @@ public:
     // field, keeping the gyro bias (before the first start it just goes on calibrating).
     void restart_estimator();
 
-    Phase phase() const { return phase_; }
-    bool gyro_calibrating() const { return gyro_cal_active_; }
-    bool mag_calibrating() const { return mag_cal_active_; }
-    uint32_t steps() const { return steps_; }
-    uint32_t time_ms() const { return steps_ * 5u; }
+    Phase phase() const { return st_.phase; }
+    bool gyro_calibrating() const { return st_.gyro_cal_active; }
+    bool mag_calibrating() const { return st_.mag_cal_active; }
+    uint32_t steps() const { return st_.steps; }
+    uint32_t time_ms() const { return st_.steps * 5u; }
     const dcm::Dcm& estimator() const { return dcm_; }
     // Calibrated bias plus what the estimator has learned since, rad/s.
     linalg::Vector3f gyro_bias_rad_s() const;
     float temperature_c() const { return last_.temperature_c; }
-    uint32_t spikes() const { return spikes_; }
+    uint32_t spikes() const { return st_.spikes; }
     // "<prefix>x y z deg/s": the calibrated bias, or (status) the calibrated bias plus the
     // estimator's, followed by ", temperature T C".
     void print_bias(text::Flash prefix, bool status) const;
@@ -143,23 +142,28 @@ private:
     calib::MagCalibrator mag_cal_;
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
-    RateLimiter warn_spike_, warn_gyro_sat_, warn_accel_sat_, warn_mag_, warn_moved_;
-    uint32_t steps_ = 0;
-    uint32_t spikes_ = 0;
-    uint16_t gyro_cal_steps_ = 0;
-    uint16_t mag_cal_steps_ = 0;
-    uint16_t output_acc_ = 0;
-    Phase phase_ = Phase::WaitImu;
-    uint8_t spike_run_ = 0;
-    uint8_t accel_saturated_steps_ = 0;  // consecutive saturated accel samples
-    bool have_last_ = false;
-    bool mag_present_ = false;
-    bool mag_pending_ = false;
-    bool have_mag_ = false;
-    bool gyro_cal_active_ = false;
-    bool mag_cal_active_ = false;
-    bool output_due_ = false;
-    bool reinit_pending_ = false;
+    // Every counter and flag, zero at the start: one plain struct, so the constructor
+    // clears it in one loop instead of a store per member (~250 B of AVR flash).
+    struct State {
+        RateLimiter warn_spike, warn_gyro_sat, warn_accel_sat, warn_mag, warn_moved;
+        uint32_t steps;
+        uint32_t spikes;
+        uint16_t gyro_cal_steps;
+        uint16_t mag_cal_steps;
+        uint16_t output_acc;
+        Phase phase;                    // WaitImu
+        uint8_t spike_run;
+        uint8_t accel_saturated_steps;  // consecutive saturated accel samples
+        bool have_last;
+        bool mag_present;
+        bool mag_pending;
+        bool have_mag;
+        bool gyro_cal_active;
+        bool mag_cal_active;
+        bool output_due;
+        bool reinit_pending;
+    };
+    State st_;
 };
 
 }  // namespace pipeline
