@@ -27,9 +27,17 @@ uint8_t split(const char* line, char copy[kLineCapacity + 1], const char* words[
     }
 }
 
-bool equals(const char* a, const char* b) {
-    while (*a != '\0' && *a == *b) { ++a; ++b; }
-    return *a == *b;
+// Index of `word` in `names` (TXT words, each NUL-terminated, an empty word last), or -1.
+int8_t find_word(const char* word, text::Flash names) {
+    const char* p = names.p;
+    for (int8_t i = 0; text::flash_byte(p) != 0u; ++i) {
+        const char* w = word;
+        while (*w != '\0' && (uint8_t)*w == text::flash_byte(p)) { ++w; ++p; }
+        if (*w == '\0' && text::flash_byte(p) == 0u) return i;
+        while (text::flash_byte(p) != 0u) ++p;
+        ++p;
+    }
+    return -1;
 }
 
 Command make(CommandId id) { return Command{id, Error::None, 0, fmt::OutputMode::Plot}; }
@@ -72,53 +80,43 @@ Command parse_line(const char* line) {
     if (n > 3) return fail(Error::ExtraArgument);
     const char* cmd = w[0];
 
-    // Commands without arguments.
-    struct Plain { const char* name; CommandId id; };
-    static const Plain kPlain[] = {
-        {"help", CommandId::Help}, {"status", CommandId::Status},
-        {"save", CommandId::Save}, {"defaults", CommandId::Defaults},
-    };
-    for (const Plain& p : kPlain) {
-        if (equals(cmd, p.name)) return n == 1 ? make(p.id) : fail(Error::ExtraArgument);
-    }
-    if (equals(cmd, "?")) return n == 1 ? make(CommandId::Help) : fail(Error::ExtraArgument);
-
-    if (equals(cmd, "rate") || equals(cmd, "decl") || equals(cmd, "mode") || equals(cmd, "cal")) {
-        if (n < 2) return fail(Error::MissingArgument);
-        if (n > 2) return fail(Error::ExtraArgument);
-    } else {
-        return fail(Error::Unknown);
-    }
+    // The command names in flash, those without an argument first.
+    static const CommandId kIds[] = {CommandId::Help, CommandId::Help, CommandId::Status, CommandId::Save,
+                                     CommandId::Defaults, CommandId::Rate, CommandId::Decl, CommandId::Mode};
+    constexpr int8_t kFirstWithArgument = 5;
+    const int8_t k = find_word(cmd, TXT("help\0?\0status\0save\0defaults\0rate\0decl\0mode\0cal\0"));
+    if (k < 0) return fail(Error::Unknown);
+    if (k < kFirstWithArgument) return n == 1 ? make(kIds[k]) : fail(Error::ExtraArgument);
+    if (n < 2) return fail(Error::MissingArgument);
+    if (n > 2) return fail(Error::ExtraArgument);
     const char* arg = w[1];
-    if (equals(cmd, "rate")) {
+    const CommandId id = k < (int8_t)(sizeof kIds / sizeof kIds[0]) ? kIds[k] : CommandId::CalGyro;
+    Command r = make(id);
+    if (id == CommandId::Rate || id == CommandId::Decl) {
         int32_t c;
         if (!parse_centi(arg, c)) return fail(Error::BadNumber);
-        if (c % 100 != 0 || c < settings::kRateMinHz * 100 || c > settings::kRateMaxHz * 100)
-            return fail(Error::RateRange);
-        Command r = make(CommandId::Rate);
-        r.value = c / 100;
-        return r;
-    }
-    if (equals(cmd, "decl")) {
-        int32_t c;
-        if (!parse_centi(arg, c)) return fail(Error::BadNumber);
-        if (c < settings::kDeclMinCentideg || c > settings::kDeclMaxCentideg) return fail(Error::DeclRange);
-        Command r = make(CommandId::Decl);
+        if (id == CommandId::Rate) {
+            if (c % 100 != 0 || c < settings::kRateMinHz * 100 || c > settings::kRateMaxHz * 100)
+                return fail(Error::RateRange);
+            c /= 100;
+        } else if (c < settings::kDeclMinCentideg || c > settings::kDeclMaxCentideg) {
+            return fail(Error::DeclRange);
+        }
         r.value = c;
         return r;
     }
-    if (equals(cmd, "mode")) {
-        Command r = make(CommandId::Mode);
-        if (equals(arg, "plot")) r.mode = fmt::OutputMode::Plot;
-        else if (equals(arg, "csv")) r.mode = fmt::OutputMode::Csv;
-        else if (equals(arg, "quiet")) r.mode = fmt::OutputMode::Quiet;
-        else return fail(Error::BadMode);
+    if (id == CommandId::Mode) {
+        // The names in the order of fmt::OutputMode's values.
+        const int8_t m = find_word(arg, TXT("plot\0csv\0quiet\0"));
+        if (m < 0) return fail(Error::BadMode);
+        r.mode = (fmt::OutputMode)m;
         return r;
     }
     // cal
-    if (equals(arg, "gyro")) return make(CommandId::CalGyro);
-    if (equals(arg, "mag")) return make(CommandId::CalMag);
-    return fail(Error::BadCalTarget);
+    const int8_t t = find_word(arg, TXT("gyro\0mag\0"));
+    if (t < 0) return fail(Error::BadCalTarget);
+    r.id = t == 0 ? CommandId::CalGyro : CommandId::CalMag;
+    return r;
 }
 
 Command LineReader::feed(uint8_t byte) {

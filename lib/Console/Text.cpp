@@ -44,10 +44,8 @@ bool to_centi(float x, int32_t& out) {
 
 namespace {
 #ifdef __AVR__
-uint8_t flash_byte(const char* p) { return pgm_read_byte(p); }
 #define TEXT_PROGMEM PROGMEM
 #else
-uint8_t flash_byte(const char* p) { return (uint8_t)*p; }
 #define TEXT_PROGMEM
 #endif
 // The fragments of Text.h, NUL-separated, in flash: code k is the k-th.

@@ -41,6 +41,14 @@ struct Flash {
     const char* p;
 };
 inline Flash flash(const char* p) { return Flash{p}; }
+// One byte of a TXT string.
+inline uint8_t flash_byte(const char* p) {
+#ifdef __AVR__
+    return pgm_read_byte(p);
+#else
+    return (uint8_t)*p;
+#endif
+}
 
 struct Sink {
     void* ctx;
