@@ -112,7 +112,7 @@ sim: deps firmware tools
 	  $(if $(SECONDS),--seconds $(SECONDS))
 
 test: deps firmware tools
-	cd $(HOST_BUILD) && ctest --output-on-failure
+	cd $(HOST_BUILD) && ctest --output-on-failure -j$$(nproc 2>/dev/null || echo 2)
 
 bench: deps firmware tools
 	python3 bench/bench.py --build $(BUILD)

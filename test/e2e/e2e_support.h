@@ -108,7 +108,10 @@ inline double field(const std::string& text, const std::string& label) {
 // Splits `--stamp` output into lines; angle lines are those that do not begin with '#'.
 inline std::vector<Line> parse_stamped(const std::string& out) {
     std::vector<Line> lines;
-    std::istringstream in(out);
+    // The run can stop in the middle of a line (e.g. "12.34 roll:0.00 pi" at the end):
+    // only lines that ended with a newline are whole, so a final unterminated one is dropped.
+    const size_t last_newline = out.rfind('\n');
+    std::istringstream in(last_newline == std::string::npos ? std::string() : out.substr(0, last_newline + 1));
     std::string raw;
     while (std::getline(in, raw)) {
         if (!raw.empty() && raw.back() == '\r') raw.pop_back();
@@ -177,17 +180,70 @@ struct SimRun {
     std::vector<Line> lines;
 };
 
-// build/apm25sim --elf ELF --trajectory <scenario> --seconds S --stamp [extra...]
-inline SimRun run_sim(const std::string& elf, const std::string& scenario, double seconds,
-                      const std::string& extra_args = "") {
+// build/apm25sim on a trajectory file (not a named scenario).
+inline SimRun run_sim_file(const std::string& elf, const std::string& csv, double seconds,
+                           const std::string& extra_args = "") {
     SimRun run;
-    const std::string csv = scenario_csv(scenario, seconds);
     char seconds_text[32];
     std::snprintf(seconds_text, sizeof seconds_text, "%g", seconds);
     run.result = run_command(tool("apm25sim") + " --elf " + elf + " --trajectory " + csv + " --seconds " +
                              seconds_text + " --stamp " + extra_args);
     run.lines = parse_stamped(run.result.out);
     return run;
+}
+
+// build/apm25sim --elf ELF --trajectory <scenario> --seconds S --stamp [extra...]
+inline SimRun run_sim(const std::string& elf, const std::string& scenario, double seconds,
+                      const std::string& extra_args = "") {
+    return run_sim_file(elf, scenario_csv(scenario, seconds), seconds, extra_args);
+}
+
+// The AVR test programs of test/e2e/avr (probe.elf, probe_violation.elf, selftest.elf),
+// built once per process; flock serialises the builds of the test processes ctest runs
+// in parallel, and build.sh renames each ELF into place so a running one is never
+// rewritten under it.
+struct AvrPrograms {
+    bool toolchain = false;  // avr-g++ and the Arduino core are installed
+    bool built = false;
+    std::string dir;
+    std::string log;         // build.sh's output when it failed
+};
+
+inline const AvrPrograms& avr_programs() {
+    static const AvrPrograms programs = [] {
+        AvrPrograms p;
+        p.toolchain = run_command("command -v avr-g++").exit_code == 0 &&
+                      file_exists("/usr/share/arduino/hardware/arduino/avr/cores/arduino/Arduino.h");
+        if (!p.toolchain) return p;
+        p.dir = work_dir() + "/probe";
+        const CommandResult r = run_command("flock " + work_dir() + "/probe.lock " + project_dir() +
+                                            "/test/e2e/avr/build.sh " + p.dir + " 2>&1");
+        p.built = r.exit_code == 0;
+        if (!p.built) p.log = r.out.substr(0, 4000);
+        return p;
+    }();
+    return programs;
+}
+
+// Skips without the AVR toolchain; a build that fails with it installed is a failure.
+#define E2E_REQUIRE_AVR_PROGRAMS(dir)                                                   \
+    const e2e::AvrPrograms& avr_ = e2e::avr_programs();                                 \
+    if (!avr_.toolchain) GTEST_SKIP() << "avr-g++ or the Arduino core is missing";     \
+    ASSERT_TRUE(avr_.built) << "test/e2e/avr/build.sh failed:\n" << avr_.log;          \
+    const std::string dir = avr_.dir
+
+// Writes `content` to work_dir()/name through a temporary file and a rename, so that a
+// test process running in parallel never reads it half written. Returns the path.
+inline std::string write_work_file(const std::string& name, const std::string& content) {
+    const std::string path = work_dir() + "/" + name;
+    const std::string tmp = path + ".tmp." + std::to_string(getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        out << content;
+        if (!out) return "";
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) return "";
+    return path;
 }
 
 // Writes `text` to a file under the work directory for --input.

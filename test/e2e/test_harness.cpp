@@ -5,21 +5,9 @@
 
 namespace {
 
-// Builds the probe ELFs once (flock: ctest may run these tests in parallel).
-std::string probe_dir() {
-    const std::string dir = e2e::work_dir() + "/probe";
-    const std::string cmd = "flock " + e2e::work_dir() + "/probe.lock " + e2e::project_dir() +
-                            "/test/e2e/avr/build.sh " + dir;
-    const e2e::CommandResult r = e2e::run_command(cmd);
-    if (r.exit_code != 0) return "";
-    return dir;
-}
-
-#define REQUIRE_PROBE(dir)                                                              \
-    E2E_REQUIRE_TOOLS("apm25sim", "scenario");                                          \
-    const std::string dir = probe_dir();                                                \
-    if (dir.empty() || !e2e::file_exists(dir + "/probe.elf"))                           \
-        GTEST_SKIP() << "cannot build the probe (avr-gcc and the Arduino core needed)"
+#define REQUIRE_PROBE(dir)                         \
+    E2E_REQUIRE_TOOLS("apm25sim", "scenario");     \
+    E2E_REQUIRE_AVR_PROGRAMS(dir)
 
 const e2e::Line* find_text(const std::vector<e2e::Line>& lines, const std::string& text) {
     for (const e2e::Line& l : lines)
