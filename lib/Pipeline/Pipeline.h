@@ -55,7 +55,7 @@ constexpr uint16_t kWarnIntervalSteps = 400;    // rate limit of each warning ki
 constexpr float kSpikeGyroJump_rad_s = 17.45f;  // 1000 deg/s in one 5 ms step: not a rotation
 constexpr float kSpikeAccel_g = 4.0f;           // |a| above this right after a normal sample
 constexpr float kNormalAccel_g = 2.0f;
-constexpr uint8_t kMaxSpikeRun = 3;             // more in a row: it is real, use it
+constexpr uint8_t kMaxSpikeRun = 10;            // up to 50 ms of glitch; longer is real (a crash): use it
 constexpr uint8_t kAccelSaturationFaultSteps = 20;  // 100 ms of clipped accel: a stuck sensor, not a motion
 constexpr float kMagMin_uT = 10.0f;             // Earth: 25..65 uT; outside 10..200 = not the Earth
 constexpr float kMagMax_uT = 200.0f;
