@@ -48,8 +48,8 @@ float fast_atan2(float y, float x);
 struct Vector3f {
     float x, y, z;
 
-    Vector3f() : x(0.0f), y(0.0f), z(0.0f) {}
-    Vector3f(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
+    constexpr Vector3f() : x(0.0f), y(0.0f), z(0.0f) {}
+    constexpr Vector3f(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
 
     Vector3f operator+(const Vector3f& v) const;
     Vector3f operator-(const Vector3f& v) const;
@@ -82,8 +82,8 @@ inline Vector3f operator*(float s, const Vector3f& v) { return v * s; }
 struct Matrix3f {
     Vector3f a, b, c;  // rows
 
-    Matrix3f() : a(1.0f, 0.0f, 0.0f), b(0.0f, 1.0f, 0.0f), c(0.0f, 0.0f, 1.0f) {}
-    Matrix3f(const Vector3f& row1, const Vector3f& row2, const Vector3f& row3)
+    constexpr Matrix3f() : a(1.0f, 0.0f, 0.0f), b(0.0f, 1.0f, 0.0f), c(0.0f, 0.0f, 1.0f) {}
+    constexpr Matrix3f(const Vector3f& row1, const Vector3f& row2, const Vector3f& row3)
         : a(row1), b(row2), c(row3) {}
 
     static Matrix3f identity() { return Matrix3f(); }
