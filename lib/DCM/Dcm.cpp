@@ -97,7 +97,9 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     // average (BROAD's fast translation, up to 10 g, shows it: 16 deg RMSE with
     // weighting, 0.7 without). Only a sample beyond any accelerometer's range is
     // garbage and skipped.
-    if (accel_plausible(accel_m_s2)) {
+    // A gyro value beyond any sensor's range means the whole sample is a broken read
+    // (a glitch on the bus, a spike): its accel is not trusted either.
+    if (gyro_ok && accel_plausible(accel_m_s2)) {
         last_accel_m_s2_ = accel_m_s2;
         const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
         accel_lp_ef_ += (r_ * accel_m_s2 - accel_lp_ef_) * alpha;
