@@ -7,20 +7,23 @@ using linalg::Vector3f;
 using linalg::fast_atan2;
 
 EulerAngles euler_from_dcm(const Matrix3f& r) {
-    // R31 = r.c.x, R32 = r.c.y, R33 = r.c.z, R21 = r.b.x, R11 = r.a.x (rows a, b, c).
+    return euler_from_entries(r.a.x, r.a.y, r.b.x, r.b.y, r.c.x, r.c.y, r.c.z);
+}
+
+EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float r31, float r32, float r33) {
     EulerAngles e;
     // cos(theta) from the other two entries of the last row: pitch by atan2 is
     // accurate near +-90 deg, where asin(R31) loses all its digits.
-    const float cos_pitch = linalg::safe_sqrt(r.c.y * r.c.y + r.c.z * r.c.z);
-    e.pitch_rad = fast_atan2(-r.c.x, cos_pitch);
+    const float cos_pitch = linalg::safe_sqrt(r32 * r32 + r33 * r33);
+    e.pitch_rad = fast_atan2(-r31, cos_pitch);
     if (cos_pitch > kGimbalLockCos) {
-        e.roll_rad = fast_atan2(r.c.y, r.c.z);
-        e.yaw_rad = fast_atan2(r.b.x, r.a.x);
+        e.roll_rad = fast_atan2(r32, r33);
+        e.yaw_rad = fast_atan2(r21, r11);
     } else {
         // Gimbal lock: roll := 0, all of the heading in yaw. With phi = 0,
         // R12 = -sin(psi) and R22 = cos(psi) exactly.
         e.roll_rad = 0.0f;
-        e.yaw_rad = fast_atan2(-r.a.y, r.b.y);
+        e.yaw_rad = fast_atan2(-r12, r22);
     }
     return e;
 }

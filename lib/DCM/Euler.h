@@ -30,6 +30,9 @@ struct EulerAngles {
 constexpr float kGimbalLockCos = 2e-5f;
 
 EulerAngles euler_from_dcm(const linalg::Matrix3f& r);
+// The same from the seven entries it reads (Rij: row i, column j), for callers that
+// have those without a whole matrix.
+EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float r31, float r32, float r33);
 linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 
 // Heading in degrees, 0 <= h < 360, from a yaw angle in radians and a declination
