@@ -10,12 +10,19 @@
 #pragma once
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 namespace linalg {
 
-// True if x is neither NaN nor infinite. Written without isfinite() because
-// avr-libc and the host libc disagree on where it lives.
-inline bool is_finite(float x) { return (x == x) && (x - x == 0.0f); }
+// True if x is neither NaN nor infinite: the exponent bits are not all ones (IEEE
+// 754 single, on the host and on the AVR alike). A bit test, not float arithmetic:
+// ~20 cycles on the 2560 where x == x && x - x == 0 costs ~250.
+inline bool is_finite(float x) {
+    uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits & 0x7F800000u) != 0x7F800000u;
+}
 
 // Clamp x to [lo, hi]; a NaN becomes lo so that it never propagates.
 inline float constrain(float x, float lo, float hi) {
