@@ -168,6 +168,16 @@ inline const Line* find_report(const std::vector<Line>& lines, const std::string
 }
 
 // Smallest signed difference a - b between two headings, degrees.
+// Circular mean of the headings of `lines` (0/360 wrap), degrees.
+inline double mean_heading(const std::vector<Line>& lines) {
+    double s = 0.0, c = 0.0;
+    for (const Line& l : lines) {
+        s += std::sin(l.yaw * M_PI / 180.0);
+        c += std::cos(l.yaw * M_PI / 180.0);
+    }
+    return std::atan2(s, c) * 180.0 / M_PI;
+}
+
 inline double heading_diff_deg(double a, double b) {
     double d = std::fmod(a - b, 360.0);
     if (d > 180.0) d -= 360.0;

@@ -49,15 +49,6 @@ const std::vector<FaultCase>& cases() {
     return list;
 }
 
-// Circular mean of the headings of `lines`, degrees.
-double mean_heading(const std::vector<e2e::Line>& lines) {
-    double s = 0.0, c = 0.0;
-    for (const e2e::Line& l : lines) {
-        s += std::sin(l.yaw * M_PI / 180.0);
-        c += std::cos(l.yaw * M_PI / 180.0);
-    }
-    return std::atan2(s, c) * 180.0 / M_PI;
-}
 
 class Fault : public ::testing::TestWithParam<FaultCase> {};
 
@@ -95,7 +86,7 @@ TEST_P(Fault, ReportedSurvivedAndRecovered) {
     if (c.clear_s > 0) {
         const std::vector<e2e::Line> before = e2e::angle_lines(run.lines, 2.0, c.onset_s);
         ASSERT_FALSE(before.empty()) << e2e::dump(run, 400);
-        const double heading_before = mean_heading(before);
+        const double heading_before = e2e::mean_heading(before);
         const std::vector<e2e::Line> tail = e2e::angle_lines(run.lines, c.seconds - 1.0, c.seconds + 1.0);
         ASSERT_GT(tail.size(), 20u) << e2e::dump(run, 400);
         const e2e::Line* worst_tilt = &tail.front();

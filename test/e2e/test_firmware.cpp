@@ -21,15 +21,6 @@ double mean(const std::vector<e2e::Line>& lines, double e2e::Line::*angle) {
     return lines.empty() ? NAN : sum / (double)lines.size();
 }
 
-// Circular mean of headings (0/360 wrap), degrees.
-double mean_heading(const std::vector<e2e::Line>& lines) {
-    double s = 0.0, c = 0.0;
-    for (const e2e::Line& l : lines) {
-        s += std::sin(l.yaw * M_PI / 180.0);
-        c += std::cos(l.yaw * M_PI / 180.0);
-    }
-    return std::atan2(s, c) * 180.0 / M_PI;
-}
 
 // Output lines per second of angle data in [from_s, to_s).
 double line_rate_hz(const std::vector<e2e::Line>& lines, double from_s, double to_s) {
@@ -64,7 +55,7 @@ TEST(Firmware, LevelRest60sWithinHalfADegreeWithoutDrift) {
     const std::vector<e2e::Line> late = e2e::angle_lines(run.lines, 50.0, 61.0);
     EXPECT_NEAR(mean(late, &e2e::Line::roll), mean(early, &e2e::Line::roll), 0.2);
     EXPECT_NEAR(mean(late, &e2e::Line::pitch), mean(early, &e2e::Line::pitch), 0.2);
-    EXPECT_NEAR(e2e::heading_diff_deg(mean_heading(late), mean_heading(early)), 0.0, 1.0);
+    EXPECT_NEAR(e2e::heading_diff_deg(e2e::mean_heading(late), e2e::mean_heading(early)), 0.0, 1.0);
 }
 
 // Level, facing north, still; from 2 s on (after the firmware's start-up gyro
@@ -243,7 +234,7 @@ TEST(Firmware, PitchLoopThroughPlusAndMinus90IsFiniteAndContinuous) {
     ASSERT_FALSE(end.empty());
     EXPECT_LT(max_abs(end, &e2e::Line::pitch), 1.0);
     EXPECT_LT(max_abs(end, &e2e::Line::roll), 1.0);
-    EXPECT_NEAR(e2e::heading_diff_deg(mean_heading(end), PitchLoop::kHeading_deg), 0.0, 1.0);
+    EXPECT_NEAR(e2e::heading_diff_deg(e2e::mean_heading(end), PitchLoop::kHeading_deg), 0.0, 1.0);
 }
 
 // --- console ----------------------------------------------------------------------
