@@ -208,7 +208,7 @@ inline SimRun run_sim(const std::string& elf, const std::string& scenario, doubl
     return run_sim_file(elf, scenario_csv(scenario, seconds), seconds, extra_args);
 }
 
-// The AVR test programs of test/e2e/avr (probe.elf, probe_violation.elf, selftest.elf),
+// The AVR test programs of test/e2e/support/avr (probe.elf, probe_violation.elf, selftest.elf),
 // built once per process; flock serialises the builds of the test processes ctest runs
 // in parallel, and build.sh renames each ELF into place so a running one is never
 // rewritten under it.
@@ -227,7 +227,7 @@ inline const AvrPrograms& avr_programs() {
         if (!p.toolchain) return p;
         p.dir = work_dir() + "/probe";
         const CommandResult r = run_command("flock " + work_dir() + "/probe.lock " + project_dir() +
-                                            "/test/e2e/avr/build.sh " + p.dir + " 2>&1");
+                                            "/test/e2e/support/avr/build.sh " + p.dir + " 2>&1");
         p.built = r.exit_code == 0;
         if (!p.built) p.log = r.out.substr(0, 4000);
         return p;
@@ -239,7 +239,7 @@ inline const AvrPrograms& avr_programs() {
 #define E2E_REQUIRE_AVR_PROGRAMS(dir)                                                   \
     const e2e::AvrPrograms& avr_ = e2e::avr_programs();                                 \
     if (!avr_.toolchain) GTEST_SKIP() << "avr-g++ or the Arduino core is missing";     \
-    ASSERT_TRUE(avr_.built) << "test/e2e/avr/build.sh failed:\n" << avr_.log;          \
+    ASSERT_TRUE(avr_.built) << "test/e2e/support/avr/build.sh failed:\n" << avr_.log;          \
     const std::string dir = avr_.dir
 
 // Writes `content` to work_dir()/name through a temporary file and a rename, so that a

@@ -1,4 +1,4 @@
-// The simulated board itself, checked with a probe AVR program (test/e2e/avr/probe.cpp)
+// The simulated board itself, checked with a probe AVR program (test/e2e/support/avr/probe.cpp)
 // rather than the firmware: sensors answer on the real buses, faults reach the bus,
 // bus timing is the board's, the chip-select rule is enforced, console input arrives.
 #include "e2e_support.h"

@@ -1,4 +1,4 @@
-// The host unit tests' checks on the target: test/e2e/avr/selftest.cpp, built by
+// The host unit tests' checks on the target: test/e2e/support/avr/selftest.cpp, built by
 // avr-gcc from the same lib/ sources as the firmware, run as an ATmega2560 in apm25sim.
 // Every check must report "ok", each exactly once, and the summary must count them all
 // (a check that silently did not run fails this test too).

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds the AVR programs the e2e tests run in apm25sim, against the Arduino core
 # archive the project's Makefile builds, into OUT_DIR:
-#   test/e2e/avr/build.sh OUT_DIR   ->  OUT_DIR/probe.elf, OUT_DIR/probe_violation.elf,
+#   test/e2e/support/avr/build.sh OUT_DIR   ->  OUT_DIR/probe.elf, OUT_DIR/probe_violation.elf,
 #                                       OUT_DIR/selftest.elf
 # probe: the simulated board without the firmware; selftest: the host unit tests' checks
 # on the ATmega2560, compiled from the same lib/ sources as the firmware.
@@ -11,7 +11,7 @@
 # the tests also serialise this script with flock).
 set -e
 here=$(cd "$(dirname "$0")" && pwd)
-project=$(cd "$here/../../.." && pwd)
+project=$(cd "$here/../../../.." && pwd)
 out=${1:?usage: build.sh OUT_DIR}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)

@@ -1,5 +1,5 @@
 // The host unit tests' checks, on the ATmega2560: the lib/ routines the firmware runs,
-// compiled by avr-gcc (test/e2e/avr/build.sh) and run in apm25sim by
+// compiled by avr-gcc (test/e2e/support/avr/build.sh) and run in apm25sim by
 // test/e2e/test_selftest.cpp, so that "host-tested" also means "works on the target"
 // (float, int and libm behaviour of avr-gcc/avr-libc, not the host's).
 //

@@ -1,6 +1,6 @@
 // A tiny AVR program that exercises the simulated board (sim/apm25sim) without the
 // firmware: MPU6000 over SPI, HMC5883L over Wire, the INT and DRDY lines, the serial
-// console input and the GPIOR profiling markers. Built by test/e2e/avr/build.sh.
+// console input and the GPIOR profiling markers. Built by test/e2e/support/avr/build.sh.
 //
 // -DPROBE_BUS_VIOLATION: drives the barometer chip select (pin 40) low while the
 // MPU6000 chip select (pin 53) is low, which the harness must flag.
