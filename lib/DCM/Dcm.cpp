@@ -13,8 +13,6 @@ constexpr uint16_t kMaxMagIntervalSteps = 20;
 constexpr float kStartupAccelAlpha = 0.02f;
 }  // namespace
 
-
-
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
     bias_rad_s_ = bias;
@@ -96,9 +94,8 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     // not weighted by how close |a| is to 1 g: dropping the large ones biases that
     // average (BROAD's fast translation, up to 10 g, shows it: 16 deg RMSE with
     // weighting, 0.7 without). Only a sample beyond any accelerometer's range is
-    // garbage and skipped.
-    // A gyro value beyond any sensor's range means the whole sample is a broken read
-    // (a glitch on the bus, a spike): its accel is not trusted either.
+    // garbage and skipped, and so is one whose gyro is beyond any range: the whole
+    // read is broken then (a glitch on the bus, a spike).
     if (gyro_ok && accel_plausible(accel_m_s2)) {
         last_accel_m_s2_ = accel_m_s2;
         const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
