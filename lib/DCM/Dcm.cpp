@@ -134,9 +134,9 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     yaw_pending_ = false;
     // One pass leaves ~(X.Y)^2: a second one, needed only at high rates (a step of
     // more than ~3 deg), keeps the matrix orthonormal to 1e-5 up to the gyro's range.
-    const float skew_before = r_.a.dot(r_.b);
-    bool ok = renormalise();
-    if (ok && (skew_before > 2e-3f || skew_before < -2e-3f)) ok = renormalise();
+    float skew = 0.0f;
+    bool ok = renormalise(skew);
+    if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
     if (!ok) recover();
     if (steps_ < 0xFFFFFFFFu) ++steps_;
 }
@@ -274,8 +274,9 @@ void Dcm::clamp_bias() {
 // Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, bring
 // each to unit length, and make Z their cross product (unit to within the square
 // of the remaining error, so it needs no scaling of its own).
-bool Dcm::renormalise() {
-    const float half_error = 0.5f * r_.a.dot(r_.b);
+bool Dcm::renormalise(float& skew) {
+    skew = r_.a.dot(r_.b);
+    const float half_error = 0.5f * skew;
     const Vector3f x = r_.a - r_.b * half_error;
     const Vector3f y = r_.b - r_.a * half_error;
     if (!rescale(x, r_.a) || !rescale(y, r_.b)) return false;

@@ -142,7 +142,7 @@ public:
 
 private:
     void correct_tilt(float startup_left, bool hold_integrator);
-    bool renormalise();
+    bool renormalise(float& skew);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
     void recover();
     void clamp_bias();
