@@ -39,11 +39,14 @@ Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad) {
 }
 
 float heading_deg(float yaw_rad, float declination_deg) {
+    // yaw within +-180 deg and the declination within +-180 give -360 < h < 360: two
+    // folds, where fmodf would cost ~300 B of AVR flash.
     float h = yaw_rad * linalg::kDegPerRad + declination_deg;
-    if (!linalg::is_finite(h)) return 0.0f;
-    h = fmodf(h, 360.0f);
     if (h < 0.0f) h += 360.0f;
-    if (h >= 360.0f) h = 0.0f;  // -1e-9 + 360 rounds to 360
+    if (h < 0.0f) h += 360.0f;
+    if (h >= 360.0f) h -= 360.0f;
+    // NaN, or beyond the documented ranges, or -1e-9 + 360 rounding to 360: 0.
+    if (!(h >= 0.0f && h < 360.0f)) h = 0.0f;
     return h;
 }
 

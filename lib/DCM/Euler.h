@@ -35,8 +35,9 @@ EulerAngles euler_from_dcm(const linalg::Matrix3f& r);
 EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float r31, float r32, float r33);
 linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 
-// Heading in degrees, 0 <= h < 360, from a yaw angle in radians and a declination
-// (east positive) in degrees: the firmware's output convention.
+// Heading in degrees, 0 <= h < 360, from a yaw angle in radians (-pi..pi) and a
+// declination (east positive) in degrees (-180..180): the firmware's output
+// convention. Outside those ranges, or for NaN, it gives 0 (never NaN).
 float heading_deg(float yaw_rad, float declination_deg);
 
 }  // namespace dcm

@@ -191,14 +191,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
 
 Angles AttitudePipeline::angles() const {
     const dcm::EulerAngles e = dcm_.euler_now();
-    // yaw is within +-180 deg and the declination within +-180 (settings range): two
-    // folds reach 0 <= h < 360, where dcm::heading_deg's fmodf would cost ~300 B of flash.
-    float h = e.yaw_rad * linalg::kDegPerRad + settings_.declination_deg();
-    if (!linalg::is_finite(h)) h = 0.0f;
-    if (h < 0.0f) h += 360.0f;
-    if (h < 0.0f) h += 360.0f;
-    if (h >= 360.0f) h -= 360.0f;
-    if (h >= 360.0f || h < 0.0f) h = 0.0f;  // -1e-9 + 360 rounds to 360
+    const float h = dcm::heading_deg(e.yaw_rad, settings_.declination_deg());
     return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad, h};
 }
 
