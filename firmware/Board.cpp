@@ -255,6 +255,6 @@ int16_t serial_read() {
 }
 
 static void sink_write(void*, const char* data, uint8_t len) { serial_write(data, len); }
-const text::Sink kSerialSink = {nullptr, sink_write, nullptr};  // Writer reads the flash itself
+const text::Sink kSerialSink = {nullptr, sink_write};
 
 }  // namespace board

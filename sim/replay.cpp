@@ -74,7 +74,6 @@ bool i2c_read_regs(void* ctx, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t
 }
 
 void log_write(void*, const char* data, uint8_t len) { fwrite(data, 1, len, stderr); }
-void log_write_flash(void*, const char* s) { fputs(s, stderr); }
 
 }  // namespace
 
@@ -120,7 +119,7 @@ int main(int argc, char** argv) {
     Board board{&mpu_model, &mag_model, 0.0, mpu6000::kConfigClockHz};
     const mpu6000::SpiDevice spi{&board, spi_select, spi_transfer, delay_ms};
     const hmc5883::I2cBus i2c{&board, i2c_write_reg, i2c_read_regs, delay_ms};
-    const text::Sink log_sink{nullptr, log_write, log_write_flash};
+    const text::Sink log_sink{nullptr, log_write};
 
     // Set-up, in the firmware's order and on its timeline (firmware/main.cpp setup()).
     mpu6000::Mpu6000 mpu(spi);

@@ -165,7 +165,6 @@ TEST(Calibration, MagQualityChecks) {
 namespace {
 
 void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
-void sink_flash(void* ctx, const char* s) { static_cast<std::string*>(ctx)->append(s); }
 
 mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) {
     return mpu6000::Sample{gyro, accel, 25.0f, false, false};
@@ -178,7 +177,7 @@ const Vector3f kFieldNorthDown(20.0f, 0.0f, 40.0f);
 
 TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
     std::string log;
-    const text::Sink sink{&log, sink_write, sink_flash};
+    const text::Sink sink{&log, sink_write};
     pipeline::AttitudePipeline p(&sink);
     p.set_mag_present(true);
     int first_output = -1;
@@ -212,7 +211,7 @@ TEST(Pipeline, RolledAndPitchedBoardFromGravity) {
 
 TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
     std::string log;
-    const text::Sink sink{&log, sink_write, sink_flash};
+    const text::Sink sink{&log, sink_write};
     pipeline::AttitudePipeline p(&sink);
     int first_output = -1;
     for (int i = 0; i < 400 && first_output < 0; ++i) {
@@ -242,7 +241,7 @@ TEST(Pipeline, OutputRateFollowsTheSetting) {
 
 TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
     std::string log;
-    const text::Sink sink{&log, sink_write, sink_flash};
+    const text::Sink sink{&log, sink_write};
     pipeline::AttitudePipeline p(&sink);
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(kBias, kLevel));
     log.clear();
@@ -258,7 +257,7 @@ TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
 
 TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
     std::string log;
-    const text::Sink sink{&log, sink_write, sink_flash};
+    const text::Sink sink{&log, sink_write};
     pipeline::AttitudePipeline p(&sink);
     for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));  // past the start-up ramp
     log.clear();
@@ -299,7 +298,7 @@ TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
 
 TEST(Pipeline, MagCalibrationCommand) {
     std::string log;
-    const text::Sink sink{&log, sink_write, sink_flash};
+    const text::Sink sink{&log, sink_write};
     pipeline::AttitudePipeline p(&sink);
     p.set_mag_present(true);
     for (int i = 0; i < 250; ++i) p.on_imu_sample(imu(kBias, kLevel));

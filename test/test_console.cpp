@@ -13,7 +13,6 @@ using console::Error;
 namespace {
 
 void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
-void sink_flash(void* ctx, const char* s) { static_cast<std::string*>(ctx)->append(s); }
 
 Command parse(const char* s) { return console::parse_line(s); }
 
@@ -158,7 +157,7 @@ TEST(Console, PseudoRandomBytesNeverChangeSettings) {
     console::LineReader r;
     uint32_t x = 12345;
     std::string out;
-    const text::Sink sink{&out, sink_write, sink_flash};
+    const text::Sink sink{&out, sink_write};
     settings::Settings s = settings::defaults();
     const settings::Settings before = s;
     for (int i = 0; i < 20000; ++i) {
@@ -177,7 +176,7 @@ TEST(Console, PseudoRandomBytesNeverChangeSettings) {
 
 TEST(Console, ApplySettingsAndReplies) {
     std::string out;
-    const text::Sink sink{&out, sink_write, sink_flash};
+    const text::Sink sink{&out, sink_write};
     settings::Settings s = settings::defaults();
 
     EXPECT_TRUE(console::apply_setting(parse("rate 20"), s, &sink));
@@ -212,7 +211,7 @@ TEST(Console, ErrorMessagesAreHashLines) {
     const char* bad[] = {"bogus", "rate", "rate 1 2", "rate x", "rate 0", "decl 999", "mode x", "cal x"};
     for (const char* line : bad) {
         std::string out;
-        const text::Sink sink{&out, sink_write, sink_flash};
+        const text::Sink sink{&out, sink_write};
         const Command c = parse(line);
         ASSERT_EQ(c.id, CommandId::Error) << line;
         console::print_error(c, &sink);
@@ -224,7 +223,7 @@ TEST(Console, ErrorMessagesAreHashLines) {
 
 TEST(Console, HelpListsEveryCommandOnHashLines) {
     std::string out;
-    const text::Sink sink{&out, sink_write, sink_flash};
+    const text::Sink sink{&out, sink_write};
     console::print_help(&sink);
     for (const char* word : {"rate", "decl", "mode", "status", "cal gyro", "cal mag", "save", "defaults"})
         EXPECT_NE(out.find(word), std::string::npos) << word;

@@ -89,12 +89,11 @@ TEST(Format, ToCentiRejectsNonFinite) {
 
 namespace {
 void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
-void sink_flash(void* ctx, const char* s) { static_cast<std::string*>(ctx)->append(s); }
 }  // namespace
 
 TEST(Format, WriterChains) {
     std::string s;
-    const text::Sink sink{&s, sink_write, sink_flash};
+    const text::Sink sink{&s, sink_write};
     text::Writer(&sink).str(TXT("# x=")).i32(-12).chr(' ').u32(4000000000u).chr(' ').hex8(0x6A)
         .chr(' ').fixed2(3.14159f).chr(' ').fixed2(std::nanf("")).end();
     EXPECT_EQ(s, "# x=-12 4000000000 6A 3.14 ?\n");

@@ -4,8 +4,9 @@
 // On AVR a string literal lives in SRAM unless it is put in flash (PROGMEM), and the
 // firmware has < 2 KB of static RAM to spend: every message is written TXT("...")
 // (flash on AVR, an ordinary literal on the host); Writer::str reads it byte by byte,
-// expands the shared fragments (TXT_WARN ...) and hands the text to the sink's write. No Arduino include: the firmware implements the sink with Serial, the
-// host tests with a std::string, the replay tool with nothing (a null sink is silent).
+// expands the shared fragments (TXT_WARN ...) and hands the text to the sink's write.
+// No Arduino include: the firmware implements the sink with its UART, the host tests
+// with a std::string, the replay tool with stderr (a null sink is silent).
 #pragma once
 
 #include <stdint.h>
@@ -53,9 +54,6 @@ inline uint8_t flash_byte(const char* p) {
 struct Sink {
     void* ctx;
     void (*write)(void* ctx, const char* data, uint8_t len);  // bytes in RAM
-    // Not used by Writer any more (it expands the fragments itself and hands runs to
-    // write); kept so that existing sinks still compile. May be null.
-    void (*write_flash)(void* ctx, const char* flash_str);
 };
 
 // Decimal digits of v into buf (no NUL); returns the count (<= 10).

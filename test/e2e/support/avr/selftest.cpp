@@ -40,14 +40,10 @@ namespace {
 // ---- output ----------------------------------------------------------------------
 #ifdef __AVR__
 void out_write(void*, const char* data, uint8_t len) { Serial.write(reinterpret_cast<const uint8_t*>(data), len); }
-void out_flash(void*, const char* s) {
-    for (char c = (char)pgm_read_byte(s); c != '\0'; c = (char)pgm_read_byte(++s)) Serial.write((uint8_t)c);
-}
 #else
 void out_write(void*, const char* data, uint8_t len) { fwrite(data, 1, len, stdout); }
-void out_flash(void*, const char* s) { fputs(s, stdout); }
 #endif
-const text::Sink kOut = {nullptr, out_write, out_flash};
+const text::Sink kOut = {nullptr, out_write};
 
 // ---- expectations ----------------------------------------------------------------
 struct State {
@@ -420,7 +416,6 @@ console::Command feed(console::LineReader& r, const char* bytes, uint8_t len) {
 console::Command feed(console::LineReader& r, const char* s) { return feed(r, s, (uint8_t)strlen(s)); }
 
 void null_write(void*, const char*, uint8_t) {}
-void null_flash(void*, const char*) {}
 
 // The console's parser and line reader, and the settings commands (test_console.cpp).
 void check_console_parse() {
@@ -457,7 +452,7 @@ void check_console_parse() {
     EXPECT(feed(r, "mode csv\xff\n").error == Error::Garbage);
     EXPECT(feed(r, "rate\0 5\n", 8).error == Error::Garbage);
     // Settings commands: a good one changes exactly its setting, an error nothing.
-    const text::Sink quiet = {nullptr, null_write, null_flash};
+    const text::Sink quiet = {nullptr, null_write};
     settings::Settings s = settings::defaults();
     EXPECT(console::apply_setting(parse_line("rate 10"), s, &quiet) && s.rate_hz == 10);
     EXPECT(console::apply_setting(parse_line("decl 10"), s, &quiet) && s.declination_centideg == 1000);
