@@ -30,9 +30,6 @@ constexpr uint16_t kStatusPollAfterUs = 4000;
 constexpr uint16_t kTimerFallbackUs = 12000;   // neither: pace on the timer and say so
 constexpr uint16_t kRetryMs = 1000;            // a failed sensor is tried again this often
 constexpr uint16_t kWarnMs = 2000;             // rate limit of the firmware's warnings
-// 75 Hz = 13.3 ms; DRDY stuck high: <= 100 Hz. Counted in estimator steps, not
-// millis(), so the reads fall on the same steps as in the host replay tool.
-constexpr uint8_t kMagReadMinSteps = 2;
 constexpr uint8_t kMagDrdySilentMs = 50;       // DRDY low this long: ask the status register
 constexpr uint16_t kMagDeadMs = 1000;          // no good sample this long: stopped answering
 constexpr uint8_t kConsoleBytesPerLoop = 16;
@@ -232,7 +229,7 @@ void service_mag(uint32_t now_ms) {
     const bool by_pin = board::mag_drdy_high();
     bool due = false;
     if (by_pin) {
-        due = pipe.steps() - last_mag_read_step >= kMagReadMinSteps;
+        due = pipe.steps() - last_mag_read_step >= pipeline::kMagReadMinSteps;
     } else if (since >= kMagDrdySilentMs) {
         bool ready = false;
         if (!mag.ready_by_status(ready)) ++mag_failures;

@@ -138,7 +138,6 @@ int main(int argc, char** argv) {
 
     board.advance(pipeline::kLoopStartMs * 1e-3);
     printf("t,roll,pitch,yaw\n");
-    const uint32_t kMagReadMinSteps = 2;  // the firmware's
     uint32_t last_mag_read_step = 0;
     while (board.t_s < end_s) {
         // Wait for the data-ready line, as the loop does.
@@ -149,7 +148,7 @@ int main(int argc, char** argv) {
             fprintf(stderr, "replay: MPU6000 burst read failed at t=%.3f s\n", board.t_s);
             return 2;
         }
-        if (mag_ok && mag_model.drdy_pin_high() && pipe.steps() - last_mag_read_step >= kMagReadMinSteps) {
+        if (mag_ok && mag_model.drdy_pin_high() && pipe.steps() - last_mag_read_step >= pipeline::kMagReadMinSteps) {
             linalg::Vector3f field_uT;
             if (mag.read(field_uT) == hmc5883::ReadStatus::Ok) pipe.on_mag_sample(field_uT);
             last_mag_read_step = pipe.steps();

@@ -46,6 +46,11 @@ namespace pipeline {
 constexpr uint16_t kMpuStartMs = 50;    // after the banner
 constexpr uint16_t kMagStartMs = 200;   // after the MPU6000's 100 ms reset and wake
 constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the banner's drain
+// The compass is read when its DRDY pin is high and at least this many estimator
+// steps after the previous read (75 Hz = 13.3 ms; a DRDY stuck high: <= 100 Hz).
+// Counted in steps, not milliseconds, so the reads fall on the same steps in the
+// firmware and in the host replay tool.
+constexpr uint8_t kMagReadMinSteps = 2;
 
 constexpr uint16_t kRateHz = 200;               // the MPU6000's sample rate = the estimator step
 constexpr float kStep_s = 0.005f;
