@@ -256,6 +256,29 @@ inline std::string write_work_file(const std::string& name, const std::string& c
     return path;
 }
 
+// A value `key=...` from build/score's one-line output; NaN if absent.
+inline double score_field(const std::string& out, const std::string& key) {
+    const size_t pos = out.find(key + "=");
+    return pos == std::string::npos ? NAN : std::atof(out.c_str() + pos + key.size() + 1);
+}
+
+// The angle lines of a simavr run scored against `trajectory` by build/score, as
+// replay's output would be (`options`: extra score flags such as --all).
+inline CommandResult score_lines(const std::vector<Line>& lines, const std::string& trajectory,
+                                 const std::string& options = "") {
+    const std::string estimate = work_dir() + "/estimate." + std::to_string(getpid()) + "." +
+                                 std::to_string(lines.size()) + ".csv";
+    {
+        std::ofstream out(estimate);
+        out << "t,roll,pitch,yaw\n";
+        for (const Line& l : angle_lines(lines)) out << l.t_s << "," << l.roll << "," << l.pitch << "," << l.yaw << "\n";
+    }
+    const CommandResult r =
+        run_command(tool("score") + " " + options + " --trajectory " + trajectory + " --estimate " + estimate);
+    unlink(estimate.c_str());
+    return r;
+}
+
 // Writes `text` to a file under the work directory for --input.
 inline std::string input_file(const std::string& name, const std::string& text) {
     const std::string path = work_dir() + "/" + name + "." + std::to_string(getpid()) + ".txt";

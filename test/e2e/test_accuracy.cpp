@@ -26,11 +26,6 @@ std::vector<Row> parse_replay(const std::string& out) {
     return rows;
 }
 
-double score_field(const std::string& out, const std::string& key) {
-    const size_t pos = out.find(key + "=");
-    return pos == std::string::npos ? NAN : std::atof(out.c_str() + pos + key.size() + 1);
-}
-
 std::string recording(const std::string& name) {
     return std::string(SHARED_DIR) + "/data/broad/" + name + ".csv.gz";
 }
@@ -96,13 +91,13 @@ TEST(Broad, ReplayOnEveryRecording) {
         const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + f + " | " +
                                                       e2e::tool("score") + " --trajectory " + f + " --estimate -");
         ASSERT_EQ(r.exit_code, 0) << name << ": " << r.out << r.err;
-        const double total = score_field(r.out, "total_rmse_deg");
+        const double total = e2e::score_field(r.out, "total_rmse_deg");
         ASSERT_TRUE(std::isfinite(total)) << name << ": " << r.out;
         // Today's worst trial is ~2.7 deg; the bound is 15.
         EXPECT_LT(total, 6.0) << name << ": " << r.out;
         sum_total += total;
-        sum_incl += score_field(r.out, "incl_rmse_deg");
-        sum_heading += score_field(r.out, "heading_rmse_deg");
+        sum_incl += e2e::score_field(r.out, "incl_rmse_deg");
+        sum_heading += e2e::score_field(r.out, "heading_rmse_deg");
     }
     const double n = sizeof names / sizeof names[0];
     // Today ~1.9 / 1.1 / 1.5 deg. The target is 4.5; VQF scores 2.37 / 0.75 / 2.20.
@@ -123,17 +118,9 @@ void simavr_on_recording(const std::string& name, double bound_deg) {
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const std::vector<e2e::Line> lines = e2e::parse_stamped(run.out);
     EXPECT_FALSE(e2e::has_non_finite(lines));
-    const std::string estimate = e2e::work_dir() + "/" + name + "_sim." + std::to_string(getpid()) + ".csv";
-    {
-        std::ofstream out(estimate);
-        out << "t,roll,pitch,yaw\n";
-        for (const e2e::Line& l : e2e::angle_lines(lines)) out << l.t_s << "," << l.roll << "," << l.pitch << "," << l.yaw << "\n";
-    }
-    const e2e::CommandResult s =
-        e2e::run_command(e2e::tool("score") + " --all --trajectory " + f + " --estimate " + estimate);
-    unlink(estimate.c_str());
+    const e2e::CommandResult s = e2e::score_lines(lines, f, "--all");
     ASSERT_EQ(s.exit_code, 0) << s.out << s.err;
-    EXPECT_LT(score_field(s.out, "total_rmse_deg"), bound_deg) << s.out;
+    EXPECT_LT(e2e::score_field(s.out, "total_rmse_deg"), bound_deg) << s.out;
 
     const e2e::CommandResult replay =
         e2e::run_command(e2e::tool("replay") + " --trajectory " + f + " --seconds " + std::to_string(seconds));

@@ -4,13 +4,6 @@
 
 namespace {
 
-// total_rmse_deg=... in build/score's one-line output; NaN if absent.
-double score_field(const std::string& out, const std::string& key) {
-    const size_t pos = out.find(key + "=");
-    if (pos == std::string::npos) return NAN;
-    return std::atof(out.c_str() + pos + key.size() + 1);
-}
-
 TEST(Replay, LevelRestWithinHalfADegree) {
     E2E_REQUIRE_TOOLS("replay", "scenario");
     const std::string csv = e2e::scenario_csv("rest", 60);
@@ -39,7 +32,7 @@ TEST(Replay, TiltTourScoresWithinBounds) {
     const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " | " +
                                                   e2e::tool("score") + " --trajectory " + csv + " --estimate -");
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-    const double total = score_field(r.out, "total_rmse_deg");
+    const double total = e2e::score_field(r.out, "total_rmse_deg");
     ASSERT_TRUE(std::isfinite(total)) << r.out;
     EXPECT_LT(total, 3.0) << r.out;
 }
@@ -52,7 +45,7 @@ TEST(Replay, RealRecordingScoresWithinBounds) {
                                                   e2e::tool("score") + " --trajectory " + recording +
                                                   " --estimate -");
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-    const double total = score_field(r.out, "total_rmse_deg");
+    const double total = e2e::score_field(r.out, "total_rmse_deg");
     ASSERT_TRUE(std::isfinite(total)) << r.out;
     EXPECT_LT(total, 10.0) << r.out;
 }
@@ -63,18 +56,9 @@ TEST(Simavr, TiltTourScoresWithinBounds) {
     const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "tilt_tour", 40.0);
     ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
     EXPECT_FALSE(e2e::has_non_finite(run.lines));
-    const std::string estimate = e2e::work_dir() + "/tilt_tour_sim." + std::to_string(getpid()) + ".csv";
-    {
-        std::ofstream out(estimate);
-        out << "t,roll,pitch,yaw\n";
-        for (const e2e::Line& l : e2e::angle_lines(run.lines))
-            out << l.t_s << "," << l.roll << "," << l.pitch << "," << l.yaw << "\n";
-    }
-    const e2e::CommandResult r = e2e::run_command(e2e::tool("score") + " --trajectory " +
-                                                  e2e::scenario_csv("tilt_tour", 40.0) + " --estimate " + estimate);
-    unlink(estimate.c_str());
+    const e2e::CommandResult r = e2e::score_lines(run.lines, e2e::scenario_csv("tilt_tour", 40.0));
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-    const double total = score_field(r.out, "total_rmse_deg");
+    const double total = e2e::score_field(r.out, "total_rmse_deg");
     ASSERT_TRUE(std::isfinite(total)) << r.out;
     EXPECT_LT(total, 3.0) << r.out;
 }
