@@ -100,7 +100,7 @@ TEST(Broad, ReplayOnEveryRecording) {
         sum_heading += e2e::score_field(r.out, "heading_rmse_deg");
     }
     const double n = sizeof names / sizeof names[0];
-    // Today ~1.9 / 1.1 / 1.5 deg. The target is 4.5; VQF scores 2.37 / 0.75 / 2.20.
+    // Today ~1.6 / 0.7 / 1.4 deg. The target is 4.5; VQF scores 2.37 / 0.75 / 2.20.
     EXPECT_LT(sum_total / n, 2.5);
     EXPECT_LT(sum_incl / n, 1.5);
     EXPECT_LT(sum_heading / n, 2.2);
