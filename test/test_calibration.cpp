@@ -302,7 +302,7 @@ TEST(Pipeline, MagCalibrationCommand) {
     pipeline::AttitudePipeline p(&sink);
     p.set_mag_present(true);
     for (int i = 0; i < 250; ++i) p.on_imu_sample(imu(kBias, kLevel));
-    ASSERT_TRUE(p.handle(console::parse_line("cal mag")));
+    p.start_mag_calibration();
     EXPECT_TRUE(p.mag_calibrating());
     // Only turned about z: the check must fail and keep the old calibration.
     for (int i = 0; i < calib::kMagCalSeconds * 200; ++i) {
@@ -314,6 +314,6 @@ TEST(Pipeline, MagCalibrationCommand) {
     EXPECT_NE(log.find("# error: cal mag failed: z axis not turned enough"), std::string::npos) << log;
     EXPECT_TRUE(p.settings().cal.mag_scale == Vector3f(1.0f, 1.0f, 1.0f));
     // Defaults keep the gyro bias measured at this start.
-    p.handle(console::parse_line("defaults"));
+    p.restore_defaults();
     EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, kBias.x, 1e-6f);
 }

@@ -192,6 +192,10 @@ void print_help(const text::Sink* out) {
         "# save | defaults: store settings / back to defaults\n"));
 }
 
+void print_defaults(const text::Sink* out) {
+    Writer(out).str(TXT("# defaults: rate 50 Hz, decl 0.00, mode plot, no compass cal (save to keep)")).end();
+}
+
 bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* out) {
     Writer w(out);
     switch (c.id) {
@@ -212,7 +216,7 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
             return true;
         case CommandId::Defaults:
             s = settings::defaults();
-            w.str(TXT("# defaults: rate 50 Hz, decl 0.00, mode plot, no compass cal (save to keep)")).end();
+            print_defaults(out);
             return true;
         default:
             return false;

@@ -96,6 +96,9 @@ void print_help(const text::Sink* out);
 // too returns to zero bias and unit scale.
 bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* out);
 
+// The reply to `defaults`.
+void print_defaults(const text::Sink* out);
+
 // "t_ms,roll,pitch,yaw\n": the csv header (after `mode csv` and at start in csv mode).
 text::Flash csv_header();
 

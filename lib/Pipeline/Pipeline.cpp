@@ -250,30 +250,13 @@ void AttitudePipeline::finish_mag_calibration() {
         .str(TXT(" uT; calibration unchanged")).end();
 }
 
-bool AttitudePipeline::handle(const console::Command& c) {
-    switch (c.id) {
-        case console::CommandId::Defaults: {
-            // The gyro bias measured at this start is a measurement, not a setting: keep it.
-            const Vector3f bias = settings_.cal.gyro_bias_rad_s;
-            const uint8_t gyro_flag = (uint8_t)(settings_.flags & settings::kFlagGyroCalibrated);
-            console::apply_setting(c, settings_, log_);
-            settings_.cal.gyro_bias_rad_s = bias;
-            settings_.flags = (uint8_t)(settings_.flags | gyro_flag);
-            return true;
-        }
-        case console::CommandId::Rate:
-        case console::CommandId::Decl:
-        case console::CommandId::Mode:
-            return console::apply_setting(c, settings_, log_);
-        case console::CommandId::CalGyro:
-            start_gyro_calibration();
-            return true;
-        case console::CommandId::CalMag:
-            start_mag_calibration();
-            return true;
-        default:
-            return false;
-    }
+void AttitudePipeline::restore_defaults() {
+    // The gyro bias measured at this start is a measurement, not a setting: keep it.
+    const Vector3f bias = settings_.cal.gyro_bias_rad_s;
+    const uint8_t gyro_flag = (uint8_t)(settings_.flags & settings::kFlagGyroCalibrated);
+    settings_ = settings::defaults();
+    settings_.cal.gyro_bias_rad_s = bias;
+    settings_.flags = (uint8_t)(settings_.flags | gyro_flag);
 }
 
 }  // namespace pipeline

@@ -30,7 +30,6 @@
 #include <stdint.h>
 
 #include "Calibration.h"
-#include "Console.h"
 #include "Dcm.h"
 #include "LinAlg.h"
 #include "Mpu6000Registers.h"
@@ -111,9 +110,9 @@ public:
     // Current angles (Euler extraction: ~5 ksteps of float work on AVR; call when due).
     Angles angles() const;
 
-    // Console commands that act on the pipeline: rate, decl, mode, defaults (settings),
-    // cal gyro, cal mag. Returns false for the others (help, status, save: the firmware's).
-    bool handle(const console::Command& c);
+    // Back to the default settings and calibration, keeping the gyro bias measured at
+    // this start (a measurement, not a setting). Not saved until the caller saves.
+    void restore_defaults();
     void start_gyro_calibration();
     void start_mag_calibration();
     // After a sensor outage: the next sample restarts the DCM from gravity and the latest
