@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
     const hmc5883::I2cBus i2c{&board, i2c_write_reg, i2c_read_regs, delay_ms};
     const text::Sink log_sink{nullptr, log_write};
 
-    // Set-up, in the firmware's order and on its timeline (firmware/main.cpp setup()).
+    // Set-up, in the firmware's order and on its timeline (firmware/firmware.ino setup()).
     mpu6000::Mpu6000 mpu(spi);
     hmc5883::Hmc5883 mag(i2c);
     pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr);

@@ -1,0 +1,15 @@
+// Hooks for your own code, defined in user.ino (the sketch's second file). The
+// firmware calls them; they run in the same loop as the estimator, so keep each call
+// short: the next MPU6000 sample is due 5 ms after the previous one.
+#pragma once
+
+#include "Pipeline.h"
+
+// Once, at the end of setup(): start your own devices (Serial1 for a GPS, servos, ...).
+void user_setup();
+// Every loop() iteration (thousands of times a second while the loop waits for data).
+void user_loop();
+// After every estimator step (200 Hz), while the attitude is being estimated:
+// pipe.estimator() is the DCM (its rotation matrix), pipe.angles() the Euler angles
+// (~17 k cycles: call it at the rate you need, not every step).
+void user_attitude_step(const pipeline::AttitudePipeline& pipe);
