@@ -16,7 +16,7 @@ out=${1:?usage: build.sh OUT_DIR}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 avr=/usr/share/arduino/hardware/arduino/avr
-make --no-print-directory -s -C "$project" BUILD="$out/core" "$out/core/avr/core.a" >/dev/null
+make --no-print-directory -s -C "$project" -f mk/build.mk BUILD="$out/core" "$out/core/avr/core.a" >/dev/null
 flags="-mmcu=atmega2560 -DF_CPU=16000000L -DARDUINO=10819 -DARDUINO_AVR_MEGA2560 -DARDUINO_ARCH_AVR
   -Os -flto -std=gnu++11 -fno-exceptions -fno-threadsafe-statics -fno-rtti -DDECIMAL_DIG=__DECIMAL_DIG__
   -I$avr/cores/arduino -I$avr/variants/mega -I$avr/libraries/Wire/src -I$avr/libraries/SPI/src"

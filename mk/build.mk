@@ -1,0 +1,133 @@
+# The build, run by the Makefile once the toolchain is installed (make -f mk/build.mk GOAL
+# works too when it is). V=1 shows every command.
+
+BUILD       ?= build
+ARDUINO_AVR ?= /usr/share/arduino/hardware/arduino/avr
+PORT        ?= /dev/ttyACM0
+BAUD        := 115200
+SCENARIO    ?= tilt_tour
+SECONDS     ?=
+
+ifeq ($(V),1)
+Q :=
+say = @:
+else
+Q := @
+say = @printf '  %-8s %s\n' '$(1)' '$(2)'
+endif
+
+.PHONY: all firmware tools sim test bench upload size
+all: firmware tools
+
+# ---------------------------------------------------------------------------
+# Firmware: the sketch firmware/firmware.ino (+ the folder's other .ino and .cpp files),
+# the project's libraries lib/*, and the Arduino core with SPI and Wire, as the Arduino
+# IDE builds them (../shared/SIM.md: Debian's avr-gcc 5.4 and arduino-core-avr).
+MCU   := atmega2560
+F_CPU := 16000000L
+AVR_CC  := avr-gcc
+AVR_CXX := avr-g++
+AVR_AR  := avr-gcc-ar
+CORE_DIR := $(ARDUINO_AVR)/cores/arduino
+WIRE_DIR := $(ARDUINO_AVR)/libraries/Wire/src
+SPI_DIR  := $(ARDUINO_AVR)/libraries/SPI/src
+EEPROM_DIR := $(ARDUINO_AVR)/libraries/EEPROM/src
+LIB_DIRS := $(sort $(dir $(wildcard lib/*/)))
+
+AVR_DEFS  := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -DARDUINO=10819 -DARDUINO_AVR_MEGA2560 -DARDUINO_ARCH_AVR
+AVR_INC   := -I$(CORE_DIR) -I$(ARDUINO_AVR)/variants/mega -I$(WIRE_DIR) -I$(WIRE_DIR)/utility \
+             -I$(SPI_DIR) -I$(EEPROM_DIR) $(addprefix -I,$(LIB_DIRS)) -Ifirmware
+# -mcall-prologues -mrelax: 1.5 KB less flash for +0.4 % loop cycles (measured with --profile)
+AVR_OPT   := -Os -flto -ffunction-sections -fdata-sections -mcall-prologues -mrelax
+AVR_CFLAGS   := $(AVR_DEFS) $(AVR_OPT) -std=gnu11
+AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 -fno-exceptions -fno-threadsafe-statics \
+                -fno-rtti -DDECIMAL_DIG=__DECIMAL_DIG__
+# The project's own files: every warning is an error.
+PROJECT_WARN := -Wall -Wextra -Werror -Wdouble-promotion
+AVR_LDFLAGS  := -mmcu=$(MCU) -Os -flto -fuse-linker-plugin -Wl,--gc-sections -mcall-prologues -mrelax
+
+CORE_SRC := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcard $(CORE_DIR)/*.S) \
+            $(WIRE_DIR)/Wire.cpp $(WIRE_DIR)/utility/twi.c $(SPI_DIR)/SPI.cpp
+CORE_OBJ := $(patsubst $(ARDUINO_AVR)/%,$(BUILD)/avr/arduino/%.o,$(CORE_SRC))
+# The sketch's .ino files as the Arduino IDE joins them: the main one, then the others
+# in alphabetical order, after #include <Arduino.h>. (They need no generated prototypes:
+# every function is declared before use.)
+SKETCH_INO := firmware/firmware.ino $(sort $(filter-out firmware/firmware.ino,$(wildcard firmware/*.ino)))
+SKETCH_CPP := $(BUILD)/avr/sketch/firmware.ino.cpp
+FW_SRC   := $(wildcard firmware/*.cpp) $(foreach d,$(LIB_DIRS),$(wildcard $(d)*.cpp))
+FW_OBJ   := $(patsubst %,$(BUILD)/avr/%.o,$(FW_SRC)) $(SKETCH_CPP).o
+FW_HDR   := $(wildcard firmware/*.h) $(foreach d,$(LIB_DIRS),$(wildcard $(d)*.h))
+
+firmware: $(BUILD)/firmware.hex size
+
+$(BUILD)/avr/arduino/%.c.o: $(ARDUINO_AVR)/%.c
+	@mkdir -p $(dir $@)
+	$(Q)$(AVR_CC) $(AVR_CFLAGS) $(AVR_INC) -w -c $< -o $@
+$(BUILD)/avr/arduino/%.cpp.o: $(ARDUINO_AVR)/%.cpp
+	@mkdir -p $(dir $@)
+	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(AVR_INC) -w -c $< -o $@
+$(BUILD)/avr/arduino/%.S.o: $(ARDUINO_AVR)/%.S
+	@mkdir -p $(dir $@)
+	$(Q)$(AVR_CC) $(AVR_DEFS) -x assembler-with-cpp $(AVR_INC) -c $< -o $@
+$(BUILD)/avr/core.a: $(CORE_OBJ)
+	$(call say,CORE,Arduino core + SPI + Wire ($(words $(CORE_OBJ)) files) -> $@)
+	@rm -f $@
+	$(Q)$(AVR_AR) rcs $@ $^
+
+$(SKETCH_CPP): $(SKETCH_INO)
+	@mkdir -p $(dir $@)
+	$(Q){ echo '#include <Arduino.h>'; for f in $^; do echo "#line 1 \"$$f\""; cat "$$f"; done; } > $@
+$(SKETCH_CPP).o: $(SKETCH_CPP) $(FW_HDR)
+	$(call say,AVR-CXX,$(SKETCH_INO))
+	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
+$(BUILD)/avr/%.cpp.o: %.cpp $(FW_HDR)
+	$(call say,AVR-CXX,$<)
+	@mkdir -p $(dir $@)
+	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
+
+$(BUILD)/firmware.elf: $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@)
+	$(Q)$(AVR_CXX) $(AVR_LDFLAGS) $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@
+
+$(BUILD)/firmware.hex: $(BUILD)/firmware.elf
+	$(Q)avr-objcopy -O ihex -R .eeprom $< $@
+
+size: $(BUILD)/firmware.elf
+	@avr-size -A $< | awk '/^\.text|^\.data|^\.bss/ {s[$$1]=$$2} END { \
+	  printf "# firmware: flash %d bytes (of 253952), static RAM %d bytes (of 8192)\n", \
+	  s[".text"]+s[".data"], s[".data"]+s[".bss"] }'
+
+# ---------------------------------------------------------------------------
+# Host tools and tests (CMake + GoogleTest). CMake is configured every time (a second or
+# so): its source globs and the optional tools are read at configure time, so a new file
+# is never missed. The compiler's output goes to a log, shown when something fails.
+HOST_BUILD := $(BUILD)/host
+HOST_LOG   := $(HOST_BUILD)/build.log
+NPROC      := $(shell nproc 2>/dev/null || echo 2)
+tools:
+	$(call say,HOST,tools and tests in $(HOST_BUILD) (log: $(HOST_LOG)))
+	@mkdir -p $(HOST_BUILD)
+ifeq ($(V),1)
+	cmake -S . -B $(HOST_BUILD) -DCMAKE_BUILD_TYPE=Release -DTOOLS_DIR=$(abspath $(BUILD))
+	$(MAKE) --no-print-directory -C $(HOST_BUILD) -j$(NPROC)
+else
+	@{ cmake -S . -B $(HOST_BUILD) -DCMAKE_BUILD_TYPE=Release -DTOOLS_DIR=$(abspath $(BUILD)) && \
+	   $(MAKE) --no-print-directory -C $(HOST_BUILD) -j$(NPROC); } > $(HOST_LOG) 2>&1 || \
+	 { grep -E -B2 -A12 'error|Error' $(HOST_LOG) | head -80; echo "# host build failed: see $(HOST_LOG)"; exit 1; }
+endif
+
+sim: firmware tools
+	@mkdir -p $(BUILD)/scenarios
+	@$(BUILD)/scenario $(SCENARIO) > $(BUILD)/scenarios/$(SCENARIO).csv
+	@echo "# simavr: build/firmware.elf on scenario '$(SCENARIO)' (SCENARIO=name, SECONDS=s to change)"
+	@$(BUILD)/apm25sim --elf $(BUILD)/firmware.elf --trajectory $(BUILD)/scenarios/$(SCENARIO).csv \
+	  $(if $(SECONDS),--seconds $(SECONDS))
+
+test: firmware tools
+	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)
+
+bench: firmware tools
+	python3 bench/bench.py --build $(BUILD)
+
+upload: firmware
+	avrdude -p $(MCU) -c wiring -P $(PORT) -b $(BAUD) -D -U flash:w:$(BUILD)/firmware.hex:i
