@@ -1,0 +1,55 @@
+#!/bin/sh
+# The sketch as the Arduino IDE builds it: Debian's arduino-builder compiles
+# firmware/firmware.ino with lib/ as its libraries folder (and, in a second build, with
+# test/sketch/user_extension.ino in place of user.ino), then each ELF runs in apm25sim
+# for 4 simulated seconds and must print angle lines.
+#   arduino_builder.sh PROJECT_DIR TOOLS_DIR OUT_DIR
+set -u
+project=${1:?usage: arduino_builder.sh PROJECT_DIR TOOLS_DIR OUT_DIR}
+tools=${2:?}
+out=${3:?}
+passed=0
+failed=0
+fail() { echo "FAIL: $*"; failed=$((failed + 1)); }
+pass() { echo "ok: $*"; passed=$((passed + 1)); }
+
+command -v arduino-builder >/dev/null || { echo "FAIL: arduino-builder not installed (make deps)"; echo "0 passed, 1 failed"; exit 1; }
+
+build() {  # build NAME SKETCH_DIR: arduino-builder into $out/NAME, log in $out/NAME.log
+  rm -rf "$out/$1" && mkdir -p "$out/$1"
+  arduino-builder -compile -hardware /usr/share/arduino/hardware -tools /usr/share/arduino-builder \
+    -libraries "$project/lib" -fqbn arduino:avr:mega:cpu=atmega2560 -build-path "$out/$1" \
+    -prefs=compiler.cpp.extra_flags=-DDECIMAL_DIG=__DECIMAL_DIG__ \
+    -prefs=tools.ctags.path=/usr/bin -prefs=tools.ctags.cmd.path=/usr/bin/arduino-ctags \
+    '-prefs=tools.ctags.pattern="{cmd.path}" -u --language-force=c++ -f - --c++-kinds=svpf --fields=KSTtzns --line-directives "{source_file}"' \
+    "$2/firmware.ino" > "$out/$1.log" 2>&1
+}
+
+run() {  # run NAME: 4 s of the rest scenario; prints the serial output to $out/NAME.out
+  "$tools/apm25sim" --elf "$out/$1/firmware.ino.elf" --trajectory "$out/rest.csv" --seconds 4 > "$out/$1.out" 2> "$out/$1.err"
+}
+
+mkdir -p "$out"
+"$tools/scenario" rest --seconds 4 > "$out/rest.csv" || { echo "FAIL: build/scenario"; exit 1; }
+
+# 1. The sketch as it is.
+if build sketch "$project/firmware"; then pass "arduino-builder compiled firmware/firmware.ino"
+else fail "arduino-builder on firmware/firmware.ino:"; tail -30 "$out/sketch.log"; fi
+if [ -f "$out/sketch/firmware.ino.elf" ] && run sketch && [ "$(grep -c '^roll:' "$out/sketch.out")" -ge 50 ]; then
+  pass "the arduino-builder ELF prints angles in apm25sim"
+else fail "no angle lines from the arduino-builder ELF"; head -20 "$out/sketch.out" "$out/sketch.err" 2>/dev/null; fi
+
+# 2. A user's second sketch file using Serial1, Serial, Wire and SPI beside the firmware.
+ext="$out/extended/firmware"
+rm -rf "$out/extended" && mkdir -p "$ext" && cp "$project"/firmware/* "$ext"/
+cp "$project/test/sketch/user_extension.ino" "$ext/user.ino"
+if build extended-build "$ext"; then pass "the sketch with a user file calling Serial1.begin, Serial.print, Wire.setClock, SPI.usingInterrupt links"
+else fail "the sketch with the user file:"; tail -30 "$out/extended-build.log"; fi
+if [ -f "$out/extended-build/firmware.ino.elf" ] && run extended-build &&
+   grep -q '^# user code: Serial1 at 38400 baud' "$out/extended-build.out" &&
+   [ "$(grep -c '^roll:' "$out/extended-build.out")" -ge 50 ]; then
+  pass "with the user's code the angles still flow, and its message is printed"
+else fail "the extended sketch in apm25sim"; head -20 "$out/extended-build.out" "$out/extended-build.err" 2>/dev/null; fi
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
