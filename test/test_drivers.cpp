@@ -9,6 +9,7 @@
 
 #include "Hmc5883.h"
 #include "Mpu6000.h"
+#include "Mpu6000Model.h"
 
 namespace {
 
@@ -279,4 +280,63 @@ TEST(Hmc5883Driver, ReadsBodyFrameDropsFirstAndOverflow) {
     const linalg::Vector3f before = f;
     EXPECT_EQ(mag.read(f), hmc5883::ReadStatus::Overflow);
     EXPECT_TRUE(f == before);
+}
+
+// The FIFO path the firmware takes when the INT pin is silent, against the simulator's
+// register model: start_fifo, the count in whole samples, and each queued sample read
+// and decoded as the burst would be.
+namespace {
+struct ModelBus {
+    sim::Mpu6000Model* mpu;
+    static void select(void* ctx, bool on, uint32_t) { static_cast<ModelBus*>(ctx)->mpu->set_chip_select(on); }
+    static uint8_t transfer(void* ctx, uint8_t out) { return static_cast<ModelBus*>(ctx)->mpu->transfer(out, 1e6); }
+    static void delay(void* ctx, uint16_t ms) {
+        sim::Mpu6000Model* m = static_cast<ModelBus*>(ctx)->mpu;
+        m->advance_to(m->time_s() + ms * 1e-3);
+    }
+};
+}  // namespace
+
+TEST(Mpu6000Driver, FifoDeliversEverySampleInOrder) {
+    sim::Trajectory t;
+    for (int k = 0; k <= 10; ++k) {
+        sim::TrajectorySample s{};
+        s.t_s = k;
+        s.gyro_rad_s[2] = 2.0 * k;  // a ramp of ~9 counts a sample: each sample differs
+        s.accel_m_s2[2] = -9.81;
+        s.mag_uT[0] = 20;
+        s.quat[0] = 1;
+        s.movement = true;
+        t.samples().push_back(s);
+    }
+    sim::Mpu6000Model model(t);
+    ModelBus bus{&model};
+    mpu6000::Mpu6000 mpu(mpu6000::SpiDevice{&bus, ModelBus::select, ModelBus::transfer, ModelBus::delay});
+    ASSERT_EQ(mpu.begin().status, mpu6000::InitStatus::Ok);
+    model.advance_to(1.0);
+    EXPECT_EQ(mpu.fifo_samples(), 0u);  // off until started
+    mpu.start_fifo();
+    model.advance_to(1.0 + 5 * 0.005 + 0.001);
+    ASSERT_EQ(mpu.fifo_samples(), 5u);
+    mpu6000::Sample s{}, prev{};
+    for (int i = 0; i < 5; ++i) {
+        ASSERT_EQ(mpu.read_fifo(s), mpu6000::BurstStatus::Ok);
+        EXPECT_NEAR(s.accel_m_s2.z, -9.81f, 0.01f);
+        if (i > 0) EXPECT_GT(s.gyro_rad_s.z, prev.gyro_rad_s.z) << i;
+        prev = s;
+    }
+    EXPECT_EQ(mpu.fifo_samples(), 0u);
+    mpu6000::Sample latest{};
+    ASSERT_EQ(mpu.read(latest), mpu6000::BurstStatus::Ok);
+    EXPECT_EQ(latest.gyro_rad_s.z, prev.gyro_rad_s.z);  // the last queued sample is the registers'
+    mpu.stop_fifo();
+    model.advance_to(model.time_s() + 0.05);
+    EXPECT_EQ(mpu.fifo_samples(), 0u);
+}
+
+TEST(Mpu6000Driver, FifoCountFromASilentBusIsZero) {
+    FakeMpu fake;
+    fake.present = false;
+    mpu6000::Mpu6000 mpu(fake.device());
+    EXPECT_EQ(mpu.fifo_samples(), 0u);
 }

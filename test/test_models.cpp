@@ -393,3 +393,97 @@ TEST(Hmc5883Model, DataLockDropsSamplesUntilAllSixAreRead) {
 }
 
 }  // namespace
+
+// FIFO (Register Map 4.6, 4.29-4.31): with FIFO_EN = accel, temp and gyro, each output
+// sample is queued as the 14 bytes of the burst, in the same order; the count says how
+// many bytes wait, reads of FIFO_R_W pop them (a burst stays on FIFO_R_W), FIFO_RESET
+// empties it, and a full FIFO drops its oldest bytes and flags FIFO_OFLOW.
+namespace {
+uint16_t fifo_count(sim::Mpu6000Model& mpu) {
+    uint8_t c[2];
+    mpu.read_registers(mpu6000::REG_FIFO_COUNTH, c, 2);
+    return (uint16_t)((c[0] << 8) | c[1]);
+}
+void start_fifo(sim::Mpu6000Model& mpu) {
+    mpu.write_register(mpu6000::REG_FIFO_EN, mpu6000::kFifoEnBurstSample);
+    mpu.write_register(mpu6000::REG_USER_CTRL, mpu6000::kUserCtrlI2cIfDis | mpu6000::kUserCtrlFifoEn |
+                                                   mpu6000::kUserCtrlFifoReset);
+}
+}  // namespace
+
+TEST(Mpu6000Model, FifoIsOffUntilEnabled) {
+    sim::Mpu6000Model mpu(constant_trajectory(kGyro_rad_s, kAccel_m_s2, kMag_uT));
+    bring_up(mpu, 0x18, 0x08);
+    mpu.advance_to(0.5);
+    EXPECT_EQ(fifo_count(mpu), 0u);
+}
+
+TEST(Mpu6000Model, FifoQueuesEachSampleAsTheBurst) {
+    sim::Mpu6000Model mpu(constant_trajectory(kGyro_rad_s, kAccel_m_s2, kMag_uT));
+    bring_up(mpu, 0x18, 0x08);
+    mpu.advance_to(0.3);
+    start_fifo(mpu);
+    EXPECT_EQ(mpu.peek_register(mpu6000::REG_USER_CTRL) & mpu6000::kUserCtrlFifoReset, 0);  // self-clearing
+    const uint32_t before = mpu.counters().samples;
+    mpu.advance_to(0.3 + 3 * 0.005 + 0.001);
+    const uint32_t queued = mpu.counters().samples - before;
+    ASSERT_EQ(queued, 3u);
+    EXPECT_EQ(fifo_count(mpu), 3u * mpu6000::kBurstLength);
+    uint8_t latest[mpu6000::kBurstLength];
+    mpu.read_registers(mpu6000::REG_ACCEL_XOUT_H, latest, sizeof latest);
+    uint8_t popped[mpu6000::kBurstLength] = {};
+    for (int i = 0; i < 3; ++i) mpu.read_registers(mpu6000::REG_FIFO_R_W, popped, sizeof popped);
+    // A constant trajectory: every queued sample equals the registers' (the last one is them).
+    for (int i = 0; i < mpu6000::kBurstLength; ++i) EXPECT_EQ(popped[i], latest[i]) << "byte " << i;
+    EXPECT_EQ(fifo_count(mpu), 0u);
+    EXPECT_EQ(mpu.counters().fifo_underruns, 0u);
+    mpu.read_registers(mpu6000::REG_FIFO_R_W, popped, 1);
+    EXPECT_EQ(mpu.counters().fifo_underruns, 1u);
+}
+
+TEST(Mpu6000Model, FifoKeepsTheOrderOfChangingSamples) {
+    // A rate ramp: each queued sample differs, and they come out oldest first.
+    sim::Trajectory t;
+    for (int k = 0; k <= 10; ++k) {
+        sim::TrajectorySample s{};
+        s.t_s = k;
+        s.gyro_rad_s[0] = 0.2 * k;
+        s.accel_m_s2[2] = -9.81;
+        s.mag_uT[0] = 20;
+        s.quat[0] = 1;
+        s.movement = true;
+        t.samples().push_back(s);
+    }
+    sim::Mpu6000Model mpu(t);
+    bring_up(mpu, 0x18, 0x08);
+    mpu.advance_to(1.0);
+    start_fifo(mpu);
+    mpu.advance_to(1.0 + 10 * 0.005 + 0.001);
+    mpu6000::Sample prev{}, s{};
+    uint8_t raw[mpu6000::kBurstLength];
+    for (int i = 0; i < 10; ++i) {
+        mpu.read_registers(mpu6000::REG_FIFO_R_W, raw, sizeof raw);
+        ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G4, s),
+                  mpu6000::BurstStatus::Ok);
+        if (i > 0) EXPECT_GT(s.gyro_rad_s.x, prev.gyro_rad_s.x) << i;
+        prev = s;
+    }
+}
+
+TEST(Mpu6000Model, FifoResetEmptiesAndOverflowDropsTheOldest) {
+    sim::Mpu6000Model mpu(constant_trajectory(kGyro_rad_s, kAccel_m_s2, kMag_uT));
+    bring_up(mpu, 0x18, 0x08);
+    mpu.advance_to(0.3);
+    start_fifo(mpu);
+    mpu.advance_to(0.35);
+    EXPECT_GT(fifo_count(mpu), 0u);
+    mpu.write_register(mpu6000::REG_USER_CTRL, mpu6000::kUserCtrlI2cIfDis | mpu6000::kUserCtrlFifoEn |
+                                                   mpu6000::kUserCtrlFifoReset);
+    EXPECT_EQ(fifo_count(mpu), 0u);
+    mpu.advance_to(0.35 + 0.5);  // 100 samples of 14 bytes: more than 1024
+    EXPECT_EQ(fifo_count(mpu), mpu6000::kFifoSize);
+    EXPECT_GT(mpu.counters().fifo_overflows, 0u);
+    uint8_t status = 0;
+    mpu.read_registers(mpu6000::REG_INT_STATUS, &status, 1);
+    EXPECT_EQ(status & mpu6000::kIntStatusFifoOverflow, mpu6000::kIntStatusFifoOverflow);
+}

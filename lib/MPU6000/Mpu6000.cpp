@@ -57,14 +57,44 @@ bool Mpu6000::data_ready() {
     return (read_register(REG_INT_STATUS, kReadClockHz) & kIntStatusDataReady) != 0;
 }
 
-BurstStatus Mpu6000::read(Sample& out, uint8_t* raw) {
-    uint8_t buf[kBurstLength];
+void Mpu6000::read_burst(uint8_t first_reg, uint8_t* buf) {
     dev_.select(dev_.ctx, true, kReadClockHz);
-    dev_.transfer(dev_.ctx, (uint8_t)(REG_ACCEL_XOUT_H | kReadFlag));
+    dev_.transfer(dev_.ctx, (uint8_t)(first_reg | kReadFlag));
     for (uint8_t i = 0; i < kBurstLength; ++i) buf[i] = dev_.transfer(dev_.ctx, 0x00);
     dev_.select(dev_.ctx, false, kReadClockHz);
+}
+
+BurstStatus Mpu6000::read(Sample& out, uint8_t* raw) {
+    uint8_t buf[kBurstLength];
+    read_burst(REG_ACCEL_XOUT_H, buf);
     if (raw != nullptr)
         for (uint8_t i = 0; i < kBurstLength; ++i) raw[i] = buf[i];
+    return decode_burst(buf, kGyroRange, kAccelRange, out);
+}
+
+void Mpu6000::start_fifo() {
+    write_register(REG_FIFO_EN, kFifoEnBurstSample);
+    write_register(REG_USER_CTRL, (uint8_t)(kUserCtrlI2cIfDis | kUserCtrlFifoEn | kUserCtrlFifoReset));
+}
+
+void Mpu6000::stop_fifo() {
+    write_register(REG_USER_CTRL, kUserCtrlI2cIfDis);
+    write_register(REG_FIFO_EN, 0x00);
+}
+
+uint16_t Mpu6000::fifo_samples() {
+    dev_.select(dev_.ctx, true, kReadClockHz);
+    dev_.transfer(dev_.ctx, (uint8_t)(REG_FIFO_COUNTH | kReadFlag));
+    const uint8_t high = dev_.transfer(dev_.ctx, 0x00);
+    const uint8_t low = dev_.transfer(dev_.ctx, 0x00);
+    dev_.select(dev_.ctx, false, kReadClockHz);
+    const uint16_t bytes = (uint16_t)linalg::int16_from_be(high, low);
+    return bytes > kFifoSize ? 0 : (uint16_t)(bytes / kBurstLength);
+}
+
+BurstStatus Mpu6000::read_fifo(Sample& out) {
+    uint8_t buf[kBurstLength];
+    read_burst(REG_FIFO_R_W, buf);
     return decode_burst(buf, kGyroRange, kAccelRange, out);
 }
 

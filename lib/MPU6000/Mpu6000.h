@@ -14,6 +14,7 @@
 //   INT latched, cleared on any read (INT_PIN_CFG 0x30): the data-ready pin stays high
 //                         until the burst read, so polling it cannot miss a 50 us pulse.
 // Register writes at 1 MHz (datasheet limit for writes), sensor reads at 8 MHz.
+// FIFO: off unless the INT pin fails (start_fifo), then the loop reads from it.
 #pragma once
 
 #include <stdint.h>
@@ -68,6 +69,17 @@ public:
     InitResult begin();
     // INT_STATUS data-ready bit (reading it clears the latched interrupt).
     bool data_ready();
+
+    // The FIFO, for when the INT pin cannot pace the loop: each sample is queued as the
+    // same 14 bytes as the burst, so a poll can neither race a new sample (reading
+    // INT_STATUS clears the flag of one that lands during the read) nor come too late
+    // (the FIFO holds 73 samples, 365 ms). start_fifo empties it and starts it.
+    void start_fifo();
+    void stop_fifo();
+    // Whole samples waiting; 0 when the count is impossible (nobody on the bus).
+    uint16_t fifo_samples();
+    // The oldest queued sample, decoded (call only when fifo_samples() > 0).
+    BurstStatus read_fifo(Sample& out);
     // The 14-byte burst from ACCEL_XOUT_H at 8 MHz, decoded. NoSensor leaves `out`
     // untouched. `raw` (optional) receives the bytes.
     BurstStatus read(Sample& out, uint8_t* raw = nullptr);
@@ -76,6 +88,7 @@ public:
     void write_register(uint8_t reg, uint8_t value);
 
 private:
+    void read_burst(uint8_t first_reg, uint8_t* buf);
     SpiDevice dev_;
 };
 

@@ -20,18 +20,28 @@ constexpr uint8_t REG_SMPLRT_DIV = 0x19;
 constexpr uint8_t REG_CONFIG = 0x1A;
 constexpr uint8_t REG_GYRO_CONFIG = 0x1B;
 constexpr uint8_t REG_ACCEL_CONFIG = 0x1C;
+constexpr uint8_t REG_FIFO_EN = 0x23;
 constexpr uint8_t REG_INT_PIN_CFG = 0x37;
 constexpr uint8_t REG_INT_ENABLE = 0x38;
 constexpr uint8_t REG_INT_STATUS = 0x3A;
 constexpr uint8_t REG_ACCEL_XOUT_H = 0x3B;  // first of the 14-byte burst
 constexpr uint8_t REG_USER_CTRL = 0x6A;
 constexpr uint8_t REG_PWR_MGMT_1 = 0x6B;
+constexpr uint8_t REG_FIFO_COUNTH = 0x72;  // FIFO_COUNTL follows: bytes in the FIFO, big-endian
+constexpr uint8_t REG_FIFO_R_W = 0x74;     // reads pop the FIFO; a burst keeps this address
 constexpr uint8_t REG_WHO_AM_I = 0x75;
 
 constexpr uint8_t kWhoAmIValue = 0x68;
 constexpr uint8_t kPwrDeviceReset = 0x80;    // PWR_MGMT_1 bit 7; the reset takes <= 100 ms
 constexpr uint8_t kPwrClockPllGyroZ = 0x03;  // PWR_MGMT_1 CLKSEL = 3
 constexpr uint8_t kUserCtrlI2cIfDis = 0x10;  // USER_CTRL: SPI only
+constexpr uint8_t kUserCtrlFifoEn = 0x40;    // USER_CTRL: the FIFO runs
+constexpr uint8_t kUserCtrlFifoReset = 0x04; // USER_CTRL: empties the FIFO (self-clearing)
+// FIFO_EN: TEMP, XG, YG, ZG, ACCEL (Register Map 4.6): the FIFO then holds each sample
+// as the same 14 bytes, in the same order, as the burst from ACCEL_XOUT_H.
+constexpr uint8_t kFifoEnBurstSample = 0xF8;
+constexpr uint16_t kFifoSize = 1024;         // bytes (Product Specification 7.17)
+constexpr uint8_t kIntStatusFifoOverflow = 0x10;
 constexpr uint8_t kIntPinCfgClearOnRead = 0x10;
 constexpr uint8_t kIntEnableDataReady = 0x01;
 constexpr uint8_t kIntStatusDataReady = 0x01;

@@ -28,7 +28,8 @@ constexpr float kAccelBandwidth_hz[8] = {260, 184, 94, 44, 21, 10, 5, 260};
 bool is_data_register(uint8_t reg) { return reg >= mpu6000::REG_ACCEL_XOUT_H && reg <= kLastDataReg; }
 
 bool is_read_only(uint8_t reg) {
-    return is_data_register(reg) || reg == mpu6000::REG_INT_STATUS || reg == mpu6000::REG_WHO_AM_I;
+    return is_data_register(reg) || reg == mpu6000::REG_INT_STATUS || reg == mpu6000::REG_WHO_AM_I ||
+           reg == mpu6000::REG_FIFO_COUNTH || reg == mpu6000::REG_FIFO_COUNTH + 1;
 }
 
 int16_t end_of_range(double truth) { return truth >= 0.0 ? 32767 : -32768; }
@@ -49,6 +50,7 @@ void Mpu6000Model::reset_registers() {
     data_ready_ = false;
     filter_primed_ = false;
     int_pulse_end_s_ = -1.0;
+    fifo_.clear();
 }
 
 bool Mpu6000Model::asleep() const { return (regs_[mpu6000::REG_PWR_MGMT_1] & kPwrSleep) != 0; }
@@ -144,10 +146,42 @@ void Mpu6000Model::publish_sample(double t_s) {
 
     ++counters_.samples;
     if (!sample_read_ && counters_.samples > 1) ++counters_.samples_not_read;
+    push_fifo_sample();
     sample_read_ = false;
     data_ready_ = true;
     regs_[mpu6000::REG_INT_STATUS] |= mpu6000::kIntStatusDataReady;
     int_pulse_end_s_ = t_s + kIntPulse_s;
+}
+
+void Mpu6000Model::push_fifo_sample() {
+    if (!(regs_[mpu6000::REG_USER_CTRL] & mpu6000::kUserCtrlFifoEn)) return;
+    const uint8_t en = regs_[mpu6000::REG_FIFO_EN];
+    // Register order (Register Map 4.6): ACCEL (bit 3), TEMP (bit 7), XG, YG, ZG (bits 6..4).
+    struct Source { uint8_t bit, reg, bytes; };
+    const Source kSources[] = {{0x08, mpu6000::REG_ACCEL_XOUT_H, 6}, {0x80, kRegTempOutH, 2},
+                               {0x40, kRegGyroXoutH, 2}, {0x20, kRegGyroXoutH + 2, 2}, {0x10, kRegGyroXoutH + 4, 2}};
+    bool overflowed = false;
+    for (const Source& src : kSources) {
+        if (!(en & src.bit)) continue;
+        for (uint8_t i = 0; i < src.bytes; ++i) {
+            if (fifo_.size() >= mpu6000::kFifoSize) {
+                fifo_.pop_front();
+                overflowed = true;
+            }
+            fifo_.push_back(regs_[src.reg + i]);
+        }
+    }
+    if (overflowed) {
+        ++counters_.fifo_overflows;
+        regs_[mpu6000::REG_INT_STATUS] |= mpu6000::kIntStatusFifoOverflow;
+    }
+    update_fifo_count();
+}
+
+void Mpu6000Model::update_fifo_count() {
+    const int16_t count = (int16_t)fifo_.size();
+    regs_[mpu6000::REG_FIFO_COUNTH] = linalg::high_byte(count);
+    regs_[mpu6000::REG_FIFO_COUNTH + 1] = linalg::low_byte(count);
 }
 
 void Mpu6000Model::clear_data_ready() {
@@ -197,13 +231,24 @@ uint8_t Mpu6000Model::transfer(uint8_t mosi, double sck_hz) {
         return 0x00;
     }
     const uint8_t reg = address_;
-    address_ = (uint8_t)((address_ + 1) & 0x7F);  // burst auto-increment
+    if (reg != mpu6000::REG_FIFO_R_W) address_ = (uint8_t)((address_ + 1) & 0x7F);  // burst auto-increment
     if (reading_) return read_register_for_spi(reg);
     write_register_from_spi(reg, mosi, sck_hz);
     return 0x00;
 }
 
 uint8_t Mpu6000Model::read_register_for_spi(uint8_t reg) {
+    if (reg == mpu6000::REG_FIFO_R_W) {
+        if (fifo_.empty()) {
+            ++counters_.fifo_underruns;
+            return 0x00;
+        }
+        const uint8_t b = fifo_.front();
+        fifo_.pop_front();
+        update_fifo_count();
+        sample_read_ = true;
+        return b;
+    }
     uint8_t value = snapshot_[reg];
     if (reg == mpu6000::REG_WHO_AM_I && faults_.who_am_i >= 0) value = (uint8_t)faults_.who_am_i;
     if (is_data_register(reg)) {
@@ -213,6 +258,7 @@ uint8_t Mpu6000Model::read_register_for_spi(uint8_t reg) {
         }
         sample_read_ = true;
     }
+    if (reg == mpu6000::REG_INT_STATUS) regs_[reg] &= (uint8_t)~mpu6000::kIntStatusFifoOverflow;
     if (reg == mpu6000::REG_INT_STATUS || (regs_[mpu6000::REG_INT_PIN_CFG] & kIntRdClear)) clear_data_ready();
     return value;
 }
@@ -228,6 +274,11 @@ void Mpu6000Model::write_register_from_spi(uint8_t reg, uint8_t value, double sc
         reset_registers();
         reset_until_s_ = time_s_ + kResetDuration_s;
         return;
+    }
+    if (reg == mpu6000::REG_USER_CTRL && (value & mpu6000::kUserCtrlFifoReset)) {
+        fifo_.clear();
+        update_fifo_count();
+        value = (uint8_t)(value & ~mpu6000::kUserCtrlFifoReset);  // self-clearing
     }
     regs_[reg] = value;
     if (reg == mpu6000::REG_PWR_MGMT_1 && !(value & kPwrSleep)) {

@@ -19,14 +19,21 @@
 // - INT pin: data-ready when INT_ENABLE bit 0; INT_PIN_CFG INT_LEVEL (bit 7, active low),
 //   LATCH_INT_EN (bit 5: held until cleared, else a 50 us pulse), INT_RD_CLEAR (bit 4:
 //   any read clears, else only reading INT_STATUS).
+// - FIFO (Register Map 4.6, 4.29-4.31): with USER_CTRL FIFO_EN, each output sample
+//   appends the registers FIFO_EN selects, in register order; FIFO_COUNTH/L read from
+//   the chip-select snapshot; reads of FIFO_R_W pop bytes (a burst stays on FIFO_R_W);
+//   USER_CTRL FIFO_RESET empties it; when full, the oldest bytes are dropped and
+//   INT_STATUS FIFO_OFLOW is set.
 // - Temperature: constant 30 degC.
-// Not modelled: self-test bits, FIFO, the auxiliary I2C master, noise (scenarios add it).
+// Not modelled: self-test bits, the auxiliary I2C master, noise (scenarios add it).
 //
 // Axis mapping: the inverse of the driver's, mpu6000::body_to_chip (lib/MPU6000).
 #pragma once
 
 #include <stddef.h>
 #include <stdint.h>
+
+#include <deque>
 
 #include "TimeWindow.h"
 #include "Trajectory.h"
@@ -56,6 +63,8 @@ struct Mpu6000Counters {
     uint32_t writes_to_read_only = 0;  // data, status or WHO_AM_I registers
     uint32_t writes_above_1mhz = 0;    // datasheet: register writes at SCLK <= 1 MHz
     uint32_t bytes_without_select = 0; // transfer() with chip select high
+    uint32_t fifo_overflows = 0;       // samples that pushed unread bytes out of the FIFO
+    uint32_t fifo_underruns = 0;       // FIFO_R_W reads of an empty FIFO
 };
 
 class Mpu6000Model {
@@ -98,6 +107,8 @@ private:
     void reset_registers();
     void internal_sample(double t_s);
     void publish_sample(double t_s);
+    void push_fifo_sample();
+    void update_fifo_count();
     void clear_data_ready();
     uint8_t read_register_for_spi(uint8_t reg);
     void write_register_from_spi(uint8_t reg, uint8_t value, double sck_hz);
@@ -119,6 +130,8 @@ private:
     bool data_ready_ = false;
     bool sample_read_ = true;
     double int_pulse_end_s_ = -1.0;
+
+    std::deque<uint8_t> fifo_;
 
     bool selected_ = false;
     unsigned byte_index_ = 0;
