@@ -5,12 +5,13 @@
 using text::Writer;
 
 namespace {
-// Reading INT_STATUS clears the data-ready flag and the latched pin: a poll that races
-// a new sample loses it. So INT_STATUS is asked only when the pin is overdue (it is
-// silent), and every loop from 4 ms on once the pin has been found silent.
-constexpr uint16_t kStatusPollOverdueUs = 7000;
-constexpr uint16_t kStatusPollAfterUs = 4000;
-constexpr uint16_t kTimerFallbackUs = 12000;  // neither answers: pace on the timer
+// The pin is overdue this long after a sample (the period is 5 ms): ask INT_STATUS once.
+// If a sample is there, the pin is silent: from then on the FIFO holds every sample,
+// and its count (read without side effects) is polled from kFifoPollAfterUs on.
+constexpr uint16_t kPinOverdueUs = 7000;
+constexpr uint16_t kFifoPollAfterUs = 4000;
+constexpr uint16_t kTimerFallbackUs = 12000;  // nothing delivers: pace on the timer
+constexpr uint16_t kFifoFullSamples = 70;     // of 73: about to drop the oldest, start over
 constexpr uint16_t kWarnMs = 2000;            // rate limit of the missed-sample warning
 }  // namespace
 
@@ -18,6 +19,7 @@ bool Imu::start(uint32_t now_ms) {
     const mpu6000::InitResult r = chip_.begin();
     if (r.status == mpu6000::InitStatus::Ok) {
         have_sample_time_ = false;
+        int_pin_ok_ = true;  // the reset turned the FIFO off
         if (health_.working()) Writer(out_).str(TXT("# recovered: " TXT_MPU)).end();
         return true;
     }
@@ -42,16 +44,28 @@ bool Imu::retry(uint32_t now_ms) {
 bool Imu::sample_ready(uint32_t now_us) {
     if (!health_.ok()) return false;
     const uint32_t since = now_us - last_sample_us_;
+    from_fifo_ = false;
     bool ready = board::mpu_int_high();
     if (ready) {
+        if (!int_pin_ok_) chip_.stop_fifo();  // the pin works again
         int_pin_ok_ = true;
         pacing_warned_ = false;
-    } else if (since >= (int_pin_ok_ ? kStatusPollOverdueUs : kStatusPollAfterUs) || !have_sample_time_) {
-        ready = chip_.data_ready();
-        if (ready && have_sample_time_ && int_pin_ok_) {
+    } else if (!int_pin_ok_) {
+        if (since >= kFifoPollAfterUs || timer_pacing_) {
+            const uint16_t queued = chip_.fifo_samples();
+            if (queued >= kFifoFullSamples) {
+                chip_.start_fifo();  // empties it: those samples are lost, and counted
+                missed_ += queued;
+            } else {
+                ready = from_fifo_ = queued > 0;
+            }
+        }
+    } else if (since >= kPinOverdueUs || !have_sample_time_) {
+        ready = chip_.data_ready();  // this sample is read from the registers
+        if (ready && have_sample_time_) {
             int_pin_ok_ = false;
-            have_sample_time_ = false;  // this gap is not a missed sample
-            Writer(out_).str(TXT(TXT_WARN TXT_MPU " INT pin silent: polling INT_STATUS")).end();
+            chip_.start_fifo();
+            Writer(out_).str(TXT(TXT_WARN TXT_MPU " INT pin silent: reading its FIFO")).end();
         }
     }
     if (ready) {
@@ -70,7 +84,8 @@ bool Imu::sample_ready(uint32_t now_us) {
 }
 
 bool Imu::read(mpu6000::Sample& out, uint32_t now_us, uint32_t now_ms) {
-    if (have_sample_time_) {
+    // A sample from the FIFO was queued when it was taken: a late read loses nothing.
+    if (have_sample_time_ && !from_fifo_) {
         const uint32_t gap = now_us - last_sample_us_;
         if (gap > kPeriodUs + kPeriodUs / 2u) {
             const uint16_t missed = (uint16_t)((gap + kPeriodUs / 2u) / kPeriodUs - 1u);
@@ -85,7 +100,7 @@ bool Imu::read(mpu6000::Sample& out, uint32_t now_us, uint32_t now_ms) {
     have_sample_time_ = true;
 
     board::mark_begin(board::kSecMpuRead);
-    const mpu6000::BurstStatus st = chip_.read(out);
+    const mpu6000::BurstStatus st = from_fifo_ ? chip_.read_fifo(out) : chip_.read(out);
     board::mark_end(board::kSecMpuRead);
     if (st == mpu6000::BurstStatus::Ok) return true;
     if (health_.failed(now_ms))

@@ -22,8 +22,10 @@ public:
     bool retry(uint32_t now_ms);
     bool ok() const { return health_.ok(); }
 
-    // True when a new sample is waiting: the INT pin (latched until the burst read),
-    // else INT_STATUS when a sample is overdue, else the timer (said once).
+    // True when a new sample is waiting: the INT pin (latched until the burst read);
+    // when the pin is silent, the MPU6000's FIFO (polled from 4 ms after the previous
+    // sample: no sample is lost to a late poll or to the race of reading INT_STATUS);
+    // when neither delivers, the timer (said once).
     bool sample_ready(uint32_t now_us);
     // The burst read of the sample sample_ready() saw at now_us. Counts the samples
     // missed since the previous one (a gap over 1.5 periods), with a rate-limited
@@ -39,7 +41,8 @@ private:
     uint32_t missed_ = 0;
     pipeline::RateLimiter warn_missed_{};
     bool have_sample_time_ = false;  // false: the next gap is not counted as missed
-    bool int_pin_ok_ = true;         // the INT pin paces the loop (else INT_STATUS)
+    bool int_pin_ok_ = true;         // the INT pin paces the loop (else the FIFO)
+    bool from_fifo_ = false;         // the waiting sample is in the FIFO, not the registers
     bool timer_pacing_ = false;
     bool pacing_warned_ = false;
 };
