@@ -11,7 +11,7 @@ static char ring[kCapacity];
 static uint16_t head = 0, tail = 0;  // head: next write, tail: next byte for Serial
 
 uint16_t queued() { return (uint16_t)((head - tail) & kMask); }
-static uint16_t room() { return (uint16_t)(kMask - queued()); }
+uint16_t room() { return (uint16_t)(kMask - queued()); }
 
 void begin() { Serial.begin(kBaud); }
 

@@ -32,6 +32,8 @@ bool write_line_if_room(const char* line, uint8_t len);
 // Blocks until everything queued has gone to Serial (set-up only).
 void flush();
 uint16_t queued();
+// Free bytes in the queue.
+uint16_t room();
 
 // The sink every message goes through (text::Writer).
 extern const text::Sink kSink;

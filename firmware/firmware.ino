@@ -95,6 +95,15 @@ static void emit_output(uint32_t now_ms) {
 
 // ---------------------------------------------------------------------------
 // Console: each complete line is one command (lib/Console parses; help in README.md).
+//
+// Nothing typed or pasted is lost: bytes are taken from Serial's 64-byte receive ring
+// and parsed at once, every loop iteration and again inside the step after the
+// estimator (at 115200 baud the ring fills in 5.6 ms; the longest step is ~4.5 ms), and
+// the parsed commands wait in a queue. A command runs only when the output queue has
+// room for its longest reply (help, 300 bytes): a paste is answered line by line as
+// fast as the UART carries the replies, and a reply never blocks the loop.
+constexpr uint16_t kLongestReplyBytes = 320;
+console::CommandQueue commands;
 
 static void execute(const console::Command& c) {
     switch (c.id) {
@@ -113,12 +122,19 @@ static void execute(const console::Command& c) {
     }
 }
 
-static void poll_console() {
-    for (uint8_t n = 0; n < 16; ++n) {  // at most 16 bytes a loop iteration
+// Received bytes -> parsed commands, while the command queue has room (when it has none,
+// the bytes wait in Serial's ring).
+static void take_console_input() {
+    while (!commands.full()) {
         const int b = Serial.read();
         if (b < 0) return;
-        execute(reader.feed((uint8_t)b));
+        const console::Command c = reader.feed((uint8_t)b);
+        if (c.id != console::CommandId::None) commands.push(c);
     }
+}
+
+static void run_console_command() {
+    if (!commands.empty() && serial_text::room() >= kLongestReplyBytes) execute(commands.pop());
 }
 
 // ---------------------------------------------------------------------------
@@ -133,6 +149,7 @@ static void step(uint32_t now_us) {
         board::mark_begin(board::kSecEstimator);
         pipe.on_imu_sample(sample);
         board::mark_end(board::kSecEstimator);
+        take_console_input();
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
         if (pipe.output_due()) emit_output(now_ms);
     }
@@ -182,7 +199,8 @@ void setup() {
 
 void loop() {
     serial_text::pump();
-    poll_console();
+    take_console_input();
+    run_console_command();
     store.service();
     const uint32_t now_ms = millis();
     if (imu.retry(now_ms)) pipe.restart_estimator();

@@ -233,3 +233,27 @@ TEST(Console, HelpListsEveryCommandOnHashLines) {
         start = out.find('\n', start) + 1;
     }
 }
+
+TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
+    console::CommandQueue q;
+    EXPECT_TRUE(q.empty());
+    for (uint8_t i = 0; i < console::CommandQueue::kCapacity; ++i) {
+        console::Command c = console::parse_line("rate 10");
+        c.value = 10 + i;
+        EXPECT_TRUE(q.push(c));
+    }
+    EXPECT_TRUE(q.full());
+    EXPECT_FALSE(q.push(console::parse_line("help")));
+    // Oldest first, and the ring wraps: pop two, push two, then all in order.
+    EXPECT_EQ(q.pop().value, 10);
+    EXPECT_EQ(q.pop().value, 11);
+    console::Command a = console::parse_line("rate 50"), b = console::parse_line("decl 8.5");
+    EXPECT_TRUE(q.push(a));
+    EXPECT_TRUE(q.push(b));
+    for (int32_t v = 12; v < 10 + console::CommandQueue::kCapacity; ++v) EXPECT_EQ(q.pop().value, v);
+    EXPECT_EQ(q.pop().id, console::CommandId::Rate);
+    const console::Command last = q.pop();
+    EXPECT_EQ(last.id, console::CommandId::Decl);
+    EXPECT_EQ(last.value, 850);
+    EXPECT_TRUE(q.empty());
+}

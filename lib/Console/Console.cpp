@@ -223,4 +223,18 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
     }
 }
 
+bool CommandQueue::push(const Command& c) {
+    if (full()) return false;
+    items_[(uint8_t)((head_ + count_) % kCapacity)] = c;
+    ++count_;
+    return true;
+}
+
+Command CommandQueue::pop() {
+    const Command c = items_[head_];
+    head_ = (uint8_t)((head_ + 1u) % kCapacity);
+    --count_;
+    return c;
+}
+
 }  // namespace console

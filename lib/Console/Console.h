@@ -105,4 +105,25 @@ text::Flash csv_header();
 // "plot", "csv" or "quiet".
 text::Flash mode_name(fmt::OutputMode m);
 
+// Parsed commands waiting to run, oldest first. The firmware parses input as soon as it
+// arrives (so the UART's small receive ring never overflows) but runs a command only
+// when its reply has room to go out: a paste of several lines waits here.
+class CommandQueue {
+public:
+    static constexpr uint8_t kCapacity = 8;  // a paste of 8 short lines
+
+    bool full() const { return count_ == kCapacity; }
+    bool empty() const { return count_ == 0; }
+    uint8_t size() const { return count_; }
+    // False (nothing stored) when full.
+    bool push(const Command& c);
+    // The oldest command; call only when not empty.
+    Command pop();
+
+private:
+    Command items_[kCapacity] = {};
+    uint8_t head_ = 0;
+    uint8_t count_ = 0;
+};
+
 }  // namespace console
