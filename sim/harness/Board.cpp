@@ -7,6 +7,7 @@
 #include <cstdarg>
 #include <cstring>
 
+#include "avr_eeprom.h"
 #include "avr_ioport.h"
 #include "avr_spi.h"
 #include "avr_twi.h"
@@ -127,6 +128,7 @@ bool Board::init() {
         return false;
     }
     avr_->frequency = kCpuHz;
+    if (!load_eeprom()) return false;
     avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
     avr_->log = LOG_WARNING;
 
@@ -406,6 +408,53 @@ uint64_t Board::on_uart_input_tick() {
     const unsigned divisor = (avr_->data[kUcsr0a] & 0x02) ? 8u : 16u;  // U2X0
     const uint64_t cycles_per_char = 10u * (uint64_t)divisor * (ubrr + 1u);
     return avr_->cycle + cycles_per_char;
+}
+
+// --- EEPROM -------------------------------------------------------------------
+
+// The file's bytes from address 0; beyond its end (or without a file) the EEPROM is
+// erased (0xFF), as a new chip. The file is the chip: any byte pattern is accepted,
+// a file longer than the chip is refused.
+bool Board::load_eeprom() {
+    if (options_.eeprom_path.empty()) return true;
+    std::vector<uint8_t> bytes(kEepromSize, 0xFF);
+    FILE* f = std::fopen(options_.eeprom_path.c_str(), "rb");
+    if (f) {
+        const size_t n = std::fread(bytes.data(), 1, kEepromSize, f);
+        const bool longer = std::fgetc(f) != EOF;
+        std::fclose(f);
+        (void)n;
+        if (longer) {
+            error_ = "the EEPROM file '" + options_.eeprom_path + "' is longer than the chip's 4096 bytes";
+            return false;
+        }
+    }
+    avr_eeprom_desc_t desc;
+    desc.ee = bytes.data();
+    desc.offset = 0;
+    desc.size = kEepromSize;
+    if (avr_ioctl(avr_, AVR_IOCTL_EEPROM_SET, &desc) != 0) {
+        error_ = "simavr refused the EEPROM contents";
+        return false;
+    }
+    return true;
+}
+
+bool Board::save_eeprom() {
+    if (options_.eeprom_path.empty() || !avr_) return true;
+    std::vector<uint8_t> bytes(kEepromSize, 0xFF);
+    avr_eeprom_desc_t desc;
+    desc.ee = bytes.data();
+    desc.offset = 0;
+    desc.size = kEepromSize;
+    if (avr_ioctl(avr_, AVR_IOCTL_EEPROM_GET, &desc) != 0) return false;
+    // Through a temporary file and a rename: an interrupted write never leaves half a chip.
+    const std::string tmp = options_.eeprom_path + ".tmp";
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) return false;
+    const bool ok = std::fwrite(bytes.data(), 1, kEepromSize, f) == kEepromSize;
+    if (std::fclose(f) != 0 || !ok) return false;
+    return std::rename(tmp.c_str(), options_.eeprom_path.c_str()) == 0;
 }
 
 // --- profiling ----------------------------------------------------------------

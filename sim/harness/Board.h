@@ -29,6 +29,7 @@ struct avr_irq_t;
 namespace sim {
 
 constexpr uint32_t kCpuHz = 16000000;
+constexpr uint32_t kEepromSize = 4096;  // ATmega2560 datasheet 8.4: 4 KB EEPROM
 
 struct BoardOptions {
     std::string elf_path;
@@ -37,6 +38,7 @@ struct BoardOptions {
     double input_start_s = 2.5;     // latest start of the input (earlier: first angle line)
     bool input_start_fixed = false; // start exactly at input_start_s (--input-at)
     bool profile = false;
+    std::string eeprom_path;        // --eeprom: the EEPROM's bytes at start and written back at exit
 };
 
 // Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
@@ -67,6 +69,8 @@ public:
     bool write_profile(const std::string& path) const;
     void print_counters(FILE* out) const;
     void finish_output();  // flushes a partial last line
+    // Writes the EEPROM's kEepromSize bytes to options.eeprom_path (a no-op without one).
+    bool save_eeprom();
 
     // simavr callbacks (static trampolines call these).
     void on_spdr_write(uint8_t value);
@@ -86,6 +90,7 @@ private:
     bool baro_deselected() const;
     void check_bus(const char* when);
     void start_input();
+    bool load_eeprom();
     double sck_hz() const;
 
     Mpu6000Model mpu_;
