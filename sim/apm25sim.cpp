@@ -47,7 +47,8 @@ const char* const kUsage =
     "MPU6000 chip select (pin 53) is low, checked when pin 53 goes low and at every SPI byte.\n"
     "A violation is printed on stderr and the exit status is 3.\n"
     "Timing: an SPI byte takes 8 SCK periods at the divider SPCR/SPSR set; an I2C bit takes\n"
-    "16 + 2*TWBR*4^TWPS CPU cycles (simavr 1.6's fixed times corrected).\n"
+    "16 + 2*TWBR*4^TWPS CPU cycles; an EEPROM byte write keeps EEPE set for 3.4 ms\n"
+    "(simavr 1.6's fixed times corrected).\n"
     "Exit status: 0 run completed, 1 usage or file error, 2 the core crashed, 3 bus violation.\n"
     "\n";
 
