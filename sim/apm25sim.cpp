@@ -17,7 +17,8 @@ namespace {
 
 const char* const kUsage =
     "usage: apm25sim --elf FILE.elf --trajectory FILE.csv[.gz] [--seconds S] [--stamp]\n"
-    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--profile FILE] [--verbose]\n"
+    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--profile FILE]\n"
+    "                [--verbose]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
@@ -31,6 +32,11 @@ const char* const kUsage =
     "                   first angle line (first line not beginning with '#') or at t = 2.5 s,\n"
     "                   whichever comes first\n"
     "  --input-at S     start the input at exactly S simulated seconds instead\n"
+    "  --eeprom FILE    the ATmega2560's 4096-byte EEPROM: start from FILE's bytes (a missing\n"
+    "                   file, or the bytes beyond its end, read as erased 0xFF; a longer file is\n"
+    "                   an error) and write all 4096 bytes back to FILE when the run ends (also\n"
+    "                   after a crash), so settings saved survive the next run as a power cycle;\n"
+    "                   the run's end is a power cut: an EEPROM write in progress stays partial\n"
     "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..15 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
@@ -41,7 +47,8 @@ const char* const kUsage =
     "MPU6000 chip select (pin 53) is low, checked when pin 53 goes low and at every SPI byte.\n"
     "A violation is printed on stderr and the exit status is 3.\n"
     "Timing: an SPI byte takes 8 SCK periods at the divider SPCR/SPSR set; an I2C bit takes\n"
-    "16 + 2*TWBR*4^TWPS CPU cycles (simavr 1.6's fixed times corrected).\n"
+    "16 + 2*TWBR*4^TWPS CPU cycles; an EEPROM byte write keeps EEPE set for 3.4 ms\n"
+    "(simavr 1.6's fixed times corrected).\n"
     "Exit status: 0 run completed, 1 usage or file error, 2 the core crashed, 3 bus violation.\n"
     "\n";
 
@@ -90,6 +97,8 @@ int main(int argc, char** argv) {
         } else if (arg == "--input-at") {
             options.input_start_s = std::atof(value("--input-at"));
             options.input_start_fixed = true;
+        } else if (arg == "--eeprom") {
+            options.eeprom_path = value("--eeprom");
         } else if (arg == "--profile") {
             profile_path = value("--profile");
         } else if (arg == "--verbose") {
@@ -129,6 +138,10 @@ int main(int argc, char** argv) {
     }
     const bool ran = board.run(seconds);
     board.finish_output();
+    if (!board.save_eeprom()) {
+        std::fprintf(stderr, "apm25sim: cannot write the EEPROM file '%s'\n", options.eeprom_path.c_str());
+        return 1;
+    }
     if (!ran) std::fprintf(stderr, "apm25sim: %s\n", board.error().c_str());
     if (verbose) board.print_counters(stderr);
     if (options.profile && !board.write_profile(profile_path)) {

@@ -7,6 +7,7 @@
 #include <cstdarg>
 #include <cstring>
 
+#include "avr_eeprom.h"
 #include "avr_ioport.h"
 #include "avr_spi.h"
 #include "avr_twi.h"
@@ -26,6 +27,12 @@ constexpr uint16_t kSpdr = 0x4E;
 constexpr uint16_t kTwbr = 0xB8;
 constexpr uint16_t kTwsr = 0xB9;
 constexpr uint16_t kTwcr = 0xBC;
+constexpr uint16_t kEecr = 0x3F;     // EEPROM control (datasheet 8.6.3)
+constexpr uint8_t kEepe = 1u << 1;   // EEPROM write enable: set while a write is in progress
+constexpr uint8_t kEempe = 1u << 2;  // EEPROM master write enable
+// Datasheet table 8-1: erase and write in one operation (EEPM = 00, what avr-libc's
+// eeprom_update_byte uses) takes 3.4 ms.
+constexpr double kEepromWrite_s = 3.4e-3;
 constexpr uint16_t kUcsr0a = 0xC0;
 constexpr uint16_t kUbrr0l = 0xC4;
 constexpr uint16_t kUbrr0h = 0xC5;
@@ -48,6 +55,13 @@ void spdr_write_hook(avr_t*, avr_io_addr_t, uint8_t v, void* param) {
 }
 avr_cycle_count_t spi_done_timer(avr_t*, avr_cycle_count_t, void* param) {
     static_cast<Board*>(param)->on_spi_byte_done();
+    return 0;
+}
+void eecr_write_hook(avr_t*, avr_io_addr_t addr, uint8_t v, void* param) {
+    static_cast<Board*>(param)->on_eecr_write(addr, v);
+}
+avr_cycle_count_t eeprom_done_timer(avr_t* avr, avr_cycle_count_t, void*) {
+    avr->data[kEecr] = (uint8_t)(avr->data[kEecr] & ~kEepe);
     return 0;
 }
 void twcr_write_hook(avr_t*, avr_io_addr_t addr, uint8_t v, void* param) {
@@ -127,6 +141,7 @@ bool Board::init() {
         return false;
     }
     avr_->frequency = kCpuHz;
+    if (!load_eeprom()) return false;
     avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
     avr_->log = LOG_WARNING;
 
@@ -157,6 +172,14 @@ bool Board::init() {
     if (twcr_original_) {
         avr_->io[AVR_DATA_TO_IO(kTwcr)].w.c = twcr_write_hook;
         avr_->io[AVR_DATA_TO_IO(kTwcr)].w.param = this;
+    }
+
+    // EEPROM: a write keeps EEPE set for the chip's write time (simavr 1.6: no time).
+    eecr_original_ = avr_->io[AVR_DATA_TO_IO(kEecr)].w.c;
+    eecr_original_param_ = avr_->io[AVR_DATA_TO_IO(kEecr)].w.param;
+    if (eecr_original_) {
+        avr_->io[AVR_DATA_TO_IO(kEecr)].w.c = eecr_write_hook;
+        avr_->io[AVR_DATA_TO_IO(kEecr)].w.param = this;
     }
 
     // Chip selects: PORTB/DDRB and PORTG/DDRG register writes.
@@ -298,6 +321,18 @@ void Board::on_port_change(char port, bool direction, uint8_t value) {
 
 // --- TWI ----------------------------------------------------------------------
 
+// simavr 1.6 writes the EEPROM byte at once and clears EEPE in the same instant; the
+// chip is busy for kEepromWrite_s, EEPE reading 1 (datasheet 8.6.3), which is what
+// eeprom_is_ready() and avr-libc's busy-wait see. The byte itself is in the EEPROM
+// from the start: a run that ends during the write keeps it (a cut is byte-exact).
+void Board::on_eecr_write(uint16_t addr, uint8_t value) {
+    const bool starts_write = (value & kEepe) && (avr_->data[kEecr] & kEempe) && !(avr_->data[kEecr] & kEepe);
+    eecr_original_(avr_, addr, value, eecr_original_param_);
+    if (!starts_write) return;
+    avr_->data[kEecr] = (uint8_t)(avr_->data[kEecr] | kEepe);
+    avr_cycle_timer_register(avr_, (avr_cycle_count_t)std::llround(kEepromWrite_s * kCpuHz), eeprom_done_timer, this);
+}
+
 void Board::on_twcr_write(uint16_t addr, uint8_t value) {
     // Timers simavr's TWI already had pending, so only the new one is re-timed.
     std::vector<avr_cycle_count_t> before;
@@ -406,6 +441,60 @@ uint64_t Board::on_uart_input_tick() {
     const unsigned divisor = (avr_->data[kUcsr0a] & 0x02) ? 8u : 16u;  // U2X0
     const uint64_t cycles_per_char = 10u * (uint64_t)divisor * (ubrr + 1u);
     return avr_->cycle + cycles_per_char;
+}
+
+// --- EEPROM -------------------------------------------------------------------
+
+// simavr's EEPROM module ("eeprom" in the core's list of I/O modules). Its memory is
+// reached directly: simavr 1.6's AVR_IOCTL_EEPROM_GET/SET return -1 even when they work
+// (and GET does not copy), so their result cannot be trusted.
+uint8_t* Board::eeprom_bytes() const {
+    for (avr_io_t* port = avr_ ? avr_->io_port : nullptr; port != nullptr; port = port->next) {
+        if (port->kind == nullptr || std::strcmp(port->kind, "eeprom") != 0) continue;
+        avr_eeprom_t* e = reinterpret_cast<avr_eeprom_t*>(port);  // io is its first member
+        return e->eeprom != nullptr && e->size == kEepromSize ? e->eeprom : nullptr;
+    }
+    return nullptr;
+}
+
+// The file's bytes from address 0; beyond its end (or without a file) the EEPROM is
+// erased (0xFF), as a new chip. The file is the chip: any byte pattern is accepted,
+// a file longer than the chip is refused.
+bool Board::load_eeprom() {
+    if (options_.eeprom_path.empty()) return true;
+    std::vector<uint8_t> bytes(kEepromSize, 0xFF);
+    FILE* f = std::fopen(options_.eeprom_path.c_str(), "rb");
+    if (f) {
+        const size_t n = std::fread(bytes.data(), 1, kEepromSize, f);
+        const bool longer = std::fgetc(f) != EOF;
+        std::fclose(f);
+        (void)n;
+        if (longer) {
+            error_ = "the EEPROM file '" + options_.eeprom_path + "' is longer than the chip's 4096 bytes";
+            return false;
+        }
+    }
+    uint8_t* chip = eeprom_bytes();
+    if (!chip) {
+        error_ = "simavr's atmega2560 has no 4096-byte EEPROM module";
+        return false;
+    }
+    std::memcpy(chip, bytes.data(), kEepromSize);
+    return true;
+}
+
+bool Board::save_eeprom() {
+    if (options_.eeprom_path.empty() || !avr_) return true;
+    const uint8_t* chip = eeprom_bytes();
+    if (!chip) return false;
+    const std::vector<uint8_t> bytes(chip, chip + kEepromSize);
+    // Through a temporary file and a rename: an interrupted write never leaves half a chip.
+    const std::string tmp = options_.eeprom_path + ".tmp";
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) return false;
+    const bool ok = std::fwrite(bytes.data(), 1, kEepromSize, f) == kEepromSize;
+    if (std::fclose(f) != 0 || !ok) return false;
+    return std::rename(tmp.c_str(), options_.eeprom_path.c_str()) == 0;
 }
 
 // --- profiling ----------------------------------------------------------------

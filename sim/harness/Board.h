@@ -7,6 +7,7 @@
 //   in CPU cycles (simavr 1.6 charges a fixed 100 us).
 // - TWI: after each TWCR write, simavr's pending TWI state timer (1 us per bit in 1.6)
 //   is re-armed at the bit time TWBR/TWPS give: 16 + 2 * TWBR * 4^TWPS cycles per bit.
+// - EEPROM: a write keeps EEPE set for the chip's 3.4 ms (simavr 1.6: no time at all).
 // - Time is avr->cycle / 16 MHz; the sensor models are advanced to it before every
 //   bus byte and by a cycle timer at each of their events (at least every 1 ms).
 #pragma once
@@ -29,6 +30,7 @@ struct avr_irq_t;
 namespace sim {
 
 constexpr uint32_t kCpuHz = 16000000;
+constexpr uint32_t kEepromSize = 4096;  // ATmega2560 datasheet 8.4: 4 KB EEPROM
 
 struct BoardOptions {
     std::string elf_path;
@@ -37,6 +39,7 @@ struct BoardOptions {
     double input_start_s = 2.5;     // latest start of the input (earlier: first angle line)
     bool input_start_fixed = false; // start exactly at input_start_s (--input-at)
     bool profile = false;
+    std::string eeprom_path;        // --eeprom: the EEPROM's bytes at start and written back at exit
 };
 
 // Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
@@ -67,6 +70,8 @@ public:
     bool write_profile(const std::string& path) const;
     void print_counters(FILE* out) const;
     void finish_output();  // flushes a partial last line
+    // Writes the EEPROM's kEepromSize bytes to options.eeprom_path (a no-op without one).
+    bool save_eeprom();
 
     // simavr callbacks (static trampolines call these).
     void on_spdr_write(uint8_t value);
@@ -74,6 +79,7 @@ public:
     void on_port_change(char port, bool direction, uint8_t value);
     void on_twi_message(uint32_t value);
     void on_twcr_write(uint16_t addr, uint8_t value);
+    void on_eecr_write(uint16_t addr, uint8_t value);
     void on_uart_byte(uint8_t byte);
     uint64_t on_sensor_tick();
     uint64_t on_uart_input_tick();
@@ -86,6 +92,8 @@ private:
     bool baro_deselected() const;
     void check_bus(const char* when);
     void start_input();
+    bool load_eeprom();
+    uint8_t* eeprom_bytes() const;
     double sck_hz() const;
 
     Mpu6000Model mpu_;
@@ -103,6 +111,8 @@ private:
     avr_irq_t* mag_drdy_irq_ = nullptr;
     void (*twcr_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
     void* twcr_original_param_ = nullptr;
+    void (*eecr_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
+    void* eecr_original_param_ = nullptr;
 
     uint8_t spi_out_byte_ = 0;
     uint8_t port_b_ = 0, ddr_b_ = 0, port_g_ = 0, ddr_g_ = 0;

@@ -36,11 +36,11 @@
 namespace sim {
 
 struct Hmc5883Faults {
-    TimeWindow absent;           // NACKs its address (and any byte), DRDY low
-    TimeWindow drdy_stuck_low;   // DRDY pin low whatever the data
-    TimeWindow drdy_stuck_high;  // DRDY pin high whatever the data
-    TimeWindow overflow;         // every channel of every sample reads -4096
-    TimeWindow spike;            // absurd in-range counts
+    TimeWindows absent;          // NACKs its address (and any byte), DRDY low
+    TimeWindows drdy_stuck_low;  // DRDY pin low whatever the data
+    TimeWindows drdy_stuck_high; // DRDY pin high whatever the data
+    TimeWindows overflow;        // every channel of every sample reads -4096
+    TimeWindows spike;           // absurd in-range counts
     int id[3] = {-1, -1, -1};    // >= 0: the ID registers read these instead of 'H','4','3'
 };
 

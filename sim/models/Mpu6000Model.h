@@ -41,12 +41,12 @@
 namespace sim {
 
 struct Mpu6000Faults {
-    TimeWindow absent;          // MISO idle (reads 0x00), writes ignored, INT low; registers kept
-    TimeWindow int_stuck_low;   // the INT line stays low (data still updates)
-    TimeWindow frozen;          // data registers stop updating, no data-ready
-    TimeWindow gyro_saturate;   // every gyro axis at the end of its range (sign of the truth)
-    TimeWindow accel_saturate;  // every accel axis at the end of its range
-    TimeWindow spike;           // absurd in-range values on gyro and accel
+    TimeWindows absent;         // MISO idle (reads 0x00), writes ignored, INT low; registers kept
+    TimeWindows int_stuck_low;  // the INT line stays low (data still updates)
+    TimeWindows frozen;         // data registers stop updating, no data-ready
+    TimeWindows gyro_saturate;  // every gyro axis at the end of its range (sign of the truth)
+    TimeWindows accel_saturate; // every accel axis at the end of its range
+    TimeWindows spike;          // absurd in-range values on gyro and accel
     int who_am_i = -1;          // >= 0: WHO_AM_I reads this instead of 0x68
 };
 

@@ -20,12 +20,86 @@ TEST(Harness, HelpDocumentsTheFaultLanguage) {
     const e2e::CommandResult r = e2e::run_command(e2e::tool("apm25sim") + " --help");
     EXPECT_EQ(r.exit_code, 0);
     for (const char* spec : {"mpu:absent", "mpu:whoami=", "mag:absent", "mag:drdy-stuck-low", "mag:overflow",
-                             "gyro:saturate", "accel:saturate", "imu:spike", "i2c:sda-low", "--profile", "--input"})
+                             "gyro:saturate", "accel:saturate", "imu:spike", "i2c:sda-low", "--profile", "--input",
+                             "--eeprom", "overlap"})
         EXPECT_NE(r.out.find(spec), std::string::npos) << spec;
     const e2e::CommandResult bad = e2e::run_command(e2e::tool("apm25sim") + " --elf x --trajectory " +
                                                     e2e::scenario_csv("rest", 1) + " --fault mpu:melted");
     EXPECT_EQ(bad.exit_code, 1);
     EXPECT_NE(bad.err.find("mpu:melted"), std::string::npos) << bad.err;
+}
+
+// Every --fault of one kind holds: two gyro saturation windows, each seen by the probe's
+// reads (every 100 ms), with a healthy read between them.
+TEST(Harness, EveryWindowOfOneKindReachesTheBus) {
+    REQUIRE_PROBE(dir);
+    const e2e::SimRun run = e2e::run_sim(dir + "/probe.elf", "rest", 0.5,
+                                         "--fault gyro:saturate@0.2-0.25 --fault gyro:saturate@0.4-0.45");
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    std::vector<std::pair<double, bool>> reads;  // (time, every gyro axis at an end of its range)
+    for (const e2e::Line& l : run.lines) {
+        if (l.text.rfind("ax:", 0) != 0 || l.t_s < 0.15) continue;
+        bool ends = true;
+        for (const char* axis : {"gx", "gy", "gz"}) {
+            const double v = e2e::field(l.text, axis);
+            ends = ends && (v == 32767 || v == -32768);
+        }
+        reads.emplace_back(l.t_s, ends);
+    }
+    int in_first = 0, between = 0, in_second = 0;
+    for (const auto& r : reads) {
+        if (r.first >= 0.2 && r.first < 0.25) in_first += r.second ? 1 : -100;
+        if (r.first >= 0.26 && r.first < 0.39) between += r.second ? 100 : 1;
+        if (r.first >= 0.4 && r.first < 0.45) in_second += r.second ? 1 : -100;
+    }
+    EXPECT_GE(in_first, 1) << e2e::dump(run);
+    EXPECT_GE(between, 1) << e2e::dump(run);
+    EXPECT_LT(between, 100) << e2e::dump(run);
+    EXPECT_GE(in_second, 1) << e2e::dump(run);
+}
+
+// An overlap of two windows of one kind, or a malformed SPEC, stops apm25sim before the
+// run: exit status 1 and the SPEC named on stderr, nothing on stdout.
+TEST(Harness, OverlappingOrMalformedFaultsAreRefused) {
+    E2E_REQUIRE_TOOLS("apm25sim", "scenario", "firmware.elf");
+    const std::string base = e2e::tool("apm25sim") + " --elf " + e2e::firmware_elf() + " --trajectory " +
+                             e2e::scenario_csv("rest", 1) + " ";
+    for (const std::string& faults : {std::string("--fault mpu:absent@2-3 --fault mpu:absent@2.5-4"),
+                                      std::string("--fault mag:overflow@1 --fault mag:overflow@3-4"),
+                                      std::string("--fault mpu:absent@nan"), std::string("--fault mpu:absent@3-2"),
+                                      std::string("--fault mpu:absent=1@2-3"), std::string("--fault mpu:whoami=0x70@1-2")}) {
+        const e2e::CommandResult r = e2e::run_command(base + faults);
+        EXPECT_EQ(r.exit_code, 1) << faults;
+        EXPECT_TRUE(r.out.empty()) << faults << ": " << r.out.substr(0, 200);
+        const std::string last = faults.substr(faults.rfind("--fault ") + 8);
+        EXPECT_NE(r.err.find(last), std::string::npos) << faults << ": " << r.err;
+    }
+}
+
+// --eeprom: the file's bytes are the EEPROM the program reads, and what it holds at the
+// end of the run goes back to the file (a missing file is an erased chip).
+TEST(Harness, EepromFileIsTheChip) {
+    E2E_REQUIRE_TOOLS("apm25sim", "scenario", "firmware.elf");
+    const std::string path = e2e::work_dir() + "/harness_eeprom." + std::to_string(getpid()) + ".bin";
+    unlink(path.c_str());
+    const e2e::SimRun fresh = e2e::run_sim(e2e::firmware_elf(), "rest", 0.1, "--eeprom " + path);
+    ASSERT_EQ(fresh.result.exit_code, 0) << e2e::dump(fresh);
+    EXPECT_TRUE(find_text(fresh.lines, "EEPROM blank")) << e2e::dump(fresh);
+    std::string bytes = e2e::read_text(path);
+    ASSERT_EQ(bytes.size(), 4096u);
+    EXPECT_EQ(bytes, std::string(4096, '\xFF'));
+    // Something else at address 0: the firmware reads those bytes, and leaves them.
+    bytes.replace(0, 4, "JUNK");
+    std::ofstream(path, std::ios::binary) << bytes;
+    const e2e::SimRun junk = e2e::run_sim(e2e::firmware_elf(), "rest", 0.1, "--eeprom " + path);
+    EXPECT_TRUE(find_text(junk.lines, "EEPROM holds something else")) << e2e::dump(junk);
+    EXPECT_EQ(e2e::read_text(path), bytes);
+    // Longer than the chip: refused.
+    std::ofstream(path, std::ios::binary) << std::string(4097, '\0');
+    const e2e::SimRun longer = e2e::run_sim(e2e::firmware_elf(), "rest", 0.1, "--eeprom " + path);
+    EXPECT_EQ(longer.result.exit_code, 1);
+    EXPECT_NE(longer.result.err.find("4096"), std::string::npos) << longer.result.err;
+    unlink(path.c_str());
 }
 
 TEST(Harness, SensorsAnswerOnSpiAndI2cWithDataReadyLines) {
