@@ -272,7 +272,9 @@ class View:
         t.tick_params(colors="white")
         for s in t.spines.values():
             s.set_color("#888888")
-        t.axvline(0, color="#ffd21f", lw=2, zorder=5)
+        # The pointer: a line over the ticks and a notch at the top, clear of the labels.
+        t.plot([0, 0], [0, 0.42], color="#ffd21f", lw=2.5, zorder=5)
+        t.plot([0], [0.97], "v", color="#ffd21f", ms=9, zorder=5, clip_on=False)
         self.tape_marks = []
         self.tape_label = t.text(0.5, 1.08, "", transform=t.transAxes, color="white", ha="center", va="bottom",
                                  fontsize=11, family="monospace")
@@ -336,7 +338,7 @@ class View:
             self.tape_marks.append(t.plot([x, x], [0, 0.35 if major else 0.18], color="white", lw=1)[0])
             label = names.get(hh) if hh % 45 == 0 else ("%d" % hh if hh % 30 == 0 else None)
             if label:
-                self.tape_marks.append(t.text(x, 0.62, label, color="#ffd21f" if hh in names else "white",
+                self.tape_marks.append(t.text(x, 0.66, label, color="#ffd21f" if hh in names else "white",
                                               ha="center", va="center", fontsize=9))
         t.set_xticks([])
         self.tape_label.set_text("heading %06.2f" % heading)
