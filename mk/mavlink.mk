@@ -65,3 +65,27 @@ else
 	$(VENV_PY) tools/view.py --sim $(BUILD)/apm25sim --elf $(BUILD)/firmware.elf \
 	  --trajectory $(BUILD)/scenarios/$(SCENARIO).csv $(if $(SECONDS),--seconds $(SECONDS)) $(VIEW_FLAGS)
 endif
+
+# What lib/MavLink costs on the 2560: flash (linked, against the same program without
+# the packing) and cycles per message counted exactly by apm25sim --profile.
+MAVCOST_DIR   := $(BUILD)/mavlink-cost
+MAVCOST_FLAGS := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -Os -flto -std=gnu++11 -fno-exceptions -fno-rtti \
+                 -fno-threadsafe-statics -ffunction-sections -fdata-sections -mcall-prologues -mrelax \
+                 -Wall -Wextra -Werror -Wdouble-promotion -Ilib/MavLink -Ilib/LinAlg -Ilib/Console \
+                 -I$(MAVLINK_DIR) -Wl,--gc-sections
+MAVCOST_SRC   := bench/mavlink_cost.cpp lib/MavLink/MavLink.cpp lib/LinAlg/LinAlg.cpp lib/Console/Text.cpp
+
+.PHONY: mavlink-cost
+mavlink-cost: $(MAVLINK_STAMP) tools
+	@mkdir -p $(MAVCOST_DIR)
+	@$(AVR_CXX) $(MAVCOST_FLAGS) $(MAVCOST_SRC) -lm -o $(MAVCOST_DIR)/cost.elf
+	@$(AVR_CXX) $(MAVCOST_FLAGS) -DMAV_COST_EMPTY bench/mavlink_cost.cpp -o $(MAVCOST_DIR)/empty.elf
+	@full=$$(avr-size -A $(MAVCOST_DIR)/cost.elf | awk '/^\.text|^\.data/ {s+=$$2} END {print s}'); \
+	  empty=$$(avr-size -A $(MAVCOST_DIR)/empty.elf | awk '/^\.text|^\.data/ {s+=$$2} END {print s}'); \
+	  echo "# lib/MavLink flash: $$((full - empty)) bytes (linked, -Os -flto)"
+	@$(BUILD)/scenario rest --seconds 1 > $(MAVCOST_DIR)/rest.csv
+	@$(BUILD)/apm25sim --elf $(MAVCOST_DIR)/cost.elf --trajectory $(MAVCOST_DIR)/rest.csv --seconds 0.2 \
+	  --profile $(MAVCOST_DIR)/profile.csv > /dev/null
+	@awk -F, 'BEGIN { n[1]="HEARTBEAT"; n[2]="ATTITUDE"; n[3]="SYS_STATUS"; n[4]="STATUSTEXT, 30-char line"; \
+	  n[5]="STATUSTEXT, 70-char line (2 chunks)"; n[7]="FrameFilter, 21-byte frame" } \
+	  ($$1 in n) { printf "# %-38s %6d cycles avg (min %d, max %d)\n", n[$$1], $$3, $$4, $$5 }' $(MAVCOST_DIR)/profile.csv
