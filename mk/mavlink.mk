@@ -8,8 +8,11 @@
 #                    the pymavlink package ships (MAVLink 2; nothing generated is committed)
 #   make view                         the live attitude view, fed by the simulated board
 #   make view SCENARIO=pitch90 SECONDS=20
+#   make view MODE=quat               ... with `mode quat` typed into the simulated board
+#                                     (quat, csv, mavlink: the view reads them all)
 #   make view PORT=/dev/ttyACM0       ... by a real board (115200)
 #   make view FILE=stream.txt         ... by a recorded stream (text modes or MAVLink)
+#   make view VIEW_FLAGS="--frames DIR"   headless: PNG frames into DIR, no window
 #
 # mavgen reads only the XML files beside common.xml (standard.xml, minimal.xml) and copies
 # its fixed C headers from the package: it needs no network once the venv exists.
@@ -62,8 +65,10 @@ else
 	@$(MAKE) --no-print-directory firmware tools
 	@mkdir -p $(BUILD)/scenarios
 	@$(BUILD)/scenario $(SCENARIO) > $(BUILD)/scenarios/$(SCENARIO).csv
+	@printf '$(if $(MODE),mode $(MODE)\n)' > $(BUILD)/scenarios/view-input.txt
 	$(VENV_PY) tools/view.py --sim $(BUILD)/apm25sim --elf $(BUILD)/firmware.elf \
-	  --trajectory $(BUILD)/scenarios/$(SCENARIO).csv $(if $(SECONDS),--seconds $(SECONDS)) $(VIEW_FLAGS)
+	  --trajectory $(BUILD)/scenarios/$(SCENARIO).csv $(if $(SECONDS),--seconds $(SECONDS)) \
+	  $(if $(MODE),--input $(BUILD)/scenarios/view-input.txt) $(VIEW_FLAGS)
 endif
 
 # What lib/MavLink costs on the 2560: flash (linked, against the same program without
