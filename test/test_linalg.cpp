@@ -209,3 +209,13 @@ TEST(LinAlg, QuatFromRotationIsUnitForAScaledMatrixAndIdentityForNaN) {
     EXPECT_EQ(i.y, 0.0f);
     EXPECT_EQ(i.z, 0.0f);
 }
+
+TEST(LinAlg, QuatTurnedAboutDownAddsTheDeclinationToTheHeading) {
+    // A board at roll 10, pitch -20, magnetic heading 30; declination +12 (east): the
+    // true-north quaternion is the one of heading 42 with the same roll and pitch.
+    const linalg::Quaternion q = linalg::quat_from_rotation(matrix_from_euler_deg(10, -20, 30));
+    const float half = 0.5f * 12.0f * linalg::kRadPerDeg;
+    const linalg::Quaternion t = linalg::quat_turned_about_down(q, std::cos(half), std::sin(half));
+    const linalg::Quaternion want = linalg::quat_from_rotation(matrix_from_euler_deg(10, -20, 42));
+    EXPECT_NEAR(std::fabs(t.w * want.w + t.x * want.x + t.y * want.y + t.z * want.z), 1.0f, 1e-6f);
+}

@@ -95,4 +95,10 @@ Quaternion quat_from_rotation(const Matrix3f& m) {
     return Quaternion{q[0] * inv_n, q[1] * inv_n, q[2] * inv_n, q[3] * inv_n};
 }
 
+Quaternion quat_turned_about_down(const Quaternion& q, float cos_half, float sin_half) {
+    // (c, 0, 0, s) * (w, x, y, z), Hamilton product.
+    return Quaternion{cos_half * q.w - sin_half * q.z, cos_half * q.x - sin_half * q.y,
+                      cos_half * q.y + sin_half * q.x, cos_half * q.z + sin_half * q.w};
+}
+
 }  // namespace linalg

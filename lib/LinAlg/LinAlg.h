@@ -136,4 +136,10 @@ struct Quaternion {
 // `mode quat`. A non-finite matrix gives the identity.
 Quaternion quat_from_rotation(const Matrix3f& m);
 
+// q turned about the earth's down axis by an angle a given as cos(a/2), sin(a/2)
+// (computed once when the angle changes): qz(a) * q. The DCM's earth frame is magnetic
+// north-east-down; a = the declination makes q's earth frame true north, as the heading
+// in the angle lines is. 16 multiplies, no trigonometry.
+Quaternion quat_turned_about_down(const Quaternion& q, float cos_half, float sin_half);
+
 }  // namespace linalg
