@@ -9,8 +9,8 @@ DIR/replay, DIR/scenario, DIR/score (`make all`); a missing one skips its part w
 message. The real recordings are read from ../shared/data/broad beside the repository
 (skipped with a message when absent).
 
-It runs itself in its own virtual environment, DIR/bench/venv, which it creates and fills
-from PyPI on first use (numpy, matplotlib and the peers vqf, ahrs, imufusion).
+It runs itself in the project's virtual environment, DIR/venv (`make venv`: the packages
+of requirements.txt, among them numpy, matplotlib and the peers vqf, ahrs, imufusion).
 
 Writes DIR/bench/report.md, DIR/bench/figures.json, DIR/bench/*.png; peer results are
 cached by file hash in DIR/bench/cache so that reruns are fast.
@@ -26,9 +26,9 @@ import time
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
 
-# The virtualenv's packages. ahrs 0.4.0 works with numpy 2 (checked); imufusion's API
-# changed between 1.2 and 1.3, so it is pinned with the peers.
-REQUIREMENTS = ["numpy>=1.24", "matplotlib>=3.6", "vqf==2.1.2", "ahrs==0.4.0", "imufusion==1.3.3"]
+# The virtualenv's packages (requirements.txt: the peers are pinned; ahrs 0.4.0 works with
+# numpy 2, imufusion's API changed between 1.2 and 1.3). Part of the peer cache's key.
+REQUIREMENTS = open(os.path.join(REPO, "requirements.txt")).read().split()
 
 FIGURE_KEYS = ["step_cycles_avg", "euler_cycles_avg", "line_cycles_avg", "loop_load_pct",
                "flash_bytes", "ram_bytes", "broad_total_deg", "broad_incl_deg", "broad_heading_deg"]
@@ -65,28 +65,16 @@ def log(msg):
 # The virtual environment
 
 def ensure_venv(build):
-    venv = os.path.join(build, "bench", "venv")
+    """Re-runs this script in the project's virtualenv, build/venv: `make venv` owns it
+    (mk/python.mk, from requirements.txt) and is a no-op when it is up to date."""
+    venv = os.path.join(build, "venv")
     if os.path.realpath(sys.prefix) == os.path.realpath(venv):
         return
+    r = subprocess.run(["make", "--no-print-directory", "-f", "mk/build.mk", "BUILD=" + os.path.abspath(build),
+                        "venv"], cwd=REPO)
+    if r.returncode != 0:
+        sys.exit("bench: `make venv` failed (python3-venv and PyPI are needed)")
     py = os.path.join(venv, "bin", "python")
-    stamp = os.path.join(venv, ".bench-requirements")
-    wanted = "\n".join(REQUIREMENTS) + "\n"
-    if not os.path.exists(py):
-        log("creating the virtual environment " + os.path.relpath(venv, REPO))
-        os.makedirs(os.path.dirname(venv), exist_ok=True)
-        r = subprocess.run([sys.executable, "-m", "venv", venv])
-        if r.returncode != 0 or not os.path.exists(py):
-            sys.exit("bench: could not create a virtualenv with '%s -m venv' (Debian: apt-get install "
-                     "python3-venv, or run `make deps`)" % sys.executable)
-    have = open(stamp).read() if os.path.exists(stamp) else ""
-    if have != wanted:
-        log("installing into the virtualenv: " + " ".join(REQUIREMENTS) + " (once)")
-        r = subprocess.run([py, "-m", "pip", "install", "--quiet", "--disable-pip-version-check"]
-                           + REQUIREMENTS)
-        if r.returncode != 0:
-            sys.exit("bench: pip install failed (PyPI must be reachable); rerun `make bench` to retry")
-        with open(stamp, "w") as f:
-            f.write(wanted)
     os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:])
 
 

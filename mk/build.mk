@@ -123,7 +123,7 @@ sim: firmware tools
 	@$(BUILD)/apm25sim --elf $(BUILD)/firmware.elf --trajectory $(BUILD)/scenarios/$(SCENARIO).csv \
 	  $(if $(SECONDS),--seconds $(SECONDS))
 
-test: firmware tools
+test: firmware tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)
 
 bench: firmware tools
@@ -131,3 +131,9 @@ bench: firmware tools
 
 upload: firmware
 	avrdude -p $(MCU) -c wiring -P $(PORT) -b $(BAUD) -D -U flash:w:$(BUILD)/firmware.hex:i
+
+# ---------------------------------------------------------------------------
+# The Python environment, MAVLink headers and live view, fuzzing and sanitizers.
+include mk/python.mk
+include mk/mavlink.mk
+include mk/fuzz.mk

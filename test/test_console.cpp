@@ -91,6 +91,11 @@ TEST(Console, Mode) {
     EXPECT_EQ(parse("mode plot").mode, fmt::OutputMode::Plot);
     EXPECT_EQ(parse("mode CSV").mode, fmt::OutputMode::Csv);
     EXPECT_EQ(parse("mode quiet").mode, fmt::OutputMode::Quiet);
+    EXPECT_EQ(parse("mode quat").mode, fmt::OutputMode::Quat);
+    EXPECT_EQ(parse("mode RAW").mode, fmt::OutputMode::Raw);
+    EXPECT_EQ(parse("mode mavlink").mode, fmt::OutputMode::Mavlink);
+    EXPECT_EQ(parse("mode mav").error, Error::BadMode);
+    EXPECT_EQ(parse("mode quaternion").error, Error::BadMode);
     EXPECT_EQ(parse("mode loud").error, Error::BadMode);
     EXPECT_EQ(parse("mode").error, Error::MissingArgument);
 }
@@ -256,4 +261,29 @@ TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
     EXPECT_EQ(last.id, console::CommandId::Decl);
     EXPECT_EQ(last.value, 850);
     EXPECT_TRUE(q.empty());
+}
+
+TEST(Console, EveryModeNameParsesBackToItsMode) {
+    for (uint8_t m = 0; m <= (uint8_t)fmt::kLastOutputMode; ++m) {
+        const fmt::OutputMode mode = (fmt::OutputMode)m;
+        const std::string line = std::string("mode ") + console::mode_name(mode).p;
+        const console::Command c = parse(line.c_str());
+        EXPECT_EQ(c.id, CommandId::Mode) << line;
+        EXPECT_EQ(c.mode, mode) << line;
+    }
+}
+
+TEST(Console, ModeMavlinkIsAppliedAndHelpNamesTheNewModes) {
+    settings::Settings s = settings::defaults();
+    std::string out;
+    const text::Sink sink{&out, sink_write};
+    EXPECT_TRUE(console::apply_setting(parse("mode mavlink"), s, &sink));
+    EXPECT_EQ(s.mode, fmt::OutputMode::Mavlink);
+    EXPECT_EQ(out, "# mode mavlink\n");
+    out.clear();
+    console::print_help(&sink);
+    for (const char* word : {"quat", "raw", "mavlink"}) EXPECT_NE(out.find(word), std::string::npos) << word;
+    out.clear();
+    console::print_error(parse("mode loud"), &sink);
+    EXPECT_EQ(out, "# error: mode must be plot, csv, quat, raw, mavlink or quiet; nothing changed\n");
 }

@@ -99,3 +99,71 @@ TEST(Format, WriterChains) {
     EXPECT_EQ(s, "# x=-12 4000000000 6A 3.14 ?\n");
     text::Writer(nullptr).str(TXT("silent")).i32(3).end();  // a null sink is a no-op
 }
+
+namespace {
+
+std::string quat(float w, float x, float y, float z) {
+    char buf[fmt::kLineMax];
+    return std::string(buf, fmt::format_quat_line(buf, linalg::Quaternion{w, x, y, z}));
+}
+
+std::string raw(const linalg::Vector3f& g, const linalg::Vector3f& a, const linalg::Vector3f& m) {
+    char buf[fmt::kRawLineMax];
+    return std::string(buf, fmt::format_raw_line(buf, g, a, m));
+}
+
+}  // namespace
+
+TEST(Format, QuatLineHasFourDecimalsInLabelValueForm) {
+    EXPECT_EQ(quat(0.70710678f, 0.0f, -0.70710678f, 0.00004f), "qw:0.7071 qx:0.0000 qy:-0.7071 qz:0.0000\n");
+    EXPECT_EQ(quat(1.0f, -0.00005f, 0.12345f, -0.99995f), "qw:1.0000 qx:-0.0001 qy:0.1235 qz:-1.0000\n");
+    EXPECT_EQ(quat(-1.0f, -1.0f, -1.0f, -1.0f).size(), 44u);
+    EXPECT_LE(quat(-1.0f, -1.0f, -1.0f, -1.0f).size(), (size_t)fmt::kLineMax);
+}
+
+TEST(Format, QuatLineRefusesWhatIsNotAUnitQuaternionComponent) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(quat(nan, 0.0f, 0.0f, 0.0f), "");
+    EXPECT_EQ(quat(1.0f, 0.0f, std::numeric_limits<float>::infinity(), 0.0f), "");
+    EXPECT_EQ(quat(1.01f, 0.0f, 0.0f, 0.0f), "");
+    EXPECT_EQ(quat(1.0f, 0.0f, 0.0f, -1.01f), "");
+}
+
+TEST(Format, RawLineHasTheCalibratedValuesWithTheirUnitsResolution) {
+    using linalg::Vector3f;
+    EXPECT_EQ(raw(Vector3f(0.123f, -0.061f, 0.0f), Vector3f(0.0124f, -0.0031f, -1.0006f), Vector3f(20.14f, 0.26f, 45.25f)),
+              "gx:0.12 gy:-0.06 gz:0.00 ax:0.012 ay:-0.003 az:-1.001 mx:20.1 my:0.3 mz:45.3\n");
+    EXPECT_EQ(raw(Vector3f(-2000.0f, 1999.99f, 5.0f), Vector3f(8.0f, -8.0f, 0.5f), Vector3f(-810.0f, 0.0f, 1.0f)),
+              "gx:-2000.00 gy:1999.99 gz:5.00 ax:8.000 ay:-8.000 az:0.500 mx:-810.0 my:0.0 mz:1.0\n");
+}
+
+TEST(Format, RawLongestLineFitsAndBeyondTheSensorsIsRefused) {
+    using linalg::Vector3f;
+    const std::string longest =
+        raw(Vector3f(-9999.0f, -9999.0f, -9999.0f), Vector3f(-40.0f, -40.0f, -40.0f), Vector3f(-999.9f, -999.9f, -999.9f));
+    EXPECT_EQ(longest.size(), 99u);
+    EXPECT_LE(longest.size(), (size_t)fmt::kRawLineMax);
+    const Vector3f z;
+    EXPECT_EQ(raw(Vector3f(10000.0f, 0.0f, 0.0f), z, z), "");
+    EXPECT_EQ(raw(z, Vector3f(0.0f, -40.5f, 0.0f), z), "");
+    EXPECT_EQ(raw(z, z, Vector3f(0.0f, 0.0f, 1000.0f)), "");
+    EXPECT_EQ(raw(z, z, Vector3f(0.0f, std::numeric_limits<float>::quiet_NaN(), 0.0f)), "");
+}
+
+TEST(Format, FixedPointAtEveryPrecision) {
+    char buf[20];
+    EXPECT_EQ(std::string(buf, text::format_fixed(buf, -12345, 4)), "-1.2345");
+    EXPECT_EQ(std::string(buf, text::format_fixed(buf, 5, 3)), "0.005");
+    EXPECT_EQ(std::string(buf, text::format_fixed(buf, 7, 1)), "0.7");
+    EXPECT_EQ(std::string(buf, text::format_fixed(buf, -42, 0)), "-42");
+    EXPECT_EQ(std::string(buf, text::format_fixed(buf, INT32_MIN, 4)), "-214748.3648");
+    int32_t v = 7;
+    EXPECT_TRUE(text::to_fixed(-0.00005f, 4, v));
+    EXPECT_EQ(v, -1);
+    EXPECT_TRUE(text::to_fixed(1.23456f, 3, v));
+    EXPECT_EQ(v, 1235);
+    v = 7;
+    EXPECT_FALSE(text::to_fixed(3e5f, 4, v));  // 3e9 does not fit
+    EXPECT_FALSE(text::to_fixed(1.0f, 5, v));
+    EXPECT_EQ(v, 7);
+}

@@ -6,6 +6,7 @@
 
 #include "Bytes.h"
 #include "LinAlg.h"
+#include "ScoreMetric.h"
 
 using linalg::Matrix3f;
 using linalg::Vector3f;
@@ -141,4 +142,80 @@ TEST(Bytes, BigEndianInt16AndSaturation) {
     EXPECT_EQ(linalg::saturate_int16(NAN), 0);
     EXPECT_EQ(linalg::saturate_int16(2.5f), 3);
     EXPECT_EQ(linalg::saturate_int16(-2.5f), -3);
+}
+
+// quat_from_rotation: checked against sim/ScoreMetric.h's Euler quaternion (double,
+// independent code) and by rotating vectors with the quaternion.
+
+namespace {
+
+// R = Rz(yaw) Ry(pitch) Rx(roll), body -> earth (APM25.md).
+linalg::Matrix3f matrix_from_euler_deg(float roll, float pitch, float yaw) {
+    const float r = roll * linalg::kRadPerDeg, p = pitch * linalg::kRadPerDeg, y = yaw * linalg::kRadPerDeg;
+    const float cr = std::cos(r), sr = std::sin(r), cp = std::cos(p), sp = std::sin(p), cy = std::cos(y),
+                sy = std::sin(y);
+    return linalg::Matrix3f(linalg::Vector3f(cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
+                            linalg::Vector3f(sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
+                            linalg::Vector3f(-sp, cp * sr, cp * cr));
+}
+
+// v' = q v q*
+linalg::Vector3f rotate(const linalg::Quaternion& q, const linalg::Vector3f& v) {
+    const linalg::Vector3f u(q.x, q.y, q.z);
+    const linalg::Vector3f t = u.cross(v) * 2.0f;
+    return v + t * q.w + u.cross(t);
+}
+
+}  // namespace
+
+TEST(LinAlg, QuatFromRotationMatchesEulerQuaternionsEverywhere) {
+    // Every branch of Shepperd's method: near identity, and 180-degree turns about x, y, z
+    // (trace -1, one diagonal element +1).
+    const float cases[][3] = {{0, 0, 0},     {10, -20, 30},  {180, 0, 0},  {0, 0, 180},  {179, 1, 90},
+                              {0, 89.9f, 0}, {-90, 45, 270}, {170, -5, 10}, {0, 180, 0}, {-179.5f, -30, 359}};
+    for (const auto& c : cases) {
+        const linalg::Quaternion q = linalg::quat_from_rotation(matrix_from_euler_deg(c[0], c[1], c[2]));
+        score::Quat e = score::quat_from_euler_deg(c[0], c[1], c[2]);
+        if (e.w < 0.0) e = score::Quat{-e.w, -e.x, -e.y, -e.z};
+        const double dot = q.w * e.w + q.x * e.x + q.y * e.y + q.z * e.z;
+        EXPECT_NEAR(std::fabs(dot), 1.0, 1e-6) << c[0] << " " << c[1] << " " << c[2];
+        EXPECT_GE(q.w, 0.0f);
+        EXPECT_NEAR(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z, 1.0f, 1e-6f);
+    }
+}
+
+TEST(LinAlg, QuatFromRotationRotatesVectorsAsTheMatrixDoes) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int i = 0; i < 500; ++i) {
+        const linalg::Matrix3f m = matrix_from_euler_deg(180.0f * u(rng), 90.0f * u(rng), 180.0f * u(rng));
+        const linalg::Quaternion q = linalg::quat_from_rotation(m);
+        const linalg::Vector3f v(u(rng), u(rng), u(rng));
+        const linalg::Vector3f a = m * v, b = rotate(q, v);
+        EXPECT_NEAR(a.x, b.x, 2e-6f);
+        EXPECT_NEAR(a.y, b.y, 2e-6f);
+        EXPECT_NEAR(a.z, b.z, 2e-6f);
+    }
+}
+
+TEST(LinAlg, QuatFromRotationIsUnitForAScaledMatrixAndIdentityForNaN) {
+    const linalg::Quaternion q = linalg::quat_from_rotation(matrix_from_euler_deg(30, 20, 10) * 1.001f);
+    EXPECT_NEAR(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z, 1.0f, 1e-6f);
+    linalg::Matrix3f bad;
+    bad.b.y = std::nanf("");
+    const linalg::Quaternion i = linalg::quat_from_rotation(bad);
+    EXPECT_EQ(i.w, 1.0f);
+    EXPECT_EQ(i.x, 0.0f);
+    EXPECT_EQ(i.y, 0.0f);
+    EXPECT_EQ(i.z, 0.0f);
+}
+
+TEST(LinAlg, QuatTurnedAboutDownAddsTheDeclinationToTheHeading) {
+    // A board at roll 10, pitch -20, magnetic heading 30; declination +12 (east): the
+    // true-north quaternion is the one of heading 42 with the same roll and pitch.
+    const linalg::Quaternion q = linalg::quat_from_rotation(matrix_from_euler_deg(10, -20, 30));
+    const float half = 0.5f * 12.0f * linalg::kRadPerDeg;
+    const linalg::Quaternion t = linalg::quat_turned_about_down(q, std::cos(half), std::sin(half));
+    const linalg::Quaternion want = linalg::quat_from_rotation(matrix_from_euler_deg(10, -20, 42));
+    EXPECT_NEAR(std::fabs(t.w * want.w + t.x * want.x + t.y * want.y + t.z * want.z), 1.0f, 1e-6f);
 }

@@ -145,3 +145,28 @@ TEST(Settings, OutOfRangeValueWithGoodCrcGivesDefaults) {
     EXPECT_EQ(settings::decode(rec, out), LoadResult::BadValue);
     expect_defaults(out);
 }
+
+TEST(Settings, EveryOutputModeIsStoredAndNothingBeyondTheLast) {
+    // quat, raw and mavlink are new values of the same byte: the record layout is unchanged.
+    EXPECT_EQ(settings::kPayloadLength, 41u);
+    for (uint8_t m = 0; m <= (uint8_t)fmt::kLastOutputMode; ++m) {
+        Settings in = sample();
+        in.mode = (fmt::OutputMode)m;
+        uint8_t rec[settings::kRecordSize];
+        settings::encode(in, rec);
+        EXPECT_EQ(rec[7], m);
+        Settings out;
+        ASSERT_EQ(settings::decode(rec, out), LoadResult::Ok) << int(m);
+        EXPECT_EQ(out.mode, in.mode);
+    }
+    EXPECT_EQ((uint8_t)fmt::OutputMode::Quat, 3u);
+    EXPECT_EQ((uint8_t)fmt::OutputMode::Raw, 4u);
+    EXPECT_EQ((uint8_t)fmt::OutputMode::Mavlink, 5u);
+    Settings bad = sample();
+    bad.mode = (fmt::OutputMode)((uint8_t)fmt::kLastOutputMode + 1u);
+    uint8_t rec[settings::kRecordSize];
+    settings::encode(bad, rec);
+    Settings out;
+    EXPECT_EQ(settings::decode(rec, out), LoadResult::BadValue);
+    expect_defaults(out);
+}

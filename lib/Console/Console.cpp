@@ -107,7 +107,7 @@ Command parse_line(const char* line) {
     }
     if (id == CommandId::Mode) {
         // The names in the order of fmt::OutputMode's values.
-        const int8_t m = find_word(arg, TXT("plot\0csv\0quiet\0"));
+        const int8_t m = find_word(arg, TXT("plot\0csv\0quiet\0quat\0raw\0mavlink\0"));
         if (m < 0) return fail(Error::BadMode);
         r.mode = (fmt::OutputMode)m;
         return r;
@@ -157,6 +157,9 @@ text::Flash mode_name(fmt::OutputMode m) {
     switch (m) {
         case fmt::OutputMode::Csv: return TXT("csv");
         case fmt::OutputMode::Quiet: return TXT("quiet");
+        case fmt::OutputMode::Quat: return TXT("quat");
+        case fmt::OutputMode::Raw: return TXT("raw");
+        case fmt::OutputMode::Mavlink: return TXT("mavlink");
         case fmt::OutputMode::Plot: break;
     }
     return TXT("plot");
@@ -174,7 +177,7 @@ void print_error(const Command& c, const text::Sink* out) {
         case Error::BadNumber: w.str(TXT("not a number (e.g. 50 or -2.5)")); break;
         case Error::RateRange: w.str(TXT("rate must be a whole number 1..100 Hz")); break;
         case Error::DeclRange: w.str(TXT("decl must be -180..180 degrees")); break;
-        case Error::BadMode: w.str(TXT("mode must be plot, csv or quiet")); break;
+        case Error::BadMode: w.str(TXT("mode must be plot, csv, quat, raw, mavlink or quiet")); break;
         case Error::BadCalTarget: w.str(TXT("cal gyro or cal mag")); break;
         case Error::None: w.str(TXT("internal")); break;
     }
@@ -185,7 +188,7 @@ void print_help(const text::Sink* out) {
     Writer(out).str(TXT(
         "# rate <Hz>: output rate 1..100\n"
         "# decl <deg>: declination -180..180, east +\n"
-        "# mode plot|csv|quiet: output format\n"
+        "# mode plot|csv|quat|raw|mavlink|quiet: output\n"
         "# status: health, load, bias, temperature, uptime\n"
         "# cal gyro: gyro bias (keep still 1 s)\n"
         "# cal mag: compass (turn every way for 30 s)\n"

@@ -3,7 +3,9 @@
 //   help                 the command list
 //   rate <Hz>            output lines per second, whole number 1..100
 //   decl <degrees>       magnetic declination, east positive, -180..180 (2 decimals kept)
-//   mode plot|csv|quiet  output format (csv prints its header "t_ms,roll,pitch,yaw" first)
+//   mode plot|csv|quat|raw|mavlink|quiet
+//                        output format (csv prints its header "t_ms,roll,pitch,yaw" first;
+//                        quat and raw lines: Format.h; mavlink: MAVLink 2, lib/MavLink)
 //   status               sensor health, loop load, overruns, gyro bias, temperature, uptime
 //   cal gyro             measure the gyro bias again (keep the board still ~1 s)
 //   cal mag              hard iron + scale: turn the board every way for 30 s
@@ -54,7 +56,7 @@ enum class Error : uint8_t {
     BadNumber,        // not a number of the expected form
     RateRange,        // not 1..100 or not whole
     DeclRange,        // outside -180..180
-    BadMode,          // not plot|csv|quiet
+    BadMode,          // not plot|csv|quat|raw|mavlink|quiet
     BadCalTarget,     // cal without gyro|mag
 };
 
@@ -102,7 +104,7 @@ void print_defaults(const text::Sink* out);
 // "t_ms,roll,pitch,yaw\n": the csv header (after `mode csv` and at start in csv mode).
 text::Flash csv_header();
 
-// "plot", "csv" or "quiet".
+// "plot", "csv", "quiet", "quat", "raw" or "mavlink".
 text::Flash mode_name(fmt::OutputMode m);
 
 // Parsed commands waiting to run, oldest first. The firmware parses input as soon as it

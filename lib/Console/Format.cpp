@@ -86,4 +86,40 @@ uint8_t format_csv_line(char buf[kLineMax], uint32_t t_ms, float roll_deg, float
     return (uint8_t)(p - buf);
 }
 
+namespace {
+
+// "label:value" with `decimals` decimals; false if v is not finite or |v| > limit.
+bool put_field(char*& p, const char* label, float v, uint8_t decimals, float limit) {
+    int32_t scaled;
+    if (!(v >= -limit && v <= limit) || !text::to_fixed(v, decimals, scaled)) return false;
+    p = put(p, label);
+    p += text::format_fixed(p, scaled, decimals);
+    return true;
+}
+
+}  // namespace
+
+uint8_t format_quat_line(char buf[kLineMax], const linalg::Quaternion& q) {
+    char* p = buf;
+    if (!put_field(p, "qw:", q.w, 4, 1.0001f) || !put_field(p, " qx:", q.x, 4, 1.0001f) ||
+        !put_field(p, " qy:", q.y, 4, 1.0001f) || !put_field(p, " qz:", q.z, 4, 1.0001f))
+        return 0;
+    *p++ = '\n';
+    return (uint8_t)(p - buf);
+}
+
+uint8_t format_raw_line(char buf[kRawLineMax], const linalg::Vector3f& gyro_dps, const linalg::Vector3f& accel_g,
+                        const linalg::Vector3f& field_uT) {
+    constexpr float kGyroMaxDps = 9999.0f, kAccelMaxG = 40.0f, kFieldMaxUt = 999.9f;
+    char* p = buf;
+    if (!put_field(p, "gx:", gyro_dps.x, 2, kGyroMaxDps) || !put_field(p, " gy:", gyro_dps.y, 2, kGyroMaxDps) ||
+        !put_field(p, " gz:", gyro_dps.z, 2, kGyroMaxDps) || !put_field(p, " ax:", accel_g.x, 3, kAccelMaxG) ||
+        !put_field(p, " ay:", accel_g.y, 3, kAccelMaxG) || !put_field(p, " az:", accel_g.z, 3, kAccelMaxG) ||
+        !put_field(p, " mx:", field_uT.x, 1, kFieldMaxUt) || !put_field(p, " my:", field_uT.y, 1, kFieldMaxUt) ||
+        !put_field(p, " mz:", field_uT.z, 1, kFieldMaxUt))
+        return 0;
+    *p++ = '\n';
+    return (uint8_t)(p - buf);
+}
+
 }  // namespace fmt

@@ -48,7 +48,7 @@ void encode(const Settings& s, uint8_t out[kRecordSize]) {
 bool is_valid(const Settings& s) {
     return s.rate_hz >= kRateMinHz && s.rate_hz <= kRateMaxHz &&
            s.declination_centideg >= kDeclMinCentideg && s.declination_centideg <= kDeclMaxCentideg &&
-           (uint8_t)s.mode <= (uint8_t)fmt::OutputMode::Quiet && (s.flags & ~0x03u) == 0u &&
+           (uint8_t)s.mode <= (uint8_t)fmt::kLastOutputMode && (s.flags & ~0x03u) == 0u &&
            calib::is_plausible(s.cal);
 }
 

@@ -23,24 +23,49 @@ uint8_t format_int(char* buf, int32_t v) {
     return (uint8_t)(1u + format_u32(buf + 1, (uint32_t)0 - (uint32_t)v));
 }
 
-uint8_t format_centi(char* buf, int32_t centi) {
-    const uint32_t mag = centi < 0 ? (uint32_t)0 - (uint32_t)centi : (uint32_t)centi;
+namespace {
+// 10^d for d <= 4 (a loop, not a table: a table would sit in the AVR's SRAM).
+uint16_t pow10(uint8_t d) {
+    uint16_t p = 1u;
+    while (d-- > 0u) p = (uint16_t)(p * 10u);
+    return p;
+}
+}  // namespace
+
+uint8_t format_fixed(char* buf, int32_t scaled, uint8_t decimals) {
+    if (decimals > 4u) decimals = 4u;
+    const uint16_t unit = pow10(decimals);
+    const uint32_t mag = scaled < 0 ? (uint32_t)0 - (uint32_t)scaled : (uint32_t)scaled;
     uint8_t len = 0;
-    if (centi < 0) buf[len++] = '-';
-    len = (uint8_t)(len + format_u32(buf + len, mag / 100u));
-    const uint8_t frac = (uint8_t)(mag % 100u);
+    if (scaled < 0) buf[len++] = '-';
+    const uint32_t whole = mag / unit;
+    len = (uint8_t)(len + format_u32(buf + len, whole));
+    if (decimals == 0u) return len;
+    uint16_t frac = (uint16_t)(mag - whole * unit);
     buf[len++] = '.';
-    buf[len++] = (char)('0' + frac / 10u);
-    buf[len++] = (char)('0' + frac % 10u);
+    for (uint8_t i = decimals; i > 0u; --i) {  // leading zeros kept: 5 at 2 decimals is "0.05"
+        const uint16_t pw = pow10((uint8_t)(i - 1u));
+        char d = '0';
+        while (frac >= pw) {
+            frac = (uint16_t)(frac - pw);
+            ++d;
+        }
+        buf[len++] = d;
+    }
     return len;
 }
 
-bool to_centi(float x, int32_t& out) {
-    if (!linalg::is_finite(x) || x > 2.0e7f || x < -2.0e7f) return false;
-    const float scaled = x * 100.0f;
+uint8_t format_centi(char* buf, int32_t centi) { return format_fixed(buf, centi, 2); }
+
+bool to_fixed(float x, uint8_t decimals, int32_t& out) {
+    if (!linalg::is_finite(x) || decimals > 4u) return false;
+    const float scaled = x * (float)pow10(decimals);
+    if (scaled > 2.0e9f || scaled < -2.0e9f) return false;
     out = (int32_t)(scaled >= 0.0f ? scaled + 0.5f : scaled - 0.5f);
     return true;
 }
+
+bool to_centi(float x, int32_t& out) { return to_fixed(x, 2, out); }
 
 namespace {
 #ifdef __AVR__

@@ -60,10 +60,16 @@ struct Sink {
 uint8_t format_u32(char* buf, uint32_t v);
 // Decimal digits of v into buf (no NUL); returns the count (<= 11).
 uint8_t format_int(char* buf, int32_t v);
+// scaled / 10^decimals with exactly `decimals` (0..4) decimals ("-1.2345", "0.05");
+// returns the count (<= 16).
+uint8_t format_fixed(char* buf, int32_t scaled, uint8_t decimals);
 // v/100 with exactly two decimals ("-1.23", "0.05"); returns the count (<= 14).
 uint8_t format_centi(char* buf, int32_t centi);
-// Nearest hundredth of x, rounding half away from zero. False (out untouched) when x
-// is NaN, infinite or beyond +-2e7, so nothing non-finite ever reaches the text.
+// Nearest x * 10^decimals (0..4), rounding half away from zero. False (out untouched)
+// when x is NaN, infinite or |x * 10^decimals| > 2e9, so nothing non-finite ever
+// reaches the text.
+bool to_fixed(float x, uint8_t decimals, int32_t& out);
+// to_fixed(x, 2, out): false beyond +-2e7.
 bool to_centi(float x, int32_t& out);
 
 // Chained writes to a sink; every call is a no-op when the sink is null.

@@ -55,4 +55,50 @@ Vector3f Vector3f::normalized() const {
 Vector3f Matrix3f::operator*(const Vector3f& v) const { return Vector3f(a.dot(v), b.dot(v), c.dot(v)); }
 Vector3f Matrix3f::mul_transpose(const Vector3f& v) const { return a * v.x + b * v.y + c * v.z; }
 
+Quaternion quat_from_rotation(const Matrix3f& m) {
+    const float trace = m.a.x + m.b.y + m.c.z;
+    // 4 q_i^2 for each component: the largest has the best-conditioned square root.
+    float q[4];
+    if (trace >= m.a.x && trace >= m.b.y && trace >= m.c.z) {
+        const float s = 2.0f * safe_sqrt(1.0f + trace);  // 4 w
+        const float inv = s > 0.0f ? 1.0f / s : 0.0f;
+        q[0] = 0.25f * s;
+        q[1] = (m.c.y - m.b.z) * inv;
+        q[2] = (m.a.z - m.c.x) * inv;
+        q[3] = (m.b.x - m.a.y) * inv;
+    } else if (m.a.x >= m.b.y && m.a.x >= m.c.z) {
+        const float s = 2.0f * safe_sqrt(1.0f + m.a.x - m.b.y - m.c.z);  // 4 x
+        const float inv = s > 0.0f ? 1.0f / s : 0.0f;
+        q[0] = (m.c.y - m.b.z) * inv;
+        q[1] = 0.25f * s;
+        q[2] = (m.a.y + m.b.x) * inv;
+        q[3] = (m.a.z + m.c.x) * inv;
+    } else if (m.b.y >= m.c.z) {
+        const float s = 2.0f * safe_sqrt(1.0f - m.a.x + m.b.y - m.c.z);  // 4 y
+        const float inv = s > 0.0f ? 1.0f / s : 0.0f;
+        q[0] = (m.a.z - m.c.x) * inv;
+        q[1] = (m.a.y + m.b.x) * inv;
+        q[2] = 0.25f * s;
+        q[3] = (m.b.z + m.c.y) * inv;
+    } else {
+        const float s = 2.0f * safe_sqrt(1.0f - m.a.x - m.b.y + m.c.z);  // 4 z
+        const float inv = s > 0.0f ? 1.0f / s : 0.0f;
+        q[0] = (m.b.x - m.a.y) * inv;
+        q[1] = (m.a.z + m.c.x) * inv;
+        q[2] = (m.b.z + m.c.y) * inv;
+        q[3] = 0.25f * s;
+    }
+    const float n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    if (!(n2 > 0.0f) || !is_finite(n2)) return Quaternion{1.0f, 0.0f, 0.0f, 0.0f};
+    float inv_n = 1.0f / sqrtf(n2);
+    if (q[0] < 0.0f) inv_n = -inv_n;  // w >= 0
+    return Quaternion{q[0] * inv_n, q[1] * inv_n, q[2] * inv_n, q[3] * inv_n};
+}
+
+Quaternion quat_turned_about_down(const Quaternion& q, float cos_half, float sin_half) {
+    // (c, 0, 0, s) * (w, x, y, z), Hamilton product.
+    return Quaternion{cos_half * q.w - sin_half * q.z, cos_half * q.x - sin_half * q.y,
+                      cos_half * q.y + sin_half * q.x, cos_half * q.z + sin_half * q.w};
+}
+
 }  // namespace linalg

@@ -19,7 +19,7 @@ build() {  # build NAME SKETCH_DIR: arduino-builder into $out/NAME, log in $out/
   rm -rf "$out/$1" && mkdir -p "$out/$1"
   arduino-builder -compile -hardware /usr/share/arduino/hardware -tools /usr/share/arduino-builder \
     -libraries "$project/lib" -fqbn arduino:avr:mega:cpu=atmega2560 -build-path "$out/$1" \
-    -prefs=compiler.cpp.extra_flags=-DDECIMAL_DIG=__DECIMAL_DIG__ \
+    "-prefs=compiler.cpp.extra_flags=-DDECIMAL_DIG=__DECIMAL_DIG__ -I$tools/mavlink" \
     -prefs=tools.ctags.path=/usr/bin -prefs=tools.ctags.cmd.path=/usr/bin/arduino-ctags \
     '-prefs=tools.ctags.pattern="{cmd.path}" -u --language-force=c++ -f - --c++-kinds=svpf --fields=KSTtzns --line-directives "{source_file}"' \
     "$2/firmware.ino" > "$out/$1.log" 2>&1

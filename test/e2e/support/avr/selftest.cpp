@@ -522,6 +522,28 @@ void check_format() {
     EXPECT(text::to_centi(-2.345f, centi) && centi == -235);
 }
 
+// quat and raw lines, fixed point at 1..4 decimals (test_format.cpp), and the DCM's
+// quaternion (test_linalg.cpp): 16-bit int arithmetic on this target.
+void check_quat_raw() {
+    char buf[fmt::kRawLineMax];
+    EXPECT(line_is(buf, fmt::format_quat_line(buf, linalg::Quaternion{0.70710678f, 0.0f, -0.70710678f, 0.00004f}),
+                   "qw:0.7071 qx:0.0000 qy:-0.7071 qz:0.0000\n"));
+    EXPECT(fmt::format_quat_line(buf, linalg::Quaternion{1.01f, 0.0f, 0.0f, 0.0f}) == 0);
+    EXPECT(line_is(buf,
+                   fmt::format_raw_line(buf, linalg::Vector3f(-2000.0f, 1999.99f, 5.0f), linalg::Vector3f(8.0f, -8.0f, 0.5f),
+                                        linalg::Vector3f(-810.0f, 0.0f, 1.0f)),
+                   "gx:-2000.00 gy:1999.99 gz:5.00 ax:8.000 ay:-8.000 az:0.500 mx:-810.0 my:0.0 mz:1.0\n"));
+    EXPECT(line_is(buf, text::format_fixed(buf, INT32_MIN, 4), "-214748.3648"));
+    // 90 degrees of yaw: R rows (0 -1 0), (1 0 0), (0 0 1); q = (cos 45, 0, 0, sin 45).
+    const linalg::Quaternion q = linalg::quat_from_rotation(linalg::Matrix3f(
+        linalg::Vector3f(0.0f, -1.0f, 0.0f), linalg::Vector3f(1.0f, 0.0f, 0.0f), linalg::Vector3f(0.0f, 0.0f, 1.0f)));
+    EXPECT(fabsf(q.w - 0.70710678f) < 1e-6f && fabsf(q.z - 0.70710678f) < 1e-6f && q.x == 0.0f && q.y == 0.0f);
+    // 180 degrees about x (trace -1): q = (0, 1, 0, 0).
+    const linalg::Quaternion r = linalg::quat_from_rotation(linalg::Matrix3f(
+        linalg::Vector3f(1.0f, 0.0f, 0.0f), linalg::Vector3f(0.0f, -1.0f, 0.0f), linalg::Vector3f(0.0f, 0.0f, -1.0f)));
+    EXPECT(fabsf(r.x - 1.0f) < 1e-6f && r.w == 0.0f && r.y == 0.0f && r.z == 0.0f);
+}
+
 }  // namespace
 
 static void run_all() {
@@ -538,6 +560,7 @@ static void run_all() {
     run(TXT("console_parse"), check_console_parse);
     run(TXT("settings_crc"), check_settings_crc);
     run(TXT("format"), check_format);
+    run(TXT("quat_raw"), check_quat_raw);
     text::Writer(&kOut).str(TXT("# selftest done: ")).u32(g_checks).str(TXT(" checks, ")).u32(g_ok)
         .str(TXT(" ok, ")).u32((uint32_t)(g_checks - g_ok)).str(TXT(" FAIL")).end();
 }

@@ -1,0 +1,85 @@
+// Cost of lib/MavLink on the ATmega2560: a bare program (no Arduino core) that packs
+// each message between the cycle markers apm25sim --profile counts (section id to GPIOR0
+// at the start, GPIOR1 at the end). Built twice by `make mavlink-cost`: with
+// -DMAV_COST_EMPTY the same program without the packing, so the flash difference is
+// what the MavLink code costs in a linked image (LTO, --gc-sections, as the firmware).
+//
+//   section 1  HEARTBEAT             (1 Hz)
+//   section 2  ATTITUDE              (every output line)
+//   section 3  SYS_STATUS            (1 Hz)
+//   section 4  a 30-character "# " line through StatusText (one STATUSTEXT)
+//   section 5  a 70-character "# error:" line (two chunks)
+//   section 7  FrameFilter over one 21-byte HEARTBEAT frame from a GCS
+//   section 6  the whole run
+#include <avr/io.h>
+#include <stdint.h>
+
+#ifndef MAV_COST_EMPTY
+#include "MavLink.h"
+#endif
+
+namespace {
+
+volatile uint8_t g_sink;
+volatile float g_angle = 12.5f;
+
+#ifndef MAV_COST_EMPTY
+void sink(void*, const uint8_t* frame, uint8_t len) {
+    uint8_t s = 0;
+    for (uint8_t i = 0; i < len; ++i) s = (uint8_t)(s + frame[i]);
+    g_sink = s;
+}
+#endif
+
+inline void begin(uint8_t id) { GPIOR0 = id; }
+inline void end(uint8_t id) { GPIOR1 = id; }
+
+}  // namespace
+
+int main() {
+    begin(6);
+#ifndef MAV_COST_EMPTY
+    mav::Packer packer;
+    mav::StatusText text(packer, mav::FrameSink{nullptr, &sink});
+    mav::FrameFilter filter;
+    uint8_t frame[mav::kMaxFrame];
+    uint8_t gcs[mav::kMaxFrame];
+    mav::Packer gcs_packer;
+    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active);
+    static const char kShort[] = "# mode mavlink: MAVLink 2 now\n";
+    static const char kLong[] = "# error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68), retrying each s\n";
+#endif
+    for (uint8_t k = 0; k < 20; ++k) {
+#ifndef MAV_COST_EMPTY
+        begin(1);
+        uint8_t n = packer.heartbeat(frame, mav::State::Active);
+        end(1);
+        sink(nullptr, frame, n);
+        begin(2);
+        n = packer.attitude(frame, 1000u * k, g_angle, -g_angle, 359.0f - g_angle,
+                            linalg::Vector3f(0.01f, -0.02f, g_angle * 0.001f));
+        end(2);
+        sink(nullptr, frame, n);
+        begin(3);
+        n = packer.sys_status(frame, mav::health(true, true, true, k & 1u), 593u, k);
+        end(3);
+        sink(nullptr, frame, n);
+        begin(4);
+        text.write(kShort, (uint8_t)(sizeof kShort - 1));
+        end(4);
+        begin(5);
+        text.write(kLong, (uint8_t)(sizeof kLong - 1));
+        end(5);
+        begin(7);
+        for (uint8_t i = 0; i < gcs_len; ++i) g_sink = filter.consume(gcs[i]);
+        end(7);
+#else
+        begin(1);
+        g_sink = (uint8_t)(g_sink + (uint8_t)g_angle);
+        end(1);
+#endif
+    }
+    end(6);
+    for (;;) {
+    }
+}
