@@ -98,9 +98,13 @@ constexpr float kFitInvScale = 1.0f / kFitScale_uT;
 
 // Index of the monomial x^i y^j z^k in MagCalibrator's sums: by degree d = i + j + k,
 // then by r = j + k, then by k (1, x, y, z, x^2, xy, xz, y^2, yz, z^2, x^3, ...).
+// Tables, not d (d + 1) (d + 2) / 6 and r (r + 1) / 2: a division is a library call on
+// the AVR, and add() looks up 34 indices a sample.
+const uint8_t kTetrahedral[5] = {0, 1, 4, 10, 20};  // monomials of degree < d
+const uint8_t kTriangular[5] = {0, 1, 3, 6, 10};
 uint8_t moment_index(uint8_t i, uint8_t j, uint8_t k) {
-    const uint8_t d = (uint8_t)(i + j + k), r = (uint8_t)(j + k);
-    return (uint8_t)(d * (d + 1) * (d + 2) / 6 + r * (r + 1) / 2 + k);
+    const uint8_t r = (uint8_t)(j + k);
+    return (uint8_t)(kTetrahedral[i + r] + kTriangular[r] + k);
 }
 
 // Exponents packed two bits each (i | j << 2 | k << 4).
@@ -180,10 +184,11 @@ void MagCalibrator::add(const Vector3f& field_uT) {
     for (uint8_t d = 1; d <= 4; ++d) {
         for (uint8_t r = 0; r <= d; ++r) {
             for (uint8_t k = 0; k <= r; ++k, ++n) {
-                const uint8_t i = (uint8_t)(d - r), j = (uint8_t)(r - k);
-                if (i > 0) m[n] = m[moment_index((uint8_t)(i - 1), j, k)] * var[0];
-                else if (j > 0) m[n] = m[moment_index(0, (uint8_t)(j - 1), k)] * var[1];
-                else m[n] = m[moment_index(0, 0, (uint8_t)(k - 1))] * var[2];
+                // Parent: x^(i-1) y^j z^k (same r) times x while i > 0, else y, else z.
+                const uint8_t below = (uint8_t)(kTetrahedral[d - 1] + k);
+                if (r < d) m[n] = m[below + kTriangular[r]] * var[0];
+                else if (k < r) m[n] = m[below + kTriangular[r - 1]] * var[1];
+                else m[n] = m[below - 1 + kTriangular[r - 1]] * var[2];
             }
         }
     }
@@ -314,7 +319,8 @@ MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
 // ---------------------------------------------------------------------------
 void OffsetLearner::restart(float prior_uT) {
     have_ref_ = false;
-    p_uT2_ = prior_uT * prior_uT;
+    prior_info_ = 1.0f / (prior_uT * prior_uT);
+    for (uint8_t i = 0; i < 6; ++i) info_[i] = 0.0f;
 }
 
 bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t steps, Vector3f& learned_uT) {
@@ -330,15 +336,27 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t st
     // cos theta of the turn R1 -> R2: (trace(R2^T R1) - 1) / 2.
     const float cos_turn = 0.5f * (r.a.dot(r_ref_.a) + r.b.dot(r_ref_.b) + r.c.dot(r_ref_.c) - 1.0f);
     if (cos_turn > kLearnMinCos) return false;  // not turned enough yet: keep the pair open
-    const float one_minus_cos = 1.0f - cos_turn;
-    // r_e = R2 f2 - R1 f1 = (R2 - R1) e; the estimate of e across the axis is
-    // (R2 - R1)^T r_e / (2 (1 - cos theta)).
-    const Vector3f field_ef = r * field_uT;
-    const Vector3f residual_ef = field_ef - field_ef_ref_;
+    // r_e = R2 f2 - R1 f1 = (R2 - R1) e = H e; H^T r_e is what the pair says of e.
+    const Vector3f residual_ef = r * field_uT - field_ef_ref_;
     const Vector3f across = r.mul_transpose(residual_ef) - r_ref_.mul_transpose(residual_ef);
-    const float noise_uT2 = kLearnPairNoise_uT * kLearnPairNoise_uT / one_minus_cos;
-    const float gain = p_uT2_ / (p_uT2_ + noise_uT2);
-    Vector3f step = across * (gain * 0.5f / one_minus_cos);
+    // H^T H = 2 I - M - M^T, M = R2^T R1 = sum over the earth axes k of r2_k r1_k^T.
+    const float* r2 = &r.a.x;
+    const float* r1 = &r_ref_.a.x;
+    static const uint8_t kRow[6] = {0, 1, 2, 0, 0, 1}, kCol[6] = {0, 1, 2, 1, 2, 2};
+    const float fade = 1.0f - 1.0f / kLearnMemoryPairs;
+    const float inv_noise = 1.0f / (kLearnPairNoise_uT * kLearnPairNoise_uT);
+    for (uint8_t e = 0; e < 6; ++e) {
+        const uint8_t i = kRow[e], j = kCol[e];
+        float m = 0.0f;
+        for (uint8_t k = 0; k < 9; k += 3) m += r2[k + i] * r1[k + j] + r2[k + j] * r1[k + i];
+        info_[e] = info_[e] * fade + ((i == j ? 2.0f : 0.0f) - m) * inv_noise;
+    }
+    // The prior stays: it holds the axis never turned about where it is.
+    float a[3][kMaxUnknowns + 1] = {{info_[0] + prior_info_, info_[3], info_[4], across.x * inv_noise},
+                                    {info_[3], info_[1] + prior_info_, info_[5], across.y * inv_noise},
+                                    {info_[4], info_[5], info_[2] + prior_info_, across.z * inv_noise}};
+    if (!solve(a, 3)) return false;
+    Vector3f step(a[0][3], a[1][3], a[2][3]);
     float* s = &step.x;
     float* o = &learned_uT.x;
     for (uint8_t i = 0; i < 3; ++i) {
@@ -347,8 +365,6 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t st
         o[i] = linalg::constrain(o[i] + s[i], -kLearnMaxOffset_uT, kLearnMaxOffset_uT);
         s[i] = o[i] - before;
     }
-    // Two of the three components were measured: P shrinks by (1 - gain) on two thirds.
-    p_uT2_ = p_uT2_ * (1.0f - gain * (2.0f / 3.0f)) + kLearnDrift_uT2;
     if (updates_ < 0xFFFFu) ++updates_;
     // The sample that closed this pair opens the next, with the new offset removed.
     r_ref_ = r;

@@ -165,19 +165,22 @@ private:
 // so two calibrated samples f1, f2 taken at attitudes R1, R2 (body to earth) satisfy
 // R2 f2 = R1 f1 if the offset is right; a residual offset e leaves
 //   r = R2 f2 - R1 f1 = (R2 - R1) e.
-// Each pair with a turn of theta between them measures e's two components across the
-// rotation axis: the least-squares estimate is (R2 - R1)^T r / (2 (1 - cos theta)).
-// It is weighed against the estimate so far as a scalar Kalman filter would: gain
-// P / (P + noise), noise = kLearnPairNoise_uT^2 / (1 - cos theta), P shrinking with
-// each update and growing slowly (kLearnDrift) so a changed hard iron is followed.
-// Pairs are taken kLearnMinTurn apart and at most kLearnMaxPairSteps apart (the
-// attitude's own drift over longer spans is not small against the signal).
+// Each pair measures the two components of e across the rotation axis, with
+// information H^T H / sigma^2, H = R2 - R1 (H^T H = 2 (1 - cos theta) (I - n n^T)).
+// The learner is recursive least squares in information form: L += H^T H / sigma^2,
+// e = (I / prior^2 + L)^-1 H^T r / sigma^2, L fading by 1/kLearnMemoryPairs a pair, so
+// that a hard iron that changes (a battery moved) is followed. Pairs are
+// taken at least 20 deg apart and at most kLearnMaxPairSteps apart (the attitude's own
+// drift over a longer span is no longer small against the signal).
 constexpr float kLearnMinCos = 0.94f;           // pairs at least 20 deg apart: cos 20 deg
-// Noise of one pair's residual per unit |R2 - R1|: the HMC5883L's 0.2 uT on each
-// sample, and the attitude's error over the pair (0.5 deg of gyro drift and
-// heading correction in 2 s, times a 50 uT field: 0.4 uT), summed in quadrature.
+// Noise of one pair's residual: the HMC5883L's 0.2 uT on each sample, and the
+// attitude's error over the pair (0.5 deg of gyro drift and heading correction in 2 s,
+// times a 50 uT field: 0.4 uT), summed in quadrature.
 constexpr float kLearnPairNoise_uT = 0.5f;
 constexpr uint16_t kLearnMaxPairSteps = 400;    // 2 s at 200 Hz
+// ~2 pairs a second while turning: a minute of turning to follow a change, and one
+// pair's noise averaged down by ~10 (0.05 uT).
+constexpr float kLearnMemoryPairs = 100.0f;
 constexpr float kLearnMaxStep_uT = 5.0f;        // one pair moves no axis further (a passing magnet)
 // ArduPilot's "compass offsets too high" limit (500 mGauss): beyond, calibrate.
 constexpr float kLearnMaxOffset_uT = 50.0f;
@@ -185,27 +188,28 @@ constexpr float kLearnMaxOffset_uT = 50.0f;
 // the fit's own error is a fraction of a uT.
 constexpr float kLearnPriorUncalibrated_uT = 30.0f;
 constexpr float kLearnPriorCalibrated_uT = 1.0f;
-// Growth of P per pair: the hard iron may change (a battery moved) by ~0.1 uT per pair;
-// it also floors the gain at ~ 0.1^2 / (0.5^2 / 0.06) ~ 0.2 %... see OffsetLearner.
-constexpr float kLearnDrift_uT2 = 0.01f;
 
 class OffsetLearner {
 public:
-    // Forgets the pair in progress; prior_uT: how far off the current offset may be.
+    // Starts afresh; prior_uT: how far off the current offset may be, each axis.
     void restart(float prior_uT);
+    // Drops the pair in progress (the attitude was reset: its turn is not the board's).
+    void forget_pair() { have_ref_ = false; }
     // One calibrated field sample (uT, body frame: the learned offset already
     // removed) and the attitude R (body to earth) at the same instant, `steps` estimator
     // steps after the previous call. When a pair completes, updates `learned_uT` (the
     // offset that calibration subtracts) and returns true.
     bool add(const linalg::Vector3f& field_uT, const linalg::Matrix3f& r, uint16_t steps,
              linalg::Vector3f& learned_uT);
-    float uncertainty_uT2() const { return p_uT2_; }
     uint16_t updates() const { return updates_; }
+    // The information from pairs so far, 1/uT^2 (diagonal xx yy zz, then xy xz yz).
+    const float* information() const { return info_; }
 
 private:
     linalg::Matrix3f r_ref_;
     linalg::Vector3f field_ef_ref_;  // R1 f1
-    float p_uT2_ = kLearnPriorUncalibrated_uT * kLearnPriorUncalibrated_uT;
+    float info_[6] = {};
+    float prior_info_ = 1.0f / (kLearnPriorUncalibrated_uT * kLearnPriorUncalibrated_uT);
     uint16_t age_steps_ = 0;
     uint16_t updates_ = 0;
     bool have_ref_ = false;

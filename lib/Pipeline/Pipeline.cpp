@@ -42,22 +42,30 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         }
         return;
     }
-    if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) learn_mag_offset(f);
+    // The learner's pair is worked out in a later step without output (a pair update
+    // is ~20 k cycles: on top of the Euler angles and the line it would overrun the
+    // 5 ms step); the attitude is the one of this sample.
+    if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
+        learn_field_uT_ = f;
+        learn_r_ = dcm_.matrix();
+        st_.learn_steps = st_.steps_since_mag;
+        st_.learn_pending = true;
+    }
+    st_.steps_since_mag = 0;
     mag_cal_uT_ = f;
     st_.mag_pending = true;
     st_.have_mag = true;
 }
 
-// The learner moves the offset that apply_mag subtracts last; `field_uT` (calibrated with
-// the old one) is brought up to date. Once the offset has moved by kMagReferenceShift_uT
+// The learner moves the offset that apply_mag subtracts last; the latest field (calibrated
+// with the old one) is brought up to date. Once the offset has moved by kMagReferenceShift_uT
 // since the DCM learned the earth field, the DCM learns it again.
-void AttitudePipeline::learn_mag_offset(Vector3f& field_uT) {
+void AttitudePipeline::learn_mag_offset() {
+    st_.learn_pending = false;
     Vector3f& learned = settings_.cal.mag_learned_uT;
     const Vector3f before = learned;
-    const uint16_t steps = st_.steps_since_mag;
-    st_.steps_since_mag = 0;
-    if (!learner_.add(field_uT, dcm_.matrix(), steps, learned)) return;
-    field_uT -= learned - before;
+    if (!learner_.add(learn_field_uT_, learn_r_, st_.learn_steps, learned)) return;
+    mag_cal_uT_ -= learned - before;
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
         forget_mag_reference();
 }
@@ -67,7 +75,8 @@ void AttitudePipeline::learn_mag_offset(Vector3f& field_uT) {
 void AttitudePipeline::forget_mag_reference() {
     dcm_.reset_mag_reference();
     learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
-    learner_.restart(sqrtf(learner_.uncertainty_uT2()));
+    learner_.forget_pair();
+    st_.learn_pending = false;
 }
 
 // Spikes and non-finite values are replaced by the previous sample; saturation is
@@ -224,6 +233,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
+    if (st_.learn_pending && !st_.output_due) learn_mag_offset();
 }
 
 Angles AttitudePipeline::angles() const {

@@ -153,7 +153,7 @@ private:
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
-    void learn_mag_offset(linalg::Vector3f& field_uT);
+    void learn_mag_offset();
     void forget_mag_reference();
 
     const text::Sink* log_;
@@ -163,6 +163,8 @@ private:
     calib::MagCalibrator mag_cal_;
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
+    linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and its attitude
+    linalg::Matrix3f learn_r_;
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
@@ -174,6 +176,7 @@ private:
         uint16_t gyro_cal_steps;
         uint16_t mag_cal_steps;
         uint16_t steps_since_mag;       // for the offset learner's pairs
+        uint16_t learn_steps;           // steps_since_mag of the waiting sample
         uint16_t output_acc;
         Phase phase;                    // WaitImu
         uint8_t spike_run;
@@ -186,6 +189,7 @@ private:
         bool mag_cal_active;
         bool output_due;
         bool reinit_pending;
+        bool learn_pending;             // learn_field_uT_ waits for a step without output
     };
     State st_;
 };
