@@ -357,6 +357,18 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t st
                                     {info_[4], info_[5], info_[2] + prior_info_, across.z * inv_noise}};
     if (!solve(a, 3)) return false;
     Vector3f step(a[0][3], a[1][3], a[2][3]);
+    // A pair says nothing along its rotation axis n (the skew part of M: M - M^T =
+    // 2 sin(theta) [n x]); what the solve puts there is the weak prior amplifying
+    // rounding and attitude error: it is taken out.
+    float skew[3];
+    for (uint8_t e = 0; e < 3; ++e) {
+        const uint8_t i = kRow[e + 3], j = kCol[e + 3];
+        float m = 0.0f;
+        for (uint8_t k = 0; k < 9; k += 3) m += r2[k + i] * r1[k + j] - r2[k + j] * r1[k + i];
+        skew[e] = m;
+    }
+    const Vector3f axis = Vector3f(skew[2], -skew[1], skew[0]).normalized();
+    step -= axis * axis.dot(step);
     float* s = &step.x;
     float* o = &learned_uT.x;
     for (uint8_t i = 0; i < 3; ++i) {

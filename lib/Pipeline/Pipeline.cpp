@@ -46,7 +46,11 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     // is ~20 k cycles: on top of the Euler angles and the line it would overrun the
     // 5 ms step); the attitude is the one of this sample.
     if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
-        learn_field_uT_ = f;
+        // The sample is mag_latency_s older than the attitude: turned forward by the
+        // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
+        // as an offset.
+        const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s);
+        learn_field_uT_ = f + f.cross(rate) * dcm_.settings().mag_latency_s;
         learn_r_ = dcm_.matrix();
         st_.learn_steps = st_.steps_since_mag;
         st_.learn_pending = true;
