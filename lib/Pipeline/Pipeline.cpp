@@ -32,7 +32,11 @@ void AttitudePipeline::set_mag_present(bool present) {
 
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
-    if (st_.mag_cal_active) mag_cal_.add(field_uT);
+    // The fit's sums (~10 k cycles) wait for a step without output, as the learner does.
+    if (st_.mag_cal_active) {
+        cal_field_uT_ = field_uT;
+        st_.cal_pending = true;
+    }
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
@@ -237,7 +241,10 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
-    if (st_.learn_pending && !st_.output_due) learn_mag_offset();
+    if (st_.output_due) return;
+    if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
+    st_.cal_pending = false;
+    if (st_.learn_pending) learn_mag_offset();
 }
 
 Angles AttitudePipeline::angles() const {

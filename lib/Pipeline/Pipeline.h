@@ -165,6 +165,7 @@ private:
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
     linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and its attitude
     linalg::Matrix3f learn_r_;
+    linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
@@ -190,6 +191,7 @@ private:
         bool output_due;
         bool reinit_pending;
         bool learn_pending;             // learn_field_uT_ waits for a step without output
+        bool cal_pending;               // cal_field_uT_ likewise
     };
     State st_;
 };
