@@ -1,7 +1,7 @@
 // build/scenario: synthetic trajectories in the format of ../shared/SIM.md.
 //
-//   build/scenario NAME [--seconds S] [--rate HZ]     CSV on stdout
-//   build/scenario --list                             names and one-line descriptions
+//   build/scenario NAME [--seconds S] [--rate HZ] [sensor-error options]   CSV on stdout
+//   build/scenario --list                             names, descriptions and the options
 //
 // Physically consistent: each scenario is an analytic attitude q(t) (body -> earth, NED,
 // built as Rz(yaw) Ry(pitch) Rx(roll) from smooth keyframed angles, any angle range);
@@ -11,6 +11,12 @@
 // Sensor noise (white, fixed seed, so every run is identical): gyro 0.03 deg/s, accel
 // 0.025 m/s^2, field 0.2 uT rms, about the MPU6000 / HMC5883L datasheet densities at the
 // configured bandwidths. movement = 0 for the first 2 s (start-up), 1 after.
+//
+// Sensor errors a real, uncalibrated board has (all off by default, so that the default
+// files stay exactly what they were): gyro bias and its drift, accel offset and scale,
+// compass hard and soft iron, noise at the datasheets' densities, quantisation to the
+// chips' resolution. They apply to the measured columns only; the truth is untouched.
+// `--preset uncalibrated` sets all of them to values typical of an APM 2.5 (usage text).
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -142,6 +148,17 @@ std::vector<Scenario> scenarios() {
                    {}};
         list.push_back(s);
     }
+    {
+        // Every body axis points down and up in turn (z down, y down, z up, y up, x up, x
+        // down), with yaw turning throughout: what a compass calibration asks for.
+        Scenario s{"tumble", "still 5 s, tumbled through every orientation (all axes up and down) for 30 s, still 15 s",
+                   {{0, 0, 0, 0}, {5, 0, 0, 0}, {7.5, 90, 0, 30}, {10, 180, 0, 60}, {12.5, 270, 0, 120},
+                    {15, 360, 0, 180}, {17.5, 360, 85, 220}, {20, 360, 0, 270}, {22.5, 360, -85, 300},
+                    {25, 360, 0, 360}, {27.5, 450, 45, 420}, {30, 540, -45, 480}, {32.5, 630, 30, 540},
+                    {35, 720, 0, 540}, {50, 720, 0, 540}},
+                   {}};
+        list.push_back(s);
+    }
     return list;
 }
 
@@ -189,11 +206,118 @@ struct Noise {
     }
 };
 
+// Imperfections of the measured columns (body frame), applied after the physics:
+//   gyro  = omega + bias + drift * t + walk(t) + noise
+//   accel = scale .* f + offset + noise
+//   mag   = S * B + hard_iron + noise        (S: soft iron, B: the field the board is in)
+// then each rounded to its chip's resolution when quantise is set.
+struct SensorErrors {
+    double gyro_bias_dps[3] = {0, 0, 0};
+    double gyro_drift_dps_per_min[3] = {0, 0, 0};  // a ramp: the warm-up drift of the zero-rate output
+    double gyro_walk_dps_per_sqrt_min = 0.0;       // a random walk per axis (a bias instability)
+    double accel_offset_m_s2[3] = {0, 0, 0};
+    double accel_scale[3] = {1, 1, 1};
+    double hard_iron_uT[3] = {0, 0, 0};
+    double soft_iron[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    bool datasheet_noise = false;  // white noise at the datasheets' densities instead of the fixed amounts
+    bool quantise = false;
+    uint64_t seed = 0;             // 0: the fixed seed of the default files
+};
+
+// MPU6000 Product Specification 6.1/6.2: rate noise spectral density 0.005 deg/s/sqrt(Hz),
+// accel 400 ug/sqrt(Hz); white noise of density d sampled at r Hz has sigma d * sqrt(r / 2).
+// HMC5883L datasheet: noise floor 2 mG (0.2 uT) standard deviation per output sample.
+constexpr double kGyroDensity_dps_sqrt_hz = 0.005;
+constexpr double kAccelDensity_g_sqrt_hz = 400e-6;
+constexpr double kMagFloor_uT = 0.2;
+// The firmware's ranges (lib/MPU6000 kGyroRange 2000 deg/s, kAccelRange 8 g; lib/HMC5883
+// kGain 1.3 Ga): one count of each chip.
+constexpr double kGyroLsb_dps = 1.0 / 16.4;
+constexpr double kAccelLsb_m_s2 = kGravity_m_s2 / 4096.0;
+constexpr double kMagLsb_uT = 100.0 / 1090.0;
+
+// A realistic uncalibrated APM 2.5, each value well inside its datasheet tolerance:
+// gyro zero-rate offset (MPU6000 +-20 deg/s initial) of 1-1.5 deg/s, drifting as the board
+// warms (+-20 deg/s over 125 K is 0.16 deg/s/K; ~1 K/min after power-up: ~0.1 deg/s/min);
+// accel zero-g offset (+-50 mg x/y, +-80 mg z) of 10-20 mg and sensitivity (+-3 %) of
+// 1-2 %; compass hard iron of 5-10 uT from the board's own parts (ArduPilot accepts
+// offsets up to 500 mG = 50 uT) and soft iron of a few percent with cross terms; noise at
+// the densities above; values quantised to the chips' counts.
+void set_uncalibrated(SensorErrors& e) {
+    const double bias[3] = {1.5, -1.0, 0.8}, drift[3] = {0.10, -0.08, 0.06};
+    const double offset[3] = {0.10, -0.08, 0.20}, scale[3] = {1.02, 0.985, 1.01};
+    const double hard[3] = {6.0, -4.0, 9.0};
+    const double soft[3][3] = {{1.04, 0.02, -0.015}, {0.02, 0.97, 0.01}, {-0.015, 0.01, 1.01}};
+    for (int i = 0; i < 3; ++i) {
+        e.gyro_bias_dps[i] = bias[i];
+        e.gyro_drift_dps_per_min[i] = drift[i];
+        e.accel_offset_m_s2[i] = offset[i];
+        e.accel_scale[i] = scale[i];
+        e.hard_iron_uT[i] = hard[i];
+        for (int j = 0; j < 3; ++j) e.soft_iron[i][j] = soft[i][j];
+    }
+    e.datasheet_noise = true;
+    e.quantise = true;
+}
+
+const char* const kOptionsHelp =
+    "sensor-error options (default: none; they change only the measured columns):\n"
+    "  --gyro-bias X,Y,Z       gyro bias, deg/s per body axis\n"
+    "  --gyro-drift X,Y,Z      gyro bias ramp, deg/s per minute per axis (from t = 0)\n"
+    "  --gyro-walk S           gyro bias random walk, deg/s per sqrt(minute), each axis\n"
+    "  --accel-offset X,Y,Z    accel offset, m/s^2\n"
+    "  --accel-scale X,Y,Z     accel scale factor per axis (1 = exact; 1.02 = +2 %)\n"
+    "  --hard-iron X,Y,Z       compass hard iron, uT, body frame (added to the field)\n"
+    "  --soft-iron A,B,C       compass soft iron: per-axis scales (diagonal matrix), or\n"
+    "  --soft-iron A,B,C,XY,XZ,YZ   scales and symmetric cross terms, or\n"
+    "  --soft-iron M11,...,M33 the full 3x3 matrix, row by row (mag = M * field + hard iron)\n"
+    "  --noise datasheet       white noise at the datasheets' densities at the file's rate\n"
+    "                          (MPU6000 0.005 deg/s/sqrt(Hz), 400 ug/sqrt(Hz); HMC5883L 0.2 uT);\n"
+    "  --noise default         the fixed amounts (0.03 deg/s, 0.025 m/s^2, 0.2 uT rms)\n"
+    "  --quantise              round to one count of each chip at the firmware's ranges\n"
+    "                          (1/16.4 deg/s, 8 g / 32768, 1/1090 G)\n"
+    "  --seed N                another noise sequence (default: the fixed one)\n"
+    "  --preset uncalibrated   a realistic uncalibrated board: gyro bias (1.5,-1,0.8) deg/s\n"
+    "                          drifting (0.1,-0.08,0.06) deg/s/min, accel offset\n"
+    "                          (0.1,-0.08,0.2) m/s^2 and scale (1.02,0.985,1.01), hard iron\n"
+    "                          (6,-4,9) uT, soft iron scales (1.04,0.97,1.01) with cross terms\n"
+    "                          (0.02,-0.015,0.01), datasheet noise, quantised; later options\n"
+    "                          override single values\n";
+
 void print_list(const std::vector<Scenario>& list) {
     for (const Scenario& s : list) {
         std::printf("%-16s %5.0f s  %s\n", s.name, s.keys.back().t_s, s.description);
     }
 }
+
+// --list: the names (one a line, as tools read them), then the options as `# ` lines.
+void print_list_with_options(const std::vector<Scenario>& list) {
+    print_list(list);
+    const char* p = kOptionsHelp;
+    while (*p) {
+        const char* e = std::strchr(p, '\n');
+        std::printf("# %.*s\n", (int)(e - p), p);
+        p = e + 1;
+    }
+}
+
+// "a,b,c" into exactly n_min..n_max doubles; false on anything else.
+bool parse_list(const char* text, double* out, int n_min, int n_max, int& n) {
+    n = 0;
+    const char* p = text;
+    while (true) {
+        char* end = nullptr;
+        const double v = std::strtod(p, &end);
+        if (end == p || n >= n_max || !std::isfinite(v)) return false;
+        out[n++] = v;
+        if (*end == '\0') break;
+        if (*end != ',') return false;
+        p = end + 1;
+    }
+    return n >= n_min;
+}
+
+double quantised(double v, double lsb) { return std::round(v / lsb) * lsb; }
 
 }  // namespace
 
@@ -201,19 +325,78 @@ int main(int argc, char** argv) {
     const std::vector<Scenario> list = scenarios();
     std::string name;
     double seconds = -1.0, rate_hz = 400.0;
+    SensorErrors err;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
+        const bool has_value = i + 1 < argc;
+        int n = 0;
         if (arg == "--list") {
-            print_list(list);
+            print_list_with_options(list);
             return 0;
         } else if (arg == "--help" || arg == "-h") {
-            std::printf("usage: scenario NAME [--seconds S] [--rate HZ] > FILE.csv\n       scenario --list\n");
+            std::printf("usage: scenario NAME [--seconds S] [--rate HZ] [options] > FILE.csv\n"
+                        "       scenario --list\n%s\nscenarios:\n", kOptionsHelp);
             print_list(list);
             return 0;
-        } else if (arg == "--seconds" && i + 1 < argc) {
+        } else if (arg == "--seconds" && has_value) {
             seconds = std::atof(argv[++i]);
-        } else if (arg == "--rate" && i + 1 < argc) {
+        } else if (arg == "--rate" && has_value) {
             rate_hz = std::atof(argv[++i]);
+        } else if (arg == "--preset" && has_value) {
+            if (std::strcmp(argv[++i], "uncalibrated") != 0) {
+                std::fprintf(stderr, "scenario: unknown preset '%s' (there is: uncalibrated)\n", argv[i]);
+                return 1;
+            }
+            set_uncalibrated(err);
+        } else if ((arg == "--gyro-bias" || arg == "--gyro-drift" || arg == "--accel-offset" ||
+                    arg == "--accel-scale" || arg == "--hard-iron") && has_value) {
+            double* out = arg == "--gyro-bias"      ? err.gyro_bias_dps
+                          : arg == "--gyro-drift"   ? err.gyro_drift_dps_per_min
+                          : arg == "--accel-offset" ? err.accel_offset_m_s2
+                          : arg == "--accel-scale"  ? err.accel_scale
+                                                    : err.hard_iron_uT;
+            double v[3];
+            if (!parse_list(argv[++i], v, 3, 3, n)) {
+                std::fprintf(stderr, "scenario: %s needs X,Y,Z (three numbers), not '%s'\n", arg.c_str(), argv[i]);
+                return 1;
+            }
+            for (int k = 0; k < 3; ++k) out[k] = v[k];
+        } else if (arg == "--gyro-walk" && has_value) {
+            double v[1];
+            if (!parse_list(argv[++i], v, 1, 1, n) || v[0] < 0.0) {
+                std::fprintf(stderr, "scenario: --gyro-walk needs one number >= 0, not '%s'\n", argv[i]);
+                return 1;
+            }
+            err.gyro_walk_dps_per_sqrt_min = v[0];
+        } else if (arg == "--soft-iron" && has_value) {
+            double v[9];
+            if (!parse_list(argv[++i], v, 3, 9, n) || (n != 3 && n != 6 && n != 9)) {
+                std::fprintf(stderr, "scenario: --soft-iron needs 3, 6 or 9 numbers, not '%s'\n", argv[i]);
+                return 1;
+            }
+            double (&m)[3][3] = err.soft_iron;
+            if (n == 9) {
+                for (int k = 0; k < 9; ++k) m[k / 3][k % 3] = v[k];
+            } else {
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c) m[r][c] = r == c ? v[r] : 0.0;
+                if (n == 6) {
+                    m[0][1] = m[1][0] = v[3];
+                    m[0][2] = m[2][0] = v[4];
+                    m[1][2] = m[2][1] = v[5];
+                }
+            }
+        } else if (arg == "--noise" && has_value) {
+            const std::string v = argv[++i];
+            if (v != "datasheet" && v != "default") {
+                std::fprintf(stderr, "scenario: --noise is datasheet or default, not '%s'\n", v.c_str());
+                return 1;
+            }
+            err.datasheet_noise = v == "datasheet";
+        } else if (arg == "--quantise" || arg == "--quantize") {
+            err.quantise = true;
+        } else if (arg == "--seed" && has_value) {
+            err.seed = std::strtoull(argv[++i], nullptr, 10);
         } else if (name.empty() && arg[0] != '-') {
             name = arg;
         } else {
@@ -237,6 +420,17 @@ int main(int argc, char** argv) {
 
     const Extras& x = scenario->extras;
     Noise noise;
+    if (err.seed != 0) noise.state ^= err.seed * 0xD1B54A32D192ED03ull;
+    Noise walk_noise;  // its own sequence, so the options never shift the default noise
+    walk_noise.state = noise.state ^ 0x5851F42D4C957F2Dull;
+    const double gyro_sigma_rad_s =
+        err.datasheet_noise ? kGyroDensity_dps_sqrt_hz * std::sqrt(rate_hz / 2.0) * kDeg : kGyroNoise_rad_s;
+    const double accel_sigma_m_s2 =
+        err.datasheet_noise ? kAccelDensity_g_sqrt_hz * kGravity_m_s2 * std::sqrt(rate_hz / 2.0) : kAccelNoise_m_s2;
+    const double mag_sigma_uT = err.datasheet_noise ? kMagFloor_uT : kMagNoise_uT;
+    // Random walk: each step adds sigma * sqrt(dt) with sigma in deg/s per sqrt(s).
+    const double walk_step_dps = err.gyro_walk_dps_per_sqrt_min / std::sqrt(60.0) * std::sqrt(1.0 / rate_hz);
+    double walk_dps[3] = {0, 0, 0};
     std::printf("t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz,movement\n");
     const long n = (long)std::floor(seconds * rate_hz + 1e-9);
     const double h_s = 1e-5;
@@ -256,15 +450,29 @@ int main(int argc, char** argv) {
         double field_ned[3] = {kEarthField_uT[0], kEarthField_uT[1], kEarthField_uT[2]};
         if (t_s >= x.disturb_from_s && t_s < x.disturb_to_s)
             for (int i = 0; i < 3; ++i) field_ned[i] += x.disturb_uT[i];
+        double field_body[3];
+        earth_to_body(q, field_ned, field_body);
         double mag[3];
-        earth_to_body(q, field_ned, mag);
+        for (int i = 0; i < 3; ++i)
+            mag[i] = err.soft_iron[i][0] * field_body[0] + err.soft_iron[i][1] * field_body[1] +
+                     err.soft_iron[i][2] * field_body[2] + err.hard_iron_uT[i];
 
         for (int i = 0; i < 3; ++i) {
-            gyro[i] += x.gyro_bias_rad_s[i] + kGyroNoise_rad_s * noise.gauss();
-            accel[i] += kAccelNoise_m_s2 * noise.gauss() + x.vibration_m_s2 * noise.gauss();
-            mag[i] += kMagNoise_uT * noise.gauss();
+            const double bias_dps = err.gyro_bias_dps[i] + err.gyro_drift_dps_per_min[i] * t_s / 60.0 + walk_dps[i];
+            gyro[i] += x.gyro_bias_rad_s[i] + bias_dps * kDeg + gyro_sigma_rad_s * noise.gauss();
+            accel[i] = err.accel_scale[i] * accel[i] + err.accel_offset_m_s2[i];
+            accel[i] += accel_sigma_m_s2 * noise.gauss() + x.vibration_m_s2 * noise.gauss();
+            mag[i] += mag_sigma_uT * noise.gauss();
+            if (walk_step_dps > 0.0) walk_dps[i] += walk_step_dps * walk_noise.gauss();
         }
         accel[2] += x.vibration_tone_m_s2 * std::sin(2 * kPi * 25.0 * t_s);
+        if (err.quantise) {
+            for (int i = 0; i < 3; ++i) {
+                gyro[i] = quantised(gyro[i], kGyroLsb_dps * kDeg);
+                accel[i] = quantised(accel[i], kAccelLsb_m_s2);
+                mag[i] = quantised(mag[i], kMagLsb_uT);
+            }
+        }
         const Quat qc = q.w < 0 ? Quat{-q.w, -q.x, -q.y, -q.z} : q;  // scalar part >= 0
         std::printf("%.6f,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.9f,%.9f,%.9f,%.9f,%d\n", t_s, gyro[0],
                     gyro[1], gyro[2], accel[0], accel[1], accel[2], mag[0], mag[1], mag[2], qc.w, qc.x, qc.y, qc.z,

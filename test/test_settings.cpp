@@ -19,6 +19,8 @@ Settings sample() {
     s.cal.gyro_bias_rad_s = linalg::Vector3f(0.01f, -0.02f, 0.03f);
     s.cal.mag_offset_uT = linalg::Vector3f(12.5f, -30.0f, 4.0f);
     s.cal.mag_scale = linalg::Vector3f(1.1f, 0.95f, 1.02f);
+    s.cal.mag_cross = linalg::Vector3f(0.01f, -0.03f, 0.002f);
+    s.cal.mag_learned_uT = linalg::Vector3f(-1.5f, 0.25f, 3.0f);
     return s;
 }
 
@@ -30,6 +32,8 @@ void expect_defaults(const Settings& s) {
     EXPECT_EQ(s.flags, d.flags);
     EXPECT_TRUE(s.cal.gyro_bias_rad_s == d.cal.gyro_bias_rad_s);
     EXPECT_TRUE(s.cal.mag_scale == d.cal.mag_scale);
+    EXPECT_TRUE(s.cal.mag_cross == d.cal.mag_cross);
+    EXPECT_TRUE(s.cal.mag_learned_uT == d.cal.mag_learned_uT);
 }
 
 }  // namespace
@@ -59,6 +63,8 @@ TEST(Settings, RoundTrip) {
     EXPECT_TRUE(out.cal.gyro_bias_rad_s == in.cal.gyro_bias_rad_s);
     EXPECT_TRUE(out.cal.mag_offset_uT == in.cal.mag_offset_uT);
     EXPECT_TRUE(out.cal.mag_scale == in.cal.mag_scale);
+    EXPECT_TRUE(out.cal.mag_cross == in.cal.mag_cross);
+    EXPECT_TRUE(out.cal.mag_learned_uT == in.cal.mag_learned_uT);
 }
 
 TEST(Settings, LayoutIsFixed) {
@@ -122,6 +128,45 @@ TEST(Settings, OldVersionGivesDefaults) {
     expect_defaults(out);
 }
 
+// What the version-1 firmware wrote (41-byte payload: no cross terms, no learned
+// offset), CRC and all: read as another version, never as garbage.
+TEST(Settings, Version1RecordGivesDefaults) {
+    uint8_t rec[settings::kRecordSize];
+    std::memset(rec, 0xFF, sizeof rec);
+    const uint8_t v1_payload = 41;
+    rec[0] = 'A';
+    rec[1] = 'T';
+    rec[2] = 1;
+    rec[3] = v1_payload;
+    rec[4] = 25;
+    rec[5] = 0;
+    rec[6] = 0;
+    rec[7] = 0;
+    rec[8] = settings::kFlagMagCalibrated;
+    const float v1_cal[9] = {0.0f, 0.0f, 0.0f, 8.0f, -5.0f, 3.0f, 1.0f, 1.0f, 1.0f};
+    std::memcpy(rec + 9, v1_cal, sizeof v1_cal);
+    const uint16_t crc = settings::crc16(rec, 4 + v1_payload);
+    rec[4 + v1_payload] = (uint8_t)(crc & 0xFF);
+    rec[5 + v1_payload] = (uint8_t)(crc >> 8);
+    Settings out = sample();
+    EXPECT_EQ(settings::decode(rec, out), LoadResult::OldVersion);
+    expect_defaults(out);
+}
+
+TEST(Settings, OutOfRangeLearnedOffsetGivesDefaults) {
+    Settings bad = sample();
+    bad.cal.mag_learned_uT.z = 500.0f;
+    uint8_t rec[settings::kRecordSize];
+    settings::encode(bad, rec);
+    Settings out;
+    EXPECT_EQ(settings::decode(rec, out), LoadResult::BadValue);
+    expect_defaults(out);
+    bad = sample();
+    bad.cal.mag_cross.x = 0.9f;
+    settings::encode(bad, rec);
+    EXPECT_EQ(settings::decode(rec, out), LoadResult::BadValue);
+}
+
 TEST(Settings, WrongMagic) {
     uint8_t rec[settings::kRecordSize];
     settings::encode(sample(), rec);
@@ -147,8 +192,9 @@ TEST(Settings, OutOfRangeValueWithGoodCrcGivesDefaults) {
 }
 
 TEST(Settings, EveryOutputModeIsStoredAndNothingBeyondTheLast) {
-    // quat, raw and mavlink are new values of the same byte: the record layout is unchanged.
-    EXPECT_EQ(settings::kPayloadLength, 41u);
+    // quat, raw and mavlink are new values of the mode byte: they need no new field in
+    // the record (version 2's 65 bytes: the compass calibration's terms).
+    EXPECT_EQ(settings::kPayloadLength, 65u);
     for (uint8_t m = 0; m <= (uint8_t)fmt::kLastOutputMode; ++m) {
         Settings in = sample();
         in.mode = (fmt::OutputMode)m;

@@ -2,26 +2,41 @@
 
 namespace calib {
 
+using linalg::Matrix3f;
 using linalg::Vector3f;
+using linalg::safe_sqrt;
 
 Calibration default_calibration() {
     Calibration c;
     c.gyro_bias_rad_s = Vector3f();
     c.mag_offset_uT = Vector3f();
     c.mag_scale = Vector3f(1.0f, 1.0f, 1.0f);
+    c.mag_cross = Vector3f();
+    c.mag_learned_uT = Vector3f();
     return c;
+}
+
+// W rows: (sx, xy, xz), (xy, sy, yz), (xz, yz, sz).
+static Matrix3f soft_iron(const Calibration& c) {
+    return Matrix3f(Vector3f(c.mag_scale.x, c.mag_cross.x, c.mag_cross.y),
+                    Vector3f(c.mag_cross.x, c.mag_scale.y, c.mag_cross.z),
+                    Vector3f(c.mag_cross.y, c.mag_cross.z, c.mag_scale.z));
+}
+
+Vector3f apply_mag(const Calibration& c, const Vector3f& field_uT) {
+    return soft_iron(c) * (field_uT - c.mag_offset_uT) - c.mag_learned_uT;
 }
 
 static bool within(float v, float lo, float hi) { return v >= lo && v <= hi; }  // false for NaN
 
 bool is_plausible(const Calibration& c) {
-    // Bias, offset and scale are nine packed floats (three Vector3f).
-    static_assert(sizeof(Calibration) == 9 * sizeof(float), "Calibration is nine floats");
+    // Bias, offset, diagonal, cross terms, learned offset: fifteen packed floats.
+    static_assert(sizeof(Calibration) == 15 * sizeof(float), "Calibration is fifteen floats");
     const float* v = &c.gyro_bias_rad_s.x;
-    for (uint8_t i = 0; i < 9; ++i) {
+    for (uint8_t i = 0; i < 15; ++i) {
         const uint8_t k = (uint8_t)(i / 3u);
-        const float lo = k == 0 ? -kGyroBiasMax_rad_s : k == 1 ? -200.0f : 0.5f;
-        const float hi = k == 0 ? kGyroBiasMax_rad_s : k == 1 ? 200.0f : 2.0f;
+        const float lo = k == 0 ? -kGyroBiasMax_rad_s : k == 2 ? 0.5f : k == 3 ? -0.5f : -200.0f;
+        const float hi = k == 0 ? kGyroBiasMax_rad_s : k == 2 ? 2.0f : k == 3 ? 0.5f : 200.0f;
         if (!within(v[i], lo, hi)) return false;
     }
     return true;
@@ -71,43 +86,303 @@ GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vec
 }
 
 // ---------------------------------------------------------------------------
-void MagCalibrator::restart() {
-    n_ = 0;
-    axis_ = 0;
+namespace {
+
+// The samples are centred on the pivot and scaled by this (a power of two: exact), so
+// that the sums are of numbers near 1.
+constexpr float kFitScale_uT = 64.0f;
+
+// Not fabsf: avr-libc's is fabs on double (a promotion warning, though both are 32-bit).
+float absf(float v) { return v < 0.0f ? -v : v; }
+constexpr float kFitInvScale = 1.0f / kFitScale_uT;
+
+// Index of the monomial x^i y^j z^k in MagCalibrator's sums: by degree d = i + j + k,
+// then by r = j + k, then by k (1, x, y, z, x^2, xy, xz, y^2, yz, z^2, x^3, ...).
+// Tables, not d (d + 1) (d + 2) / 6 and r (r + 1) / 2: a division is a library call on
+// the AVR, and add() looks up 34 indices a sample.
+const uint8_t kTetrahedral[5] = {0, 1, 4, 10, 20};  // monomials of degree < d
+const uint8_t kTriangular[5] = {0, 1, 3, 6, 10};
+uint8_t moment_index(uint8_t i, uint8_t j, uint8_t k) {
+    const uint8_t r = (uint8_t)(j + k);
+    return (uint8_t)(kTetrahedral[i + r] + kTriangular[r] + k);
+}
+
+// Exponents packed two bits each (i | j << 2 | k << 4).
+uint8_t moment_of(uint8_t packed) { return moment_index(packed & 3u, (packed >> 2) & 3u, (packed >> 4) & 3u); }
+uint8_t moment_of_sum(uint8_t a, uint8_t b) {
+    return moment_index((uint8_t)((a & 3u) + (b & 3u)), (uint8_t)(((a >> 2) & 3u) + ((b >> 2) & 3u)),
+                        (uint8_t)(((a >> 4) & 3u) + ((b >> 4) & 3u)));
+}
+constexpr uint8_t kX = 1, kY = 4, kZ = 16, kOne = 0;
+
+// Solves the n x n system held as an augmented matrix a[n][n+1] (Gaussian elimination
+// with partial pivoting); the solution replaces column n. False when a pivot is below
+// 1e-6 of the largest diagonal term: the fit is not determined.
+constexpr uint8_t kMaxUnknowns = 9;
+bool solve(float a[][kMaxUnknowns + 1], uint8_t n) {
+    float scale = 0.0f;
+    for (uint8_t i = 0; i < n; ++i) scale = a[i][i] > scale ? a[i][i] : scale;
+    const float tiny = scale * 1e-6f;
+    for (uint8_t col = 0; col < n; ++col) {
+        uint8_t best = col;
+        for (uint8_t row = (uint8_t)(col + 1); row < n; ++row)
+            if (absf(a[row][col]) > absf(a[best][col])) best = row;
+        if (!(absf(a[best][col]) > tiny)) return false;
+        if (best != col)
+            for (uint8_t k = col; k <= n; ++k) {
+                const float t = a[col][k];
+                a[col][k] = a[best][k];
+                a[best][k] = t;
+            }
+        const float inv = 1.0f / a[col][col];
+        for (uint8_t row = 0; row < n; ++row) {
+            if (row == col) continue;
+            const float f = a[row][col] * inv;
+            for (uint8_t k = col; k <= n; ++k) a[row][k] -= f * a[col][k];
+        }
+    }
+    for (uint8_t i = 0; i < n; ++i) a[i][n] /= a[i][i];
+    return true;
+}
+
+// Symmetric square root of a symmetric positive matrix near I (Newton-Schulz:
+// Y -> Y T, Z -> T Z, T = (3I - Z Y) / 2; quadratic convergence while |I - A| < 1).
+// False when it has not converged (A too far from I: soft iron beyond any limit).
+bool sqrt_near_identity(const Matrix3f& a, Matrix3f& root) {
+    Matrix3f y = a, z;
+    for (uint8_t it = 0; it < 8; ++it) {
+        const Matrix3f zy = z * y;
+        const Matrix3f t = Matrix3f(Vector3f(1.5f - 0.5f * zy.a.x, -0.5f * zy.a.y, -0.5f * zy.a.z),
+                                    Vector3f(-0.5f * zy.b.x, 1.5f - 0.5f * zy.b.y, -0.5f * zy.b.z),
+                                    Vector3f(-0.5f * zy.c.x, -0.5f * zy.c.y, 1.5f - 0.5f * zy.c.z));
+        y = y * t;
+        z = t * z;
+    }
+    root = y;
+    const Matrix3f d = y * y - a;
+    const float err = d.a.length_squared() + d.b.length_squared() + d.c.length_squared();
+    return err < 1e-8f && y.is_finite();
+}
+
+}  // namespace
+
+void MagCalibrator::restart(const Vector3f& pivot_uT) {
+    for (uint8_t i = 0; i < kMoments; ++i) sums_[i] = 0.0f;
+    for (uint8_t i = 0; i < kCells; ++i) cell_count_[i] = 0;
+    pivot_uT_ = cover_centre_uT_ = pivot_uT.is_finite() ? pivot_uT : Vector3f();
+    residual_uT_ = sphere_residual_uT_ = radius_uT_ = 0.0f;
 }
 
 void MagCalibrator::add(const Vector3f& field_uT) {
-    if (!field_uT.is_finite()) return;
-    const float* v = &field_uT.x;
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (n_ == 0 || v[i] < min_[i]) min_[i] = v[i];
-        if (n_ == 0 || v[i] > max_[i]) max_[i] = v[i];
+    if (!field_uT.is_finite() || count() == 0xFFFFu) return;
+    // The monomials in index order, each one a product of a lower one: 31 multiplies.
+    const Vector3f u = (field_uT - pivot_uT_) * kFitInvScale;
+    const float var[3] = {u.x, u.y, u.z};
+    float m[kMoments];
+    m[0] = 1.0f;
+    uint8_t n = 1;
+    for (uint8_t d = 1; d <= 4; ++d) {
+        for (uint8_t r = 0; r <= d; ++r) {
+            for (uint8_t k = 0; k <= r; ++k, ++n) {
+                // Parent: x^(i-1) y^j z^k (same r) times x while i > 0, else y, else z.
+                const uint8_t below = (uint8_t)(kTetrahedral[d - 1] + k);
+                if (r < d) m[n] = m[below + kTriangular[r]] * var[0];
+                else if (k < r) m[n] = m[below + kTriangular[r - 1]] * var[1];
+                else m[n] = m[below - 1 + kTriangular[r - 1]] * var[2];
+            }
+        }
     }
-    if (n_ < 0xFFFFu) ++n_;
+    for (uint8_t i = 0; i < kMoments; ++i) sums_[i] += m[i];
+
+    // Coverage: the direction from the centre (the sphere fit so far, refreshed each
+    // kCoverageRefitSamples; the pivot before), quantised to one of 26 cells by the
+    // sign of each component that is at least tan 22.5 deg of the largest one (faces,
+    // edges and corners of a cube).
+    if (count() % kCoverageRefitSamples == 0 && fit_sphere()) cover_centre_uT_ = sphere_offset_uT_;
+    const Vector3f d = field_uT - cover_centre_uT_;
+    const float c[3] = {d.x, d.y, d.z};
+    float big = 0.0f;
+    for (uint8_t a = 0; a < 3; ++a) {
+        const float m_abs = absf(c[a]);
+        if (m_abs > big) big = m_abs;
+    }
+    if (!(big > 0.0f)) return;
+    uint8_t cell = 0;
+    for (uint8_t a = 0; a < 3; ++a) {
+        const uint8_t q = absf(c[a]) < 0.4142f * big ? 1 : (c[a] > 0.0f ? 2 : 0);
+        cell = (uint8_t)(cell * 3u + q);
+    }
+    if (cell > 13) --cell;  // 13 (all components small) cannot happen
+    if (cell_count_[cell] < 255) ++cell_count_[cell];
+}
+
+uint8_t MagCalibrator::coverage_pct() const {
+    uint8_t seen = 0;
+    for (uint8_t i = 0; i < kCells; ++i) seen = (uint8_t)(seen + (cell_count_[i] >= kMagCellMinSamples));
+    return (uint8_t)((seen * 100u + kCells / 2u) / kCells);
+}
+
+// Sphere: |u|^2 = a x + b y + c z + d, linear in (a, b, c, d); centre (a, b, c) / 2,
+// radius^2 = d + |centre|^2. Residual: |u - c|^2 - R^2 ~ 2 R (|u - c| - R).
+bool MagCalibrator::fit_sphere() {
+    static const uint8_t reg[4] = {kX, kY, kZ, kOne};
+    float a[4][kMaxUnknowns + 1];
+    float tt;  // sum |u|^4
+    for (uint8_t p = 0; p < 4; ++p) {
+        for (uint8_t q = 0; q < 4; ++q) a[p][q] = sums_[moment_of_sum(reg[p], reg[q])];
+        a[p][4] = sums_[moment_of_sum(reg[p], 2 * kX)] + sums_[moment_of_sum(reg[p], 2 * kY)] +
+                  sums_[moment_of_sum(reg[p], 2 * kZ)];
+    }
+    tt = sums_[moment_index(4, 0, 0)] + sums_[moment_index(0, 4, 0)] + sums_[moment_index(0, 0, 4)] +
+         2.0f * (sums_[moment_index(2, 2, 0)] + sums_[moment_index(2, 0, 2)] + sums_[moment_index(0, 2, 2)]);
+    float rhs[4];
+    for (uint8_t p = 0; p < 4; ++p) rhs[p] = a[p][4];
+    if (!solve(a, 4)) return false;
+    const Vector3f centre(a[0][4] * 0.5f, a[1][4] * 0.5f, a[2][4] * 0.5f);
+    const float r2 = a[3][4] + centre.length_squared();
+    if (!(r2 > 0.0f)) return false;
+    float sse = tt;
+    for (uint8_t p = 0; p < 4; ++p) sse -= a[p][4] * rhs[p];
+    const float r = sqrtf(r2);
+    sphere_offset_uT_ = pivot_uT_ + centre * kFitScale_uT;
+    sphere_residual_uT_ = safe_sqrt(sse / sums_[0]) / (2.0f * r) * kFitScale_uT;
+    radius_uT_ = r * kFitScale_uT;
+    return true;
+}
+
+// Ellipsoid: u^T Q u + g.u = 1 with Q symmetric, linear in its nine terms
+// (A x^2 + B y^2 + C z^2 + D yz + E xz + F xy + G x + H y + I z = 1; a pivot near the
+// centre keeps the constant term away from zero). Centre c = -Q^-1 g / 2; then
+// (u - c)^T Q (u - c) = k = 1 + c^T Q c. W = sqrt(Q / det(Q)^(1/3)) has det 1 and
+// maps the ellipsoid onto a sphere of radius sqrt(k / det(Q)^(1/3)).
+bool MagCalibrator::fit_ellipsoid(Calibration& cal) {
+    static const uint8_t reg[9] = {2 * kX, 2 * kY, 2 * kZ, kY + kZ, kX + kZ, kX + kY, kX, kY, kZ};
+    float a[9][kMaxUnknowns + 1];
+    float rhs[9];
+    for (uint8_t p = 0; p < 9; ++p) {
+        for (uint8_t q = 0; q < 9; ++q) a[p][q] = sums_[moment_of_sum(reg[p], reg[q])];
+        a[p][9] = rhs[p] = sums_[moment_of(reg[p])];
+    }
+    if (!solve(a, 9)) return false;
+    // A pivot outside the ellipsoid flips the sign of the whole quadric: then
+    // -u^T Q u - g.u = -1, with -Q positive.
+    const float side = a[0][9] < 0.0f ? -1.0f : 1.0f;
+    float t[9];
+    for (uint8_t p = 0; p < 9; ++p) t[p] = a[p][9] * side;
+    const Matrix3f q(Vector3f(t[0], 0.5f * t[5], 0.5f * t[4]), Vector3f(0.5f * t[5], t[1], 0.5f * t[3]),
+                     Vector3f(0.5f * t[4], 0.5f * t[3], t[2]));
+    const float det = q.determinant();
+    if (!(det > 0.0f) || !(t[0] > 0.0f)) return false;  // not an ellipsoid
+    float c3[3][kMaxUnknowns + 1] = {{q.a.x, q.a.y, q.a.z, -0.5f * t[6]},
+                                     {q.b.x, q.b.y, q.b.z, -0.5f * t[7]},
+                                     {q.c.x, q.c.y, q.c.z, -0.5f * t[8]}};
+    if (!solve(c3, 3)) return false;
+    const Vector3f centre(c3[0][3], c3[1][3], c3[2][3]);
+    const float k = side + centre.dot(q * centre);
+    const float cube_root_det = cbrtf(det);
+    if (!(k > 0.0f)) return false;
+    Matrix3f w;
+    if (!sqrt_near_identity(q * (1.0f / cube_root_det), w)) return false;
+    float sse = sums_[0];
+    for (uint8_t p = 0; p < 9; ++p) sse -= side * t[p] * rhs[p];
+    const float r = sqrtf(k / cube_root_det);
+    radius_uT_ = r * kFitScale_uT;
+    residual_uT_ = r * safe_sqrt(sse / sums_[0]) / (2.0f * k) * kFitScale_uT;
+    cal.mag_offset_uT = pivot_uT_ + centre * kFitScale_uT;
+    cal.mag_scale = Vector3f(w.a.x, w.b.y, w.c.z);
+    cal.mag_cross = Vector3f(w.a.y, w.a.z, w.b.z);
+    cal.mag_learned_uT = Vector3f();
+    return true;
+}
+
+static bool within_box(const Vector3f& v, float limit) {
+    return within(v.x, -limit, limit) && within(v.y, -limit, limit) && within(v.z, -limit, limit);
 }
 
 MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
-    if (n_ < kMagCalMinSamples) return Quality::TooFewSamples;
-    float h[3];
-    float lo = 0.0f, hi = 0.0f, sum = 0.0f;
-    for (uint8_t i = 0; i < 3; ++i) {
-        h[i] = (max_[i] - min_[i]) * 0.5f;
-        axis_ = i;
-        if (h[i] < kMagMinHalfSpan_uT) return Quality::AxisNotTurned;
-        if (h[i] > kMagMaxHalfSpan_uT) return Quality::SpanTooLarge;
-        if (i == 0 || h[i] < lo) lo = h[i];
-        if (i == 0 || h[i] > hi) hi = h[i];
-        sum += h[i];
-    }
-    if (hi > lo * kMagMaxSpanRatio) return Quality::AxesDisagree;
-    const float mean = sum * (1.0f / 3.0f);
-    float* offset = &cal.mag_offset_uT.x;
-    float* scale = &cal.mag_scale.x;
-    for (uint8_t i = 0; i < 3; ++i) {
-        offset[i] = (max_[i] + min_[i]) * 0.5f;
-        scale[i] = mean / h[i];
-    }
+    if (count() < kMagCalMinSamples) return Quality::TooFewSamples;
+    if (coverage_pct() < kMagMinCoveragePct) return Quality::ThinCoverage;
+    if (!fit_sphere()) return Quality::FitFailed;
+    if (!within(radius_uT_, kMagMinRadius_uT, kMagMaxRadius_uT)) return Quality::NotEarthField;
+    Calibration c = cal;
+    if (!fit_ellipsoid(c)) return Quality::FitFailed;
+    if (!within(radius_uT_, kMagMinRadius_uT, kMagMaxRadius_uT) || !within_box(c.mag_offset_uT, kMagMaxOffset_uT))
+        return Quality::NotEarthField;
+    if (!within(c.mag_scale.x, kMagMinDiag, kMagMaxDiag) || !within(c.mag_scale.y, kMagMinDiag, kMagMaxDiag) ||
+        !within(c.mag_scale.z, kMagMinDiag, kMagMaxDiag) || !within_box(c.mag_cross, kMagMaxCross))
+        return Quality::SoftIronTooLarge;
+    if (!(residual_uT_ <= kMagMaxResidual_uT)) return Quality::PoorFit;
+    cal = c;
     return Quality::Ok;
+}
+
+// ---------------------------------------------------------------------------
+void OffsetLearner::restart(float prior_uT) {
+    have_ref_ = false;
+    prior_info_ = 1.0f / (prior_uT * prior_uT);
+    for (uint8_t i = 0; i < 6; ++i) info_[i] = 0.0f;
+}
+
+bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t steps, Vector3f& learned_uT) {
+    if (!field_uT.is_finite() || !r.is_finite()) return false;
+    age_steps_ = (uint16_t)(age_steps_ + steps < kLearnMaxPairSteps ? age_steps_ + steps : kLearnMaxPairSteps);
+    if (!have_ref_ || age_steps_ >= kLearnMaxPairSteps) {
+        r_ref_ = r;  // too old, or none: this sample starts the next pair
+        field_ef_ref_ = r * field_uT;
+        age_steps_ = 0;
+        have_ref_ = true;
+        return false;
+    }
+    // cos theta of the turn R1 -> R2: (trace(R2^T R1) - 1) / 2.
+    const float cos_turn = 0.5f * (r.a.dot(r_ref_.a) + r.b.dot(r_ref_.b) + r.c.dot(r_ref_.c) - 1.0f);
+    if (cos_turn > kLearnMinCos) return false;  // not turned enough yet: keep the pair open
+    // r_e = R2 f2 - R1 f1 = (R2 - R1) e = H e; H^T r_e is what the pair says of e.
+    const Vector3f residual_ef = r * field_uT - field_ef_ref_;
+    const Vector3f across = r.mul_transpose(residual_ef) - r_ref_.mul_transpose(residual_ef);
+    // H^T H = 2 I - M - M^T, M = R2^T R1 = sum over the earth axes k of r2_k r1_k^T.
+    const float* r2 = &r.a.x;
+    const float* r1 = &r_ref_.a.x;
+    static const uint8_t kRow[6] = {0, 1, 2, 0, 0, 1}, kCol[6] = {0, 1, 2, 1, 2, 2};
+    const float fade = 1.0f - 1.0f / kLearnMemoryPairs;
+    const float inv_noise = 1.0f / (kLearnPairNoise_uT * kLearnPairNoise_uT);
+    for (uint8_t e = 0; e < 6; ++e) {
+        const uint8_t i = kRow[e], j = kCol[e];
+        float m = 0.0f;
+        for (uint8_t k = 0; k < 9; k += 3) m += r2[k + i] * r1[k + j] + r2[k + j] * r1[k + i];
+        info_[e] = info_[e] * fade + ((i == j ? 2.0f : 0.0f) - m) * inv_noise;
+    }
+    // The prior stays: it holds the axis never turned about where it is.
+    float a[3][kMaxUnknowns + 1] = {{info_[0] + prior_info_, info_[3], info_[4], across.x * inv_noise},
+                                    {info_[3], info_[1] + prior_info_, info_[5], across.y * inv_noise},
+                                    {info_[4], info_[5], info_[2] + prior_info_, across.z * inv_noise}};
+    if (!solve(a, 3)) return false;
+    Vector3f step(a[0][3], a[1][3], a[2][3]);
+    // A pair says nothing along its rotation axis n (the skew part of M: M - M^T =
+    // 2 sin(theta) [n x]); what the solve puts there is the weak prior amplifying
+    // rounding and attitude error: it is taken out.
+    float skew[3];
+    for (uint8_t e = 0; e < 3; ++e) {
+        const uint8_t i = kRow[e + 3], j = kCol[e + 3];
+        float m = 0.0f;
+        for (uint8_t k = 0; k < 9; k += 3) m += r2[k + i] * r1[k + j] - r2[k + j] * r1[k + i];
+        skew[e] = m;
+    }
+    const Vector3f axis = Vector3f(skew[2], -skew[1], skew[0]).normalized();
+    step -= axis * axis.dot(step);
+    float* s = &step.x;
+    float* o = &learned_uT.x;
+    for (uint8_t i = 0; i < 3; ++i) {
+        s[i] = linalg::constrain(s[i], -kLearnMaxStep_uT, kLearnMaxStep_uT);
+        const float before = o[i];
+        o[i] = linalg::constrain(o[i] + s[i], -kLearnMaxOffset_uT, kLearnMaxOffset_uT);
+        s[i] = o[i] - before;
+    }
+    if (updates_ < 0xFFFFu) ++updates_;
+    // The sample that closed this pair opens the next, with the new offset removed.
+    r_ref_ = r;
+    field_ef_ref_ = r * (field_uT - step);
+    age_steps_ = 0;
+    return true;
 }
 
 }  // namespace calib

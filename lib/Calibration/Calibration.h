@@ -15,8 +15,10 @@ namespace calib {
 
 struct Calibration {
     linalg::Vector3f gyro_bias_rad_s;  // subtracted from every gyro sample
-    linalg::Vector3f mag_offset_uT;    // hard iron, subtracted first
-    linalg::Vector3f mag_scale;        // then multiplied per axis (soft-iron diagonal)
+    linalg::Vector3f mag_offset_uT;    // hard iron from `cal mag`, subtracted first
+    linalg::Vector3f mag_scale;        // then the soft-iron matrix W: its diagonal
+    linalg::Vector3f mag_cross;        //   and its off-diagonal terms (xy, xz, yz); W symmetric
+    linalg::Vector3f mag_learned_uT;   // then the offset learned in motion (OffsetLearner)
 };
 
 // Zero bias and offset, unit scale.
@@ -25,14 +27,13 @@ Calibration default_calibration();
 inline linalg::Vector3f apply_gyro(const Calibration& c, const linalg::Vector3f& gyro_rad_s) {
     return gyro_rad_s - c.gyro_bias_rad_s;
 }
-inline linalg::Vector3f apply_mag(const Calibration& c, const linalg::Vector3f& field_uT) {
-    const linalg::Vector3f d = field_uT - c.mag_offset_uT;
-    return linalg::Vector3f(d.x * c.mag_scale.x, d.y * c.mag_scale.y, d.z * c.mag_scale.z);
-}
+// f = W (m - offset) - learned. W symmetric: a soft-iron correction that stretches
+// the ellipsoid back to a sphere without turning the compass's axes.
+linalg::Vector3f apply_mag(const Calibration& c, const linalg::Vector3f& field_uT);
 
 // True when every number is finite and within what a real board could need (bias
-// below 30 deg/s per axis, offset below 200 uT, scale within 0.5..2): a record
-// that fails this is treated as corrupt.
+// below 30 deg/s per axis, offsets below 200 uT, soft-iron diagonal within 0.5..2,
+// cross terms within +-0.5): a record that fails this is treated as corrupt.
 bool is_plausible(const Calibration& c);
 
 // ---------------------------------------------------------------------------
@@ -78,41 +79,140 @@ private:
 };
 
 // ---------------------------------------------------------------------------
-// Magnetometer: hard-iron offset = centre of the extremes per axis, scale = mean
-// half-span / half-span of that axis. The user turns the board through every
-// orientation for kMagCalSeconds; the result is rejected (and the old calibration
-// kept) when an axis saw too little of the field or the axes disagree.
+// Magnetometer calibration (`cal mag`): a least-squares fit on every sample of a
+// kMagCalSeconds rotation, first a sphere |m - o| = R (the hard-iron offset o), then
+// an ellipsoid |W (m - o)| = R (o, and a symmetric soft-iron W with det W = 1), as
+// ArduPilot's CompassCalibrator does, but without storing the samples: the fits are
+// linear in their parameters, so their normal equations are sums of the monomials
+// x^i y^j z^k (i + j + k <= 4) of the samples, 35 sums accumulated as they come
+// (140 B). The samples are centred on a pivot (the centre already in use) and scaled
+// by 1/64 uT, so that the float32 sums (AVR's double is 32-bit too) keep their
+// precision. A fit is refused, with the reason, when the board did not see enough
+// directions, when the residual is larger than a clean compass gives, or when the
+// result is not an Earth-like field or a plausible soft iron.
 constexpr uint8_t kMagCalSeconds = 30;
 constexpr uint16_t kMagCalMinSamples = 200;     // at 75 Hz the 30 s give ~2 250
-constexpr float kMagMinHalfSpan_uT = 12.0f;     // Earth: 25..65 uT; a full turn gives that each side
-constexpr float kMagMaxHalfSpan_uT = 150.0f;    // beyond: not the Earth's field (magnet nearby)
-constexpr float kMagMaxSpanRatio = 1.5f;        // largest/smallest half-span: soft iron this bad = not turned enough
+// Of the 26 direction cells (the cube's faces, edges and corners seen from the
+// centre), the share the field must have visited. Turning about one axis only visits
+// a ring (~1/3); an ellipsoid fitted to a cap trades its offset along the missing
+// direction against scale, so most of the sphere must be seen.
+constexpr uint8_t kMagMinCoveragePct = 70;
+constexpr uint8_t kMagCellMinSamples = 3;       // a cell counts once seen this often (not one noisy sample)
+constexpr uint8_t kCoverageRefitSamples = 75;   // the cells' centre is refitted each second at 75 Hz
+// ArduPilot's default fitness (COMPASS_CAL_FIT 16 mGauss): rms distance of the samples
+// from the fitted ellipsoid. The HMC5883L's own noise gives ~0.2 uT; 1.6 uT of a 50 uT
+// field is at most 1.8 deg of heading: more means a moving magnet or a bad sensor.
+constexpr float kMagMaxResidual_uT = 1.6f;
+constexpr float kMagMinRadius_uT = 15.0f;       // Earth: 25..65 uT; outside 15..100 is not the Earth's field
+constexpr float kMagMaxRadius_uT = 100.0f;
+constexpr float kMagMaxOffset_uT = 150.0f;      // the HMC5883L saturates at 130 uT (1.3 Ga): beyond is no fit
+// ArduPilot's limits on the soft-iron terms (diagonal 0.8..1.2, off-diagonal +-0.2):
+// a board needing more has a magnet next to the compass, not soft iron.
+constexpr float kMagMinDiag = 0.8f;
+constexpr float kMagMaxDiag = 1.2f;
+constexpr float kMagMaxCross = 0.2f;
 
 class MagCalibrator {
 public:
     enum class Quality : uint8_t {
         Ok,
         TooFewSamples,
-        AxisNotTurned,   // an axis' half-span is below kMagMinHalfSpan_uT: axis() says which
-        SpanTooLarge,    // a half-span above kMagMaxHalfSpan_uT
-        AxesDisagree,    // half-span ratio above kMagMaxSpanRatio
+        ThinCoverage,     // coverage_pct() below kMagMinCoveragePct
+        FitFailed,        // singular normal equations, or not an ellipsoid
+        NotEarthField,    // radius or offset out of range (magnet nearby?)
+        SoftIronTooLarge, // soft-iron terms beyond ArduPilot's limits
+        PoorFit,          // residual_uT() above kMagMaxResidual_uT
     };
 
-    void restart();
+    // Starts a new collection; pivot_uT: the centre in use (raw field, uT), which the
+    // samples are centred on (any value works; closer is more precise).
+    void restart(const linalg::Vector3f& pivot_uT);
     // Feeds one field sample (uT, body frame, BEFORE calibration); non-finite ignored.
     void add(const linalg::Vector3f& field_uT);
-    uint16_t count() const { return n_; }
-    // Checks the collected extremes; on Ok writes offset and scale into cal (gyro bias untouched).
+    uint16_t count() const { return (uint16_t)sums_[0]; }
+    // Share of the 26 direction cells seen at least kMagCellMinSamples times, percent.
+    uint8_t coverage_pct() const;
+    // Fits; on Ok writes the offset, the soft-iron terms and a zero learned offset
+    // into cal (gyro bias untouched). The figures below are valid after any finish()
+    // that got as far as the fit (Ok, NotEarthField, SoftIronTooLarge, PoorFit).
     Quality finish(Calibration& cal);
-    // The axis (0 = x, 1 = y, 2 = z) that failed AxisNotTurned / SpanTooLarge.
-    uint8_t axis() const { return axis_; }
-    linalg::Vector3f min_uT() const { return linalg::Vector3f(min_[0], min_[1], min_[2]); }
-    linalg::Vector3f max_uT() const { return linalg::Vector3f(max_[0], max_[1], max_[2]); }
+    float residual_uT() const { return residual_uT_; }
+    float radius_uT() const { return radius_uT_; }
+    // The sphere fit's offset and residual (the first stage).
+    linalg::Vector3f sphere_offset_uT() const { return sphere_offset_uT_; }
+    float sphere_residual_uT() const { return sphere_residual_uT_; }
+
+    static constexpr uint8_t kMoments = 35;  // monomials of degree <= 4 in x, y, z
+    static constexpr uint8_t kCells = 26;
 
 private:
-    float min_[3], max_[3];  // valid once count() > 0
-    uint16_t n_ = 0;
-    uint8_t axis_ = 0;
+    bool fit_sphere();
+    bool fit_ellipsoid(Calibration& cal);
+
+    float sums_[kMoments];          // sums of x^i y^j z^k of the centred, scaled samples; [0] = count
+    linalg::Vector3f pivot_uT_;
+    linalg::Vector3f cover_centre_uT_;  // the coverage cells' centre: the sphere fit so far
+    uint8_t cell_count_[kCells];
+    linalg::Vector3f sphere_offset_uT_;
+    float sphere_residual_uT_ = 0.0f;
+    float residual_uT_ = 0.0f;
+    float radius_uT_ = 0.0f;
+};
+
+// ---------------------------------------------------------------------------
+// Hard-iron learning in motion (Premerlani, "Magnetometer Offset Nulling Revisited",
+// eq. 11; ArduPilot's Compass::null_offsets on the APM2). The earth field is fixed,
+// so two calibrated samples f1, f2 taken at attitudes R1, R2 (body to earth) satisfy
+// R2 f2 = R1 f1 if the offset is right; a residual offset e leaves
+//   r = R2 f2 - R1 f1 = (R2 - R1) e.
+// Each pair measures the two components of e across the rotation axis, with
+// information H^T H / sigma^2, H = R2 - R1 (H^T H = 2 (1 - cos theta) (I - n n^T)).
+// The learner is recursive least squares in information form: L += H^T H / sigma^2,
+// e = (I / prior^2 + L)^-1 H^T r / sigma^2, L fading by 1/kLearnMemoryPairs a pair, so
+// that a hard iron that changes (a battery moved) is followed. Pairs are
+// taken at least 20 deg apart and at most kLearnMaxPairSteps apart (the attitude's own
+// drift over a longer span is no longer small against the signal).
+constexpr float kLearnMinCos = 0.94f;           // pairs at least 20 deg apart: cos 20 deg
+// Noise of one pair's residual: the HMC5883L's 0.2 uT on each sample, and the
+// attitude's error over the pair (0.5 deg of gyro drift and heading correction in 2 s,
+// times a 50 uT field: 0.4 uT), summed in quadrature.
+constexpr float kLearnPairNoise_uT = 0.5f;
+constexpr uint16_t kLearnMaxPairSteps = 400;    // 2 s at 200 Hz
+// ~2 pairs a second while turning: a minute of turning to follow a change, and one
+// pair's noise averaged down by ~10 (0.05 uT).
+constexpr float kLearnMemoryPairs = 100.0f;
+constexpr float kLearnMaxStep_uT = 5.0f;        // one pair moves no axis further (a passing magnet)
+// ArduPilot's "compass offsets too high" limit (500 mGauss): beyond, calibrate.
+constexpr float kLearnMaxOffset_uT = 50.0f;
+// Prior uncertainty: an uncalibrated APM 2.5 compass is tens of uT off; after `cal mag`
+// the fit's own error is a fraction of a uT.
+constexpr float kLearnPriorUncalibrated_uT = 30.0f;
+constexpr float kLearnPriorCalibrated_uT = 1.0f;
+
+class OffsetLearner {
+public:
+    // Starts afresh; prior_uT: how far off the current offset may be, each axis.
+    void restart(float prior_uT);
+    // Drops the pair in progress (the attitude was reset: its turn is not the board's).
+    void forget_pair() { have_ref_ = false; }
+    // One calibrated field sample (uT, body frame: the learned offset already
+    // removed) and the attitude R (body to earth) at the same instant, `steps` estimator
+    // steps after the previous call. When a pair completes, updates `learned_uT` (the
+    // offset that calibration subtracts) and returns true.
+    bool add(const linalg::Vector3f& field_uT, const linalg::Matrix3f& r, uint16_t steps,
+             linalg::Vector3f& learned_uT);
+    uint16_t updates() const { return updates_; }
+    // The information from pairs so far, 1/uT^2 (diagonal xx yy zz, then xy xz yz).
+    const float* information() const { return info_; }
+
+private:
+    linalg::Matrix3f r_ref_;
+    linalg::Vector3f field_ef_ref_;  // R1 f1
+    float info_[6] = {};
+    float prior_info_ = 1.0f / (kLearnPriorUncalibrated_uT * kLearnPriorUncalibrated_uT);
+    uint16_t age_steps_ = 0;
+    uint16_t updates_ = 0;
+    bool have_ref_ = false;
 };
 
 }  // namespace calib

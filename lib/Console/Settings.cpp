@@ -25,9 +25,10 @@ uint16_t crc16(const uint8_t* data, uint16_t len) {
     return crc;
 }
 
-// The payload: rate, declination (2), mode, flags, then the calibration's nine floats
+// The payload: rate, declination (2), mode, flags, then the calibration's fifteen floats
 // (IEEE-754, little-endian on both the AVR and x86/ARM hosts: memcpy is the layout).
-static_assert(sizeof(calib::Calibration) == 36, "Calibration is nine packed floats");
+static_assert(sizeof(calib::Calibration) == 60, "Calibration is fifteen packed floats");
+static_assert(kPayloadLength == 5 + sizeof(calib::Calibration), "payload = header bytes + calibration");
 
 void encode(const Settings& s, uint8_t out[kRecordSize]) {
     out[0] = kMagic0;

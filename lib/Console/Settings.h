@@ -21,9 +21,10 @@ namespace settings {
 
 constexpr uint8_t kMagic0 = 'A';
 constexpr uint8_t kMagic1 = 'T';
-constexpr uint8_t kSettingsVersion = 1;
-// rate(1) + decl(2) + mode(1) + flags(1) + 9 floats(36)
-constexpr uint8_t kPayloadLength = 41;
+// 2: the compass calibration gained the soft-iron cross terms and the learned offset.
+constexpr uint8_t kSettingsVersion = 2;
+// rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
+constexpr uint8_t kPayloadLength = 65;
 constexpr uint8_t kRecordSize = 4 + kPayloadLength + 2;
 constexpr uint16_t kEepromAddress = 0;
 
@@ -35,7 +36,7 @@ constexpr int16_t kDeclMaxCentideg = 18000;
 
 enum Flags : uint8_t {
     kFlagGyroCalibrated = 0x01,  // cal.gyro_bias was measured (used when start-up calibration fails)
-    kFlagMagCalibrated = 0x02,   // cal.mag_* came from `cal mag`
+    kFlagMagCalibrated = 0x02,   // cal.mag_offset/scale/cross came from `cal mag`
 };
 
 struct Settings {

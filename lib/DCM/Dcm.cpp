@@ -201,7 +201,8 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // for mag_recover_s is a new environment (the board was moved): it becomes the
     // reference, and its heading is taken at once. A magnet fixed to a rotating
     // board never looks the same twice, so it never gets in.
-    if (!field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
+    const bool forgotten = !(mag_ref_norm_ > 0.0f);  // reset_mag_reference(): adopt this one
+    if (forgotten || !field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
             mag_steady_steps_ += interval_steps;
         } else {
@@ -209,7 +210,7 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         }
         mag_candidate_norm_ += 0.2f * (norm - mag_candidate_norm_);
         mag_candidate_down_ += 0.2f * (down_component - mag_candidate_down_);
-        if ((float)mag_steady_steps_ < mag_recover_steps_) return;
+        if (!forgotten && (float)mag_steady_steps_ < mag_recover_steps_) return;
         // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
         // (the rotation that puts the field's horizontal part on north).
         learn_field(norm, down_component);

@@ -118,6 +118,12 @@ public:
     // learned earth field are rejected (kStatusMagIgnored).
     void correct_heading(const linalg::Vector3f& mag_field);
 
+    // Forgets the learned earth field (strength and dip): the next field sample is
+    // taken as the reference and its heading at once, as a new steady field is after
+    // mag_recover_s. For a new compass calibration, whose fields the old reference
+    // would reject as disturbed.
+    void reset_mag_reference() { mag_ref_norm_ = 0.0f; }
+
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     uint8_t status() const { return status_; }
     uint16_t recoveries() const { return recoveries_; }

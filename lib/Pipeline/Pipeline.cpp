@@ -32,8 +32,12 @@ void AttitudePipeline::set_mag_present(bool present) {
 
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
-    if (st_.mag_cal_active) mag_cal_.add(field_uT);
-    const Vector3f f = calib::apply_mag(settings_.cal, field_uT);
+    // The fit's sums (~10 k cycles) wait for a step without output, as the learner does.
+    if (st_.mag_cal_active) {
+        cal_field_uT_ = field_uT;
+        st_.cal_pending = true;
+    }
+    Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
         if (st_.warn_mag.allow(st_.steps, kWarnIntervalSteps)) {
@@ -42,9 +46,45 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         }
         return;
     }
+    // The learner's pair is worked out in a later step without output (a pair update
+    // is ~20 k cycles: on top of the Euler angles and the line it would overrun the
+    // 5 ms step); the attitude is the one of this sample.
+    if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
+        // The sample is mag_latency_s older than the attitude: turned forward by the
+        // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
+        // as an offset.
+        const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s);
+        learn_field_uT_ = f + f.cross(rate) * dcm_.settings().mag_latency_s;
+        learn_r_ = dcm_.matrix();
+        st_.learn_steps = st_.steps_since_mag;
+        st_.learn_pending = true;
+    }
+    st_.steps_since_mag = 0;
     mag_cal_uT_ = f;
     st_.mag_pending = true;
     st_.have_mag = true;
+}
+
+// The learner moves the offset that apply_mag subtracts last; the latest field (calibrated
+// with the old one) is brought up to date. Once the offset has moved by kMagReferenceShift_uT
+// since the DCM learned the earth field, the DCM learns it again.
+void AttitudePipeline::learn_mag_offset() {
+    st_.learn_pending = false;
+    Vector3f& learned = settings_.cal.mag_learned_uT;
+    const Vector3f before = learned;
+    if (!learner_.add(learn_field_uT_, learn_r_, st_.learn_steps, learned)) return;
+    mag_cal_uT_ -= learned - before;
+    if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
+        forget_mag_reference();
+}
+
+// The DCM takes the next calibrated sample as the earth field and its heading at once;
+// that turn of the estimate is not a turn of the board, so the learner's open pair goes.
+void AttitudePipeline::forget_mag_reference() {
+    dcm_.reset_mag_reference();
+    learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
+    learner_.forget_pair();
+    st_.learn_pending = false;
 }
 
 // Spikes and non-finite values are replaced by the previous sample; saturation is
@@ -87,14 +127,27 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
     Writer w(log_);
     w.str(prefix).vec(status ? gyro_bias_rad_s() : settings_.cal.gyro_bias_rad_s, linalg::kDegPerRad)
         .str(TXT(" deg/s"));
-    if (status) w.str(TXT(", temperature ")).fixed2(last_.temperature_c).str(TXT(" C"));
-    w.end();
+    if (!status) {
+        w.end();
+        return;
+    }
+    w.str(TXT(", temperature ")).fixed2(last_.temperature_c).str(TXT(" C")).end();
+    w.str(TXT("# compass: cal "))
+        .str((settings_.flags & settings::kFlagMagCalibrated) ? TXT("yes") : TXT("none"))
+        .str(TXT(", learned offset ")).vec(settings_.cal.mag_learned_uT).str(TXT(" uT ("))
+        .u32(learner_.updates()).str(TXT(" updates)")).end();
 }
 
 void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     dcm_ = dcm::Dcm(dcm::kDefaultDcmSettings);
     dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
     st_.mag_pending = false;
+    // How far off the offset in use may be: a fraction of a uT after `cal mag` or
+    // learning, tens of uT on a compass never calibrated.
+    const bool calibrated = (settings_.flags & settings::kFlagMagCalibrated) != 0 ||
+                            !(settings_.cal.mag_learned_uT == Vector3f());
+    learner_.restart(calibrated ? calib::kLearnPriorCalibrated_uT : calib::kLearnPriorUncalibrated_uT);
+    learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
     st_.phase = Phase::Running;
     st_.output_acc = kRateHz;  // the first line comes with the first step
 }
@@ -141,6 +194,7 @@ static uint8_t clipped_axes(const Vector3f& a_m_s2) {
 void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     st_.output_due = false;
     ++st_.steps;
+    if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     const mpu6000::Sample s = guard(raw);
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
@@ -187,6 +241,10 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
+    if (st_.output_due) return;
+    if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
+    st_.cal_pending = false;
+    if (st_.learn_pending) learn_mag_offset();
 }
 
 Angles AttitudePipeline::angles() const {
@@ -218,7 +276,9 @@ void AttitudePipeline::start_mag_calibration() {
         Writer(log_).str(TXT(TXT_ERROR "cal mag: " TXT_HMC " absent")).end();
         return;
     }
-    mag_cal_.restart();
+    // The centre in use (the fit's offset plus the learned one, which W ~ I barely
+    // changes) centres the fit's sums.
+    mag_cal_.restart(settings_.cal.mag_offset_uT + settings_.cal.mag_learned_uT);
     st_.mag_cal_steps = 0;
     st_.mag_cal_active = true;
     Writer(log_).str(TXT("# cal mag: turn the board every way for 30 s")).end();
@@ -233,21 +293,33 @@ void AttitudePipeline::finish_mag_calibration() {
         settings_.cal = c;
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
         w.str(TXT("# cal mag: offset ")).vec(c.mag_offset_uT).str(TXT(" uT, scale ")).vec(c.mag_scale)
-            .str(TXT(" (save to keep)")).end();
+            .str(TXT(", cross ")).vec(c.mag_cross).str(TXT(", residual ")).fixed2(mag_cal_.residual_uT())
+            .str(TXT(" uT, coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("% (save to keep)")).end();
+        // Applied from the next sample: the estimator learns the calibrated field afresh.
+        learner_.restart(calib::kLearnPriorCalibrated_uT);
+        if (st_.phase == Phase::Running) forget_mag_reference();
         return;
     }
     w.str(TXT(TXT_ERROR "cal mag failed: "));
-    if (q == calib::MagCalibrator::Quality::TooFewSamples) {
-        w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
-    } else if (q == calib::MagCalibrator::Quality::AxesDisagree) {
-        w.str(TXT("axes disagree"));
-    } else {
-        w.chr((char)('x' + mag_cal_.axis()))
-            .str(q == calib::MagCalibrator::Quality::AxisNotTurned ? TXT(" axis not turned enough")
-                                                                   : TXT(" axis span too large (magnet near?)"));
+    switch (q) {
+        case calib::MagCalibrator::Quality::TooFewSamples:
+            w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
+            break;
+        case calib::MagCalibrator::Quality::ThinCoverage:
+            w.str(TXT("not turned every way (coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("%, need "))
+                .u32(calib::kMagMinCoveragePct).str(TXT("%)"));
+            break;
+        case calib::MagCalibrator::Quality::FitFailed: w.str(TXT("no ellipsoid fits the samples")); break;
+        case calib::MagCalibrator::Quality::NotEarthField:
+            w.str(TXT("field ")).fixed2(mag_cal_.radius_uT()).str(TXT(" uT is not the Earth's (magnet near?)"));
+            break;
+        case calib::MagCalibrator::Quality::SoftIronTooLarge: w.str(TXT("soft iron beyond 20% (magnet near?)")); break;
+        default:
+            w.str(TXT("residual ")).fixed2(mag_cal_.residual_uT()).str(TXT(" uT, over "))
+                .fixed2(calib::kMagMaxResidual_uT).str(TXT(" (field changed while turning?)"));
+            break;
     }
-    w.str(TXT("; half spans ")).vec(mag_cal_.max_uT() - mag_cal_.min_uT(), 0.5f)
-        .str(TXT(" uT; calibration unchanged")).end();
+    w.str(TXT("; calibration unchanged")).end();
 }
 
 void AttitudePipeline::restore_defaults() {
@@ -257,6 +329,10 @@ void AttitudePipeline::restore_defaults() {
     settings_ = settings::defaults();
     settings_.cal.gyro_bias_rad_s = bias;
     settings_.flags = (uint8_t)(settings_.flags | gyro_flag);
+    // The compass is uncalibrated again: the estimator relearns its field, the learner
+    // starts from scratch.
+    if (st_.phase == Phase::Running) forget_mag_reference();
+    learner_.restart(calib::kLearnPriorUncalibrated_uT);
 }
 
 }  // namespace pipeline

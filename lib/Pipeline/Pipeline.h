@@ -21,6 +21,14 @@
 // accelerometer sample goes in as NaN: no gravity weight that step), then
 // Dcm::correct_heading if a field sample came in since the previous step.
 //
+// Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
+// the offset learned in motion) before the DCM sees it; while running, the learner
+// (calib::OffsetLearner) refines the learned offset from the field's change against
+// the estimator's rotation. A new calibration, or a learned offset that has moved by
+// kMagReferenceShift_uT since the estimator learned the earth field, makes the
+// estimator forget that field (Dcm::reset_mag_reference): its strength and dip are
+// those of the calibrated field from then on.
+//
 // Messages (to the sink, each a "# " line): gyro calibration progress and result,
 // "# warn: MPU6000 ..." for spikes and saturation (at most one per kWarnIntervalSteps
 // per kind, with the count), "# warn: HMC5883L ..." for absurd fields, the `cal mag`
@@ -63,6 +71,10 @@ constexpr uint8_t kMaxSpikeRun = 10;            // up to 50 ms of glitch; longer
 constexpr uint8_t kAccelSaturationFaultSteps = 20;  // 100 ms of clipped accel: a stuck sensor, not a motion
 constexpr float kMagMin_uT = 10.0f;             // Earth: 25..65 uT; outside 10..200 = not the Earth
 constexpr float kMagMax_uT = 200.0f;
+// The estimator rejects a field whose strength is 10 % (~5 uT) off the one it learned:
+// a learned offset that has moved by half that since it learned the field makes it
+// learn the field again, before the shift can get a good field rejected.
+constexpr float kMagReferenceShift_uT = 2.5f;
 
 enum class Phase : uint8_t {
     WaitImu,      // no sample yet
@@ -130,20 +142,29 @@ public:
     float temperature_c() const { return last_.temperature_c; }
     uint32_t spikes() const { return st_.spikes; }
     // "<prefix>x y z deg/s": the calibrated bias, or (status) the calibrated bias plus the
-    // estimator's, followed by ", temperature T C".
+    // estimator's, followed by ", temperature T C" and a second line, the compass's:
+    // "# compass: cal yes|none, learned offset x y z uT (n updates)".
     void print_bias(text::Flash prefix, bool status) const;
+    const calib::OffsetLearner& offset_learner() const { return learner_; }
 
 private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
+    void learn_mag_offset();
+    void forget_mag_reference();
 
     const text::Sink* log_;
     settings::Settings settings_;
     dcm::Dcm dcm_;
     calib::GyroCalibrator gyro_cal_;
     calib::MagCalibrator mag_cal_;
+    calib::OffsetLearner learner_;
+    linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
+    linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and its attitude
+    linalg::Matrix3f learn_r_;
+    linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
@@ -154,6 +175,8 @@ private:
         uint32_t spikes;
         uint16_t gyro_cal_steps;
         uint16_t mag_cal_steps;
+        uint16_t steps_since_mag;       // for the offset learner's pairs
+        uint16_t learn_steps;           // steps_since_mag of the waiting sample
         uint16_t output_acc;
         Phase phase;                    // WaitImu
         uint8_t spike_run;
@@ -166,6 +189,8 @@ private:
         bool mag_cal_active;
         bool output_due;
         bool reinit_pending;
+        bool learn_pending;             // learn_field_uT_ waits for a step without output
+        bool cal_pending;               // cal_field_uT_ likewise
     };
     State st_;
 };
