@@ -12,6 +12,8 @@
 // The loop is paced by the MPU6000's data-ready (200 Hz): each sample is read,
 // calibrated, checked and fed to the DCM estimator (lib/DCM); a compass sample is
 // read when its DRDY pin says so. Every line that is not angle data begins with "# ".
+// Other output modes (`mode csv|quat|raw|mavlink|quiet`): README.md; in `mode mavlink`
+// the board speaks MAVLink 2 to a ground station and its "# " lines go as STATUSTEXT.
 #include <SPI.h>
 #include <Wire.h>
 
@@ -21,6 +23,7 @@
 #include "Console.h"
 #include "Format.h"
 #include "Imu.h"
+#include "MavLink.h"
 #include "Pipeline.h"
 #include "SerialText.h"
 #include "SettingsStore.h"
@@ -29,12 +32,17 @@
 using text::Flash;
 using text::Writer;
 
-const text::Sink* const out = &serial_text::kSink;
+// Every "# " message goes through `out`: to the serial port as text, or, in `mode
+// mavlink`, as STATUSTEXT frames (write_message, below).
+static void write_message(void*, const char* data, uint8_t len);
+const text::Sink message_sink = {nullptr, write_message};
+const text::Sink* const out = &message_sink;
 pipeline::AttitudePipeline pipe(out);
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
 console::LineReader reader;
+mav::FrameFilter mavlink_input;  // a ground station's frames, kept from the console
 
 // Loop load: the share of each second spent on samples (measured, shown by `status`).
 uint32_t work_us = 0, window_start_us = 0;
@@ -76,21 +84,70 @@ static void print_status() {
     print_settings_line();
 }
 
-// One angle line in the chosen mode (none in quiet mode).
+// MAVLink (lib/MavLink): frames go out whole or not at all, through the same queue as
+// the text, so a frame is never cut by a message.
+mav::Packer mavlink;
+static void write_frame(void*, const uint8_t* frame, uint8_t len) {
+    serial_text::write(reinterpret_cast<const char*>(frame), len);  // STATUSTEXT: a reply, never dropped
+}
+mav::StatusText status_text(mavlink, mav::FrameSink{nullptr, write_frame});
+
+static bool mavlink_mode() { return pipe.settings().mode == fmt::OutputMode::Mavlink; }
+
+static void write_message(void*, const char* data, uint8_t len) {
+    if (mavlink_mode()) status_text.write(data, len);
+    else serial_text::write(data, len);
+}
+
+// HEARTBEAT and SYS_STATUS, once a second in `mode mavlink` (MAVLink's 1 Hz convention:
+// a ground station drops a link after ~3 s without a heartbeat).
+static void send_heartbeat_and_status() {
+    const pipeline::Phase ph = pipe.phase();
+    const mav::State state = !imu.ok() || !compass.ok() ? mav::State::Critical
+                             : ph == pipeline::Phase::WaitImu ? mav::State::Boot
+                             : ph == pipeline::Phase::Calibrating || pipe.gyro_calibrating() || pipe.mag_calibrating()
+                                 ? mav::State::Calibrating
+                                 : mav::State::Active;
+    uint8_t frame[mav::kMaxFrame];
+    uint8_t n = mavlink.heartbeat(frame, state);
+    serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
+    const uint32_t missed = imu.missed_samples();
+    n = mavlink.sys_status(frame, mav::health(true, imu.ok(), true, compass.ok()), (uint16_t)(load_pct * 10u),
+                           (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu));
+    serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
+}
+
+// One output line (or frame) in the chosen mode, none in quiet mode. Lines are written
+// only when they fit whole: a backlog of replies delays a line, never a sample.
 static void emit_output(uint32_t now_ms) {
-    const settings::Settings& s = pipe.settings();
-    if (s.mode == fmt::OutputMode::Quiet) return;
-    board::mark_begin(board::kSecEuler);
-    const pipeline::Angles a = pipe.angles();
-    board::mark_end(board::kSecEuler);
-    char line[fmt::kLineMax];
+    const fmt::OutputMode mode = pipe.settings().mode;
+    if (mode == fmt::OutputMode::Quiet) return;
+    char line[fmt::kRawLineMax];
+    uint8_t n;
     board::mark_begin(board::kSecFormat);
-    const uint8_t n = s.mode == fmt::OutputMode::Csv
-                          ? fmt::format_csv_line(line, now_ms, a.roll_deg, a.pitch_deg, a.heading_deg)
-                          : fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
+    if (mode == fmt::OutputMode::Quat) {
+        n = fmt::format_quat_line(line, pipe.quaternion());
+    } else if (mode == fmt::OutputMode::Raw) {
+        const float inv_g = 1.0f / dcm::kGravity_m_s2;
+        n = fmt::format_raw_line(line, pipe.gyro_rad_s() * linalg::kDegPerRad, pipe.accel_m_s2() * inv_g,
+                                 pipe.field_uT());
+    } else {
+        board::mark_end(board::kSecFormat);
+        board::mark_begin(board::kSecEuler);
+        const pipeline::Angles a = pipe.angles();
+        board::mark_end(board::kSecEuler);
+        board::mark_begin(board::kSecFormat);
+        if (mode == fmt::OutputMode::Mavlink) {
+            n = mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg, a.heading_deg,
+                                 pipe.body_rate_rad_s());
+        } else {
+            n = mode == fmt::OutputMode::Csv ? fmt::format_csv_line(line, now_ms, a.roll_deg, a.pitch_deg, a.heading_deg)
+                                             : fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
+        }
+    }
     board::mark_end(board::kSecFormat);
-    if (n > 0) serial_text::write_line_if_room(line, n);  // a backlog of replies delays a line, not a sample
-    else if (warn_angle.allow(now_ms, 2000)) say(TXT(TXT_WARN "angle not finite: line skipped"));
+    if (n > 0) serial_text::write_line_if_room(line, n);
+    else if (warn_angle.allow(now_ms, 2000)) say(TXT(TXT_WARN "output not finite: line skipped"));
 }
 
 // ---------------------------------------------------------------------------
@@ -128,6 +185,7 @@ static void take_console_input() {
     while (!commands.full()) {
         const int b = Serial.read();
         if (b < 0) return;
+        if (mavlink_input.consume((uint8_t)b)) continue;  // a ground station's frame, not text
         const console::Command c = reader.feed((uint8_t)b);
         if (c.id != console::CommandId::None) commands.push(c);
     }
@@ -213,6 +271,7 @@ void loop() {
         work_us = 0;
         window_start_us = now_us;
         update_leds();
+        if (mavlink_mode()) send_heartbeat_and_status();
     }
     if (!imu.sample_ready(now_us)) return;
     step(now_us);

@@ -1,5 +1,7 @@
 #include "Pipeline.h"
 
+#include <math.h>
+
 namespace pipeline {
 
 using linalg::Vector3f;
@@ -252,6 +254,14 @@ Angles AttitudePipeline::angles() const {
     const float h = dcm::heading_deg(e.yaw_rad, settings_.declination_deg());
     return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad, h};
 }
+
+linalg::Quaternion AttitudePipeline::quaternion() const {
+    // The DCM's earth frame is magnetic north: turned about down by the declination.
+    const float half_rad = 0.5f * settings_.declination_deg() * linalg::kRadPerDeg;
+    return linalg::quat_turned_about_down(linalg::quat_from_rotation(dcm_.matrix()), cosf(half_rad), sinf(half_rad));
+}
+
+Vector3f AttitudePipeline::gyro_rad_s() const { return calib::apply_gyro(settings_.cal, last_.gyro_rad_s); }
 
 Vector3f AttitudePipeline::gyro_bias_rad_s() const {
     return settings_.cal.gyro_bias_rad_s + dcm_.gyro_bias_rad_s();

@@ -121,6 +121,16 @@ public:
     bool output_due() const { return st_.output_due; }
     // Current angles (Euler extraction: ~5 ksteps of float work on AVR; call when due).
     Angles angles() const;
+    // The same attitude as a unit quaternion, body to the true-north earth frame
+    // (declination applied like the heading's): `mode quat`.
+    linalg::Quaternion quaternion() const;
+    // The latest sample, calibrated (body frame: gyro less its calibrated bias, accel as
+    // measured, field with the compass calibration): `mode raw`.
+    linalg::Vector3f gyro_rad_s() const;
+    const linalg::Vector3f& accel_m_s2() const { return last_.accel_m_s2; }
+    const linalg::Vector3f& field_uT() const { return mag_cal_uT_; }
+    // The body rates less every bias estimate, rad/s (MAVLink ATTITUDE).
+    linalg::Vector3f body_rate_rad_s() const { return last_.gyro_rad_s - gyro_bias_rad_s(); }
 
     // Back to the default settings and calibration, keeping the gyro bias measured at
     // this start (a measurement, not a setting). Not saved until the caller saves.
