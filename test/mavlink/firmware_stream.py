@@ -1,0 +1,157 @@
+#!/usr/bin/env python3
+"""The firmware's MAVLink stream, decoded by pymavlink as a ground station would (issue 12).
+
+    build/venv/bin/python test/mavlink/firmware_stream.py --tools build --work DIR
+
+Runs build/firmware.elf in build/apm25sim twice on the same 12 s of the tilt tour with the
+HMC5883L unplugged from 6 to 7 s: once with `mode csv` typed at 3 s (the reference angles,
+time-stamped), once with `mode mavlink` typed at 3 s. Checks, for the MAVLink run:
+  - everything after the reply to `mode mavlink` decodes: no bad CRC, no stray byte;
+  - HEARTBEAT about once a second (every ~50 ATTITUDE), generic type and autopilot;
+  - ATTITUDE at the output rate (50 Hz: time_boot_ms 20 +- 3 ms apart, none missing), its
+    roll, pitch and yaw equal to the csv run's at the same time_boot_ms within 0.01 rad;
+  - SYS_STATUS each second, the compass' health bit cleared while it is unplugged;
+  - STATUSTEXT for the fault ("HMC5883L", severity error) and its recovery.
+Exit 1 with every failure listed.
+"""
+import argparse
+import math
+import os
+import subprocess
+import sys
+
+from pymavlink.dialects.v20 import common as mavlink2
+
+RATE_HZ = 50
+SECONDS = 12
+FAULT = "mag:absent@6-7"
+failures = []
+
+
+def check(cond, what):
+    if not cond:
+        failures.append(what)
+    return cond
+
+
+def run(tools, work, trajectory, command):
+    path = os.path.join(work, command.replace(" ", "_") + ".in")
+    with open(path, "w") as f:
+        f.write(command + "\n")
+    r = subprocess.run([os.path.join(tools, "apm25sim"), "--elf", os.path.join(tools, "firmware.elf"),
+                        "--trajectory", trajectory, "--seconds", str(SECONDS), "--input", path,
+                        "--input-at", "3", "--fault", FAULT], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    if r.returncode != 0:
+        sys.exit("apm25sim exited %d: %s" % (r.returncode, r.stderr.decode(errors="replace")[-500:]))
+    return r.stdout
+
+
+def csv_angles(out):
+    """time_ms -> (roll, pitch, heading) in degrees, from the csv rows after the header."""
+    rows = {}
+    text = out.decode(errors="replace")
+    body = text[text.find("t_ms,roll,pitch,yaw"):]
+    for line in body.splitlines()[1:]:
+        parts = line.split(",")
+        if len(parts) == 4 and not line.startswith("#"):
+            try:
+                rows[int(parts[0])] = tuple(float(p) for p in parts[1:])
+            except ValueError:
+                pass
+    return rows
+
+
+def angle_diff_rad(a, b):
+    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--tools", required=True, help="the build directory (apm25sim, scenario, firmware.elf)")
+    ap.add_argument("--work", required=True)
+    args = ap.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    trajectory = os.path.join(args.work, "tilt_tour.csv")
+    with open(trajectory, "wb") as f:
+        subprocess.run([os.path.join(args.tools, "scenario"), "tilt_tour"], stdout=f, check=True)
+
+    reference = csv_angles(run(args.tools, args.work, trajectory, "mode csv"))
+    check(len(reference) > 400, "csv run: %d rows" % len(reference))
+    out = run(args.tools, args.work, trajectory, "mode mavlink")
+
+    # Text until the reply to the command (which is itself the first STATUSTEXT), then
+    # nothing but frames.
+    start = out.find(b"\xfd")
+    if not check(start > 0 and out[:start].count(b"roll:") > 20, "no MAVLink after the text lines"):
+        return
+    mav = mavlink2.MAVLink(None)
+    mav.robust_parsing = True  # a bad frame comes back as BAD_DATA instead of raising
+    msgs = mav.parse_buffer(out[start:]) or []
+    bad = [m for m in msgs if m.get_type() == "BAD_DATA"]
+    check(not bad and mav.total_receive_errors == 0,
+          "%d bad frames, %d receive errors: %r" % (len(bad), mav.total_receive_errors, bad[:3]))
+    types = [m.get_type() for m in msgs]
+    check(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT"}, "unexpected: %r" % set(types))
+    check(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
+          "first frame: the reply to the command, got %r" % (msgs[:1],))
+    seqs = [m.get_seq() for m in msgs]
+    check(all((b - a) % 256 == 1 for a, b in zip(seqs, seqs[1:])), "sequence numbers with gaps")
+
+    # ATTITUDE at the output rate, equal to the csv angles.
+    att = [m for m in msgs if m.get_type() == "ATTITUDE"]
+    span_s = SECONDS - 3
+    check(len(att) >= (span_s - 0.2) * RATE_HZ, "%d ATTITUDE in %d s (%d Hz expected)" % (len(att), span_s, RATE_HZ))
+    steps = [b.time_boot_ms - a.time_boot_ms for a, b in zip(att, att[1:])]
+    # time_boot_ms is millis() when the line is made: a millisecond or two of jitter,
+    # none missing (a missing one would leave a 40 ms step).
+    check(steps and all(abs(s - 1000 // RATE_HZ) <= 3 for s in steps), "ATTITUDE intervals %r" % sorted(set(steps)))
+    check(steps and abs(sum(steps) / len(steps) - 1000 / RATE_HZ) < 0.2, "ATTITUDE mean interval off")
+    compared = 0
+    worst = 0.0
+    for a in att:
+        ref = reference.get(a.time_boot_ms)
+        if ref is None:
+            continue
+        compared += 1
+        worst = max(worst, angle_diff_rad(a.roll, math.radians(ref[0])), angle_diff_rad(a.pitch, math.radians(ref[1])),
+                    angle_diff_rad(a.yaw, math.radians(ref[2])))
+    check(compared >= 0.95 * len(att), "only %d of %d ATTITUDE matched a csv row by time" % (compared, len(att)))
+    check(worst <= 0.01, "ATTITUDE differs from the csv angles by %.4f rad" % worst)
+    check(any(abs(a.rollspeed) > 0.2 for a in att), "rollspeed never shows the tour's roll rate")
+
+    # HEARTBEAT each second: ~50 ATTITUDE between two.
+    hb_at = [i for i, m in enumerate(msgs) if m.get_type() == "HEARTBEAT"]
+    check(len(hb_at) >= span_s - 1, "%d HEARTBEAT in %d s" % (len(hb_at), span_s))
+    for a, b in zip(hb_at, hb_at[1:]):
+        n = sum(1 for m in msgs[a:b] if m.get_type() == "ATTITUDE")
+        check(45 <= n <= 55, "%d ATTITUDE between two HEARTBEAT (one a second expected)" % n)
+    for i in hb_at:
+        hb = msgs[i]
+        check(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC
+              and hb.mavlink_version == 3, "HEARTBEAT %r" % hb)
+
+    # SYS_STATUS: the compass bit follows the fault.
+    status = [m for m in msgs if m.get_type() == "SYS_STATUS"]
+    check(len(status) == len(hb_at), "%d SYS_STATUS for %d HEARTBEAT" % (len(status), len(hb_at)))
+    mag = mavlink2.MAV_SYS_STATUS_SENSOR_3D_MAG
+    check(any(not (s.onboard_control_sensors_health & mag) for s in status), "compass never unhealthy")
+    check(status and status[-1].onboard_control_sensors_health & mag, "compass not healthy again at the end")
+    check(all(0 < s.load <= 1000 for s in status), "load %r" % [s.load for s in status])
+
+    # STATUSTEXT for the fault and its recovery.
+    texts = [m for m in msgs if m.get_type() == "STATUSTEXT"]
+    check(any("HMC5883L" in t.text and t.severity == mavlink2.MAV_SEVERITY_ERROR for t in texts),
+          "no error STATUSTEXT for the unplugged compass: %r" % [t.text for t in texts])
+    check(any(t.text.startswith("recovered") and "HMC5883L" in t.text for t in texts), "no recovery STATUSTEXT")
+    print("# %d frames: %d ATTITUDE (worst %.4f rad from csv), %d HEARTBEAT, %d SYS_STATUS, %d STATUSTEXT"
+          % (len(msgs), len(att), worst, len(hb_at), len(status), len(texts)))
+
+
+if __name__ == "__main__":
+    main()
+    if failures:
+        print("MAVLink stream: %d failure(s)" % len(failures))
+        for f in failures:
+            print("  " + f)
+        sys.exit(1)
+    print("pymavlink decoded the firmware's stream as expected")
