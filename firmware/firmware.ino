@@ -157,9 +157,9 @@ static void emit_output(uint32_t now_ms) {
 // and parsed at once, every loop iteration and again inside the step after the
 // estimator (at 115200 baud the ring fills in 5.6 ms; the longest step is ~4.5 ms), and
 // the parsed commands wait in a queue. A command runs only when the output queue has
-// room for its longest reply (help, 300 bytes): a paste is answered line by line as
-// fast as the UART carries the replies, and a reply never blocks the loop.
-constexpr uint16_t kLongestReplyBytes = 320;
+// room for its reply and an angle line after it (console::reply_bound): a paste is
+// answered line by line as fast as the UART carries the replies, a reply never blocks
+// the loop, and the angle lines keep flowing between replies.
 console::CommandQueue commands;
 
 static void execute(const console::Command& c) {
@@ -192,7 +192,8 @@ static void take_console_input() {
 }
 
 static void run_console_command() {
-    if (!commands.empty() && serial_text::room() >= kLongestReplyBytes) execute(commands.pop());
+    if (commands.empty() || serial_text::room() < console::reply_bound(commands.peek()) + fmt::kRawLineMax) return;
+    execute(commands.pop());
 }
 
 // ---------------------------------------------------------------------------

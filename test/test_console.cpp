@@ -263,6 +263,29 @@ TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
     EXPECT_TRUE(q.empty());
 }
 
+TEST(CommandQueue, EveryReplyFitsItsBound) {
+    // The firmware runs a command when its output queue has reply_bound bytes free: a
+    // reply longer than that would block the loop.
+    std::string out;
+    const text::Sink sink{&out, sink_write};
+    console::print_help(&sink);
+    EXPECT_LE(out.size(), console::reply_bound(parse("help")));
+    EXPECT_GT(out.size(), console::kShortReply);  // the bound for help is the long one
+    const char* const lines[] = {"rate 100", "decl -179.99", "mode mavlink", "mode x", "rate 0", "decl 200",
+                                 "cal x", "frobnicate", "rate", "rate 5 6", "rate abc", "\x01\x02"};
+    for (const char* line : lines) {
+        settings::Settings s = settings::defaults();
+        const console::Command c = parse(line);
+        out.clear();
+        if (c.id == CommandId::Error) console::print_error(c, &sink);
+        else console::apply_setting(c, s, &sink);
+        EXPECT_LE(out.size(), console::reply_bound(c)) << line << ": " << out;
+    }
+    out.clear();
+    console::print_defaults(&sink);
+    EXPECT_LE(out.size(), console::reply_bound(parse("defaults")));
+}
+
 TEST(Console, EveryModeNameParsesBackToItsMode) {
     for (uint8_t m = 0; m <= (uint8_t)fmt::kLastOutputMode; ++m) {
         const fmt::OutputMode mode = (fmt::OutputMode)m;

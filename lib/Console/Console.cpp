@@ -240,4 +240,8 @@ Command CommandQueue::pop() {
     return c;
 }
 
+uint16_t reply_bound(const Command& c) {
+    return c.id == CommandId::Help || c.id == CommandId::Status ? kLongReply : kShortReply;
+}
+
 }  // namespace console

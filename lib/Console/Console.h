@@ -107,12 +107,22 @@ text::Flash csv_header();
 // "plot", "csv", "quiet", "quat", "raw" or "mavlink".
 text::Flash mode_name(fmt::OutputMode m);
 
+// The most bytes the reply to c can take: the firmware runs a command only when its
+// output queue has that much room (help and status are the long ones: kLongReply;
+// status is printed by the firmware and sized by its test).
+constexpr uint16_t kShortReply = 96;
+constexpr uint16_t kLongReply = 400;
+uint16_t reply_bound(const Command& c);
+
 // Parsed commands waiting to run, oldest first. The firmware parses input as soon as it
 // arrives (so the UART's small receive ring never overflows) but runs a command only
 // when its reply has room to go out: a paste of several lines waits here.
 class CommandQueue {
 public:
-    static constexpr uint8_t kCapacity = 8;  // a paste of 8 short lines
+    // A burst of garbage with commands between makes an error line for every ~20 bytes
+    // received, whose replies (~60 bytes) outrun the UART for a while: 32 commands
+    // (7 bytes each) hold that backlog, so the 64-byte receive ring is always emptied.
+    static constexpr uint8_t kCapacity = 32;
 
     bool full() const { return count_ == kCapacity; }
     bool empty() const { return count_ == 0; }
@@ -121,6 +131,8 @@ public:
     bool push(const Command& c);
     // The oldest command; call only when not empty.
     Command pop();
+    // The oldest command, left in place; call only when not empty.
+    const Command& peek() const { return items_[head_]; }
 
 private:
     Command items_[kCapacity] = {};
