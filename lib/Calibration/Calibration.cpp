@@ -323,51 +323,47 @@ void OffsetLearner::restart(float prior_uT) {
     for (uint8_t i = 0; i < 6; ++i) info_[i] = 0.0f;
 }
 
-bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t steps, Vector3f& learned_uT) {
-    if (!field_uT.is_finite() || !r.is_finite()) return false;
+bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint16_t steps, Vector3f& learned_uT) {
+    if (!field_uT.is_finite() || !turn_rad.is_finite()) return false;
     age_steps_ = (uint16_t)(age_steps_ + steps < kLearnMaxPairSteps ? age_steps_ + steps : kLearnMaxPairSteps);
     if (!have_ref_ || age_steps_ >= kLearnMaxPairSteps) {
-        r_ref_ = r;  // too old, or none: this sample starts the next pair
-        field_ef_ref_ = r * field_uT;
+        turn_ = Matrix3f();  // too old, or none: this sample starts the next pair
+        field_ref_ = field_uT;
         age_steps_ = 0;
         have_ref_ = true;
         return false;
     }
-    // cos theta of the turn R1 -> R2: (trace(R2^T R1) - 1) / 2.
-    const float cos_turn = 0.5f * (r.a.dot(r_ref_.a) + r.b.dot(r_ref_.b) + r.c.dot(r_ref_.c) - 1.0f);
+    // P <- P exp([t x]), exp([t x]) = (1 - c a^2) I + s [t x] + c t t^T, a = |t|, to
+    // fourth order: s = 1 - a^2 / 6, c = 1/2 - a^2 / 24 (a <= 0.5 rad between samples).
+    const float a2 = turn_rad.length_squared();
+    const float sn = 1.0f - a2 * (1.0f / 6.0f), cs = 0.5f - a2 * (1.0f / 24.0f);
+    const Vector3f t = turn_rad, ct = turn_rad * cs;
+    const float d = 1.0f - cs * a2;
+    turn_ = turn_ * Matrix3f(Vector3f(d + ct.x * t.x, ct.x * t.y - sn * t.z, ct.x * t.z + sn * t.y),
+                             Vector3f(ct.y * t.x + sn * t.z, d + ct.y * t.y, ct.y * t.z - sn * t.x),
+                             Vector3f(ct.z * t.x - sn * t.y, ct.z * t.y + sn * t.x, d + ct.z * t.z));
+    const Matrix3f& p = turn_;
+    // cos theta = (trace P - 1) / 2.
+    const float cos_turn = 0.5f * (p.a.x + p.b.y + p.c.z - 1.0f);
     if (cos_turn > kLearnMinCos) return false;  // not turned enough yet: keep the pair open
-    // r_e = R2 f2 - R1 f1 = (R2 - R1) e = H e; H^T r_e is what the pair says of e.
-    const Vector3f residual_ef = r * field_uT - field_ef_ref_;
-    const Vector3f across = r.mul_transpose(residual_ef) - r_ref_.mul_transpose(residual_ef);
-    // H^T H = 2 I - M - M^T, M = R2^T R1 = sum over the earth axes k of r2_k r1_k^T.
-    const float* r2 = &r.a.x;
-    const float* r1 = &r_ref_.a.x;
-    static const uint8_t kRow[6] = {0, 1, 2, 0, 0, 1}, kCol[6] = {0, 1, 2, 1, 2, 2};
+    // r = P f2 - f1 = H e; H^T r = P^T r - r is what the pair says of e.
+    const Vector3f residual = p * field_uT - field_ref_;
+    const Vector3f across = p.mul_transpose(residual) - residual;
+    // H^T H = 2 I - P - P^T.
     const float fade = 1.0f - 1.0f / kLearnMemoryPairs;
     const float inv_noise = 1.0f / (kLearnPairNoise_uT * kLearnPairNoise_uT);
-    for (uint8_t e = 0; e < 6; ++e) {
-        const uint8_t i = kRow[e], j = kCol[e];
-        float m = 0.0f;
-        for (uint8_t k = 0; k < 9; k += 3) m += r2[k + i] * r1[k + j] + r2[k + j] * r1[k + i];
-        info_[e] = info_[e] * fade + ((i == j ? 2.0f : 0.0f) - m) * inv_noise;
-    }
+    const float hth[6] = {2.0f - 2.0f * p.a.x, 2.0f - 2.0f * p.b.y, 2.0f - 2.0f * p.c.z,
+                          -(p.a.y + p.b.x), -(p.a.z + p.c.x), -(p.b.z + p.c.y)};
+    for (uint8_t e = 0; e < 6; ++e) info_[e] = info_[e] * fade + hth[e] * inv_noise;
     // The prior stays: it holds the axis never turned about where it is.
-    float a[3][kMaxUnknowns + 1] = {{info_[0] + prior_info_, info_[3], info_[4], across.x * inv_noise},
+    float m[3][kMaxUnknowns + 1] = {{info_[0] + prior_info_, info_[3], info_[4], across.x * inv_noise},
                                     {info_[3], info_[1] + prior_info_, info_[5], across.y * inv_noise},
                                     {info_[4], info_[5], info_[2] + prior_info_, across.z * inv_noise}};
-    if (!solve(a, 3)) return false;
-    Vector3f step(a[0][3], a[1][3], a[2][3]);
-    // A pair says nothing along its rotation axis n (the skew part of M: M - M^T =
-    // 2 sin(theta) [n x]); what the solve puts there is the weak prior amplifying
-    // rounding and attitude error: it is taken out.
-    float skew[3];
-    for (uint8_t e = 0; e < 3; ++e) {
-        const uint8_t i = kRow[e + 3], j = kCol[e + 3];
-        float m = 0.0f;
-        for (uint8_t k = 0; k < 9; k += 3) m += r2[k + i] * r1[k + j] - r2[k + j] * r1[k + i];
-        skew[e] = m;
-    }
-    const Vector3f axis = Vector3f(skew[2], -skew[1], skew[0]).normalized();
+    if (!solve(m, 3)) return false;
+    Vector3f step(m[0][3], m[1][3], m[2][3]);
+    // A pair says nothing along its rotation axis n (P - P^T = 2 sin(theta) [n x]); what
+    // the solve puts there is the weak prior amplifying the pair's error: taken out.
+    const Vector3f axis = Vector3f(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y).normalized();
     step -= axis * axis.dot(step);
     float* s = &step.x;
     float* o = &learned_uT.x;
@@ -379,8 +375,8 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Matrix3f& r, uint16_t st
     }
     if (updates_ < 0xFFFFu) ++updates_;
     // The sample that closed this pair opens the next, with the new offset removed.
-    r_ref_ = r;
-    field_ef_ref_ = r * (field_uT - step);
+    turn_ = Matrix3f();
+    field_ref_ = field_uT - step;
     age_steps_ = 0;
     return true;
 }

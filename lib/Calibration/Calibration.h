@@ -161,25 +161,29 @@ private:
 
 // ---------------------------------------------------------------------------
 // Hard-iron learning in motion (Premerlani, "Magnetometer Offset Nulling Revisited",
-// eq. 11; ArduPilot's Compass::null_offsets on the APM2). The earth field is fixed,
-// so two calibrated samples f1, f2 taken at attitudes R1, R2 (body to earth) satisfy
-// R2 f2 = R1 f1 if the offset is right; a residual offset e leaves
-//   r = R2 f2 - R1 f1 = (R2 - R1) e.
-// Each pair measures the two components of e across the rotation axis, with
-// information H^T H / sigma^2, H = R2 - R1 (H^T H = 2 (1 - cos theta) (I - n n^T)).
-// The learner is recursive least squares in information form: L += H^T H / sigma^2,
-// e = (I / prior^2 + L)^-1 H^T r / sigma^2, L fading by 1/kLearnMemoryPairs a pair, so
-// that a hard iron that changes (a battery moved) is followed. Pairs are
-// taken at least 20 deg apart and at most kLearnMaxPairSteps apart (the attitude's own
+// eq. 11; ArduPilot's Compass::null_offsets on the APM2). The earth field is fixed, so
+// two calibrated samples f1, f2 with the board turned by P between them (P: body 2 to
+// body 1, integrated from the gyro) satisfy P f2 = f1 if the offset is right; a
+// residual offset e leaves
+//   r = P f2 - f1 = (P - I) e = H e.
+// A pair measures the two components of e across the rotation axis, with information
+// H^T H / sigma^2 (H^T H = 2 (1 - cos theta) (I - n n^T)). The learner is recursive
+// least squares in information form: e = (I / prior^2 + L)^-1 H^T r / sigma^2, L the
+// sum of the pairs' information fading by 1/kLearnMemoryPairs a pair (a hard iron that
+// changes, a battery moved, is followed); the step is kept across the pair's axis.
+// The turn comes from the gyro alone, not from the estimator's attitude: the
+// estimator's drift corrections turn its matrix by up to a degree a second (1 uT of a
+// 50 uT field over a pair), which is not a turn of the board.
+// Pairs are taken at least 20 deg apart and at most kLearnMaxPairSteps apart (gyro
 // drift over a longer span is no longer small against the signal).
 constexpr float kLearnMinCos = 0.94f;           // pairs at least 20 deg apart: cos 20 deg
-// Noise of one pair's residual: the HMC5883L's 0.2 uT on each sample, and the
-// attitude's error over the pair (0.5 deg of gyro drift and heading correction in 2 s,
-// times a 50 uT field: 0.4 uT), summed in quadrature.
+// Noise of one pair's residual: the HMC5883L's 0.2 uT on each sample, and the gyro's
+// error over the pair (0.5 deg: 2 s of a 0.1 deg/s bias residual and a 0.5 % scale
+// error over 60 deg, times a 50 uT field: 0.4 uT), summed in quadrature.
 constexpr float kLearnPairNoise_uT = 0.5f;
 constexpr uint16_t kLearnMaxPairSteps = 400;    // 2 s at 200 Hz
 // ~2 pairs a second while turning: a minute of turning to follow a change, and one
-// pair's noise averaged down by ~10 (0.05 uT).
+// pair's noise averaged down by ~10.
 constexpr float kLearnMemoryPairs = 100.0f;
 constexpr float kLearnMaxStep_uT = 5.0f;        // one pair moves no axis further (a passing magnet)
 // ArduPilot's "compass offsets too high" limit (500 mGauss): beyond, calibrate.
@@ -193,22 +197,20 @@ class OffsetLearner {
 public:
     // Starts afresh; prior_uT: how far off the current offset may be, each axis.
     void restart(float prior_uT);
-    // Drops the pair in progress (the attitude was reset: its turn is not the board's).
+    // Drops the pair in progress.
     void forget_pair() { have_ref_ = false; }
-    // One calibrated field sample (uT, body frame: the learned offset already
-    // removed) and the attitude R (body to earth) at the same instant, `steps` estimator
-    // steps after the previous call. When a pair completes, updates `learned_uT` (the
-    // offset that calibration subtracts) and returns true.
-    bool add(const linalg::Vector3f& field_uT, const linalg::Matrix3f& r, uint16_t steps,
+    // One calibrated field sample (uT, body frame: the learned offset already removed),
+    // the board's turn since the previous sample (rad, body frame: the gyro's rate
+    // integrated) and the estimator steps since. When a pair completes, updates
+    // `learned_uT` (the offset that calibration subtracts) and returns true.
+    bool add(const linalg::Vector3f& field_uT, const linalg::Vector3f& turn_rad, uint16_t steps,
              linalg::Vector3f& learned_uT);
     uint16_t updates() const { return updates_; }
-    // The information from pairs so far, 1/uT^2 (diagonal xx yy zz, then xy xz yz).
-    const float* information() const { return info_; }
 
 private:
-    linalg::Matrix3f r_ref_;
-    linalg::Vector3f field_ef_ref_;  // R1 f1
-    float info_[6] = {};
+    linalg::Matrix3f turn_;          // P: the board's turn since the pair's first sample
+    linalg::Vector3f field_ref_;     // f1
+    float info_[6] = {};             // L, 1/uT^2: xx yy zz, then xy xz yz
     float prior_info_ = 1.0f / (kLearnPriorUncalibrated_uT * kLearnPriorUncalibrated_uT);
     uint16_t age_steps_ = 0;
     uint16_t updates_ = 0;

@@ -201,7 +201,12 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // for mag_recover_s is a new environment (the board was moved): it becomes the
     // reference, and its heading is taken at once. A magnet fixed to a rotating
     // board never looks the same twice, so it never gets in.
-    const bool forgotten = !(mag_ref_norm_ > 0.0f);  // reset_mag_reference(): adopt this one
+    bool forgotten = !(mag_ref_norm_ > 0.0f);  // reset_mag_reference(): adopt this one
+    if (forgotten && !mag_take_heading_) {
+        learn_field(norm, down_component);  // the strength and dip only; the heading as usual
+        mag_take_heading_ = true;
+        forgotten = false;
+    }
     if (forgotten || !field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
             mag_steady_steps_ += interval_steps;

@@ -119,10 +119,15 @@ public:
     void correct_heading(const linalg::Vector3f& mag_field);
 
     // Forgets the learned earth field (strength and dip): the next field sample is
-    // taken as the reference and its heading at once, as a new steady field is after
-    // mag_recover_s. For a new compass calibration, whose fields the old reference
-    // would reject as disturbed.
-    void reset_mag_reference() { mag_ref_norm_ = 0.0f; }
+    // taken as the reference. take_heading: its heading too, at once, as a new steady
+    // field's is after mag_recover_s (a new compass calibration, whose fields the old
+    // reference would reject as disturbed); false: the heading is corrected at the usual
+    // rate (a learned offset that moved by a few uT: a small, uncertain change that
+    // must not turn the heading in one step).
+    void reset_mag_reference(bool take_heading = true) {
+        mag_ref_norm_ = 0.0f;
+        mag_take_heading_ = take_heading;
+    }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     uint8_t status() const { return status_; }
@@ -178,6 +183,7 @@ private:
     linalg::Vector3f last_mag_field_;
     linalg::Vector3f last_rate_rad_s_;   // the last corrected rate, to bring field samples up to date
     float mag_ref_norm_ = 0.0f;          // learned field strength
+    bool mag_take_heading_ = true;       // reset_mag_reference's take_heading
     float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
     float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
     float mag_candidate_down_ = 0.0f;

@@ -57,11 +57,13 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         // as an offset.
         const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s);
         learn_field_uT_ = f + f.cross(rate) * dcm_.settings().mag_latency_s;
-        learn_r_ = dcm_.matrix();
-        st_.learn_steps = st_.steps_since_mag;
+        // The turn since the previous sample (that one's too, if it never got its step).
+        learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad_ : turn_rad_;
+        st_.learn_steps = st_.learn_pending ? (uint16_t)(st_.learn_steps + st_.steps_since_mag) : st_.steps_since_mag;
         st_.learn_pending = true;
     }
     st_.steps_since_mag = 0;
+    turn_rad_ = Vector3f();
     mag_cal_uT_ = f;
     st_.mag_pending = true;
     st_.have_mag = true;
@@ -74,19 +76,17 @@ void AttitudePipeline::learn_mag_offset() {
     st_.learn_pending = false;
     Vector3f& learned = settings_.cal.mag_learned_uT;
     const Vector3f before = learned;
-    if (!learner_.add(learn_field_uT_, learn_r_, st_.learn_steps, learned)) return;
+    if (!learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned)) return;
     mag_cal_uT_ -= learned - before;
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
-        forget_mag_reference();
+        forget_mag_reference(false);
 }
 
-// The DCM takes the next calibrated sample as the earth field and its heading at once;
-// that turn of the estimate is not a turn of the board, so the learner's open pair goes.
-void AttitudePipeline::forget_mag_reference() {
-    dcm_.reset_mag_reference();
+// The DCM takes the next calibrated sample as the earth field (and, take_heading, its
+// heading at once: a new calibration).
+void AttitudePipeline::forget_mag_reference(bool take_heading) {
+    dcm_.reset_mag_reference(take_heading);
     learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
-    learner_.forget_pair();
-    st_.learn_pending = false;
 }
 
 // Spikes and non-finite values are replaced by the previous sample; saturation is
@@ -222,8 +222,12 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel_m_s2) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
     const float nan = __builtin_nanf("");
-    dcm_.update(calib::apply_gyro(settings_.cal, s.gyro_rad_s), accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2);
-    if (st_.mag_pending && st_.mag_present) dcm_.correct_heading(mag_cal_uT_);
+    const Vector3f gyro_rad_s = calib::apply_gyro(settings_.cal, s.gyro_rad_s);
+    dcm_.update(gyro_rad_s, accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2);
+    // The board's turn for the compass learner: the gyro alone, less the estimator's bias.
+    turn_rad_ += (gyro_rad_s - dcm_.gyro_bias_rad_s()) * kStep_s;
+    const bool heading_corrected = st_.mag_pending && st_.mag_present;
+    if (heading_corrected) dcm_.correct_heading(mag_cal_uT_);
     st_.mag_pending = false;
 
     if (st_.mag_cal_active) {
@@ -243,7 +247,11 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
-    if (st_.output_due) return;
+    // The deferred compass work (the cal mag sums, the learner: each ~20-30 k cycles on
+    // the AVR) goes on a step with neither an output line nor a heading correction, so
+    // that no step carries two of them (the compass' 75 Hz and a 50 Hz output leave
+    // ~75 such steps a second; a sample waits at most a few steps).
+    if (st_.output_due || heading_corrected) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
     if (st_.learn_pending) learn_mag_offset();
@@ -307,7 +315,7 @@ void AttitudePipeline::finish_mag_calibration() {
             .str(TXT(" uT, coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("% (save to keep)")).end();
         // Applied from the next sample: the estimator learns the calibrated field afresh.
         learner_.restart(calib::kLearnPriorCalibrated_uT);
-        if (st_.phase == Phase::Running) forget_mag_reference();
+        if (st_.phase == Phase::Running) forget_mag_reference(true);
         return;
     }
     w.str(TXT(TXT_ERROR "cal mag failed: "));
@@ -341,7 +349,7 @@ void AttitudePipeline::restore_defaults() {
     settings_.flags = (uint8_t)(settings_.flags | gyro_flag);
     // The compass is uncalibrated again: the estimator relearns its field, the learner
     // starts from scratch.
-    if (st_.phase == Phase::Running) forget_mag_reference();
+    if (st_.phase == Phase::Running) forget_mag_reference(true);
     learner_.restart(calib::kLearnPriorUncalibrated_uT);
 }
 

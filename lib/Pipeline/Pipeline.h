@@ -163,7 +163,7 @@ private:
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
     void learn_mag_offset();
-    void forget_mag_reference();
+    void forget_mag_reference(bool take_heading);
 
     const text::Sink* log_;
     settings::Settings settings_;
@@ -172,8 +172,9 @@ private:
     calib::MagCalibrator mag_cal_;
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
-    linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and its attitude
-    linalg::Matrix3f learn_r_;
+    linalg::Vector3f turn_rad_;                 // the gyro's turn since the last field sample
+    linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the turn before it
+    linalg::Vector3f learn_turn_rad_;
     linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
