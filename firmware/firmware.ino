@@ -185,7 +185,9 @@ static void take_console_input() {
     while (!commands.full()) {
         const int b = Serial.read();
         if (b < 0) return;
-        if (mavlink_input.consume((uint8_t)b)) continue;  // a ground station's frame, not text
+        // In `mode mavlink`, a ground station's frames are set aside (not garbage to
+        // answer). Only then: 0xFD/0xFE in garbage would hide the next ~260 bytes.
+        if (mavlink_mode() && mavlink_input.consume((uint8_t)b)) continue;
         const console::Command c = reader.feed((uint8_t)b);
         if (c.id != console::CommandId::None) commands.push(c);
     }

@@ -18,7 +18,7 @@ FUZZ_NAMES   := $(patsubst test/fuzz/fuzz_%.cpp,%,$(wildcard test/fuzz/fuzz_*.cp
 FUZZ_LIB_SRC := $(wildcard lib/*/*.cpp)
 FUZZ_LIB_HDR := $(wildcard lib/*/*.h)
 FUZZ_FLAGS   := -std=c++14 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-                -fno-omit-frame-pointer $(addprefix -I,$(sort $(dir $(FUZZ_LIB_HDR))))
+                -fno-omit-frame-pointer $(addprefix -I,$(sort $(dir $(FUZZ_LIB_HDR)))) -I$(BUILD)/mavlink
 FUZZ_ENV     := ASAN_OPTIONS=abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # Console input is lines of <= 40 characters: 512 bytes hold a dozen lines and keep the
 # rate up (libFuzzer's default 4096 runs ~8x slower and finds nothing more).
@@ -61,7 +61,7 @@ fuzz-smoke: $(addprefix fuzz-smoke-,$(FUZZ_NAMES))
 # HARDENING_TESTS=OFF there so it does not register itself again.
 asan-unit:
 	@cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHARDENING_TESTS=OFF \
-	  -DTOOLS_DIR=$(abspath $(ASAN_BUILD))/tools -DCMAKE_CXX_FLAGS="$(ASAN_FLAGS)" \
+	  -DTOOLS_DIR=$(abspath $(ASAN_BUILD))/tools -DMAVLINK_DIR=$(abspath $(BUILD))/mavlink -DCMAKE_CXX_FLAGS="$(ASAN_FLAGS)" \
 	  -DCMAKE_C_FLAGS="$(ASAN_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(ASAN_FLAGS)" > /dev/null
 	@$(MAKE) --no-print-directory -C $(ASAN_BUILD) unit_tests > $(ASAN_BUILD)/build.log 2>&1 || \
 	  { tail -30 $(ASAN_BUILD)/build.log; exit 1; }

@@ -263,6 +263,36 @@ TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
     EXPECT_TRUE(q.empty());
 }
 
+TEST(CommandQueue, ErrorsBeyondTheirSlotsAreCountedAndCommandsStillFit) {
+    console::CommandQueue q;
+    const uint8_t slots = console::CommandQueue::kErrorSlots;
+    const console::Command bad = parse("frobnicate");
+    ASSERT_EQ(bad.id, CommandId::Error);
+    for (uint8_t i = 0; i < slots; ++i) EXPECT_TRUE(q.push(bad));
+    for (int i = 0; i < 100; ++i) EXPECT_TRUE(q.push(bad));  // merged into the newest
+    EXPECT_EQ(q.size(), slots);
+    // A command still gets a slot, and an error after it takes one of its own.
+    EXPECT_TRUE(q.push(parse("rate 10")));
+    EXPECT_TRUE(q.push(bad));
+    uint32_t answered = 0, merged = 0;
+    std::string out;
+    const text::Sink sink{&out, sink_write};
+    while (!q.empty()) {
+        const console::Command c = q.pop();
+        if (c.id != CommandId::Error) continue;
+        ++answered;
+        merged += (uint32_t)c.value;
+        EXPECT_LE(0, c.value);
+        out.clear();
+        console::print_error(c, &sink);
+        EXPECT_LE(out.size(), console::reply_bound(c));
+        if (c.value > 0) {
+            EXPECT_NE(out.find("# error: 100 more bad lines"), std::string::npos) << out;
+        }
+    }
+    EXPECT_EQ(answered + merged, slots + 100u + 1u);  // every bad line accounted for
+}
+
 TEST(CommandQueue, EveryReplyFitsItsBound) {
     // The firmware runs a command when its output queue has reply_bound bytes free: a
     // reply longer than that would block the loop.

@@ -182,6 +182,10 @@ void print_error(const Command& c, const text::Sink* out) {
         case Error::None: w.str(TXT("internal")); break;
     }
     w.str(TXT("; nothing changed")).end();
+    if (c.value > 0) {
+        w.str(TXT(TXT_ERROR)).u32((uint32_t)c.value)
+            .str(TXT(" more bad lines (too many to answer one by one); nothing changed")).end();
+    }
 }
 
 void print_help(const text::Sink* out) {
@@ -227,6 +231,13 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
 }
 
 bool CommandQueue::push(const Command& c) {
+    if (c.id == CommandId::Error && count_ >= kErrorSlots) {
+        Command& newest = items_[(uint8_t)((head_ + count_ - 1u) % kCapacity)];
+        if (newest.id == CommandId::Error) {
+            if (newest.value < 0xFFFF) ++newest.value;
+            return true;
+        }
+    }
     if (full()) return false;
     items_[(uint8_t)((head_ + count_) % kCapacity)] = c;
     ++count_;
@@ -241,7 +252,8 @@ Command CommandQueue::pop() {
 }
 
 uint16_t reply_bound(const Command& c) {
-    return c.id == CommandId::Help || c.id == CommandId::Status ? kLongReply : kShortReply;
+    if (c.id == CommandId::Help || c.id == CommandId::Status) return kLongReply;
+    return c.id == CommandId::Error && c.value > 0 ? 2u * kShortReply : kShortReply;
 }
 
 }  // namespace console

@@ -63,7 +63,7 @@ enum class Error : uint8_t {
 struct Command {
     CommandId id;
     Error error;
-    int32_t value;
+    int32_t value;  // Rate: Hz, Decl: hundredths of a degree; Error: further bad lines merged in (CommandQueue)
     fmt::OutputMode mode;
 };
 
@@ -109,7 +109,8 @@ text::Flash mode_name(fmt::OutputMode m);
 
 // The most bytes the reply to c can take: the firmware runs a command only when its
 // output queue has that much room (help and status are the long ones: kLongReply;
-// status is printed by the firmware and sized by its test).
+// status is printed by the firmware and sized by its test; an error with merged ones
+// takes two lines).
 constexpr uint16_t kShortReply = 96;
 constexpr uint16_t kLongReply = 400;
 uint16_t reply_bound(const Command& c);
@@ -120,14 +121,19 @@ uint16_t reply_bound(const Command& c);
 class CommandQueue {
 public:
     // A burst of garbage with commands between makes an error line for every ~20 bytes
-    // received, whose replies (~60 bytes) outrun the UART for a while: 32 commands
-    // (7 bytes each) hold that backlog, so the 64-byte receive ring is always emptied.
-    static constexpr uint8_t kCapacity = 32;
+    // received, whose replies (~50 bytes) outrun the UART for a while: 64 commands (7
+    // bytes each) hold that backlog (a 20 KB burst needs ~40), so the 64-byte receive
+    // ring is always emptied.
+    static constexpr uint8_t kCapacity = 64;
+    // Past this many, a bad line is merged into the newest queued error (its value
+    // counts them) instead of taking a slot: garbage that makes more errors than the UART
+    // can answer one by one (a line end every few bytes) never crowds out a command.
+    static constexpr uint8_t kErrorSlots = kCapacity - 8;
 
     bool full() const { return count_ == kCapacity; }
     bool empty() const { return count_ == 0; }
     uint8_t size() const { return count_; }
-    // False (nothing stored) when full.
+    // False (nothing stored) when full; an error beyond kErrorSlots is merged (true).
     bool push(const Command& c);
     // The oldest command; call only when not empty.
     Command pop();

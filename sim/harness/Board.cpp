@@ -76,6 +76,11 @@ void uart_output_hook(avr_irq_t*, uint32_t value, void* param) {
 avr_cycle_count_t sensor_timer(avr_t*, avr_cycle_count_t, void* param) {
     return static_cast<Board*>(param)->on_sensor_tick();
 }
+// simavr's UART says XOFF when its 64-byte receive FIFO is full and XON when there is
+// room again (avr_uart.h).
+void uart_xoff_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->set_uart_input_held(true); }
+void uart_xon_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->set_uart_input_held(false); }
+
 avr_cycle_count_t uart_input_timer(avr_t*, avr_cycle_count_t, void* param) {
     return static_cast<Board*>(param)->on_uart_input_tick();
 }
@@ -153,6 +158,8 @@ bool Board::init() {
     avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT), uart_output_hook,
                             this);
     uart_input_irq_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF), uart_xoff_hook, this);
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON), uart_xon_hook, this);
 
     // SPI: take over the SPDR write so a byte lasts what the configured clock says.
     spi_ = static_cast<avr_spi_t*>(avr_->io[AVR_DATA_TO_IO(kSpdr)].w.param);
@@ -435,7 +442,13 @@ uint64_t Board::on_uart_input_tick() {
         return 0;
     }
     if (input_pos_ >= options_.input.size()) return 0;
-    avr_raise_irq(uart_input_irq_, (uint8_t)options_.input[input_pos_++]);
+    // simavr hands the core a received byte one character time after the previous one
+    // was read, so over a long burst it falls behind the line by the interrupt's latency
+    // and its FIFO fills (a real USART takes a byte every character time whatever the
+    // reader does). While simavr says XOFF the next byte waits, instead of being lost
+    // inside the simulator; the wait is counted (uart_input_held_chars, --verbose).
+    if (!uart_input_held_) avr_raise_irq(uart_input_irq_, (uint8_t)options_.input[input_pos_++]);
+    else ++uart_input_held_chars_;
     // One character = 10 bits at the baud rate UBRR0 sets (datasheet 22.3.1).
     const unsigned ubrr = (unsigned)avr_->data[kUbrr0l] | ((unsigned)(avr_->data[kUbrr0h] & 0x0F) << 8);
     const unsigned divisor = (avr_->data[kUcsr0a] & 0x02) ? 8u : 16u;  // U2X0
@@ -559,6 +572,8 @@ void Board::print_counters(FILE* out) const {
                  h.transactions, h.bytes_written, h.bytes_read, h.samples, h.samples_dropped_by_lock,
                  h.nacked_while_absent, h.writes_to_read_only, h.reads_of_invalid_register, bus_violations_,
                  profile_errors_);
+    std::fprintf(out, "# apm25sim: UART0 input %zu of %zu bytes typed, %llu character times held by XOFF\n",
+                 input_pos_, options_.input.size(), (unsigned long long)uart_input_held_chars_);
 }
 
 }  // namespace sim

@@ -83,6 +83,7 @@ public:
     void on_uart_byte(uint8_t byte);
     uint64_t on_sensor_tick();
     uint64_t on_uart_input_tick();
+    void set_uart_input_held(bool held) { uart_input_held_ = held; }
     void on_gpior_write(bool end, uint8_t value);
 
 private:
@@ -124,6 +125,8 @@ private:
     std::string line_;
     bool first_angle_line_seen_ = false;
     bool input_started_ = false;
+    bool uart_input_held_ = false;        // simavr's receive FIFO is full (XOFF)
+    uint64_t uart_input_held_chars_ = 0;  // character times the input waited for it
     size_t input_pos_ = 0;
 
     SectionProfile sections_[16];
