@@ -44,7 +44,4 @@ void flush() {
     Serial.flush();
 }
 
-static void sink_write(void*, const char* data, uint8_t len) { write(data, len); }
-const text::Sink kSink = {nullptr, sink_write};
-
 }  // namespace serial_text

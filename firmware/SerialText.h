@@ -35,7 +35,4 @@ uint16_t queued();
 // Free bytes in the queue.
 uint16_t room();
 
-// The sink every message goes through (text::Writer).
-extern const text::Sink kSink;
-
 }  // namespace serial_text
