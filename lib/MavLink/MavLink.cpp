@@ -19,6 +19,10 @@
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 #pragma GCC diagnostic ignored "-Waddress-of-packed-member"
+// mavlink_types.h first: the Arduino IDE finds a library by a header at its top level,
+// so with build/mavlink installed as a library (README) this include makes the IDE add
+// it to the include path; common/mavlink.h, one folder down, then resolves.
+#include "mavlink_types.h"
 #include "common/mavlink.h"
 #pragma GCC diagnostic pop
 

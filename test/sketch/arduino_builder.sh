@@ -1,6 +1,7 @@
 #!/bin/sh
 # The sketch as the Arduino IDE builds it: Debian's arduino-builder compiles
-# firmware/firmware.ino with lib/ as its libraries folder (and, in a second build, with
+# firmware/firmware.ino with lib/ and the MAVLink headers (build/mavlink, as a library
+# named MAVLink, as the README installs them) as its libraries (and, in a second build, with
 # test/sketch/user_extension.ino in place of user.ino), then each ELF runs in apm25sim
 # for 4 simulated seconds and must print angle lines.
 #   arduino_builder.sh PROJECT_DIR TOOLS_DIR OUT_DIR
@@ -19,7 +20,7 @@ build() {  # build NAME SKETCH_DIR: arduino-builder into $out/NAME, log in $out/
   rm -rf "$out/$1" && mkdir -p "$out/$1"
   arduino-builder -compile -hardware /usr/share/arduino/hardware -tools /usr/share/arduino-builder \
     -libraries "$project/lib" -fqbn arduino:avr:mega:cpu=atmega2560 -build-path "$out/$1" \
-    "-prefs=compiler.cpp.extra_flags=-DDECIMAL_DIG=__DECIMAL_DIG__ -I$tools/mavlink" \
+    -libraries "$out/libraries" -prefs=compiler.cpp.extra_flags=-DDECIMAL_DIG=__DECIMAL_DIG__ \
     -prefs=tools.ctags.path=/usr/bin -prefs=tools.ctags.cmd.path=/usr/bin/arduino-ctags \
     '-prefs=tools.ctags.pattern="{cmd.path}" -u --language-force=c++ -f - --c++-kinds=svpf --fields=KSTtzns --line-directives "{source_file}"' \
     "$2/firmware.ino" > "$out/$1.log" 2>&1
@@ -30,6 +31,10 @@ run() {  # run NAME: 4 s of the rest scenario; prints the serial output to $out/
 }
 
 mkdir -p "$out"
+# The MAVLink headers (make mavlink) as the README installs them for the Arduino IDE: a
+# library folder named MAVLink.
+[ -f "$tools/mavlink/common/mavlink.h" ] || { echo "FAIL: $tools/mavlink missing (make mavlink)"; echo "0 passed, 1 failed"; exit 1; }
+rm -rf "$out/libraries" && mkdir -p "$out/libraries" && ln -s "$tools/mavlink" "$out/libraries/MAVLink"
 "$tools/scenario" rest --seconds 4 > "$out/rest.csv" || { echo "FAIL: build/scenario"; exit 1; }
 
 # 1. The sketch as it is.
