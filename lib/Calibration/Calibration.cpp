@@ -323,6 +323,7 @@ void OffsetLearner::restart(float prior_uT, const Vector3f& in_use_uT) {
     for (uint8_t i = 0; i < 6; ++i) info_[i] = 0.0f;
     estimate_uT_ = start_uT_ = in_use_uT;
     reject_share_ = 0.0f;
+    significant_run_ = 0;
 }
 
 bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint16_t steps, Vector3f& in_use_uT) {
@@ -419,7 +420,9 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint
     if (step_cut) return false;
     const bool following = !(in_use_uT == start_uT_);
     const bool hard_iron = !at_bound && reject_share_ <= kLearnMaxRejectShare;
-    const Vector3f use = hard_iron && (significant || following) ? estimate_uT_ : start_uT_;
+    significant_run_ = significant ? (uint8_t)(significant_run_ < 255 ? significant_run_ + 1 : 255) : 0;
+    const bool confirmed = significant_run_ >= kLearnConfirmPairs;
+    const Vector3f use = hard_iron && (confirmed || following) ? estimate_uT_ : start_uT_;
     if (use == in_use_uT) return false;
     in_use_uT = use;
     return true;

@@ -180,12 +180,13 @@ private:
 // The estimate x is not the offset in use: a wrong offset costs heading (0.3 uT of a
 // 15 uT horizontal field is 1.1 deg), and the pairs carry errors that do not average
 // out (below). The offset in use moves from where it started (the saved one, zero after
-// `cal mag`) to x only while x differs from that start by more than kLearnSignificance
-// times its uncertainty on some axis, the uncertainty being the posterior's (the
-// inverse information) and the pairs' systematic error in quadrature; not when x has
-// run into kLearnMaxOffset_uT, nor while more than kLearnMaxRejectShare of the recent
-// pairs disagree with x: both are a magnet at the compass, which no fixed offset
-// describes (the estimator's disturbance rejection deals with it).
+// `cal mag`) to x once x has differed from that start by more than kLearnSignificance
+// times its uncertainty on some axis for kLearnConfirmPairs pairs, the uncertainty being
+// the posterior's (the inverse information) and the pairs' systematic error in
+// quadrature; from then on it follows x. Except while x is at (or a step from)
+// kLearnMaxOffset_uT, or more than kLearnMaxRejectShare of the recent pairs disagree
+// with x: both are a magnet at the compass, which no fixed offset describes (the
+// estimator's disturbance rejection deals with it); then the start is in use.
 constexpr float kLearnMinCos = 0.94f;           // pairs at least 20 deg apart: cos 20 deg
 // Noise of one pair's innovation, each of its two components: the HMC5883L's 0.2 uT,
 // the gyro's scale error over the turn (0.5 % of 60 deg of a 45 uT field: 0.25 uT), the
@@ -196,13 +197,16 @@ constexpr float kLearnMinCos = 0.94f;           // pairs at least 20 deg apart: 
 constexpr float kLearnPairNoise_uT = 1.5f;
 // The part of the pairs' error that does not average out over a recording (gradients
 // along the path, soft iron left after calibration): each BROAD recording's pairs,
-// solved for one offset, give 0.97 uT rms an axis on the odd undisturbed trials,
-// ~1 uT on the even ones; the truth says the compass has a few tenths.
+// solved for one offset, give 0.97 uT rms an axis on the odd trials, 0.78 on the even
+// ones (those without a magnet or a phone on the board); the truth, a few tenths.
 constexpr float kLearnSystematic_uT = 1.0f;
 // Sigmas from the start before x is put in use: the test is made on 3 axes at every
 // pair, ~10 independent looks a recording (1 000 pairs over a memory of 100): 3.6 sigmas
 // (two-sided 3e-4 a look) keeps a false start below ~1 % a recording.
 constexpr float kLearnSignificance = 3.6f;
+// ... on this many pairs in a row (~1.5 s of turning): one pair can carry x over the line
+// by its own error; a hard iron stays there, the next pairs confirm it.
+constexpr uint8_t kLearnConfirmPairs = 3;
 // A pair whose innovation is beyond this many sigmas of its covariance (the pair noise
 // and the estimate's uncertainty; 3 components: chi-square 99.9 % = 16.3 = 4.0^2) is
 // not explained by any offset near x: it is dropped.
@@ -251,6 +255,7 @@ private:
     uint16_t age_steps_ = 0;
     uint16_t updates_ = 0;
     uint16_t rejected_ = 0;
+    uint8_t significant_run_ = 0;    // pairs in a row with x significant
     bool have_ref_ = false;
 };
 
