@@ -379,15 +379,18 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint
                   cxz * b.x + cyz * b.y + czz * b.z);
     // A pair says nothing along its rotation axis n (P - P^T = 2 sin(theta) [n x]); what
     // the solve puts there is the weak prior amplifying the pair's error: taken out.
-    const Vector3f axis = Vector3f(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y).normalized();
-    step -= axis * axis.dot(step);
+    // (v = 2 sin(theta) n: step -= v (v . step) / |v|^2, no square root.)
+    const Vector3f v(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y);
+    const float v2 = v.length_squared();
+    if (!(v2 > 0.0f)) return false;
+    step -= v * (v.dot(step) / v2);
     // The innovation's covariance is S = H C0 H^T + sigma^2 I (C0: the covariance before
     // this pair), and what the step leaves of it is sigma^2 S^-1 r: r^T S^-1 r, the
-    // innovation in sigmas squared, is r . left / sigma^2. Beyond kLearnGate^2 no offset
-    // near x explains the pair (a magnet passing, the board carried through a gradient):
-    // dropped, x and L unchanged.
-    const Vector3f left = residual - (p * step - step);
-    const bool consistent = residual.dot(left) < kLearnGate * kLearnGate * kLearnPairNoise_uT * kLearnPairNoise_uT;
+    // innovation in sigmas squared, is r . (r - H step) / sigma^2 = (r . r - H^T r . step)
+    // / sigma^2. Beyond kLearnGate^2 no offset near x explains the pair (a magnet passing,
+    // the board carried through a gradient): dropped, x and L unchanged.
+    const bool consistent = residual.length_squared() - across.dot(step) <
+                            kLearnGate * kLearnGate * kLearnPairNoise_uT * kLearnPairNoise_uT;
     reject_share_ = reject_share_ * fade + (consistent ? 0.0f : 1.0f / kLearnMemoryPairs);
     if (!consistent) {
         if (rejected_ < 0xFFFFu) ++rejected_;

@@ -204,9 +204,9 @@ constexpr float kLearnSystematic_uT = 1.0f;
 // pair, ~10 independent looks a recording (1 000 pairs over a memory of 100): 3.6 sigmas
 // (two-sided 3e-4 a look) keeps a false start below ~1 % a recording.
 constexpr float kLearnSignificance = 3.6f;
-// ... on this many pairs in a row (~1.5 s of turning): one pair can carry x over the line
+// ... on this many pairs in a row (~1 s of turning): one pair can carry x over the line
 // by its own error; a hard iron stays there, the next pairs confirm it.
-constexpr uint8_t kLearnConfirmPairs = 3;
+constexpr uint8_t kLearnConfirmPairs = 2;
 // A pair whose innovation is beyond this many sigmas of its covariance (the pair noise
 // and the estimate's uncertainty; 3 components: chi-square 99.9 % = 16.3 = 4.0^2) is
 // not explained by any offset near x: it is dropped.
