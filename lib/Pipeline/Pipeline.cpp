@@ -318,7 +318,15 @@ void AttitudePipeline::finish_mag_calibration() {
             .str(TXT(" uT, coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("% (save to keep)")).end();
         // Applied from the next sample: the estimator learns the calibrated field afresh.
         learner_.restart(calib::kLearnPriorCalibrated_uT, Vector3f());
-        if (st_.phase == Phase::Running) forget_mag_reference(true);
+        if (st_.phase == Phase::Running) {
+            forget_mag_reference(true);
+            // The estimator's bias residual was learned partly from heading corrections
+            // against the old calibration (a simulated tumble with 8 uT of hard iron, `cal
+            // mag` at its end: kept, the heading at rest swung from -0.9 to +0.9 deg over
+            // the next 15 s; dropped, it settles from -0.9 to 0.0): it goes with it, and
+            // is learned again.
+            dcm_.set_gyro_bias_rad_s(Vector3f());
+        }
         return;
     }
     w.str(TXT(TXT_ERROR "cal mag failed: "));
