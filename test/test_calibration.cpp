@@ -295,20 +295,23 @@ Matrix3f rotation(const Vector3f& theta) {
 }
 
 struct LearnRun {
-    Vector3f learned;
+    Vector3f learned;   // the offset in use
+    Vector3f estimate;  // the learner's estimate
     uint16_t updates = 0;
-    float largest_step_uT = 0.0f;
+    uint16_t rejected = 0;
+    float largest_step_uT = 0.0f;  // of the estimate
 };
 
 // A board turning at rate_rad_s about an axis that itself wanders (body frame),
 // its compass reading the (20, 0, 45) uT earth field plus `offset` plus noise at
-// 75 Hz; the learner is fed the field minus what it has learned, and the gyro's turn
-// (with 0.03 deg/s of noise).
+// 75 Hz; the learner is fed that field (no learned offset removed: it works from its
+// own estimate) and the gyro's turn (with 0.03 deg/s of noise); `learned` is the offset
+// it puts in use.
 LearnRun run_learner(const Vector3f& offset, float seconds, float rate_rad_s, bool z_only, float noise_uT,
                      float prior_uT = calib::kLearnPriorUncalibrated_uT) {
     const Vector3f earth(20.0f, 0.0f, 45.0f);
     calib::OffsetLearner learner;
-    learner.restart(prior_uT);
+    learner.restart(prior_uT, Vector3f());
     LearnRun run;
     Matrix3f r;
     uint32_t seed = 21;
@@ -325,15 +328,17 @@ LearnRun run_learner(const Vector3f& offset, float seconds, float rate_rad_s, bo
         if (i % 8 == 0 || i % 8 == 3 || i % 8 == 5) {  // 75 Hz
             const Vector3f raw = r.mul_transpose(earth) + offset +
                                  Vector3f(gauss(seed), gauss(seed), gauss(seed)) * noise_uT;
-            const Vector3f before = run.learned;
-            learner.add(raw - run.learned, turn, since, run.learned);
+            const Vector3f before = learner.estimate_uT();
+            learner.add(raw, turn, since, run.learned);
             turn = Vector3f();
-            const float step = (run.learned - before).length();
+            const float step = (learner.estimate_uT() - before).length();
             if (step > run.largest_step_uT) run.largest_step_uT = step;
             since = 0;
         }
     }
     run.updates = learner.updates();
+    run.rejected = learner.rejected();
+    run.estimate = learner.estimate_uT();
     return run;
 }
 }  // namespace
@@ -374,13 +379,37 @@ TEST(OffsetLearner, LearnsOnlyAcrossTheRotationAxis) {
 TEST(OffsetLearner, CalibratedCompassStaysPut) {
     const LearnRun run = run_learner(Vector3f(), 60.0f, 1.57f, false, 0.2f, calib::kLearnPriorCalibrated_uT);
     EXPECT_GT(run.updates, 100);
-    EXPECT_LT(run.learned.length(), 0.15f);
+    EXPECT_LT(run.estimate.length(), 0.15f);
+    EXPECT_TRUE(run.learned == Vector3f());  // not significant: nothing put in use
 }
 
+// An offset within what the pairs' systematic error (kLearnSystematic_uT) could make is
+// estimated but not put in use: the learner cannot tell it from zero, and a wrong one
+// costs heading.
+TEST(OffsetLearner, OffsetItCannotTellFromZeroIsNotApplied) {
+    const Vector3f small(1.5f, -1.0f, 0.5f);
+    const LearnRun run = run_learner(small, 60.0f, 1.57f, false, 0.2f);
+    EXPECT_NEAR(run.estimate.x, small.x, 0.3f);
+    EXPECT_NEAR(run.estimate.y, small.y, 0.3f);
+    EXPECT_TRUE(run.learned == Vector3f());
+}
+
+// A field that changes by more than the pair noise from pair to pair (a magnet near the
+// compass, its field not fixed in the body) is not a hard iron: most pairs are dropped
+// and nothing is put in use, whatever the estimate did early on.
+TEST(OffsetLearner, FieldNoHardIronExplainsIsNotApplied) {
+    const LearnRun run = run_learner(Vector3f(8.0f, -5.0f, 3.0f), 60.0f, 1.57f, false, 8.0f);
+    EXPECT_GT(run.rejected, run.updates / 5);
+    EXPECT_TRUE(run.learned == Vector3f());
+}
+
+// The estimate's steps and size are bounded; an estimate at the bound is a magnet, not a
+// hard iron to learn: it is not put in use.
 TEST(OffsetLearner, StepsAndOffsetAreBounded) {
     const LearnRun run = run_learner(Vector3f(120.0f, 0.0f, 0.0f), 30.0f, 1.57f, false, 0.2f);
     EXPECT_LE(run.largest_step_uT, calib::kLearnMaxStep_uT * 1.7321f + 1e-4f);  // per axis
-    EXPECT_NEAR(run.learned.x, calib::kLearnMaxOffset_uT, 1e-4f);
+    EXPECT_NEAR(run.estimate.x, calib::kLearnMaxOffset_uT, 1e-4f);
+    EXPECT_TRUE(run.learned == Vector3f());
 }
 
 // ---------------------------------------------------------------------------

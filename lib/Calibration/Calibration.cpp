@@ -317,13 +317,16 @@ MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
 }
 
 // ---------------------------------------------------------------------------
-void OffsetLearner::restart(float prior_uT) {
+void OffsetLearner::restart(float prior_uT, const Vector3f& in_use_uT) {
     have_ref_ = false;
     prior_info_ = 1.0f / (prior_uT * prior_uT);
     for (uint8_t i = 0; i < 6; ++i) info_[i] = 0.0f;
+    estimate_uT_ = start_uT_ = in_use_uT;
+    reject_share_ = 0.0f;
+    significant_run_ = 0;
 }
 
-bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint16_t steps, Vector3f& learned_uT) {
+bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint16_t steps, Vector3f& in_use_uT) {
     if (!field_uT.is_finite() || !turn_rad.is_finite()) return false;
     age_steps_ = (uint16_t)(age_steps_ + steps < kLearnMaxPairSteps ? age_steps_ + steps : kLearnMaxPairSteps);
     if (!have_ref_ || age_steps_ >= kLearnMaxPairSteps) {
@@ -342,42 +345,89 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint
     turn_ = turn_ * Matrix3f(Vector3f(d + ct.x * t.x, ct.x * t.y - sn * t.z, ct.x * t.z + sn * t.y),
                              Vector3f(ct.y * t.x + sn * t.z, d + ct.y * t.y, ct.y * t.z - sn * t.x),
                              Vector3f(ct.z * t.x - sn * t.y, ct.z * t.y + sn * t.x, d + ct.z * t.z));
-    const Matrix3f& p = turn_;
     // cos theta = (trace P - 1) / 2.
-    const float cos_turn = 0.5f * (p.a.x + p.b.y + p.c.z - 1.0f);
+    const float cos_turn = 0.5f * (turn_.a.x + turn_.b.y + turn_.c.z - 1.0f);
     if (cos_turn > kLearnMinCos) return false;  // not turned enough yet: keep the pair open
-    // r = P f2 - f1 = H e; H^T r = P^T r - r is what the pair says of e.
-    const Vector3f residual = p * field_uT - field_ref_;
+    // The sample that closes this pair opens the next.
+    const Matrix3f p = turn_;
+    turn_ = Matrix3f();
+    const Vector3f f1 = field_ref_;
+    field_ref_ = field_uT;
+    age_steps_ = 0;
+    // Innovation r = P f2 - f1 - (P - I) x = H (e - x); H^T r = P^T r - r.
+    const Vector3f& x = estimate_uT_;
+    const Vector3f residual = p * (field_uT - x) - (f1 - x);
     const Vector3f across = p.mul_transpose(residual) - residual;
-    // H^T H = 2 I - P - P^T.
+    // A = I / prior^2 + L (L faded, this pair's H^T H / sigma^2 added; H^T H = 2 I - P - P^T),
+    // and its inverse C (symmetric: cofactors over the determinant), the posterior
+    // covariance, uT^2.
     const float fade = 1.0f - 1.0f / kLearnMemoryPairs;
     const float inv_noise = 1.0f / (kLearnPairNoise_uT * kLearnPairNoise_uT);
     const float hth[6] = {2.0f - 2.0f * p.a.x, 2.0f - 2.0f * p.b.y, 2.0f - 2.0f * p.c.z,
                           -(p.a.y + p.b.x), -(p.a.z + p.c.x), -(p.b.z + p.c.y)};
-    for (uint8_t e = 0; e < 6; ++e) info_[e] = info_[e] * fade + hth[e] * inv_noise;
-    // The prior stays: it holds the axis never turned about where it is.
-    float m[3][kMaxUnknowns + 1] = {{info_[0] + prior_info_, info_[3], info_[4], across.x * inv_noise},
-                                    {info_[3], info_[1] + prior_info_, info_[5], across.y * inv_noise},
-                                    {info_[4], info_[5], info_[2] + prior_info_, across.z * inv_noise}};
-    if (!solve(m, 3)) return false;
-    Vector3f step(m[0][3], m[1][3], m[2][3]);
+    float info[6];
+    for (uint8_t e = 0; e < 6; ++e) info[e] = info_[e] * fade + hth[e] * inv_noise;
+    const float axx = info[0] + prior_info_, ayy = info[1] + prior_info_, azz = info[2] + prior_info_;
+    const float axy = info[3], axz = info[4], ayz = info[5];
+    const float cxx = ayy * azz - ayz * ayz, cyy = axx * azz - axz * axz, czz = axx * ayy - axy * axy;
+    const float cxy = axz * ayz - axy * azz, cxz = axy * ayz - axz * ayy, cyz = axy * axz - axx * ayz;
+    const float det = axx * cxx + axy * cxy + axz * cxz;
+    if (!(det > 0.0f)) return false;
+    const float inv_det = 1.0f / det;
+    const Vector3f b = across * (inv_noise * inv_det);
+    Vector3f step(cxx * b.x + cxy * b.y + cxz * b.z, cxy * b.x + cyy * b.y + cyz * b.z,
+                  cxz * b.x + cyz * b.y + czz * b.z);
     // A pair says nothing along its rotation axis n (P - P^T = 2 sin(theta) [n x]); what
     // the solve puts there is the weak prior amplifying the pair's error: taken out.
-    const Vector3f axis = Vector3f(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y).normalized();
-    step -= axis * axis.dot(step);
-    float* s = &step.x;
-    float* o = &learned_uT.x;
-    for (uint8_t i = 0; i < 3; ++i) {
-        s[i] = linalg::constrain(s[i], -kLearnMaxStep_uT, kLearnMaxStep_uT);
-        const float before = o[i];
-        o[i] = linalg::constrain(o[i] + s[i], -kLearnMaxOffset_uT, kLearnMaxOffset_uT);
-        s[i] = o[i] - before;
+    // (v = 2 sin(theta) n: step -= v (v . step) / |v|^2, no square root.)
+    const Vector3f v(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y);
+    const float v2 = v.length_squared();
+    if (!(v2 > 0.0f)) return false;
+    step -= v * (v.dot(step) / v2);
+    // The innovation's covariance is S = H C0 H^T + sigma^2 I (C0: the covariance before
+    // this pair), and what the step leaves of it is sigma^2 S^-1 r: r^T S^-1 r, the
+    // innovation in sigmas squared, is r . (r - H step) / sigma^2 = (r . r - H^T r . step)
+    // / sigma^2. Beyond kLearnGate^2 no offset near x explains the pair (a magnet passing,
+    // the board carried through a gradient): dropped, x and L unchanged.
+    const bool consistent = residual.length_squared() - across.dot(step) <
+                            kLearnGate * kLearnGate * kLearnPairNoise_uT * kLearnPairNoise_uT;
+    reject_share_ = reject_share_ * fade + (consistent ? 0.0f : 1.0f / kLearnMemoryPairs);
+    if (!consistent) {
+        if (rejected_ < 0xFFFFu) ++rejected_;
+        return false;
     }
+    float* s = &step.x;
+    float* o = &estimate_uT_.x;
+    const float* start = &start_uT_.x;
+    const float var[3] = {cxx * inv_det, cyy * inv_det, czz * inv_det};
+    bool step_cut = false, at_bound = false, significant = false;
+    for (uint8_t i = 0; i < 3; ++i) {
+        step_cut = step_cut || !(s[i] > -kLearnMaxStep_uT && s[i] < kLearnMaxStep_uT);
+        o[i] += linalg::constrain(s[i], -kLearnMaxStep_uT, kLearnMaxStep_uT);
+        o[i] = linalg::constrain(o[i], -kLearnMaxOffset_uT, kLearnMaxOffset_uT);
+        // At the bound, or one pair's step from it: a magnet (it hovers there).
+        at_bound = at_bound || !(absf(o[i]) < kLearnMaxOffset_uT - kLearnMaxStep_uT);
+        const float dev = o[i] - start[i];
+        significant = significant || dev * dev > kLearnSignificance * kLearnSignificance *
+                                                     (var[i] + kLearnSystematic_uT * kLearnSystematic_uT);
+    }
+    // A step cut short has not taken the pair in: its information is not counted, or the
+    // next pairs would be judged against an estimate that is not there; and an estimate
+    // still on its way is not put in use.
+    if (!step_cut)
+        for (uint8_t e = 0; e < 6; ++e) info_[e] = info[e];
     if (updates_ < 0xFFFFu) ++updates_;
-    // The sample that closed this pair opens the next, with the new offset removed.
-    turn_ = Matrix3f();
-    field_ref_ = field_uT - step;
-    age_steps_ = 0;
+    // Once put in use, the offset follows the estimate (no toggling about the threshold:
+    // each change makes the estimator learn the field again); an estimate still on its
+    // way (a step cut short) changes nothing.
+    if (step_cut) return false;
+    const bool following = !(in_use_uT == start_uT_);
+    const bool hard_iron = !at_bound && reject_share_ <= kLearnMaxRejectShare;
+    significant_run_ = significant ? (uint8_t)(significant_run_ < 255 ? significant_run_ + 1 : 255) : 0;
+    const bool confirmed = significant_run_ >= kLearnConfirmPairs;
+    const Vector3f use = hard_iron && (confirmed || following) ? estimate_uT_ : start_uT_;
+    if (use == in_use_uT) return false;
+    in_use_uT = use;
     return true;
 }
 

@@ -55,8 +55,10 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         // The sample is mag_latency_s older than the attitude: turned forward by the
         // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
         // as an offset.
+        // The learner takes the field without the learned offset: it works from its own
+        // estimate, which is not always the offset in use.
         const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s);
-        learn_field_uT_ = f + f.cross(rate) * dcm_.settings().mag_latency_s;
+        learn_field_uT_ = f + settings_.cal.mag_learned_uT + f.cross(rate) * dcm_.settings().mag_latency_s;
         // The turn since the previous sample (that one's too, if it never got its step).
         learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad_ : turn_rad_;
         st_.learn_steps = st_.learn_pending ? (uint16_t)(st_.learn_steps + st_.steps_since_mag) : st_.steps_since_mag;
@@ -69,8 +71,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     st_.have_mag = true;
 }
 
-// The learner moves the offset that apply_mag subtracts last; the latest field (calibrated
-// with the old one) is brought up to date. Once the offset has moved by kMagReferenceShift_uT
+// The learner moves the offset that apply_mag subtracts last (when its estimate is
+// significant); the latest field (calibrated with the old one) is brought up to date. Once the offset has moved by kMagReferenceShift_uT
 // since the DCM learned the earth field, the DCM learns it again.
 void AttitudePipeline::learn_mag_offset() {
     st_.learn_pending = false;
@@ -148,7 +150,8 @@ void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     // learning, tens of uT on a compass never calibrated.
     const bool calibrated = (settings_.flags & settings::kFlagMagCalibrated) != 0 ||
                             !(settings_.cal.mag_learned_uT == Vector3f());
-    learner_.restart(calibrated ? calib::kLearnPriorCalibrated_uT : calib::kLearnPriorUncalibrated_uT);
+    learner_.restart(calibrated ? calib::kLearnPriorCalibrated_uT : calib::kLearnPriorUncalibrated_uT,
+                     settings_.cal.mag_learned_uT);
     learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
     st_.phase = Phase::Running;
     st_.output_acc = kRateHz;  // the first line comes with the first step
@@ -317,8 +320,16 @@ void AttitudePipeline::finish_mag_calibration() {
             .str(TXT(", cross ")).vec(c.mag_cross).str(TXT(", residual ")).fixed2(mag_cal_.residual_uT())
             .str(TXT(" uT, coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("% (save to keep)")).end();
         // Applied from the next sample: the estimator learns the calibrated field afresh.
-        learner_.restart(calib::kLearnPriorCalibrated_uT);
-        if (st_.phase == Phase::Running) forget_mag_reference(true);
+        learner_.restart(calib::kLearnPriorCalibrated_uT, Vector3f());
+        if (st_.phase == Phase::Running) {
+            forget_mag_reference(true);
+            // The estimator's bias residual was learned partly from heading corrections
+            // against the old calibration (a simulated tumble with 8 uT of hard iron, `cal
+            // mag` at its end: kept, the heading at rest swung from -0.9 to +0.9 deg over
+            // the next 15 s; dropped, it settles from -0.9 to 0.0): it goes with it, and
+            // is learned again.
+            dcm_.set_gyro_bias_rad_s(Vector3f());
+        }
         return;
     }
     w.str(TXT(TXT_ERROR "cal mag failed: "));
@@ -353,7 +364,7 @@ void AttitudePipeline::restore_defaults() {
     // The compass is uncalibrated again: the estimator relearns its field, the learner
     // starts from scratch.
     if (st_.phase == Phase::Running) forget_mag_reference(true);
-    learner_.restart(calib::kLearnPriorUncalibrated_uT);
+    learner_.restart(calib::kLearnPriorUncalibrated_uT, Vector3f());
 }
 
 }  // namespace pipeline
