@@ -21,6 +21,8 @@ public:
     // (the caller restarts the estimator: the attitude may have changed meanwhile).
     bool retry(uint32_t now_ms);
     bool ok() const { return health_.ok(); }
+    // Paced on the timer: data-ready is not seen, the samples may be stale.
+    bool pacing_on_timer() const { return timer_pacing_; }
 
     // True when a new sample is waiting: the INT pin (latched until the burst read);
     // when the pin is silent, the MPU6000's FIFO (polled from 4 ms after the previous

@@ -207,6 +207,7 @@ static void step(uint32_t now_us) {
     mpu6000::Sample sample;
     if (imu.read(sample, now_us, now_ms)) {
         compass.service(now_ms);
+        if (imu.pacing_on_timer()) pipe.imu_doubtful();
         board::mark_begin(board::kSecEstimator);
         pipe.on_imu_sample(sample);
         board::mark_end(board::kSecEstimator);

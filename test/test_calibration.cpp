@@ -573,3 +573,33 @@ TEST(Pipeline, MagCalibrationCommand) {
     p.restore_defaults();
     EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, kBias.x, 1e-6f);
 }
+
+// A board turning about down at 1 rad/s with (8, -5, 0) uT of hard iron: the pipeline's
+// learner takes pairs; with the IMU in doubt (the firmware pacing on its timer: a frozen
+// sensor repeats a stale rate) it takes none, and none across a gyro spike either.
+TEST(Pipeline, LearnerTakesNoPairAcrossADoubtfulTurn) {
+    const Vector3f field_ef(20.0f, 0.0f, 45.0f), hard_iron(8.0f, -5.0f, 0.0f);
+    for (int run = 0; run < 3; ++run) {  // 0: clean, 1: IMU in doubt, 2: a spike every 10 ms
+        pipeline::AttitudePipeline p;
+        p.set_mag_present(true);
+        for (int i = 0; i < 250; ++i) {
+            if (i % 3 == 0) p.on_mag_sample(field_ef + hard_iron);
+            p.on_imu_sample(imu(kBias, kLevel));
+        }
+        ASSERT_EQ(p.phase(), pipeline::Phase::Running);
+        const float rate_rad_s = 1.0f;
+        for (int i = 0; i < 200 * 10; ++i) {
+            const float yaw = rate_rad_s * (float)i * 0.005f;  // body field: the earth's turned by -yaw
+            const Vector3f body(cosf(yaw) * field_ef.x, -sinf(yaw) * field_ef.x, field_ef.z);
+            if (i % 3 == 0) p.on_mag_sample(body + hard_iron);
+            if (run == 1) p.imu_doubtful();
+            const bool spike = run == 2 && i % 2 == 0;
+            p.on_imu_sample(imu(kBias + Vector3f(0.0f, 0.0f, spike ? 20.0f : rate_rad_s), kLevel));
+        }
+        if (run == 0) {
+            EXPECT_GT(p.offset_learner().updates(), 10);
+        } else {
+            EXPECT_EQ(p.offset_learner().updates(), 0) << "run " << run;
+        }
+    }
+}

@@ -51,7 +51,14 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     // The learner's pair is worked out in a later step without output (a pair update
     // is ~20 k cycles: on top of the Euler angles and the line it would overrun the
     // 5 ms step); the attitude is the one of this sample.
-    if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
+    if (st_.turn_doubtful) {
+        // The gyro's turn since the last field sample is not the board's (a spike stood
+        // in for, a saturated or frozen gyro): a pair across it would read the turn's
+        // error as hard iron. The open pair goes; the next sample starts another.
+        learner_.forget_pair();
+        st_.learn_pending = false;
+        st_.turn_doubtful = false;
+    } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
         // The sample is mag_latency_s older than the attitude: turned forward by the
         // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
         // as an offset.
@@ -112,12 +119,17 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
         }
         mpu6000::Sample out = last_;
         out.temperature_c = s.temperature_c;
+        st_.turn_doubtful = true;  // the gyro stood in for, not measured: no learner pair across it
         return out;
     }
     // A run longer than kMaxSpikeRun is real (saturation, a crash) and used; a non-finite
     // sample never is, with or without a previous one to stand in.
-    if (!s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite()) return last_;
+    if (!s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite()) {
+        st_.turn_doubtful = true;
+        return last_;
+    }
     st_.spike_run = 0;
+    if (s.gyro_saturated) st_.turn_doubtful = true;  // the rate is only a lower bound
     if (s.gyro_saturated && st_.warn_gyro_sat.allow(st_.steps, kWarnIntervalSteps))
         Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated (beyond 2000 deg/s)")).end();
     if (s.accel_saturated && st_.warn_accel_sat.allow(st_.steps, kWarnIntervalSteps))

@@ -140,6 +140,10 @@ public:
     // After a sensor outage: the next sample restarts the DCM from gravity and the latest
     // field, keeping the gyro bias (before the first start it just goes on calibrating).
     void restart_estimator();
+    // The MPU6000's samples may not be the board's motion for now (the firmware paces
+    // on its timer: a sensor whose data-ready stopped may be repeating a frozen sample):
+    // the compass learner takes no pair across this.
+    void imu_doubtful() { st_.turn_doubtful = true; }
 
     Phase phase() const { return st_.phase; }
     bool gyro_calibrating() const { return st_.gyro_cal_active; }
@@ -202,6 +206,7 @@ private:
         bool reinit_pending;
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
+        bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
     };
     State st_;
 };
