@@ -67,6 +67,8 @@ MAVCOST_FLAGS := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -Os -flto -std=gnu++11 -fno-excep
 MAVCOST_SRC   := bench/mavlink_cost.cpp lib/MavLink/MavLink.cpp lib/LinAlg/LinAlg.cpp lib/Console/Text.cpp
 
 .PHONY: mavlink-cost
+# make bench prints these too.
+bench: mavlink-cost
 mavlink-cost: $(MAVLINK_STAMP) tools
 	@mkdir -p $(MAVCOST_DIR)
 	@$(AVR_CXX) $(MAVCOST_FLAGS) $(MAVCOST_SRC) -lm -o $(MAVCOST_DIR)/cost.elf
