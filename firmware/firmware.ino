@@ -122,6 +122,13 @@ static void send_heartbeat_and_status() {
 static void emit_output(uint32_t now_ms) {
     const fmt::OutputMode mode = pipe.settings().mode;
     if (mode == fmt::OutputMode::Quiet) return;
+    pipeline::Angles a{};
+    const bool angles = mode != fmt::OutputMode::Quat && mode != fmt::OutputMode::Raw;
+    if (angles) {
+        board::mark_begin(board::kSecEuler);
+        a = pipe.angles();
+        board::mark_end(board::kSecEuler);
+    }
     char line[fmt::kRawLineMax];
     uint8_t n;
     board::mark_begin(board::kSecFormat);
@@ -131,19 +138,13 @@ static void emit_output(uint32_t now_ms) {
         const float inv_g = 1.0f / dcm::kGravity_m_s2;
         n = fmt::format_raw_line(line, pipe.gyro_rad_s() * linalg::kDegPerRad, pipe.accel_m_s2() * inv_g,
                                  pipe.field_uT());
+    } else if (mode == fmt::OutputMode::Mavlink) {
+        n = mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg, a.heading_deg,
+                             pipe.body_rate_rad_s());
+    } else if (mode == fmt::OutputMode::Csv) {
+        n = fmt::format_csv_line(line, now_ms, a.roll_deg, a.pitch_deg, a.heading_deg);
     } else {
-        board::mark_end(board::kSecFormat);
-        board::mark_begin(board::kSecEuler);
-        const pipeline::Angles a = pipe.angles();
-        board::mark_end(board::kSecEuler);
-        board::mark_begin(board::kSecFormat);
-        if (mode == fmt::OutputMode::Mavlink) {
-            n = mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg, a.heading_deg,
-                                 pipe.body_rate_rad_s());
-        } else {
-            n = mode == fmt::OutputMode::Csv ? fmt::format_csv_line(line, now_ms, a.roll_deg, a.pitch_deg, a.heading_deg)
-                                             : fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
-        }
+        n = fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
     }
     board::mark_end(board::kSecFormat);
     if (n > 0) serial_text::write_line_if_room(line, n);
