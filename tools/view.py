@@ -398,6 +398,11 @@ def main(argv=None):
     if headless:
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    if not headless and matplotlib.get_backend().lower() == "agg":
+        # matplotlib found no display or no GUI toolkit: a window would silently not open.
+        print("view: no window possible (no display, or no GUI toolkit: Debian's python3-tk, "
+              "which `make deps` installs); headless frames: --frames DIR", file=sys.stderr)
+        return 2
 
     w, h = (int(v) for v in args.size.lower().split("x"))
     view = View(plt, (w, h))
