@@ -16,7 +16,7 @@
 # fresh machine is only possible after the packages are installed.
 
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
-                libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang
+                libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 BUILD_GOALS := all firmware tools sim test bench upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit
 

@@ -231,6 +231,7 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
 }
 
 bool CommandQueue::push(const Command& c) {
+    // Merged only into the newest item, so that replies keep the order of the lines.
     if (c.id == CommandId::Error && count_ >= kErrorSlots) {
         Command& newest = items_[(uint8_t)((head_ + count_ - 1u) % kCapacity)];
         if (newest.id == CommandId::Error) {

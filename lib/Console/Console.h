@@ -121,13 +121,15 @@ uint16_t reply_bound(const Command& c);
 class CommandQueue {
 public:
     // A burst of garbage with commands between makes an error line for every ~20 bytes
-    // received, whose replies (~50 bytes) outrun the UART for a while: 64 commands (7
-    // bytes each) hold that backlog (a 20 KB burst needs ~40), so the 64-byte receive
-    // ring is always emptied.
-    static constexpr uint8_t kCapacity = 64;
-    // Past this many, a bad line is merged into the newest queued error (its value
-    // counts them) instead of taking a slot: garbage that makes more errors than the UART
-    // can answer one by one (a line end every few bytes) never crowds out a command.
+    // received on average, whose replies (~50 bytes) outrun the UART wherever the
+    // garbage lines are short: 96 commands (7 bytes each, 672 bytes of RAM standing for
+    // ~4.6 KB of replies, 0.4 s of the UART) hold that backlog for a 20 KB burst of random
+    // bytes, so the 64-byte receive ring is always emptied.
+    static constexpr uint8_t kCapacity = 96;
+    // Past this many, a bad line is merged into the newest item if that is an error (its
+    // value counts them) instead of taking a slot: garbage that makes more errors than
+    // the UART can answer one by one (a line end every few bytes) never crowds out a
+    // command, and replies keep the order of the lines.
     static constexpr uint8_t kErrorSlots = kCapacity - 8;
 
     bool full() const { return count_ == kCapacity; }

@@ -8,7 +8,7 @@ HMC5883L unplugged from 6 to 7 s: once with `mode csv` typed at 3 s (the referen
 time-stamped), once with `mode mavlink` typed at 3 s. Checks, for the MAVLink run:
   - everything after the reply to `mode mavlink` decodes: no bad CRC, no stray byte;
   - HEARTBEAT about once a second (every ~50 ATTITUDE), generic type and autopilot;
-  - ATTITUDE at the output rate (50 Hz: time_boot_ms 20 +- 3 ms apart, none missing), its
+  - ATTITUDE at the output rate (50 Hz: time_boot_ms 20 +- 6 ms apart, 20 on average, none missing), its
     roll, pitch and yaw equal to the csv run's at the same time_boot_ms within 0.01 rad;
   - SYS_STATUS each second, the compass' health bit cleared while it is unplugged;
   - STATUSTEXT for the fault ("HMC5883L", severity error) and its recovery.
@@ -102,9 +102,10 @@ def main():
     span_s = SECONDS - 3
     check(len(att) >= (span_s - 0.2) * RATE_HZ, "%d ATTITUDE in %d s (%d Hz expected)" % (len(att), span_s, RATE_HZ))
     steps = [b.time_boot_ms - a.time_boot_ms for a, b in zip(att, att[1:])]
-    # time_boot_ms is millis() when the line is made: a millisecond or two of jitter,
-    # none missing (a missing one would leave a 40 ms step).
-    check(steps and all(abs(s - 1000 // RATE_HZ) <= 3 for s in steps), "ATTITUDE intervals %r" % sorted(set(steps)))
+    # time_boot_ms is millis() when the line is made: a line due on a step that corrects
+    # the heading goes out one 5 ms step later (the pipeline keeps heavy work apart), plus
+    # a millisecond of jitter; none missing (a missing one would leave a 35+ ms step).
+    check(steps and all(abs(s - 1000 // RATE_HZ) <= 6 for s in steps), "ATTITUDE intervals %r" % sorted(set(steps)))
     check(steps and abs(sum(steps) / len(steps) - 1000 / RATE_HZ) < 0.2, "ATTITUDE mean interval off")
     compared = 0
     worst = 0.0
