@@ -30,7 +30,7 @@ ASAN_FLAGS   := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 
 fuzz-build: $(addprefix $(FUZZ_DIR)/fuzz_,$(FUZZ_NAMES))
 
-$(FUZZ_DIR)/fuzz_%: test/fuzz/fuzz_%.cpp $(FUZZ_LIB_SRC) $(FUZZ_LIB_HDR)
+$(FUZZ_DIR)/fuzz_%: test/fuzz/fuzz_%.cpp test/fuzz/FuzzAssert.h $(FUZZ_LIB_SRC) $(FUZZ_LIB_HDR)
 	@command -v $(FUZZ_CXX) > /dev/null || { echo "# fuzz: $(FUZZ_CXX) missing (Debian package clang)"; exit 1; }
 	@mkdir -p $(FUZZ_DIR)
 	$(FUZZ_CXX) $(FUZZ_FLAGS) $< $(FUZZ_LIB_SRC) -o $@.tmp && mv $@.tmp $@

@@ -20,6 +20,9 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
 import peers  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from soft_assert import finish, soft_assert  # noqa: E402
+
 REST_FROM_S = 36.0
 SECONDS = 50.0
 
@@ -45,9 +48,8 @@ def main():
         parts = line.split()
         if len(parts) == 4 and parts[1].startswith("roll:") and float(parts[0]) >= REST_FROM_S:
             rows.append([float(p.split(":")[1]) for p in parts[1:]])
-    if len(rows) < 200:
-        print("firmware: only %d angle lines at rest" % len(rows))
-        return 1
+    if not soft_assert(len(rows) >= 200, "firmware: only %d angle lines at rest" % len(rows)):
+        return finish("compass learner vs VQF", "")
     ours = peers.quat_from_euler(*np.array(rows).T)
     _, _, ours_heading = peers.error_angles(np.tile(q_rest, (len(ours), 1)), ours)
 
@@ -58,14 +60,10 @@ def main():
     rms = lambda v: float(np.sqrt(np.mean(v ** 2)))
     print("# heading at rest from %.0f s: firmware rms %.2f max %.2f deg; VQF rms %.2f max %.2f deg"
           % (REST_FROM_S, rms(ours_heading), ours_heading.max(), rms(vqf_heading), vqf_heading.max()))
-    failures = []
-    if not ours_heading.max() < 1.0:
-        failures.append("firmware heading error %.2f deg >= 1" % ours_heading.max())
-    if not rms(ours_heading) <= rms(vqf_heading):
-        failures.append("firmware rms %.2f worse than VQF's %.2f" % (rms(ours_heading), rms(vqf_heading)))
-    for f in failures:
-        print("FAIL: " + f)
-    return 1 if failures else 0
+    soft_assert(ours_heading.max() < 1.0, "firmware heading error %.2f deg >= 1" % ours_heading.max())
+    soft_assert(rms(ours_heading) <= rms(vqf_heading),
+                "firmware rms %.2f worse than VQF's %.2f" % (rms(ours_heading), rms(vqf_heading)))
+    return finish("compass learner vs VQF", "firmware heading at rest within 1 deg and no worse than VQF's")
 
 
 if __name__ == "__main__":

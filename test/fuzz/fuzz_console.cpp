@@ -17,16 +17,13 @@
 #include <cstring>
 #include <string>
 
+#include "FuzzAssert.h"
 #include "Console.h"
 #include "Settings.h"
 
 namespace {
 
 void append(void* ctx, const char* data, uint8_t len) { static_cast<std::string*>(ctx)->append(data, len); }
-
-void check(bool ok) {
-    if (!ok) std::abort();
-}
 
 bool same(const settings::Settings& a, const settings::Settings& b) {
     uint8_t ra[settings::kRecordSize], rb[settings::kRecordSize];
@@ -40,10 +37,10 @@ void check_reply(const std::string& out) {
     size_t start = 0;
     while (start < out.size()) {
         const size_t nl = out.find('\n', start);
-        check(nl != std::string::npos);
+        fuzz_assert(nl != std::string::npos);
         const std::string line = out.substr(start, nl - start);
-        check(line.rfind("# ", 0) == 0 || line == "t_ms,roll,pitch,yaw");
-        for (char c : line) check(c >= 0x20 && c <= 0x7E);
+        fuzz_assert(line.rfind("# ", 0) == 0 || line == "t_ms,roll,pitch,yaw");
+        for (char c : line) fuzz_assert(c >= 0x20 && c <= 0x7E);
         start = nl + 1;
     }
 }
@@ -90,14 +87,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (c.id == console::CommandId::None) continue;  // mid-line: nothing to check
         const settings::Settings before = s;
         if (c.id == console::CommandId::Error) {
-            check(c.error != console::Error::None);
+            fuzz_assert(c.error != console::Error::None);
             console::print_error(c, &sink);
         } else if (c.id == console::CommandId::Help) {
             console::print_help(&sink);
         } else if (!console::apply_setting(c, s, &sink)) {
-            check(same(before, s));
+            fuzz_assert(same(before, s));
         }
-        check(settings::is_valid(s));
+        fuzz_assert(settings::is_valid(s));
     }
     check_reply(out);
 
@@ -105,14 +102,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::string line(reinterpret_cast<const char*>(data), size);
     line = line.c_str();
     const console::Command c = console::parse_line(line.c_str());
-    if (c.id == console::CommandId::Rate) check(c.value >= settings::kRateMinHz && c.value <= settings::kRateMaxHz);
+    if (c.id == console::CommandId::Rate) fuzz_assert(c.value >= settings::kRateMinHz && c.value <= settings::kRateMaxHz);
     if (c.id == console::CommandId::Decl)
-        check(c.value >= settings::kDeclMinCentideg && c.value <= settings::kDeclMaxCentideg);
+        fuzz_assert(c.value >= settings::kDeclMinCentideg && c.value <= settings::kDeclMaxCentideg);
 
     // 3. parse_centi against the reference.
     int32_t got = 0, want = 0;
     const bool ok = console::parse_centi(line.c_str(), got);
-    check(ok == reference_centi(line.c_str(), want));
-    if (ok) check(got == want);
+    fuzz_assert(ok == reference_centi(line.c_str(), want));
+    if (ok) fuzz_assert(got == want);
     return 0;
 }

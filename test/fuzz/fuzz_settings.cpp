@@ -13,13 +13,10 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "FuzzAssert.h"
 #include "Settings.h"
 
 namespace {
-
-void check(bool ok) {
-    if (!ok) std::abort();
-}
 
 bool is_defaults(const settings::Settings& s) {
     uint8_t a[settings::kRecordSize], b[settings::kRecordSize];
@@ -48,12 +45,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::memset(&s, 0xA5, sizeof s);  // garbage in: decode must overwrite it
     const settings::LoadResult r = settings::decode(rec, s);
     if (r == settings::LoadResult::Ok) {
-        check(settings::is_valid(s));
+        fuzz_assert(settings::is_valid(s));
         uint8_t again[settings::kRecordSize];
         settings::encode(s, again);
-        check(std::memcmp(again, rec, sizeof rec) == 0);
+        fuzz_assert(std::memcmp(again, rec, sizeof rec) == 0);
     } else {
-        check(is_defaults(s));
+        fuzz_assert(is_defaults(s));
     }
 
     // 2. Round trip of settings within range, and a flipped bit.
@@ -68,17 +65,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     v.cal.gyro_bias_rad_s = linalg::Vector3f(in.in(-bias, bias), in.in(-bias, bias), in.in(-bias, bias));
     v.cal.mag_offset_uT = linalg::Vector3f(in.in(-200.0f, 200.0f), in.in(-200.0f, 200.0f), in.in(-200.0f, 200.0f));
     v.cal.mag_scale = linalg::Vector3f(in.in(0.5f, 2.0f), in.in(0.5f, 2.0f), in.in(0.5f, 2.0f));
-    check(settings::is_valid(v));
+    fuzz_assert(settings::is_valid(v));
     uint8_t good[settings::kRecordSize], back[settings::kRecordSize];
     settings::encode(v, good);
     settings::Settings w;
-    check(settings::decode(good, w) == settings::LoadResult::Ok);
+    fuzz_assert(settings::decode(good, w) == settings::LoadResult::Ok);
     settings::encode(w, back);
-    check(std::memcmp(good, back, sizeof good) == 0);
+    fuzz_assert(std::memcmp(good, back, sizeof good) == 0);
 
     const unsigned bit = in.u16() % (settings::kRecordSize * 8u);
     good[bit / 8u] = (uint8_t)(good[bit / 8u] ^ (1u << (bit % 8u)));
-    check(settings::decode(good, w) != settings::LoadResult::Ok);
-    check(is_defaults(w));
+    fuzz_assert(settings::decode(good, w) != settings::LoadResult::Ok);
+    fuzz_assert(is_defaults(w));
     return 0;
 }

@@ -1,22 +1,20 @@
 #!/usr/bin/env python3
-"""pymavlink, as a ground station would, decodes the frames of test/mavlink/mavlink_frames.cpp.
+"""pymavlink, as a ground station would, decodes the frames of test/mavlink/support/mavlink_frames.cpp.
 
     build/venv/bin/python test/mavlink/decode_frames.py PATH/TO/mavlink_frames
 
 Fails (exit 1, with the reason) on a bad CRC, an unexpected message or a wrong field.
 """
 import math
+import os
 import subprocess
 import sys
 
 from pymavlink.dialects.v20 import common as mavlink2
 
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from soft_assert import finish, soft_assert  # noqa: E402
 
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
 
 
 def main():
@@ -25,62 +23,57 @@ def main():
     mav.robust_parsing = True  # bad frames come back as MAVLink_bad_data instead of raising
     msgs = mav.parse_buffer(data) or []
     bad = [m for m in msgs if m.get_type() == "BAD_DATA"]
-    check(not bad, "bad frames: %r" % bad)
-    check(mav.total_receive_errors == 0, "receive errors: %d" % mav.total_receive_errors)
+    soft_assert(not bad, "bad frames: %r" % bad)
+    soft_assert(mav.total_receive_errors == 0, "receive errors: %d" % mav.total_receive_errors)
     types = [m.get_type() for m in msgs]
     want = ["HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT",
             "HEARTBEAT"]
-    check(types == want, "message order %r, expected %r" % (types, want))
+    soft_assert(types == want, "message order %r, expected %r" % (types, want))
     if types != want:
         return
     seqs = [m.get_seq() for m in msgs]
-    check(seqs == list(range(len(msgs))), "sequence numbers %r" % seqs)
+    soft_assert(seqs == list(range(len(msgs))), "sequence numbers %r" % seqs)
     for m in msgs:
-        check(m.get_srcSystem() == 1 and m.get_srcComponent() == 1, "source %d/%d" % (m.get_srcSystem(),
+        soft_assert(m.get_srcSystem() == 1 and m.get_srcComponent() == 1, "source %d/%d" % (m.get_srcSystem(),
                                                                                      m.get_srcComponent()))
     hb = msgs[0]
-    check(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC,
+    soft_assert(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC,
           "heartbeat type/autopilot %d/%d" % (hb.type, hb.autopilot))
-    check(hb.system_status == mavlink2.MAV_STATE_ACTIVE and hb.base_mode == 0 and hb.mavlink_version == 3,
+    soft_assert(hb.system_status == mavlink2.MAV_STATE_ACTIVE and hb.base_mode == 0 and hb.mavlink_version == 3,
           "heartbeat state %d base_mode %d version %d" % (hb.system_status, hb.base_mode, hb.mavlink_version))
-    check(msgs[7].system_status == mavlink2.MAV_STATE_CRITICAL, "second heartbeat: critical")
+    soft_assert(msgs[7].system_status == mavlink2.MAV_STATE_CRITICAL, "second heartbeat: critical")
 
     att = msgs[1]
-    check(att.time_boot_ms == 123456, "time_boot_ms %d" % att.time_boot_ms)
+    soft_assert(att.time_boot_ms == 123456, "time_boot_ms %d" % att.time_boot_ms)
     for name, got, exp in (("roll", att.roll, -math.radians(30)), ("pitch", att.pitch, math.radians(45)),
                            ("yaw", att.yaw, -math.radians(90)), ("rollspeed", att.rollspeed, 0.5),
                            ("pitchspeed", att.pitchspeed, -0.25), ("yawspeed", att.yawspeed, 1.5)):
-        check(abs(got - exp) < 1e-6, "%s %r, expected %r" % (name, got, exp))
+        soft_assert(abs(got - exp) < 1e-6, "%s %r, expected %r" % (name, got, exp))
 
     ss = msgs[2]
     bits = (mavlink2.MAV_SYS_STATUS_SENSOR_3D_GYRO | mavlink2.MAV_SYS_STATUS_SENSOR_3D_ACCEL |
             mavlink2.MAV_SYS_STATUS_SENSOR_3D_MAG)
-    check(ss.onboard_control_sensors_present == bits and ss.onboard_control_sensors_enabled == bits,
+    soft_assert(ss.onboard_control_sensors_present == bits and ss.onboard_control_sensors_enabled == bits,
           "present/enabled %d/%d" % (ss.onboard_control_sensors_present, ss.onboard_control_sensors_enabled))
-    check(ss.onboard_control_sensors_health == bits & ~mavlink2.MAV_SYS_STATUS_SENSOR_3D_MAG,
+    soft_assert(ss.onboard_control_sensors_health == bits & ~mavlink2.MAV_SYS_STATUS_SENSOR_3D_MAG,
           "health %d" % ss.onboard_control_sensors_health)
-    check(ss.load == 593 and ss.errors_count1 == 12, "load %d errors %d" % (ss.load, ss.errors_count1))
-    check(ss.voltage_battery == 65535 and ss.current_battery == -1 and ss.battery_remaining == -1,
+    soft_assert(ss.load == 593 and ss.errors_count1 == 12, "load %d errors %d" % (ss.load, ss.errors_count1))
+    soft_assert(ss.voltage_battery == 65535 and ss.current_battery == -1 and ss.battery_remaining == -1,
           "battery fields not 'unknown'")
 
     texts = msgs[3:7]
-    check(texts[0].severity == mavlink2.MAV_SEVERITY_WARNING and texts[0].text == "warn: compass overflow"
+    soft_assert(texts[0].severity == mavlink2.MAV_SEVERITY_WARNING and texts[0].text == "warn: compass overflow"
           and texts[0].id == 0, "warn line %r" % texts[0])
     err = texts[1:3]
     joined = "".join(t.text for t in err)
-    check(joined == "error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68); retrying every second",
+    soft_assert(joined == "error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68); retrying every second",
           "error line chunks %r" % joined)
-    check(all(t.severity == mavlink2.MAV_SEVERITY_ERROR for t in err), "error severity")
-    check(err[0].id != 0 and err[0].id == err[1].id and [t.chunk_seq for t in err] == [0, 1],
+    soft_assert(all(t.severity == mavlink2.MAV_SEVERITY_ERROR for t in err), "error severity")
+    soft_assert(err[0].id != 0 and err[0].id == err[1].id and [t.chunk_seq for t in err] == [0, 1],
           "chunk ids %r" % [(t.id, t.chunk_seq) for t in err])
-    check(texts[3].severity == mavlink2.MAV_SEVERITY_INFO and texts[3].text == "status: ok", "info line")
+    soft_assert(texts[3].severity == mavlink2.MAV_SEVERITY_INFO and texts[3].text == "status: ok", "info line")
 
 
 if __name__ == "__main__":
     main()
-    if failures:
-        print("pymavlink decode: %d failure(s)" % len(failures))
-        for f in failures:
-            print("  " + f)
-        sys.exit(1)
-    print("pymavlink decoded all frames as expected")
+    sys.exit(finish("pymavlink decode", "pymavlink decoded all frames as expected"))

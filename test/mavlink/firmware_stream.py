@@ -22,16 +22,12 @@ import sys
 
 from pymavlink.dialects.v20 import common as mavlink2
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from soft_assert import finish, soft_assert  # noqa: E402
+
 RATE_HZ = 50
 SECONDS = 12
 FAULT = "mag:absent@6-7"
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-    return cond
 
 
 def run(tools, work, trajectory, command):
@@ -76,37 +72,37 @@ def main():
         subprocess.run([os.path.join(args.tools, "scenario"), "tilt_tour"], stdout=f, check=True)
 
     reference = csv_angles(run(args.tools, args.work, trajectory, "mode csv"))
-    check(len(reference) > 400, "csv run: %d rows" % len(reference))
+    soft_assert(len(reference) > 400, "csv run: %d rows" % len(reference))
     out = run(args.tools, args.work, trajectory, "mode mavlink")
 
     # Text until the reply to the command (which is itself the first STATUSTEXT), then
     # nothing but frames.
     start = out.find(b"\xfd")
-    if not check(start > 0 and out[:start].count(b"roll:") > 20, "no MAVLink after the text lines"):
+    if not soft_assert(start > 0 and out[:start].count(b"roll:") > 20, "no MAVLink after the text lines"):
         return
     mav = mavlink2.MAVLink(None)
     mav.robust_parsing = True  # a bad frame comes back as BAD_DATA instead of raising
     msgs = mav.parse_buffer(out[start:]) or []
     bad = [m for m in msgs if m.get_type() == "BAD_DATA"]
-    check(not bad and mav.total_receive_errors == 0,
+    soft_assert(not bad and mav.total_receive_errors == 0,
           "%d bad frames, %d receive errors: %r" % (len(bad), mav.total_receive_errors, bad[:3]))
     types = [m.get_type() for m in msgs]
-    check(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT"}, "unexpected: %r" % set(types))
-    check(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
+    soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT"}, "unexpected: %r" % set(types))
+    soft_assert(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
           "first frame: the reply to the command, got %r" % (msgs[:1],))
     seqs = [m.get_seq() for m in msgs]
-    check(all((b - a) % 256 == 1 for a, b in zip(seqs, seqs[1:])), "sequence numbers with gaps")
+    soft_assert(all((b - a) % 256 == 1 for a, b in zip(seqs, seqs[1:])), "sequence numbers with gaps")
 
     # ATTITUDE at the output rate, equal to the csv angles.
     att = [m for m in msgs if m.get_type() == "ATTITUDE"]
     span_s = SECONDS - 3
-    check(len(att) >= (span_s - 0.2) * RATE_HZ, "%d ATTITUDE in %d s (%d Hz expected)" % (len(att), span_s, RATE_HZ))
+    soft_assert(len(att) >= (span_s - 0.2) * RATE_HZ, "%d ATTITUDE in %d s (%d Hz expected)" % (len(att), span_s, RATE_HZ))
     steps = [b.time_boot_ms - a.time_boot_ms for a, b in zip(att, att[1:])]
     # time_boot_ms is millis() when the line is made: a line due on a step that corrects
     # the heading goes out one 5 ms step later (the pipeline keeps heavy work apart), plus
     # a millisecond of jitter; none missing (a missing one would leave a 35+ ms step).
-    check(steps and all(abs(s - 1000 // RATE_HZ) <= 6 for s in steps), "ATTITUDE intervals %r" % sorted(set(steps)))
-    check(steps and abs(sum(steps) / len(steps) - 1000 / RATE_HZ) < 0.2, "ATTITUDE mean interval off")
+    soft_assert(steps and all(abs(s - 1000 // RATE_HZ) <= 6 for s in steps), "ATTITUDE intervals %r" % sorted(set(steps)))
+    soft_assert(steps and abs(sum(steps) / len(steps) - 1000 / RATE_HZ) < 0.2, "ATTITUDE mean interval off")
     compared = 0
     worst = 0.0
     for a in att:
@@ -116,43 +112,38 @@ def main():
         compared += 1
         worst = max(worst, angle_diff_rad(a.roll, math.radians(ref[0])), angle_diff_rad(a.pitch, math.radians(ref[1])),
                     angle_diff_rad(a.yaw, math.radians(ref[2])))
-    check(compared >= 0.95 * len(att), "only %d of %d ATTITUDE matched a csv row by time" % (compared, len(att)))
-    check(worst <= 0.01, "ATTITUDE differs from the csv angles by %.4f rad" % worst)
-    check(any(abs(a.rollspeed) > 0.2 for a in att), "rollspeed never shows the tour's roll rate")
+    soft_assert(compared >= 0.95 * len(att), "only %d of %d ATTITUDE matched a csv row by time" % (compared, len(att)))
+    soft_assert(worst <= 0.01, "ATTITUDE differs from the csv angles by %.4f rad" % worst)
+    soft_assert(any(abs(a.rollspeed) > 0.2 for a in att), "rollspeed never shows the tour's roll rate")
 
     # HEARTBEAT each second: ~50 ATTITUDE between two.
     hb_at = [i for i, m in enumerate(msgs) if m.get_type() == "HEARTBEAT"]
-    check(len(hb_at) >= span_s - 1, "%d HEARTBEAT in %d s" % (len(hb_at), span_s))
+    soft_assert(len(hb_at) >= span_s - 1, "%d HEARTBEAT in %d s" % (len(hb_at), span_s))
     for a, b in zip(hb_at, hb_at[1:]):
         n = sum(1 for m in msgs[a:b] if m.get_type() == "ATTITUDE")
-        check(45 <= n <= 55, "%d ATTITUDE between two HEARTBEAT (one a second expected)" % n)
+        soft_assert(45 <= n <= 55, "%d ATTITUDE between two HEARTBEAT (one a second expected)" % n)
     for i in hb_at:
         hb = msgs[i]
-        check(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC
+        soft_assert(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC
               and hb.mavlink_version == 3, "HEARTBEAT %r" % hb)
 
     # SYS_STATUS: the compass bit follows the fault.
     status = [m for m in msgs if m.get_type() == "SYS_STATUS"]
-    check(len(status) == len(hb_at), "%d SYS_STATUS for %d HEARTBEAT" % (len(status), len(hb_at)))
+    soft_assert(len(status) == len(hb_at), "%d SYS_STATUS for %d HEARTBEAT" % (len(status), len(hb_at)))
     mag = mavlink2.MAV_SYS_STATUS_SENSOR_3D_MAG
-    check(any(not (s.onboard_control_sensors_health & mag) for s in status), "compass never unhealthy")
-    check(status and status[-1].onboard_control_sensors_health & mag, "compass not healthy again at the end")
-    check(all(0 < s.load <= 1000 for s in status), "load %r" % [s.load for s in status])
+    soft_assert(any(not (s.onboard_control_sensors_health & mag) for s in status), "compass never unhealthy")
+    soft_assert(status and status[-1].onboard_control_sensors_health & mag, "compass not healthy again at the end")
+    soft_assert(all(0 < s.load <= 1000 for s in status), "load %r" % [s.load for s in status])
 
     # STATUSTEXT for the fault and its recovery.
     texts = [m for m in msgs if m.get_type() == "STATUSTEXT"]
-    check(any("HMC5883L" in t.text and t.severity == mavlink2.MAV_SEVERITY_ERROR for t in texts),
+    soft_assert(any("HMC5883L" in t.text and t.severity == mavlink2.MAV_SEVERITY_ERROR for t in texts),
           "no error STATUSTEXT for the unplugged compass: %r" % [t.text for t in texts])
-    check(any(t.text.startswith("recovered") and "HMC5883L" in t.text for t in texts), "no recovery STATUSTEXT")
+    soft_assert(any(t.text.startswith("recovered") and "HMC5883L" in t.text for t in texts), "no recovery STATUSTEXT")
     print("# %d frames: %d ATTITUDE (worst %.4f rad from csv), %d HEARTBEAT, %d SYS_STATUS, %d STATUSTEXT"
           % (len(msgs), len(att), worst, len(hb_at), len(status), len(texts)))
 
 
 if __name__ == "__main__":
     main()
-    if failures:
-        print("MAVLink stream: %d failure(s)" % len(failures))
-        for f in failures:
-            print("  " + f)
-        sys.exit(1)
-    print("pymavlink decoded the firmware's stream as expected")
+    sys.exit(finish("MAVLink stream", "pymavlink decoded the firmware's stream as expected"))

@@ -27,14 +27,10 @@ import matplotlib.image as mpimg  # noqa: E402
 import numpy as np  # noqa: E402
 from pymavlink.dialects.v20 import common as mavlink2  # noqa: E402
 
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from soft_assert import failures, finish, soft_assert  # noqa: E402
+
 TOLERANCE_PX = 2.5  # the white horizon line is 1.5 pt (~2 px) wide at 100 dpi
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-    return cond
 
 
 def quat_from_euler_deg(roll, pitch, yaw):
@@ -80,11 +76,11 @@ def write_stream(path, form, roll, pitch, heading, n=60):
 def render(view, stream, frames_dir):
     r = subprocess.run([sys.executable, view, "--file", stream, "--frames", frames_dir, "--frame-every", "1000",
                         "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=240)
-    check(r.returncode == 0, "%s: view.py exit %d: %s" % (stream, r.returncode, r.stdout[-500:]))
+    soft_assert(r.returncode == 0, "%s: view.py exit %d: %s" % (stream, r.returncode, r.stdout[-500:]))
     with open(os.path.join(frames_dir, "layout.json")) as f:
         layout = json.load(f)
     pngs = sorted(p for p in os.listdir(frames_dir) if p.endswith(".png"))
-    check(len(pngs) == 1, "%s: %d frames, expected 1" % (stream, len(pngs)))
+    soft_assert(len(pngs) == 1, "%s: %d frames, expected 1" % (stream, len(pngs)))
     img = mpimg.imread(os.path.join(frames_dir, pngs[-1]))[:, :, :3] if pngs else None
     return layout, img, r.stdout
 
@@ -144,27 +140,21 @@ def main():
         if img is None:
             continue
         w, h = layout["image_px"]
-        check(img.shape[0] == h and img.shape[1] == w, "%s: image %r, expected %dx%d" % (name, img.shape, w, h))
+        soft_assert(img.shape[0] == h and img.shape[1] == w, "%s: image %r, expected %dx%d" % (name, img.shape, w, h))
         # Drawn: many colours, not one flat fill.
-        check(float(img.std()) > 0.1 and len(np.unique((img * 255).astype(np.uint8).reshape(-1, 3), axis=0)) > 50,
+        soft_assert(float(img.std()) > 0.1 and len(np.unique((img * 255).astype(np.uint8).reshape(-1, 3), axis=0)) > 50,
               "%s: the frame looks blank" % name)
         if form == "mavlink":
-            check("60 samples" in out and "0 bad" in out, "%s: view.py said %r" % (name, out.strip()))
+            soft_assert("60 samples" in out and "0 bad" in out, "%s: view.py said %r" % (name, out.strip()))
         for x_deg in (-20.0, 20.0):
             got, n_sky, n_ground = boundary_row(img, layout, x_deg)
             want = expected_row(layout, x_deg, roll, pitch)
-            check(n_sky > 20 and n_ground > 20, "%s x=%g: %d sky, %d ground pixels" % (name, x_deg, n_sky, n_ground))
-            if check(got is not None, "%s x=%g: no ground found" % (name, x_deg)):
-                check(abs(got - want) <= TOLERANCE_PX,
+            soft_assert(n_sky > 20 and n_ground > 20, "%s x=%g: %d sky, %d ground pixels" % (name, x_deg, n_sky, n_ground))
+            if soft_assert(got is not None, "%s x=%g: no ground found" % (name, x_deg)):
+                soft_assert(abs(got - want) <= TOLERANCE_PX,
                       "%s x=%g: horizon at row %d, expected %.1f" % (name, x_deg, got, want))
         print("%-28s horizon rows as expected" % name if not failures else "%-28s checked" % name)
-    if failures:
-        print("view frames: %d failure(s)" % len(failures))
-        for f in failures:
-            print("  " + f)
-        return 1
-    print("view frames: %d streams rendered, horizon where the angles put it" % len(CASES))
-    return 0
+    return finish("view frames", "view frames: %d streams rendered, horizon where the angles put it" % len(CASES))
 
 
 if __name__ == "__main__":
