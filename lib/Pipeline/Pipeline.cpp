@@ -34,7 +34,7 @@ void AttitudePipeline::set_mag_present(bool present) {
 
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
-    // The fit's sums (~10 k cycles) wait for a step without output, as the learner does.
+    // The fit's sums (~10 k cycles) wait for a step free of heavy work, as the learner does.
     if (st_.mag_cal_active) {
         cal_field_uT_ = field_uT;
         st_.cal_pending = true;
@@ -48,9 +48,9 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         }
         return;
     }
-    // The learner's pair is worked out in a later step without output (a pair update
-    // is ~20 k cycles: on top of the Euler angles and the line it would overrun the
-    // 5 ms step); the attitude is the one of this sample.
+    // The learner's pair is worked out in a later step with neither an output line nor a
+    // heading correction (a pair update is ~15 k cycles: on top of either it would
+    // overrun the 5 ms step); the turn it uses is the gyro's up to this sample.
     if (st_.turn_doubtful) {
         // The gyro's turn since the last field sample is not the board's (a spike stood
         // in for, a saturated or frozen gyro): a pair across it would read the turn's
@@ -79,8 +79,9 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
 }
 
 // The learner moves the offset that apply_mag subtracts last (when its estimate is
-// significant); the latest field (calibrated with the old one) is brought up to date. Once the offset has moved by kMagReferenceShift_uT
-// since the DCM learned the earth field, the DCM learns it again.
+// significant); the latest field (calibrated with the old one) is brought up to date.
+// Once the offset has moved by kMagReferenceShift_uT since the DCM learned the earth
+// field, the DCM learns its strength and dip again (not its heading: see Dcm).
 void AttitudePipeline::learn_mag_offset() {
     st_.learn_pending = false;
     Vector3f& learned = settings_.cal.mag_learned_uT;
