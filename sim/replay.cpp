@@ -1,6 +1,6 @@
 // build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
 //
-//   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log]
+//   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]
 //
 // The same pipeline as the board, minus the AVR: the simulator's register models
 // (sim/models) answer the very drivers the firmware runs (lib/MPU6000, lib/HMC5883)
@@ -28,12 +28,63 @@ namespace {
 
 void usage(FILE* out) {
     fprintf(out,
-            "usage: replay --trajectory FILE.csv[.gz] [--seconds S] [--log]\n"
+            "usage: replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]\n"
             "  Runs the firmware's drivers, calibration and DCM on the host against the\n"
             "  simulated MPU6000 and HMC5883L, and prints CSV t,roll,pitch,yaw (degrees)\n"
             "  at the firmware's output rate.\n"
             "  --seconds S  stop after S simulated seconds (default: the trajectory's length)\n"
-            "  --log        the pipeline's messages (calibration, warnings) on stderr\n");
+            "  --log        the pipeline's messages (calibration, warnings) on stderr\n"
+            "  --set NAME=VALUE  one of the estimator's settings instead of the firmware's\n"
+            "               (lib/DCM/Dcm.h, DcmSettings; angles in degrees): for tuning and\n"
+            "               cross-validation (bench/tune.py). --set list prints them.\n");
+}
+
+// The estimator's settings by name, for --set (DcmSettings in lib/DCM/Dcm.h).
+struct SettingName {
+    const char* name;
+    float dcm::DcmSettings::*member;
+    float scale;  // from the command line's unit to the setting's
+};
+const SettingName kSettingNames[] = {
+    {"kp_rp_1_s", &dcm::DcmSettings::kp_rp_1_s, 1.0f},
+    {"ki_rp_1_s2", &dcm::DcmSettings::ki_rp_1_s2, 1.0f},
+    {"kp_yaw_1_s", &dcm::DcmSettings::kp_yaw_1_s, 1.0f},
+    {"ki_yaw_1_s2", &dcm::DcmSettings::ki_yaw_1_s2, 1.0f},
+    {"kp_startup_1_s", &dcm::DcmSettings::kp_startup_1_s, 1.0f},
+    {"startup_s", &dcm::DcmSettings::startup_s, 1.0f},
+    {"accel_lowpass_s", &dcm::DcmSettings::accel_lowpass_s, 1.0f},
+    {"integrator_hold_rate_deg_s", &dcm::DcmSettings::integrator_hold_rate_rad_s, linalg::kRadPerDeg},
+    {"bias_limit_deg_s", &dcm::DcmSettings::bias_limit_rad_s, linalg::kRadPerDeg},
+    {"mag_norm_tolerance", &dcm::DcmSettings::mag_norm_tolerance, 1.0f},
+    {"mag_dip_tolerance", &dcm::DcmSettings::mag_dip_tolerance, 1.0f},
+    {"mag_recover_s", &dcm::DcmSettings::mag_recover_s, 1.0f},
+    {"mag_latency_s", &dcm::DcmSettings::mag_latency_s, 1.0f},
+    {"rest_gyro_deviation_deg_s", &dcm::DcmSettings::rest_gyro_deviation_rad_s, linalg::kRadPerDeg},
+    {"rest_accel_deviation_m_s2", &dcm::DcmSettings::rest_accel_deviation_m_s2, 1.0f},
+    {"rest_min_s", &dcm::DcmSettings::rest_min_s, 1.0f},
+    {"rest_bias_s", &dcm::DcmSettings::rest_bias_s, 1.0f},
+    {"output_lead_s", &dcm::DcmSettings::output_lead_s, 1.0f},
+    {"mag_new_min_rate_deg_s", &dcm::DcmSettings::mag_new_min_rate_rad_s, linalg::kRadPerDeg},
+};
+
+// NAME=VALUE into settings; false (with a message) for an unknown name or a bad number.
+bool set_setting(dcm::DcmSettings& settings, const std::string& assignment) {
+    const size_t eq = assignment.find('=');
+    const std::string name = assignment.substr(0, eq);
+    for (const SettingName& s : kSettingNames) {
+        if (name != s.name) continue;
+        char* end = nullptr;
+        const char* text = eq == std::string::npos ? "" : assignment.c_str() + eq + 1;
+        const double value = strtod(text, &end);
+        if (!*text || !end || *end || !(value == value)) {
+            fprintf(stderr, "replay: --set %s needs a number, not '%s'\n", name.c_str(), text);
+            return false;
+        }
+        settings.*(s.member) = (float)value * s.scale;
+        return true;
+    }
+    fprintf(stderr, "replay: --set: no setting '%s' (--set list names them)\n", name.c_str());
+    return false;
 }
 
 // Simulated time shared by both sensor models; the drivers' waits move it on.
@@ -81,6 +132,7 @@ int main(int argc, char** argv) {
     std::string path;
     double seconds = -1.0;
     bool log = false;
+    dcm::DcmSettings dcm_settings = dcm::kDefaultDcmSettings;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--trajectory" && i + 1 < argc) {
@@ -94,6 +146,13 @@ int main(int argc, char** argv) {
             }
         } else if (a == "--log") {
             log = true;
+        } else if (a == "--set" && i + 1 < argc) {
+            if (std::string(argv[i + 1]) == "list") {
+                for (const SettingName& s : kSettingNames)
+                    printf("%s=%g\n", s.name, (double)(dcm_settings.*(s.member) / s.scale));
+                return 0;
+            }
+            if (!set_setting(dcm_settings, argv[++i])) return 1;
         } else if (a == "--help" || a == "-h") {
             usage(stdout);
             return 0;
@@ -124,7 +183,7 @@ int main(int argc, char** argv) {
     // Set-up, in the firmware's order and on its timeline (firmware/firmware.ino setup()).
     mpu6000::Mpu6000 mpu(spi);
     hmc5883::Hmc5883 mag(i2c);
-    pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr);
+    pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr, dcm_settings);
     board.advance(pipeline::kMpuStartMs * 1e-3);
     const mpu6000::InitResult mpu_init = mpu.begin();
     if (mpu_init.status != mpu6000::InitStatus::Ok) {

@@ -54,6 +54,10 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     offset_rad_s_ = bias_rad_s_;
     yaw_pending_ = false;
     mag_steady_steps_ = 0;
+    rest_corrections_ = 0;
+    gyro_sum_rad_s_ = Vector3f();
+    accel_sum_m_s2_ = Vector3f();
+    rest_accel_mean_m_s2_ = accel_m_s2;
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
@@ -97,17 +101,21 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     // garbage and skipped, and so is one whose gyro is beyond any range: the whole
     // read is broken then (a glitch on the bus, a spike).
     if (gyro_ok && accel_plausible(accel_m_s2)) {
+        gyro_sum_rad_s_ += gyro_rad_s;
+        accel_sum_m_s2_ += accel_m_s2;
         last_accel_m_s2_ = accel_m_s2;
         const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
         accel_lp_ef_ += (r_ * accel_m_s2 - accel_lp_ef_) * alpha;
     } else {
         status_ |= kStatusAccelIgnored;
+        rest_corrections_ = 0;  // a broken read is no rest
     }
     // The roll/pitch error (Premerlani & Bizard eq. 27, measured down x estimated
     // down) moves slowly once low-passed: it is worked out every kCorrectionDivider
     // steps and applied at every step in between.
     if (++correction_phase_ >= kCorrectionDivider) {
         correction_phase_ = 0;
+        detect_rest();
         correct_tilt(startup_left, hold_integrator);
         offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
     }
@@ -139,6 +147,41 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
     if (!ok) recover();
     if (steps_ < 0xFFFFFFFFu) ++steps_;
+}
+
+// Rest detection and the gyro bias at rest (after VQF, Laidig & Seel 2023, sec. 3.4):
+// the board is still when, for rest_min_s, the gyro and the accelerometer stay close to
+// their recent means (deviations, so that any bias passes the test). There the gyro
+// reads its bias alone, on every axis, the vertical one too, which neither gravity nor
+// the compass can measure well: the bias estimate moves to the mean gyro reading with
+// rest_bias_s. The MPU6000's rate noise, 0.005 deg/s/sqrt(Hz), averages to ~0.004 deg/s
+// over the 0.5 s mean; a hand-held board's tremor is below 2 deg/s and 0.5 m/s^2.
+void Dcm::detect_rest() {
+    const Vector3f gyro_mean = gyro_sum_rad_s_ * (1.0f / (float)kCorrectionDivider);
+    const Vector3f accel_mean = accel_sum_m_s2_ * (1.0f / (float)kCorrectionDivider);
+    gyro_sum_rad_s_ = Vector3f();
+    accel_sum_m_s2_ = Vector3f();
+    status_ &= (uint8_t)~kStatusAtRest;
+    // A steady turn passes the deviation test too: the mean must also be within the
+    // same bound of the bias estimate (VQF bounds it by its 2 deg/s bias clip). What
+    // the gyro calibration at start leaves is far below it; a larger bias on the
+    // vertical axis is not told from a slow turn (gravity learns the horizontal ones).
+    const bool still = (gyro_mean - rest_gyro_mean_rad_s_).length_squared() < rest_gyro_dev2_ &&
+                       (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() < rest_gyro_dev2_ &&
+                       (accel_mean - rest_accel_mean_m_s2_).length_squared() < rest_accel_dev2_;
+    rest_gyro_mean_rad_s_ += (gyro_mean - rest_gyro_mean_rad_s_) * rest_alpha_;
+    rest_accel_mean_m_s2_ += (accel_mean - rest_accel_mean_m_s2_) * rest_alpha_;
+    if (!still) {
+        rest_corrections_ = 0;
+        return;
+    }
+    if (rest_corrections_ < rest_min_corrections_) {
+        ++rest_corrections_;
+        return;
+    }
+    status_ |= kStatusAtRest;
+    bias_rad_s_ += (rest_gyro_mean_rad_s_ - bias_rad_s_) * rest_bias_alpha_;
+    clamp_bias();
 }
 
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
@@ -208,18 +251,25 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         forgotten = false;
     }
     if (forgotten || !field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
+        // Only a field that stays the same while the board turns is shown to be fixed
+        // in the earth frame: at rest any disturbance (a magnet on the desk, one fixed to
+        // the board) is steady too. VQF's rule: a mean rate of 20 deg/s over the window.
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
             mag_steady_steps_ += interval_steps;
+            mag_steady_turn_rad_ += sqrtf(last_rate_rad_s_.length_squared()) * settings_.step_s * (float)interval_steps;
         } else {
             mag_steady_steps_ = 0;
+            mag_steady_turn_rad_ = 0.0f;
         }
         mag_candidate_norm_ += 0.2f * (norm - mag_candidate_norm_);
         mag_candidate_down_ += 0.2f * (down_component - mag_candidate_down_);
-        if (!forgotten && (float)mag_steady_steps_ < mag_recover_steps_) return;
+        if (!forgotten && ((float)mag_steady_steps_ < mag_recover_steps_ ||
+                           mag_steady_turn_rad_ < mag_new_min_turn_rad_)) return;
         // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
         // (the rotation that puts the field's horizontal part on north).
         learn_field(norm, down_component);
         mag_steady_steps_ = 0;
+        mag_steady_turn_rad_ = 0.0f;
         const float cos_error = field_ef.x * inv_horizontal;
         const Vector3f north = r_.a * cos_error + r_.b * sin_error;
         r_.b = r_.b * cos_error - r_.a * sin_error;
@@ -228,6 +278,7 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         return;
     }
     mag_steady_steps_ = 0;
+    mag_steady_turn_rad_ = 0.0f;
     mag_candidate_norm_ = norm;
     mag_candidate_down_ = down_component;
     status_ &= (uint8_t)~kStatusMagIgnored;

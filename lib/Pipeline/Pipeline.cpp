@@ -22,8 +22,8 @@ bool RateLimiter::allow(uint32_t now, uint16_t interval) {
     return true;
 }
 
-AttitudePipeline::AttitudePipeline(const text::Sink* log)
-    : log_(log), settings_(settings::defaults()), dcm_(dcm::kDefaultDcmSettings), st_() {
+AttitudePipeline::AttitudePipeline(const text::Sink* log, const dcm::DcmSettings& dcm_settings)
+    : log_(log), settings_(settings::defaults()), dcm_(dcm_settings), st_() {
     last_ = mpu6000::Sample{Vector3f(), Vector3f(0.0f, 0.0f, -kG), 0.0f, false, false};
 }
 
@@ -156,7 +156,7 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
 }
 
 void AttitudePipeline::start_estimator(const Vector3f& gravity) {
-    dcm_ = dcm::Dcm(dcm::kDefaultDcmSettings);
+    dcm_ = dcm::Dcm(dcm_.settings());
     dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
     st_.mag_pending = false;
     // How far off the offset in use may be: a fraction of a uT after `cal mag` or

@@ -102,7 +102,10 @@ struct RateLimiter {
 
 class AttitudePipeline {
 public:
-    explicit AttitudePipeline(const text::Sink* log = nullptr);
+    // dcm_settings: the estimator's gains (the firmware's are the defaults; the host
+    // replay tool may try others, `replay --set`).
+    explicit AttitudePipeline(const text::Sink* log = nullptr,
+                              const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
 
     // Rate, declination, mode and calibration; change them freely (console commands).
     settings::Settings& settings() { return settings_; }

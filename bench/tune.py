@@ -1,0 +1,243 @@
+#!/usr/bin/env python3
+"""Cross-validation of the estimator's settings: tune on one half of the recordings, score on the other.
+
+    python3 bench/tune.py [--build DIR] [--data DIR] [--jobs N] [--set NAME=VALUE ...]
+                          [--grid NAME=V1,V2,... ...] [--no-scenarios]
+
+The 15 BROAD recordings are split into two folds that each hold every kind: sorted by trial
+number, alternate ones go to fold A and fold B (A: 01 05 09 14 21 26 30 34, B: 03 07 11 16 24
+28 32). Without --grid it scores the settings given (default: the firmware's) on every
+recording and on the scenarios with a realistic uncalibrated board (`scenario NAME --preset
+uncalibrated`), beside VQF on the same files, per recording, per kind and per fold.
+
+With --grid it cross-validates: every combination of the grid's values is scored on fold A,
+the best (lowest mean total) is then scored on fold B, and the other way round; the figure
+that counts is the mean over the two held-out folds. The scenarios are not part of the
+choice (they are the check that the gains hold on a different world).
+
+`make tune` runs it with the project's grid (Makefile variable TUNE_ARGS overrides).
+"""
+import argparse
+import itertools
+import json
+import os
+import subprocess
+import sys
+from multiprocessing import Pool
+
+BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(BENCH_DIR)
+sys.path.insert(0, BENCH_DIR)
+
+import bench  # noqa: E402  (helpers: venv, cache keys, score parsing)
+
+# Kinds of motion and disturbance, from the trial's name (BROAD's groups, README of the data).
+KINDS = [("rotation", ("rotation",)), ("translation", ("translation", "combined")),
+         ("tapping/vibration", ("tapping", "vibration")), ("magnet beside", ("stationary_magnet",)),
+         ("magnet attached", ("attached_magnet",))]
+
+
+def kind_of(trial):
+    for kind, keys in KINDS:
+        if any(k in trial for k in keys):
+            return kind
+    return "other"
+
+
+def folds_of(trials):
+    """Alternate trials (sorted by number) into folds A and B: each holds every kind."""
+    ordered = sorted(trials)
+    return {"A": ordered[0::2], "B": ordered[1::2]}
+
+
+def run_ours(args):
+    label, traj, sets, build, est_dir = args
+    tag = bench.slug(" ".join(sets))[:60] or "defaults"
+    est = os.path.join(est_dir, "%s-%s.csv" % (label, tag))
+    cmd = [os.path.join(build, "replay"), "--trajectory", traj]
+    for s in sets:
+        cmd += ["--set", s]
+    with open(est, "w") as f:
+        r = subprocess.run(cmd, stdout=f, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        return label, tuple(sets), None, r.stderr.strip()
+    s = subprocess.run([os.path.join(build, "score"), "--trajectory", traj, "--estimate", est, "--csv"],
+                       capture_output=True, text=True)
+    os.remove(est)
+    if s.returncode != 0:
+        return label, tuple(sets), None, s.stderr.strip()
+    return label, tuple(sets), bench.parse_score_csv(s.stdout), None
+
+
+def run_vqf(args):
+    label, traj, cache_dir = args
+    import numpy as np
+    import peers
+    key = bench.peer_cache_key(bench.file_hash(traj))
+    cached = bench.load_cached_peer(cache_dir, key, "VQF")
+    if cached is not None:
+        return label, cached
+    tr = peers.load_trajectory(traj)
+    q = peers.run_vqf(tr)
+    s = peers.score(tr["quat"], q, tr["movement"])
+    step = max(1, int(round(0.02 / peers.sample_period(tr["t"]))))
+    np.savez_compressed(os.path.join(cache_dir, "%s-%s.npz" % (key, bench.slug("VQF"))), t=tr["t"][::step],
+                        q=q[::step].astype(np.float32), score=json.dumps(s))
+    return label, s
+
+
+# Sensor errors of a real board (scenario's options): "+uncal" the whole uncalibrated board
+# (gyro bias and drift, accel offset and scale, hard and soft iron, noise, quantisation);
+# "+imu" the same inertial errors with a calibrated compass (after `cal mag`).
+SENSOR_ERRORS = [("+uncal", ["--preset", "uncalibrated"]),
+                 ("+imu", ["--preset", "uncalibrated", "--hard-iron", "0,0,0", "--soft-iron", "1,1,1"])]
+
+
+def scenario_files(build, out_dir):
+    """The project's scenarios with the sensor errors of SENSOR_ERRORS."""
+    scen = os.path.join(build, "scenario")
+    paths = {}
+    d = os.path.join(out_dir, "scenarios")
+    os.makedirs(d, exist_ok=True)
+    for suffix, options in SENSOR_ERRORS:
+        for name in bench.list_scenarios(build):
+            p = os.path.join(d, name + suffix + ".csv")
+            if not os.path.exists(p):
+                with open(p, "w") as f:
+                    r = subprocess.run([scen, name] + options, stdout=f, stderr=subprocess.PIPE, text=True)
+                if r.returncode != 0:
+                    bench.log("scenario %s failed: %s" % (name, r.stderr.strip()))
+                    os.remove(p)
+                    continue
+            paths[name + suffix] = p
+    return paths
+
+
+def mean(vals):
+    vals = [v for v in vals if v is not None]
+    return sum(vals) / len(vals) if vals else float("nan")
+
+
+def score_sets(pool, files, sets, build, est_dir):
+    tasks = [(label, path, list(sets), build, est_dir) for label, path in files.items()]
+    out = {}
+    for label, _, s, err in pool.imap_unordered(run_ours, tasks):
+        if err:
+            bench.log("%s: %s" % (label, err))
+        out[label] = s
+    return out
+
+
+def table(trials, scen, ours, vqf, folds):
+    rows = []
+    for t in trials:
+        o, v = ours.get(t), vqf.get(t)
+        fold = "A" if t in folds["A"] else "B"
+        rows.append([t, kind_of(t), fold, "%.2f / %.2f / %.2f" % (o["total"], o["incl"], o["heading"]) if o else "–",
+                     "%.2f" % v["total"] if v else "–", "%+.2f" % (o["total"] - v["total"]) if o and v else "–"])
+    out = [bench.md_table(["recording", "kind", "fold", "ours total / incl / heading °", "VQF total °",
+                           "ours − VQF"], rows), ""]
+    rows = []
+    for kind, _ in KINDS:
+        ts = [t for t in trials if kind_of(t) == kind]
+        if not ts:
+            continue
+        o = mean([ours[t]["total"] for t in ts if ours.get(t)])
+        v = mean([vqf[t]["total"] for t in ts if vqf.get(t)])
+        rows.append([kind, len(ts), "%.2f" % o, "%.2f" % v, "%+.2f" % (o - v)])
+    for name, ts in sorted(folds.items()):
+        o = mean([ours[t]["total"] for t in ts if ours.get(t)])
+        v = mean([vqf[t]["total"] for t in ts if vqf.get(t)])
+        rows.append(["fold " + name, len(ts), "%.2f" % o, "%.2f" % v, "%+.2f" % (o - v)])
+    o = mean([ours[t]["total"] for t in trials if ours.get(t)])
+    v = mean([vqf[t]["total"] for t in trials if vqf.get(t)])
+    rows.append(["all", len(trials), "%.2f" % o, "%.2f" % v, "%+.2f" % (o - v)])
+    out += [bench.md_table(["group", "n", "ours total °", "VQF total °", "ours − VQF"], rows), ""]
+    if scen:
+        rows = []
+        for n in scen:
+            o, v = ours.get(n), vqf.get(n)
+            ok = o and v and (o["total"] <= 1.1 * v["total"] or o["total"] <= v["total"] + 0.15)
+            rows.append([n, "%.2f / %.2f / %.2f" % (o["total"], o["incl"], o["heading"]) if o else "–",
+                         "%.2f" % v["total"] if v else "–", "%.2f" % (o["total"] / v["total"]) if o and v else "–",
+                         "yes" if ok else "NO"])
+        out += [bench.md_table(["scenario (uncalibrated board)", "ours total / incl / heading °", "VQF total °",
+                                "ours / VQF", "≤ 1.1× or +0.15°"], rows), ""]
+    return "\n".join(out)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=os.environ.get("BUILD") or "build")
+    ap.add_argument("--data", default=os.path.join(os.path.dirname(REPO), "shared", "data", "broad"))
+    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    ap.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2,...")
+    ap.add_argument("--no-scenarios", action="store_true")
+    ap.add_argument("--no-venv", action="store_true")
+    args = ap.parse_args()
+    build = os.path.abspath(os.path.join(REPO, args.build))
+    if not args.no_venv:
+        bench.ensure_venv(build)
+    out_dir = os.path.join(build, "tune")
+    est_dir = os.path.join(out_dir, "estimates")
+    cache_dir = os.path.join(build, "bench", "cache")
+    for d in (out_dir, est_dir, cache_dir):
+        os.makedirs(d, exist_ok=True)
+
+    recordings = {}
+    if os.path.isdir(args.data):
+        for f in sorted(os.listdir(args.data)):
+            if f.endswith(".csv.gz") or f.endswith(".csv"):
+                recordings[bench.trial_name(f)] = os.path.join(args.data, f)
+    if not recordings:
+        bench.log("no recordings in %s: nothing to cross-validate (it needs ../shared/data/broad)" % args.data)
+        return 0
+    scen = {} if args.no_scenarios else scenario_files(build, out_dir)
+    trials = sorted(recordings)
+    folds = folds_of(trials)
+    files = dict(recordings)
+    files.update(scen)
+
+    with Pool(args.jobs) as pool:
+        vqf = dict(pool.imap_unordered(run_vqf, [(l, p, cache_dir) for l, p in files.items()]))
+        if not args.grid:
+            ours = score_sets(pool, files, args.set, build, est_dir)
+            print("\nSettings: %s\n" % (" ".join(args.set) or "the firmware's"))
+            print(table(trials, list(scen), ours, vqf, folds))
+            return 0
+
+        names, values = [], []
+        for g in args.grid:
+            n, v = g.split("=", 1)
+            names.append(n)
+            values.append(v.split(","))
+        combos = [tuple(args.set) + tuple("%s=%s" % (n, x) for n, x in zip(names, c))
+                  for c in itertools.product(*values)]
+        bench.log("%d combinations x %d recordings" % (len(combos), len(trials)))
+        tasks = [(l, recordings[l], list(c), build, est_dir) for c in combos for l in trials]
+        by_combo = {}
+        for label, sets, s, err in pool.imap_unordered(run_ours, tasks):
+            by_combo.setdefault(sets, {})[label] = s
+        held_out = {}
+        chosen = {}
+        for train, test in (("A", "B"), ("B", "A")):
+            best = min(combos, key=lambda c: mean([by_combo[c][t]["total"] for t in folds[train]
+                                                   if by_combo[c].get(t)]))
+            chosen[test] = best
+            for t in folds[test]:
+                held_out[t] = by_combo[best][t]
+            bench.log("tuned on %s: %s (%.3f on %s) -> %.3f on held-out %s" % (
+                train, " ".join(best[len(args.set):]),
+                mean([by_combo[best][t]["total"] for t in folds[train]]), train,
+                mean([by_combo[best][t]["total"] for t in folds[test]]), test))
+        print("\nCross-validated (each fold scored with the settings tuned on the other):\n")
+        print(table(trials, [], held_out, vqf, folds))
+        rows = [[" ".join(c[len(args.set):])] + ["%.3f" % mean([by_combo[c][t]["total"] for t in folds[f]])
+                                                 for f in ("A", "B")] for c in combos]
+        print(bench.md_table(["combination", "fold A mean total °", "fold B mean total °"], rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
