@@ -6,6 +6,7 @@
 #   make test       every test: host GoogleTest units, the simavr end-to-end suite, the
 #                   sketch built by arduino-builder
 #   make bench      cycles, size and accuracy against the peers (build/bench/report.md)
+#   make tune       cross-validation of the estimator's gains on the BROAD recordings
 #   make deps       install what is missing (apt-get; through sudo when not root)
 #   make upload PORT=/dev/ttyACM0    flash with avrdude (wiring protocol, 115200)
 #   make monitor PORT=/dev/ttyACM0   watch the serial output (115200)
@@ -18,7 +19,7 @@
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
                 libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-BUILD_GOALS := all firmware tools sim test bench upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit
+BUILD_GOALS := all firmware tools sim test bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean

@@ -41,6 +41,13 @@ SECTIONS = [
     (4, "mpu", "MPU6000 burst read", ("mpu",)),
     (5, "hmc", "HMC5883L read", ("hmc", "compass", "mag")),
     (6, "loop", "one loop iteration's work", ("loop",)),
+    # The parts of the estimator step (lib/LinAlg/Profile.h), inside section 1.
+    (12, "checks", "step part: sample checks, calibration", ()),
+    (7, "integration", "step part: gyro integration", ()),
+    (8, "renormalisation", "step part: renormalisation", ()),
+    (9, "gravity", "step part: gravity (low-pass, rest, roll/pitch)", ()),
+    (10, "compass", "step part: heading correction", ()),
+    (11, "learner", "step part: compass offset learner", ()),
 ]
 
 # Targets of issue 5: (key, label, limit, unit).
@@ -55,6 +62,11 @@ TARGET_BROAD_WORST = 15.0
 TARGET_REST = 0.5
 
 OURS = "ours: DCM (replay)"
+
+# The cross-validation's grid (bench/tune.py): the two correction gains at half, once and
+# twice their physical values (1/s: gravity within ~1 s of the 3 s low-pass; 0.1/s: the
+# compass over ~10 s, longer than a hand's or a vehicle's disturbances).
+CV_GRID = ["kp_rp_1_s=0.5,1,2", "kp_yaw_1_s=0.05,0.1,0.2"]
 
 
 def log(msg):
@@ -376,6 +388,7 @@ def main():
     ap.add_argument("--no-peers", action="store_true", help="only our estimator")
     ap.add_argument("--seconds", type=float, default=20.0, help="simulated seconds profiled in simavr")
     ap.add_argument("--no-venv", action="store_true", help="use the current interpreter as it is")
+    ap.add_argument("--no-cv", action="store_true", help="skip the cross-validation (bench/tune.py's grid)")
     args = ap.parse_args()
     build = os.path.abspath(os.path.join(REPO, args.build))
     if not args.no_venv:
@@ -386,6 +399,7 @@ def main():
     import numpy as np
     import peers
     import plots
+    import tune
 
     out_dir = os.path.join(build, "bench")
     cache_dir = os.path.join(out_dir, "cache")
@@ -417,6 +431,11 @@ def main():
     scen_paths = write_scenarios(build, out_dir, list_scenarios(build)) if tool(build, "scenario") else {}
     if scen_paths:
         log("%d scenarios: %s" % (len(scen_paths), ", ".join(scen_paths)))
+    # The same scenarios on a real board's sensors (tune.SENSOR_ERRORS).
+    err_paths = tune.scenario_files(build, out_dir) if tool(build, "scenario") else {}
+    if err_paths:
+        log("%d scenarios with sensor errors (%s)" % (len(err_paths), ", ".join(s for s, _ in tune.SENSOR_ERRORS)))
+    scen_paths.update(err_paths)
 
     files = [(trial_name(p), p, "broad") for p in recordings] + [(n, p, "scenario") for n, p in scen_paths.items()]
     peer_names = [] if args.no_peers else list(peers.PEERS)
@@ -473,6 +492,10 @@ def main():
 
     trials = [trial_name(p) for p in recordings]
     scen_names = list(scen_paths)
+    cv = None
+    if recordings and replay and score_tool and not args.no_cv:
+        log("cross-validation: %s" % " ".join(CV_GRID))
+        cv = tune.cross_validate(build, {trial_name(p): p for p in recordings}, CV_GRID, args.jobs)
     check = None
     if recordings and score_tool:
         check = metric_cross_check(recordings[0], score_tool, out_dir)
@@ -482,7 +505,7 @@ def main():
     pngs = []
     plot_trials = [t for t in trials if t.split("_")[0] in ("01", "21", "30")] or trials[:3]
     for label, path, kind in files:
-        if label not in scen_names and label not in plot_trials:
+        if (label not in scen_names and label not in plot_trials) or "+" in label:
             continue
         est_path = os.path.join(est_dir, label + ".csv")
         if label not in results[OURS] or not os.path.exists(est_path):
@@ -541,13 +564,17 @@ def main():
     rep += ["## Cycles on the ATmega2560 (simavr, 16 MHz)", ""]
     if cycles:
         rows = []
+        steps = sec[1]["count"] if 1 in sec else 0
         for num, _, label, _ in SECTIONS:
             s = sec.get(num)
-            rows.append([label] + ([fmt(s["count"]), fmt(s["avg"], 0), fmt(s["min"], 0), fmt(s["max"], 0)]
-                                   if s else ["–"] * 4))
-        rep.append("Scenario `tilt_tour`, %g simulated seconds through `apm25sim --profile`." % cycles["seconds"])
+            per_step = fmt(s["total"] / steps, 0) if s and steps else "–"
+            rows.append([label] + ([fmt(s["count"]), fmt(s["avg"], 0), fmt(s["min"], 0), fmt(s["max"], 0), per_step]
+                                   if s else ["–"] * 5))
+        rep.append("Scenario `tilt_tour`, %g simulated seconds through `apm25sim --profile`. *per step*: the "
+                   "section's cycles over the run divided by the estimator steps (what it adds to the step's "
+                   "average)." % cycles["seconds"])
         rep.append("")
-        rep.append(md_table(["section", "count", "avg", "min", "max"], rows))
+        rep.append(md_table(["section", "count", "avg", "min", "max", "per step"], rows))
         rep.append("")
         if cycles["load"] is not None:
             rep.append("Loop CPU load at 200 Hz: %.1f %% (section 6 cycles / run window of %s cycles)." % (
@@ -588,28 +615,65 @@ def main():
             rep.append("Metric cross-check (VQF on %s through build/score and through numpy): %s." % (
                 trials[0], check))
             rep.append("")
-        rep += ["### Per trial (total RMSE °; ours: total / inclination / heading)", ""]
+        folds = tune.folds_of(trials)
+        rep += ["### Per trial (total RMSE °; ours: total / inclination / heading)", "",
+                "Kinds from BROAD's groups; folds: the trials sorted by number go alternately to A and B, "
+                "so each holds every kind.", ""]
         rows = []
         for t in trials:
             o = results[OURS].get(t)
-            row = [t, "%s / %s / %s" % (fmt(o["total"]), fmt(o["incl"]), fmt(o["heading"])) if o else "–"]
+            row = [t, tune.kind_of(t), "A" if t in folds["A"] else "B",
+                   "%s / %s / %s" % (fmt(o["total"]), fmt(o["incl"]), fmt(o["heading"])) if o else "–"]
             row += [fmt(results[n][t]["total"]) if t in results[n] else "–" for n in peer_names]
             rows.append(row)
-        rep.append(md_table(["trial", "ours"] + peer_names, rows))
+        rep.append(md_table(["trial", "kind", "fold", "ours"] + peer_names, rows))
         rep.append("")
+        rep += ["### Per kind and per fold (mean total RMSE °)", ""]
+        groups = [(kind, [t for t in trials if tune.kind_of(t) == kind]) for kind, _ in tune.KINDS]
+        groups += [("fold " + f, folds[f]) for f in ("A", "B")] + [("all %d" % len(trials), trials)]
+        rows = []
+        for gname, ts in groups:
+            if not ts:
+                continue
+            rows.append([gname, str(len(ts))] + [fmt(mean_of(results[n], ts, "total")) for n in [OURS] + peer_names])
+        rep.append(md_table(["group", "n", "ours"] + peer_names, rows))
+        rep.append("")
+        if cv:
+            rep += ["### Cross-validated (held-out folds)", "",
+                    "`bench/tune.py` scored every combination of %s on one fold, took the best, and scored it "
+                    "on the other fold, both ways: the held-out figure is what the settings do on recordings "
+                    "they were not chosen on." % cv["grid"], ""]
+            rows = []
+            for f in ("A", "B"):
+                rows.append(["fold %s (tuned on %s)" % (f, "B" if f == "A" else "A"), cv["chosen"][f],
+                             fmt(cv["held_out"][f]), fmt(mean_of(results["VQF"], folds[f], "total"))
+                             if "VQF" in results else "–"])
+            vqf_mean = (mean_of(results["VQF"], folds["A"], "total") + mean_of(results["VQF"], folds["B"], "total")) / 2 \
+                if "VQF" in results and results["VQF"] else None
+            rows.append(["mean of the held-out folds", "", fmt((cv["held_out"]["A"] + cv["held_out"]["B"]) / 2),
+                         fmt(vqf_mean)])
+            rep.append(md_table(["fold", "settings chosen on the other fold", "ours total °", "VQF total °"], rows))
+            rep.append("")
     else:
         rep.append("Skipped: no recordings (../shared/data/broad is not beside the repository).")
         rep.append("")
     if scen_names:
-        rep += ["## The project's scenarios (total / inclination / heading RMSE °)", ""]
+        rep += ["## The project's scenarios (total / inclination / heading RMSE °)", "",
+                "Ideal sensors, then the same scenarios with a real board's errors: *+uncal* an uncalibrated "
+                "board (`scenario NAME --preset uncalibrated`: gyro bias and drift, accel offset and scale, hard "
+                "and soft iron, datasheet noise, quantisation), *+imu* the same with a calibrated compass. "
+                "*ours/VQF*: the ratio of total RMSE (the target: at most 1.1, or within 0.15°).", ""]
         rows = []
         for sname in scen_names:
             row = [sname]
             for name in [OURS] + peer_names:
                 s = results[name].get(sname)
                 row.append("%s / %s / %s" % (fmt(s["total"]), fmt(s["incl"]), fmt(s["heading"])) if s else "–")
+            o, v = results[OURS].get(sname), results.get("VQF", {}).get(sname)
+            row.append(("%.2f%s" % (o["total"] / v["total"], "" if o["total"] <= 1.1 * v["total"] or
+                                     o["total"] <= v["total"] + 0.15 else " MISS")) if o and v else "–")
             rows.append(row)
-        rep.append(md_table(["scenario", "ours"] + peer_names, rows))
+        rep.append(md_table(["scenario", "ours"] + peer_names + ["ours/VQF"], rows))
         rep.append("")
 
     # targets

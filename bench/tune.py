@@ -2,7 +2,7 @@
 """Cross-validation of the estimator's settings: tune on one half of the recordings, score on the other.
 
     python3 bench/tune.py [--build DIR] [--data DIR] [--jobs N] [--set NAME=VALUE ...]
-                          [--grid NAME=V1,V2,... ...] [--no-scenarios]
+                          [--grid NAME=V1,V2,... ...] [--cv] [--no-scenarios]
 
 The 15 BROAD recordings are split into two folds that each hold every kind: sorted by trial
 number, alternate ones go to fold A and fold B (A: 01 05 09 14 21 26 30 34, B: 03 07 11 16 24
@@ -15,7 +15,8 @@ the best (lowest mean total) is then scored on fold B, and the other way round; 
 that counts is the mean over the two held-out folds. The scenarios are not part of the
 choice (they are the check that the gains hold on a different world).
 
-`make tune` runs it with the project's grid (Makefile variable TUNE_ARGS overrides).
+--cv is --grid with the project's grid (bench.CV_GRID, the one `make bench` reports).
+`make tune` runs `tune.py --cv` (the Makefile variable TUNE_ARGS replaces --cv).
 """
 import argparse
 import itertools
@@ -173,10 +174,13 @@ def main():
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     ap.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2,...")
+    ap.add_argument("--cv", action="store_true", help="cross-validate the project's grid (bench.CV_GRID)")
     ap.add_argument("--no-scenarios", action="store_true")
     ap.add_argument("--no-venv", action="store_true")
     args = ap.parse_args()
     build = os.path.abspath(os.path.join(REPO, args.build))
+    if args.cv and not args.grid:
+        args.grid = list(bench.CV_GRID)
     if not args.no_venv:
         bench.ensure_venv(build)
     out_dir = os.path.join(build, "tune")
@@ -207,36 +211,48 @@ def main():
             print(table(trials, list(scen), ours, vqf, folds))
             return 0
 
-        names, values = [], []
-        for g in args.grid:
-            n, v = g.split("=", 1)
-            names.append(n)
-            values.append(v.split(","))
-        combos = [tuple(args.set) + tuple("%s=%s" % (n, x) for n, x in zip(names, c))
-                  for c in itertools.product(*values)]
-        bench.log("%d combinations x %d recordings" % (len(combos), len(trials)))
-        tasks = [(l, recordings[l], list(c), build, est_dir) for c in combos for l in trials]
-        by_combo = {}
-        for label, sets, s, err in pool.imap_unordered(run_ours, tasks):
-            by_combo.setdefault(sets, {})[label] = s
-        held_out = {}
-        chosen = {}
-        for train, test in (("A", "B"), ("B", "A")):
-            best = min(combos, key=lambda c: mean([by_combo[c][t]["total"] for t in folds[train]
-                                                   if by_combo[c].get(t)]))
-            chosen[test] = best
-            for t in folds[test]:
-                held_out[t] = by_combo[best][t]
-            bench.log("tuned on %s: %s (%.3f on %s) -> %.3f on held-out %s" % (
-                train, " ".join(best[len(args.set):]),
-                mean([by_combo[best][t]["total"] for t in folds[train]]), train,
-                mean([by_combo[best][t]["total"] for t in folds[test]]), test))
-        print("\nCross-validated (each fold scored with the settings tuned on the other):\n")
-        print(table(trials, [], held_out, vqf, folds))
-        rows = [[" ".join(c[len(args.set):])] + ["%.3f" % mean([by_combo[c][t]["total"] for t in folds[f]])
-                                                 for f in ("A", "B")] for c in combos]
-        print(bench.md_table(["combination", "fold A mean total °", "fold B mean total °"], rows))
+    cv = cross_validate(build, recordings, args.grid, args.jobs, args.set)
+    print("\nCross-validated (each fold scored with the settings tuned on the other):\n")
+    print(table(trials, [], cv["per_trial"], vqf, folds))
+    rows = [[c] + ["%.3f" % v for v in cv["combos"][c]] for c in cv["combos"]]
+    print(bench.md_table(["combination", "fold A mean total °", "fold B mean total °"], rows))
     return 0
+
+
+def cross_validate(build, recordings, grid, jobs, base_sets=()):
+    """Every combination of grid (["NAME=V1,V2", ...]) on every recording; per fold, the
+    combination best on the other fold. Returns dict(grid, chosen={fold: settings},
+    held_out={fold: mean total}, per_trial={trial: score}, combos={settings: (mean A, mean B)})."""
+    est_dir = os.path.join(build, "tune", "estimates")
+    os.makedirs(est_dir, exist_ok=True)
+    trials = sorted(recordings)
+    folds = folds_of(trials)
+    names, values = [], []
+    for g in grid:
+        n, v = g.split("=", 1)
+        names.append(n)
+        values.append(v.split(","))
+    combos = [tuple(base_sets) + tuple("%s=%s" % (n, x) for n, x in zip(names, c)) for c in itertools.product(*values)]
+    bench.log("cross-validation: %d combinations x %d recordings" % (len(combos), len(trials)))
+    tasks = [(l, recordings[l], list(c), build, est_dir) for c in combos for l in trials]
+    by_combo = {}
+    with Pool(jobs) as pool:
+        for label, sets, s, err in pool.imap_unordered(run_ours, tasks):
+            if err:
+                bench.log("%s: %s" % (label, err))
+            by_combo.setdefault(sets, {})[label] = s
+    fold_mean = lambda c, f: mean([by_combo[c][t]["total"] for t in folds[f] if by_combo[c].get(t)])
+    out = dict(grid=" ".join(grid), chosen={}, held_out={}, per_trial={},
+               combos={" ".join(c[len(base_sets):]): (fold_mean(c, "A"), fold_mean(c, "B")) for c in combos})
+    for train, test in (("A", "B"), ("B", "A")):
+        best = min(combos, key=lambda c: fold_mean(c, train))
+        out["chosen"][test] = " ".join(best[len(base_sets):])
+        out["held_out"][test] = fold_mean(best, test)
+        for t in folds[test]:
+            out["per_trial"][t] = by_combo[best][t]
+        bench.log("tuned on %s: %s (%.3f there) -> %.3f on held-out %s" % (
+            train, out["chosen"][test], fold_mean(best, train), out["held_out"][test], test))
+    return out
 
 
 if __name__ == "__main__":

@@ -16,7 +16,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools sim test bench upload size
+.PHONY: all firmware tools sim test bench tune upload size
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -128,6 +128,11 @@ test: firmware tools venv
 
 bench: firmware tools
 	python3 bench/bench.py --build $(BUILD)
+
+# Cross-validation of the estimator's settings on the BROAD recordings (bench/tune.py).
+TUNE_ARGS ?= --cv
+tune: tools
+	python3 bench/tune.py --build $(BUILD) $(TUNE_ARGS)
 
 upload: firmware
 	avrdude -p $(MCU) -c wiring -P $(PORT) -b $(BAUD) -D -U flash:w:$(BUILD)/firmware.hex:i

@@ -223,6 +223,28 @@ TEST(Dcm, TracksARotationAndHoldsTheIntegratorWhileFast) {
     EXPECT_LT(filter.gyro_bias_rad_s().length(), 1e-4f);
 }
 
+TEST(Dcm, HoldsTheIntegratorOnALastingTurnNotOnAVibration) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), mag_for(Matrix3f::identity())));
+    const float dt = filter.settings().step_s;
+    for (int i = 0; i < 800; ++i) filter.update(Vector3f(), accel_for(Matrix3f::identity()));  // past start-up
+    // An 8 Hz wobble about x peaking at 50 deg/s (a motor's vibration): the integrator learns on.
+    int held = 0;
+    for (int i = 0; i < 400; ++i) {
+        const float rate_rad_s = 50.0f * linalg::kRadPerDeg * sinf(2.0f * 3.14159265f * 8.0f * dt * (float)i);
+        filter.update(Vector3f(rate_rad_s, 0, 0), accel_for(Matrix3f::identity()));
+        if (i >= 100 && (filter.status() & dcm::kStatusBiasHeld)) ++held;
+    }
+    EXPECT_EQ(held, 0);
+    // A steady 60 deg/s turn: held within 0.5 s and from then on.
+    held = 0;
+    for (int i = 0; i < 400; ++i) {
+        filter.update(Vector3f(0, 0, 60.0f * linalg::kRadPerDeg), accel_for(Matrix3f::identity()));
+        if (i >= 100 && (filter.status() & dcm::kStatusBiasHeld)) ++held;
+    }
+    EXPECT_EQ(held, 300);
+}
+
 TEST(Dcm, RejectsAMagneticDisturbanceAndRecoversFromALastingOne) {
     const Matrix3f truth = Matrix3f::identity();
     RestRun run(truth);

@@ -31,7 +31,7 @@ struct DcmSettings {
     float startup_s;                 // length of the start-up ramp (also speeds up the accel low-pass), s
     float accel_max_g;               // beyond any accelerometer's range: such a sample is garbage, g
     float accel_lowpass_s;           // time constant of the earth-frame accel low-pass, s
-    float integrator_hold_rate_rad_s;// |gyro| above which the bias integrator is held, rad/s
+    float integrator_hold_rate_rad_s;// mean rate (0.5 s) above which the bias integrator is held, rad/s
     float bias_limit_rad_s;          // bound on each axis of the gyro-bias estimate, rad/s
     float mag_norm_tolerance;        // |field| may differ from the learned one by this fraction
     float mag_dip_tolerance;         // field.down/|field| may differ from the learned one by this
@@ -114,7 +114,8 @@ public:
           max_rate2_(kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s),
           hold_rate2_(settings.integrator_hold_rate_rad_s * settings.integrator_hold_rate_rad_s),
           accel_max_m_s2_(settings.accel_max_g * kGravity_m_s2),
-          accel_alpha_(settings.step_s / (settings.accel_lowpass_s + settings.step_s)),
+          accel_alpha_(settings.step_s * (float)kCorrectionDivider /
+                       (settings.accel_lowpass_s + settings.step_s * (float)kCorrectionDivider)),
           correction_dt_(settings.step_s * (float)kCorrectionDivider),
           mag_recover_steps_(settings.mag_recover_s / settings.step_s),
           rest_gyro_dev2_(settings.rest_gyro_deviation_rad_s * settings.rest_gyro_deviation_rad_s),
@@ -181,7 +182,7 @@ public:
 
 private:
     void correct_tilt(float startup_left, bool hold_integrator);
-    void detect_rest();
+    void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
     bool renormalise(float& skew);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
     void recover();
@@ -198,7 +199,7 @@ private:
     float max_rate2_;                    // (rad/s)^2
     float hold_rate2_;                   // (rad/s)^2
     float accel_max_m_s2_;
-    float accel_alpha_;                  // low-pass factor per step
+    float accel_alpha_;                  // low-pass factor per correction
     float correction_dt_;                // s between two roll/pitch corrections
     float mag_recover_steps_;
     float rest_gyro_dev2_;               // (rad/s)^2
@@ -221,6 +222,7 @@ private:
     linalg::Vector3f rest_gyro_mean_rad_s_;  // their low-passed means, for the rest test
     linalg::Vector3f rest_accel_mean_m_s2_;
     uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
+    uint8_t window_samples_ = 0;         // samples in the sums
     linalg::Vector3f last_rate_rad_s_;   // the last corrected rate, to bring field samples up to date
     float mag_ref_norm_ = 0.0f;          // learned field strength
     bool mag_take_heading_ = true;       // reset_mag_reference's take_heading

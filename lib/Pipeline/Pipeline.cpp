@@ -1,5 +1,7 @@
 #include "Pipeline.h"
 
+#include "Profile.h"
+
 #include <math.h>
 
 namespace pipeline {
@@ -213,6 +215,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     st_.output_due = false;
     ++st_.steps;
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
+    profile::begin(profile::kChecks);
     const mpu6000::Sample s = guard(raw);
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
@@ -220,7 +223,10 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         start_gyro_calibration();
     }
     if (st_.gyro_cal_active) step_calibration(s);
-    if (st_.phase != Phase::Running) return;
+    if (st_.phase != Phase::Running) {
+        profile::end(profile::kChecks);
+        return;
+    }
     if (st_.reinit_pending) {
         st_.reinit_pending = false;
         start_estimator(s.accel_m_s2);
@@ -239,11 +245,16 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
     const float nan = __builtin_nanf("");
     const Vector3f gyro_rad_s = calib::apply_gyro(settings_.cal, s.gyro_rad_s);
+    profile::end(profile::kChecks);
     dcm_.update(gyro_rad_s, accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2);
     // The board's turn for the compass learner: the gyro alone, less the estimator's bias.
     turn_rad_ += (gyro_rad_s - dcm_.gyro_bias_rad_s()) * kStep_s;
     const bool heading_corrected = st_.mag_pending && st_.mag_present;
-    if (heading_corrected) dcm_.correct_heading(mag_cal_uT_);
+    if (heading_corrected) {
+        profile::begin(profile::kCompass);
+        dcm_.correct_heading(mag_cal_uT_);
+        profile::end(profile::kCompass);
+    }
     st_.mag_pending = false;
 
     if (st_.mag_cal_active) {
@@ -273,7 +284,11 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     if (st_.output_due || heading_corrected) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
-    if (st_.learn_pending) learn_mag_offset();
+    if (st_.learn_pending) {
+        profile::begin(profile::kLearner);
+        learn_mag_offset();
+        profile::end(profile::kLearner);
+    }
 }
 
 Angles AttitudePipeline::angles() const {
