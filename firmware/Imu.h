@@ -34,6 +34,8 @@ public:
     // warning. False (reported once, then retried by retry()) when nobody answered.
     bool read(mpu6000::Sample& out, uint32_t now_us, uint32_t now_ms);
     uint32_t missed_samples() const { return missed_; }
+    // Time since the last sample was read (0 before the first).
+    uint32_t us_since_sample(uint32_t now_us) const { return have_sample_time_ ? now_us - last_sample_us_ : 0u; }
 
 private:
     mpu6000::Mpu6000 chip_;

@@ -194,8 +194,14 @@ static void take_console_input() {
     }
 }
 
+// A sample is missed when the next read comes more than 1.5 periods (7.5 ms) after the
+// previous one. The longest command, status, takes 3.4 ms (54 k cycles), so a command
+// starts only within 3.5 ms of the last sample: after a step that used more of its
+// period it waits for the next one (a step averages ~3 ms, so most do not wait).
+constexpr uint32_t kCommandLatestStartUs = 3500;
 static void run_console_command() {
     if (commands.empty() || serial_text::room() < console::reply_bound(commands.peek()) + fmt::kRawLineMax) return;
+    if (imu.us_since_sample(micros()) > kCommandLatestStartUs) return;
     execute(commands.pop());
 }
 

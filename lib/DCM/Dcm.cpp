@@ -13,6 +13,13 @@ namespace {
 constexpr uint16_t kMaxMagIntervalSteps = 20;
 // The accel low-pass during start-up, per correction (50 Hz): a 0.25 s time constant.
 constexpr float kStartupAccelAlpha = 0.074f;
+// The field may move this much in body axes during a rest: the HMC5883L's noise is
+// ~0.2 uT with its 8-sample average; a turn of 3 deg moves a 20 uT horizontal field by
+// 1 uT, so a steady turn of more than 2 deg/s ends a rest within its first 1.5 s, and
+// a slower one before it has lasted 1 uT / (20 uT x rate).
+constexpr float kRestFieldMove_uT = 1.0f;
+// A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
+constexpr uint16_t kRestCompassSteps = 20;
 // 1/n for the means of n samples (no division on the AVR).
 constexpr float kInverse[Dcm::kCorrectionDivider] = {1.0f, 0.5f, 1.0f / 3.0f, 0.25f};
 }  // namespace
@@ -62,6 +69,10 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     gyro_sum_rad_s_ = Vector3f();
     accel_sum_m_s2_ = Vector3f();
     window_samples_ = 0;
+    accel_sum_of_sums_ = Vector3f();
+    first_half_rad_s_ = Vector3f();
+    turn_sum_rad_s_ = Vector3f();
+    pending_steps_ = 0;
     rest_accel_mean_m_s2_ = accel_m_s2;
     steps_ = 0;
     status_ |= kStatusInitialised;
@@ -80,7 +91,6 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     }
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
-    const float dt = settings_.step_s;
     // Start-up: a faster response that ramps down linearly to the steady one over
     // startup_s, so a poor first sample is forgotten quickly (Fusion does the same);
     // the bias is not learned from those transients.
@@ -116,6 +126,7 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     if (gyro_ok && accel_plausible(accel_m_s2)) {
         gyro_sum_rad_s_ += gyro_rad_s;
         accel_sum_m_s2_ += accel_m_s2;
+        accel_sum_of_sums_ += accel_sum_m_s2_;  // sum of (samples from this one on) a_j
         ++window_samples_;
         last_accel_m_s2_ = accel_m_s2;
     } else {
@@ -125,59 +136,55 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
     // The roll/pitch error (Premerlani & Bizard eq. 27, measured down x estimated
     // down) moves slowly once low-passed: it is worked out every kCorrectionDivider
     // steps and applied at every step in between.
-    if (++correction_phase_ >= kCorrectionDivider) {
+    // Worked out half-way between two integrations, so that no step carries both.
+    if (++correction_phase_ >= kCorrectionDivider) correction_phase_ = 0;
+    if (correction_phase_ == kCorrectionDivider / 2) {
         profile::begin(profile::kGravity);
-        correction_phase_ = 0;
         if (window_samples_ > 0) {
             const float inv_n = kInverse[window_samples_ - 1];
             const Vector3f gyro_mean = gyro_sum_rad_s_ * inv_n;
             const Vector3f accel_mean = accel_sum_m_s2_ * inv_n;
             // Sample j of the window meets the matrix of the step before it, R_(j-1) =
-            // R (I - [phi_j x]), phi_j the turn since: on average 1.5 steps of the
-            // mean rate, so R_(j-1) a_j averages to R (a - phi x a).
-            const Vector3f phi = (gyro_mean - offset_rad_s_) * (1.5f * settings_.step_s);
+            // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind
+            // this step's sample by the steps not yet integrated and this one, so the
+            // steps are (n - j + 1) - (pending + 1), and sum_j phi_j x a_j is
+            // w dt x (sum_j (n - j + 1) a_j - (pending + 1) sum_j a_j): the first sum is
+            // the sum of the running sums, three additions a step. (Weighting each
+            // sample, not the mean, matters under a 10 g shake while turning.)
+            const Vector3f turn_per_step = (gyro_mean - offset_rad_s_) * settings_.step_s;
+            const Vector3f weighted = accel_sum_of_sums_ - accel_sum_m_s2_ * (float)(pending_steps_ + 1);
             const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
-            accel_lp_ef_ += (r_ * (accel_mean - phi.cross(accel_mean)) - accel_lp_ef_) * alpha;
+            accel_lp_ef_ += (r_ * (accel_mean - turn_per_step.cross(weighted) * inv_n) - accel_lp_ef_) * alpha;
             detect_rest(gyro_mean, accel_mean, window_samples_ == kCorrectionDivider);
         }
         gyro_sum_rad_s_ = Vector3f();
         accel_sum_m_s2_ = Vector3f();
+        accel_sum_of_sums_ = Vector3f();
         window_samples_ = 0;
         correct_tilt(startup_left, hold_integrator);
         offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
         profile::end(profile::kGravity);
     }
 
-    // Gyro integration (eq. 17, to second order): R <- R exp([theta x]), theta = w dt.
-    // For a row r, r exp([theta x]) = r + (1 + |theta|^2/3)(r x theta)
-    //                                   + theta (r . theta) / 2 + (a length change),
-    // to O(theta^4) once renormalised. The paper's first-order R (I + [theta x]) is
-    // not a rotation: renormalising it shrinks each row's component along the axis
-    // by theta^2/2 a step, which at 640 deg/s tilts the matrix by 50 deg in 10 s at
-    // 200 Hz. The (1 + |theta|^2/3) undoes the atan|theta| that renormalising
-    // r + r x theta turns the angle into. Row c is not integrated: renormalisation
-    // rebuilds it as a x b.
-    profile::begin(profile::kIntegration);
+    // Gyro integration, multi-rate (Savage, "Strapdown Inertial Navigation Integration
+    // Algorithm Design", part 1): the corrected rates are summed at every step, and
+    // every kIntegrationSteps steps the summed rotation vector turns the matrix, with
+    // the two-sample coning term (2/3) A x B of its two halves A and B (Savage eq. 55:
+    // the rotation vector of a rotation whose axis moved within the interval). The
+    // error against a 200 Hz update on BROAD's fast rotations: README, Performance.
     if (gyro_ok) {
         Vector3f rate_rad_s = gyro_rad_s - offset_rad_s_;
         if (yaw_pending_) rate_rad_s += omega_yaw_rad_s_;  // a mag correction is applied once
         last_rate_rad_s_ = rate_rad_s;
-        const Vector3f theta = rate_rad_s * dt;
-        const Vector3f half_theta = theta * 0.5f;
-        const Vector3f stretched = theta * (1.0f + (1.0f / 3.0f) * theta.length_squared());
-        r_.a += r_.a.cross(stretched) + theta * r_.a.dot(half_theta);
-        r_.b += r_.b.cross(stretched) + theta * r_.b.dot(half_theta);
+        turn_sum_rad_s_ += rate_rad_s;
     }
     yaw_pending_ = false;
-    profile::end(profile::kIntegration);
-    profile::begin(profile::kRenormalisation);
-    // One pass leaves ~(X.Y)^2: a second one, needed only at high rates (a step of
-    // more than ~3 deg), keeps the matrix orthonormal to 1e-5 up to the gyro's range.
-    float skew = 0.0f;
-    bool ok = renormalise(skew);
-    if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
-    if (!ok) recover();
-    profile::end(profile::kRenormalisation);
+    ++pending_steps_;
+    if (pending_steps_ == kIntegrationSteps / 2) {
+        first_half_rad_s_ = turn_sum_rad_s_;
+        turn_sum_rad_s_ = Vector3f();
+    }
+    if (pending_steps_ >= kIntegrationSteps) integrate();
     if (steps_ < 0xFFFFFFFFu) ++steps_;
 }
 
@@ -190,12 +197,14 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
 // over the 0.5 s mean; a hand-held board's tremor is below 2 deg/s and 0.5 m/s^2.
 void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, bool whole_window) {
     status_ &= (uint8_t)~kStatusAtRest;
-    // A steady turn passes the deviation test too: the mean must also be within the
-    // same bound of the bias estimate (VQF bounds it by its 2 deg/s bias clip). What
-    // the gyro calibration at start leaves is far below it; a larger bias on the
-    // vertical axis is not told from a slow turn (gravity learns the horizontal ones).
+    // A steady turn passes the deviation test too. The compass tells: at rest the field
+    // stays put in body axes, in a turn it turns (correct_heading resets the rest when
+    // it moves by kRestFieldMove_uT). Without a compass delivering, the mean must be
+    // within the tremor bound of the bias estimate instead (VQF's rule, its 2 deg/s
+    // bias clip): a larger vertical bias is then not told from a slow turn.
+    const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
     const bool still = (gyro_mean - rest_gyro_mean_rad_s_).length_squared() < rest_gyro_dev2_ &&
-                       (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() < rest_gyro_dev2_ &&
+                       (compass_watching || (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() < rest_gyro_dev2_) &&
                        (accel_mean - rest_accel_mean_m_s2_).length_squared() < rest_accel_dev2_;
     rest_gyro_mean_rad_s_ += (gyro_mean - rest_gyro_mean_rad_s_) * rest_alpha_;
     rest_accel_mean_m_s2_ += (accel_mean - rest_accel_mean_m_s2_) * rest_alpha_;
@@ -211,6 +220,46 @@ void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, boo
     bias_rad_s_ += (rest_gyro_mean_rad_s_ - bias_rad_s_) * rest_bias_alpha_;
     clamp_bias();
 }
+
+// R <- R exp([theta x]) with theta the summed turn and its coning term (eq. 17, exact
+// to the series' order). For a row r and a = |theta|, Rodrigues' formula is
+//   r exp([theta x]) = cos(a) [r + (tan(a)/a)(r x theta) + k theta (r . theta)],
+//   k = (1 - cos a) / (a^2 cos a),
+// and the factor cos(a) is a length, which renormalisation takes out. The series below
+// (tan(a)/a = 1 + a^2/3 + 2a^4/15 + 17a^6/315, k = 1/2 + 5a^2/24 + 61a^4/720) leave
+// below 1e-6 rad an update up to a = 0.5 rad (1 430 deg/s at 50 Hz); the terms after
+// a^2 are what a 50 Hz update needs (0.24 deg an update at 0.5 rad without them). The
+// paper's first-order R (I + [theta x]) is not a rotation: renormalising it shrinks
+// each row's component along the axis by a^2/2 an update. Row c is not integrated:
+// renormalisation rebuilds it as a x b.
+void Dcm::integrate() {
+    profile::begin(profile::kIntegration);
+    const float dt = settings_.step_s;
+    const Vector3f first = first_half_rad_s_ * dt;
+    const Vector3f second = turn_sum_rad_s_ * dt;
+    const Vector3f theta = first + second + first.cross(second) * (2.0f / 3.0f);
+    first_half_rad_s_ = Vector3f();
+    turn_sum_rad_s_ = Vector3f();
+    pending_steps_ = 0;
+    const float a2 = theta.length_squared();
+    const float tan_ratio = 1.0f + a2 * (1.0f / 3.0f + a2 * (2.0f / 15.0f + a2 * (17.0f / 315.0f)));
+    const float k = 0.5f + a2 * (5.0f / 24.0f + a2 * (61.0f / 720.0f));
+    const Vector3f stretched = theta * tan_ratio;
+    const Vector3f k_theta = theta * k;
+    r_.a += r_.a.cross(stretched) + theta * r_.a.dot(k_theta);
+    r_.b += r_.b.cross(stretched) + theta * r_.b.dot(k_theta);
+    profile::end(profile::kIntegration);
+    profile::begin(profile::kRenormalisation);
+    // One pass leaves ~(X.Y)^2: a second one, needed only at high rates (an update of
+    // more than ~3 deg), keeps the matrix orthonormal to 1e-5 up to the gyro's range.
+    float skew = 0.0f;
+    bool ok = renormalise(skew);
+    if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
+    if (!ok) recover();
+    profile::end(profile::kRenormalisation);
+}
+
+Vector3f Dcm::pending_turn_rad() const { return (first_half_rad_s_ + turn_sum_rad_s_) * settings_.step_s; }
 
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
@@ -245,6 +294,12 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     const float norm2 = mag_field.length_squared();
     if (!(norm2 > 0.0f) || !linalg::is_finite(norm2)) return;
     last_mag_field_ = mag_field;
+    // The rest test's witness: a field that moved in body axes since the rest began
+    // means the board turns (or a magnet moved): no rest.
+    if ((mag_field - rest_field_uT_).length_squared() > kRestFieldMove_uT * kRestFieldMove_uT) {
+        rest_field_uT_ = mag_field;
+        rest_corrections_ = 0;
+    }
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
         // The first field sample after a start without one: take its heading as is.
@@ -255,7 +310,11 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // The sample is older than the gyro-propagated attitude (the chip's averaging
     // and the wait for the next step): turn it forward by the rotation since, as a
     // fixed earth vector seen from the body moves, dm/dt = m x w.
-    const Vector3f field_now = mag_field + mag_field.cross(last_rate_rad_s_) * settings_.mag_latency_s;
+    // The matrix itself is behind the last sample by the turn not yet integrated: the
+    // field is brought back by that much (a fixed earth vector seen from the body
+    // after a turn p reads v - p x v = v + v x p, so before it v x -p).
+    const Vector3f field_now =
+        mag_field + mag_field.cross(last_rate_rad_s_ * settings_.mag_latency_s - pending_turn_rad());
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
     const Vector3f field_ef = r_ * field_now;
@@ -333,7 +392,7 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
 }
 
 EulerAngles Dcm::euler_now() const {
-    const Vector3f theta = last_rate_rad_s_ * settings_.output_lead_s;
+    const Vector3f theta = last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad();
     const Vector3f a = r_.a + r_.a.cross(theta);
     const Vector3f b = r_.b + r_.b.cross(theta);
     const Vector3f c = r_.c + r_.c.cross(theta);

@@ -157,6 +157,10 @@ public:
     }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
+    // The last update turned the matrix or worked out the gravity correction (the
+    // step's two heavy parts, each on its own step): a caller with deferrable work
+    // (the compass learner) puts it on another step.
+    bool heavy_step() const { return pending_steps_ == 0 || correction_phase_ == kCorrectionDivider / 2; }
     uint8_t status() const { return status_; }
     uint16_t recoveries() const { return recoveries_; }
     const linalg::Matrix3f& matrix() const { return r_; }
@@ -177,11 +181,16 @@ public:
     // default 200 Hz step) and applied at every step: it moves at the 3 s pace of
     // the accel low-pass, and the work saved is a quarter of the step.
     static constexpr uint8_t kCorrectionDivider = 4;
+    // The matrix is turned every this many steps (50 Hz at the 200 Hz step) by the
+    // rates summed meanwhile (Dcm::integrate). Even: the coning term needs two halves.
+    static constexpr uint8_t kIntegrationSteps = 4;
     // The means the rest test compares the samples against (VQF's 0.5 s).
     static constexpr float kRestMeanTau_s = 0.5f;
 
 private:
     void correct_tilt(float startup_left, bool hold_integrator);
+    void integrate();
+    linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
     void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
     bool renormalise(float& skew);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
@@ -222,7 +231,12 @@ private:
     linalg::Vector3f rest_gyro_mean_rad_s_;  // their low-passed means, for the rest test
     linalg::Vector3f rest_accel_mean_m_s2_;
     uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
+    linalg::Vector3f rest_field_uT_;     // the field (body axes) when the board last seemed to turn
+    linalg::Vector3f accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
+    linalg::Vector3f first_half_rad_s_;  // corrected rates summed over the integration's first half
+    linalg::Vector3f turn_sum_rad_s_;    // ... and since
+    uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
     linalg::Vector3f last_rate_rad_s_;   // the last corrected rate, to bring field samples up to date
     float mag_ref_norm_ = 0.0f;          // learned field strength
     bool mag_take_heading_ = true;       // reset_mag_reference's take_heading

@@ -277,11 +277,12 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
-    // The deferred compass work (the cal mag sums, the learner: each ~20-30 k cycles on
-    // the AVR) goes on a step with neither an output line nor a heading correction, so
-    // that no step carries two of them (the compass' 75 Hz and a 50 Hz output leave
-    // ~75 such steps a second; a sample waits at most a few steps).
-    if (st_.output_due || heading_corrected) return;
+    // The deferred compass work (the cal mag sums, the learner: each ~20-50 k cycles on
+    // the AVR) goes on a step with neither an output line, a heading correction nor the
+    // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
+    // two heavy parts (of four steps two are the DCM's; the compass' 75 Hz and a 50 Hz
+    // output leave ~40 free steps a second; a sample waits at most a few steps).
+    if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
     if (st_.learn_pending) {
