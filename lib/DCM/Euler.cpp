@@ -1,31 +1,94 @@
 #include "Euler.h"
 
+#include "Fixed.h"
+
 namespace dcm {
 
 using linalg::Matrix3f;
 using linalg::Vector3f;
-using linalg::fast_atan2;
+
+namespace {
+
+// kGimbalLockCos in Q30.
+constexpr uint32_t kGimbalLockCosQ30 = (uint32_t)(kGimbalLockCos * 1073741824.0f);
+
+// The angles from the seven entries in Q30 (any int32: a non-rotation gives finite
+// angles too).
+EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
+                           int32_t r33) {
+    using linalg::atan2_q24;
+    using linalg::magnitude;
+    // Roll and cos(pitch) share one ratio, min/max of |R32| and |R33|.
+    const uint32_t m32 = magnitude(r32), m33 = magnitude(r33);
+    uint32_t ratio_q31;
+    int32_t roll = atan2_q24(r32 < 0, m32, r33 < 0, m33, &ratio_q31);
+    // cos(theta) = sqrt(R32^2 + R33^2): pitch by atan2 is accurate near +-90 deg,
+    // where asin(R31) loses all its digits.
+    const uint32_t cos_pitch_q30 = linalg::hypot_from_ratio(m32 > m33 ? m32 : m33, ratio_q31);
+    const int32_t pitch = atan2_q24(r31 > 0, magnitude(r31), false, cos_pitch_q30);
+    int32_t yaw;
+    if (cos_pitch_q30 > kGimbalLockCosQ30) {
+        yaw = atan2_q24(r21 < 0, magnitude(r21), r11 < 0, magnitude(r11));
+    } else {
+        // Gimbal lock: roll := 0, all of the heading in yaw. With phi = 0,
+        // R12 = -sin(psi) and R22 = cos(psi) exactly.
+        roll = 0;
+        yaw = atan2_q24(r12 > 0, magnitude(r12), r22 < 0, magnitude(r22));
+    }
+    EulerAngles e;
+    e.roll_rad = linalg::float_from_fixed(roll, linalg::kAngleQ);
+    e.pitch_rad = linalg::float_from_fixed(pitch, linalg::kAngleQ);
+    e.yaw_rad = linalg::float_from_fixed(yaw, linalg::kAngleQ);
+    return e;
+}
+
+int32_t q30(float entry) { return linalg::fixed_from_float(entry, linalg::kQ30); }
+
+// An entry of R carried forward, in Q30, limited to +-1.5 so that adding the
+// first-order terms cannot overflow.
+constexpr int32_t kEntryLimitQ30 = (int32_t)3 << 29;
+int32_t carried_entry(float entry) {
+    const int32_t e = q30(entry);
+    return e > kEntryLimitQ30 ? kEntryLimitQ30 : e < -kEntryLimitQ30 ? -kEntryLimitQ30 : e;
+}
+// theta in Q17 (+-0.25 rad), rounded: steps of 7.6e-6 rad, a rotation error of
+// 3.8e-6 rad (0.0002 deg) at most.
+int16_t theta_q17(float theta_rad) {
+    int32_t t = linalg::fixed_from_float(theta_rad, 18);
+    t = (t + 1) >> 1;
+    return (int16_t)(t > 32767 ? 32767 : t < -32767 ? -32767 : t);
+}
+// A Q30 entry rounded to its top 16 bits (Q14) for the first-order terms: moves a
+// term by 2^-15 * |theta|, ~3e-7 at the output's typical theta (0.01 rad).
+int16_t q14(int32_t e_q30) { return (int16_t)((e_q30 + 0x8000) >> 16); }
+// e + p*tp - q*tq: Q30 + (Q14 * Q17 = Q31) / 2.
+int32_t plus_cross(int32_t e, int16_t p, int16_t tp, int16_t q, int16_t tq) {
+    return e + (((int32_t)p * tp) >> 1) - (((int32_t)q * tq) >> 1);
+}
+
+}  // namespace
 
 EulerAngles euler_from_dcm(const Matrix3f& r) {
     return euler_from_entries(r.a.x, r.a.y, r.b.x, r.b.y, r.c.x, r.c.y, r.c.z);
 }
 
 EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float r31, float r32, float r33) {
-    EulerAngles e;
-    // cos(theta) from the other two entries of the last row: pitch by atan2 is
-    // accurate near +-90 deg, where asin(R31) loses all its digits.
-    const float cos_pitch = linalg::safe_sqrt(r32 * r32 + r33 * r33);
-    e.pitch_rad = fast_atan2(-r31, cos_pitch);
-    if (cos_pitch > kGimbalLockCos) {
-        e.roll_rad = fast_atan2(r32, r33);
-        e.yaw_rad = fast_atan2(r21, r11);
-    } else {
-        // Gimbal lock: roll := 0, all of the heading in yaw. With phi = 0,
-        // R12 = -sin(psi) and R22 = cos(psi) exactly.
-        e.roll_rad = 0.0f;
-        e.yaw_rad = fast_atan2(-r12, r22);
-    }
-    return e;
+    return euler_from_q30(q30(r11), q30(r12), q30(r21), q30(r22), q30(r31), q30(r32), q30(r33));
+}
+
+EulerAngles euler_carried(const Matrix3f& r, const Vector3f& theta_rad) {
+    const int16_t tx = theta_q17(theta_rad.x), ty = theta_q17(theta_rad.y), tz = theta_q17(theta_rad.z);
+    const int32_t a[3] = {carried_entry(r.a.x), carried_entry(r.a.y), carried_entry(r.a.z)};
+    const int32_t b[3] = {carried_entry(r.b.x), carried_entry(r.b.y), carried_entry(r.b.z)};
+    const int32_t c[3] = {carried_entry(r.c.x), carried_entry(r.c.y), carried_entry(r.c.z)};
+    // r' = r + r x theta = r + (r_y t_z - r_z t_y, r_z t_x - r_x t_z, r_x t_y - r_y t_x).
+    return euler_from_q30(plus_cross(a[0], q14(a[1]), tz, q14(a[2]), ty),  // R11
+                          plus_cross(a[1], q14(a[2]), tx, q14(a[0]), tz),  // R12
+                          plus_cross(b[0], q14(b[1]), tz, q14(b[2]), ty),  // R21
+                          plus_cross(b[1], q14(b[2]), tx, q14(b[0]), tz),  // R22
+                          plus_cross(c[0], q14(c[1]), tz, q14(c[2]), ty),  // R31
+                          plus_cross(c[1], q14(c[2]), tx, q14(c[0]), tz),  // R32
+                          plus_cross(c[2], q14(c[0]), ty, q14(c[1]), tx));  // R33
 }
 
 Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad) {
