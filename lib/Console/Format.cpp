@@ -53,9 +53,13 @@ char* put_centi(char* p, int32_t c) {
     return p;
 }
 
-char* put(char* p, const char* s) {
-    while (*s != '\0') *p++ = *s++;
-    return p;
+// A label from flash (TXT: in SRAM the labels of the four formats took ~80 bytes).
+char* put(char* p, text::Flash s) {
+    for (const char* q = s.p;; ++q) {
+        const char ch = (char)text::flash_byte(q);
+        if (ch == '\0') return p;
+        *p++ = ch;
+    }
 }
 
 }  // namespace
@@ -63,11 +67,11 @@ char* put(char* p, const char* s) {
 uint8_t format_plot_line(char buf[kLineMax], float roll_deg, float pitch_deg, float heading_deg) {
     int32_t c[3];
     if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
-    char* p = put(buf, "roll:");
+    char* p = put(buf, TXT("roll:"));
     p = put_centi(p, c[0]);
-    p = put(p, " pitch:");
+    p = put(p, TXT(" pitch:"));
     p = put_centi(p, c[1]);
-    p = put(p, " yaw:");
+    p = put(p, TXT(" yaw:"));
     p = put_centi(p, c[2]);
     *p++ = '\n';
     return (uint8_t)(p - buf);
@@ -89,7 +93,7 @@ uint8_t format_csv_line(char buf[kLineMax], uint32_t t_ms, float roll_deg, float
 namespace {
 
 // "label:value" with `decimals` decimals; false if v is not finite or |v| > limit.
-bool put_field(char*& p, const char* label, float v, uint8_t decimals, float limit) {
+bool put_field(char*& p, text::Flash label, float v, uint8_t decimals, float limit) {
     int32_t scaled;
     if (!(v >= -limit && v <= limit) || !text::to_fixed(v, decimals, scaled)) return false;
     p = put(p, label);
@@ -101,8 +105,8 @@ bool put_field(char*& p, const char* label, float v, uint8_t decimals, float lim
 
 uint8_t format_quat_line(char buf[kLineMax], const linalg::Quaternion& q) {
     char* p = buf;
-    if (!put_field(p, "qw:", q.w, 4, 1.0001f) || !put_field(p, " qx:", q.x, 4, 1.0001f) ||
-        !put_field(p, " qy:", q.y, 4, 1.0001f) || !put_field(p, " qz:", q.z, 4, 1.0001f))
+    if (!put_field(p, TXT("qw:"), q.w, 4, 1.0001f) || !put_field(p, TXT(" qx:"), q.x, 4, 1.0001f) ||
+        !put_field(p, TXT(" qy:"), q.y, 4, 1.0001f) || !put_field(p, TXT(" qz:"), q.z, 4, 1.0001f))
         return 0;
     *p++ = '\n';
     return (uint8_t)(p - buf);
@@ -112,11 +116,15 @@ uint8_t format_raw_line(char buf[kRawLineMax], const linalg::Vector3f& gyro_dps,
                         const linalg::Vector3f& field_uT) {
     constexpr float kGyroMaxDps = 9999.0f, kAccelMaxG = 40.0f, kFieldMaxUt = 999.9f;
     char* p = buf;
-    if (!put_field(p, "gx:", gyro_dps.x, 2, kGyroMaxDps) || !put_field(p, " gy:", gyro_dps.y, 2, kGyroMaxDps) ||
-        !put_field(p, " gz:", gyro_dps.z, 2, kGyroMaxDps) || !put_field(p, " ax:", accel_g.x, 3, kAccelMaxG) ||
-        !put_field(p, " ay:", accel_g.y, 3, kAccelMaxG) || !put_field(p, " az:", accel_g.z, 3, kAccelMaxG) ||
-        !put_field(p, " mx:", field_uT.x, 1, kFieldMaxUt) || !put_field(p, " my:", field_uT.y, 1, kFieldMaxUt) ||
-        !put_field(p, " mz:", field_uT.z, 1, kFieldMaxUt))
+    if (!put_field(p, TXT("gx:"), gyro_dps.x, 2, kGyroMaxDps) ||
+        !put_field(p, TXT(" gy:"), gyro_dps.y, 2, kGyroMaxDps) ||
+        !put_field(p, TXT(" gz:"), gyro_dps.z, 2, kGyroMaxDps) ||
+        !put_field(p, TXT(" ax:"), accel_g.x, 3, kAccelMaxG) ||
+        !put_field(p, TXT(" ay:"), accel_g.y, 3, kAccelMaxG) ||
+        !put_field(p, TXT(" az:"), accel_g.z, 3, kAccelMaxG) ||
+        !put_field(p, TXT(" mx:"), field_uT.x, 1, kFieldMaxUt) ||
+        !put_field(p, TXT(" my:"), field_uT.y, 1, kFieldMaxUt) ||
+        !put_field(p, TXT(" mz:"), field_uT.z, 1, kFieldMaxUt))
         return 0;
     *p++ = '\n';
     return (uint8_t)(p - buf);
