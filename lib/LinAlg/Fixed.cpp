@@ -1,5 +1,12 @@
 #include "Fixed.h"
 
+// -O2 here (the build is -Os): at -Os avr-gcc calls its register-saving prologue and
+// epilogue routines and keeps the small helpers out of line; -O2 saves ~120 cycles per
+// atan2 on the output path for ~1 KB of flash.
+#ifdef __AVR__
+#pragma GCC optimize("O2")
+#endif
+
 #ifdef __AVR__
 #include <avr/pgmspace.h>
 #define FIXED_PROGMEM PROGMEM

@@ -40,6 +40,9 @@ inline uint16_t bits_7_to_22(uint32_t x) {
 // x * 2^frac_bits, truncated toward zero, read from the float's bits (no float call;
 // inline: ~60 cycles on the AVR where a call with its register saving took ~140):
 // saturates at +-(2^31 - 1) (infinities too); NaN gives 0.
+#ifdef __AVR__
+__attribute__((always_inline))
+#endif
 inline int32_t fixed_from_float(float x, uint8_t frac_bits) {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
@@ -52,6 +55,10 @@ inline int32_t fixed_from_float(float x, uint8_t frac_bits) {
     const int16_t shift = (int16_t)((int16_t)exponent - 150 + (int16_t)frac_bits);
     if (shift >= 8) {
         m = 0x7FFFFFFFu;  // >= 2^31 (and infinity)
+    } else if (shift >= 4) {
+        // A byte left, then back right: 8 - shift <= 4 turns of the bit loop instead of
+        // shift <= 7 (matrix entries in [0.5, 1) have shift 6).
+        m = (m << 8) >> (uint8_t)(8 - shift);
     } else if (shift >= 0) {
         m <<= shift;
     } else {
