@@ -128,8 +128,9 @@ TEST(Fixed, HypotWithin2p5e5Relative) {
 
 // Random attitudes: the fixed-point angles against atan2/hypot in double on the same
 // float matrix. Up to 80 deg pitch: closer to the lock roll and yaw divide every error
-// of the entries by cos(pitch) (theta's 3.8e-6 rad rounding makes 0.005 deg at 87 deg);
-// there the round-trip tests of test_euler.cpp apply.
+// of the entries by cos(pitch) (a fast turn's theta, rounded to 3.8e-6 rad, makes
+// 0.005 deg at 87 deg); there the round-trip tests of test_euler.cpp and the slow-turn
+// test below apply.
 TEST(Fixed, EulerWithinHalfAPrintedCountAwayFromTheLock) {
     std::mt19937 rng(8);
     std::uniform_real_distribution<float> angle(-3.14159f, 3.14159f), lead(-0.03f, 0.03f);
@@ -161,6 +162,32 @@ TEST(Fixed, EulerWithinHalfAPrintedCountAwayFromTheLock) {
     EXPECT_LT(worst_carried, half_count_rad) << worst_carried * 180.0 / kPi << " deg";
     std::printf("worst: plain %.5f deg, carried %.5f deg\n", worst_plain * 180.0 / kPi,
                 worst_carried * 180.0 / kPi);
+}
+
+// Near the lock the lead's own rounding counts (roll and yaw divide it by cos(pitch)):
+// a slow turn (|theta| < 2^-10 rad, the board resting nose up) uses the fine step.
+TEST(Fixed, SlowTurnNearTheLockWithinHalfAPrintedCount) {
+    std::mt19937 rng(10);
+    std::uniform_real_distribution<float> angle(-3.14159f, 3.14159f), near(85.0f, 89.9f), lead(-9e-4f, 9e-4f);
+    double worst = 0.0;
+    for (int i = 0; i < 100000; ++i) {
+        const float pitch = near(rng) * (i % 2 ? 1.0f : -1.0f) * 0.0174532925f;
+        const Matrix3f r = dcm::dcm_from_euler(angle(rng), pitch, angle(rng));
+        const Vector3f theta(lead(rng), lead(rng), lead(rng));
+        const double m[3][3] = {{r.a.x, r.a.y, r.a.z}, {r.b.x, r.b.y, r.b.z}, {r.c.x, r.c.y, r.c.z}};
+        const double t[3] = {theta.x, theta.y, theta.z};
+        double p[3][3];
+        for (int k = 0; k < 3; ++k) {
+            p[k][0] = m[k][0] + m[k][1] * t[2] - m[k][2] * t[1];
+            p[k][1] = m[k][1] + m[k][2] * t[0] - m[k][0] * t[2];
+            p[k][2] = m[k][2] + m[k][0] * t[1] - m[k][1] * t[0];
+        }
+        const dcm::EulerAngles c = dcm::euler_carried(r, theta);
+        worst = std::max({worst, angle_diff(c.roll_rad, std::atan2(p[2][1], p[2][2])),
+                          angle_diff(c.pitch_rad, std::atan2(-p[2][0], std::hypot(p[2][1], p[2][2]))),
+                          angle_diff(c.yaw_rad, std::atan2(p[1][0], p[0][0]))});
+    }
+    EXPECT_LT(worst, 0.005 * kPi / 180.0) << worst * 180.0 / kPi << " deg";
 }
 
 TEST(Fixed, CarriedByZeroIsThePlainExtraction) {
