@@ -51,44 +51,51 @@ namespace {
 
 int32_t q30(float entry) { return linalg::fixed_from_float(entry, linalg::kQ30); }
 
-// theta rounded to an int16 in Q(frac_bits), saturated.
-int16_t theta_fixed(float theta_rad, uint8_t frac_bits) {
-    int32_t t = linalg::fixed_from_float(theta_rad, (uint8_t)(frac_bits + 1u));
-    t = (t + 1) >> 1;
-    return (int16_t)(t > 32767 ? 32767 : t < -32767 ? -32767 : t);
-}
 // A Q30 entry rounded to its top 16 bits (Q14) for the first-order terms: moves a
 // term by 2^-15 * |theta|, ~3e-7 at the output's typical theta (0.01 rad).
-int16_t q14(int32_t e_q30) { return (int16_t)((e_q30 + 0x8000) >> 16); }
-
-// e + p*tp - q*tq: Q30 + Q14 * Q(kThetaQ) shifted to Q30. In unsigned arithmetic: a
-// matrix far from a rotation (|entry| near 2) wraps instead of overflowing (its angles
-// are garbage but finite; a rotation's entries stay below 1.1 here).
-template <uint8_t kThetaQ>
-int32_t plus_cross(int32_t e, int16_t p, int16_t tp, int16_t q, int16_t tq) {
-    constexpr uint8_t kShift = (uint8_t)(14 + kThetaQ - 30);
-    return (int32_t)((uint32_t)e + (uint32_t)(((int32_t)p * tp) >> kShift) - (uint32_t)(((int32_t)q * tq) >> kShift));
-}
-
-// r' = r + r x theta = r + (r_y t_z - r_z t_y, r_z t_x - r_x t_z, r_x t_y - r_y t_x),
-// the seven entries the angles read.
-template <uint8_t kThetaQ>
-EulerAngles carried(const int32_t a[3], const int32_t b[3], const int32_t c[3], int16_t tx, int16_t ty, int16_t tz) {
-    return euler_from_q30(plus_cross<kThetaQ>(a[0], q14(a[1]), tz, q14(a[2]), ty),   // R11
-                          plus_cross<kThetaQ>(a[1], q14(a[2]), tx, q14(a[0]), tz),   // R12
-                          plus_cross<kThetaQ>(b[0], q14(b[1]), tz, q14(b[2]), ty),   // R21
-                          plus_cross<kThetaQ>(b[1], q14(b[2]), tx, q14(b[0]), tz),   // R22
-                          plus_cross<kThetaQ>(c[0], q14(c[1]), tz, q14(c[2]), ty),   // R31
-                          plus_cross<kThetaQ>(c[1], q14(c[2]), tx, q14(c[0]), tz),   // R32
-                          plus_cross<kThetaQ>(c[2], q14(c[0]), ty, q14(c[1]), tx));  // R33
-}
+FIXED_INLINE int16_t q14(int32_t e_q30) { return (int16_t)((e_q30 + 0x8000) >> 16); }
 
 // theta in int16: Q17 covers +-0.25 rad in steps of 7.6e-6 rad; below 2^-10 rad
-// (0.33 rad/s over the 3 ms lead: a slow turn) Q25 steps of 3e-8 rad. The step is a
-// rotation error, which roll and yaw divide by cos(pitch): near +-90 deg pitch,
-// where the board often rests still, the fine step keeps them within a count.
-constexpr uint8_t kThetaCoarseQ = 17, kThetaFineQ = 25;
-constexpr int16_t kFineLimit = 32767;
+// (0.33 rad/s over the 3 ms lead: a slow turn, a board at rest) Q25 steps of 3e-8 rad.
+// The step is a rotation error, which roll and yaw divide by cos(pitch): near +-90 deg
+// pitch the fine step keeps them within a count.
+struct Theta {
+    int16_t x, y, z;
+    bool fine;  // Q25, else Q17
+};
+
+// p*tp - q*tq (Q14 * theta) in Q30: Q31 >> 1 for a Q17 theta, Q39 >> 9 for Q25 (a
+// byte shift first: a whole byte is register moves on the AVR).
+FIXED_INLINE int32_t cross_term(const Theta& t, int16_t p, int16_t tp, int16_t q, int16_t tq) {
+    int32_t pp = linalg::mul_s16(p, tp), qq = linalg::mul_s16(q, tq);
+    if (t.fine) {
+        pp >>= 8;
+        qq >>= 8;
+    }
+    return (pp >> 1) - (qq >> 1);
+}
+// e + the cross term, in unsigned arithmetic: a matrix far from a rotation (|entry|
+// near 2) wraps instead of overflowing (its angles are garbage but finite; a
+// rotation's entries stay below 1.1 here).
+FIXED_INLINE int32_t plus_cross(int32_t e, const Theta& t, int16_t p, int16_t tp, int16_t q, int16_t tq) {
+    return (int32_t)((uint32_t)e + (uint32_t)cross_term(t, p, tp, q, tq));
+}
+
+// One conversion per axis (Q26), rounded to Q25, or when any axis is past the fine
+// range to Q17 (a byte and a bit further right), saturated at +-0.25 rad.
+FIXED_INLINE int16_t round_shift(int32_t q26, uint8_t right) {
+    const int32_t r = (q26 + ((int32_t)1 << (right - 1u))) >> right;
+    return (int16_t)(r > 32767 ? 32767 : r < -32767 ? -32767 : r);
+}
+Theta theta_for(const Vector3f& theta_rad) {
+    const int32_t x = linalg::fixed_from_float(theta_rad.x, 26), y = linalg::fixed_from_float(theta_rad.y, 26),
+                  z = linalg::fixed_from_float(theta_rad.z, 26);
+    constexpr int32_t kFineLimitQ26 = (int32_t)32767 << 1;  // 2^-10 rad
+    if (x > -kFineLimitQ26 && x < kFineLimitQ26 && y > -kFineLimitQ26 && y < kFineLimitQ26 &&
+        z > -kFineLimitQ26 && z < kFineLimitQ26)
+        return Theta{round_shift(x, 1), round_shift(y, 1), round_shift(z, 1), true};
+    return Theta{round_shift(x, 9), round_shift(y, 9), round_shift(z, 9), false};
+}
 
 }  // namespace
 
@@ -101,16 +108,19 @@ EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float
 }
 
 EulerAngles euler_carried(const Matrix3f& r, const Vector3f& theta_rad) {
+    const Theta t = theta_for(theta_rad);
     const int32_t a[3] = {q30(r.a.x), q30(r.a.y), q30(r.a.z)};
     const int32_t b[3] = {q30(r.b.x), q30(r.b.y), q30(r.b.z)};
     const int32_t c[3] = {q30(r.c.x), q30(r.c.y), q30(r.c.z)};
-    const int16_t fx = theta_fixed(theta_rad.x, kThetaFineQ), fy = theta_fixed(theta_rad.y, kThetaFineQ),
-                  fz = theta_fixed(theta_rad.z, kThetaFineQ);
-    if (fx > -kFineLimit && fx < kFineLimit && fy > -kFineLimit && fy < kFineLimit && fz > -kFineLimit &&
-        fz < kFineLimit)
-        return carried<kThetaFineQ>(a, b, c, fx, fy, fz);
-    return carried<kThetaCoarseQ>(a, b, c, theta_fixed(theta_rad.x, kThetaCoarseQ),
-                                  theta_fixed(theta_rad.y, kThetaCoarseQ), theta_fixed(theta_rad.z, kThetaCoarseQ));
+    // r' = r + r x theta = r + (r_y t_z - r_z t_y, r_z t_x - r_x t_z, r_x t_y - r_y t_x),
+    // the seven entries the angles read.
+    return euler_from_q30(plus_cross(a[0], t, q14(a[1]), t.z, q14(a[2]), t.y),   // R11
+                          plus_cross(a[1], t, q14(a[2]), t.x, q14(a[0]), t.z),   // R12
+                          plus_cross(b[0], t, q14(b[1]), t.z, q14(b[2]), t.y),   // R21
+                          plus_cross(b[1], t, q14(b[2]), t.x, q14(b[0]), t.z),   // R22
+                          plus_cross(c[0], t, q14(c[1]), t.z, q14(c[2]), t.y),   // R31
+                          plus_cross(c[1], t, q14(c[2]), t.x, q14(c[0]), t.z),   // R32
+                          plus_cross(c[2], t, q14(c[0]), t.y, q14(c[1]), t.x));  // R33
 }
 
 Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad) {

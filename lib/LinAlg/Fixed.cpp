@@ -106,11 +106,11 @@ __attribute__((noinline)) uint32_t mul16(uint16_t a, uint16_t b) { return (uint3
 
 // (x * g) >> 16 for a 32-bit x and a 16-bit g: two 16x16->32 multiplies (avr-gcc
 // would call its 32x32 routine, ~105 cycles, for the plain product, and lose the top).
-inline uint32_t mul_u32_u16_shr16(uint32_t x, uint16_t g) {
+FIXED_INLINE uint32_t mul_u32_u16_shr16(uint32_t x, uint16_t g) {
     return mul16((uint16_t)(x >> 16), g) + (mul16((uint16_t)x, g) >> 16);
 }
 
-inline uint16_t entry(const uint16_t* table, uint16_t i) {
+FIXED_INLINE uint16_t entry(const uint16_t* table, uint16_t i) {
 #ifdef __AVR__
     return pgm_read_word(table + i);
 #else
@@ -120,18 +120,20 @@ inline uint16_t entry(const uint16_t* table, uint16_t i) {
 
 // Linear interpolation at index i + f/2^16 of an increasing (sign +1) or decreasing
 // table, in the table's Q plus 16 bits.
-inline uint32_t interpolate_up(const uint16_t* table, uint16_t i, uint16_t f) {
+FIXED_INLINE uint32_t interpolate_up(const uint16_t* table, uint16_t i, uint16_t f) {
     const uint16_t lo = entry(table, i);
     const uint16_t step = (uint16_t)(entry(table, (uint16_t)(i + 1u)) - lo);
     return ((uint32_t)lo << 16) + mul16(step, f);
 }
-inline uint32_t interpolate_down(const uint16_t* table, uint16_t i, uint16_t f) {
+FIXED_INLINE uint32_t interpolate_down(const uint16_t* table, uint16_t i, uint16_t f) {
     const uint16_t hi = entry(table, i);
     const uint16_t step = (uint16_t)(hi - entry(table, (uint16_t)(i + 1u)));
     return ((uint32_t)hi << 16) - mul16(step, f);
 }
 
 }  // namespace
+
+__attribute__((noinline)) int32_t mul_s16(int16_t a, int16_t b) { return (int32_t)a * (int32_t)b; }
 
 int32_t atan_of_ratio_q24(uint32_t num, uint32_t den, uint32_t* ratio_q31) {
     if (den == 0) {

@@ -12,6 +12,15 @@
 #include <stdint.h>
 #include <string.h>
 
+// Small helpers on the output path forced inline on the AVR: out of line, -mcall-prologues
+// gives each one the register-saving routines (~40 cycles a call) whatever the
+// optimisation level.
+#ifdef __AVR__
+#define FIXED_INLINE __attribute__((always_inline)) inline
+#else
+#define FIXED_INLINE inline
+#endif
+
 namespace linalg {
 
 constexpr uint8_t kQ30 = 30;
@@ -40,10 +49,7 @@ inline uint16_t bits_7_to_22(uint32_t x) {
 // x * 2^frac_bits, truncated toward zero, read from the float's bits (no float call;
 // inline: ~60 cycles on the AVR where a call with its register saving took ~140):
 // saturates at +-(2^31 - 1) (infinities too); NaN gives 0.
-#ifdef __AVR__
-__attribute__((always_inline))
-#endif
-inline int32_t fixed_from_float(float x, uint8_t frac_bits) {
+FIXED_INLINE int32_t fixed_from_float(float x, uint8_t frac_bits) {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
     const uint8_t exponent = fixed_detail::bits_23_to_30(bits);
@@ -102,6 +108,11 @@ int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_negative, uint32
 // relative 2.5e-5 (and 1 unit), from the ratio t = min/max that atan_of_ratio_q24 gives:
 // max * sqrt(1 + t^2), the square root from a table. No overflow: < 1.42 * 2^31.
 uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31);
+
+// a * b for int16 factors, with avr-gcc's widening multiply (__mulhisi3, ~25 cycles):
+// out of line because inlined, gcc often turns (int32_t)a * b into its 32x32 routine
+// (__mulsi3, ~105 cycles).
+int32_t mul_s16(int16_t a, int16_t b);
 
 // |q| as an unsigned magnitude (|-2^31| fits).
 inline uint32_t magnitude(int32_t q) { return q < 0 ? (uint32_t)0 - (uint32_t)q : (uint32_t)q; }
