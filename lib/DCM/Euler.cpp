@@ -49,7 +49,7 @@ EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, i
 
 namespace {
 
-int32_t q30(float entry) { return linalg::fixed_from_float(entry, linalg::kQ30); }
+FIXED_INLINE int32_t q30(float entry) { return linalg::fixed_from_float(entry, linalg::kQ30); }
 
 // A Q30 entry rounded to its top 16 bits (Q14) for the first-order terms: moves a
 // term by 2^-15 * |theta|, ~3e-7 at the output's typical theta (0.01 rad).
