@@ -1,18 +1,25 @@
 #include "Format.h"
 
+#include "Fixed.h"
 #include "Text.h"
 
 namespace fmt {
 
 namespace {
 
-// Hundredths of an angle, rounded half away from zero: one float multiply, one add and
-// one conversion (~400 cycles on the 2560). False for NaN, infinities and anything
-// beyond a full turn (|c| > 36000), which is not an attitude angle.
+// Hundredths of an angle, rounded half away from zero, in integers: the angle read in
+// Q15 from its bits (|deg| < 360.005: < 2^24), times 100 (< 2^31), rounded (~250 cycles
+// on the 2560 where a float multiply, add and conversion took ~400; the Q15 truncation,
+// < 3.1e-5 deg, moves a value only within 0.003 % of a half count). False for NaN,
+// infinities and anything beyond a full turn (|c| > 36000), which is not an attitude
+// angle.
 bool centi_angle(float deg, int32_t& out) {
     if (!(deg > -360.005f && deg < 360.005f)) return false;  // NaN fails both
-    const float s = deg * 100.0f;
-    out = (int32_t)(s >= 0.0f ? s + 0.5f : s - 0.5f);
+    const int32_t q15 = linalg::fixed_from_float(deg, 15);
+    const uint32_t m = linalg::magnitude(q15) * 100u + 0x4000u;
+    // m >> 15 from whole bytes and one bit (the result is <= 36001).
+    const uint16_t c = (uint16_t)((uint16_t)((uint16_t)(m >> 16) << 1) | (uint16_t)((uint16_t)m >> 15));
+    out = q15 < 0 ? -(int32_t)c : (int32_t)c;
     return out >= -36000 && out <= 36000;
 }
 
