@@ -26,6 +26,29 @@ double angle_diff(double a, double b) {
     return d;
 }
 
+struct Angles {
+    double roll, pitch, yaw;
+};
+
+// R carried by theta (r' = r + r x theta) and its angles, in double: the reference.
+Angles carried_in_double(const Matrix3f& r, const Vector3f& theta) {
+    const double m[3][3] = {{r.a.x, r.a.y, r.a.z}, {r.b.x, r.b.y, r.b.z}, {r.c.x, r.c.y, r.c.z}};
+    const double t[3] = {theta.x, theta.y, theta.z};
+    double p[3][3];
+    for (int k = 0; k < 3; ++k) {
+        p[k][0] = m[k][0] + m[k][1] * t[2] - m[k][2] * t[1];
+        p[k][1] = m[k][1] + m[k][2] * t[0] - m[k][0] * t[2];
+        p[k][2] = m[k][2] + m[k][0] * t[1] - m[k][1] * t[0];
+    }
+    return Angles{std::atan2(p[2][1], p[2][2]), std::atan2(-p[2][0], std::hypot(p[2][1], p[2][2])),
+                  std::atan2(p[1][0], p[0][0])};
+}
+
+double worst_difference(const dcm::EulerAngles& e, const Angles& exact) {
+    return std::max({angle_diff(e.roll_rad, exact.roll), angle_diff(e.pitch_rad, exact.pitch),
+                     angle_diff(e.yaw_rad, exact.yaw)});
+}
+
 }  // namespace
 
 TEST(Fixed, FromFloatTruncatesAndSaturates) {
@@ -140,22 +163,10 @@ TEST(Fixed, EulerWithinHalfAPrintedCountAwayFromTheLock) {
         const Matrix3f r = dcm::dcm_from_euler(angle(rng), pitch, angle(rng));
         // theta up to 0.03 rad per axis: 10 rad/s (570 deg/s) over the 3 ms lead.
         const Vector3f theta(lead(rng), lead(rng), lead(rng));
-        const double m[3][3] = {{r.a.x, r.a.y, r.a.z}, {r.b.x, r.b.y, r.b.z}, {r.c.x, r.c.y, r.c.z}};
-        const double t[3] = {theta.x, theta.y, theta.z};
-        double p[3][3];
-        for (int k = 0; k < 3; ++k) {
-            p[k][0] = m[k][0] + m[k][1] * t[2] - m[k][2] * t[1];
-            p[k][1] = m[k][1] + m[k][2] * t[0] - m[k][0] * t[2];
-            p[k][2] = m[k][2] + m[k][0] * t[1] - m[k][1] * t[0];
-        }
-        const dcm::EulerAngles e = dcm::euler_from_dcm(r);
-        worst_plain = std::max({worst_plain, angle_diff(e.roll_rad, std::atan2(m[2][1], m[2][2])),
-                                angle_diff(e.pitch_rad, std::atan2(-m[2][0], std::hypot(m[2][1], m[2][2]))),
-                                angle_diff(e.yaw_rad, std::atan2(m[1][0], m[0][0]))});
-        const dcm::EulerAngles c = dcm::euler_carried(r, theta);
-        worst_carried = std::max({worst_carried, angle_diff(c.roll_rad, std::atan2(p[2][1], p[2][2])),
-                                  angle_diff(c.pitch_rad, std::atan2(-p[2][0], std::hypot(p[2][1], p[2][2]))),
-                                  angle_diff(c.yaw_rad, std::atan2(p[1][0], p[0][0]))});
+        const double plain = worst_difference(dcm::euler_from_dcm(r), carried_in_double(r, Vector3f()));
+        const double carried = worst_difference(dcm::euler_carried(r, theta), carried_in_double(r, theta));
+        worst_plain = std::max(worst_plain, plain);
+        worst_carried = std::max(worst_carried, carried);
     }
     const double half_count_rad = 0.005 * kPi / 180.0;
     EXPECT_LT(worst_plain, half_count_rad) << worst_plain * 180.0 / kPi << " deg";
@@ -174,18 +185,7 @@ TEST(Fixed, SlowTurnNearTheLockWithinHalfAPrintedCount) {
         const float pitch = near(rng) * (i % 2 ? 1.0f : -1.0f) * 0.0174532925f;
         const Matrix3f r = dcm::dcm_from_euler(angle(rng), pitch, angle(rng));
         const Vector3f theta(lead(rng), lead(rng), lead(rng));
-        const double m[3][3] = {{r.a.x, r.a.y, r.a.z}, {r.b.x, r.b.y, r.b.z}, {r.c.x, r.c.y, r.c.z}};
-        const double t[3] = {theta.x, theta.y, theta.z};
-        double p[3][3];
-        for (int k = 0; k < 3; ++k) {
-            p[k][0] = m[k][0] + m[k][1] * t[2] - m[k][2] * t[1];
-            p[k][1] = m[k][1] + m[k][2] * t[0] - m[k][0] * t[2];
-            p[k][2] = m[k][2] + m[k][0] * t[1] - m[k][1] * t[0];
-        }
-        const dcm::EulerAngles c = dcm::euler_carried(r, theta);
-        worst = std::max({worst, angle_diff(c.roll_rad, std::atan2(p[2][1], p[2][2])),
-                          angle_diff(c.pitch_rad, std::atan2(-p[2][0], std::hypot(p[2][1], p[2][2]))),
-                          angle_diff(c.yaw_rad, std::atan2(p[1][0], p[0][0]))});
+        worst = std::max(worst, worst_difference(dcm::euler_carried(r, theta), carried_in_double(r, theta)));
     }
     EXPECT_LT(worst, 0.005 * kPi / 180.0) << worst * 180.0 / kPi << " deg";
 }
