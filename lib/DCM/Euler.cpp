@@ -53,7 +53,9 @@ FIXED_INLINE int32_t q30(float entry) { return linalg::fixed_from_float(entry, l
 
 // A Q30 entry rounded to its top 16 bits (Q14) for the first-order terms: moves a
 // term by 2^-15 * |theta|, ~3e-7 at the output's typical theta (0.01 rad).
-FIXED_INLINE int16_t q14(int32_t e_q30) { return (int16_t)((e_q30 + 0x8000) >> 16); }
+// (In unsigned arithmetic: the rounding add wraps for an entry saturated at 2^31 - 1,
+// a garbage matrix, instead of overflowing.)
+FIXED_INLINE int16_t q14(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
 
 // theta in int16: Q17 covers +-0.25 rad in steps of 7.6e-6 rad; below 2^-10 rad
 // (0.33 rad/s over the 3 ms lead: a slow turn, a board at rest) Q25 steps of 3e-8 rad.
@@ -84,6 +86,10 @@ FIXED_INLINE int32_t plus_cross(int32_t e, const Theta& t, int16_t p, int16_t tp
 // One conversion per axis (Q26), rounded to Q25, or when any axis is past the fine
 // range to Q17 (a byte and a bit further right), saturated at +-0.25 rad.
 FIXED_INLINE int16_t round_shift(int32_t q26, uint8_t right) {
+    // Limited to +-2^30 first (32 rad, far past the saturation) so that the rounding
+    // add cannot overflow.
+    constexpr int32_t kLimit = (int32_t)1 << 30;
+    q26 = q26 > kLimit ? kLimit : q26 < -kLimit ? -kLimit : q26;
     const int32_t r = (q26 + ((int32_t)1 << (right - 1u))) >> right;
     return (int16_t)(r > 32767 ? 32767 : r < -32767 ? -32767 : r);
 }
