@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 
 #include "Format.h"
@@ -166,4 +167,27 @@ TEST(Format, FixedPointAtEveryPrecision) {
     EXPECT_FALSE(text::to_fixed(3e5f, 4, v));  // 3e9 does not fit
     EXPECT_FALSE(text::to_fixed(1.0f, 5, v));
     EXPECT_EQ(v, 7);
+}
+
+// The hundredths come from the angle's bits in Q15: the printed value is the exact
+// angle rounded half away from zero, except within the Q15 truncation (3.1e-5 deg,
+// 0.0031 of a count) of a half count.
+TEST(Format, HundredthsAreTheExactAngleRounded) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> deg(-360.0f, 360.0f);
+    int checked = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const float a = deg(rng) * std::pow(2.0f, -(float)(i % 12));
+        const double exact = (double)a * 100.0;
+        const double frac = std::fabs(exact) - std::floor(std::fabs(exact));
+        if (std::fabs(frac - 0.5) < 0.0032) continue;
+        const long expected = (long)(exact >= 0.0 ? std::floor(exact + 0.5) : -std::floor(-exact + 0.5));
+        const std::string line = csv(0, a, 0.0f, 0.0f);
+        ASSERT_FALSE(line.empty()) << a;
+        const std::string field = line.substr(2, line.find(',', 2) - 2);
+        char buf[16];
+        ASSERT_EQ(field, std::string(buf, text::format_centi(buf, (int32_t)expected))) << a;
+        ++checked;
+    }
+    EXPECT_GT(checked, 190000);
 }

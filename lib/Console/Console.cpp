@@ -230,23 +230,44 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
     }
 }
 
+static_assert((uint8_t)CommandId::Defaults < 16 && (uint8_t)Error::BadCalTarget < 16,
+              "CommandQueue packs id and error into 4 bits each");
+
+CommandQueue::Packed CommandQueue::pack(const Command& c) {
+    const uint16_t v = c.id == CommandId::Mode ? (uint16_t)c.mode : (uint16_t)c.value;
+    return Packed{(uint8_t)((uint8_t)c.id | (uint8_t)((uint8_t)c.error << 4)), (uint8_t)(v & 0xFFu),
+                  (uint8_t)(v >> 8)};
+}
+
+Command CommandQueue::unpack(const Packed& p) {
+    Command c = make((CommandId)(p.id_error & 0x0Fu));
+    c.error = (Error)(p.id_error >> 4);
+    const uint16_t v = (uint16_t)(p.value_lo | (uint16_t)((uint16_t)p.value_hi << 8));
+    if (c.id == CommandId::Mode) c.mode = (fmt::OutputMode)v;
+    else if (c.id == CommandId::Error) c.value = v;  // a count, 0..0xFFFF
+    else c.value = (int16_t)v;                       // rate, decl: signed
+    return c;
+}
+
 bool CommandQueue::push(const Command& c) {
     // Merged only into the newest item, so that replies keep the order of the lines.
     if (c.id == CommandId::Error && count_ >= kErrorSlots) {
-        Command& newest = items_[(uint8_t)((head_ + count_ - 1u) % kCapacity)];
-        if (newest.id == CommandId::Error) {
-            if (newest.value < 0xFFFF) ++newest.value;
+        Packed& newest = items_[(uint8_t)((head_ + count_ - 1u) % kCapacity)];
+        if ((newest.id_error & 0x0Fu) == (uint8_t)CommandId::Error) {
+            Command merged = unpack(newest);
+            if (merged.value < 0xFFFF) ++merged.value;
+            newest = pack(merged);
             return true;
         }
     }
     if (full()) return false;
-    items_[(uint8_t)((head_ + count_) % kCapacity)] = c;
+    items_[(uint8_t)((head_ + count_) % kCapacity)] = pack(c);
     ++count_;
     return true;
 }
 
 Command CommandQueue::pop() {
-    const Command c = items_[head_];
+    const Command c = unpack(items_[head_]);
     head_ = (uint8_t)((head_ + 1u) % kCapacity);
     --count_;
     return c;

@@ -161,12 +161,24 @@ void StatusText::end_line() {
     id_ = 0;
 }
 
+namespace {
+// True if the len bytes at s begin with the TXT string prefix (flash on the AVR: not
+// SRAM).
+bool starts_with(const char* s, uint8_t len, text::Flash prefix) {
+    for (uint8_t i = 0;; ++i) {
+        const char ch = (char)text::flash_byte(prefix.p + i);
+        if (ch == '\0') return true;
+        if (i >= len || s[i] != ch) return false;
+    }
+}
+}  // namespace
+
 void StatusText::flush_chunk() {
     if (chunk_seq_ == 0) {
         // The first word gives the severity ("# error: ..." and "# warn: ..." lines).
         severity_ = Severity::Info;
-        if (len_ >= 6 && memcmp(chunk_, "error:", 6) == 0) severity_ = Severity::Error;
-        else if (len_ >= 5 && memcmp(chunk_, "warn:", 5) == 0) severity_ = Severity::Warning;
+        if (starts_with(chunk_, len_, TXT("error:"))) severity_ = Severity::Error;
+        else if (starts_with(chunk_, len_, TXT("warn:"))) severity_ = Severity::Warning;
     }
     uint8_t frame[kMaxFrame];
     const uint8_t n = packer_.statustext(frame, severity_, chunk_, len_, id_, chunk_seq_);
