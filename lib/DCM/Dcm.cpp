@@ -392,11 +392,9 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
 }
 
 EulerAngles Dcm::euler_now() const {
-    const Vector3f theta = last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad();
-    const Vector3f a = r_.a + r_.a.cross(theta);
-    const Vector3f b = r_.b + r_.b.cross(theta);
-    const Vector3f c = r_.c + r_.c.cross(theta);
-    return euler_from_entries(a.x, a.y, b.x, b.y, c.x, c.y, c.z);
+    // R carried forward by the lead and any turn not yet integrated (none after
+    // bring_up_to_date(), which the pipeline calls before a line), in fixed point.
+    return euler_carried(r_, last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad());
 }
 
 bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,

@@ -276,6 +276,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
+        dcm_.bring_up_to_date();  // the line shows the last sample's attitude (50 Hz: on the update's own step)
     }
     // The deferred compass work (the cal mag sums, the learner: each ~20-50 k cycles on
     // the AVR) goes on a step with neither an output line, a heading correction nor the
