@@ -183,7 +183,7 @@ def section_id(name):
     return None
 
 
-def measure_cycles(build, out_dir, seconds):
+def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
     sim = tool(build, "apm25sim")
     scen = tool(build, "scenario")
     elf = os.path.join(build, "firmware.elf")
@@ -192,14 +192,14 @@ def measure_cycles(build, out_dir, seconds):
                    if not ok]
         log("cycles not measured: missing %s (make all)" % ", ".join(missing))
         return None
-    traj = os.path.join(out_dir, "scenarios", "tilt_tour.csv")
+    traj = os.path.join(out_dir, "scenarios", scenario + ".csv")
     os.makedirs(os.path.dirname(traj), exist_ok=True)
     with open(traj, "w") as f:
-        r = subprocess.run([scen, "tilt_tour"], stdout=f, stderr=subprocess.PIPE, text=True)
+        r = subprocess.run([scen, scenario], stdout=f, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
-        log("scenario tilt_tour failed: %s" % r.stderr.strip())
+        log("scenario %s failed: %s" % (scenario, r.stderr.strip()))
         return None
-    prof = os.path.join(out_dir, "profile.csv")
+    prof = os.path.join(out_dir, "profile.csv" if scenario == "tilt_tour" else "profile_%s.csv" % scenario)
     if os.path.exists(prof):
         os.remove(prof)
     cmd = [sim, "--elf", elf, "--trajectory", traj, "--seconds", str(seconds), "--profile", prof]
@@ -413,6 +413,9 @@ def main():
     # 1. size and cycles
     size = measure_size(build)
     cycles = measure_cycles(build, out_dir, args.seconds)
+    # Issue 10 measures a shaking board too (the vibration keeps the rest test and the
+    # integrator hold busy).
+    cycles_shake = measure_cycles(build, out_dir, args.seconds, "shake")
 
     # 2. accuracy
     replay = tool(build, "replay")
@@ -582,6 +585,13 @@ def main():
         if cycles["load"] is not None:
             rep.append("Loop CPU load at 200 Hz: %.1f %% (section 6 cycles / run window of %s cycles)." % (
                 cycles["load"], fmt(int(cycles["window"]))))
+        if cycles_shake:
+            ss = cycles_shake["sections"]
+            pick = lambda n, k: fmt(ss[n][k], 0) if n in ss else "–"
+            rep += ["", "Scenario `shake` (%g s): estimator step %s avg / %s max, Euler %s, loop %s avg / %s max "
+                    "(%s %%)." % (cycles_shake["seconds"], pick(1, "avg"), pick(1, "max"), pick(2, "avg"),
+                                  pick(6, "avg"), pick(6, "max"),
+                                  "%.1f" % cycles_shake["load"] if cycles_shake["load"] is not None else "–")]
     else:
         rep.append("Not measured (apm25sim, scenario or firmware.elf missing, or the run failed).")
     rep.append("")

@@ -195,13 +195,18 @@ static void take_console_input() {
 }
 
 // A sample is missed when the next read comes more than 1.5 periods (7.5 ms) after the
-// previous one. The longest command, status, takes 3.4 ms (54 k cycles), so a command
-// starts only within 3.5 ms of the last sample: after a step that used more of its
-// period it waits for the next one (a step averages ~3 ms, so most do not wait).
-constexpr uint32_t kCommandLatestStartUs = 3500;
+// previous one. A short reply (an error, rate, decl, mode, save: under 0.7 ms) may start
+// up to 6 ms after the last sample; the long ones (status takes 3.4 ms, help 1.4 ms)
+// start only within 3.5 ms of it, and after a step that used more of its period they
+// wait for the next one (a step averages ~3 ms).
+constexpr uint32_t kShortCommandLatestStartUs = 6000;
+constexpr uint32_t kLongCommandLatestStartUs = 3500;
 static void run_console_command() {
-    if (commands.empty() || serial_text::room() < console::reply_bound(commands.peek()) + fmt::kRawLineMax) return;
-    if (imu.us_since_sample(micros()) > kCommandLatestStartUs) return;
+    if (commands.empty()) return;
+    const uint16_t reply_bytes = console::reply_bound(commands.peek());
+    if (serial_text::room() < reply_bytes + fmt::kRawLineMax) return;
+    const uint32_t latest_us = reply_bytes < console::kLongReply ? kShortCommandLatestStartUs : kLongCommandLatestStartUs;
+    if (imu.us_since_sample(micros()) > latest_us) return;
     execute(commands.pop());
 }
 

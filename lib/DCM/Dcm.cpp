@@ -21,7 +21,8 @@ constexpr float kRestFieldMove_uT = 1.0f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
 // 1/n for the means of n samples (no division on the AVR).
-constexpr float kInverse[Dcm::kCorrectionDivider] = {1.0f, 0.5f, 1.0f / 3.0f, 0.25f};
+constexpr uint8_t kMaxWindow = 8;
+constexpr float kInverse[kMaxWindow] = {1.0f, 0.5f, 1.0f / 3.0f, 0.25f, 0.2f, 1.0f / 6.0f, 1.0f / 7.0f, 0.125f};
 }  // namespace
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
@@ -84,7 +85,7 @@ void Dcm::learn_field(float norm, float down_component) {
     mag_ref_down_ = mag_candidate_down_ = down_component;
 }
 
-void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
+void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool line_due) {
     if (!initialised()) {
         init(accel_m_s2, last_mag_field_);
         return;
@@ -133,37 +134,12 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
         status_ |= kStatusAccelIgnored;
         rest_corrections_ = 0;  // a broken read is no rest
     }
-    // The roll/pitch error (Premerlani & Bizard eq. 27, measured down x estimated
-    // down) moves slowly once low-passed: it is worked out every kCorrectionDivider
-    // steps and applied at every step in between.
-    // Worked out half-way between two integrations, so that no step carries both.
-    if (++correction_phase_ >= kCorrectionDivider) correction_phase_ = 0;
-    if (correction_phase_ == kCorrectionDivider / 2) {
-        profile::begin(profile::kGravity);
-        if (window_samples_ > 0) {
-            const float inv_n = kInverse[window_samples_ - 1];
-            const Vector3f gyro_mean = gyro_sum_rad_s_ * inv_n;
-            const Vector3f accel_mean = accel_sum_m_s2_ * inv_n;
-            // Sample j of the window meets the matrix of the step before it, R_(j-1) =
-            // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind
-            // this step's sample by the steps not yet integrated and this one, so the
-            // steps are (n - j + 1) - (pending + 1), and sum_j phi_j x a_j is
-            // w dt x (sum_j (n - j + 1) a_j - (pending + 1) sum_j a_j): the first sum is
-            // the sum of the running sums, three additions a step. (Weighting each
-            // sample, not the mean, matters under a 10 g shake while turning.)
-            const Vector3f turn_per_step = (gyro_mean - offset_rad_s_) * settings_.step_s;
-            const Vector3f weighted = accel_sum_of_sums_ - accel_sum_m_s2_ * (float)(pending_steps_ + 1);
-            const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
-            accel_lp_ef_ += (r_ * (accel_mean - turn_per_step.cross(weighted) * inv_n) - accel_lp_ef_) * alpha;
-            detect_rest(gyro_mean, accel_mean, window_samples_ == kCorrectionDivider);
-        }
-        gyro_sum_rad_s_ = Vector3f();
-        accel_sum_m_s2_ = Vector3f();
-        accel_sum_of_sums_ = Vector3f();
-        window_samples_ = 0;
-        correct_tilt(startup_left, hold_integrator);
-        offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
-        profile::end(profile::kGravity);
+    // The roll/pitch error (Premerlani & Bizard eq. 27) moves slowly once low-passed:
+    // it is worked out every kCorrectionDivider steps and applied at every step in
+    // between (below, on a step without an integration).
+    if (++correction_phase_ >= kCorrectionDivider) {
+        correction_phase_ = 0;
+        gravity_due_ = true;
     }
 
     // Gyro integration, multi-rate (Savage, "Strapdown Inertial Navigation Integration
@@ -184,7 +160,17 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2) {
         first_half_rad_s_ = turn_sum_rad_s_;
         turn_sum_rad_s_ = Vector3f();
     }
-    if (pending_steps_ >= kIntegrationSteps) integrate();
+    // One heavy part a step at most: the integration when due (or before an output
+    // line, line_due, with two or more steps waiting), else the gravity correction
+    // when due (a step later costs nothing: it follows a 3 s low-pass).
+    heavy_ = true;
+    if (pending_steps_ >= kIntegrationSteps || (line_due && pending_steps_ >= 2)) {
+        integrate();
+    } else if (gravity_due_) {
+        correct_gravity(startup_left, hold_integrator);
+    } else {
+        heavy_ = false;
+    }
     if (steps_ < 0xFFFFFFFFu) ++steps_;
 }
 
@@ -219,6 +205,37 @@ void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, boo
     status_ |= kStatusAtRest;
     bias_rad_s_ += (rest_gyro_mean_rad_s_ - bias_rad_s_) * rest_bias_alpha_;
     clamp_bias();
+}
+
+// The gravity correction: the accel window low-passed in earth axes, the rest test,
+// and the roll/pitch error (correct_tilt).
+void Dcm::correct_gravity(float startup_left, bool hold_integrator) {
+    profile::begin(profile::kGravity);
+    gravity_due_ = false;
+    if (window_samples_ > 0) {
+        const float inv_n = window_samples_ <= kMaxWindow ? kInverse[window_samples_ - 1] : 1.0f / (float)window_samples_;
+        const Vector3f gyro_mean = gyro_sum_rad_s_ * inv_n;
+        const Vector3f accel_mean = accel_sum_m_s2_ * inv_n;
+        // Sample j of the window meets the matrix of the step before it, R_(j-1) =
+        // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
+        // step's sample by the steps not yet integrated (this one among them), so the
+        // steps are (n - j + 1) - pending, and sum_j phi_j x a_j is
+        // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
+        // of the running sums, three additions a step. (Weighting each sample, not the
+        // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
+        const Vector3f turn_per_step = (gyro_mean - offset_rad_s_) * settings_.step_s;
+        const Vector3f weighted = accel_sum_of_sums_ - accel_sum_m_s2_ * (float)pending_steps_;
+        const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
+        accel_lp_ef_ += (r_ * (accel_mean - turn_per_step.cross(weighted) * inv_n) - accel_lp_ef_) * alpha;
+        detect_rest(gyro_mean, accel_mean, window_samples_ >= kCorrectionDivider);
+    }
+    gyro_sum_rad_s_ = Vector3f();
+    accel_sum_m_s2_ = Vector3f();
+    accel_sum_of_sums_ = Vector3f();
+    window_samples_ = 0;
+    correct_tilt(startup_left, hold_integrator);
+    offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
+    profile::end(profile::kGravity);
 }
 
 // R <- R exp([theta x]) with theta the summed turn and its coning term (eq. 17, exact
@@ -392,8 +409,8 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
 }
 
 EulerAngles Dcm::euler_now() const {
-    // R carried forward by the lead and any turn not yet integrated (none after
-    // bring_up_to_date(), which the pipeline calls before a line), in fixed point.
+    // R carried forward by the lead and any turn not yet integrated (at most one step
+    // when the update was told a line is due), in fixed point.
     return euler_carried(r_, last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad());
 }
 

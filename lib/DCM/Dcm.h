@@ -137,7 +137,9 @@ public:
     // every kCorrectionDivider steps, applied at every step). A non-finite gyro
     // sample is rejected (not integrated); a non-finite or absurd accel sample gets
     // no weight.
-    void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2);
+    // line_due: an output line follows this step; the matrix is brought up to date for it
+    // (Dcm::integrate when two or more steps wait; one is carried by euler_now()).
+    void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2, bool line_due = false);
 
     // Yaw drift correction from a new magnetometer sample (call when one arrives,
     // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down,
@@ -160,14 +162,7 @@ public:
     // The last update turned the matrix or worked out the gravity correction (the
     // step's two heavy parts, each on its own step): a caller with deferrable work
     // (the compass learner) puts it on another step.
-    // Integrates the rates summed so far now rather than at the next fourth step, when
-    // two or more steps wait: the matrix is then the attitude of the last sample, or one
-    // step behind it, which euler_now() carries to first order (|turn|^2 / 2: 0.05 deg at
-    // 500 deg/s). Called before an output line.
-    void bring_up_to_date() {
-        if (pending_steps_ >= 2) integrate();
-    }
-    bool heavy_step() const { return pending_steps_ == 0 || correction_phase_ == kCorrectionDivider / 2; }
+    bool heavy_step() const { return heavy_; }
     uint8_t status() const { return status_; }
     uint16_t recoveries() const { return recoveries_; }
     const linalg::Matrix3f& matrix() const { return r_; }
@@ -197,6 +192,7 @@ public:
 private:
     void correct_tilt(float startup_left, bool hold_integrator);
     void integrate();
+    void correct_gravity(float startup_left, bool hold_integrator);
     linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
     void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
     bool renormalise(float& skew);  // skew: the X.Y it found
@@ -244,6 +240,8 @@ private:
     linalg::Vector3f first_half_rad_s_;  // corrected rates summed over the integration's first half
     linalg::Vector3f turn_sum_rad_s_;    // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
+    bool gravity_due_ = false;           // a gravity correction waits for a step without an integration
+    bool heavy_ = false;                 // the last update integrated or corrected gravity
     linalg::Vector3f last_rate_rad_s_;   // the last corrected rate, to bring field samples up to date
     float mag_ref_norm_ = 0.0f;          // learned field strength
     bool mag_take_heading_ = true;       // reset_mag_reference's take_heading

@@ -246,10 +246,19 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     const float nan = __builtin_nanf("");
     const Vector3f gyro_rad_s = calib::apply_gyro(settings_.cal, s.gyro_rad_s);
     profile::end(profile::kChecks);
-    dcm_.update(gyro_rad_s, accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2);
+    const bool heading_corrected = st_.mag_pending && st_.mag_present;
+    st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
+    // A line (Euler angles and formatting, ~10 k cycles on the AVR) is not made on a
+    // step that corrects the heading (~16 k): it moves to the next step, 5 ms later, so
+    // that no step carries both. The DCM brings its matrix up to date for it.
+    if (st_.output_acc >= kRateHz && !heading_corrected) {
+        st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
+        if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
+        st_.output_due = true;
+    }
+    dcm_.update(gyro_rad_s, accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2, st_.output_due);
     // The board's turn for the compass learner: the gyro alone, less the estimator's bias.
     turn_rad_ += (gyro_rad_s - dcm_.gyro_bias_rad_s()) * kStep_s;
-    const bool heading_corrected = st_.mag_pending && st_.mag_present;
     if (heading_corrected) {
         profile::begin(profile::kCompass);
         dcm_.correct_heading(mag_cal_uT_);
@@ -268,21 +277,11 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
     }
 
-    st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
-    // A line (Euler angles and formatting, ~25 k cycles on the AVR) is not made on a
-    // step that corrected the heading (the estimator's heaviest, ~65 k): it moves to
-    // the next step, 5 ms later, so that no step carries both and overruns the period.
-    if (st_.output_acc >= kRateHz && !heading_corrected) {
-        st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
-        if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
-        st_.output_due = true;
-        dcm_.bring_up_to_date();  // the line shows the last sample's attitude (50 Hz: on the update's own step)
-    }
     // The deferred compass work (the cal mag sums, the learner: each ~20-50 k cycles on
     // the AVR) goes on a step with neither an output line, a heading correction nor the
     // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
-    // two heavy parts (of four steps two are the DCM's; the compass' 75 Hz and a 50 Hz
-    // output leave ~40 free steps a second; a sample waits at most a few steps).
+    // two heavy parts beyond an integration with a heading correction or a line (of four
+    // steps two are the DCM's; a sample waits at most a few steps).
     if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
