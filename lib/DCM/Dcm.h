@@ -132,11 +132,12 @@ public:
     // Returns false (and stays uninitialised) when gravity is unusable.
     bool init(const linalg::Vector3f& accel_m_s2, const linalg::Vector3f& mag_field);
 
-    // One fixed step: integrate the gyro (R <- R exp([w dt x]), to second order),
-    // renormalise, and feed gravity to the roll/pitch drift correction (worked out
-    // every kCorrectionDivider steps, applied at every step). A non-finite gyro
-    // sample is rejected (not integrated); a non-finite or absurd accel sample gets
-    // no weight.
+    // One fixed step: the corrected rate and the accel sample are summed; every
+    // kIntegrationSteps steps the summed turn rotates R (R <- R exp([theta x]), with
+    // coning) and R is renormalised; every kCorrectionDivider steps the gravity
+    // correction is worked out (applied at every step); never both in one step. A
+    // non-finite gyro sample is rejected (not summed); a non-finite or absurd accel
+    // sample gets no weight.
     // line_due: an output line follows this step; the matrix is brought up to date for it
     // (Dcm::integrate when two or more steps wait; one is carried by euler_now()).
     void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2, bool line_due = false);
