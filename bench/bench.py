@@ -242,12 +242,16 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
 # Accuracy: tasks run in a pool
 
 def task_replay(args):
-    """Our estimator through build/replay on one trajectory, scored by build/score."""
-    label, traj, est_path, replay, score = args
+    """Our estimator through build/replay on one trajectory, scored by build/score. An
+    optional sixth item lists replay's --set assignments (bench/tune.py)."""
+    label, traj, est_path, replay, score = args[:5]
+    sets = args[5] if len(args) > 5 else ()
+    cmd = [replay, "--trajectory", traj]
+    for assignment in sets:
+        cmd += ["--set", assignment]
     t0 = time.time()
     with open(est_path, "w") as f:
-        r = subprocess.run([replay, "--trajectory", traj], stdout=f, stderr=subprocess.PIPE, text=True,
-                           timeout=1800)
+        r = subprocess.run(cmd, stdout=f, stderr=subprocess.PIPE, text=True, timeout=1800)
     if r.returncode != 0:
         return ("replay", label, None, "replay failed (exit %d): %s" % (r.returncode, r.stderr.strip()[-300:]),
                 time.time() - t0)

@@ -20,7 +20,6 @@ choice (they are the check that the gains hold on a different world).
 """
 import argparse
 import itertools
-import json
 import os
 import subprocess
 import sys
@@ -52,39 +51,25 @@ def folds_of(trials):
 
 
 def run_ours(args):
+    """bench.task_replay with replay --set: (label, settings, score or None, error)."""
     label, traj, sets, build, est_dir = args
     tag = bench.slug(" ".join(sets))[:60] or "defaults"
     est = os.path.join(est_dir, "%s-%s.csv" % (label, tag))
-    cmd = [os.path.join(build, "replay"), "--trajectory", traj]
-    for s in sets:
-        cmd += ["--set", s]
-    with open(est, "w") as f:
-        r = subprocess.run(cmd, stdout=f, stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0:
-        return label, tuple(sets), None, r.stderr.strip()
-    s = subprocess.run([os.path.join(build, "score"), "--trajectory", traj, "--estimate", est, "--csv"],
-                       capture_output=True, text=True)
-    os.remove(est)
-    if s.returncode != 0:
-        return label, tuple(sets), None, s.stderr.strip()
-    return label, tuple(sets), bench.parse_score_csv(s.stdout), None
+    _, _, score, err, _ = bench.task_replay((label, traj, est, os.path.join(build, "replay"),
+                                             os.path.join(build, "score"), sets))
+    if os.path.exists(est):
+        os.remove(est)
+    return label, tuple(sets), score, err
 
 
 def run_vqf(args):
+    """VQF's score on one file, from bench's peer cache or computed into it (bench.task_peers)."""
     label, traj, cache_dir = args
-    import numpy as np
-    import peers
     key = bench.peer_cache_key(bench.file_hash(traj))
     cached = bench.load_cached_peer(cache_dir, key, "VQF")
-    if cached is not None:
-        return label, cached
-    tr = peers.load_trajectory(traj)
-    q = peers.run_vqf(tr)
-    s = peers.score(tr["quat"], q, tr["movement"])
-    step = max(1, int(round(0.02 / peers.sample_period(tr["t"]))))
-    np.savez_compressed(os.path.join(cache_dir, "%s-%s.npz" % (key, bench.slug("VQF"))), t=tr["t"][::step],
-                        q=q[::step].astype(np.float32), score=json.dumps(s))
-    return label, s
+    if cached is None:
+        cached = bench.task_peers((label, traj, ["VQF"], cache_dir, key))[2]["VQF"]
+    return label, cached
 
 
 # Sensor errors of a real board (scenario's options): "+uncal" the whole uncalibrated board
