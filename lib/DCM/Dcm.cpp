@@ -145,8 +145,9 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     // Gyro integration, multi-rate (Savage, "Strapdown Inertial Navigation Integration
     // Algorithm Design", part 1): the corrected rates are summed at every step, and
     // every kIntegrationSteps steps the summed rotation vector turns the matrix, with
-    // the two-sample coning term (2/3) A x B of its two halves A and B (Savage eq. 55:
-    // the rotation vector of a rotation whose axis moved within the interval). The
+    // the two-sample coning term (2/3) A x B of its two halves A and B (Savage's
+    // two-sample coning algorithm: the rotation vector of a rotation whose axis moved
+    // within the interval). The
     // error against a 200 Hz update on BROAD's fast rotations: README, Performance.
     if (gyro_ok) {
         Vector3f rate_rad_s = gyro_rad_s - offset_rad_s_;
