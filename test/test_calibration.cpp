@@ -422,9 +422,8 @@ namespace {
 
 void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
 
-mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) {
-    return mpu6000::Sample{gyro, accel, 25.0f, false, false};
-}
+// The sample the MPU6000 gives for these values (counts of its 2000 deg/s and 8 g ranges).
+mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) { return mpu6000::sample_from_si(gyro, accel, 25.0f); }
 
 // North-facing level board: field north and down (dip ~60 deg).
 const Vector3f kFieldNorthDown(20.0f, 0.0f, 40.0f);
@@ -444,7 +443,8 @@ TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
     }
     EXPECT_EQ(first_output, calib::kGyroWindow - 1);  // the step that finished the calibration
     EXPECT_EQ(p.phase(), pipeline::Phase::Running);
-    EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, kBias.x, 1e-6f);
+    // The mean of what the sensor gave: kBias in whole counts.
+    EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, imu(kBias, kLevel).gyro_rad_s().x, 1e-6f);
     const pipeline::Angles a = p.angles();
     EXPECT_NEAR(a.roll_deg, 0.0f, 0.1f);
     EXPECT_NEAR(a.pitch_deg, 0.0f, 0.1f);
@@ -528,7 +528,7 @@ TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
     EXPECT_NE(log.find("# warn: MPU6000 accel saturated"), std::string::npos) << log;
     // The gyro still counts: 0.5 s at 20 deg/s about x with a stuck accel rolls 10 deg.
     mpu6000::Sample turning = clipped;
-    turning.gyro_rad_s = kBias + Vector3f(20.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    turning.gyro = imu(kBias + Vector3f(20.0f * linalg::kRadPerDeg, 0.0f, 0.0f), Vector3f()).gyro;
     for (int i = 0; i < 100; ++i) p.on_imu_sample(turning);
     EXPECT_NEAR(p.angles().roll_deg, 10.0f, 0.3f);
 }
@@ -571,7 +571,8 @@ TEST(Pipeline, MagCalibrationCommand) {
     EXPECT_TRUE(p.settings().cal.mag_scale == Vector3f(1.0f, 1.0f, 1.0f));
     // Defaults keep the gyro bias measured at this start.
     p.restore_defaults();
-    EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, kBias.x, 1e-6f);
+    // The mean of what the sensor gave: kBias in whole counts.
+    EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, imu(kBias, kLevel).gyro_rad_s().x, 1e-6f);
 }
 
 // A board turning about down at 1 rad/s with (8, -5, 0) uT of hard iron: the pipeline's

@@ -31,25 +31,25 @@ TEST(Mpu6000Decode, EachAxisMapsToTheBodyFrame) {
     mpu6000::Sample s{};
     ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s),
               mpu6000::BurstStatus::Ok);
-    EXPECT_NEAR(s.accel_m_s2.x, 0.0f, 1e-6f);
-    EXPECT_NEAR(s.accel_m_s2.y, kG, 1e-4f);
-    EXPECT_NEAR(s.gyro_rad_s.y, 100.0f * kD2R, 1e-5f);
-    EXPECT_NEAR(s.gyro_rad_s.x, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.accel_m_s2().x, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.accel_m_s2().y, kG, 1e-4f);
+    EXPECT_NEAR(s.gyro_rad_s().y, 100.0f * kD2R, 1e-5f);
+    EXPECT_NEAR(s.gyro_rad_s().x, 0.0f, 1e-6f);
 
     const int16_t y_only[7] = {0, 4096, 0, 0, 0, -1640, 0};
     make_burst(raw, y_only);
     ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s),
               mpu6000::BurstStatus::Ok);
-    EXPECT_NEAR(s.accel_m_s2.x, kG, 1e-4f);
-    EXPECT_NEAR(s.gyro_rad_s.x, -100.0f * kD2R, 1e-5f);
+    EXPECT_NEAR(s.accel_m_s2().x, kG, 1e-4f);
+    EXPECT_NEAR(s.gyro_rad_s().x, -100.0f * kD2R, 1e-5f);
 
     // Level at rest the chip's z reads +1 g: body z = -1 g (specific force, z down).
     const int16_t z_only[7] = {0, 0, 4096, 0, 0, 0, 164};
     make_burst(raw, z_only);
     ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s),
               mpu6000::BurstStatus::Ok);
-    EXPECT_NEAR(s.accel_m_s2.z, -kG, 1e-4f);
-    EXPECT_NEAR(s.gyro_rad_s.z, -10.0f * kD2R, 1e-5f);
+    EXPECT_NEAR(s.accel_m_s2().z, -kG, 1e-4f);
+    EXPECT_NEAR(s.gyro_rad_s().z, -10.0f * kD2R, 1e-5f);
 }
 
 TEST(Mpu6000Decode, EveryRangeHasItsScale) {
@@ -66,8 +66,8 @@ TEST(Mpu6000Decode, EveryRangeHasItsScale) {
         make_burst(raw, v);
         mpu6000::Sample s{};
         ASSERT_EQ(mpu6000::decode_burst(raw, c.g, c.a, s), mpu6000::BurstStatus::Ok);
-        EXPECT_NEAR(s.accel_m_s2.x, 0.5f * kG, 2e-3f);
-        EXPECT_NEAR(s.gyro_rad_s.y, 20.0f * kD2R, 2e-3f);
+        EXPECT_NEAR(s.accel_m_s2().x, 0.5f * kG, 2e-3f);
+        EXPECT_NEAR(s.gyro_rad_s().y, 20.0f * kD2R, 2e-3f);
         EXPECT_FLOAT_EQ(mpu6000::gyro_lsb_per_dps(c.g), c.lsb_dps);
         EXPECT_FLOAT_EQ(mpu6000::accel_lsb_per_g(c.a), c.lsb_g);
     }
@@ -80,7 +80,7 @@ TEST(Mpu6000Decode, TemperatureAndSaturation) {
     mpu6000::Sample s{};
     ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s),
               mpu6000::BurstStatus::Ok);
-    EXPECT_NEAR(s.temperature_c, -521.0f / 340.0f + 36.53f, 1e-4f);
+    EXPECT_NEAR(s.temperature_c(), -521.0f / 340.0f + 36.53f, 1e-4f);
     EXPECT_TRUE(s.accel_saturated);
     EXPECT_TRUE(s.gyro_saturated);
     const int16_t quiet[7] = {1, 2, 3, 0, 4, 5, 6};
@@ -93,14 +93,14 @@ TEST(Mpu6000Decode, TemperatureAndSaturation) {
 TEST(Mpu6000Decode, AbsentSensorPatternsAreFlagged) {
     uint8_t raw[14];
     mpu6000::Sample s{};
-    s.temperature_c = 99.0f;
+    s.temperature_raw = 1234;
     memset(raw, 0x00, sizeof raw);
     EXPECT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s),
               mpu6000::BurstStatus::NoSensor);
     memset(raw, 0xFF, sizeof raw);
     EXPECT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s),
               mpu6000::BurstStatus::NoSensor);
-    EXPECT_EQ(s.temperature_c, 99.0f);  // untouched
+    EXPECT_EQ(s.temperature_raw, 1234);  // untouched
 }
 
 TEST(Mpu6000Registers, SampleRateDivider) {

@@ -139,11 +139,11 @@ TEST(Mpu6000Driver, BurstAt8MHzDecodesToBodyFrame) {
     ASSERT_EQ(chip.burst_clocks.size(), 1u);
     EXPECT_EQ(chip.burst_clocks[0], 8000000u);
     EXPECT_EQ(raw[4], 0x10);
-    EXPECT_NEAR(s.accel_m_s2.z, -9.80665f, 1e-3f);
-    EXPECT_NEAR(s.accel_m_s2.x, 0.0f, 1e-6f);
-    EXPECT_NEAR(s.gyro_rad_s.y, 10.0f * linalg::kRadPerDeg, 1e-4f);   // body y = chip x
-    EXPECT_NEAR(s.gyro_rad_s.z, 20.0f * linalg::kRadPerDeg, 1e-4f);   // body z = -chip z
-    EXPECT_NEAR(s.temperature_c, 36.53f, 1e-3f);
+    EXPECT_NEAR(s.accel_m_s2().z, -9.80665f, 1e-3f);
+    EXPECT_NEAR(s.accel_m_s2().x, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.gyro_rad_s().y, 10.0f * linalg::kRadPerDeg, 1e-4f);   // body y = chip x
+    EXPECT_NEAR(s.gyro_rad_s().z, 20.0f * linalg::kRadPerDeg, 1e-4f);   // body z = -chip z
+    EXPECT_NEAR(s.temperature_c(), 36.53f, 1e-3f);
     EXPECT_FALSE(s.gyro_saturated);
 }
 
@@ -153,9 +153,9 @@ TEST(Mpu6000Driver, SilentBusIsNoSensor) {
     ASSERT_EQ(mpu.begin().status, mpu6000::InitStatus::Ok);
     chip.present = false;
     mpu6000::Sample s{};
-    s.temperature_c = 99.0f;
+    s.temperature_raw = 1234;
     EXPECT_EQ(mpu.read(s), mpu6000::BurstStatus::NoSensor);
-    EXPECT_EQ(s.temperature_c, 99.0f);  // untouched
+    EXPECT_EQ(s.temperature_raw, 1234);  // untouched
 }
 
 namespace {
@@ -321,14 +321,14 @@ TEST(Mpu6000Driver, FifoDeliversEverySampleInOrder) {
     mpu6000::Sample s{}, prev{};
     for (int i = 0; i < 5; ++i) {
         ASSERT_EQ(mpu.read_fifo(s), mpu6000::BurstStatus::Ok);
-        EXPECT_NEAR(s.accel_m_s2.z, -9.81f, 0.01f);
-        if (i > 0) EXPECT_GT(s.gyro_rad_s.z, prev.gyro_rad_s.z) << i;
+        EXPECT_NEAR(s.accel_m_s2().z, -9.81f, 0.01f);
+        if (i > 0) EXPECT_GT(s.gyro_rad_s().z, prev.gyro_rad_s().z) << i;
         prev = s;
     }
     EXPECT_EQ(mpu.fifo_samples(), 0u);
     mpu6000::Sample latest{};
     ASSERT_EQ(mpu.read(latest), mpu6000::BurstStatus::Ok);
-    EXPECT_EQ(latest.gyro_rad_s.z, prev.gyro_rad_s.z);  // the last queued sample is the registers'
+    EXPECT_EQ(latest.gyro_rad_s().z, prev.gyro_rad_s().z);  // the last queued sample is the registers'
     mpu.stop_fifo();
     model.advance_to(model.time_s() + 0.05);
     EXPECT_EQ(mpu.fifo_samples(), 0u);

@@ -109,13 +109,13 @@ TEST(Mpu6000Model, BurstDecodesToTheTrajectoryInEveryRange) {
             const float gyro_res = linalg::kRadPerDeg / mpu6000::gyro_lsb_per_dps((mpu6000::GyroRange)gyro_config);
             const float accel_res = mpu6000::kStandardGravity_m_s2 /
                                     mpu6000::accel_lsb_per_g((mpu6000::AccelRange)accel_config);
-            const float gyro[3] = {sample.gyro_rad_s.x, sample.gyro_rad_s.y, sample.gyro_rad_s.z};
-            const float accel[3] = {sample.accel_m_s2.x, sample.accel_m_s2.y, sample.accel_m_s2.z};
+            const float gyro[3] = {sample.gyro_rad_s().x, sample.gyro_rad_s().y, sample.gyro_rad_s().z};
+            const float accel[3] = {sample.accel_m_s2().x, sample.accel_m_s2().y, sample.accel_m_s2().z};
             for (int i = 0; i < 3; ++i) {
                 EXPECT_NEAR(gyro[i], kGyro_rad_s[i], gyro_res) << "gyro axis " << i << " cfg " << (int)gyro_config;
                 EXPECT_NEAR(accel[i], kAccel_m_s2[i], accel_res) << "accel axis " << i << " cfg " << (int)accel_config;
             }
-            EXPECT_NEAR(sample.temperature_c, 30.0f, 0.01f);
+            EXPECT_NEAR(sample.temperature_c(), 30.0f, 0.01f);
             EXPECT_FALSE(sample.gyro_saturated);
             EXPECT_FALSE(sample.accel_saturated);
         }
@@ -148,8 +148,8 @@ TEST(Mpu6000Model, AWrongRangeGivesWrongValues) {
     mpu.advance_to(0.5);
     mpu6000::Sample sample{};
     ASSERT_EQ(read_sample(mpu, 0x18, 0x08, sample), mpu6000::BurstStatus::Ok);  // decoded as 2000 / 4 g
-    EXPECT_NEAR(sample.gyro_rad_s.z, kGyro_rad_s[2] * 131.0 / 16.4, 0.01);
-    EXPECT_NEAR(sample.accel_m_s2.z, kAccel_m_s2[2] * 2.0, 0.01);
+    EXPECT_NEAR(sample.gyro_rad_s().z, kGyro_rad_s[2] * 131.0 / 16.4, 0.01);
+    EXPECT_NEAR(sample.accel_m_s2().z, kAccel_m_s2[2] * 2.0, 0.01);
 }
 
 TEST(Mpu6000Model, DataReadyAtTheConfiguredRateOnTheIntPin) {
@@ -204,7 +204,7 @@ TEST(Mpu6000Model, LowerDlpfBandwidthIsSlower) {
         mpu.advance_to(1.010);
         mpu6000::Sample sample{};
         read_sample(mpu, 0x18, 0x08, sample);
-        return sample.gyro_rad_s.z;
+        return sample.gyro_rad_s().z;
     };
     const float slow = step_response((uint8_t)mpu6000::Dlpf::Hz5);
     const float fast = step_response((uint8_t)mpu6000::Dlpf::Hz42);
@@ -232,8 +232,8 @@ TEST(Mpu6000Model, FaultsAbsentSaturateSpike) {
     EXPECT_FALSE(sample.accel_saturated);
     mpu.advance_to(5.5);
     EXPECT_EQ(read_sample(mpu, 0x18, 0x08, sample), mpu6000::BurstStatus::Ok);
-    EXPECT_GT(sample.gyro_rad_s.length(), 20.0f);   // > 1000 deg/s
-    EXPECT_GT(sample.accel_m_s2.length(), 50.0f);   // > 5 g
+    EXPECT_GT(sample.gyro_rad_s().length(), 20.0f);   // > 1000 deg/s
+    EXPECT_GT(sample.accel_m_s2().length(), 50.0f);   // > 5 g
 }
 
 // --- HMC5883L ------------------------------------------------------------------
@@ -465,7 +465,7 @@ TEST(Mpu6000Model, FifoKeepsTheOrderOfChangingSamples) {
         mpu.read_registers(mpu6000::REG_FIFO_R_W, raw, sizeof raw);
         ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G4, s),
                   mpu6000::BurstStatus::Ok);
-        if (i > 0) EXPECT_GT(s.gyro_rad_s.x, prev.gyro_rad_s.x) << i;
+        if (i > 0) EXPECT_GT(s.gyro_rad_s().x, prev.gyro_rad_s().x) << i;
         prev = s;
     }
 }

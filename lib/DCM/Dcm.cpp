@@ -1,18 +1,23 @@
 #include "Dcm.h"
 
+#include "Fixed.h"
 #include "Profile.h"
 
 namespace dcm {
 
 using linalg::Matrix3f;
 using linalg::Vector3f;
+using linalg::Vector3l;
 
 namespace {
 // A mag correction stands for the time since the previous sample, but never more
 // than this many steps (after an outage the first sample must not make a jump).
 constexpr uint16_t kMaxMagIntervalSteps = 20;
-// The accel low-pass during start-up, per correction (50 Hz): a 0.25 s time constant.
-constexpr float kStartupAccelAlpha = 0.074f;
+// The recent disturbed field, for the new-field test, follows the samples with 53 ms
+// (a fifth of the way at each 75 Hz sample); the learned field tracks slow changes
+// (temperature, location) with 1.3 s.
+constexpr float kCandidateTau_s = 0.053f;
+constexpr float kReferenceTau_s = 1.32f;
 // The field may move this much in body axes during a rest: the HMC5883L's noise is
 // ~0.2 uT with its 8-sample average; a turn of 3 deg moves a 20 uT horizontal field by
 // 1 uT, so a steady turn of more than 2 deg/s ends a rest within its first 1.5 s, and
@@ -20,16 +25,38 @@ constexpr float kStartupAccelAlpha = 0.074f;
 constexpr float kRestFieldMove_uT = 1.0f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
-// 1/n for the means of n samples (no division on the AVR).
-constexpr uint8_t kMaxWindow = 8;
-constexpr float kInverse[kMaxWindow] = {1.0f, 0.5f, 1.0f / 3.0f, 0.25f, 0.2f, 1.0f / 6.0f, 1.0f / 7.0f, 0.125f};
 }  // namespace
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
     bias_rad_s_ = bias;
     clamp_bias();
-    offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
+    update_offset();
+}
+
+void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
+    if (!bias.is_finite()) return;
+    sensor_bias_rad_s_ = bias;
+    update_offset();
+}
+
+void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count) {
+    gyro_scale_ = gyro_rad_s_per_count;
+    accel_scale_ = accel_m_s2_per_count;
+    update_offset();
+}
+
+// What each step subtracts from the gyro: in rad/s for the corrections' arithmetic, and
+// in the integer units of the turn sums (counts * 2^kTurnFraction) for the 200 Hz step.
+void Dcm::update_offset() {
+    offset_rad_s_ = sensor_bias_rad_s_ + bias_rad_s_ - correction_rad_s_;
+    offset_units_ = units_of(offset_rad_s_);
+}
+
+Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
+    const float k = (float)(1L << kTurnFraction) / gyro_scale_;
+    const Vector3f u = rate_rad_s * k;
+    return Vector3l{linalg::fixed_from_float(u.x, 0), linalg::fixed_from_float(u.y, 0), linalg::fixed_from_float(u.z, 0)};
 }
 
 // Each axis within the range of any accelerometer (16 g): three comparisons where
@@ -45,7 +72,9 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     if (!accel_m_s2.is_finite()) return false;
     const Vector3f down = (-accel_m_s2).normalized();  // specific force points up
     if (down.is_zero()) return false;
-    last_accel_m_s2_ = accel_m_s2;
+    const Vector3f accel_units = accel_m_s2 * (1.0f / accel_scale_);  // for a rebuild (recover)
+    last_accel_ = Vector3l(linalg::fixed_from_float(accel_units.x, 0), linalg::fixed_from_float(accel_units.y, 0),
+                           linalg::fixed_from_float(accel_units.z, 0));
 
     // North: the field's component perpendicular to down. Without a usable field,
     // the body x axis projected on the horizontal (yaw 0), or body y at pitch 90.
@@ -63,16 +92,16 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     r_ = Matrix3f(north, down.cross(north), down);
     accel_lp_ef_ = Vector3f(0.0f, 0.0f, -kGravity_m_s2);
     correction_rad_s_ = Vector3f();
-    offset_rad_s_ = bias_rad_s_;
+    update_offset();
     yaw_pending_ = false;
     mag_steady_steps_ = 0;
     rest_corrections_ = 0;
-    gyro_sum_rad_s_ = Vector3f();
-    accel_sum_m_s2_ = Vector3f();
+    gyro_sum_ = Vector3l();
+    accel_sum_ = Vector3l();
     window_samples_ = 0;
-    accel_sum_of_sums_ = Vector3f();
-    first_half_rad_s_ = Vector3f();
-    turn_sum_rad_s_ = Vector3f();
+    accel_sum_of_sums_ = Vector3l();
+    first_half_ = Vector3l();
+    turn_sum_ = Vector3l();
     pending_steps_ = 0;
     rest_accel_mean_m_s2_ = accel_m_s2;
     steps_ = 0;
@@ -85,32 +114,50 @@ void Dcm::learn_field(float norm, float down_component) {
     mag_ref_down_ = mag_candidate_down_ = down_component;
 }
 
+// The float form: the sample in SI units, held in the integer units of the step
+// (kFloatGyroScale, kFloatAccelScale), after the checks a float sample needs.
 void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool line_due) {
+    if (gyro_scale_ != kFloatGyroScale || accel_scale_ != kFloatAccelScale)
+        set_sample_scales(kFloatGyroScale, kFloatAccelScale);
+    // NaN and infinity fail these comparisons too: such samples are rejected.
+    const bool gyro_ok = gyro_rad_s.length_squared() < max_rate2_;
+    const bool accel_ok = accel_plausible(accel_m_s2);
+    const float to_gyro = 1.0f / kFloatGyroScale, to_accel = 1.0f / kFloatAccelScale;
+    Vector3l gyro, accel;
+    if (gyro_ok)
+        gyro = Vector3l{linalg::fixed_from_float(gyro_rad_s.x * to_gyro, 0), linalg::fixed_from_float(gyro_rad_s.y * to_gyro, 0),
+                        linalg::fixed_from_float(gyro_rad_s.z * to_gyro, 0)};
+    if (accel_ok)
+        accel = Vector3l{linalg::fixed_from_float(accel_m_s2.x * to_accel, 0),
+                         linalg::fixed_from_float(accel_m_s2.y * to_accel, 0),
+                         linalg::fixed_from_float(accel_m_s2.z * to_accel, 0)};
     if (!initialised()) {
         init(accel_m_s2, last_mag_field_);
         return;
     }
+    step(gyro, accel, gyro_ok, accel_ok, line_due);
+}
+
+void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, bool accel_valid,
+                 bool line_due) {
+    const Vector3l gyro{gyro_counts.x, gyro_counts.y, gyro_counts.z};
+    const Vector3l accel{accel_counts.x, accel_counts.y, accel_counts.z};
+    if (!initialised()) {
+        init(accel.scaled(accel_scale_), last_mag_field_);
+        return;
+    }
+    step(gyro, accel, true, accel_valid, line_due);
+}
+
+void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
-    // Start-up: a faster response that ramps down linearly to the steady one over
-    // startup_s, so a poor first sample is forgotten quickly (Fusion does the same);
-    // the bias is not learned from those transients.
-    const bool starting = steps_ < startup_steps_;
-    const float startup_left = starting ? 1.0f - (float)steps_ * inv_startup_steps_ : 0.0f;
-
-    // NaN and infinity fail these comparisons too: such samples are rejected.
-    const float rate2 = gyro_rad_s.length_squared();
-    const bool gyro_ok = rate2 < max_rate2_;
-    if (!gyro_ok) status_ |= kStatusGyroRejected;
-    // No bias learning while rotating fast either: gyro scale errors look like bias
-    // there (ArduPilot's rule). What counts is the turn that lasts, the 0.5 s mean rate
-    // of the rest test: a scale error on a vibration (an 8 Hz wobble at 50 deg/s) makes
-    // an error that averages out, while a hand's or a vehicle's turn does not (shake,
-    // a board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
-    // BROAD 1.57 -> 1.58).
-    rotating_fast_ = !gyro_ok || (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() > hold_rate2_;
-    const bool hold_integrator = rotating_fast_ || starting;
-    if (hold_integrator) status_ |= kStatusBiasHeld;
+    if (!gyro_ok) {
+        status_ |= kStatusGyroRejected;
+        rotating_fast_ = true;  // a broken gyro read: no bias learning on it (below, correct_gravity)
+    }
+    // Start-up (steps_ < startup_steps_): faster gains, no bias learning (correct_gravity).
+    if (rotating_fast_ || steps_ < startup_steps_) status_ |= kStatusBiasHeld;
 
     // Gravity. The specific force is low-passed in the (estimated) earth frame, as
     // VQF does: there a linear acceleration averages out over the filter's time,
@@ -120,16 +167,14 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     // weighting, 0.7 without). Only a sample beyond any accelerometer's range is
     // garbage and skipped, and so is one whose gyro is beyond any range: the whole
     // read is broken then (a glitch on the bus, a spike).
-    // The samples are summed here and low-passed at the correction's pace (50 Hz): the
-    // low-pass is seconds long, so the mean of four samples loses nothing, and the
-    // sum costs three additions where the rotation to earth axes costs fifteen
-    // multiplications and additions.
-    if (gyro_ok && accel_plausible(accel_m_s2)) {
-        gyro_sum_rad_s_ += gyro_rad_s;
-        accel_sum_m_s2_ += accel_m_s2;
-        accel_sum_of_sums_ += accel_sum_m_s2_;  // sum of (samples from this one on) a_j
+    // The samples are summed here, in integers, and low-passed at the correction's pace
+    // (50 Hz): the low-pass is seconds long, so the mean of four samples loses nothing.
+    if (gyro_ok && accel_ok) {
+        gyro_sum_ += gyro;
+        accel_sum_ += accel;
+        accel_sum_of_sums_ += accel_sum_;  // sum of (samples from this one on) a_j
         ++window_samples_;
-        last_accel_m_s2_ = accel_m_s2;
+        last_accel_ = accel;
     } else {
         status_ |= kStatusAccelIgnored;
         rest_corrections_ = 0;  // a broken read is no rest
@@ -147,19 +192,21 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     // every kIntegrationSteps steps the summed rotation vector turns the matrix, with
     // the two-sample coning term (2/3) A x B of its two halves A and B (Savage's
     // two-sample coning algorithm: the rotation vector of a rotation whose axis moved
-    // within the interval). The
-    // error against a 200 Hz update on BROAD's fast rotations: README, Performance.
+    // within the interval). The sums are integers: counts * 2^kTurnFraction less the
+    // offset in the same units (the bias to 1/256 of a count). The error against a
+    // 200 Hz update on BROAD's fast rotations: README, Performance.
     if (gyro_ok) {
-        Vector3f rate_rad_s = gyro_rad_s - offset_rad_s_;
-        if (yaw_pending_) rate_rad_s += omega_yaw_rad_s_;  // a mag correction is applied once
-        last_rate_rad_s_ = rate_rad_s;
-        turn_sum_rad_s_ += rate_rad_s;
+        last_gyro_ = gyro;
+        turn_sum_.x += gyro.x * kTurnScale - offset_units_.x;
+        turn_sum_.y += gyro.y * kTurnScale - offset_units_.y;
+        turn_sum_.z += gyro.z * kTurnScale - offset_units_.z;
+        if (yaw_pending_) turn_sum_ += yaw_units_;  // a mag correction is applied once
     }
     yaw_pending_ = false;
     ++pending_steps_;
     if (pending_steps_ == kIntegrationSteps / 2) {
-        first_half_rad_s_ = turn_sum_rad_s_;
-        turn_sum_rad_s_ = Vector3f();
+        first_half_ = turn_sum_;
+        turn_sum_ = Vector3l();
     }
     // One heavy part a step at most: the integration when due (or before an output
     // line, line_due, with two or more steps waiting), else the gravity correction
@@ -168,7 +215,7 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     if (pending_steps_ >= kIntegrationSteps || (line_due && pending_steps_ >= 2)) {
         integrate();
     } else if (gravity_due_) {
-        correct_gravity(startup_left, hold_integrator);
+        correct_gravity();
     } else {
         heavy_ = false;
     }
@@ -210,13 +257,24 @@ void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, boo
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
 // and the roll/pitch error (correct_tilt).
-void Dcm::correct_gravity(float startup_left, bool hold_integrator) {
+void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
     gravity_due_ = false;
+    const bool starting = steps_ < startup_steps_;
+    const float startup_left = starting ? 1.0f - (float)steps_ * inv_startup_steps_ : 0.0f;
+    // No bias learning while rotating fast: gyro scale errors look like bias there
+    // (ArduPilot's rule). What counts is the turn that lasts, the 0.5 s mean rate of
+    // the rest test: a scale error on a vibration (an 8 Hz wobble at 50 deg/s) makes an
+    // error that averages out, while a hand's or a vehicle's turn does not (shake, a
+    // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
+    // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
+    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 ||
+                     (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() > hold_rate2_;
+    const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
-        const float inv_n = window_samples_ <= kMaxWindow ? kInverse[window_samples_ - 1] : 1.0f / (float)window_samples_;
-        const Vector3f gyro_mean = gyro_sum_rad_s_ * inv_n;
-        const Vector3f accel_mean = accel_sum_m_s2_ * inv_n;
+        const float inv_n = 1.0f / (float)window_samples_;
+        const Vector3f gyro_mean = gyro_sum_.scaled(gyro_scale_ * inv_n) - sensor_bias_rad_s_;
+        const Vector3f accel_mean = accel_sum_.scaled(accel_scale_ * inv_n);
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
         // step's sample by the steps not yet integrated (this one among them), so the
@@ -224,18 +282,22 @@ void Dcm::correct_gravity(float startup_left, bool hold_integrator) {
         // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
         // of the running sums, three additions a step. (Weighting each sample, not the
         // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
-        const Vector3f turn_per_step = (gyro_mean - offset_rad_s_) * settings_.step_s;
-        const Vector3f weighted = accel_sum_of_sums_ - accel_sum_m_s2_ * (float)pending_steps_;
-        const float alpha = accel_alpha_ + (kStartupAccelAlpha - accel_alpha_) * startup_left;
+        const Vector3f turn_per_step = (gyro_mean + sensor_bias_rad_s_ - offset_rad_s_) * settings_.step_s;
+        const int32_t pending = pending_steps_;
+        const Vector3f weighted = Vector3l{accel_sum_of_sums_.x - accel_sum_.x * pending,
+                                           accel_sum_of_sums_.y - accel_sum_.y * pending,
+                                           accel_sum_of_sums_.z - accel_sum_.z * pending}
+                                      .scaled(accel_scale_);
+        const float alpha = accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left;
         accel_lp_ef_ += (r_ * (accel_mean - turn_per_step.cross(weighted) * inv_n) - accel_lp_ef_) * alpha;
         detect_rest(gyro_mean, accel_mean, window_samples_ >= kCorrectionDivider);
     }
-    gyro_sum_rad_s_ = Vector3f();
-    accel_sum_m_s2_ = Vector3f();
-    accel_sum_of_sums_ = Vector3f();
+    gyro_sum_ = Vector3l();
+    accel_sum_ = Vector3l();
+    accel_sum_of_sums_ = Vector3l();
     window_samples_ = 0;
     correct_tilt(startup_left, hold_integrator);
-    offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
+    update_offset();
     profile::end(profile::kGravity);
 }
 
@@ -252,12 +314,12 @@ void Dcm::correct_gravity(float startup_left, bool hold_integrator) {
 // renormalisation rebuilds it as a x b.
 void Dcm::integrate() {
     profile::begin(profile::kIntegration);
-    const float dt = settings_.step_s;
-    const Vector3f first = first_half_rad_s_ * dt;
-    const Vector3f second = turn_sum_rad_s_ * dt;
+    const float turn_per_unit = turn_rad_per_unit();
+    const Vector3f first = first_half_.scaled(turn_per_unit);
+    const Vector3f second = turn_sum_.scaled(turn_per_unit);
     const Vector3f theta = first + second + first.cross(second) * (2.0f / 3.0f);
-    first_half_rad_s_ = Vector3f();
-    turn_sum_rad_s_ = Vector3f();
+    first_half_ = Vector3l();
+    turn_sum_ = Vector3l();
     pending_steps_ = 0;
     const float a2 = theta.length_squared();
     const float tan_ratio = 1.0f + a2 * (1.0f / 3.0f + a2 * (2.0f / 15.0f + a2 * (17.0f / 315.0f)));
@@ -277,7 +339,17 @@ void Dcm::integrate() {
     profile::end(profile::kRenormalisation);
 }
 
-Vector3f Dcm::pending_turn_rad() const { return (first_half_rad_s_ + turn_sum_rad_s_) * settings_.step_s; }
+Vector3f Dcm::pending_turn_rad() const {
+    Vector3l sum = first_half_;
+    sum += turn_sum_;
+    return sum.scaled(turn_rad_per_unit());
+}
+
+Vector3f Dcm::last_rate_rad_s() const {
+    const Vector3l units{last_gyro_.x * kTurnScale - offset_units_.x, last_gyro_.y * kTurnScale - offset_units_.y,
+                         last_gyro_.z * kTurnScale - offset_units_.z};
+    return units.scaled(gyro_scale_ * (1.0f / (float)kTurnScale));
+}
 
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
@@ -321,7 +393,7 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
         // The first field sample after a start without one: take its heading as is.
-        init(last_accel_m_s2_, mag_field);
+        init(last_accel_.scaled(accel_scale_), mag_field);
         return;
     }
 
@@ -331,8 +403,9 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // The matrix itself is behind the last sample by the turn not yet integrated: the
     // field is brought back by that much (a fixed earth vector seen from the body
     // after a turn p reads v - p x v = v + v x p, so before it v x -p).
+    const Vector3f rate_rad_s = last_rate_rad_s();
     const Vector3f field_now =
-        mag_field + mag_field.cross(last_rate_rad_s_ * settings_.mag_latency_s - pending_turn_rad());
+        mag_field + mag_field.cross(rate_rad_s * settings_.mag_latency_s - pending_turn_rad());
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
     const Vector3f field_ef = r_ * field_now;
@@ -342,6 +415,8 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     const float down_component = field_ef.z / norm;
     const float inv_horizontal = 1.0f / sqrtf(horizontal2);
     const float sin_error = field_ef.y * inv_horizontal;
+    // The time this sample stands for (the low-passes below are in time, not samples).
+    const float sample_dt = settings_.step_s * (float)(interval_steps < kMaxMagIntervalSteps ? interval_steps : kMaxMagIntervalSteps);
 
     // Disturbance rejection (as VQF does): a field whose strength or dip differs
     // from the learned earth field is a magnet or iron nearby, not north, and is not
@@ -361,13 +436,14 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         // the board) is steady too. VQF's rule: a mean rate of 20 deg/s over the window.
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
             mag_steady_steps_ += interval_steps;
-            mag_steady_turn_rad_ += sqrtf(last_rate_rad_s_.length_squared()) * settings_.step_s * (float)interval_steps;
+            mag_steady_turn_rad_ += sqrtf(rate_rad_s.length_squared()) * settings_.step_s * (float)interval_steps;
         } else {
             mag_steady_steps_ = 0;
             mag_steady_turn_rad_ = 0.0f;
         }
-        mag_candidate_norm_ += 0.2f * (norm - mag_candidate_norm_);
-        mag_candidate_down_ += 0.2f * (down_component - mag_candidate_down_);
+        const float candidate_alpha = sample_dt / (kCandidateTau_s + sample_dt);
+        mag_candidate_norm_ += candidate_alpha * (norm - mag_candidate_norm_);
+        mag_candidate_down_ += candidate_alpha * (down_component - mag_candidate_down_);
         if (!forgotten && ((float)mag_steady_steps_ < mag_recover_steps_ ||
                            mag_steady_turn_rad_ < mag_new_min_turn_rad_)) return;
         // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
@@ -388,8 +464,9 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     mag_candidate_down_ = down_component;
     status_ &= (uint8_t)~kStatusMagIgnored;
     // Track slow changes of the local field (temperature, location): ~1.3 s at 75 Hz.
-    mag_ref_norm_ += 0.01f * (norm - mag_ref_norm_);
-    mag_ref_down_ += 0.01f * (down_component - mag_ref_down_);
+    const float reference_alpha = sample_dt * (1.0f / kReferenceTau_s);  // <= 0.08: first order
+    mag_ref_norm_ += reference_alpha * (norm - mag_ref_norm_);
+    mag_ref_down_ += reference_alpha * (down_component - mag_ref_down_);
 
     // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
     const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
@@ -400,19 +477,19 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     const float steps = (float)interval_steps;
     const Vector3f error = r_.c * -heading_error;
     const bool starting = steps_ < startup_steps_;
-    omega_yaw_rad_s_ = error * ((starting ? settings_.kp_startup_1_s : settings_.kp_yaw_1_s) * steps);
+    yaw_units_ = units_of(error * ((starting ? settings_.kp_startup_1_s : settings_.kp_yaw_1_s) * steps));
     yaw_pending_ = true;
-    if (!rotating_fast_ && !starting) {
+    if (!rotating_fast_ && !starting && settings_.ki_yaw_1_s2 != 0.0f) {
         bias_rad_s_ -= error * (settings_.ki_yaw_1_s2 * settings_.step_s * steps);
         clamp_bias();
-        offset_rad_s_ = bias_rad_s_ - correction_rad_s_;
+        update_offset();
     }
 }
 
 EulerAngles Dcm::euler_now() const {
     // R carried forward by the lead and any turn not yet integrated (at most one step
     // when the update was told a line is due), in fixed point.
-    return euler_carried(r_, last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad());
+    return euler_carried(r_, last_rate_rad_s() * settings_.output_lead_s + pending_turn_rad());
 }
 
 bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,
@@ -464,7 +541,7 @@ bool Dcm::rescale(const Vector3f& row, Vector3f& out) {
 void Dcm::recover() {
     ++recoveries_;
     status_ |= kStatusRecovered;
-    if (!init(last_accel_m_s2_, last_mag_field_)) r_ = Matrix3f::identity();
+    if (!init(last_accel_.scaled(accel_scale_), last_mag_field_)) r_ = Matrix3f::identity();
 }
 
 }  // namespace dcm

@@ -121,9 +121,14 @@ public:
           rest_gyro_dev2_(settings.rest_gyro_deviation_rad_s * settings.rest_gyro_deviation_rad_s),
           rest_accel_dev2_(settings.rest_accel_deviation_m_s2 * settings.rest_accel_deviation_m_s2),
           rest_min_corrections_((uint16_t)(settings.rest_min_s / (settings.step_s * (float)kCorrectionDivider))),
-          rest_alpha_(settings.step_s * (float)kCorrectionDivider / kRestMeanTau_s),
-          rest_bias_alpha_(settings.rest_bias_s > 0.0f ? settings.step_s * (float)kCorrectionDivider / settings.rest_bias_s
-                                                       : 0.0f),
+          rest_alpha_(settings.step_s * (float)kCorrectionDivider /
+                      (kRestMeanTau_s + settings.step_s * (float)kCorrectionDivider)),
+          rest_bias_alpha_(settings.rest_bias_s > 0.0f
+                               ? settings.step_s * (float)kCorrectionDivider /
+                                     (settings.rest_bias_s + settings.step_s * (float)kCorrectionDivider)
+                               : 0.0f),
+          startup_accel_alpha_(settings.step_s * (float)kCorrectionDivider /
+                               (kStartupAccelTau_s + settings.step_s * (float)kCorrectionDivider)),
           mag_new_min_turn_rad_(settings.mag_recover_s * settings.mag_new_min_rate_rad_s) {}
 
     // Start-up attitude from one gravity and one field sample (TRIAD):
@@ -140,7 +145,20 @@ public:
     // sample gets no weight.
     // line_due: an output line follows this step; the matrix is brought up to date for it
     // (Dcm::integrate when two or more steps wait; one is carried by euler_now()).
+    // The sample in the sensor's counts (the firmware's path: integer sums at 200 Hz,
+    // floats only on the steps that use them), scaled by set_sample_scales; the gyro
+    // counts carry the sensor bias set by set_sensor_bias_rad_s. accel_valid false: the
+    // sample gives gravity no weight (a stuck accelerometer).
+    void update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, bool accel_valid,
+                bool line_due = false);
+    // The same in SI units (host tests, tools): rad/s and m/s^2, held in fine integer
+    // units (kFloatGyroScale, kFloatAccelScale). Not to be mixed with the counts form.
     void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2, bool line_due = false);
+    // The scales of the counts update() takes: rad/s and m/s^2 per count.
+    void set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count);
+    // The calibrated bias the gyro counts carry (rad/s; the start-up calibration): the
+    // step subtracts it with the estimator's own bias estimate.
+    void set_sensor_bias_rad_s(const linalg::Vector3f& bias);
 
     // Yaw drift correction from a new magnetometer sample (call when one arrives,
     // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down,
@@ -189,12 +207,27 @@ public:
     static constexpr uint8_t kIntegrationSteps = 4;
     // The means the rest test compares the samples against (VQF's 0.5 s).
     static constexpr float kRestMeanTau_s = 0.5f;
+    // The accel low-pass's time constant at start (startup_s ramps it to accel_lowpass_s).
+    static constexpr float kStartupAccelTau_s = 0.25f;
+    // The turn sums hold gyro counts * kTurnScale (2^kTurnFraction): the offset the step
+    // subtracts is resolved to 1/256 of a count (0.0002 deg/s on the 2000 deg/s range).
+    static constexpr uint8_t kTurnFraction = 8;
+    static constexpr int32_t kTurnScale = 1L << kTurnFraction;
+    // The float form's units: 2^-14 rad/s (50 rad/s * 2^8 * 4 steps fits in 32 bits)
+    // and 2^-12 m/s^2.
+    static constexpr float kFloatGyroScale = 1.0f / 16384.0f;
+    static constexpr float kFloatAccelScale = 1.0f / 4096.0f;
 
 private:
+    void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void correct_tilt(float startup_left, bool hold_integrator);
     void integrate();
-    void correct_gravity(float startup_left, bool hold_integrator);
+    void correct_gravity();
+    void update_offset();
+    linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
+    float turn_rad_per_unit() const { return gyro_scale_ * settings_.step_s * (1.0f / (float)kTurnScale); }
     linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
+    linalg::Vector3f last_rate_rad_s() const;   // the last sample, corrected
     void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
     bool renormalise(float& skew);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
@@ -220,30 +253,35 @@ private:
     uint16_t rest_min_corrections_;
     float rest_alpha_;                   // low-pass factor of the rest means, per correction
     float rest_bias_alpha_;              // bias step towards the rest mean, per correction
+    float startup_accel_alpha_;          // the accel low-pass factor at the start of the ramp, per correction
     float mag_new_min_turn_rad_;         // how far the board must turn while a new field stays steady
 
     linalg::Matrix3f r_;
     linalg::Vector3f bias_rad_s_;        // integrator: gyro-bias estimate
     linalg::Vector3f correction_rad_s_;  // roll/pitch correction, held between corrections
-    linalg::Vector3f offset_rad_s_;      // bias - correction: what the step subtracts from the gyro
-    linalg::Vector3f omega_yaw_rad_s_;   // yaw correction from the last field sample, applied once
+    linalg::Vector3f offset_rad_s_;      // sensor bias + bias - correction: what the step subtracts from the gyro
+    linalg::Vector3l offset_units_;      // ... in the turn sums' units
+    linalg::Vector3f sensor_bias_rad_s_; // set_sensor_bias_rad_s
+    float gyro_scale_ = kFloatGyroScale; // rad/s per count
+    float accel_scale_ = kFloatAccelScale; // m/s^2 per count
+    linalg::Vector3l yaw_units_;         // yaw correction from the last field sample (a turn sums' step), applied once
     linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
-    linalg::Vector3f last_accel_m_s2_;   // for a rebuild if the matrix degenerates
+    linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
+    linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
     linalg::Vector3f last_mag_field_;
-    linalg::Vector3f gyro_sum_rad_s_;    // raw gyro and accel summed over the correction period
-    linalg::Vector3f accel_sum_m_s2_;
+    linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
+    linalg::Vector3l accel_sum_;
     linalg::Vector3f rest_gyro_mean_rad_s_;  // their low-passed means, for the rest test
     linalg::Vector3f rest_accel_mean_m_s2_;
     uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
     linalg::Vector3f rest_field_uT_;     // the field (body axes) when the board last seemed to turn
-    linalg::Vector3f accel_sum_of_sums_; // the running sums summed: weights n - j + 1
+    linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
-    linalg::Vector3f first_half_rad_s_;  // corrected rates summed over the integration's first half
-    linalg::Vector3f turn_sum_rad_s_;    // ... and since
+    linalg::Vector3l first_half_;        // corrected rates summed over the integration's first half (kTurnScale)
+    linalg::Vector3l turn_sum_;          // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
     bool gravity_due_ = false;           // a gravity correction waits for a step without an integration
     bool heavy_ = false;                 // the last update integrated or corrected gravity
-    linalg::Vector3f last_rate_rad_s_;   // the last corrected rate, to bring field samples up to date
     float mag_ref_norm_ = 0.0f;          // learned field strength
     bool mag_take_heading_ = true;       // reset_mag_reference's take_heading
     float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)

@@ -1,6 +1,7 @@
 #include "Pipeline.h"
 
 #include "Profile.h"
+#include "Fixed.h"
 
 #include <math.h>
 
@@ -11,7 +12,16 @@ using text::Writer;
 
 namespace {
 constexpr float kG = mpu6000::kStandardGravity_m_s2;
-float absf(float v) { return v < 0.0f ? -v : v; }
+// |a - b| of two counts.
+int32_t jump(int16_t a, int16_t b) {
+    const int32_t d = (int32_t)a - b;
+    return d < 0 ? -d : d;
+}
+// |v|^2 in counts^2 (three 16x16 multiplies; below 3 * 2^30).
+uint32_t norm2(const linalg::Vector3i& v) {
+    return (uint32_t)linalg::mul_s16(v.x, v.x) + (uint32_t)linalg::mul_s16(v.y, v.y) +
+           (uint32_t)linalg::mul_s16(v.z, v.z);
+}
 }  // namespace
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
@@ -26,7 +36,7 @@ bool RateLimiter::allow(uint32_t now, uint16_t interval) {
 
 AttitudePipeline::AttitudePipeline(const text::Sink* log, const dcm::DcmSettings& dcm_settings)
     : log_(log), settings_(settings::defaults()), dcm_(dcm_settings), st_() {
-    last_ = mpu6000::Sample{Vector3f(), Vector3f(0.0f, 0.0f, -kG), 0.0f, false, false};
+    last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f);
 }
 
 void AttitudePipeline::set_mag_present(bool present) {
@@ -61,20 +71,30 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         st_.learn_pending = false;
         st_.turn_doubtful = false;
     } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
+        // A sample every kLearnMinSteps at most; the turn goes on summing until then.
+        if (st_.steps_since_mag < kLearnMinSteps) {
+            mag_cal_uT_ = f;
+            st_.mag_pending = true;
+            st_.have_mag = true;
+            return;
+        }
         // The sample is mag_latency_s older than the attitude: turned forward by the
         // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
         // as an offset.
         // The learner takes the field without the learned offset: it works from its own
         // estimate, which is not always the offset in use.
-        const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s);
+        const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s());
         learn_field_uT_ = f + settings_.cal.mag_learned_uT + f.cross(rate) * dcm_.settings().mag_latency_s;
-        // The turn since the previous sample (that one's too, if it never got its step).
-        learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad_ : turn_rad_;
+        // The turn since the previous sample (that one's too, if it never got its step):
+        // the gyro alone, less every bias estimate (the one now stands for the interval's).
+        const Vector3f turn_rad = (turn_counts_.scaled(last_.gyro_rad_s_per_count) -
+                                   gyro_bias_rad_s() * (float)st_.steps_since_mag) * kStep_s;
+        learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad : turn_rad;
         st_.learn_steps = st_.learn_pending ? (uint16_t)(st_.learn_steps + st_.steps_since_mag) : st_.steps_since_mag;
         st_.learn_pending = true;
     }
     st_.steps_since_mag = 0;
-    turn_rad_ = Vector3f();
+    turn_counts_ = linalg::Vector3l();
     mag_cal_uT_ = f;
     st_.mag_pending = true;
     st_.have_mag = true;
@@ -105,15 +125,14 @@ void AttitudePipeline::forget_mag_reference(bool take_heading) {
 // reported (a saturated gyro is used: the true rate is at least the full scale; a
 // saturated accel is withheld from the DCM by on_imu_sample).
 mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
-    bool spike = !s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite();
-    if (!spike && st_.have_last) {
-        const float* g = &s.gyro_rad_s.x;  // Vector3f is three packed floats
-        const float* h = &last_.gyro_rad_s.x;
-        for (uint8_t i = 0; i < 3; ++i) spike = spike || absf(g[i] - h[i]) > kSpikeGyroJump_rad_s;
-        spike = spike || (s.accel_m_s2.length_squared() > (kSpikeAccel_g * kG) * (kSpikeAccel_g * kG) &&
-                          last_.accel_m_s2.length_squared() < (kNormalAccel_g * kG) * (kNormalAccel_g * kG));
+    const CountLimits& lim = count_limits(s);
+    bool spike = false;
+    if (st_.have_last) {
+        spike = jump(s.gyro.x, last_.gyro.x) > lim.gyro_jump || jump(s.gyro.y, last_.gyro.y) > lim.gyro_jump ||
+                jump(s.gyro.z, last_.gyro.z) > lim.gyro_jump;
+        spike = spike || (norm2(s.accel) > lim.accel_spike2 && norm2(last_.accel) < lim.accel_normal2);
     }
-    if (spike && st_.have_last && st_.spike_run < kMaxSpikeRun) {
+    if (spike && st_.spike_run < kMaxSpikeRun) {
         ++st_.spike_run;
         ++st_.spikes;
         if (st_.warn_spike.allow(st_.steps, kWarnIntervalSteps)) {
@@ -121,16 +140,11 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
                 .u32(st_.spikes).str(TXT(" so far)")).end();
         }
         mpu6000::Sample out = last_;
-        out.temperature_c = s.temperature_c;
+        out.temperature_raw = s.temperature_raw;
         st_.turn_doubtful = true;  // the gyro stood in for, not measured: no learner pair across it
         return out;
     }
-    // A run longer than kMaxSpikeRun is real (saturation, a crash) and used; a non-finite
-    // sample never is, with or without a previous one to stand in.
-    if (!s.gyro_rad_s.is_finite() || !s.accel_m_s2.is_finite()) {
-        st_.turn_doubtful = true;
-        return last_;
-    }
+    // A run longer than kMaxSpikeRun is real (saturation, a crash) and used.
     st_.spike_run = 0;
     if (s.gyro_saturated) st_.turn_doubtful = true;  // the rate is only a lower bound
     if (s.gyro_saturated && st_.warn_gyro_sat.allow(st_.steps, kWarnIntervalSteps))
@@ -142,6 +156,20 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
     return s;
 }
 
+// The checks' thresholds in the sample's counts, worked out again only when its ranges
+// differ from the last ones (a float division costs ~500 cycles on the 2560).
+const AttitudePipeline::CountLimits& AttitudePipeline::count_limits(const mpu6000::Sample& s) {
+    CountLimits& lim = limits_;
+    if (s.gyro_rad_s_per_count == lim.gyro_scale && s.accel_m_s2_per_count == lim.accel_scale) return lim;
+    lim.gyro_scale = s.gyro_rad_s_per_count;
+    lim.accel_scale = s.accel_m_s2_per_count;
+    lim.gyro_jump = (int32_t)(kSpikeGyroJump_rad_s / lim.gyro_scale);
+    const float spike = kSpikeAccel_g * kG / lim.accel_scale, normal = kNormalAccel_g * kG / lim.accel_scale;
+    lim.accel_spike2 = (uint32_t)(spike * spike);
+    lim.accel_normal2 = (uint32_t)(normal * normal);
+    return lim;
+}
+
 void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
     Writer w(log_);
     w.str(prefix).vec(status ? gyro_bias_rad_s() : settings_.cal.gyro_bias_rad_s, linalg::kDegPerRad)
@@ -150,7 +178,7 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
         w.end();
         return;
     }
-    w.str(TXT(", temperature ")).fixed2(last_.temperature_c).str(TXT(" C")).end();
+    w.str(TXT(", temperature ")).fixed2(last_.temperature_c()).str(TXT(" C")).end();
     w.str(TXT("# compass: cal "))
         .str((settings_.flags & settings::kFlagMagCalibrated) ? TXT("yes") : TXT("none"))
         .str(TXT(", learned offset ")).vec(settings_.cal.mag_learned_uT).str(TXT(" uT ("))
@@ -159,6 +187,8 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
 
 void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     dcm_ = dcm::Dcm(dcm_.settings());
+    dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
+    dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
     dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
     st_.mag_pending = false;
     // How far off the offset in use may be: a fraction of a uT after `cal mag` or
@@ -173,7 +203,7 @@ void AttitudePipeline::start_estimator(const Vector3f& gravity) {
 }
 
 void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
-    const calib::GyroCalibrator::Result r = gyro_cal_.add(raw.gyro_rad_s, raw.accel_m_s2);
+    const calib::GyroCalibrator::Result r = gyro_cal_.add(raw.gyro_rad_s(), raw.accel_m_s2());
     ++st_.gyro_cal_steps;
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
@@ -183,6 +213,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         if (st_.phase == Phase::Calibrating) {
             start_estimator(gyro_cal_.mean_accel_m_s2());
         } else {
+            dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
         }
         return;
@@ -194,7 +225,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
             .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
             .str(TXT(" gyro bias, measuring on")).end();
-        start_estimator(raw.accel_m_s2);
+        start_estimator(raw.accel_m_s2());
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
@@ -203,12 +234,9 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     }
 }
 
-// How many axes sit at the accelerometer's full scale (8 g, 32767/4096 counts).
-static uint8_t clipped_axes(const Vector3f& a_m_s2) {
-    const float full_scale_m_s2 = 7.99f * mpu6000::kStandardGravity_m_s2;
-    return (uint8_t)((a_m_s2.x >= full_scale_m_s2 || a_m_s2.x <= -full_scale_m_s2) +
-                     (a_m_s2.y >= full_scale_m_s2 || a_m_s2.y <= -full_scale_m_s2) +
-                     (a_m_s2.z >= full_scale_m_s2 || a_m_s2.z <= -full_scale_m_s2));
+// How many axes sit at the accelerometer's full scale (decode_burst's saturation).
+static uint8_t clipped_axes(const linalg::Vector3i& a) {
+    return (uint8_t)((a.x >= 32767 || a.x <= -32767) + (a.y >= 32767 || a.y <= -32767) + (a.z >= 32767 || a.z <= -32767));
 }
 
 void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
@@ -229,7 +257,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
     if (st_.reinit_pending) {
         st_.reinit_pending = false;
-        start_estimator(s.accel_m_s2);
+        start_estimator(s.accel_m_s2());
     }
 
     // A clipped accelerometer sample still points roughly the right way: in a violent
@@ -241,12 +269,12 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // DCM gets NaN and gives gravity no weight that step (Dcm::update). The gyro is
     // always integrated (saturated, it is a lower bound of the rate).
     st_.accel_saturated_steps = s.accel_saturated ? (uint8_t)(st_.accel_saturated_steps < 255 ? st_.accel_saturated_steps + 1 : 255) : 0;
-    const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel_m_s2) >= 2 ||
+    const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
-    const float nan = __builtin_nanf("");
-    const Vector3f gyro_rad_s = calib::apply_gyro(settings_.cal, s.gyro_rad_s);
     profile::end(profile::kChecks);
-    const bool heading_corrected = st_.mag_pending && st_.mag_present;
+    if (st_.steps_since_heading < 0xFFu) ++st_.steps_since_heading;
+    const bool heading_corrected = st_.mag_pending && st_.mag_present && st_.steps_since_heading >= kHeadingMinSteps;
+    if (heading_corrected) st_.steps_since_heading = 0;
     st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
     // A line (Euler angles and formatting, ~10 k cycles on the AVR) is not made on a
     // step that corrects the heading (~16 k): it moves to the next step, 5 ms later, so
@@ -256,9 +284,10 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
-    dcm_.update(gyro_rad_s, accel_stuck ? Vector3f(nan, nan, nan) : s.accel_m_s2, st_.output_due);
-    // The board's turn for the compass learner: the gyro alone, less the estimator's bias.
-    turn_rad_ += (gyro_rad_s - dcm_.gyro_bias_rad_s()) * kStep_s;
+    dcm_.update(s.gyro, s.accel, !accel_stuck, st_.output_due);
+    // The board's turn for the compass learner: the gyro alone (the biases come off when
+    // a field sample takes it).
+    turn_counts_ += s.gyro;
     if (heading_corrected) {
         profile::begin(profile::kCompass);
         dcm_.correct_heading(mag_cal_uT_);
@@ -304,7 +333,7 @@ linalg::Quaternion AttitudePipeline::quaternion() const {
     return linalg::quat_turned_about_down(linalg::quat_from_rotation(dcm_.matrix()), cosf(half_rad), sinf(half_rad));
 }
 
-Vector3f AttitudePipeline::gyro_rad_s() const { return calib::apply_gyro(settings_.cal, last_.gyro_rad_s); }
+Vector3f AttitudePipeline::gyro_rad_s() const { return calib::apply_gyro(settings_.cal, last_.gyro_rad_s()); }
 
 Vector3f AttitudePipeline::gyro_bias_rad_s() const {
     return settings_.cal.gyro_bias_rad_s + dcm_.gyro_bias_rad_s();

@@ -58,6 +58,10 @@ constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the b
 // Counted in steps, not milliseconds, so the reads fall on the same steps in the
 // firmware and in the host replay tool.
 constexpr uint8_t kMagReadMinSteps = 2;
+// The heading is corrected from a field sample, and the offset learner takes one, at
+// most every this many steps (1: every sample).
+constexpr uint8_t kHeadingMinSteps = 1;
+constexpr uint8_t kLearnMinSteps = 1;
 
 constexpr uint16_t kRateHz = 200;               // the MPU6000's sample rate = the estimator step
 constexpr float kStep_s = 0.005f;
@@ -130,10 +134,10 @@ public:
     // The latest sample, calibrated (body frame: gyro less its calibrated bias, accel as
     // measured, field with the compass calibration): `mode raw`.
     linalg::Vector3f gyro_rad_s() const;
-    const linalg::Vector3f& accel_m_s2() const { return last_.accel_m_s2; }
+    linalg::Vector3f accel_m_s2() const { return last_.accel_m_s2(); }
     const linalg::Vector3f& field_uT() const { return mag_cal_uT_; }
     // The body rates less every bias estimate, rad/s (MAVLink ATTITUDE).
-    linalg::Vector3f body_rate_rad_s() const { return last_.gyro_rad_s - gyro_bias_rad_s(); }
+    linalg::Vector3f body_rate_rad_s() const { return last_.gyro_rad_s() - gyro_bias_rad_s(); }
 
     // Back to the default settings and calibration, keeping the gyro bias measured at
     // this start (a measurement, not a setting). Not saved until the caller saves.
@@ -156,7 +160,7 @@ public:
     const dcm::Dcm& estimator() const { return dcm_; }
     // Calibrated bias plus what the estimator has learned since, rad/s.
     linalg::Vector3f gyro_bias_rad_s() const;
-    float temperature_c() const { return last_.temperature_c; }
+    float temperature_c() const { return last_.temperature_c(); }
     uint32_t spikes() const { return st_.spikes; }
     // "<prefix>x y z deg/s": the calibrated bias, or (status) the calibrated bias plus the
     // estimator's, followed by ", temperature T C" and a second line, the compass's:
@@ -168,6 +172,13 @@ private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
+    // The sample checks' thresholds in counts, for the ranges they were worked out for.
+    struct CountLimits {
+        float gyro_scale, accel_scale;        // rad/s and m/s^2 per count
+        int32_t gyro_jump;                    // kSpikeGyroJump_rad_s
+        uint32_t accel_spike2, accel_normal2; // (kSpikeAccel_g g)^2, (kNormalAccel_g g)^2
+    };
+    const CountLimits& count_limits(const mpu6000::Sample& s);
     void finish_mag_calibration();
     void learn_mag_offset();
     void forget_mag_reference(bool take_heading);
@@ -179,7 +190,8 @@ private:
     calib::MagCalibrator mag_cal_;
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
-    linalg::Vector3f turn_rad_;                 // the gyro's turn since the last field sample
+    linalg::Vector3l turn_counts_;              // the gyro summed since the last field sample (counts)
+    CountLimits limits_ = {};
     linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the turn before it
     linalg::Vector3f learn_turn_rad_;
     linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
@@ -195,6 +207,7 @@ private:
         uint16_t mag_cal_steps;
         uint16_t steps_since_mag;       // for the offset learner's pairs
         uint16_t learn_steps;           // steps_since_mag of the waiting sample
+        uint8_t steps_since_heading;    // since the last heading correction (saturates)
         uint16_t output_acc;
         Phase phase;                    // WaitImu
         uint8_t spike_run;

@@ -332,15 +332,15 @@ void check_decode_mpu6000() {
     burst(raw, x_only);
     EXPECT(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s) ==
            mpu6000::BurstStatus::Ok);
-    EXPECT(near(s.accel_m_s2, 0, kG, 0, 1e-4f) && near(s.gyro_rad_s, 0, 100 * d2r, 0, 1e-5f));
+    EXPECT(near(s.accel_m_s2(), 0, kG, 0, 1e-4f) && near(s.gyro_rad_s(), 0, 100 * d2r, 0, 1e-5f));
     const int16_t y_only[7] = {0, 4096, 0, 0, 0, -1640, 0};
     burst(raw, y_only);
     mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s);
-    EXPECT(near(s.accel_m_s2, kG, 0, 0, 1e-4f) && near(s.gyro_rad_s, -100 * d2r, 0, 0, 1e-5f));
+    EXPECT(near(s.accel_m_s2(), kG, 0, 0, 1e-4f) && near(s.gyro_rad_s(), -100 * d2r, 0, 0, 1e-5f));
     const int16_t z_only[7] = {0, 0, 4096, 0, 0, 0, 164};
     burst(raw, z_only);
     mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s);
-    EXPECT(near(s.accel_m_s2, 0, 0, -kG, 1e-4f) && near(s.gyro_rad_s, 0, 0, -10 * d2r, 1e-5f));
+    EXPECT(near(s.accel_m_s2(), 0, 0, -kG, 1e-4f) && near(s.gyro_rad_s(), 0, 0, -10 * d2r, 1e-5f));
     struct Range {
         mpu6000::GyroRange g;
         float lsb_dps;
@@ -357,22 +357,22 @@ void check_decode_mpu6000() {
         const int16_t v[7] = {0, (int16_t)(ranges[i].lsb_g / 2), 0, 0, (int16_t)(ranges[i].lsb_dps * 20.0f), 0, 0};
         burst(raw, v);
         EXPECT(mpu6000::decode_burst(raw, ranges[i].g, ranges[i].a, s) == mpu6000::BurstStatus::Ok);
-        EXPECT(near(s.accel_m_s2.x, 0.5f * kG, 2e-3f) && near(s.gyro_rad_s.y, 20 * d2r, 2e-3f));
+        EXPECT(near(s.accel_m_s2().x, 0.5f * kG, 2e-3f) && near(s.gyro_rad_s().y, 20 * d2r, 2e-3f));
         EXPECT(mpu6000::gyro_lsb_per_dps(ranges[i].g) == ranges[i].lsb_dps);
         EXPECT(mpu6000::accel_lsb_per_g(ranges[i].a) == ranges[i].lsb_g);
     }
     const int16_t sat[7] = {32767, 0, 0, -521, 0, -32768, 0};
     burst(raw, sat);
     mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s);
-    EXPECT(s.accel_saturated && s.gyro_saturated && near(s.temperature_c, -521.0f / 340.0f + 36.53f, 1e-4f));
-    s.temperature_c = 99.0f;
+    EXPECT(s.accel_saturated && s.gyro_saturated && near(s.temperature_c(), -521.0f / 340.0f + 36.53f, 1e-4f));
+    s.temperature_raw = 1234;
     memset(raw, 0x00, sizeof raw);
     EXPECT(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s) ==
            mpu6000::BurstStatus::NoSensor);
     memset(raw, 0xFF, sizeof raw);
     EXPECT(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G8, s) ==
            mpu6000::BurstStatus::NoSensor);
-    EXPECT(s.temperature_c == 99.0f);  // untouched
+    EXPECT(s.temperature_raw == 1234);  // untouched
     EXPECT(mpu6000::smplrt_div_for_hz(200) == 4);
 }
 
