@@ -301,17 +301,16 @@ void Dcm::correct_gravity() {
     profile::end(profile::kGravity);
 }
 
-// R <- R exp([theta x]) with theta the summed turn and its coning term (eq. 17, exact
-// to the series' order). For a row r and a = |theta|, Rodrigues' formula is
-//   r exp([theta x]) = cos(a) [r + (tan(a)/a)(r x theta) + k theta (r . theta)],
-//   k = (1 - cos a) / (a^2 cos a),
-// and the factor cos(a) is a length, which renormalisation takes out. The series below
-// (tan(a)/a = 1 + a^2/3 + 2a^4/15 + 17a^6/315, k = 1/2 + 5a^2/24 + 61a^4/720) leave
-// below 1e-6 rad an update up to a = 0.5 rad (1 430 deg/s at 50 Hz); the terms after
-// a^2 are what a 50 Hz update needs (0.24 deg an update at 0.5 rad without them). The
-// paper's first-order R (I + [theta x]) is not a rotation: renormalising it shrinks
-// each row's component along the axis by a^2/2 an update. Row c is not integrated:
-// renormalisation rebuilds it as a x b.
+// R <- R exp([theta x]) with theta the summed turn and its coning term. For a row r
+// and a = |theta|, Rodrigues' formula is
+//   r exp([theta x]) = cos(a) r + (sin(a)/a) (r x theta) + ((1 - cos a)/a^2) theta (r . theta),
+// with the three factors from their series to a^6 (sin(a)/a, cos a) and a^4 ((1 - cos a)
+// /a^2): below 4e-7 an update up to a = 0.5 rad (1 430 deg/s at 50 Hz). The update is
+// then a rotation to that order and keeps R orthonormal by itself: rounding leaves
+// ~1e-7 an update, so renormalisation (which costs half an update) runs every
+// kRenormaliseEvery updates, and row c is rebuilt as a x b at each (rows a and b are
+// what the update turns). The paper's first-order R (I + [theta x]) is not a rotation:
+// it stretches each row by a^2/2 an update, which renormalising at every update hid.
 void Dcm::integrate() {
     profile::begin(profile::kIntegration);
     const float turn_per_unit = turn_rad_per_unit();
@@ -322,20 +321,26 @@ void Dcm::integrate() {
     turn_sum_ = Vector3l();
     pending_steps_ = 0;
     const float a2 = theta.length_squared();
-    const float tan_ratio = 1.0f + a2 * (1.0f / 3.0f + a2 * (2.0f / 15.0f + a2 * (17.0f / 315.0f)));
-    const float k = 0.5f + a2 * (5.0f / 24.0f + a2 * (61.0f / 720.0f));
-    const Vector3f stretched = theta * tan_ratio;
-    const Vector3f k_theta = theta * k;
-    r_.a += r_.a.cross(stretched) + theta * r_.a.dot(k_theta);
-    r_.b += r_.b.cross(stretched) + theta * r_.b.dot(k_theta);
+    const float cos_a = 1.0f - a2 * (0.5f - a2 * (1.0f / 24.0f - a2 * (1.0f / 720.0f)));
+    const float sin_ratio = 1.0f - a2 * (1.0f / 6.0f - a2 * (1.0f / 120.0f - a2 * (1.0f / 5040.0f)));
+    const float versine_ratio = 0.5f - a2 * (1.0f / 24.0f - a2 * (1.0f / 720.0f));
+    const Vector3f sin_theta = theta * sin_ratio;
+    const Vector3f versine_theta = theta * versine_ratio;
+    r_.a = r_.a * cos_a + r_.a.cross(sin_theta) + theta * r_.a.dot(versine_theta);
+    r_.b = r_.b * cos_a + r_.b.cross(sin_theta) + theta * r_.b.dot(versine_theta);
     profile::end(profile::kIntegration);
     profile::begin(profile::kRenormalisation);
-    // One pass leaves ~(X.Y)^2: a second one, needed only at high rates (an update of
-    // more than ~3 deg), keeps the matrix orthonormal to 1e-5 up to the gyro's range.
-    float skew = 0.0f;
-    bool ok = renormalise(skew);
-    if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
-    if (!ok) recover();
+    if (++updates_since_renormalise_ >= kRenormaliseEvery) {
+        updates_since_renormalise_ = 0;
+        // One pass leaves ~(X.Y)^2: a second one, needed only after a large error (a
+        // heading taken at once, a rebuilt matrix), keeps it orthonormal to 1e-5.
+        float skew = 0.0f;
+        bool ok = renormalise(skew);
+        if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
+        if (!ok) recover();
+    } else {
+        r_.c = r_.a.cross(r_.b);
+    }
     profile::end(profile::kRenormalisation);
 }
 

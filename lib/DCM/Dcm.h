@@ -205,6 +205,10 @@ public:
     // The matrix is turned every this many steps (50 Hz at the 200 Hz step) by the
     // rates summed meanwhile (Dcm::integrate). Even: the coning term needs two halves.
     static constexpr uint8_t kIntegrationSteps = 4;
+    // Renormalisation every this many integrations (6 Hz): each integration is a
+    // rotation to 4e-7 (Dcm::integrate), so eight leave R orthonormal to ~3e-6, below
+    // what a 0.01 deg output shows (1.7e-4).
+    static constexpr uint8_t kRenormaliseEvery = 8;
     // The means the rest test compares the samples against (VQF's 0.5 s).
     static constexpr float kRestMeanTau_s = 0.5f;
     // The accel low-pass's time constant at start (startup_s ramps it to accel_lowpass_s).
@@ -280,6 +284,7 @@ private:
     linalg::Vector3l first_half_;        // corrected rates summed over the integration's first half (kTurnScale)
     linalg::Vector3l turn_sum_;          // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
+    uint8_t updates_since_renormalise_ = 0;
     bool gravity_due_ = false;           // a gravity correction waits for a step without an integration
     bool heavy_ = false;                 // the last update integrated or corrected gravity
     float mag_ref_norm_ = 0.0f;          // learned field strength
