@@ -103,6 +103,10 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     first_half_ = Vector3l();
     turn_sum_ = Vector3l();
     pending_steps_ = 0;
+    heading_field_sum_ = Vector3f();
+    heading_norm2_sum_ = 0.0f;
+    heading_samples_ = 0;
+    heading_steps_ = 0;
     rest_accel_mean_m_s2_ = accel_m_s2;
     steps_ = 0;
     status_ |= kStatusInitialised;
@@ -383,11 +387,13 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
 }
 
 void Dcm::correct_heading(const Vector3f& mag_field) {
-    uint16_t interval_steps = steps_since_mag_;
+    const uint16_t since_last = steps_since_mag_;
     steps_since_mag_ = 0;
-    status_ |= kStatusMagIgnored;
-    const float norm2 = mag_field.length_squared();
-    if (!(norm2 > 0.0f) || !linalg::is_finite(norm2)) return;
+    const float sample_norm2 = mag_field.length_squared();
+    if (!(sample_norm2 > 0.0f) || !linalg::is_finite(sample_norm2)) {
+        status_ |= kStatusMagIgnored;
+        return;
+    }
     last_mag_field_ = mag_field;
     // The rest test's witness: a field that moved in body axes since the rest began
     // means the board turns (or a magnet moved): no rest.
@@ -413,7 +419,26 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
         mag_field + mag_field.cross(rate_rad_s * settings_.mag_latency_s - pending_turn_rad());
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
-    const Vector3f field_ef = r_ * field_now;
+    // The samples are averaged in earth axes over kHeadingSteps (a fixed earth field is
+    // the same vector there whatever the board did meanwhile), and the heading is
+    // corrected from their mean: each sample costs the rotation into earth axes, the
+    // correction (the rest of this function, ~2/3 of its cycles) runs at 25 Hz.
+    heading_field_sum_ += r_ * field_now;
+    heading_norm2_sum_ += sample_norm2;
+    ++heading_samples_;
+    heading_steps_ = (uint16_t)(heading_steps_ + since_last);
+    if (heading_steps_ < kHeadingSteps) return;
+    uint16_t interval_steps = heading_steps_;
+    const float inv_samples = heading_samples_ == 1 ? 1.0f : 1.0f / (float)heading_samples_;
+    const Vector3f field_ef = heading_field_sum_ * inv_samples;
+    // The strength and dip tests take the samples' mean strength (the field's strength
+    // is the same in every frame; the mean vector's is shorter where the samples differ).
+    const float norm2 = heading_norm2_sum_ * inv_samples;
+    heading_field_sum_ = Vector3f();
+    heading_norm2_sum_ = 0.0f;
+    heading_samples_ = 0;
+    heading_steps_ = 0;
+    status_ |= kStatusMagIgnored;
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
     const float norm = sqrtf(norm2);

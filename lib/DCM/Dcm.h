@@ -165,6 +165,13 @@ public:
     // applied in the next step. Samples whose strength or dip differ from the
     // learned earth field are rejected (kStatusMagIgnored).
     void correct_heading(const linalg::Vector3f& mag_field);
+    // A field sample given to correct_heading after the next update completes the
+    // average of kHeadingSteps and corrects the heading (the costly part): a caller with
+    // deferrable work (an output line, the compass learner) puts it on another step.
+    bool heading_due_next() const {
+        return initialised() && !(status_ & kStatusNoHeading) &&
+               (uint16_t)(heading_steps_ + steps_since_mag_ + 1u) >= kHeadingSteps;
+    }
 
     // Forgets the learned earth field (strength and dip): the next field sample is
     // taken as the reference. take_heading: its heading too, at once, as a new steady
@@ -175,6 +182,11 @@ public:
     void reset_mag_reference(bool take_heading = true) {
         mag_ref_norm_ = 0.0f;
         mag_take_heading_ = take_heading;
+        // The samples waiting for the heading's mean were calibrated the old way.
+        heading_field_sum_ = linalg::Vector3f();
+        heading_norm2_sum_ = 0.0f;
+        heading_samples_ = 0;
+        heading_steps_ = 0;
     }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
@@ -209,6 +221,10 @@ public:
     // rotation to 4e-7 (Dcm::integrate), so eight leave R orthonormal to ~3e-6, below
     // what a 0.01 deg output shows (1.7e-4).
     static constexpr uint8_t kRenormaliseEvery = 8;
+    // The heading is corrected from the mean of the field samples over at least this
+    // many steps (25 Hz; the HMC5883L's 75 Hz samples in threes): the correction is
+    // slow (1/kp_yaw = 10 s), and the mean keeps every sample's information.
+    static constexpr uint8_t kHeadingSteps = 8;
     // The means the rest test compares the samples against (VQF's 0.5 s).
     static constexpr float kRestMeanTau_s = 0.5f;
     // The accel low-pass's time constant at start (startup_s ramps it to accel_lowpass_s).
@@ -285,6 +301,10 @@ private:
     linalg::Vector3l turn_sum_;          // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
     uint8_t updates_since_renormalise_ = 0;
+    linalg::Vector3f heading_field_sum_; // field samples in earth axes, summed for the heading
+    float heading_norm2_sum_ = 0.0f;     // ... and their squared strengths
+    uint8_t heading_samples_ = 0;
+    uint16_t heading_steps_ = 0;         // steps the summed samples stand for
     bool gravity_due_ = false;           // a gravity correction waits for a step without an integration
     bool heavy_ = false;                 // the last update integrated or corrected gravity
     float mag_ref_norm_ = 0.0f;          // learned field strength

@@ -272,14 +272,14 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
     profile::end(profile::kChecks);
-    if (st_.steps_since_heading < 0xFFu) ++st_.steps_since_heading;
-    const bool heading_corrected = st_.mag_pending && st_.mag_present && st_.steps_since_heading >= kHeadingMinSteps;
-    if (heading_corrected) st_.steps_since_heading = 0;
+    const bool heading_corrected = st_.mag_pending && st_.mag_present;
+    // The step whose field sample completes the DCM's heading average corrects the heading.
+    const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
     st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
     // A line (Euler angles and formatting, ~10 k cycles on the AVR) is not made on a
     // step that corrects the heading (~16 k): it moves to the next step, 5 ms later, so
     // that no step carries both. The DCM brings its matrix up to date for it.
-    if (st_.output_acc >= kRateHz && !heading_corrected) {
+    if (st_.output_acc >= kRateHz && !heading_heavy) {
         st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
@@ -311,7 +311,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
     // two heavy parts beyond an integration with a heading correction or a line (of four
     // steps two are the DCM's; a sample waits at most a few steps).
-    if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
+    if (st_.output_due || heading_heavy || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
     if (st_.learn_pending) {
