@@ -43,6 +43,7 @@ void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
 void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count) {
     gyro_scale_ = gyro_rad_s_per_count;
     accel_scale_ = accel_m_s2_per_count;
+    units_per_rad_s_ = (float)kTurnScale / gyro_rad_s_per_count;
     update_offset();
 }
 
@@ -54,8 +55,7 @@ void Dcm::update_offset() {
 }
 
 Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
-    const float k = (float)(1L << kTurnFraction) / gyro_scale_;
-    const Vector3f u = rate_rad_s * k;
+    const Vector3f u = rate_rad_s * units_per_rad_s_;
     return Vector3l{linalg::fixed_from_float(u.x, 0), linalg::fixed_from_float(u.y, 0), linalg::fixed_from_float(u.z, 0)};
 }
 
@@ -111,6 +111,18 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
+}
+
+// 1/n for the few window lengths there are, without the ~500-cycle division.
+float Dcm::inverse(uint8_t n) {
+    switch (n) {
+        case 1: return 1.0f;
+        case 2: return 0.5f;
+        case 3: return 1.0f / 3.0f;
+        case 4: return 0.25f;
+        case 5: return 0.2f;
+        default: return 1.0f / (float)n;
+    }
 }
 
 void Dcm::learn_field(float norm, float down_component) {
@@ -276,9 +288,10 @@ void Dcm::correct_gravity() {
                      (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() > hold_rate2_;
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
-        const float inv_n = 1.0f / (float)window_samples_;
-        const Vector3f gyro_mean = gyro_sum_.scaled(gyro_scale_ * inv_n) - sensor_bias_rad_s_;
-        const Vector3f accel_mean = accel_sum_.scaled(accel_scale_ * inv_n);
+        const float inv_n = inverse(window_samples_);
+        const Vector3f gyro_raw_mean = gyro_sum_.scaled(gyro_scale_ * inv_n);
+        const Vector3f gyro_mean = gyro_raw_mean - sensor_bias_rad_s_;
+        const Vector3l accel_sum = accel_sum_;
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
         // step's sample by the steps not yet integrated (this one among them), so the
@@ -286,15 +299,17 @@ void Dcm::correct_gravity() {
         // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
         // of the running sums, three additions a step. (Weighting each sample, not the
         // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
-        const Vector3f turn_per_step = (gyro_mean + sensor_bias_rad_s_ - offset_rad_s_) * settings_.step_s;
+        // In counts until the rotation into earth axes; one scale after it.
+        const Vector3f turn_per_step = (gyro_raw_mean - offset_rad_s_) * settings_.step_s;
         const int32_t pending = pending_steps_;
-        const Vector3f weighted = Vector3l{accel_sum_of_sums_.x - accel_sum_.x * pending,
-                                           accel_sum_of_sums_.y - accel_sum_.y * pending,
-                                           accel_sum_of_sums_.z - accel_sum_.z * pending}
-                                      .scaled(accel_scale_);
-        const float alpha = accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left;
-        accel_lp_ef_ += (r_ * (accel_mean - turn_per_step.cross(weighted) * inv_n) - accel_lp_ef_) * alpha;
-        detect_rest(gyro_mean, accel_mean, window_samples_ >= kCorrectionDivider);
+        const Vector3f weighted = Vector3l{accel_sum_of_sums_.x - accel_sum.x * pending,
+                                           accel_sum_of_sums_.y - accel_sum.y * pending,
+                                           accel_sum_of_sums_.z - accel_sum.z * pending}
+                                      .to_float();
+        const float alpha = starting ? accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left : accel_alpha_;
+        const Vector3f accel_ef = r_ * (accel_sum.to_float() - turn_per_step.cross(weighted));
+        accel_lp_ef_ += (accel_ef * (accel_scale_ * inv_n) - accel_lp_ef_) * alpha;
+        detect_rest(gyro_mean, accel_sum.scaled(accel_scale_ * inv_n), window_samples_ >= kCorrectionDivider);
     }
     gyro_sum_ = Vector3l();
     accel_sum_ = Vector3l();
@@ -372,7 +387,9 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const float error_e = accel_lp_ef_.x * inv_lp;
     // In body axes: R^T (error_n, error_e, 0).
     const Vector3f error = r_.a * error_n + r_.b * error_e;
-    const float kp = settings_.kp_rp_1_s + (settings_.kp_startup_1_s - settings_.kp_rp_1_s) * startup_left;
+    const float kp = startup_left > 0.0f
+                         ? settings_.kp_rp_1_s + (settings_.kp_startup_1_s - settings_.kp_rp_1_s) * startup_left
+                         : settings_.kp_rp_1_s;
     correction_rad_s_ = error * kp;
     if (!hold_integrator) {
         bias_rad_s_ -= error * (settings_.ki_rp_1_s2 * correction_dt_);

@@ -244,6 +244,7 @@ private:
     void integrate();
     void correct_gravity();
     void update_offset();
+    static float inverse(uint8_t n);
     linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
     float turn_rad_per_unit() const { return gyro_scale_ * settings_.step_s * (1.0f / (float)kTurnScale); }
     linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
@@ -284,6 +285,7 @@ private:
     linalg::Vector3f sensor_bias_rad_s_; // set_sensor_bias_rad_s
     float gyro_scale_ = kFloatGyroScale; // rad/s per count
     float accel_scale_ = kFloatAccelScale; // m/s^2 per count
+    float units_per_rad_s_ = (float)kTurnScale / kFloatGyroScale;  // the turn sums' units
     linalg::Vector3l yaw_units_;         // yaw correction from the last field sample (a turn sums' step), applied once
     linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)

@@ -112,6 +112,7 @@ struct Vector3l {
         z += v.z;
         return *this;
     }
+    Vector3f to_float() const { return Vector3f((float)x, (float)y, (float)z); }
     // The vector times a scale, in float (three conversions and three multiplies).
     Vector3f scaled(float s) const { return Vector3f((float)x * s, (float)y * s, (float)z * s); }
 };

@@ -311,7 +311,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
     // two heavy parts beyond an integration with a heading correction or a line (of four
     // steps two are the DCM's; a sample waits at most a few steps).
-    if (st_.output_due || heading_heavy || dcm_.heavy_step()) return;
+    if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
     if (st_.learn_pending) {
