@@ -403,7 +403,7 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     accel_lp_ef_ += Vector3f(error_e * lp.z, -error_n * lp.z, error_n * lp.y - error_e * lp.x) * turn;
 }
 
-void Dcm::correct_heading(const Vector3f& mag_field) {
+void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const uint16_t since_last = steps_since_mag_;
     steps_since_mag_ = 0;
     const float sample_norm2 = mag_field.length_squared();
@@ -433,7 +433,8 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     // after a turn p reads v - p x v = v + v x p, so before it v x -p).
     const Vector3f rate_rad_s = last_rate_rad_s();
     const Vector3f field_now =
-        mag_field + mag_field.cross(rate_rad_s * settings_.mag_latency_s - pending_turn_rad());
+        mag_field + mag_field.cross(rate_rad_s * (settings_.mag_latency_s + settings_.step_s * (float)age_steps) -
+                                    pending_turn_rad());
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
     // The samples are averaged in earth axes over kHeadingSteps (a fixed earth field is

@@ -164,7 +164,14 @@ public:
     // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down,
     // applied in the next step. Samples whose strength or dip differ from the
     // learned earth field are rejected (kStatusMagIgnored).
-    void correct_heading(const linalg::Vector3f& mag_field);
+    // age_steps: steps the sample waited before this call (its latency grows by as much).
+    void correct_heading(const linalg::Vector3f& mag_field, uint8_t age_steps = 0);
+    // The next update (without a line) integrates or corrects gravity: a caller with
+    // deferrable work puts it on another step.
+    bool heavy_due() const {
+        return initialised() && (pending_steps_ + 1u >= kIntegrationSteps || gravity_due_ ||
+                                 correction_phase_ + 1u >= kCorrectionDivider);
+    }
     // A field sample given to correct_heading after the next update completes the
     // average of kHeadingSteps and corrects the heading (the costly part): a caller with
     // deferrable work (an output line, the compass learner) puts it on another step.

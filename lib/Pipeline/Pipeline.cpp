@@ -75,6 +75,7 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         if (st_.steps_since_mag < kLearnMinSteps) {
             mag_cal_uT_ = f;
             st_.mag_pending = true;
+            st_.mag_wait_steps = 0;
             st_.have_mag = true;
             return;
         }
@@ -97,6 +98,7 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     turn_counts_ = linalg::Vector3l();
     mag_cal_uT_ = f;
     st_.mag_pending = true;
+    st_.mag_wait_steps = 0;  // a sample still waiting is replaced by this one
     st_.have_mag = true;
 }
 
@@ -272,14 +274,19 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
     profile::end(profile::kChecks);
-    const bool heading_corrected = st_.mag_pending && st_.mag_present;
-    // The step whose field sample completes the DCM's heading average corrects the heading.
-    const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
+    // A field sample (10-20 k cycles: into earth axes, and the heading's correction
+    // every kHeadingSteps) waits out a step on which the DCM integrates or corrects
+    // gravity (~18-30 k), up to kMaxMagWaitSteps: its age is counted in the latency
+    // compensation. A line (Euler angles and formatting, ~10 k) is not made on a step
+    // with a field sample: it moves to the next step, 5 ms later (samples come at
+    // least two steps apart). The DCM brings its matrix up to date for the line.
+    bool heading_corrected = st_.mag_pending && st_.mag_present;
+    if (heading_corrected && st_.mag_wait_steps < kMaxMagWaitSteps && dcm_.heavy_due()) {
+        heading_corrected = false;
+        ++st_.mag_wait_steps;
+    }
     st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
-    // A line (Euler angles and formatting, ~10 k cycles on the AVR) is not made on a
-    // step that corrects the heading (~16 k): it moves to the next step, 5 ms later, so
-    // that no step carries both. The DCM brings its matrix up to date for it.
-    if (st_.output_acc >= kRateHz && !heading_heavy) {
+    if (st_.output_acc >= kRateHz && !heading_corrected) {
         st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
@@ -290,10 +297,11 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     turn_counts_ += s.gyro;
     if (heading_corrected) {
         profile::begin(profile::kCompass);
-        dcm_.correct_heading(mag_cal_uT_);
+        dcm_.correct_heading(mag_cal_uT_, st_.mag_wait_steps);
         profile::end(profile::kCompass);
+        st_.mag_pending = false;
+        st_.mag_wait_steps = 0;
     }
-    st_.mag_pending = false;
 
     if (st_.mag_cal_active) {
         ++st_.mag_cal_steps;

@@ -63,6 +63,9 @@ constexpr uint8_t kMagReadMinSteps = 2;
 // (kLearnMinCos) whatever the rate; the gyro's turn between two samples is summed as a
 // rotation vector, whose error over 40 ms (at most 0.2 rad at 300 deg/s) is below 0.003 rad.
 constexpr uint8_t kLearnMinSteps = 8;
+// A field sample waits at most this many steps for a step free of the DCM's heavy parts
+// (an integration may be followed by a gravity correction: two in a row at most).
+constexpr uint8_t kMaxMagWaitSteps = 2;
 
 constexpr uint16_t kRateHz = 200;               // the MPU6000's sample rate = the estimator step
 constexpr float kStep_s = 0.005f;
@@ -212,6 +215,7 @@ private:
         Phase phase;                    // WaitImu
         uint8_t spike_run;
         uint8_t accel_saturated_steps;  // consecutive saturated accel samples
+        uint8_t mag_wait_steps;         // steps the pending field sample has waited
         bool have_last;
         bool mag_present;
         bool mag_pending;
