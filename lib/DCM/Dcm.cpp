@@ -1,5 +1,6 @@
 #include "Dcm.h"
 
+#include "Fixed.h"
 #include "Profile.h"
 
 namespace dcm {
@@ -409,10 +410,12 @@ void Dcm::correct_heading(const Vector3f& mag_field) {
     }
 }
 
-EulerAngles Dcm::euler_now() const {
+EulerQ24 Dcm::euler_now_q24() const {
     // R carried forward by the lead and any turn not yet integrated (at most one step
     // when the update was told a line is due), in fixed point.
-    return euler_carried(r_, last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad());
+    const Vector3f theta_rad = last_rate_rad_s_ * settings_.output_lead_s + pending_turn_rad();
+    return euler_carried_q24(r_, linalg::fixed_from_float(theta_rad.x, 26), linalg::fixed_from_float(theta_rad.y, 26),
+                             linalg::fixed_from_float(theta_rad.z, 26));
 }
 
 bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,

@@ -178,7 +178,9 @@ public:
     // the attitude now rather than when the (low-passed, hence delayed) gyro sample
     // was taken. R (I + [w lead x]), first order: the lead is a few ms. What the
     // firmware prints.
-    EulerAngles euler_now() const;
+    EulerAngles euler_now() const { return euler_in_rad(euler_now_q24()); }
+    // The same in Q24 radians, for the integer output path.
+    EulerQ24 euler_now_q24() const;
 
     // The roll/pitch correction is worked out every this many steps (50 Hz at the
     // default 200 Hz step) and applied at every step: it moves at the 3 s pace of

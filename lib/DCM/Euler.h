@@ -33,6 +33,16 @@ struct EulerAngles {
     float yaw_rad;  // -pi..pi
 };
 
+// The same angles in Q24 radians (linalg::kAngleQ), as the integer extraction gives
+// them: the output path turns them into printed hundredths of a degree with integers
+// only (centideg_from_q24), a float caller converts them exactly (euler_in_rad).
+struct EulerQ24 {
+    int32_t roll_q24;
+    int32_t pitch_q24;
+    int32_t yaw_q24;  // -pi..pi
+};
+EulerAngles euler_in_rad(const EulerQ24& e);
+
 // Below this cos(pitch) (pitch within ~0.001 deg of +-90) roll is folded into yaw.
 // Small enough that the folded angles rebuild R to ~2e-5, large enough that roll
 // is still well-conditioned just above it.
@@ -46,10 +56,19 @@ EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float
 // that keeps R in fixed point and so skips the conversions (~110 cycles an entry on
 // the AVR). Any int32 values give finite angles.
 EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32, int32_t r33);
+EulerQ24 euler_q24_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
+                            int32_t r33);
 // The angles of R carried forward by a small rotation theta (body frame, rad):
 // R' = R (I + [theta]x), each row r' = r + r x theta (first order: the output's lead,
 // |theta| ~ rate * 3 ms). theta is clamped to +-0.25 rad per axis (beyond it the first
-// order is itself off by theta^2/2 > 1.8 deg). Only the seven entries read are formed.
+// order is itself off by theta^2/2 > 1.8 deg). Only the entries read are formed (R12
+// and R22 only at the gimbal lock).
+// theta in Q26 radians (2^26 = 1 rad, 1.5e-8 rad steps) for a caller that sums it in
+// integers; the float theta is the same after fixed_from_float(theta, 26).
+EulerQ24 euler_carried_q24(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                           int32_t theta_z_q26);
+EulerAngles euler_carried(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                          int32_t theta_z_q26);
 EulerAngles euler_carried(const linalg::Matrix3f& r, const linalg::Vector3f& theta_rad);
 linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 
@@ -57,5 +76,11 @@ linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 // declination (east positive) in degrees (-180..180): the firmware's output
 // convention. Outside those ranges, or for NaN, it gives 0 (never NaN).
 float heading_deg(float yaw_rad, float declination_deg);
+
+// The same in hundredths of a degree, 0 <= h < 36000, from yaw in Q24 radians (-pi..pi)
+// and a declination (east positive) in hundredths (-18000..18000), in integers: the
+// yaw rounded to hundredths (linalg::centideg_from_q24) before the declination, a
+// whole number of them, is added.
+int32_t heading_centideg(int32_t yaw_q24, int16_t declination_centideg);
 
 }  // namespace dcm

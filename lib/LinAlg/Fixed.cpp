@@ -178,6 +178,21 @@ int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_negative, uint32
     return y_negative && y_magnitude != 0 ? -a : a;
 }
 
+int32_t centideg_from_q24(int32_t angle_q24) {
+    // m * K / 2^40 with m = |a| < 2^26 and K = round(18000/pi * 2^16) = 375493621 <
+    // 2^29, from 16-bit halves: m K = hi 2^32 + (mid mod 2^16) 2^16 + (lo mod 2^16).
+    constexpr uint16_t kHigh = 5729, kLow = 37877;  // K = 5729 * 2^16 + 37877
+    const uint32_t m = magnitude(angle_q24);
+    const uint16_t m_high = (uint16_t)(m >> 16), m_low = (uint16_t)m;  // m_high < 2^10
+    const uint32_t lo = mul16(m_low, kLow);
+    // < 2^29 + 2^26 + 2^16: no overflow.
+    const uint32_t mid = mul16(m_low, kHigh) + mul16(m_high, kLow) + (lo >> 16);
+    const uint32_t hi = mul16(m_high, kHigh) + (mid >> 16);
+    // round(m K / 2^40) = (hi + 2^7) >> 8: the bits below hi cannot carry into it.
+    const uint16_t c = (uint16_t)((hi + 0x80u) >> 8);
+    return angle_q24 < 0 ? -(int32_t)c : (int32_t)c;
+}
+
 uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31) {
     uint16_t s;
     if (ratio_q31 >= 0x80000000u) {

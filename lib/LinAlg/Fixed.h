@@ -109,6 +109,13 @@ int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_negative, uint32
 // max * sqrt(1 + t^2), the square root from a table. No overflow: < 1.42 * 2^31.
 uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31);
 
+// An angle in Q24 radians in hundredths of a degree, rounded to nearest (half away
+// from zero): round(|a| * 18000/pi / 2^24) from four 16x16 multiplies, no float. The
+// constant is 18000/pi in Q16 rounded (relative error 1.3e-9): the result is the
+// exact rounding of the Q24 value except within 2^-15 of a count of a half. For
+// |a| < 2^26 (4 rad; atan2_q24 gives at most pi).
+int32_t centideg_from_q24(int32_t angle_q24);
+
 // a * b for int16 factors, with avr-gcc's widening multiply (__mulhisi3, ~25 cycles):
 // out of line because inlined, gcc often turns (int32_t)a * b into its 32x32 routine
 // (__mulsi3, ~105 cycles).

@@ -1,5 +1,6 @@
 #include "Pipeline.h"
 
+#include "Fixed.h"
 #include "Profile.h"
 
 #include <math.h>
@@ -296,6 +297,12 @@ Angles AttitudePipeline::angles() const {
     const dcm::EulerAngles e = dcm_.euler_now();
     const float h = dcm::heading_deg(e.yaw_rad, settings_.declination_deg());
     return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad, h};
+}
+
+AnglesCentideg AttitudePipeline::angles_centideg() const {
+    const dcm::EulerQ24 e = dcm_.euler_now_q24();
+    return AnglesCentideg{linalg::centideg_from_q24(e.roll_q24), linalg::centideg_from_q24(e.pitch_q24),
+                          dcm::heading_centideg(e.yaw_q24, settings_.declination_centideg)};
 }
 
 linalg::Quaternion AttitudePipeline::quaternion() const {

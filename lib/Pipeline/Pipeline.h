@@ -88,6 +88,14 @@ struct Angles {
     float heading_deg;  // 0 <= h < 360, declination applied
 };
 
+// The same rounded to the hundredths the output lines print, from the fixed-point
+// extraction with integers only (fmt::format_plot_line takes them as they are).
+struct AnglesCentideg {
+    int32_t roll_centideg;     // -18000..18000
+    int32_t pitch_centideg;    // -9000..9000
+    int32_t heading_centideg;  // 0 <= h < 36000, declination applied
+};
+
 // A per-kind rate limiter for warnings: allow() is true at most once per interval,
 // suppressed() tells how many were held back in all. A plain struct that starts
 // zeroed: declare it static or value-initialise it (`RateLimiter r{};`).
@@ -122,8 +130,11 @@ public:
     void on_mag_sample(const linalg::Vector3f& field_uT);
     // True once per output period after on_imu_sample (only while Running).
     bool output_due() const { return st_.output_due; }
-    // Current angles (Euler extraction: ~5 ksteps of float work on AVR; call when due).
+    // Current angles (Euler extraction in integers, then floats: ~? k cycles on the AVR;
+    // call when due).
     Angles angles() const;
+    // The same in printed hundredths, with no float at all (~? k cycles): the lines'.
+    AnglesCentideg angles_centideg() const;
     // The same attitude as a unit quaternion, body to the true-north earth frame
     // (declination applied like the heading's): `mode quat`.
     linalg::Quaternion quaternion() const;
