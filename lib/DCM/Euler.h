@@ -83,4 +83,13 @@ float heading_deg(float yaw_rad, float declination_deg);
 // whole number of them, is added.
 int32_t heading_centideg(int32_t yaw_q24, int16_t declination_centideg);
 
+// The angles as the output lines print them, in hundredths of a degree, from the
+// integer extraction with integers only.
+struct AnglesCentideg {
+    int32_t roll_centideg;     // -18000..18000
+    int32_t pitch_centideg;    // -9000..9000
+    int32_t heading_centideg;  // 0 <= h < 36000, declination applied
+};
+AnglesCentideg angles_centideg(const EulerQ24& e, int16_t declination_centideg);
+
 }  // namespace dcm

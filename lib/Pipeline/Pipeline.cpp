@@ -1,6 +1,5 @@
 #include "Pipeline.h"
 
-#include "Fixed.h"
 #include "Profile.h"
 
 #include <math.h>
@@ -300,9 +299,7 @@ Angles AttitudePipeline::angles() const {
 }
 
 AnglesCentideg AttitudePipeline::angles_centideg() const {
-    const dcm::EulerQ24 e = dcm_.euler_now_q24();
-    return AnglesCentideg{linalg::centideg_from_q24(e.roll_q24), linalg::centideg_from_q24(e.pitch_q24),
-                          dcm::heading_centideg(e.yaw_q24, settings_.declination_centideg)};
+    return dcm::angles_centideg(dcm_.euler_now_q24(), settings_.declination_centideg);
 }
 
 linalg::Quaternion AttitudePipeline::quaternion() const {

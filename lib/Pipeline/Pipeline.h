@@ -88,13 +88,8 @@ struct Angles {
     float heading_deg;  // 0 <= h < 360, declination applied
 };
 
-// The same rounded to the hundredths the output lines print, from the fixed-point
-// extraction with integers only (fmt::format_plot_line takes them as they are).
-struct AnglesCentideg {
-    int32_t roll_centideg;     // -18000..18000
-    int32_t pitch_centideg;    // -9000..9000
-    int32_t heading_centideg;  // 0 <= h < 36000, declination applied
-};
+// The same rounded to the hundredths the output lines print (fmt::format_plot_line_centideg).
+using AnglesCentideg = dcm::AnglesCentideg;
 
 // A per-kind rate limiter for warnings: allow() is true at most once per interval,
 // suppressed() tells how many were held back in all. A plain struct that starts

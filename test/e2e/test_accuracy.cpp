@@ -72,6 +72,21 @@ TEST(Equivalence, ReplayAndSimavrGiveTheSameAngles) {
     EXPECT_LT(a.worst_deg, 0.1) << a.worst_at;
 }
 
+// The output's angles are integers from the matrix entries on (Euler.h): replay prints
+// the firmware's hundredths exactly, on a shaking board too.
+TEST(Equivalence, ReplayPrintsTheFirmwaresHundredths) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "replay", "scenario");
+    const double seconds = 8.0;
+    const std::string csv = e2e::scenario_csv("shake", seconds);
+    const e2e::CommandResult replay = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
+    ASSERT_EQ(replay.exit_code, 0) << replay.err;
+    const e2e::SimRun sim = e2e::run_sim(e2e::firmware_elf(), "shake", seconds);
+    ASSERT_EQ(sim.result.exit_code, 0) << e2e::dump(sim);
+    const Agreement a = compare(sim.lines, parse_replay(replay.out), 0.0);
+    EXPECT_GT(a.compared, 300u);
+    EXPECT_LT(a.worst_deg, 0.005) << a.worst_at;  // any difference is a whole 0.01
+}
+
 TEST(Broad, ReplayOnEveryRecording) {
     E2E_REQUIRE_TOOLS("replay", "score");
     const char* names[] = {
