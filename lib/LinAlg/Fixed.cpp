@@ -4,6 +4,8 @@
 namespace linalg {
 namespace fixed_detail {
 
+const uint8_t kPowersOfTwo[8] FIXED_PROGMEM = {1, 2, 4, 8, 16, 32, 64, 128};
+
 // The tables live in flash (1.3 KB of the 256 KB: 1.3 KB of SRAM would be a sixth of
 // it). Each entry is round(formula) with the formula beside it; test_fixed.cpp checks
 // every entry against it. Linear interpolation between entries h apart errs by at most

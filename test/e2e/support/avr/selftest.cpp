@@ -541,6 +541,14 @@ void check_fixed_output() {
         const int32_t c = (int32_t)((m * 375493621ULL + (1ULL << 39)) >> 40);  // round(m 18000/pi / 2^24)
         EXPECT(linalg::centideg_from_q24(q) == ((b & 1u) ? -c : c));
     }
+    // fixed_from_float's shifts by MUL against a float scaling by 2^q (exact) and the
+    // cast's truncation, from 2^-24 to 2 in magnitude.
+    for (uint16_t i = 0; i < 500; ++i) {
+        const float x = uniform(-1.99f, 1.99f) / (float)(1UL << (i % 24));  // power-of-two division: exact
+        EXPECT(linalg::fixed_from_float(x, 30) == (int32_t)(x * 1073741824.0f));
+        EXPECT(linalg::fixed_from_float(x, 26) == (int32_t)(x * 67108864.0f));
+    }
+    EXPECT(linalg::fixed_from_float(-2.5f, 30) == -0x7FFFFFFFL && linalg::fixed_from_float(1e-12f, 30) == 0);
     const float d = linalg::kPi / 180.0f;
     const Matrix3f r = dcm::dcm_from_euler(10 * d, -20 * d, 135 * d);
     const dcm::AnglesCentideg c = dcm::angles_centideg(dcm::euler_carried_q24(r, 0, 0, 0), 1000);
