@@ -2,7 +2,8 @@
 
 #include "Fixed.h"
 
-// -O2 here (the build is -Os), as in Fixed.cpp: ~100 cycles less per output line.
+// -O2 here (the build is -Os): the output path (Fixed.h's routines inline into
+// euler_carried_q24 and angles_centideg) is ~100 cycles shorter than at -Os.
 #ifdef __AVR__
 #pragma GCC optimize("O2")
 #endif
