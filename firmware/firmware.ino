@@ -122,11 +122,17 @@ static void send_heartbeat_and_status() {
 static void emit_output(uint32_t now_ms) {
     const fmt::OutputMode mode = pipe.settings().mode;
     if (mode == fmt::OutputMode::Quiet) return;
+    // Plot and csv lines print hundredths, which the integer path gives without a float;
+    // MAVLink's ATTITUDE carries floats.
     pipeline::Angles a{};
-    const bool angles = mode != fmt::OutputMode::Quat && mode != fmt::OutputMode::Raw;
-    if (angles) {
+    pipeline::AnglesCentideg c{};
+    if (mode == fmt::OutputMode::Mavlink) {
         board::mark_begin(board::kSecEuler);
         a = pipe.angles();
+        board::mark_end(board::kSecEuler);
+    } else if (mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv) {
+        board::mark_begin(board::kSecEuler);
+        c = pipe.angles_centideg();
         board::mark_end(board::kSecEuler);
     }
     char line[fmt::kRawLineMax];
@@ -142,9 +148,9 @@ static void emit_output(uint32_t now_ms) {
         n = mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg, a.heading_deg,
                              pipe.body_rate_rad_s());
     } else if (mode == fmt::OutputMode::Csv) {
-        n = fmt::format_csv_line(line, now_ms, a.roll_deg, a.pitch_deg, a.heading_deg);
+        n = fmt::format_csv_line_centideg(line, now_ms, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
     } else {
-        n = fmt::format_plot_line(line, a.roll_deg, a.pitch_deg, a.heading_deg);
+        n = fmt::format_plot_line_centideg(line, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
     }
     board::mark_end(board::kSecFormat);
     if (n > 0) serial_text::write_line_if_room(line, n);

@@ -126,6 +126,12 @@ bool i2c_read_regs(void* ctx, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t
 
 void log_write(void*, const char* data, uint8_t len) { fwrite(data, 1, len, stderr); }
 
+// Hundredths of a degree as the firmware prints them ("-0.05", never "-0.00").
+void print_centideg(int32_t c, char end) {
+    const long m = c < 0 ? -(long)c : (long)c;
+    printf("%s%ld.%02ld%c", c < 0 ? "-" : "", m / 100, m % 100, end);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -214,9 +220,12 @@ int main(int argc, char** argv) {
         }
         pipe.on_imu_sample(sample);
         if (pipe.output_due()) {
-            const pipeline::Angles a = pipe.angles();
-            printf("%.4f,%.2f,%.2f,%.2f\n", board.t_s, (double)a.roll_deg, (double)a.pitch_deg,
-                   (double)a.heading_deg);
+            // The hundredths the firmware prints, from the same integers.
+            const pipeline::AnglesCentideg a = pipe.angles_centideg();
+            printf("%.4f,", board.t_s);
+            print_centideg(a.roll_centideg, ',');
+            print_centideg(a.pitch_centideg, ',');
+            print_centideg(a.heading_centideg, '\n');
         }
     }
     return 0;

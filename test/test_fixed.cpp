@@ -205,3 +205,93 @@ TEST(Fixed, CarriedByZeroIsThePlainExtraction) {
     const dcm::EulerAngles e = dcm::euler_carried(bad, Vector3f(NAN, 1e9f, -1e9f));
     EXPECT_TRUE(linalg::is_finite(e.roll_rad) && linalg::is_finite(e.pitch_rad) && linalg::is_finite(e.yaw_rad));
 }
+
+// The printed hundredths straight from Q24 radians: the Q24 angle itself rounded (half
+// away from zero), except where it lies within 2^-15 of a count of a half (the
+// constant's rounding), over the whole range atan2_q24 gives and beyond.
+TEST(Fixed, CentidegIsTheQ24AngleRounded) {
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<int32_t> q(-(1 << 26) + 1, (1 << 26) - 1);
+    int near_half = 0;
+    for (int i = 0; i < 2000000; ++i) {
+        const int32_t a = i < 2000 ? i - 1000 : q(rng);
+        const double exact = a / kQ24 * 18000.0 / kPi;  // hundredths
+        const double m = std::fabs(exact);
+        const int32_t c = linalg::centideg_from_q24(a);
+        if (std::fabs(m - std::floor(m) - 0.5) < 1.0 / 32768.0) {
+            ++near_half;
+            ASSERT_LE(std::fabs(c - exact), 0.5 + 1.0 / 32768.0) << a;
+            continue;
+        }
+        const double rounded = std::floor(m + 0.5);
+        ASSERT_EQ(c, (int32_t)(exact < 0 ? -rounded : rounded)) << a;
+    }
+    EXPECT_LT(near_half, 2000000 / 1000);  // the exception is rare: ~2^-14 of the values
+    EXPECT_EQ(linalg::centideg_from_q24(linalg::kPiQ24), 18000);
+    EXPECT_EQ(linalg::centideg_from_q24(-linalg::kHalfPiQ24), -9000);
+    EXPECT_EQ(linalg::centideg_from_q24(linalg::kQuarterPiQ24), 4500);
+    EXPECT_EQ(linalg::centideg_from_q24(0), 0);
+}
+
+// heading_deg's convention in integers: 0 <= h < 36000 with the declination, and the
+// float heading within a count of it.
+TEST(Fixed, HeadingCentidegFoldsWithTheDeclination) {
+    const auto q24 = [](double deg) { return (int32_t)std::llround(deg * kPi / 180.0 * kQ24); };
+    EXPECT_EQ(dcm::heading_centideg(q24(-90.0), 0), 27000);
+    EXPECT_EQ(dcm::heading_centideg(q24(175.0), 1000), 18500);
+    EXPECT_EQ(dcm::heading_centideg(q24(-5.0), 1000), 500);
+    EXPECT_EQ(dcm::heading_centideg(q24(5.0), -1000), 35500);
+    EXPECT_EQ(dcm::heading_centideg(q24(0.0), 350), 350);
+    EXPECT_EQ(dcm::heading_centideg(-1, 0), 0);  // rounds to -0.00: north, never 360.00
+    EXPECT_EQ(dcm::heading_centideg(linalg::kPiQ24, 18000), 0);
+    EXPECT_EQ(dcm::heading_centideg(-linalg::kPiQ24 + 1, -18000), 0);
+    std::mt19937 rng(12);
+    std::uniform_int_distribution<int32_t> yaw(-linalg::kPiQ24 + 1, linalg::kPiQ24);
+    std::uniform_int_distribution<int> decl(-18000, 18000);
+    for (int i = 0; i < 200000; ++i) {
+        const int32_t y = yaw(rng);
+        const int16_t d = (int16_t)decl(rng);
+        const int32_t h = dcm::heading_centideg(y, d);
+        ASSERT_TRUE(h >= 0 && h < 36000) << y << " " << d;
+        double diff = std::fabs(h * 0.01 - dcm::heading_deg((float)(y / kQ24), (float)(d * 0.01)));
+        if (diff > 180.0) diff = 360.0 - diff;
+        ASSERT_LT(diff, 0.0051) << y << " " << d;
+    }
+}
+
+// The lead in Q26 is the float lead after fixed_from_float: the same angles, bit for bit,
+// and the integer path's hundredths are those angles rounded.
+TEST(Fixed, CarriedByAQ26LeadIsTheFloatOne) {
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> angle(-3.14159f, 3.14159f), lead(-0.3f, 0.3f), small(-9e-4f, 9e-4f);
+    for (int i = 0; i < 20000; ++i) {
+        const Matrix3f r = dcm::dcm_from_euler(angle(rng), angle(rng) * 0.5f, angle(rng));
+        const Vector3f theta = i % 2 ? Vector3f(lead(rng), lead(rng), lead(rng)) : Vector3f(small(rng), small(rng), small(rng));
+        const dcm::EulerAngles a = dcm::euler_carried(r, theta);
+        const dcm::EulerQ24 q = dcm::euler_carried_q24(r, linalg::fixed_from_float(theta.x, 26),
+                                                       linalg::fixed_from_float(theta.y, 26),
+                                                       linalg::fixed_from_float(theta.z, 26));
+        const dcm::EulerAngles b = dcm::euler_in_rad(q);
+        ASSERT_EQ(a.roll_rad, b.roll_rad);
+        ASSERT_EQ(a.pitch_rad, b.pitch_rad);
+        ASSERT_EQ(a.yaw_rad, b.yaw_rad);
+        const dcm::AnglesCentideg c = dcm::angles_centideg(q, 0);
+        ASSERT_NEAR(c.roll_centideg, q.roll_q24 / kQ24 * 18000.0 / kPi, 0.5001);
+        ASSERT_NEAR(c.pitch_centideg, q.pitch_q24 / kQ24 * 18000.0 / kPi, 0.5001);
+    }
+}
+
+// At the gimbal lock the carried path reads R12 and R22 (formed only there): the same
+// convention as the plain extraction, roll 0.
+TEST(Fixed, CarriedAtTheLockFoldsRollIntoYaw) {
+    const double d = kPi / 180.0;
+    for (double pitch_deg : {90.0, -90.0}) {
+        const Matrix3f r = dcm::dcm_from_euler((float)(30 * d), (float)(pitch_deg * d), (float)(50 * d));
+        const dcm::EulerAngles plain = dcm::euler_from_dcm(r), carried = dcm::euler_carried(r, Vector3f());
+        EXPECT_EQ(carried.roll_rad, 0.0f);
+        EXPECT_EQ(plain.yaw_rad, carried.yaw_rad);
+        EXPECT_EQ(plain.pitch_rad, carried.pitch_rad);
+        // The whole heading in yaw: psi - phi nose up, psi + phi nose down (R = Rz Ry Rx).
+        EXPECT_NEAR(carried.yaw_rad, (pitch_deg > 0 ? 20.0 : 80.0) * d, 1e-4) << pitch_deg;
+    }
+}

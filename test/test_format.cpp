@@ -191,3 +191,30 @@ TEST(Format, HundredthsAreTheExactAngleRounded) {
     }
     EXPECT_GT(checked, 190000);
 }
+
+// The integer path's lines (angles already in hundredths): the same bytes as the float
+// lines of those hundredths, 36000 as a heading written 0.00, beyond a turn refused.
+TEST(Format, CentidegLinesAreTheFloatLinesOfTheSameHundredths) {
+    const auto plot_cd = [](int32_t r, int32_t p, int32_t y) {
+        char buf[fmt::kLineMax];
+        return std::string(buf, fmt::format_plot_line_centideg(buf, r, p, y));
+    };
+    const auto csv_cd = [](uint32_t t, int32_t r, int32_t p, int32_t y) {
+        char buf[fmt::kLineMax];
+        return std::string(buf, fmt::format_csv_line_centideg(buf, t, r, p, y));
+    };
+    EXPECT_EQ(plot_cd(-123, 456, 27180), "roll:-1.23 pitch:4.56 yaw:271.80\n");
+    EXPECT_EQ(plot_cd(-18000, -9000, 35999), "roll:-180.00 pitch:-90.00 yaw:359.99\n");
+    EXPECT_EQ(plot_cd(-5, 5, 36000), "roll:-0.05 pitch:0.05 yaw:0.00\n");
+    EXPECT_EQ(csv_cd(4294967295u, 0, -1, 1), "4294967295,0.00,-0.01,0.01\n");
+    EXPECT_EQ(plot_cd(36001, 0, 0), "");
+    EXPECT_EQ(plot_cd(0, -36001, 0), "");
+    EXPECT_EQ(csv_cd(1, 0, 0, 36001), "");
+    std::mt19937 rng(21);
+    std::uniform_int_distribution<int32_t> c(-18000, 18000), h(0, 35999);
+    for (int i = 0; i < 20000; ++i) {
+        const int32_t r = c(rng), p = c(rng) / 2, y = h(rng);
+        ASSERT_EQ(plot_cd(r, p, y), plot(r * 0.01f, p * 0.01f, y * 0.01f));
+        ASSERT_EQ(csv_cd((uint32_t)i * 20u, r, p, y), csv((uint32_t)i * 20u, r * 0.01f, p * 0.01f, y * 0.01f));
+    }
+}

@@ -24,9 +24,15 @@ bool centi_angle(float deg, int32_t& out) {
 }
 
 bool angles_centi(float roll_deg, float pitch_deg, float heading_deg, int32_t c[3]) {
-    if (!centi_angle(roll_deg, c[0]) || !centi_angle(pitch_deg, c[1]) || !centi_angle(heading_deg, c[2]))
-        return false;
-    if (c[2] == 36000) c[2] = 0;  // 359.996 rounds to 360.00: the same heading as 0.00
+    return centi_angle(roll_deg, c[0]) && centi_angle(pitch_deg, c[1]) && centi_angle(heading_deg, c[2]);
+}
+
+// The hundredths as printed: false beyond a full turn (not an attitude angle); a
+// heading of 360.00 (359.996 rounds to it) is the same heading as 0.00.
+bool within_turn(int32_t c) { return c >= -36000 && c <= 36000; }
+bool printable(int32_t roll, int32_t pitch, int32_t& heading) {
+    if (!within_turn(roll) || !within_turn(pitch) || !within_turn(heading)) return false;
+    if (heading == 36000) heading = 0;
     return true;
 }
 
@@ -71,30 +77,43 @@ char* put(char* p, text::Flash s) {
 
 }  // namespace
 
-uint8_t format_plot_line(char buf[kLineMax], float roll_deg, float pitch_deg, float heading_deg) {
-    int32_t c[3];
-    if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
+uint8_t format_plot_line_centideg(char buf[kLineMax], int32_t roll_centideg, int32_t pitch_centideg,
+                                  int32_t heading_centideg) {
+    if (!printable(roll_centideg, pitch_centideg, heading_centideg)) return 0;
     char* p = put(buf, TXT("roll:"));
-    p = put_centi(p, c[0]);
+    p = put_centi(p, roll_centideg);
     p = put(p, TXT(" pitch:"));
-    p = put_centi(p, c[1]);
+    p = put_centi(p, pitch_centideg);
     p = put(p, TXT(" yaw:"));
-    p = put_centi(p, c[2]);
+    p = put_centi(p, heading_centideg);
     *p++ = '\n';
     return (uint8_t)(p - buf);
 }
 
-uint8_t format_csv_line(char buf[kLineMax], uint32_t t_ms, float roll_deg, float pitch_deg,
-                        float heading_deg) {
-    int32_t c[3];
-    if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
+uint8_t format_csv_line_centideg(char buf[kLineMax], uint32_t t_ms, int32_t roll_centideg, int32_t pitch_centideg,
+                                 int32_t heading_centideg) {
+    if (!printable(roll_centideg, pitch_centideg, heading_centideg)) return 0;
     char* p = buf + text::format_u32(buf, t_ms);
+    const int32_t c[3] = {roll_centideg, pitch_centideg, heading_centideg};
     for (uint8_t i = 0; i < 3; ++i) {
         *p++ = ',';
         p = put_centi(p, c[i]);
     }
     *p++ = '\n';
     return (uint8_t)(p - buf);
+}
+
+uint8_t format_plot_line(char buf[kLineMax], float roll_deg, float pitch_deg, float heading_deg) {
+    int32_t c[3];
+    if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
+    return format_plot_line_centideg(buf, c[0], c[1], c[2]);
+}
+
+uint8_t format_csv_line(char buf[kLineMax], uint32_t t_ms, float roll_deg, float pitch_deg,
+                        float heading_deg) {
+    int32_t c[3];
+    if (!angles_centi(roll_deg, pitch_deg, heading_deg, c)) return 0;
+    return format_csv_line_centideg(buf, t_ms, c[0], c[1], c[2]);
 }
 
 namespace {

@@ -34,6 +34,12 @@ constexpr uint8_t kLineMax = 48;
 uint8_t format_plot_line(char buf[kLineMax], float roll_deg, float pitch_deg, float heading_deg);
 uint8_t format_csv_line(char buf[kLineMax], uint32_t t_ms, float roll_deg, float pitch_deg,
                         float heading_deg);
+// The same from angles already in hundredths (the firmware's integer path): 0 beyond
+// +-36000; a heading of 36000 is written 0.00.
+uint8_t format_plot_line_centideg(char buf[kLineMax], int32_t roll_centideg, int32_t pitch_centideg,
+                                  int32_t heading_centideg);
+uint8_t format_csv_line_centideg(char buf[kLineMax], uint32_t t_ms, int32_t roll_centideg, int32_t pitch_centideg,
+                                 int32_t heading_centideg);
 
 // Returns the length including the '\n', or 0 if a component is not finite or beyond
 // +-1.0001 (not a unit quaternion: a bug upstream, never printed).

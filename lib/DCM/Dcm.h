@@ -215,7 +215,9 @@ public:
     // the attitude now rather than when the (low-passed, hence delayed) gyro sample
     // was taken. R (I + [w lead x]), first order: the lead is a few ms. What the
     // firmware prints.
-    EulerAngles euler_now() const;
+    EulerAngles euler_now() const { return euler_in_rad(euler_now_q24()); }
+    // The same in Q24 radians, for the integer output path.
+    EulerQ24 euler_now_q24() const;
 
     // The roll/pitch correction is worked out every this many steps (50 Hz at the
     // default 200 Hz step) and applied at every step: it moves at the 3 s pace of
@@ -252,6 +254,8 @@ private:
     void correct_gravity();
     void update_offset();
     static float inverse(uint8_t n);
+    static int32_t scale_q15(int32_t x, uint16_t c);
+    void set_output_factors();
     linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
     float turn_rad_per_unit() const { return gyro_scale_ * settings_.step_s * (1.0f / (float)kTurnScale); }
     linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
@@ -293,6 +297,8 @@ private:
     float gyro_scale_ = kFloatGyroScale; // rad/s per count
     float accel_scale_ = kFloatAccelScale; // m/s^2 per count
     float units_per_rad_s_ = (float)kTurnScale / kFloatGyroScale;  // the turn sums' units
+    uint16_t lead_steps_q15_ = 0;        // output_lead_s / step_s, Q15 (set_output_factors)
+    uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
     linalg::Vector3l yaw_units_;         // yaw correction from the last field sample (a turn sums' step), applied once
     linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)

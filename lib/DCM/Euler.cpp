@@ -2,7 +2,8 @@
 
 #include "Fixed.h"
 
-// -O2 here (the build is -Os), as in Fixed.cpp: ~100 cycles less per output line.
+// -O2 here (the build is -Os): the output path (Fixed.h's routines inline into
+// euler_carried_q24 and angles_centideg) is ~100 cycles shorter than at -Os.
 #ifdef __AVR__
 #pragma GCC optimize("O2")
 #endif
@@ -14,37 +15,56 @@ using linalg::Vector3f;
 
 namespace {
 
+using linalg::atan2_q24;
+using linalg::magnitude;
+
 // kGimbalLockCos in Q30.
 constexpr uint32_t kGimbalLockCosQ30 = (uint32_t)(kGimbalLockCos * 1073741824.0f);
 
-}  // namespace
-
-EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
-                           int32_t r33) {
-    using linalg::atan2_q24;
-    using linalg::magnitude;
+// Roll and pitch from the third row; false at the gimbal lock (roll is then 0 and yaw
+// comes from R12 and R22, yaw_locked).
+FIXED_INLINE bool roll_pitch(int32_t r31, int32_t r32, int32_t r33, EulerQ24& e) {
     // Roll and cos(pitch) share one ratio, min/max of |R32| and |R33|.
     const uint32_t m32 = magnitude(r32), m33 = magnitude(r33);
     uint32_t ratio_q31;
-    int32_t roll = atan2_q24(r32 < 0, m32, r33 < 0, m33, &ratio_q31);
+    e.roll_q24 = atan2_q24(r32 < 0, m32, r33 < 0, m33, &ratio_q31);
     // cos(theta) = sqrt(R32^2 + R33^2): pitch by atan2 is accurate near +-90 deg,
     // where asin(R31) loses all its digits.
     const uint32_t cos_pitch_q30 = linalg::hypot_from_ratio(m32 > m33 ? m32 : m33, ratio_q31);
-    const int32_t pitch = atan2_q24(r31 > 0, magnitude(r31), false, cos_pitch_q30);
-    int32_t yaw;
-    if (cos_pitch_q30 > kGimbalLockCosQ30) {
-        yaw = atan2_q24(r21 < 0, magnitude(r21), r11 < 0, magnitude(r11));
-    } else {
-        // Gimbal lock: roll := 0, all of the heading in yaw. With phi = 0,
-        // R12 = -sin(psi) and R22 = cos(psi) exactly.
-        roll = 0;
-        yaw = atan2_q24(r12 > 0, magnitude(r12), r22 < 0, magnitude(r22));
-    }
-    EulerAngles e;
-    e.roll_rad = linalg::float_from_fixed(roll, linalg::kAngleQ);
-    e.pitch_rad = linalg::float_from_fixed(pitch, linalg::kAngleQ);
-    e.yaw_rad = linalg::float_from_fixed(yaw, linalg::kAngleQ);
+    e.pitch_q24 = atan2_q24(r31 > 0, magnitude(r31), false, cos_pitch_q30);
+    if (cos_pitch_q30 > kGimbalLockCosQ30) return true;
+    e.roll_q24 = 0;
+    return false;
+}
+// Yaw from R21 and R11, or at the gimbal lock from R12 and R22 (roll := 0, all of the
+// heading in yaw: with phi = 0, R12 = -sin(psi) and R22 = cos(psi) exactly). One
+// inline copy of atan2: the operands are chosen first.
+FIXED_INLINE int32_t yaw(bool away_from_lock, int32_t r11, int32_t r12, int32_t r21, int32_t r22) {
+    const int32_t y = away_from_lock ? r21 : r12, x = away_from_lock ? r11 : r22;
+    const bool y_negative = away_from_lock ? y < 0 : y > 0;
+    return atan2_q24(y_negative, magnitude(y), x < 0, magnitude(x));
+}
+
+}  // namespace
+
+EulerQ24 euler_q24_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
+                            int32_t r33) {
+    EulerQ24 e;
+    e.yaw_q24 = yaw(roll_pitch(r31, r32, r33, e), r11, r12, r21, r22);
     return e;
+}
+
+EulerAngles euler_in_rad(const EulerQ24& e) {
+    EulerAngles a;
+    a.roll_rad = linalg::float_from_fixed(e.roll_q24, linalg::kAngleQ);
+    a.pitch_rad = linalg::float_from_fixed(e.pitch_q24, linalg::kAngleQ);
+    a.yaw_rad = linalg::float_from_fixed(e.yaw_q24, linalg::kAngleQ);
+    return a;
+}
+
+EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
+                           int32_t r33) {
+    return euler_in_rad(euler_q24_from_q30(r11, r12, r21, r22, r31, r32, r33));
 }
 
 namespace {
@@ -71,8 +91,8 @@ struct Theta {
 FIXED_INLINE int32_t cross_term(const Theta& t, int16_t p, int16_t tp, int16_t q, int16_t tq) {
     int32_t pp = linalg::mul_s16(p, tp), qq = linalg::mul_s16(q, tq);
     if (t.fine) {
-        pp >>= 8;
-        qq >>= 8;
+        pp = linalg::opaque(pp >> 8);
+        qq = linalg::opaque(qq >> 8);
     }
     return (pp >> 1) - (qq >> 1);
 }
@@ -83,24 +103,26 @@ FIXED_INLINE int32_t plus_cross(int32_t e, const Theta& t, int16_t p, int16_t tp
     return (int32_t)((uint32_t)e + (uint32_t)cross_term(t, p, tp, q, tq));
 }
 
-// One conversion per axis (Q26), rounded to Q25, or when any axis is past the fine
-// range to Q17 (a byte and a bit further right), saturated at +-0.25 rad.
-FIXED_INLINE int16_t round_shift(int32_t q26, uint8_t right) {
-    // Limited to +-2^30 first (32 rad, far past the saturation) so that the rounding
-    // add cannot overflow.
-    constexpr int32_t kLimit = (int32_t)1 << 30;
-    q26 = q26 > kLimit ? kLimit : q26 < -kLimit ? -kLimit : q26;
-    const int32_t r = (q26 + ((int32_t)1 << (right - 1u))) >> right;
-    return (int16_t)(r > 32767 ? 32767 : r < -32767 ? -32767 : r);
+// e + p tp - q tq for three entries of a row in float.
+FIXED_INLINE int32_t carried_entry(const Theta& t, float e, float p, int16_t tp, float q, int16_t tq) {
+    return plus_cross(q30(e), t, q14(q30(p)), tp, q14(q30(q)), tq);
 }
-Theta theta_for(const Vector3f& theta_rad) {
-    const int32_t x = linalg::fixed_from_float(theta_rad.x, 26), y = linalg::fixed_from_float(theta_rad.y, 26),
-                  z = linalg::fixed_from_float(theta_rad.z, 26);
-    constexpr int32_t kFineLimitQ26 = (int32_t)32767 << 1;  // 2^-10 rad
-    if (x > -kFineLimitQ26 && x < kFineLimitQ26 && y > -kFineLimitQ26 && y < kFineLimitQ26 &&
-        z > -kFineLimitQ26 && z < kFineLimitQ26)
-        return Theta{round_shift(x, 1), round_shift(y, 1), round_shift(z, 1), true};
-    return Theta{round_shift(x, 9), round_shift(y, 9), round_shift(z, 9), false};
+
+// One conversion per axis (Q26): rounded to Q25 when all three are within 2^-10 rad,
+// else to Q17 (a byte and a bit further right) and saturated at +-0.25 rad.
+constexpr int32_t kFineLimitQ26 = (int32_t)32767 << 1;  // 2^-10 rad
+FIXED_INLINE bool fine(int32_t q26) { return q26 > -kFineLimitQ26 && q26 < kFineLimitQ26; }
+FIXED_INLINE int16_t q25_from_q26(int32_t q26) { return (int16_t)((q26 + 1) >> 1); }  // |q26| < 2^16 - 2
+FIXED_INLINE int16_t q17_from_q26(int32_t q26) {
+    // round(q26 / 2^9) beyond +-32767 from here (whatever q26: no add that overflows).
+    constexpr int32_t kSaturationQ26 = (int32_t)32767 * 512 + 256;
+    if (q26 >= kSaturationQ26) return 32767;
+    if (q26 < -kSaturationQ26) return -32767;
+    return (int16_t)(linalg::opaque((q26 + 256) >> 1) >> 8);
+}
+FIXED_INLINE Theta theta_for(int32_t x, int32_t y, int32_t z) {
+    if (fine(x) && fine(y) && fine(z)) return Theta{q25_from_q26(x), q25_from_q26(y), q25_from_q26(z), true};
+    return Theta{q17_from_q26(x), q17_from_q26(y), q17_from_q26(z), false};
 }
 
 }  // namespace
@@ -113,20 +135,37 @@ EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float
     return euler_from_q30(q30(r11), q30(r12), q30(r21), q30(r22), q30(r31), q30(r32), q30(r33));
 }
 
-EulerAngles euler_carried(const Matrix3f& r, const Vector3f& theta_rad) {
-    const Theta t = theta_for(theta_rad);
-    const int32_t a[3] = {q30(r.a.x), q30(r.a.y), q30(r.a.z)};
-    const int32_t b[3] = {q30(r.b.x), q30(r.b.y), q30(r.b.z)};
-    const int32_t c[3] = {q30(r.c.x), q30(r.c.y), q30(r.c.z)};
+EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {
+    const Theta t = theta_for(theta_x_q26, theta_y_q26, theta_z_q26);
     // r' = r + r x theta = r + (r_y t_z - r_z t_y, r_z t_x - r_x t_z, r_x t_y - r_y t_x),
-    // the seven entries the angles read.
-    return euler_from_q30(plus_cross(a[0], t, q14(a[1]), t.z, q14(a[2]), t.y),   // R11
-                          plus_cross(a[1], t, q14(a[2]), t.x, q14(a[0]), t.z),   // R12
-                          plus_cross(b[0], t, q14(b[1]), t.z, q14(b[2]), t.y),   // R21
-                          plus_cross(b[1], t, q14(b[2]), t.x, q14(b[0]), t.z),   // R22
-                          plus_cross(c[0], t, q14(c[1]), t.z, q14(c[2]), t.y),   // R31
-                          plus_cross(c[1], t, q14(c[2]), t.x, q14(c[0]), t.z),   // R32
-                          plus_cross(c[2], t, q14(c[0]), t.y, q14(c[1]), t.x));  // R33
+    // only the entries the angles read: the third row, then R11 and R21, or at the
+    // lock R12 and R22.
+    const int32_t c0 = q30(r.c.x), c1 = q30(r.c.y), c2 = q30(r.c.z);
+    const int16_t c0h = q14(c0), c1h = q14(c1), c2h = q14(c2);
+    EulerQ24 e;
+    const bool away_from_lock = roll_pitch(plus_cross(c0, t, c1h, t.z, c2h, t.y),  // R31
+                                           plus_cross(c1, t, c2h, t.x, c0h, t.z),  // R32
+                                           plus_cross(c2, t, c0h, t.y, c1h, t.x),  // R33
+                                           e);
+    // Column 1 (R11 = r_x + r_y t_z - r_z t_y) of the first two rows, or at the lock
+    // column 2 (R12 = r_y + r_z t_x - r_x t_z): the entries are chosen first, so that
+    // each row is one inline copy, converted only when it is needed.
+    const int16_t tp = away_from_lock ? t.z : t.x, tq = away_from_lock ? t.y : t.z;
+    const int32_t r_1 = away_from_lock ? carried_entry(t, r.a.x, r.a.y, tp, r.a.z, tq)
+                                       : carried_entry(t, r.a.y, r.a.z, tp, r.a.x, tq);
+    const int32_t r_2 = away_from_lock ? carried_entry(t, r.b.x, r.b.y, tp, r.b.z, tq)
+                                       : carried_entry(t, r.b.y, r.b.z, tp, r.b.x, tq);
+    e.yaw_q24 = yaw(away_from_lock, r_1, r_1, r_2, r_2);
+    return e;
+}
+
+EulerAngles euler_carried(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {
+    return euler_in_rad(euler_carried_q24(r, theta_x_q26, theta_y_q26, theta_z_q26));
+}
+
+EulerAngles euler_carried(const Matrix3f& r, const Vector3f& theta_rad) {
+    return euler_carried(r, linalg::fixed_from_float(theta_rad.x, 26), linalg::fixed_from_float(theta_rad.y, 26),
+                         linalg::fixed_from_float(theta_rad.z, 26));
 }
 
 Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad) {
@@ -148,6 +187,19 @@ float heading_deg(float yaw_rad, float declination_deg) {
     if (h >= 360.0f) h -= 360.0f;
     // NaN, or beyond the documented ranges, or -1e-9 + 360 rounding to 360: 0.
     if (!(h >= 0.0f && h < 360.0f)) h = 0.0f;
+    return h;
+}
+
+AnglesCentideg angles_centideg(const EulerQ24& e, int16_t declination_centideg) {
+    return AnglesCentideg{linalg::centideg_from_q24(e.roll_q24), linalg::centideg_from_q24(e.pitch_q24),
+                          heading_centideg(e.yaw_q24, declination_centideg)};
+}
+
+int32_t heading_centideg(int32_t yaw_q24, int16_t declination_centideg) {
+    // -36000 <= h <= 36000 in the documented ranges: one fold each way.
+    int32_t h = linalg::centideg_from_q24(yaw_q24) + declination_centideg;
+    if (h < 0) h += 36000;
+    if (h >= 36000) h -= 36000;
     return h;
 }
 

@@ -17,8 +17,10 @@
 // angles come from integer tables (atan2 within 1.5e-5 rad, 0.0009 deg, over its
 // whole domain): the angles are within 0.005 deg, half a count of the 0.01 deg the
 // output prints, of the same formulas in double (test_fixed.cpp, up to 80 deg pitch:
-// nearer the lock roll and yaw are ill-conditioned for any arithmetic), at about a
-// third of the float version's cycles on the 2560, and the same bits on the host.
+// nearer the lock roll and yaw are ill-conditioned for any arithmetic), and the same
+// bits on the host. The output path (euler_carried_q24 then angles_centideg) has no
+// float after the nine entries: ~2 800 + 460 cycles on the 2560 (the float version with
+// its float tail took ~5 900), and the lines print its hundredths as they are.
 #pragma once
 
 #include <stdint.h>
@@ -33,6 +35,16 @@ struct EulerAngles {
     float yaw_rad;  // -pi..pi
 };
 
+// The same angles in Q24 radians (linalg::kAngleQ), as the integer extraction gives
+// them: the output path turns them into printed hundredths of a degree with integers
+// only (centideg_from_q24), a float caller converts them exactly (euler_in_rad).
+struct EulerQ24 {
+    int32_t roll_q24;
+    int32_t pitch_q24;
+    int32_t yaw_q24;  // -pi..pi
+};
+EulerAngles euler_in_rad(const EulerQ24& e);
+
 // Below this cos(pitch) (pitch within ~0.001 deg of +-90) roll is folded into yaw.
 // Small enough that the folded angles rebuild R to ~2e-5, large enough that roll
 // is still well-conditioned just above it.
@@ -43,13 +55,22 @@ EulerAngles euler_from_dcm(const linalg::Matrix3f& r);
 // have those without a whole matrix.
 EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float r31, float r32, float r33);
 // The same from the seven entries in Q30 (1.0 = 2^30, lib/LinAlg/Fixed.h), for a caller
-// that keeps R in fixed point and so skips the conversions (~110 cycles an entry on
+// that keeps R in fixed point and so skips the conversions (~60 cycles an entry on
 // the AVR). Any int32 values give finite angles.
 EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32, int32_t r33);
+EulerQ24 euler_q24_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
+                            int32_t r33);
 // The angles of R carried forward by a small rotation theta (body frame, rad):
 // R' = R (I + [theta]x), each row r' = r + r x theta (first order: the output's lead,
 // |theta| ~ rate * 3 ms). theta is clamped to +-0.25 rad per axis (beyond it the first
-// order is itself off by theta^2/2 > 1.8 deg). Only the seven entries read are formed.
+// order is itself off by theta^2/2 > 1.8 deg). Only the entries read are formed (R12
+// and R22 only at the gimbal lock).
+// theta in Q26 radians (2^26 = 1 rad, 1.5e-8 rad steps) for a caller that sums it in
+// integers; the float theta is the same after fixed_from_float(theta, 26).
+EulerQ24 euler_carried_q24(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                           int32_t theta_z_q26);
+EulerAngles euler_carried(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                          int32_t theta_z_q26);
 EulerAngles euler_carried(const linalg::Matrix3f& r, const linalg::Vector3f& theta_rad);
 linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 
@@ -57,5 +78,20 @@ linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 // declination (east positive) in degrees (-180..180): the firmware's output
 // convention. Outside those ranges, or for NaN, it gives 0 (never NaN).
 float heading_deg(float yaw_rad, float declination_deg);
+
+// The same in hundredths of a degree, 0 <= h < 36000, from yaw in Q24 radians (-pi..pi)
+// and a declination (east positive) in hundredths (-18000..18000), in integers: the
+// yaw rounded to hundredths (linalg::centideg_from_q24) before the declination, a
+// whole number of them, is added.
+int32_t heading_centideg(int32_t yaw_q24, int16_t declination_centideg);
+
+// The angles as the output lines print them, in hundredths of a degree, from the
+// integer extraction with integers only.
+struct AnglesCentideg {
+    int32_t roll_centideg;     // -18000..18000
+    int32_t pitch_centideg;    // -9000..9000
+    int32_t heading_centideg;  // 0 <= h < 36000, declination applied
+};
+AnglesCentideg angles_centideg(const EulerQ24& e, int16_t declination_centideg);
 
 }  // namespace dcm

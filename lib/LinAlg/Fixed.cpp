@@ -1,26 +1,10 @@
+// The tables of the fixed-point atan2 and hypot (Fixed.h, whose routines are inline).
 #include "Fixed.h"
 
-// -O2 here (the build is -Os): at -Os avr-gcc calls its register-saving prologue and
-// epilogue routines and keeps the small helpers out of line; -O2 saves ~120 cycles per
-// atan2 on the output path for ~1 KB of flash.
-#ifdef __AVR__
-#pragma GCC optimize("O2")
-#endif
-
-#ifdef __AVR__
-#include <avr/pgmspace.h>
-#define FIXED_PROGMEM PROGMEM
-#else
-#define FIXED_PROGMEM
-#endif
-
 namespace linalg {
+namespace fixed_detail {
 
-using fixed_detail::bits_23_to_30;
-using fixed_detail::bits_7_to_22;
-using fixed_detail::byte3;
-
-namespace {
+const uint8_t kPowersOfTwo[8] FIXED_PROGMEM = {1, 2, 4, 8, 16, 32, 64, 128};
 
 // The tables live in flash (1.3 KB of the 256 KB: 1.3 KB of SRAM would be a sixth of
 // it). Each entry is round(formula) with the formula beside it; test_fixed.cpp checks
@@ -100,94 +84,6 @@ const uint16_t kHypotMinusOne[129] FIXED_PROGMEM = {
     24296, 24647, 25000, 25354, 25709, 26066, 26425, 26785, 27146,
 };
 
-// 16x16->32 with avr-gcc's widening multiply (__umulhisi3, ~25 cycles). Not inline:
-// inlined, gcc sees through (uint16_t)(x >> 16) and calls its 32x32 routine (~105).
-__attribute__((noinline)) uint32_t mul16(uint16_t a, uint16_t b) { return (uint32_t)a * (uint32_t)b; }
-
-// (x * g) >> 16 for a 32-bit x and a 16-bit g: two 16x16->32 multiplies (avr-gcc
-// would call its 32x32 routine, ~105 cycles, for the plain product, and lose the top).
-FIXED_INLINE uint32_t mul_u32_u16_shr16(uint32_t x, uint16_t g) {
-    return mul16((uint16_t)(x >> 16), g) + (mul16((uint16_t)x, g) >> 16);
-}
-
-FIXED_INLINE uint16_t entry(const uint16_t* table, uint16_t i) {
-#ifdef __AVR__
-    return pgm_read_word(table + i);
-#else
-    return table[i];
-#endif
-}
-
-// Linear interpolation at index i + f/2^16 of an increasing (sign +1) or decreasing
-// table, in the table's Q plus 16 bits.
-FIXED_INLINE uint32_t interpolate_up(const uint16_t* table, uint16_t i, uint16_t f) {
-    const uint16_t lo = entry(table, i);
-    const uint16_t step = (uint16_t)(entry(table, (uint16_t)(i + 1u)) - lo);
-    return ((uint32_t)lo << 16) + mul16(step, f);
-}
-FIXED_INLINE uint32_t interpolate_down(const uint16_t* table, uint16_t i, uint16_t f) {
-    const uint16_t hi = entry(table, i);
-    const uint16_t step = (uint16_t)(hi - entry(table, (uint16_t)(i + 1u)));
-    return ((uint32_t)hi << 16) - mul16(step, f);
-}
-
-}  // namespace
-
-__attribute__((noinline)) int32_t mul_s16(int16_t a, int16_t b) { return (int32_t)a * (int32_t)b; }
-
-int32_t atan_of_ratio_q24(uint32_t num, uint32_t den, uint32_t* ratio_q31) {
-    if (den == 0) {
-        if (ratio_q31) *ratio_q31 = 0;
-        return 0;
-    }
-    // Normalise den into [2^31, 2^32) (num <= den follows it without overflow).
-    while ((den & 0xFF000000u) == 0) {
-        den <<= 8;
-        num <<= 8;
-    }
-    while ((den & 0x80000000u) == 0) {
-        den <<= 1;
-        num <<= 1;
-    }
-    // d = den / 2^32 = (1 + u)/2 with u = i/256 + f/2^24: 1/d = 1 + g(u).
-    const uint16_t i = bits_23_to_30(den);
-    const uint16_t f = bits_7_to_22(den);
-    const uint16_t g = (uint16_t)(interpolate_down(kReciprocalMinusOne, i, f) >> 16);
-    // t = (num / 2^32) / d = n (1 + g) in Q31.
-    const uint32_t n_q31 = num >> 1;
-    uint32_t t_q31 = n_q31 + mul_u32_u16_shr16(n_q31, g);
-    if (t_q31 >= 0x80000000u) t_q31 = 0x80000000u;  // num = den (interpolation rounding)
-    if (ratio_q31) *ratio_q31 = t_q31;
-    if (t_q31 == 0x80000000u) return kQuarterPiQ24;
-    // atan(t) = t - (t - atan(t)), the table at j = t*256.
-    const uint16_t j = bits_23_to_30(t_q31);  // t_q31 < 2^31: j <= 255
-    const uint16_t fj = bits_7_to_22(t_q31);
-    const uint32_t t_minus_atan_q34 = interpolate_up(kTMinusAtan, j, fj);
-    const uint32_t atan_q32 = (t_q31 << 1) - (t_minus_atan_q34 >> 2);
-    return (int32_t)((atan_q32 + 0x80u) >> 8);
-}
-
-int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_negative, uint32_t x_magnitude,
-                  uint32_t* ratio_q31) {
-    // Fold into the first octant, as fast_atan2 does: a = atan(min/max).
-    const bool steep = y_magnitude > x_magnitude;
-    int32_t a = steep ? atan_of_ratio_q24(x_magnitude, y_magnitude, ratio_q31)
-                      : atan_of_ratio_q24(y_magnitude, x_magnitude, ratio_q31);
-    if (steep) a = kHalfPiQ24 - a;
-    if (x_negative && x_magnitude != 0) a = kPiQ24 - a;
-    return y_negative && y_magnitude != 0 ? -a : a;
-}
-
-uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31) {
-    uint16_t s;
-    if (ratio_q31 >= 0x80000000u) {
-        s = entry(kHypotMinusOne, 128);
-    } else {
-        const uint16_t j = byte3(ratio_q31);
-        const uint16_t fj = (uint16_t)(ratio_q31 >> 8);
-        s = (uint16_t)(interpolate_up(kHypotMinusOne, j, fj) >> 16);
-    }
-    return larger + mul_u32_u16_shr16(larger, s);
-}
+}  // namespace fixed_detail
 
 }  // namespace linalg

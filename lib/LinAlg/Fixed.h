@@ -17,8 +17,11 @@
 // optimisation level.
 #ifdef __AVR__
 #define FIXED_INLINE __attribute__((always_inline)) inline
+#include <avr/pgmspace.h>
+#define FIXED_PROGMEM PROGMEM
 #else
 #define FIXED_INLINE inline
+#define FIXED_PROGMEM
 #endif
 
 namespace linalg {
@@ -44,11 +47,44 @@ inline uint16_t bits_7_to_22(uint32_t x) {
     return (uint16_t)((uint16_t)((uint16_t)(x >> 8) << 1) | (uint8_t)((uint8_t)x >> 7));
 }
 
+// 2^n for n = 0..7, from a table in flash (avr-gcc computes 1 << n in a loop).
+extern const uint8_t kPowersOfTwo[8] FIXED_PROGMEM;
+FIXED_INLINE uint8_t power_of_two(uint8_t n) {
+#ifdef __AVR__
+    return pgm_read_byte(kPowersOfTwo + n);
+#else
+    return kPowersOfTwo[n];
+#endif
+}
+
 }  // namespace fixed_detail
 
+// m * p for a 24-bit m and an 8-bit p (< 2^32): on the AVR three MUL instructions, a
+// shift by 0..7 bits with p = 2^n in ~12 cycles where avr-gcc shifts a 32-bit word by a
+// variable count in a loop, ~6 cycles a bit.
+FIXED_INLINE uint32_t mul_u24_u8(uint32_t m, uint8_t p) {
+#ifdef __AVR__
+    uint32_t r;
+    __asm__("mul  %A1, %2\n\t"
+            "movw %A0, r0\n\t"
+            "mul  %C1, %2\n\t"
+            "movw %C0, r0\n\t"
+            "mul  %B1, %2\n\t"
+            "add  %B0, r0\n\t"
+            "adc  %C0, r1\n\t"
+            "clr  r1\n\t"  // eor leaves the carry
+            "adc  %D0, r1"
+            : "=&r"(r)
+            : "r"(m), "r"(p));
+    return r;
+#else
+    return (m & 0xFFFFFFu) * (uint32_t)p;
+#endif
+}
+
 // x * 2^frac_bits, truncated toward zero, read from the float's bits (no float call;
-// inline: ~60 cycles on the AVR where a call with its register saving took ~140):
-// saturates at +-(2^31 - 1) (infinities too); NaN gives 0.
+// inline, ~55 cycles on the AVR: whole bytes are register moves, the remaining 0..7
+// bits one mul_u24_u8): saturates at +-(2^31 - 1) (infinities too); NaN gives 0.
 FIXED_INLINE int32_t fixed_from_float(float x, uint8_t frac_bits) {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
@@ -61,20 +97,16 @@ FIXED_INLINE int32_t fixed_from_float(float x, uint8_t frac_bits) {
     const int16_t shift = (int16_t)((int16_t)exponent - 150 + (int16_t)frac_bits);
     if (shift >= 8) {
         m = 0x7FFFFFFFu;  // >= 2^31 (and infinity)
-    } else if (shift >= 4) {
-        // A byte left, then back right: 8 - shift <= 4 turns of the bit loop instead of
-        // shift <= 7 (matrix entries in [0.5, 1) have shift 6).
-        m = (m << 8) >> (uint8_t)(8 - shift);
     } else if (shift >= 0) {
-        m <<= shift;
+        m = mul_u24_u8(m, fixed_detail::power_of_two((uint8_t)shift));
     } else {
         uint8_t right = (uint8_t)-shift;
         if (right >= 24) return 0;
-        // Whole bytes first: avr-gcc moves bytes for a constant 8, but shifts bit by
-        // bit in a loop for a variable count.
+        // Whole bytes first (register moves), then the rest as a shift left by
+        // 8 - right and a byte right: m < 2^24 before, so m * 2^(8 - right) fits.
         if (right >= 16) { m >>= 16; right = (uint8_t)(right - 16u); }
         if (right >= 8) { m >>= 8; right = (uint8_t)(right - 8u); }
-        m >>= right;
+        if (right != 0) m = mul_u24_u8(m, fixed_detail::power_of_two((uint8_t)(8u - right))) >> 8;
     }
     return (bits & 0x80000000u) ? -(int32_t)m : (int32_t)m;
 }
@@ -91,30 +123,234 @@ inline float float_from_fixed(int32_t q, uint8_t frac_bits) {
 }
 
 
+// x unchanged, but opaque to the optimiser: avr-gcc folds (x >> 8) >> 1 into x >> 9,
+// a loop of nine 4-byte shifts (~55 cycles), where a shift by a whole byte is register
+// moves and one more bit four instructions.
+FIXED_INLINE int32_t opaque(int32_t x) {
+#ifdef __AVR__
+    __asm__("" : "+r"(x));
+#endif
+    return x;
+}
+
+// |q| as an unsigned magnitude (|-2^31| fits).
+inline uint32_t magnitude(int32_t q) { return q < 0 ? (uint32_t)0 - (uint32_t)q : (uint32_t)q; }
+
+// a * b, 16 x 16 -> 32 bits. On the AVR four MUL instructions inline (~20 cycles):
+// avr-gcc calls a library routine for a widening multiply (and for a product of casts
+// often its 32 x 32 one, __mulsi3, ~105 cycles), and a call makes the caller save
+// registers. Signed as in Atmel's AVR201 (MULS/MULSU need r16..r23: constraint "a").
+FIXED_INLINE uint32_t mul_u16(uint16_t a, uint16_t b) {
+#ifdef __AVR__
+    uint32_t r;
+    __asm__("mul  %A1, %A2\n\t"
+            "movw %A0, r0\n\t"
+            "mul  %B1, %B2\n\t"
+            "movw %C0, r0\n\t"
+            "mul  %B1, %A2\n\t"
+            "add  %B0, r0\n\t"
+            "adc  %C0, r1\n\t"
+            "clr  r1\n\t"  // eor leaves the carry
+            "adc  %D0, r1\n\t"
+            "mul  %A1, %B2\n\t"
+            "add  %B0, r0\n\t"
+            "adc  %C0, r1\n\t"
+            "clr  r1\n\t"
+            "adc  %D0, r1"
+            : "=&r"(r)
+            : "r"(a), "r"(b));
+    return r;
+#else
+    return (uint32_t)a * (uint32_t)b;
+#endif
+}
+FIXED_INLINE int32_t mul_s16(int16_t a, int16_t b) {
+#ifdef __AVR__
+    int32_t r;
+    uint8_t zero;
+    __asm__("clr   %[z]\n\t"
+            "muls  %B[a], %B[b]\n\t"
+            "movw  %C[r], r0\n\t"
+            "mul   %A[a], %A[b]\n\t"
+            "movw  %A[r], r0\n\t"
+            "mulsu %B[a], %A[b]\n\t"  // carry = sign of the partial product
+            "sbc   %D[r], %[z]\n\t"
+            "add   %B[r], r0\n\t"
+            "adc   %C[r], r1\n\t"
+            "adc   %D[r], %[z]\n\t"
+            "mulsu %B[b], %A[a]\n\t"
+            "sbc   %D[r], %[z]\n\t"
+            "add   %B[r], r0\n\t"
+            "adc   %C[r], r1\n\t"
+            "adc   %D[r], %[z]\n\t"
+            "clr   r1"
+            : [r] "=&r"(r), [z] "=&r"(zero)
+            : [a] "a"(a), [b] "a"(b));
+    return r;
+#else
+    return (int32_t)a * (int32_t)b;
+#endif
+}
+
+// (x * g) >> 16 for a 32-bit x and a 16-bit g, from two 16 x 16 products (the bits
+// below 2^16 of the low product are dropped: at most 1 below the exact floor).
+FIXED_INLINE uint32_t mul_u32_u16_shr16(uint32_t x, uint16_t g) {
+    return mul_u16((uint16_t)(x >> 16), g) + (mul_u16((uint16_t)x, g) >> 16);
+}
+
+// The tables (Fixed.cpp), in flash on the AVR; what follows is inline so that the
+// output path is one function without calls (each call with -mcall-prologues saves
+// and restores the registers it uses, ~40-80 cycles).
+namespace fixed_detail {
+extern const uint16_t kReciprocalMinusOne[257] FIXED_PROGMEM;
+extern const uint16_t kTMinusAtan[257] FIXED_PROGMEM;
+extern const uint16_t kHypotMinusOne[129] FIXED_PROGMEM;
+
+FIXED_INLINE uint16_t entry(const uint16_t* table, uint16_t i) {
+#ifdef __AVR__
+    return pgm_read_word(table + i);
+#else
+    return table[i];
+#endif
+}
+
+// Linear interpolation at index i + f/2^16 of an increasing (sign +1) or decreasing
+// table, in the table's Q plus 16 bits.
+FIXED_INLINE uint32_t interpolate_up(const uint16_t* table, uint16_t i, uint16_t f) {
+    const uint16_t lo = entry(table, i);
+    const uint16_t step = (uint16_t)(entry(table, (uint16_t)(i + 1u)) - lo);
+    return ((uint32_t)lo << 16) + mul_u16(step, f);
+}
+FIXED_INLINE uint32_t interpolate_down(const uint16_t* table, uint16_t i, uint16_t f) {
+    const uint16_t hi = entry(table, i);
+    const uint16_t step = (uint16_t)(hi - entry(table, (uint16_t)(i + 1u)));
+    return ((uint32_t)hi << 16) - mul_u16(step, f);
+}
+
+}  // namespace fixed_detail
+
 // atan(num / den) in Q24 radians for 0 <= num <= den, den > 0 (0 for den = 0), and
 // the ratio num/den in Q31 (2^31 = 1) when ratio_q31 is not null. Error below
 // 1.2e-5 rad (0.0007 deg) over the whole range, test_fixed.cpp: tables of 1/d and
 // t - atan(t) with linear interpolation, no division.
-int32_t atan_of_ratio_q24(uint32_t num, uint32_t den, uint32_t* ratio_q31);
+FIXED_INLINE int32_t atan_of_ratio_q24(uint32_t num, uint32_t den, uint32_t* ratio_q31) {
+    if (den == 0) {
+        if (ratio_q31) *ratio_q31 = 0;
+        return 0;
+    }
+    // Normalise den into [2^31, 2^32) (num <= den follows it without overflow).
+    while ((den & 0xFF000000u) == 0) {
+        den <<= 8;
+        num <<= 8;
+    }
+    while ((den & 0x80000000u) == 0) {
+        den <<= 1;
+        num <<= 1;
+    }
+    // d = den / 2^32 = (1 + u)/2 with u = i/256 + f/2^24: 1/d = 1 + g(u).
+    const uint16_t i = fixed_detail::bits_23_to_30(den);
+    const uint16_t f = fixed_detail::bits_7_to_22(den);
+    const uint16_t g = (uint16_t)(fixed_detail::interpolate_down(fixed_detail::kReciprocalMinusOne, i, f) >> 16);
+    // t = (num / 2^32) / d = n (1 + g) in Q31.
+    const uint32_t n_q31 = num >> 1;
+    uint32_t t_q31 = n_q31 + mul_u32_u16_shr16(n_q31, g);
+    if (t_q31 >= 0x80000000u) t_q31 = 0x80000000u;  // num = den (interpolation rounding)
+    if (ratio_q31) *ratio_q31 = t_q31;
+    if (t_q31 == 0x80000000u) return kQuarterPiQ24;
+    // atan(t) = t - (t - atan(t)), the table at j = t*256.
+    const uint16_t j = fixed_detail::bits_23_to_30(t_q31);  // t_q31 < 2^31: j <= 255
+    const uint16_t fj = fixed_detail::bits_7_to_22(t_q31);
+    const uint32_t t_minus_atan_q34 = fixed_detail::interpolate_up(fixed_detail::kTMinusAtan, j, fj);
+    const uint32_t atan_q32 = (t_q31 << 1) - (t_minus_atan_q34 >> 2);
+    return (int32_t)((atan_q32 + 0x80u) >> 8);
+}
 
 // atan2(y, x) in Q24 radians, -pi < a <= pi, for magnitudes and signs given apart (so
 // that a magnitude may use all 32 bits); atan2(0, 0) = 0. As fast_atan2: the sign of
 // a zero y is +, so atan2(0, -x) = +pi. ratio_q31, when not null, receives
 // min/max of the magnitudes (for hypot_from_ratio).
-int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_negative, uint32_t x_magnitude,
-                  uint32_t* ratio_q31 = nullptr);
+FIXED_INLINE int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_negative, uint32_t x_magnitude,
+                               uint32_t* ratio_q31 = nullptr) {
+    // Fold into the first octant, as fast_atan2 does: a = atan(min/max).
+    // (One inline copy of atan_of_ratio_q24: the operands are chosen first.)
+    const bool steep = y_magnitude > x_magnitude;
+    int32_t a = atan_of_ratio_q24(steep ? x_magnitude : y_magnitude, steep ? y_magnitude : x_magnitude, ratio_q31);
+    if (steep) a = kHalfPiQ24 - a;
+    if (x_negative && x_magnitude != 0) a = kPiQ24 - a;
+    return y_negative && y_magnitude != 0 ? -a : a;
+}
 
 // sqrt(a^2 + b^2) for magnitudes a, b < 2^31 (in their common scale), to within a
 // relative 2.5e-5 (and 1 unit), from the ratio t = min/max that atan_of_ratio_q24 gives:
 // max * sqrt(1 + t^2), the square root from a table. No overflow: < 1.42 * 2^31.
-uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31);
+FIXED_INLINE uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31) {
+    uint16_t s;
+    if (ratio_q31 >= 0x80000000u) {
+        s = fixed_detail::entry(fixed_detail::kHypotMinusOne, 128);
+    } else {
+        const uint16_t j = fixed_detail::byte3(ratio_q31);
+        const uint16_t fj = (uint16_t)(ratio_q31 >> 8);
+        s = (uint16_t)(fixed_detail::interpolate_up(fixed_detail::kHypotMinusOne, j, fj) >> 16);
+    }
+    return larger + mul_u32_u16_shr16(larger, s);
+}
 
-// a * b for int16 factors, with avr-gcc's widening multiply (__mulhisi3, ~25 cycles):
-// out of line because inlined, gcc often turns (int32_t)a * b into its 32x32 routine
-// (__mulsi3, ~105 cycles).
-int32_t mul_s16(int16_t a, int16_t b);
-
-// |q| as an unsigned magnitude (|-2^31| fits).
-inline uint32_t magnitude(int32_t q) { return q < 0 ? (uint32_t)0 - (uint32_t)q : (uint32_t)q; }
+// An angle in Q24 radians in hundredths of a degree, rounded to nearest (half away
+// from zero): round(|a| * 18000/pi / 2^24) from four 16x16 multiplies, no float
+// (~150 cycles on the 2560 with the sign; the float path took ~700). The
+// constant is 18000/pi in Q16 rounded (relative error 1.3e-9): the result is the
+// exact rounding of the Q24 value except within 2^-15 of a count of a half. For
+// |a| < 2^26 (4 rad; atan2_q24 gives at most pi).
+FIXED_INLINE int32_t centideg_from_q24(int32_t angle_q24) {
+    // m * K / 2^40 with m = |a| < 2^26 and K = round(18000/pi * 2^16) = 375493621 <
+    // 2^29, from 16-bit halves: m K = hi 2^32 + (mid mod 2^16) 2^16 + (lo mod 2^16).
+    constexpr uint16_t kHigh = 5729, kLow = 37877;  // K = 5729 * 2^16 + 37877
+    const uint32_t m = magnitude(angle_q24);
+    uint16_t c;
+#ifdef __AVR__
+    // The same sums byte by byte in one accumulator (16 MULs, ~80 cycles where the four
+    // mul_u16 with avr-gcc's moves between them took ~130): acc = lo, then its top half
+    // plus the two middle products (mid), then mid's top half plus the high product (hi).
+    uint32_t acc;
+    uint8_t zero;
+    __asm__("clr  %[z]\n\t"
+            // lo = m_low * kLow: acc = [A B C D]
+            "mul  %A[m], %A[kl]\n\t" "movw %A[acc], r0\n\t"
+            "mul  %B[m], %B[kl]\n\t" "movw %C[acc], r0\n\t"
+            "mul  %B[m], %A[kl]\n\t" "add %B[acc], r0\n\t" "adc %C[acc], r1\n\t" "adc %D[acc], %[z]\n\t"
+            "mul  %A[m], %B[kl]\n\t" "add %B[acc], r0\n\t" "adc %C[acc], r1\n\t" "adc %D[acc], %[z]\n\t"
+            // mid = lo >> 16 + m_low * kHigh + m_high * kLow, bytes [C D A B]
+            "clr  %A[acc]\n\t" "clr %B[acc]\n\t"
+            "mul  %A[m], %A[kh]\n\t" "add %C[acc], r0\n\t" "adc %D[acc], r1\n\t" "adc %A[acc], %[z]\n\t" "adc %B[acc], %[z]\n\t"
+            "mul  %B[m], %B[kh]\n\t" "add %A[acc], r0\n\t" "adc %B[acc], r1\n\t"
+            "mul  %B[m], %A[kh]\n\t" "add %D[acc], r0\n\t" "adc %A[acc], r1\n\t" "adc %B[acc], %[z]\n\t"
+            "mul  %A[m], %B[kh]\n\t" "add %D[acc], r0\n\t" "adc %A[acc], r1\n\t" "adc %B[acc], %[z]\n\t"
+            "mul  %C[m], %A[kl]\n\t" "add %C[acc], r0\n\t" "adc %D[acc], r1\n\t" "adc %A[acc], %[z]\n\t" "adc %B[acc], %[z]\n\t"
+            "mul  %D[m], %B[kl]\n\t" "add %A[acc], r0\n\t" "adc %B[acc], r1\n\t"
+            "mul  %D[m], %A[kl]\n\t" "add %D[acc], r0\n\t" "adc %A[acc], r1\n\t" "adc %B[acc], %[z]\n\t"
+            "mul  %C[m], %B[kl]\n\t" "add %D[acc], r0\n\t" "adc %A[acc], r1\n\t" "adc %B[acc], %[z]\n\t"
+            // hi = mid >> 16 + m_high * kHigh (< 2^24), bytes [A B C]
+            "clr  %C[acc]\n\t"
+            "mul  %C[m], %A[kh]\n\t" "add %A[acc], r0\n\t" "adc %B[acc], r1\n\t" "adc %C[acc], %[z]\n\t"
+            "mul  %D[m], %B[kh]\n\t" "add %C[acc], r0\n\t"
+            "mul  %D[m], %A[kh]\n\t" "add %B[acc], r0\n\t" "adc %C[acc], r1\n\t"
+            "mul  %C[m], %B[kh]\n\t" "add %B[acc], r0\n\t" "adc %C[acc], r1\n\t"
+            // (hi + 2^7) >> 8 in bytes [B C]
+            "lsl  %A[acc]\n\t" "adc %B[acc], %[z]\n\t" "adc %C[acc], %[z]\n\t"
+            "clr  r1"
+            : [acc] "=&r"(acc), [z] "=&r"(zero)
+            : [m] "r"(m), [kl] "r"(kLow), [kh] "r"(kHigh));
+    c = (uint16_t)(acc >> 8);
+#else
+    const uint16_t m_high = (uint16_t)(m >> 16), m_low = (uint16_t)m;  // m_high < 2^10
+    const uint32_t lo = mul_u16(m_low, kLow);
+    // < 2^29 + 2^26 + 2^16: no overflow.
+    const uint32_t mid = mul_u16(m_low, kHigh) + mul_u16(m_high, kLow) + (lo >> 16);
+    const uint32_t hi = mul_u16(m_high, kHigh) + (mid >> 16);
+    // round(m K / 2^40) = (hi + 2^7) >> 8: the bits below hi cannot carry into it.
+    c = (uint16_t)((hi + 0x80u) >> 8);
+#endif
+    return angle_q24 < 0 ? -(int32_t)c : (int32_t)c;
+}
 
 }  // namespace linalg

@@ -335,6 +335,10 @@ Angles AttitudePipeline::angles() const {
     return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad, h};
 }
 
+AnglesCentideg AttitudePipeline::angles_centideg() const {
+    return dcm::angles_centideg(dcm_.euler_now_q24(), settings_.declination_centideg);
+}
+
 linalg::Quaternion AttitudePipeline::quaternion() const {
     // The DCM's earth frame is magnetic north: turned about down by the declination.
     const float half_rad = 0.5f * settings_.declination_deg() * linalg::kRadPerDeg;

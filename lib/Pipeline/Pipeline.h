@@ -96,6 +96,9 @@ struct Angles {
     float heading_deg;  // 0 <= h < 360, declination applied
 };
 
+// The same rounded to the hundredths the output lines print (fmt::format_plot_line_centideg).
+using AnglesCentideg = dcm::AnglesCentideg;
+
 // A per-kind rate limiter for warnings: allow() is true at most once per interval,
 // suppressed() tells how many were held back in all. A plain struct that starts
 // zeroed: declare it static or value-initialise it (`RateLimiter r{};`).
@@ -130,8 +133,12 @@ public:
     void on_mag_sample(const linalg::Vector3f& field_uT);
     // True once per output period after on_imu_sample (only while Running).
     bool output_due() const { return st_.output_due; }
-    // Current angles (Euler extraction: ~5 ksteps of float work on AVR; call when due).
+    // Current angles (Euler extraction in integers, then floats: ~6 k cycles on the AVR
+    // with today's float lead; call when due).
     Angles angles() const;
+    // The same in printed hundredths, with no float after the matrix entries (~3.3 k
+    // cycles on the AVR besides the lead's): what the plot and csv lines print.
+    AnglesCentideg angles_centideg() const;
     // The same attitude as a unit quaternion, body to the true-north earth frame
     // (declination applied like the heading's): `mode quat`.
     linalg::Quaternion quaternion() const;

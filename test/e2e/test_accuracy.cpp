@@ -58,18 +58,34 @@ Agreement compare(const std::vector<e2e::Line>& sim_lines, const std::vector<Row
     return a;
 }
 
-TEST(Equivalence, ReplayAndSimavrGiveTheSameAngles) {
-    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "replay", "scenario");
-    const double seconds = 20.0;
-    const std::string csv = e2e::scenario_csv("tilt_tour", seconds);
+// A scenario through build/replay and through the firmware in simavr, each simavr line
+// against its replay row from from_s on (fatal failures inside: ASSERT_NO_FATAL_FAILURE).
+void replay_against_simavr(const char* scenario, double seconds, double from_s, Agreement& a) {
+    const std::string csv = e2e::scenario_csv(scenario, seconds);
     const e2e::CommandResult replay = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
     ASSERT_EQ(replay.exit_code, 0) << replay.err;
-    const e2e::SimRun sim = e2e::run_sim(e2e::firmware_elf(), "tilt_tour", seconds);
+    const e2e::SimRun sim = e2e::run_sim(e2e::firmware_elf(), scenario, seconds);
     ASSERT_EQ(sim.result.exit_code, 0) << e2e::dump(sim);
-    const Agreement a = compare(sim.lines, parse_replay(replay.out), 2.5);
+    a = compare(sim.lines, parse_replay(replay.out), from_s);
+}
+
+TEST(Equivalence, ReplayAndSimavrGiveTheSameAngles) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "replay", "scenario");
+    Agreement a;
+    ASSERT_NO_FATAL_FAILURE(replay_against_simavr("tilt_tour", 20.0, 2.5, a));
     // 50 Hz from ~1.3 s to 20 s: most lines must find their step.
     EXPECT_GT(a.compared, 800u);
     EXPECT_LT(a.worst_deg, 0.1) << a.worst_at;
+}
+
+// The output's angles are integers from the matrix entries on (Euler.h): replay prints
+// the firmware's hundredths exactly, on a shaking board too.
+TEST(Equivalence, ReplayPrintsTheFirmwaresHundredths) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "replay", "scenario");
+    Agreement a;
+    ASSERT_NO_FATAL_FAILURE(replay_against_simavr("shake", 8.0, 0.0, a));
+    EXPECT_GT(a.compared, 300u);
+    EXPECT_LT(a.worst_deg, 0.005) << a.worst_at;  // any difference is a whole 0.01
 }
 
 TEST(Broad, ReplayOnEveryRecording) {

@@ -11,7 +11,7 @@ const char* const kChecks[] = {
     "linalg_ops",       "linalg_degenerate", "fast_atan2",     "euler_round_trip",
     "dcm_orthonormal",  "dcm_bias_at_rest",  "dcm_absurd_inputs", "decode_mpu6000",
     "decode_hmc5883",   "console_parse",     "settings_crc",   "format",
-    "quat_raw",
+    "quat_raw",         "fixed_output",
 };
 constexpr size_t kCheckCount = sizeof kChecks / sizeof kChecks[0];
 

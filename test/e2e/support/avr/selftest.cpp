@@ -18,6 +18,7 @@
 #include "Console.h"
 #include "Dcm.h"
 #include "Euler.h"
+#include "Fixed.h"
 #include "Format.h"
 #include "Hmc5883Registers.h"
 #include "LinAlg.h"
@@ -105,12 +106,13 @@ void run(text::Flash name, void (*check)()) {
 
 // xorshift32: the same sequence on every target.
 uint32_t g_rng = 2463534242u;
-float uniform(float lo, float hi) {
+uint32_t random_u32() {
     g_rng ^= g_rng << 13;
     g_rng ^= g_rng >> 17;
     g_rng ^= g_rng << 5;
-    return lo + (hi - lo) * (float)(g_rng >> 8) * (1.0f / 16777216.0f);
+    return g_rng;
 }
+float uniform(float lo, float hi) { return lo + (hi - lo) * (float)(random_u32() >> 8) * (1.0f / 16777216.0f); }
 
 float max_abs_diff(const Matrix3f& a, const Matrix3f& b) {
     const Matrix3f d = a - b;
@@ -522,6 +524,46 @@ void check_format() {
     EXPECT(text::to_centi(-2.345f, centi) && centi == -235);
 }
 
+// The integer output path's own AVR code (inline MUL sequences, Fixed.h; test_fixed.cpp):
+// the 16x16 products against the compiler's, the hundredths against a 64-bit
+// reference, and the integer lines against the float path on carried rotations.
+void check_fixed_output() {
+    EXPECT(linalg::mul_s16(-32768, -32768) == 1073741824L && linalg::mul_s16(-32768, 32767) == -1073709056L);
+    EXPECT(linalg::mul_u16(65535u, 65535u) == 4294836225UL && linalg::mul_s16(-1, 1) == -1);
+    for (uint16_t i = 0; i < 2000; ++i) {
+        const uint32_t a = random_u32(), b = random_u32();
+        const uint16_t ua = (uint16_t)a, ub = (uint16_t)b;
+        const int16_t sa = (int16_t)(uint16_t)(a >> 16), sb = (int16_t)(uint16_t)(b >> 16);
+        EXPECT(linalg::mul_u16(ua, ub) == (uint32_t)ua * (uint32_t)ub);
+        EXPECT(linalg::mul_s16(sa, sb) == (int32_t)sa * (int32_t)sb);
+        const int32_t q = (b & 1u) ? -(int32_t)(a >> 6) : (int32_t)(a >> 6);  // |q| < 2^26
+        const uint64_t m = (uint64_t)(a >> 6);
+        const int32_t c = (int32_t)((m * 375493621ULL + (1ULL << 39)) >> 40);  // round(m 18000/pi / 2^24)
+        EXPECT(linalg::centideg_from_q24(q) == ((b & 1u) ? -c : c));
+    }
+    // fixed_from_float's shifts by MUL against a float scaling by 2^q (exact) and the
+    // cast's truncation, from 2^-24 to 2 in magnitude.
+    for (uint16_t i = 0; i < 500; ++i) {
+        const float x = uniform(-1.99f, 1.99f) / (float)(1UL << (i % 24));  // power-of-two division: exact
+        EXPECT(linalg::fixed_from_float(x, 30) == (int32_t)(x * 1073741824.0f));
+        EXPECT(linalg::fixed_from_float(x, 26) == (int32_t)(x * 67108864.0f));
+    }
+    EXPECT(linalg::fixed_from_float(-2.5f, 30) == -0x7FFFFFFFL && linalg::fixed_from_float(1e-12f, 30) == 0);
+    const float d = linalg::kPi / 180.0f;
+    const Matrix3f r = dcm::dcm_from_euler(10 * d, -20 * d, 135 * d);
+    const dcm::AnglesCentideg c = dcm::angles_centideg(dcm::euler_carried_q24(r, 0, 0, 0), 1000);
+    EXPECT(c.roll_centideg == 1000 && c.pitch_centideg == -2000 && c.heading_centideg == 14500);
+    for (uint16_t i = 0; i < 100; ++i) {
+        const Matrix3f s = dcm::dcm_from_euler(uniform(-3.1f, 3.1f), uniform(-1.4f, 1.4f), uniform(-3.1f, 3.1f));
+        const int32_t tx = (int32_t)(random_u32() >> 12) - (1L << 19), ty = (int32_t)(random_u32() >> 12) - (1L << 19);
+        const dcm::EulerQ24 e = dcm::euler_carried_q24(s, tx, ty, 0);
+        const dcm::EulerAngles f = dcm::euler_carried(s, Vector3f((float)tx / 67108864.0f, (float)ty / 67108864.0f, 0.0f));
+        const dcm::AnglesCentideg h = dcm::angles_centideg(e, 0);
+        EXPECT(near((float)h.roll_centideg, f.roll_rad * (18000.0f / linalg::kPi), 0.52f));
+        EXPECT(near((float)h.pitch_centideg, f.pitch_rad * (18000.0f / linalg::kPi), 0.52f));
+    }
+}
+
 // quat and raw lines, fixed point at 1..4 decimals (test_format.cpp), and the DCM's
 // quaternion (test_linalg.cpp): 16-bit int arithmetic on this target.
 void check_quat_raw() {
@@ -561,6 +603,7 @@ static void run_all() {
     run(TXT("settings_crc"), check_settings_crc);
     run(TXT("format"), check_format);
     run(TXT("quat_raw"), check_quat_raw);
+    run(TXT("fixed_output"), check_fixed_output);
     text::Writer(&kOut).str(TXT("# selftest done: ")).u32(g_checks).str(TXT(" checks, ")).u32(g_ok)
         .str(TXT(" ok, ")).u32((uint32_t)(g_checks - g_ok)).str(TXT(" FAIL")).end();
 }
