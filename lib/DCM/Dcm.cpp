@@ -115,7 +115,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
 }
 
 // x * c / 2^15 for |x| < 2^31, c < 2^16, rounded toward zero: two 16x16 multiplies.
-int32_t Dcm::scale_q15(int32_t x, uint16_t c) {
+FIXED_INLINE int32_t Dcm::scale_q15(int32_t x, uint16_t c) {
     const uint32_t m = linalg::magnitude(x);
     const uint32_t product = (linalg::mul_u16((uint16_t)(m >> 16), c) << 1) + (linalg::mul_u16((uint16_t)m, c) >> 15);
     return x < 0 ? -(int32_t)product : (int32_t)product;
@@ -231,9 +231,9 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
     // 200 Hz update on BROAD's fast rotations: README, Performance.
     if (gyro_ok) {
         last_gyro_ = gyro;
-        turn_sum_.x += gyro.x * kTurnScale - offset_units_.x;
-        turn_sum_.y += gyro.y * kTurnScale - offset_units_.y;
-        turn_sum_.z += gyro.z * kTurnScale - offset_units_.z;
+        turn_sum_.x += in_turn_units(gyro.x) - offset_units_.x;
+        turn_sum_.y += in_turn_units(gyro.y) - offset_units_.y;
+        turn_sum_.z += in_turn_units(gyro.z) - offset_units_.z;
         if (yaw_pending_) turn_sum_ += yaw_units_;  // a mag correction is applied once
     }
     yaw_pending_ = false;
@@ -388,8 +388,8 @@ Vector3f Dcm::pending_turn_rad() const {
 }
 
 Vector3f Dcm::last_rate_rad_s() const {
-    const Vector3l units{last_gyro_.x * kTurnScale - offset_units_.x, last_gyro_.y * kTurnScale - offset_units_.y,
-                         last_gyro_.z * kTurnScale - offset_units_.z};
+    const Vector3l units{in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
+                         in_turn_units(last_gyro_.z) - offset_units_.z};
     return units.scaled(gyro_scale_ * (1.0f / (float)kTurnScale));
 }
 
@@ -563,8 +563,8 @@ EulerQ24 Dcm::euler_now_q24() const {
     // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
     // times the radians per unit, each factor Q15 (16x16 multiplies: the float path
     // cost ~2.2 k cycles a line).
-    const Vector3l rate{last_gyro_.x * kTurnScale - offset_units_.x, last_gyro_.y * kTurnScale - offset_units_.y,
-                        last_gyro_.z * kTurnScale - offset_units_.z};
+    const Vector3l rate{in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
+                        in_turn_units(last_gyro_.z) - offset_units_.z};
     const uint16_t lead = lead_steps_q15_, k = theta_q26_per_unit_q15_;
     return euler_carried_q24(r_, scale_q15(first_half_.x + turn_sum_.x + scale_q15(rate.x, lead), k),
                              scale_q15(first_half_.y + turn_sum_.y + scale_q15(rate.y, lead), k),
