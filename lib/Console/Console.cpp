@@ -80,17 +80,22 @@ Command parse_line(const char* line) {
     if (n > 3) return fail(Error::ExtraArgument);
     const char* cmd = w[0];
 
-    // The command names in flash, those without an argument first.
-    static const CommandId kIds[] = {CommandId::Help, CommandId::Help, CommandId::Status, CommandId::Save,
-                                     CommandId::Defaults, CommandId::Rate, CommandId::Decl, CommandId::Mode};
+    // The command names in flash, those without an argument first; each name's command
+    // is its byte in kIds (a TXT string too: an array would be copied to the AVR's SRAM).
+    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x03\x04\x05\x07");
+    static_assert((uint8_t)CommandId::Help == 2 && (uint8_t)CommandId::Status == 6 &&
+                      (uint8_t)CommandId::Save == 9 && (uint8_t)CommandId::Defaults == 10 &&
+                      (uint8_t)CommandId::Rate == 3 && (uint8_t)CommandId::Decl == 4 &&
+                      (uint8_t)CommandId::Mode == 5 && (uint8_t)CommandId::CalGyro == 7,
+                  "kIds holds these values");
     constexpr int8_t kFirstWithArgument = 5;
     const int8_t k = find_word(cmd, TXT("help\0?\0status\0save\0defaults\0rate\0decl\0mode\0cal\0"));
     if (k < 0) return fail(Error::Unknown);
-    if (k < kFirstWithArgument) return n == 1 ? make(kIds[k]) : fail(Error::ExtraArgument);
+    const CommandId id = (CommandId)text::flash_byte(kIds.p + k);
+    if (k < kFirstWithArgument) return n == 1 ? make(id) : fail(Error::ExtraArgument);
     if (n < 2) return fail(Error::MissingArgument);
     if (n > 2) return fail(Error::ExtraArgument);
     const char* arg = w[1];
-    const CommandId id = k < (int8_t)(sizeof kIds / sizeof kIds[0]) ? kIds[k] : CommandId::CalGyro;
     Command r = make(id);
     if (id == CommandId::Rate || id == CommandId::Decl) {
         int32_t c;
