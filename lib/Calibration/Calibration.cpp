@@ -78,16 +78,13 @@ GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vec
     ++n_;
     if (n_ < kGyroWindow) return Result::Collecting;
     const float inv = 1.0f / (float)n_;
-    float mean[6];
-    for (uint8_t i = 0; i < 6; ++i) mean[i] = sum_[i] * inv;
-    for (uint8_t i = 3; i < 6; ++i) bias_[i] = mean[i];  // the mean accel, kept either way
-    const float len2 = mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2];
+    for (uint8_t i = 0; i < 6; ++i) sum_[i] *= inv;  // the means
+    const float len2 = sum_[0] * sum_[0] + sum_[1] * sum_[1] + sum_[2] * sum_[2];
     if (!(len2 <= 3.0f * kGyroBiasMax_rad_s * kGyroBiasMax_rad_s)) {  // steady spin: not a bias
         restart();
         ++restarts_;
         return Result::Moved;
     }
-    for (uint8_t i = 0; i < 3; ++i) bias_[i] = mean[i];
     done_ = true;
     return Result::Done;
 }
@@ -190,7 +187,7 @@ bool sqrt_near_identity(const Matrix3f& a, Matrix3f& root) {
 
 void MagCalibrator::restart(const Vector3f& pivot_uT) {
     for (uint8_t i = 0; i < kMoments; ++i) sums_[i] = 0.0f;
-    for (uint8_t i = 0; i < kCells; ++i) cell_count_[i] = 0;
+    for (uint8_t& b : cell_samples_) b = 0;
     pivot_uT_ = cover_centre_uT_ = pivot_uT.is_finite() ? pivot_uT : Vector3f();
     residual_uT_ = sphere_residual_uT_ = radius_uT_ = 0.0f;
 }
@@ -220,7 +217,7 @@ void MagCalibrator::add(const Vector3f& field_uT) {
     // kCoverageRefitSamples; the pivot before), quantised to one of 26 cells by the
     // sign of each component that is at least tan 22.5 deg of the largest one (faces,
     // edges and corners of a cube).
-    if (count() % kCoverageRefitSamples == 0 && fit_sphere()) cover_centre_uT_ = sphere_offset_uT_;
+    if (count() % kCoverageRefitSamples == 0) fit_sphere();
     const Vector3f d = field_uT - cover_centre_uT_;
     const float c[3] = {d.x, d.y, d.z};
     float big = 0.0f;
@@ -235,12 +232,18 @@ void MagCalibrator::add(const Vector3f& field_uT) {
         cell = (uint8_t)(cell * 3u + q);
     }
     if (cell > 13) --cell;  // 13 (all components small) cannot happen
-    if (cell_count_[cell] < 255) ++cell_count_[cell];
+    if (cell_samples(cell) < kMagCellMinSamples)
+        cell_samples_[cell >> 2] = (uint8_t)(cell_samples_[cell >> 2] + (1u << ((cell & 3u) * 2u)));
+}
+
+static_assert(kMagCellMinSamples <= 3, "a cell's count has 2 bits");
+uint8_t MagCalibrator::cell_samples(uint8_t cell) const {
+    return (uint8_t)((cell_samples_[cell >> 2] >> ((cell & 3u) * 2u)) & 3u);
 }
 
 uint8_t MagCalibrator::coverage_pct() const {
     uint8_t seen = 0;
-    for (uint8_t i = 0; i < kCells; ++i) seen = (uint8_t)(seen + (cell_count_[i] >= kMagCellMinSamples));
+    for (uint8_t i = 0; i < kCells; ++i) seen = (uint8_t)(seen + (cell_samples(i) >= kMagCellMinSamples));
     return (uint8_t)((seen * 100u + kCells / 2u) / kCells);
 }
 
@@ -267,7 +270,7 @@ bool MagCalibrator::fit_sphere() {
     float sse = tt;
     for (uint8_t p = 0; p < 4; ++p) sse -= a[p][4] * rhs[p];
     const float r = sqrtf(r2);
-    sphere_offset_uT_ = pivot_uT_ + centre * kFitScale_uT;
+    cover_centre_uT_ = pivot_uT_ + centre * kFitScale_uT;
     sphere_residual_uT_ = safe_sqrt(sse / sums_[0]) / (2.0f * r) * kFitScale_uT;
     radius_uT_ = r * kFitScale_uT;
     return true;
