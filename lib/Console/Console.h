@@ -130,8 +130,9 @@ text::Flash mode_name(fmt::OutputMode m);
 // (9..15 bytes) arrive, so that pastes of ~75 rate or ~60 decl lines fit. Garbage makes
 // an error line (~50 bytes of reply) for every ~20 bytes received wherever its line ends
 // are close: the 20 KB stream of random bytes with commands between
-// (e2e ConsoleInput.RandomBytesStreamWithCommandsBetween) keeps at most 7 commands
-// waiting (apm25sim), and beyond kErrorBytes a bad line is merged (below).
+// (e2e ConsoleInput.RandomBytesStreamWithCommandsBetween) keeps at most 18 commands, 24
+// bytes, waiting (apm25sim, a command staying until its reply's last line is out), and
+// beyond kErrorBytes (40) a bad line is merged (below).
 class CommandQueue {
 public:
     static constexpr uint8_t kBytes = 64;  // a power of two (index wrap by mask)
