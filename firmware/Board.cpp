@@ -5,13 +5,19 @@
 
 namespace board {
 
+// Written high before it is an output: no low glitch on a chip select.
+static void high_output(uint8_t pin) {
+    digitalWrite(pin, HIGH);
+    pinMode(pin, OUTPUT);
+}
+
 void init_pins() {
-    // Outputs written high before they are outputs: no low glitch on a chip select.
-    static const uint8_t kHighOutputs[] = {kPinLedA, kPinLedB, kPinLedC, kPinMpuCs, kPinBaroCs};
-    for (uint8_t pin : kHighOutputs) {
-        digitalWrite(pin, HIGH);
-        pinMode(pin, OUTPUT);
-    }
+    // One call per pin, not a loop over a table: a const table is copied to SRAM.
+    high_output(kPinLedA);
+    high_output(kPinLedB);
+    high_output(kPinLedC);
+    high_output(kPinMpuCs);
+    high_output(kPinBaroCs);
     pinMode(kPinMagDrdy, INPUT);
     DDRE &= (uint8_t)~_BV(PE6);  // MPU6000 INT
 }

@@ -4,14 +4,13 @@
 
 namespace serial_text {
 
-static_assert((kCapacity & (kCapacity - 1u)) == 0, "kCapacity must be a power of two");
-constexpr uint16_t kMask = kCapacity - 1u;
-
 static char ring[kCapacity];
 static uint16_t head = 0, tail = 0;  // head: next write, tail: next byte for Serial
 
-uint16_t queued() { return (uint16_t)((head - tail) & kMask); }
-uint16_t room() { return (uint16_t)(kMask - queued()); }
+static uint16_t next(uint16_t i) { return i + 1u == kCapacity ? 0u : (uint16_t)(i + 1u); }
+uint16_t queued() { return head >= tail ? (uint16_t)(head - tail) : (uint16_t)(head + kCapacity - tail); }
+static uint16_t ring_room() { return (uint16_t)(kCapacity - 1u - queued()); }
+uint16_t room() { return (uint16_t)(ring_room() + (uint16_t)Serial.availableForWrite()); }
 
 void begin() { Serial.begin(kBaud); }
 
@@ -19,14 +18,14 @@ void pump() {
     int free_bytes = Serial.availableForWrite();
     while (free_bytes-- > 0 && tail != head) {
         Serial.write((uint8_t)ring[tail]);
-        tail = (uint16_t)((tail + 1u) & kMask);
+        tail = next(tail);
     }
 }
 
 static void put(char c) {
-    while (room() == 0) pump();
+    while (ring_room() == 0) pump();
     ring[head] = c;
-    head = (uint16_t)((head + 1u) & kMask);
+    head = next(head);
 }
 
 void write(const char* data, uint8_t len) {

@@ -9,8 +9,15 @@
 //
 // Angle lines are written only when the whole line fits (write_line_if_room), so a
 // backlog of replies delays a line rather than a sample. A message that does not fit
-// waits for room while pumping: with kCapacity well above the longest reply that only
-// happens when replies come faster than 115200 baud can carry them.
+// waits for room while pumping: console replies go out a part (a line or two) at a time,
+// each only when room() holds it and an output line after it (firmware.ino), so that
+// only happens when the sensors' own messages come faster than 115200 baud carries them.
+//
+// Size: 192 bytes here and Serial's 64 behind them (room() counts both: pump() moves
+// bytes on as soon as Serial has space) hold a reply part (a line of up to 96 bytes, or
+// its two STATUSTEXT frames, 132 bytes, in `mode mavlink`) with an output line after it
+// (a 104-byte raw line, a 40-byte ATTITUDE frame) and some 50 bytes of the sensors' own
+// messages; at 115200 baud they drain in 22 ms.
 #pragma once
 
 #include <stdint.h>
@@ -19,7 +26,7 @@
 
 namespace serial_text {
 
-constexpr uint16_t kCapacity = 512;  // bytes; a power of two (index wrap by mask)
+constexpr uint16_t kCapacity = 192;  // bytes
 constexpr uint32_t kBaud = 115200;
 
 void begin();
@@ -32,7 +39,8 @@ bool write_line_if_room(const char* line, uint8_t len);
 // Blocks until everything queued has gone to Serial (set-up only).
 void flush();
 uint16_t queued();
-// Free bytes in the queue.
+// Bytes that can be written now without waiting for the UART: free in this queue and
+// in Serial's transmit ring.
 uint16_t room();
 
 }  // namespace serial_text

@@ -65,23 +65,38 @@ static void print_settings_line() {
 
 static Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
 
-static void print_status() {
+// `status`, a line (a part: console::kPartReply) at a time: false past the last part.
+// Parts 2 and 3 are the pipeline's gyro bias and compass lines, the long ones to format
+// (print_bias formats both, seven numbers from floats, for each).
+static void print_bias_line(uint8_t line);
+constexpr uint8_t kStatusBiasPart = 2, kStatusCompassPart = 3;
+static bool print_status(uint8_t part) {
     Writer w(out);
-    w.str(TXT("# status: " TXT_MPU " ")).str(ok_or_failed(imu.ok())).str(TXT(", " TXT_HMC " "))
-        .str(ok_or_failed(compass.ok()));
-    if (!compass.ok()) w.str(TXT(" (yaw gyro-only)"));
-    const pipeline::Phase ph = pipe.phase();
-    w.str(TXT(", estimator "))
-        .str(ph == pipeline::Phase::Running       ? TXT("running")
-             : ph == pipeline::Phase::Calibrating ? TXT("calibrating")
-                                                  : TXT("waiting for " TXT_MPU))
-        .end();
-    char buf[14];
-    w.str(TXT("# load ")).u32(load_pct).str(TXT("%, overruns ")).u32(imu.missed_samples())
-        .str(TXT(", spikes ")).u32(pipe.spikes()).str(TXT(", uptime "))
-        .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s")).end();
-    pipe.print_bias(TXT("# gyro bias "), true);
-    print_settings_line();
+    switch (part) {
+        case 0: {
+            w.str(TXT("# status: " TXT_MPU " ")).str(ok_or_failed(imu.ok())).str(TXT(", " TXT_HMC " "))
+                .str(ok_or_failed(compass.ok()));
+            if (!compass.ok()) w.str(TXT(" (yaw gyro-only)"));
+            const pipeline::Phase ph = pipe.phase();
+            w.str(TXT(", estimator "))
+                .str(ph == pipeline::Phase::Running       ? TXT("running")
+                     : ph == pipeline::Phase::Calibrating ? TXT("calibrating")
+                                                          : TXT("waiting for " TXT_MPU))
+                .end();
+            return true;
+        }
+        case 1: {
+            char buf[14];
+            w.str(TXT("# load ")).u32(load_pct).str(TXT("%, overruns ")).u32(imu.missed_samples())
+                .str(TXT(", spikes ")).u32(pipe.spikes()).str(TXT(", uptime "))
+                .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s")).end();
+            return true;
+        }
+        case kStatusBiasPart: print_bias_line(0); return true;
+        case kStatusCompassPart: print_bias_line(1); return true;
+        case 4: print_settings_line(); return true;
+        default: return false;
+    }
 }
 
 // MAVLink (lib/MavLink): frames go out whole or not at all, through the same queue as
@@ -94,9 +109,38 @@ mav::StatusText status_text(mavlink, mav::FrameSink{nullptr, write_frame});
 
 static bool mavlink_mode() { return pipe.settings().mode == fmt::OutputMode::Mavlink; }
 
-static void write_message(void*, const char* data, uint8_t len) {
+static void send_message(const char* data, uint8_t len) {
     if (mavlink_mode()) status_text.write(data, len);
     else serial_text::write(data, len);
+}
+
+// `status` sends the pipeline's gyro bias and compass lines, which print_bias writes in
+// one call, as two parts (a part is one line: console::kPartReply): while only_line is
+// set, write_message passes on only that line of what it is given.
+constexpr uint8_t kAllLines = 0xFF;
+static uint8_t only_line = kAllLines;
+static uint8_t lines_seen = 0;
+static void write_message(void*, const char* data, uint8_t len) {
+    if (only_line == kAllLines) {
+        send_message(data, len);
+        return;
+    }
+    while (len > 0) {
+        uint8_t n = 0;
+        while (n < len && data[n] != '\n') ++n;
+        const bool line_end = n < len;
+        if (line_end) ++n;
+        if (lines_seen == only_line) send_message(data, n);
+        if (line_end) ++lines_seen;
+        data += n;
+        len = (uint8_t)(len - n);
+    }
+}
+static void print_bias_line(uint8_t line) {
+    only_line = line;
+    lines_seen = 0;
+    pipe.print_bias(TXT("# gyro bias "), true);
+    only_line = kAllLines;
 }
 
 // HEARTBEAT and SYS_STATUS, once a second in `mode mavlink` (MAVLink's 1 Hz convention:
@@ -163,18 +207,24 @@ static void emit_output(uint32_t now_ms) {
 // Nothing typed or pasted is lost: bytes are taken from Serial's 64-byte receive ring
 // and parsed at once, every loop iteration and again inside the step after the
 // estimator (at 115200 baud the ring fills in 5.6 ms; the longest step is ~4.5 ms), and
-// the parsed commands wait in a queue. A command runs only when the output queue has
-// room for its reply and an angle line after it (console::reply_bound): a paste is
+// the parsed commands wait in a queue. A reply goes out a part (a line) at a time, each
+// only when the output queue has room for it and an output line after it: a paste is
 // answered line by line as fast as the UART carries the replies, a reply never blocks
-// the loop, and the angle lines keep flowing between replies.
+// the loop, and the angle lines keep flowing (between the lines of a long reply too).
 console::CommandQueue commands;
+uint8_t reply_part = 0;  // the next part of the reply to commands.peek()
 
-static void execute(const console::Command& c) {
+// Writes part `part` of the reply to c (and runs c with part 0); false when c's reply
+// has no such part (it is complete).
+static bool answer(const console::Command& c, uint8_t part) {
     switch (c.id) {
-        case console::CommandId::None: break;
-        case console::CommandId::Error: console::print_error(c, out); break;
-        case console::CommandId::Help: console::print_help(out); break;
-        case console::CommandId::Status: print_status(); break;
+        case console::CommandId::Error: return console::print_error(c, part, out);
+        case console::CommandId::Help: return console::print_help(part, out);
+        case console::CommandId::Status: return print_status(part);
+        default: break;
+    }
+    if (part > 0) return false;
+    switch (c.id) {
         case console::CommandId::Save: store.start_save(pipe.settings()); break;
         case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
@@ -184,6 +234,7 @@ static void execute(const console::Command& c) {
             break;
         default: console::apply_setting(c, pipe.settings(), out); break;  // rate, decl, mode
     }
+    return true;
 }
 
 // Received bytes -> parsed commands, while the command queue has room (when it has none,
@@ -200,20 +251,39 @@ static void take_console_input() {
     }
 }
 
+// Output queue bytes a part takes, at most: a line of up to console::kPartReply
+// characters, in `mode mavlink` STATUSTEXT, two frames (<= 94 characters after "# ").
+static uint16_t part_bytes() { return mavlink_mode() ? 2u * mav::kMaxFrame : console::kPartReply; }
+// ... and room for an output line after it: a raw line, the longest, or an ATTITUDE frame.
+static uint16_t output_line_bytes() { return mavlink_mode() ? mav::kAttitudeFrame : fmt::kRawLineMax; }
+// Both fit the empty queues, else a part would never run.
+static_assert(2u * mav::kMaxFrame + mav::kAttitudeFrame <= serial_text::kCapacity - 1u + SERIAL_TX_BUFFER_SIZE - 1u &&
+                  console::kPartReply + fmt::kRawLineMax <= serial_text::kCapacity - 1u + SERIAL_TX_BUFFER_SIZE - 1u,
+              "serial_text's queue and Serial's ring hold a reply part and an output line");
+
 // A sample is missed when the next read comes more than 1.5 periods (7.5 ms) after the
-// previous one. A short reply (an error, rate, decl, mode, save: under 0.7 ms) may start
-// up to 6 ms after the last sample; the long ones (status takes 3.4 ms, help 1.4 ms)
-// start only within 3.5 ms of it, and after a step that used more of its period they
-// wait for the next one (a step averages ~3 ms).
-constexpr uint32_t kShortCommandLatestStartUs = 6000;
-constexpr uint32_t kLongCommandLatestStartUs = 3500;
+// previous one: a part starts only when it ends by 7.3 ms. What a part costs at most
+// (apm25sim --profile): a line 0.7 ms, status's bias or compass line 2.0 ms (seven
+// numbers from floats); in `mode mavlink`, with the STATUSTEXT packing, 2.1 and 3.8 ms.
+// A part that cannot start now waits for a step that leaves it time (a step takes
+// 0.7..5 ms, ~1.9 at least in `mode mavlink`).
+static uint32_t latest_start_us(bool float_lines) {
+    if (mavlink_mode()) return float_lines ? 3500u : 5200u;
+    return float_lines ? 5300u : 6000u;
+}
 static void run_console_command() {
     if (commands.empty()) return;
-    const uint16_t reply_bytes = console::reply_bound(commands.peek());
-    if (serial_text::room() < reply_bytes + fmt::kRawLineMax) return;
-    const uint32_t latest_us = reply_bytes < console::kLongReply ? kShortCommandLatestStartUs : kLongCommandLatestStartUs;
-    if (imu.us_since_sample(micros()) > latest_us) return;
-    execute(commands.pop());
+    const console::Command c = commands.peek();
+    if (serial_text::room() < part_bytes() + output_line_bytes()) return;
+    const bool float_lines = c.id == console::CommandId::Status &&
+                             (reply_part == kStatusBiasPart || reply_part == kStatusCompassPart);
+    if (imu.us_since_sample(micros()) > latest_start_us(float_lines)) return;
+    if (answer(c, reply_part)) {
+        ++reply_part;
+    } else {
+        commands.pop();
+        reply_part = 0;
+    }
 }
 
 // ---------------------------------------------------------------------------

@@ -242,78 +242,139 @@ TEST(Console, HelpListsEveryCommandOnHashLines) {
 TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
     console::CommandQueue q;
     EXPECT_TRUE(q.empty());
-    for (uint8_t i = 0; i < console::CommandQueue::kCapacity; ++i) {
+    // Rates take 2 bytes: full (a decl might not fit) with 2 bytes left.
+    constexpr uint8_t kRates = (console::CommandQueue::kBytes - 2) / 2;
+    for (uint8_t i = 0; i < kRates; ++i) {
+        EXPECT_FALSE(q.full());
         console::Command c = console::parse_line("rate 10");
         c.value = 10 + i;
         EXPECT_TRUE(q.push(c));
     }
     EXPECT_TRUE(q.full());
-    EXPECT_FALSE(q.push(console::parse_line("help")));
-    // Oldest first, and the ring wraps: pop two, push two, then all in order.
+    EXPECT_EQ(q.size(), kRates);
+    EXPECT_FALSE(q.push(console::parse_line("decl 5")));  // 3 bytes: 2 are left
+    // Oldest first, and the ring wraps: pop two, push a rate and a decl, then all in order.
     EXPECT_EQ(q.pop().value, 10);
     EXPECT_EQ(q.pop().value, 11);
-    console::Command a = console::parse_line("rate 50"), b = console::parse_line("decl 8.5");
+    EXPECT_FALSE(q.full());
+    console::Command a = console::parse_line("rate 50"), b = console::parse_line("decl -180");
     EXPECT_TRUE(q.push(a));
     EXPECT_TRUE(q.push(b));
-    for (int32_t v = 12; v < 10 + console::CommandQueue::kCapacity; ++v) EXPECT_EQ(q.pop().value, v);
-    EXPECT_EQ(q.pop().id, console::CommandId::Rate);
+    for (int32_t v = 12; v < 10 + kRates; ++v) EXPECT_EQ(q.pop().value, v);
+    EXPECT_EQ(q.peek().id, console::CommandId::Rate);
+    EXPECT_EQ(q.pop().value, 50);
     const console::Command last = q.pop();
     EXPECT_EQ(last.id, console::CommandId::Decl);
-    EXPECT_EQ(last.value, 850);
+    EXPECT_EQ(last.value, -18000);
     EXPECT_TRUE(q.empty());
+}
+
+TEST(CommandQueue, EveryKindComesBackAsParsed) {
+    // Each command through the queue, again and again so that items straddle the wrap.
+    const char* const lines[] = {"help", "rate 100", "decl 179.99", "decl -0.01", "mode mavlink", "mode quiet",
+                                 "status", "cal gyro", "cal mag", "save", "defaults", "frobnicate", "rate 0",
+                                 "mode x", "cal x", "\x01"};
+    console::CommandQueue q;
+    for (int round = 0; round < 20; ++round) {
+        for (const char* line : lines) {
+            const console::Command c = line[0] == '\x01' ? console::Command{CommandId::Error, console::Error::Garbage,
+                                                                                0, fmt::OutputMode::Plot}
+                                                            : parse(line);
+            ASSERT_TRUE(q.push(c)) << line;
+            const console::Command back = q.pop();
+            EXPECT_EQ(back.id, c.id) << line;
+            EXPECT_EQ(back.error, c.error) << line;
+            EXPECT_EQ(back.value, c.value) << line;
+            EXPECT_EQ(back.mode, c.mode) << line;
+            EXPECT_TRUE(q.empty());
+        }
+    }
+    // The capacity in commands: one byte each for those without a number.
+    for (uint8_t i = 0; i < console::CommandQueue::kBytes - 2; ++i) ASSERT_TRUE(q.push(parse("help")));
+    EXPECT_TRUE(q.full());
+    EXPECT_EQ(q.size(), console::CommandQueue::kBytes - 2);
 }
 
 TEST(CommandQueue, ErrorsBeyondTheirSlotsAreCountedAndCommandsStillFit) {
     console::CommandQueue q;
-    const uint8_t slots = console::CommandQueue::kErrorSlots;
+    const uint8_t slots = console::CommandQueue::kErrorBytes;  // one byte each
     const console::Command bad = parse("frobnicate");
     ASSERT_EQ(bad.id, CommandId::Error);
     for (uint8_t i = 0; i < slots; ++i) EXPECT_TRUE(q.push(bad));
     for (int i = 0; i < 100; ++i) EXPECT_TRUE(q.push(bad));  // merged into the newest
     EXPECT_EQ(q.size(), slots);
-    // A command still gets a slot, and an error after it takes one of its own.
+    // A command still gets a slot, an error after it takes one of its own, and decls (the
+    // longest commands) fill what is left.
     EXPECT_TRUE(q.push(parse("rate 10")));
     EXPECT_TRUE(q.push(bad));
+    for (int i = 0; i < 6; ++i) EXPECT_TRUE(q.push(parse("decl 10")));
     uint32_t answered = 0, merged = 0;
     std::string out;
     const text::Sink sink{&out, sink_write};
     while (!q.empty()) {
         const console::Command c = q.pop();
         if (c.id != CommandId::Error) continue;
+        EXPECT_EQ(c.error, console::Error::Unknown);
         ++answered;
         merged += (uint32_t)c.value;
         EXPECT_LE(0, c.value);
         out.clear();
         console::print_error(c, &sink);
-        EXPECT_LE(out.size(), console::reply_bound(c));
         if (c.value > 0) {
             EXPECT_NE(out.find("# error: 100 more bad lines"), std::string::npos) << out;
+        }
+        for (uint8_t part = 0; part < 2; ++part) {  // each part one line within the bound
+            out.clear();
+            EXPECT_EQ(console::print_error(c, part, &sink), part == 0 || c.value > 0);
+            if (out.empty()) continue;
+            EXPECT_LE(out.size(), console::kPartReply) << out;
+            EXPECT_EQ(out.find('\n'), out.size() - 1) << out;
         }
     }
     EXPECT_EQ(answered + merged, slots + 100u + 1u);  // every bad line accounted for
 }
 
-TEST(CommandQueue, EveryReplyFitsItsBound) {
-    // The firmware runs a command when its output queue has reply_bound bytes free: a
-    // reply longer than that would block the loop.
+TEST(CommandQueue, EveryReplyPartFitsItsBound) {
+    // The firmware writes a reply part when its output queue has room for kPartReply
+    // bytes and an output line: a longer part would block the loop. A part is one "# "
+    // line (`mode csv` adds its header line, not a "# " line).
     std::string out;
     const text::Sink sink{&out, sink_write};
+    auto one_line_within_bound = [&](const std::string& what) {
+        EXPECT_LE(out.size(), console::kPartReply) << what << ": " << out;
+        EXPECT_EQ(out.compare(0, 2, "# "), 0) << what << ": " << out;
+        const size_t first = out.find('\n');
+        ASSERT_NE(first, std::string::npos) << what;
+        if (first + 1 < out.size()) {
+            EXPECT_EQ(out.substr(first + 1), "t_ms,roll,pitch,yaw\n") << what;
+        }
+    };
+    std::string help;
+    uint8_t parts = 0;
+    for (; parts < 20; ++parts) {
+        out.clear();
+        if (!console::print_help(parts, &sink)) break;
+        one_line_within_bound("help part " + std::to_string(parts));
+        help += out;
+    }
+    EXPECT_TRUE(out.empty()) << "nothing written past the last part";
+    EXPECT_GT(help.size(), console::kPartReply);  // help needs its parts
+    out.clear();
     console::print_help(&sink);
-    EXPECT_LE(out.size(), console::reply_bound(parse("help")));
-    EXPECT_GT(out.size(), console::kShortReply);  // the bound for help is the long one
-    const char* const lines[] = {"rate 100", "decl -179.99", "mode mavlink", "mode x", "rate 0", "decl 200",
-                                 "cal x", "frobnicate", "rate", "rate 5 6", "rate abc", "\x01\x02"};
+    EXPECT_EQ(out, help) << "the parts make the whole help";
+    const char* const lines[] = {"rate 100", "decl -179.99", "mode mavlink", "mode csv", "mode x", "rate 0",
+                                 "decl 200", "cal x", "frobnicate", "rate", "rate 5 6", "rate abc", "\x01\x02"};
     for (const char* line : lines) {
         settings::Settings s = settings::defaults();
         const console::Command c = parse(line);
         out.clear();
         if (c.id == CommandId::Error) console::print_error(c, &sink);
         else console::apply_setting(c, s, &sink);
-        EXPECT_LE(out.size(), console::reply_bound(c)) << line << ": " << out;
+        one_line_within_bound(line);
     }
     out.clear();
     console::print_defaults(&sink);
-    EXPECT_LE(out.size(), console::reply_bound(parse("defaults")));
+    one_line_within_bound("defaults");
 }
 
 TEST(Console, EveryModeNameParsesBackToItsMode) {

@@ -1,5 +1,12 @@
 #include "Calibration.h"
 
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define CALIB_PROGMEM PROGMEM
+#else
+#define CALIB_PROGMEM
+#endif
+
 namespace calib {
 
 using linalg::Matrix3f;
@@ -71,16 +78,13 @@ GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vec
     ++n_;
     if (n_ < kGyroWindow) return Result::Collecting;
     const float inv = 1.0f / (float)n_;
-    float mean[6];
-    for (uint8_t i = 0; i < 6; ++i) mean[i] = sum_[i] * inv;
-    for (uint8_t i = 3; i < 6; ++i) bias_[i] = mean[i];  // the mean accel, kept either way
-    const float len2 = mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2];
+    for (uint8_t i = 0; i < 6; ++i) sum_[i] *= inv;  // the means
+    const float len2 = sum_[0] * sum_[0] + sum_[1] * sum_[1] + sum_[2] * sum_[2];
     if (!(len2 <= 3.0f * kGyroBiasMax_rad_s * kGyroBiasMax_rad_s)) {  // steady spin: not a bias
         restart();
         ++restarts_;
         return Result::Moved;
     }
-    for (uint8_t i = 0; i < 3; ++i) bias_[i] = mean[i];
     done_ = true;
     return Result::Done;
 }
@@ -99,12 +103,22 @@ constexpr float kFitInvScale = 1.0f / kFitScale_uT;
 // Index of the monomial x^i y^j z^k in MagCalibrator's sums: by degree d = i + j + k,
 // then by r = j + k, then by k (1, x, y, z, x^2, xy, xz, y^2, yz, z^2, x^3, ...).
 // Tables, not d (d + 1) (d + 2) / 6 and r (r + 1) / 2: a division is a library call on
-// the AVR, and add() looks up 34 indices a sample.
-const uint8_t kTetrahedral[5] = {0, 1, 4, 10, 20};  // monomials of degree < d
-const uint8_t kTriangular[5] = {0, 1, 3, 6, 10};
+// the AVR, and add() looks up 34 indices a sample. The small tables are in flash on the
+// AVR (a const array is copied to SRAM at start otherwise): table_byte reads them.
+const uint8_t kTetrahedral[5] CALIB_PROGMEM = {0, 1, 4, 10, 20};  // monomials of degree < d
+const uint8_t kTriangular[5] CALIB_PROGMEM = {0, 1, 3, 6, 10};
+uint8_t table_byte(const uint8_t* table, uint8_t i) {
+#ifdef __AVR__
+    return pgm_read_byte(table + i);
+#else
+    return table[i];
+#endif
+}
+uint8_t tetrahedral(uint8_t d) { return table_byte(kTetrahedral, d); }
+uint8_t triangular(uint8_t r) { return table_byte(kTriangular, r); }
 uint8_t moment_index(uint8_t i, uint8_t j, uint8_t k) {
     const uint8_t r = (uint8_t)(j + k);
-    return (uint8_t)(kTetrahedral[i + r] + kTriangular[r] + k);
+    return (uint8_t)(tetrahedral((uint8_t)(i + r)) + triangular(r) + k);
 }
 
 // Exponents packed two bits each (i | j << 2 | k << 4).
@@ -148,13 +162,18 @@ bool solve(float a[][kMaxUnknowns + 1], uint8_t n) {
 // Symmetric square root of a symmetric positive matrix near I (Newton-Schulz:
 // Y -> Y T, Z -> T Z, T = (3I - Z Y) / 2; quadratic convergence while |I - A| < 1).
 // False when it has not converged (A too far from I: soft iron beyond any limit).
+Matrix3f newton_schulz_t(const Matrix3f& zy) {
+    return Matrix3f(Vector3f(1.5f - 0.5f * zy.a.x, -0.5f * zy.a.y, -0.5f * zy.a.z),
+                    Vector3f(-0.5f * zy.b.x, 1.5f - 0.5f * zy.b.y, -0.5f * zy.b.z),
+                    Vector3f(-0.5f * zy.c.x, -0.5f * zy.c.y, 1.5f - 0.5f * zy.c.z));
+}
 bool sqrt_near_identity(const Matrix3f& a, Matrix3f& root) {
-    Matrix3f y = a, z;
-    for (uint8_t it = 0; it < 8; ++it) {
-        const Matrix3f zy = z * y;
-        const Matrix3f t = Matrix3f(Vector3f(1.5f - 0.5f * zy.a.x, -0.5f * zy.a.y, -0.5f * zy.a.z),
-                                    Vector3f(-0.5f * zy.b.x, 1.5f - 0.5f * zy.b.y, -0.5f * zy.b.z),
-                                    Vector3f(-0.5f * zy.c.x, -0.5f * zy.c.y, 1.5f - 0.5f * zy.c.z));
+    // The first step, from Z = I, written out: T = (3I - A) / 2 and Z = T (an identity
+    // matrix object would be a 36-byte constant in the AVR's SRAM).
+    Matrix3f z = newton_schulz_t(a);
+    Matrix3f y = a * z;
+    for (uint8_t it = 1; it < 8; ++it) {
+        const Matrix3f t = newton_schulz_t(z * y);
         y = y * t;
         z = t * z;
     }
@@ -168,7 +187,7 @@ bool sqrt_near_identity(const Matrix3f& a, Matrix3f& root) {
 
 void MagCalibrator::restart(const Vector3f& pivot_uT) {
     for (uint8_t i = 0; i < kMoments; ++i) sums_[i] = 0.0f;
-    for (uint8_t i = 0; i < kCells; ++i) cell_count_[i] = 0;
+    for (uint8_t& b : cell_samples_) b = 0;
     pivot_uT_ = cover_centre_uT_ = pivot_uT.is_finite() ? pivot_uT : Vector3f();
     residual_uT_ = sphere_residual_uT_ = radius_uT_ = 0.0f;
 }
@@ -185,10 +204,10 @@ void MagCalibrator::add(const Vector3f& field_uT) {
         for (uint8_t r = 0; r <= d; ++r) {
             for (uint8_t k = 0; k <= r; ++k, ++n) {
                 // Parent: x^(i-1) y^j z^k (same r) times x while i > 0, else y, else z.
-                const uint8_t below = (uint8_t)(kTetrahedral[d - 1] + k);
-                if (r < d) m[n] = m[below + kTriangular[r]] * var[0];
-                else if (k < r) m[n] = m[below + kTriangular[r - 1]] * var[1];
-                else m[n] = m[below - 1 + kTriangular[r - 1]] * var[2];
+                const uint8_t below = (uint8_t)(tetrahedral((uint8_t)(d - 1)) + k);
+                if (r < d) m[n] = m[below + triangular(r)] * var[0];
+                else if (k < r) m[n] = m[below + triangular((uint8_t)(r - 1))] * var[1];
+                else m[n] = m[below - 1 + triangular((uint8_t)(r - 1))] * var[2];
             }
         }
     }
@@ -198,7 +217,7 @@ void MagCalibrator::add(const Vector3f& field_uT) {
     // kCoverageRefitSamples; the pivot before), quantised to one of 26 cells by the
     // sign of each component that is at least tan 22.5 deg of the largest one (faces,
     // edges and corners of a cube).
-    if (count() % kCoverageRefitSamples == 0 && fit_sphere()) cover_centre_uT_ = sphere_offset_uT_;
+    if (count() % kCoverageRefitSamples == 0) fit_sphere();
     const Vector3f d = field_uT - cover_centre_uT_;
     const float c[3] = {d.x, d.y, d.z};
     float big = 0.0f;
@@ -213,25 +232,32 @@ void MagCalibrator::add(const Vector3f& field_uT) {
         cell = (uint8_t)(cell * 3u + q);
     }
     if (cell > 13) --cell;  // 13 (all components small) cannot happen
-    if (cell_count_[cell] < 255) ++cell_count_[cell];
+    if (cell_samples(cell) < kMagCellMinSamples)
+        cell_samples_[cell >> 2] = (uint8_t)(cell_samples_[cell >> 2] + (1u << ((cell & 3u) * 2u)));
+}
+
+static_assert(kMagCellMinSamples <= 3, "a cell's count has 2 bits");
+uint8_t MagCalibrator::cell_samples(uint8_t cell) const {
+    return (uint8_t)((cell_samples_[cell >> 2] >> ((cell & 3u) * 2u)) & 3u);
 }
 
 uint8_t MagCalibrator::coverage_pct() const {
     uint8_t seen = 0;
-    for (uint8_t i = 0; i < kCells; ++i) seen = (uint8_t)(seen + (cell_count_[i] >= kMagCellMinSamples));
+    for (uint8_t i = 0; i < kCells; ++i) seen = (uint8_t)(seen + (cell_samples(i) >= kMagCellMinSamples));
     return (uint8_t)((seen * 100u + kCells / 2u) / kCells);
 }
 
 // Sphere: |u|^2 = a x + b y + c z + d, linear in (a, b, c, d); centre (a, b, c) / 2,
 // radius^2 = d + |centre|^2. Residual: |u - c|^2 - R^2 ~ 2 R (|u - c| - R).
 bool MagCalibrator::fit_sphere() {
-    static const uint8_t reg[4] = {kX, kY, kZ, kOne};
+    static const uint8_t kReg[4] CALIB_PROGMEM = {kX, kY, kZ, kOne};
     float a[4][kMaxUnknowns + 1];
     float tt;  // sum |u|^4
     for (uint8_t p = 0; p < 4; ++p) {
-        for (uint8_t q = 0; q < 4; ++q) a[p][q] = sums_[moment_of_sum(reg[p], reg[q])];
-        a[p][4] = sums_[moment_of_sum(reg[p], 2 * kX)] + sums_[moment_of_sum(reg[p], 2 * kY)] +
-                  sums_[moment_of_sum(reg[p], 2 * kZ)];
+        const uint8_t rp = table_byte(kReg, p);
+        for (uint8_t q = 0; q < 4; ++q) a[p][q] = sums_[moment_of_sum(rp, table_byte(kReg, q))];
+        a[p][4] = sums_[moment_of_sum(rp, 2 * kX)] + sums_[moment_of_sum(rp, 2 * kY)] +
+                  sums_[moment_of_sum(rp, 2 * kZ)];
     }
     tt = sums_[moment_index(4, 0, 0)] + sums_[moment_index(0, 4, 0)] + sums_[moment_index(0, 0, 4)] +
          2.0f * (sums_[moment_index(2, 2, 0)] + sums_[moment_index(2, 0, 2)] + sums_[moment_index(0, 2, 2)]);
@@ -244,7 +270,7 @@ bool MagCalibrator::fit_sphere() {
     float sse = tt;
     for (uint8_t p = 0; p < 4; ++p) sse -= a[p][4] * rhs[p];
     const float r = sqrtf(r2);
-    sphere_offset_uT_ = pivot_uT_ + centre * kFitScale_uT;
+    cover_centre_uT_ = pivot_uT_ + centre * kFitScale_uT;
     sphere_residual_uT_ = safe_sqrt(sse / sums_[0]) / (2.0f * r) * kFitScale_uT;
     radius_uT_ = r * kFitScale_uT;
     return true;
@@ -256,12 +282,13 @@ bool MagCalibrator::fit_sphere() {
 // (u - c)^T Q (u - c) = k = 1 + c^T Q c. W = sqrt(Q / det(Q)^(1/3)) has det 1 and
 // maps the ellipsoid onto a sphere of radius sqrt(k / det(Q)^(1/3)).
 bool MagCalibrator::fit_ellipsoid(Calibration& cal) {
-    static const uint8_t reg[9] = {2 * kX, 2 * kY, 2 * kZ, kY + kZ, kX + kZ, kX + kY, kX, kY, kZ};
+    static const uint8_t kReg[9] CALIB_PROGMEM = {2 * kX, 2 * kY, 2 * kZ, kY + kZ, kX + kZ, kX + kY, kX, kY, kZ};
     float a[9][kMaxUnknowns + 1];
     float rhs[9];
     for (uint8_t p = 0; p < 9; ++p) {
-        for (uint8_t q = 0; q < 9; ++q) a[p][q] = sums_[moment_of_sum(reg[p], reg[q])];
-        a[p][9] = rhs[p] = sums_[moment_of(reg[p])];
+        const uint8_t rp = table_byte(kReg, p);
+        for (uint8_t q = 0; q < 9; ++q) a[p][q] = sums_[moment_of_sum(rp, table_byte(kReg, q))];
+        a[p][9] = rhs[p] = sums_[moment_of(rp)];
     }
     if (!solve(a, 9)) return false;
     // A pivot outside the ellipsoid flips the sign of the whole quadric: then

@@ -60,19 +60,20 @@ public:
     // Feeds one sample (raw gyro, raw accel); returns what happened.
     Result add(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2);
     bool done() const { return done_; }
-    linalg::Vector3f bias() const { return linalg::Vector3f(bias_[0], bias_[1], bias_[2]); }
-    // Mean specific force over the last complete still window (gravity for the DCM init).
-    linalg::Vector3f mean_accel_m_s2() const { return linalg::Vector3f(bias_[3], bias_[4], bias_[5]); }
+    // Valid once done(), until the next add().
+    linalg::Vector3f bias() const { return linalg::Vector3f(sum_[0], sum_[1], sum_[2]); }
+    // Mean specific force over the still window (gravity for the DCM init); likewise.
+    linalg::Vector3f mean_accel_m_s2() const { return linalg::Vector3f(sum_[3], sum_[4], sum_[5]); }
     uint16_t count() const { return n_; }
     uint16_t restarts() const { return restarts_; }
 
 private:
     // Plain arrays, gyro x y z then accel x y z: one loop does all six channels, and
     // the object needs no constructor code. Valid from the first add() of a window
-    // (n_ == 0 starts them); bias_ once done().
-    float sum_[6];
+    // (n_ == 0 starts them). Once done(), sum_ holds the means (the bias, then the mean
+    // accel): the result needs no RAM of its own.
+    float sum_[6] = {};
     float lo_[6], hi_[6];
-    float bias_[6] = {};  // mean gyro (the bias), then mean accel
     uint16_t n_ = 0;
     uint16_t restarts_ = 0;
     bool done_ = false;
@@ -139,21 +140,24 @@ public:
     float residual_uT() const { return residual_uT_; }
     float radius_uT() const { return radius_uT_; }
     // The sphere fit's offset and residual (the first stage).
-    linalg::Vector3f sphere_offset_uT() const { return sphere_offset_uT_; }
+    linalg::Vector3f sphere_offset_uT() const { return cover_centre_uT_; }
     float sphere_residual_uT() const { return sphere_residual_uT_; }
 
     static constexpr uint8_t kMoments = 35;  // monomials of degree <= 4 in x, y, z
     static constexpr uint8_t kCells = 26;
 
 private:
+    // On success the centre goes to cover_centre_uT_ (it is sphere_offset_uT()).
     bool fit_sphere();
     bool fit_ellipsoid(Calibration& cal);
+    uint8_t cell_samples(uint8_t cell) const;
 
     float sums_[kMoments];          // sums of x^i y^j z^k of the centred, scaled samples; [0] = count
     linalg::Vector3f pivot_uT_;
-    linalg::Vector3f cover_centre_uT_;  // the coverage cells' centre: the sphere fit so far
-    uint8_t cell_count_[kCells];
-    linalg::Vector3f sphere_offset_uT_;
+    linalg::Vector3f cover_centre_uT_;  // the coverage cells' centre: the latest sphere fit
+    // Each cell's samples, counted up to kMagCellMinSamples (all coverage needs): 2 bits
+    // a cell, four cells a byte.
+    uint8_t cell_samples_[(kCells + 3u) / 4u];
     float sphere_residual_uT_ = 0.0f;
     float residual_uT_ = 0.0f;
     float radius_uT_ = 0.0f;

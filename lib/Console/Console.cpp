@@ -80,17 +80,22 @@ Command parse_line(const char* line) {
     if (n > 3) return fail(Error::ExtraArgument);
     const char* cmd = w[0];
 
-    // The command names in flash, those without an argument first.
-    static const CommandId kIds[] = {CommandId::Help, CommandId::Help, CommandId::Status, CommandId::Save,
-                                     CommandId::Defaults, CommandId::Rate, CommandId::Decl, CommandId::Mode};
+    // The command names in flash, those without an argument first; each name's command
+    // is its byte in kIds (a TXT string too: an array would be copied to the AVR's SRAM).
+    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x03\x04\x05\x07");
+    static_assert((uint8_t)CommandId::Help == 2 && (uint8_t)CommandId::Status == 6 &&
+                      (uint8_t)CommandId::Save == 9 && (uint8_t)CommandId::Defaults == 10 &&
+                      (uint8_t)CommandId::Rate == 3 && (uint8_t)CommandId::Decl == 4 &&
+                      (uint8_t)CommandId::Mode == 5 && (uint8_t)CommandId::CalGyro == 7,
+                  "kIds holds these values");
     constexpr int8_t kFirstWithArgument = 5;
     const int8_t k = find_word(cmd, TXT("help\0?\0status\0save\0defaults\0rate\0decl\0mode\0cal\0"));
     if (k < 0) return fail(Error::Unknown);
-    if (k < kFirstWithArgument) return n == 1 ? make(kIds[k]) : fail(Error::ExtraArgument);
+    const CommandId id = (CommandId)text::flash_byte(kIds.p + k);
+    if (k < kFirstWithArgument) return n == 1 ? make(id) : fail(Error::ExtraArgument);
     if (n < 2) return fail(Error::MissingArgument);
     if (n > 2) return fail(Error::ExtraArgument);
     const char* arg = w[1];
-    const CommandId id = k < (int8_t)(sizeof kIds / sizeof kIds[0]) ? kIds[k] : CommandId::CalGyro;
     Command r = make(id);
     if (id == CommandId::Rate || id == CommandId::Decl) {
         int32_t c;
@@ -165,8 +170,14 @@ text::Flash mode_name(fmt::OutputMode m) {
     return TXT("plot");
 }
 
-void print_error(const Command& c, const text::Sink* out) {
+bool print_error(const Command& c, uint8_t part, const text::Sink* out) {
     Writer w(out);
+    if (part == 1 && c.value > 0) {
+        w.str(TXT(TXT_ERROR)).u32((uint32_t)c.value)
+            .str(TXT(" more bad lines (too many to answer one by one); nothing changed")).end();
+        return true;
+    }
+    if (part != 0) return false;
     w.str(TXT(TXT_ERROR));
     switch (c.error) {
         case Error::Unknown: w.str(TXT("unknown command" TXT_HELP)); break;
@@ -182,21 +193,31 @@ void print_error(const Command& c, const text::Sink* out) {
         case Error::None: w.str(TXT("internal")); break;
     }
     w.str(TXT("; nothing changed")).end();
-    if (c.value > 0) {
-        w.str(TXT(TXT_ERROR)).u32((uint32_t)c.value)
-            .str(TXT(" more bad lines (too many to answer one by one); nothing changed")).end();
-    }
+    return true;
+}
+
+void print_error(const Command& c, const text::Sink* out) {
+    for (uint8_t part = 0; print_error(c, part, out); ++part) {}
+}
+
+bool print_help(uint8_t part, const text::Sink* out) {
+    // The lines, NUL-separated (an empty one last): one is written per part.
+    const char* p = TXT("# rate <Hz>: output rate 1..100\0"
+                        "# decl <deg>: declination -180..180, east +\0"
+                        "# mode plot|csv|quat|raw|mavlink|quiet: output\0"
+                        "# status: health, load, bias, temperature, uptime\0"
+                        "# cal gyro: gyro bias (keep still 1 s)\0"
+                        "# cal mag: compass (turn every way for 30 s)\0"
+                        "# save | defaults: store settings / back to defaults\0").p;
+    for (uint8_t k = 0; k < part && text::flash_byte(p) != 0u; ++k)
+        while (text::flash_byte(p++) != 0u) {}
+    if (text::flash_byte(p) == 0u) return false;
+    Writer(out).str(text::flash(p)).end();
+    return true;
 }
 
 void print_help(const text::Sink* out) {
-    Writer(out).str(TXT(
-        "# rate <Hz>: output rate 1..100\n"
-        "# decl <deg>: declination -180..180, east +\n"
-        "# mode plot|csv|quat|raw|mavlink|quiet: output\n"
-        "# status: health, load, bias, temperature, uptime\n"
-        "# cal gyro: gyro bias (keep still 1 s)\n"
-        "# cal mag: compass (turn every way for 30 s)\n"
-        "# save | defaults: store settings / back to defaults\n"));
+    for (uint8_t part = 0; print_help(part, out); ++part) {}
 }
 
 void print_defaults(const text::Sink* out) {
@@ -230,52 +251,72 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
     }
 }
 
-static_assert((uint8_t)CommandId::Defaults < 16 && (uint8_t)Error::BadCalTarget < 16,
-              "CommandQueue packs id and error into 4 bits each");
+static_assert((uint8_t)CommandId::Defaults < 15 && (uint8_t)Error::BadCalTarget < 16 &&
+                  (uint8_t)fmt::kLastOutputMode < 16,
+              "CommandQueue packs the id and the error or mode into 4 bits each, id 15 spare");
+static_assert((CommandQueue::kBytes & (CommandQueue::kBytes - 1u)) == 0, "kBytes must be a power of two");
 
-CommandQueue::Packed CommandQueue::pack(const Command& c) {
-    const uint16_t v = c.id == CommandId::Mode ? (uint16_t)c.mode : (uint16_t)c.value;
-    return Packed{(uint8_t)((uint8_t)c.id | (uint8_t)((uint8_t)c.error << 4)), (uint8_t)(v & 0xFFu),
-                  (uint8_t)(v >> 8)};
+uint8_t CommandQueue::item_bytes(uint8_t first) {
+    const uint8_t id = first & 0x0Fu;
+    if (id == (uint8_t)CommandId::Rate) return 2;
+    if (id == (uint8_t)CommandId::Decl || id == kMergedError) return 3;
+    return 1;
 }
 
-Command CommandQueue::unpack(const Packed& p) {
-    Command c = make((CommandId)(p.id_error & 0x0Fu));
-    c.error = (Error)(p.id_error >> 4);
-    const uint16_t v = (uint16_t)(p.value_lo | (uint16_t)((uint16_t)p.value_hi << 8));
-    if (c.id == CommandId::Mode) c.mode = (fmt::OutputMode)v;
-    else if (c.id == CommandId::Error) c.value = v;  // a count, 0..0xFFFF
-    else c.value = (int16_t)v;                       // rate, decl: signed
+Command CommandQueue::decode(uint8_t at) const {
+    const uint8_t first = byte(at);
+    const uint8_t id = first & 0x0Fu, high = (uint8_t)(first >> 4);
+    if (id == kMergedError) {
+        Command c = fail((Error)high);
+        c.value = word((uint8_t)(at + 1u));  // a count, 0..0xFFFF
+        return c;
+    }
+    Command c = make((CommandId)id);
+    c.error = id == (uint8_t)CommandId::Error ? (Error)high : Error::None;
+    if (id == (uint8_t)CommandId::Mode) c.mode = (fmt::OutputMode)high;
+    if (id == (uint8_t)CommandId::Rate) c.value = byte((uint8_t)(at + 1u));
+    if (id == (uint8_t)CommandId::Decl) c.value = (int16_t)word((uint8_t)(at + 1u));
     return c;
 }
 
 bool CommandQueue::push(const Command& c) {
     // Merged only into the newest item, so that replies keep the order of the lines.
-    if (c.id == CommandId::Error && count_ >= kErrorSlots) {
-        Packed& newest = items_[(uint8_t)((head_ + count_ - 1u) % kCapacity)];
-        if ((newest.id_error & 0x0Fu) == (uint8_t)CommandId::Error) {
-            Command merged = unpack(newest);
-            if (merged.value < 0xFFFF) ++merged.value;
-            newest = pack(merged);
+    if (c.id == CommandId::Error && count_ > 0 && used_ >= kErrorBytes) {
+        const uint8_t first = byte(newest_);
+        if ((first & 0x0Fu) == kMergedError) {
+            const uint16_t n = word((uint8_t)(newest_ + 1u));
+            if (n < 0xFFFFu) put_word((uint8_t)(newest_ + 1u), (uint16_t)(n + 1u));
+            return true;
+        }
+        // A plain error is the last item: its count goes in the two bytes after it.
+        if ((first & 0x0Fu) == (uint8_t)CommandId::Error && (uint8_t)(kBytes - used_) >= 2u) {
+            items_[newest_ & kMask] = (uint8_t)(kMergedError | (first & 0xF0u));
+            put_word((uint8_t)(newest_ + 1u), 1u);
+            used_ = (uint8_t)(used_ + 2u);
             return true;
         }
     }
-    if (full()) return false;
-    items_[(uint8_t)((head_ + count_) % kCapacity)] = pack(c);
+    const uint8_t high = c.id == CommandId::Mode ? (uint8_t)c.mode : (uint8_t)c.error;
+    const uint8_t first = (uint8_t)((uint8_t)c.id | (uint8_t)(high << 4));
+    const uint8_t n = item_bytes(first);
+    if ((uint8_t)(kBytes - used_) < n) return false;
+    const uint8_t at = (uint8_t)(head_ + used_);
+    items_[at & kMask] = first;
+    if (c.id == CommandId::Rate) items_[(uint8_t)(at + 1u) & kMask] = (uint8_t)c.value;
+    if (c.id == CommandId::Decl) put_word((uint8_t)(at + 1u), (uint16_t)(int16_t)c.value);
+    newest_ = (uint8_t)(at & kMask);
+    used_ = (uint8_t)(used_ + n);
     ++count_;
     return true;
 }
 
 Command CommandQueue::pop() {
-    const Command c = unpack(items_[head_]);
-    head_ = (uint8_t)((head_ + 1u) % kCapacity);
+    const Command c = decode(head_);
+    const uint8_t n = item_bytes(byte(head_));
+    head_ = (uint8_t)((head_ + n) & kMask);
+    used_ = (uint8_t)(used_ - n);
     --count_;
     return c;
-}
-
-uint16_t reply_bound(const Command& c) {
-    if (c.id == CommandId::Help || c.id == CommandId::Status) return kLongReply;
-    return c.id == CommandId::Error && c.value > 0 ? 2u * kShortReply : kShortReply;
 }
 
 }  // namespace console

@@ -89,7 +89,19 @@ private:
     bool last_was_cr_ = false;
 };
 
-// Writes "# error: <why>\n" for a parse error.
+// Replies go out a part at a time: the firmware writes a part only when its output
+// queue has room for it and an output line after it, so the queue holds a part, not a
+// whole reply (help is ~310 bytes). A part is one "# " line of at most kPartReply bytes
+// (with the csv header after `mode csv`'s); the functions below that take `part` write
+// nothing and return false past the last one.
+constexpr uint8_t kPartReply = 96;
+
+// "# error: <why>\n" for a parse error (part 0), then, when bad lines were merged into
+// it (CommandQueue), "# error: <n> more bad lines ..." (part 1).
+bool print_error(const Command& c, uint8_t part, const text::Sink* out);
+// Help, one line a part.
+bool print_help(uint8_t part, const text::Sink* out);
+// The whole reply at once (host tests and tools).
 void print_error(const Command& c, const text::Sink* out);
 void print_help(const text::Sink* out);
 
@@ -107,57 +119,62 @@ text::Flash csv_header();
 // "plot", "csv", "quiet", "quat", "raw" or "mavlink".
 text::Flash mode_name(fmt::OutputMode m);
 
-// The most bytes the reply to c can take: the firmware runs a command only when its
-// output queue has that much room (help and status are the long ones: kLongReply;
-// status is printed by the firmware and sized by its test; an error with merged ones
-// takes two lines).
-constexpr uint16_t kShortReply = 96;
-constexpr uint16_t kLongReply = 400;
-uint16_t reply_bound(const Command& c);
-
 // Parsed commands waiting to run, oldest first. The firmware parses input as soon as it
-// arrives (so the UART's small receive ring never overflows) but runs a command only
+// arrives (so the UART's small receive ring never overflows) but answers a command only
 // when its reply has room to go out: a paste of several lines waits here.
+//
+// A queued command takes 1 byte (id and error or mode), 2 for rate, 3 for decl or for an
+// error with merged ones: kBytes = 64 hold 62 help or status commands (each ~300 bytes
+// of reply, 26 ms of the UART: a paste of the whole command set seven times over), 31
+// rates or 21 decls, whose replies (13..20 bytes) go out nearly as fast as their lines
+// (9..15 bytes) arrive, so that pastes of ~75 rate or ~60 decl lines fit. Garbage makes
+// an error line (~50 bytes of reply) for every ~20 bytes received wherever its line ends
+// are close: the 20 KB stream of random bytes with commands between
+// (e2e ConsoleInput.RandomBytesStreamWithCommandsBetween) keeps at most 18 commands, 24
+// bytes, waiting (apm25sim, a command staying until its reply's last line is out), and
+// beyond kErrorBytes (40) a bad line is merged (below).
 class CommandQueue {
 public:
-    // A burst of garbage with commands between makes an error line for every ~20 bytes
-    // received on average, whose replies (~50 bytes) outrun the UART wherever the
-    // garbage lines are short: 96 commands (3 bytes each, 288 bytes of RAM standing for
-    // ~4.6 KB of replies, 0.4 s of the UART) hold that backlog for a 20 KB burst of random
-    // bytes, so the 64-byte receive ring is always emptied.
-    static constexpr uint8_t kCapacity = 96;
-    // Past this many, a bad line is merged into the newest item if that is an error (its
-    // value counts them) instead of taking a slot: garbage that makes more errors than
-    // the UART can answer one by one (a line end every few bytes) never crowds out a
-    // command, and replies keep the order of the lines.
-    static constexpr uint8_t kErrorSlots = kCapacity - 8;
+    static constexpr uint8_t kBytes = 64;  // a power of two (index wrap by mask)
+    // Once this many bytes are queued, a bad line is merged into the newest item if that
+    // is an error (its value counts them) instead of taking a byte: garbage that makes
+    // more errors than the UART can answer one by one (a line end every few bytes) never
+    // crowds out a command (the last 24 bytes hold 8 of any kind), and replies keep the
+    // order of the lines.
+    static constexpr uint8_t kErrorBytes = kBytes - 8 * 3;
 
-    bool full() const { return count_ == kCapacity; }
+    // True when a command of some kind might not fit: stop reading input.
+    bool full() const { return (uint8_t)(kBytes - used_) < kMaxItem; }
     bool empty() const { return count_ == 0; }
-    uint8_t size() const { return count_; }
-    // False (nothing stored) when full; an error beyond kErrorSlots is merged (true).
+    uint8_t size() const { return count_; }  // commands
+    // False (nothing stored) when c does not fit; an error beyond kErrorBytes is merged (true).
     bool push(const Command& c);
     // The oldest command; call only when not empty.
     Command pop();
     // The oldest command, left in place; call only when not empty.
-    Command peek() const { return unpack(items_[head_]); }
+    Command peek() const { return decode(head_); }
 
 private:
-    // A queued command in 3 bytes (a Command takes 7): id and error share a byte, and
-    // one 16-bit field holds what the command carries (rate in Hz, decl within +-18000
-    // centidegrees, the mode, a merged error count <= 0xFFFF), which parse_line and
-    // push keep within those ranges: 288 bytes of RAM instead of 672.
-    struct Packed {
-        uint8_t id_error;
-        uint8_t value_lo;
-        uint8_t value_hi;
-    };
-    static Packed pack(const Command& c);
-    static Command unpack(const Packed& p);
+    // First byte: the id in the low 4 bits (kMergedError: an error with a 16-bit count of
+    // merged ones after it), the error or the mode in the high 4; then rate (1 byte) or
+    // decl (int16, little-endian), values parse_line keeps within those ranges.
+    static constexpr uint8_t kMergedError = 0x0F;
+    static constexpr uint8_t kMaxItem = 3;
+    static constexpr uint8_t kMask = kBytes - 1u;
+    static uint8_t item_bytes(uint8_t first);
+    uint8_t byte(uint8_t at) const { return items_[at & kMask]; }
+    uint16_t word(uint8_t at) const { return (uint16_t)(byte(at) | (uint16_t)((uint16_t)byte((uint8_t)(at + 1u)) << 8)); }
+    void put_word(uint8_t at, uint16_t v) {
+        items_[at & kMask] = (uint8_t)(v & 0xFFu);
+        items_[(uint8_t)(at + 1u) & kMask] = (uint8_t)(v >> 8);
+    }
+    Command decode(uint8_t at) const;
 
-    Packed items_[kCapacity] = {};
-    uint8_t head_ = 0;
-    uint8_t count_ = 0;
+    uint8_t items_[kBytes] = {};
+    uint8_t head_ = 0;    // the oldest command's first byte
+    uint8_t used_ = 0;    // bytes
+    uint8_t newest_ = 0;  // the newest command's first byte
+    uint8_t count_ = 0;   // commands
 };
 
 }  // namespace console

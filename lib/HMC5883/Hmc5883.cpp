@@ -1,11 +1,37 @@
 #include "Hmc5883.h"
 
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define HMC5883_PROGMEM PROGMEM
+#else
+#define HMC5883_PROGMEM
+#endif
+
 namespace hmc5883 {
 
 using linalg::Vector3f;
 
 namespace {
 float absf(float v) { return v < 0.0f ? -v : v; }
+
+// The register writes of begin() and the bits they are checked on, in flash on the AVR
+// (a const table is copied to SRAM).
+struct Write {
+    uint8_t reg, value, mask;
+};
+const Write kConfig[] HMC5883_PROGMEM = {
+    {REG_CONFIG_A, kConfigA, 0x7F},  // bit 7 is reserved
+    {REG_CONFIG_B, (uint8_t)kGain, 0xE0},
+    {REG_MODE, kModeContinuous, 0x03},
+};
+Write config(uint8_t i) {
+#ifdef __AVR__
+    return Write{pgm_read_byte(&kConfig[i].reg), pgm_read_byte(&kConfig[i].value), pgm_read_byte(&kConfig[i].mask)};
+#else
+    return kConfig[i];
+#endif
+}
+constexpr uint8_t kConfigWrites = sizeof kConfig / sizeof kConfig[0];
 }  // namespace
 
 bool Hmc5883::ready_by_status(bool& ready) {
@@ -64,19 +90,15 @@ InitResult Hmc5883::begin(bool run_self_test_now) {
     const Vector3f b = chip_to_body(scale_chip_);
     scale_body_ = Vector3f(absf(b.x), absf(b.y), absf(b.z));
 
-    struct Write { uint8_t reg, value, mask; };
-    const Write kConfig[] = {
-        {REG_CONFIG_A, kConfigA, 0x7F},  // bit 7 is reserved
-        {REG_CONFIG_B, (uint8_t)kGain, 0xE0},
-        {REG_MODE, kModeContinuous, 0x03},
-    };
-    for (const Write& w : kConfig) {
+    for (uint8_t i = 0; i < kConfigWrites; ++i) {
+        const Write w = config(i);
         if (!write(w.reg, w.value)) {
             r.status = InitStatus::NoAnswer;
             return r;
         }
     }
-    for (const Write& w : kConfig) {
+    for (uint8_t i = 0; i < kConfigWrites; ++i) {
+        const Write w = config(i);
         uint8_t got = 0;
         if (!read_regs(w.reg, &got, 1)) {
             r.status = InitStatus::NoAnswer;

@@ -52,16 +52,24 @@ bool id_matches(const uint8_t id[kIdLength]) {
     return id[0] == kId[0] && id[1] == kId[1] && id[2] == kId[2];
 }
 
+namespace {
+// expected / measured for one axis; false for an absent, overflowed or implausible one.
+bool axis_ratio(int16_t measured, float expected, float& ratio) {
+    if (measured <= 0 || measured == kOverflow) return false;
+    ratio = expected / (float)measured;
+    return ratio >= 0.7f && ratio <= 1.3f;
+}
+}  // namespace
+
 bool SelfTest::add_sample(const Counts& counts) {
     if (done() || failed()) return false;
     ++tries_;
-    const int16_t measured[3] = {counts.x, counts.y, counts.z};
+    // Axis by axis with constant indices: a loop over kSelfTestExpected would keep the
+    // array in the AVR's SRAM.
     float ratio[3];
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (measured[i] <= 0 || measured[i] == kOverflow) return false;
-        ratio[i] = kSelfTestExpected[i] / (float)measured[i];
-        if (ratio[i] < 0.7f || ratio[i] > 1.3f) return false;
-    }
+    if (!axis_ratio(counts.x, kSelfTestExpected[0], ratio[0]) || !axis_ratio(counts.y, kSelfTestExpected[1], ratio[1]) ||
+        !axis_ratio(counts.z, kSelfTestExpected[2], ratio[2]))
+        return false;
     for (uint8_t i = 0; i < 3; ++i) sum_ratio_[i] += ratio[i];
     ++good_;
     return true;

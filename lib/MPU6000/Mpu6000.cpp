@@ -1,6 +1,38 @@
 #include "Mpu6000.h"
 
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define MPU6000_PROGMEM PROGMEM
+#else
+#define MPU6000_PROGMEM
+#endif
+
 namespace mpu6000 {
+
+namespace {
+// The register writes of begin(), in flash on the AVR (a const table is copied to SRAM).
+struct Write {
+    uint8_t reg, value;
+};
+const Write kConfig[] MPU6000_PROGMEM = {
+    {REG_PWR_MGMT_1, kPwrClockPllGyroZ},
+    {REG_USER_CTRL, kUserCtrlI2cIfDis},
+    {REG_SMPLRT_DIV, smplrt_div_for_hz(kRateHz)},
+    {REG_CONFIG, (uint8_t)kDlpf},
+    {REG_GYRO_CONFIG, (uint8_t)kGyroRange},
+    {REG_ACCEL_CONFIG, (uint8_t)kAccelRange},
+    {REG_INT_PIN_CFG, kIntPinCfgLatchClearOnRead},
+    {REG_INT_ENABLE, kIntEnableDataReady},
+};
+Write config(uint8_t i) {
+#ifdef __AVR__
+    return Write{pgm_read_byte(&kConfig[i].reg), pgm_read_byte(&kConfig[i].value)};
+#else
+    return kConfig[i];
+#endif
+}
+constexpr uint8_t kConfigWrites = sizeof kConfig / sizeof kConfig[0];
+}  // namespace
 
 uint8_t Mpu6000::read_register(uint8_t reg, uint32_t clock_hz) {
     dev_.select(dev_.ctx, true, clock_hz);
@@ -33,19 +65,9 @@ InitResult Mpu6000::begin() {
     // After a reset the I2C interface is back on: SPI only again before anything else.
     write_register(REG_USER_CTRL, kUserCtrlI2cIfDis);
 
-    struct Write { uint8_t reg, value; };
-    const Write kConfig[] = {
-        {REG_PWR_MGMT_1, kPwrClockPllGyroZ},
-        {REG_USER_CTRL, kUserCtrlI2cIfDis},
-        {REG_SMPLRT_DIV, smplrt_div_for_hz(kRateHz)},
-        {REG_CONFIG, (uint8_t)kDlpf},
-        {REG_GYRO_CONFIG, (uint8_t)kGyroRange},
-        {REG_ACCEL_CONFIG, (uint8_t)kAccelRange},
-        {REG_INT_PIN_CFG, kIntPinCfgLatchClearOnRead},
-        {REG_INT_ENABLE, kIntEnableDataReady},
-    };
-    for (const Write& w : kConfig) write_register(w.reg, w.value);
-    for (const Write& w : kConfig) {
+    for (uint8_t i = 0; i < kConfigWrites; ++i) write_register(config(i).reg, config(i).value);
+    for (uint8_t i = 0; i < kConfigWrites; ++i) {
+        const Write w = config(i);
         const uint8_t got = read_register(w.reg);
         if (got != w.value) return InitResult{InitStatus::ReadbackMismatch, w.reg, w.value, got};
     }
