@@ -63,7 +63,7 @@ Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
 // Each axis within the range of any accelerometer (16 g): three comparisons where
 // |a|^2 would cost five float operations. NaN fails them too.
 bool Dcm::accel_plausible(const Vector3f& a) const {
-    const float m = accel_max_m_s2_;
+    const float m = settings_->accel_max_g * kGravity_m_s2;
     return a.x < m && a.x > -m && a.y < m && a.y > -m && a.z < m && a.z > -m;
 }
 
@@ -94,7 +94,6 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     accel_lp_ef_ = Vector3f(0.0f, 0.0f, -kGravity_m_s2);
     correction_rad_s_ = Vector3f();
     update_offset();
-    yaw_pending_ = false;
     mag_steady_steps_ = 0;
     rest_corrections_ = 0;
     gyro_sum_ = Vector3l();
@@ -124,8 +123,8 @@ FIXED_INLINE int32_t Dcm::scale_q15(int32_t x, uint16_t c) {
 // The output's two factors in Q15 (0: beyond 2, the float path): the lead in steps,
 // and Q26 radians per unit of the turn sums.
 void Dcm::set_output_factors() {
-    const float lead_steps = settings_.output_lead_s / settings_.step_s;
-    const float k = gyro_scale_ * settings_.step_s * (1.0f / (float)kTurnScale) * 67108864.0f;  // 2^26
+    const float lead_steps = settings_->output_lead_s / settings_->step_s;
+    const float k = gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale) * 67108864.0f;  // 2^26
     const bool fits = lead_steps >= 0.0f && lead_steps < 1.99f && k > 0.0f && k < 1.99f;
     lead_steps_q15_ = fits ? (uint16_t)(lead_steps * 32768.0f + 0.5f) : 0;
     theta_q26_per_unit_q15_ = fits ? (uint16_t)(k * 32768.0f + 0.5f) : 0;
@@ -154,7 +153,7 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     if (gyro_scale_ != kFloatGyroScale || accel_scale_ != kFloatAccelScale)
         set_sample_scales(kFloatGyroScale, kFloatAccelScale);
     // NaN and infinity fail these comparisons too: such samples are rejected.
-    const bool gyro_ok = gyro_rad_s.length_squared() < max_rate2_;
+    const bool gyro_ok = gyro_rad_s.length_squared() < kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s;
     const bool accel_ok = accel_plausible(accel_m_s2);
     const float to_gyro = 1.0f / kFloatGyroScale, to_accel = 1.0f / kFloatAccelScale;
     Vector3l gyro, accel;
@@ -234,9 +233,7 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
         turn_sum_.x += in_turn_units(gyro.x) - offset_units_.x;
         turn_sum_.y += in_turn_units(gyro.y) - offset_units_.y;
         turn_sum_.z += in_turn_units(gyro.z) - offset_units_.z;
-        if (yaw_pending_) turn_sum_ += yaw_units_;  // a mag correction is applied once
     }
-    yaw_pending_ = false;
     ++pending_steps_;
     if (pending_steps_ == kIntegrationSteps / 2) {
         first_half_ = turn_sum_;
@@ -318,7 +315,7 @@ void Dcm::correct_gravity() {
         // of the running sums, three additions a step. (Weighting each sample, not the
         // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
         // In counts until the rotation into earth axes; one scale after it.
-        const Vector3f turn_per_step = (gyro_raw_mean - offset_rad_s_) * settings_.step_s;
+        const Vector3f turn_per_step = (gyro_raw_mean - offset_rad_s_) * settings_->step_s;
         const int32_t pending = pending_steps_;
         const Vector3f weighted = Vector3l{accel_sum_of_sums_.x - accel_sum.x * pending,
                                            accel_sum_of_sums_.y - accel_sum.y * pending,
@@ -406,11 +403,11 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // In body axes: R^T (error_n, error_e, 0).
     const Vector3f error = r_.a * error_n + r_.b * error_e;
     const float kp = startup_left > 0.0f
-                         ? settings_.kp_rp_1_s + (settings_.kp_startup_1_s - settings_.kp_rp_1_s) * startup_left
-                         : settings_.kp_rp_1_s;
+                         ? settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left
+                         : settings_->kp_rp_1_s;
     correction_rad_s_ = error * kp;
     if (!hold_integrator) {
-        bias_rad_s_ -= error * (settings_.ki_rp_1_s2 * correction_dt_);
+        bias_rad_s_ -= error * (settings_->ki_rp_1_s2 * correction_dt_);
         clamp_bias();
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
@@ -451,7 +448,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // after a turn p reads v - p x v = v + v x p, so before it v x -p).
     const Vector3f rate_rad_s = last_rate_rad_s();
     const Vector3f field_now =
-        mag_field + mag_field.cross(rate_rad_s * (settings_.mag_latency_s + settings_.step_s * (float)age_steps) -
+        mag_field + mag_field.cross(rate_rad_s * (settings_->mag_latency_s + settings_->step_s * (float)age_steps) -
                                     pending_turn_rad());
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
@@ -482,7 +479,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const float inv_horizontal = 1.0f / sqrtf(horizontal2);
     const float sin_error = field_ef.y * inv_horizontal;
     // The time this sample stands for (the low-passes below are in time, not samples).
-    const float sample_dt = settings_.step_s * (float)(interval_steps < kMaxMagIntervalSteps ? interval_steps : kMaxMagIntervalSteps);
+    const float sample_dt = settings_->step_s * (float)(interval_steps < kMaxMagIntervalSteps ? interval_steps : kMaxMagIntervalSteps);
 
     // Disturbance rejection (as VQF does): a field whose strength or dip differs
     // from the learned earth field is a magnet or iron nearby, not north, and is not
@@ -502,7 +499,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         // the board) is steady too. VQF's rule: a mean rate of 20 deg/s over the window.
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
             mag_steady_steps_ += interval_steps;
-            mag_steady_turn_rad_ += sqrtf(rate_rad_s.length_squared()) * settings_.step_s * (float)interval_steps;
+            mag_steady_turn_rad_ += sqrtf(rate_rad_s.length_squared()) * settings_->step_s * (float)interval_steps;
         } else {
             mag_steady_steps_ = 0;
             mag_steady_turn_rad_ = 0.0f;
@@ -510,7 +507,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         const float candidate_alpha = sample_dt / (kCandidateTau_s + sample_dt);
         mag_candidate_norm_ += candidate_alpha * (norm - mag_candidate_norm_);
         mag_candidate_down_ += candidate_alpha * (down_component - mag_candidate_down_);
-        if (!forgotten && ((float)mag_steady_steps_ < mag_recover_steps_ ||
+        if (!forgotten && (mag_steady_steps_ < mag_recover_steps_ ||
                            mag_steady_turn_rad_ < mag_new_min_turn_rad_)) return;
         // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
         // (the rotation that puts the field's horizontal part on north).
@@ -543,10 +540,10 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const float steps = (float)interval_steps;
     const Vector3f error = r_.c * -heading_error;
     const bool starting = steps_ < startup_steps_;
-    yaw_units_ = units_of(error * ((starting ? settings_.kp_startup_1_s : settings_.kp_yaw_1_s) * steps));
-    yaw_pending_ = true;
-    if (!rotating_fast_ && !starting && settings_.ki_yaw_1_s2 != 0.0f) {
-        bias_rad_s_ -= error * (settings_.ki_yaw_1_s2 * settings_.step_s * steps);
+    // Into the turn not yet integrated: applied with the next integration.
+    turn_sum_ += units_of(error * ((starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps));
+    if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
+        bias_rad_s_ -= error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps);
         clamp_bias();
         update_offset();
     }
@@ -556,7 +553,7 @@ EulerQ24 Dcm::euler_now_q24() const {
     // R carried forward by the lead and any turn not yet integrated (at most one step
     // when the update was told a line is due), in fixed point.
     if (theta_q26_per_unit_q15_ == 0) {  // scales beyond the integer path's factors: in float
-        const Vector3f theta_rad = last_rate_rad_s() * settings_.output_lead_s + pending_turn_rad();
+        const Vector3f theta_rad = last_rate_rad_s() * settings_->output_lead_s + pending_turn_rad();
         return euler_carried_q24(r_, linalg::fixed_from_float(theta_rad.x, 26),
                                  linalg::fixed_from_float(theta_rad.y, 26), linalg::fixed_from_float(theta_rad.z, 26));
     }
@@ -573,8 +570,8 @@ EulerQ24 Dcm::euler_now_q24() const {
 
 bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,
                         float tolerance_scale) const {
-    const float norm_tolerance = settings_.mag_norm_tolerance * tolerance_scale * ref_norm;
-    const float dip_tolerance = settings_.mag_dip_tolerance * tolerance_scale;
+    const float norm_tolerance = settings_->mag_norm_tolerance * tolerance_scale * ref_norm;
+    const float dip_tolerance = settings_->mag_dip_tolerance * tolerance_scale;
     const float norm_error = norm - ref_norm;
     const float dip_error = down_component - ref_down;
     return norm_error < norm_tolerance && norm_error > -norm_tolerance && dip_error < dip_tolerance &&
@@ -582,7 +579,7 @@ bool Dcm::field_matches(float norm, float down_component, float ref_norm, float 
 }
 
 void Dcm::clamp_bias() {
-    const float limit = settings_.bias_limit_rad_s;
+    const float limit = settings_->bias_limit_rad_s;
     float* axis[3] = {&bias_rad_s_.x, &bias_rad_s_.y, &bias_rad_s_.z};
     for (uint8_t i = 0; i < 3; ++i) *axis[i] = linalg::constrain(*axis[i], -limit, limit);
 }

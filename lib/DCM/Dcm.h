@@ -108,16 +108,14 @@ public:
     // here (at compile time for constant settings: no start-up code, and a float
     // division costs ~480 cycles on the 2560).
     explicit constexpr Dcm(const DcmSettings& settings = kDefaultDcmSettings)
-        : settings_(settings),
+        : settings_(&settings),
           startup_steps_((uint16_t)(settings.startup_s / settings.step_s)),
           inv_startup_steps_(settings.step_s / settings.startup_s),
-          max_rate2_(kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s),
           hold_rate2_(settings.integrator_hold_rate_rad_s * settings.integrator_hold_rate_rad_s),
-          accel_max_m_s2_(settings.accel_max_g * kGravity_m_s2),
           accel_alpha_(settings.step_s * (float)kCorrectionDivider /
                        (settings.accel_lowpass_s + settings.step_s * (float)kCorrectionDivider)),
           correction_dt_(settings.step_s * (float)kCorrectionDivider),
-          mag_recover_steps_(settings.mag_recover_s / settings.step_s),
+          mag_recover_steps_((uint16_t)(settings.mag_recover_s / settings.step_s)),
           rest_gyro_dev2_(settings.rest_gyro_deviation_rad_s * settings.rest_gyro_deviation_rad_s),
           rest_accel_dev2_(settings.rest_accel_deviation_m_s2 * settings.rest_accel_deviation_m_s2),
           rest_min_corrections_((uint16_t)(settings.rest_min_s / (settings.step_s * (float)kCorrectionDivider))),
@@ -208,7 +206,7 @@ public:
     linalg::Vector3f gyro_bias_rad_s() const { return bias_rad_s_; }
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
     void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
-    const DcmSettings& settings() const { return settings_; }
+    const DcmSettings& settings() const { return *settings_; }
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const { return euler_from_dcm(r_); }
     // Euler angles of R carried forward by output_lead_s at the last corrected rate:
@@ -263,7 +261,7 @@ private:
     }
     void set_output_factors();
     linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
-    float turn_rad_per_unit() const { return gyro_scale_ * settings_.step_s * (1.0f / (float)kTurnScale); }
+    float turn_rad_per_unit() const { return gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale); }
     linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
     linalg::Vector3f last_rate_rad_s() const;   // the last sample, corrected
     void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
@@ -276,16 +274,15 @@ private:
     bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
                        float tolerance_scale) const;
 
-    // From the settings, once.
-    DcmSettings settings_;
+    // The settings (not a copy: 84 bytes of RAM; they must outlive the estimator, as
+    // kDefaultDcmSettings and a tool's own set do) and what follows from them, once.
+    const DcmSettings* settings_;
     uint16_t startup_steps_;
     float inv_startup_steps_;
-    float max_rate2_;                    // (rad/s)^2
     float hold_rate2_;                   // (rad/s)^2
-    float accel_max_m_s2_;
     float accel_alpha_;                  // low-pass factor per correction
     float correction_dt_;                // s between two roll/pitch corrections
-    float mag_recover_steps_;
+    uint16_t mag_recover_steps_;
     float rest_gyro_dev2_;               // (rad/s)^2
     float rest_accel_dev2_;              // (m/s^2)^2
     uint16_t rest_min_corrections_;
@@ -305,7 +302,6 @@ private:
     float units_per_rad_s_ = (float)kTurnScale / kFloatGyroScale;  // the turn sums' units
     uint16_t lead_steps_q15_ = 0;        // output_lead_s / step_s, Q15 (set_output_factors)
     uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
-    linalg::Vector3l yaw_units_;         // yaw correction from the last field sample (a turn sums' step), applied once
     linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
@@ -341,7 +337,6 @@ private:
     uint8_t correction_phase_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
-    bool yaw_pending_ = false;
 };
 
 }  // namespace dcm

@@ -24,28 +24,6 @@ float accel_lsb_per_g(AccelRange range) {
     return 2048.0f;
 }
 
-// The same sensitivities as scale factors, constants folded at compile time (a float
-// division costs ~500 cycles on the 2560 and the decode runs 200 times a second).
-float gyro_rad_s_per_count(GyroRange range) {
-    switch (range) {
-        case GyroRange::Dps250: return linalg::kRadPerDeg / 131.0f;
-        case GyroRange::Dps500: return linalg::kRadPerDeg / 65.5f;
-        case GyroRange::Dps1000: return linalg::kRadPerDeg / 32.8f;
-        case GyroRange::Dps2000: break;
-    }
-    return linalg::kRadPerDeg / 16.4f;
-}
-
-float accel_m_s2_per_count(AccelRange range) {
-    switch (range) {
-        case AccelRange::G2: return kStandardGravity_m_s2 / 16384.0f;
-        case AccelRange::G4: return kStandardGravity_m_s2 / 8192.0f;
-        case AccelRange::G8: return kStandardGravity_m_s2 / 4096.0f;
-        case AccelRange::G16: break;
-    }
-    return kStandardGravity_m_s2 / 2048.0f;
-}
-
 static bool is_saturated(int16_t v) { return v == 32767 || v == -32768; }
 // -(-32768) does not fit: the negated full scale stays at full scale.
 static int16_t negated(int16_t v) { return v == -32768 ? (int16_t)32767 : (int16_t)-v; }

@@ -2,6 +2,7 @@
 
 #include "Profile.h"
 #include "Fixed.h"
+#include "Mpu6000.h"
 
 #include <math.h>
 
@@ -12,6 +13,15 @@ using text::Writer;
 
 namespace {
 constexpr float kG = mpu6000::kStandardGravity_m_s2;
+// The checks' thresholds in the counts of the MPU6000 driver's ranges (the samples'; a
+// host test's sample_from_si uses the same).
+constexpr float kGyroCount_rad_s = mpu6000::gyro_rad_s_per_count(mpu6000::kGyroRange);
+constexpr float kAccelCount_m_s2 = mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
+constexpr int32_t kSpikeGyroJumpCounts = (int32_t)(kSpikeGyroJump_rad_s / kGyroCount_rad_s);
+constexpr uint32_t kSpikeAccelCounts2 =
+    (uint32_t)((kSpikeAccel_g * kG / kAccelCount_m_s2) * (kSpikeAccel_g * kG / kAccelCount_m_s2));
+constexpr uint32_t kNormalAccelCounts2 =
+    (uint32_t)((kNormalAccel_g * kG / kAccelCount_m_s2) * (kNormalAccel_g * kG / kAccelCount_m_s2));
 // |a - b| of two counts.
 int32_t jump(int16_t a, int16_t b) {
     const int32_t d = (int32_t)a - b;
@@ -127,12 +137,11 @@ void AttitudePipeline::forget_mag_reference(bool take_heading) {
 // reported (a saturated gyro is used: the true rate is at least the full scale; a
 // saturated accel is withheld from the DCM by on_imu_sample).
 mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
-    const CountLimits& lim = count_limits(s);
     bool spike = false;
     if (st_.have_last) {
-        spike = jump(s.gyro.x, last_.gyro.x) > lim.gyro_jump || jump(s.gyro.y, last_.gyro.y) > lim.gyro_jump ||
-                jump(s.gyro.z, last_.gyro.z) > lim.gyro_jump;
-        spike = spike || (norm2(s.accel) > lim.accel_spike2 && norm2(last_.accel) < lim.accel_normal2);
+        spike = jump(s.gyro.x, last_.gyro.x) > kSpikeGyroJumpCounts || jump(s.gyro.y, last_.gyro.y) > kSpikeGyroJumpCounts ||
+                jump(s.gyro.z, last_.gyro.z) > kSpikeGyroJumpCounts;
+        spike = spike || (norm2(s.accel) > kSpikeAccelCounts2 && norm2(last_.accel) < kNormalAccelCounts2);
     }
     if (spike && st_.spike_run < kMaxSpikeRun) {
         ++st_.spike_run;
@@ -156,20 +165,6 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
     last_ = s;
     st_.have_last = true;
     return s;
-}
-
-// The checks' thresholds in the sample's counts, worked out again only when its ranges
-// differ from the last ones (a float division costs ~500 cycles on the 2560).
-const AttitudePipeline::CountLimits& AttitudePipeline::count_limits(const mpu6000::Sample& s) {
-    CountLimits& lim = limits_;
-    if (s.gyro_rad_s_per_count == lim.gyro_scale && s.accel_m_s2_per_count == lim.accel_scale) return lim;
-    lim.gyro_scale = s.gyro_rad_s_per_count;
-    lim.accel_scale = s.accel_m_s2_per_count;
-    lim.gyro_jump = (int32_t)(kSpikeGyroJump_rad_s / lim.gyro_scale);
-    const float spike = kSpikeAccel_g * kG / lim.accel_scale, normal = kNormalAccel_g * kG / lim.accel_scale;
-    lim.accel_spike2 = (uint32_t)(spike * spike);
-    lim.accel_normal2 = (uint32_t)(normal * normal);
-    return lim;
 }
 
 void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {

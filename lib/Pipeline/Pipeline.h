@@ -183,13 +183,6 @@ private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
-    // The sample checks' thresholds in counts, for the ranges they were worked out for.
-    struct CountLimits {
-        float gyro_scale, accel_scale;        // rad/s and m/s^2 per count
-        int32_t gyro_jump;                    // kSpikeGyroJump_rad_s
-        uint32_t accel_spike2, accel_normal2; // (kSpikeAccel_g g)^2, (kNormalAccel_g g)^2
-    };
-    const CountLimits& count_limits(const mpu6000::Sample& s);
     void finish_mag_calibration();
     void learn_mag_offset();
     void forget_mag_reference(bool take_heading);
@@ -202,7 +195,6 @@ private:
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
     linalg::Vector3l turn_counts_;              // the gyro summed since the last field sample (counts)
-    CountLimits limits_ = {};
     linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the turn before it
     linalg::Vector3f learn_turn_rad_;
     linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
