@@ -534,8 +534,8 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
     const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
     // The correction is a rotation about earth down by -error: in body axes that
-    // is the third row of R. It stands for the whole interval since the last sample
-    // and is applied in the next step, so its rate is scaled by interval / step.
+    // is the third row of R. It stands for the whole interval since the last
+    // correction, so its rate is scaled by interval / step.
     if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
     const float steps = (float)interval_steps;
     const Vector3f error = r_.c * -heading_error;

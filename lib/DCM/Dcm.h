@@ -158,10 +158,11 @@ public:
     // step subtracts it with the estimator's own bias estimate.
     void set_sensor_bias_rad_s(const linalg::Vector3f& bias);
 
-    // Yaw drift correction from a new magnetometer sample (call when one arrives,
-    // e.g. 75 Hz): the tilt-compensated heading error, projected on earth down,
-    // applied in the next step. Samples whose strength or dip differ from the
-    // learned earth field are rejected (kStatusMagIgnored).
+    // A new magnetometer sample (call when one arrives, e.g. 75 Hz): turned into earth
+    // axes and averaged; every kHeadingSteps the mean's tilt-compensated heading error,
+    // projected on earth down, goes into the turn not yet integrated (the yaw drift
+    // correction). A mean whose strength or dip differs from the learned earth field is
+    // rejected (kStatusMagIgnored).
     // age_steps: steps the sample waited before this call (its latency grows by as much).
     void correct_heading(const linalg::Vector3f& mag_field, uint8_t age_steps = 0);
     // The next update (without a line) integrates or corrects gravity: a caller with
