@@ -533,6 +533,26 @@ TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
     EXPECT_NEAR(p.angles().roll_deg, 10.0f, 0.3f);
 }
 
+TEST(Pipeline, AGyroAtFullScaleOnEveryAxisIsNotIntegrated) {
+    // Every axis at the 2000 deg/s full scale (60 rad/s together, beyond any MEMS gyro):
+    // a stuck or broken read, which the DCM rejects instead of spinning the attitude.
+    pipeline::AttitudePipeline p(nullptr);
+    for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    const mpu6000::Sample stuck = imu(Vector3f(40.0f, 40.0f, -40.0f), kLevel);
+    ASSERT_TRUE(stuck.gyro_saturated);
+    for (int i = 0; i < 200; ++i) {
+        p.on_imu_sample(stuck);
+        // The first kMaxSpikeRun steps the spike guard stands the previous sample in.
+        if (i >= pipeline::kMaxSpikeRun) EXPECT_TRUE(p.estimator().status() & dcm::kStatusGyroRejected) << i;
+    }
+    EXPECT_NEAR(p.angles().roll_deg, 0.0f, 0.1f);
+    EXPECT_NEAR(p.angles().pitch_deg, 0.0f, 0.1f);
+    // One axis at full scale is a real (if clipped) rotation: integrated (once the spike
+    // guard has seen it last longer than a glitch).
+    for (int i = 0; i <= pipeline::kMaxSpikeRun; ++i) p.on_imu_sample(imu(Vector3f(40.0f, 0.0f, 0.0f), kLevel));
+    EXPECT_FALSE(p.estimator().status() & dcm::kStatusGyroRejected);
+}
+
 TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
     // A shake that clips one axis for 40 ms at each swing: the clipped samples are
     // used, so the shake averages out as it does unclipped (withholding the clipped

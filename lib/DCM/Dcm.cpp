@@ -171,15 +171,15 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     step(gyro, accel, gyro_ok, accel_ok, line_due);
 }
 
-void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, bool accel_valid,
-                 bool line_due) {
+void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, bool gyro_valid,
+                 bool accel_valid, bool line_due) {
     const Vector3l gyro{gyro_counts.x, gyro_counts.y, gyro_counts.z};
     const Vector3l accel{accel_counts.x, accel_counts.y, accel_counts.z};
     if (!initialised()) {
         init(accel.scaled(accel_scale_), last_mag_field_);
         return;
     }
-    step(gyro, accel, true, accel_valid, line_due);
+    step(gyro, accel, gyro_valid, accel_valid, line_due);
 }
 
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {

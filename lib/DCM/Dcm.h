@@ -145,10 +145,12 @@ public:
     // (Dcm::integrate when two or more steps wait; one is carried by euler_now()).
     // The sample in the sensor's counts (the firmware's path: integer sums at 200 Hz,
     // floats only on the steps that use them), scaled by set_sample_scales; the gyro
-    // counts carry the sensor bias set by set_sensor_bias_rad_s. accel_valid false: the
-    // sample gives gravity no weight (a stuck accelerometer).
-    void update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, bool accel_valid,
-                bool line_due = false);
+    // counts carry the sensor bias set by set_sensor_bias_rad_s. gyro_valid false: the
+    // rate is beyond any MEMS gyro (kMaxCredibleRate_rad_s: every axis at full scale, a
+    // stuck or broken read) and is not integrated, nor is the accel sample used.
+    // accel_valid false: the sample gives gravity no weight (a stuck accelerometer).
+    void update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, bool gyro_valid,
+                bool accel_valid, bool line_due = false);
     // The same in SI units (host tests, tools): rad/s and m/s^2, held in fine integer
     // units (kFloatGyroScale, kFloatAccelScale). Not to be mixed with the counts form.
     void update(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2, bool line_due = false);

@@ -22,6 +22,10 @@ constexpr uint32_t kSpikeAccelCounts2 =
     (uint32_t)((kSpikeAccel_g * kG / kAccelCount_m_s2) * (kSpikeAccel_g * kG / kAccelCount_m_s2));
 constexpr uint32_t kNormalAccelCounts2 =
     (uint32_t)((kNormalAccel_g * kG / kAccelCount_m_s2) * (kNormalAccel_g * kG / kAccelCount_m_s2));
+// A rate beyond any MEMS gyro's (the DCM's kMaxCredibleRate_rad_s; three axes at the
+// 2000 deg/s full scale make 60 rad/s) is a broken read, not a rotation.
+constexpr uint32_t kMaxCredibleRateCounts2 = (uint32_t)((dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s) *
+                                                        (dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s));
 // |a - b| of two counts.
 int32_t jump(int16_t a, int16_t b) {
     const int32_t d = (int32_t)a - b;
@@ -286,7 +290,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
-    dcm_.update(s.gyro, s.accel, !accel_stuck, st_.output_due);
+    dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
     // The board's turn for the compass learner: the gyro alone (the biases come off when
     // a field sample takes it).
     turn_counts_ += s.gyro;
