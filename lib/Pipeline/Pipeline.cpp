@@ -77,6 +77,7 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     // The learner's pair is worked out in a later step with neither an output line nor a
     // heading correction (a pair update is ~15 k cycles: on top of either it would
     // overrun the 5 ms step); the turn it uses is the gyro's up to this sample.
+    bool turn_restarts = true;  // this sample ends the turn the learner sums
     if (st_.turn_doubtful) {
         // The gyro's turn since the last field sample is not the board's (a spike stood
         // in for, a saturated or frozen gyro): a pair across it would read the turn's
@@ -86,34 +87,36 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         st_.turn_doubtful = false;
     } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
         // A sample every kLearnMinSteps at most; the turn goes on summing until then.
-        if (st_.steps_since_mag < kLearnMinSteps) {
-            mag_cal_uT_ = f;
-            st_.mag_pending = true;
-            st_.mag_wait_steps = 0;
-            st_.have_mag = true;
-            return;
-        }
-        // The sample is mag_latency_s older than the attitude: turned forward by the
-        // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
-        // as an offset.
-        // The learner takes the field without the learned offset: it works from its own
-        // estimate, which is not always the offset in use.
-        const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s());
-        learn_field_uT_ = f + settings_.cal.mag_learned_uT + f.cross(rate) * dcm_.settings().mag_latency_s;
-        // The turn since the previous sample (that one's too, if it never got its step):
-        // the gyro alone, less every bias estimate (the one now stands for the interval's).
-        const Vector3f turn_rad = (turn_counts_.scaled(last_.gyro_rad_s_per_count) -
-                                   gyro_bias_rad_s() * (float)st_.steps_since_mag) * kStep_s;
-        learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad : turn_rad;
-        st_.learn_steps = st_.learn_pending ? (uint16_t)(st_.learn_steps + st_.steps_since_mag) : st_.steps_since_mag;
-        st_.learn_pending = true;
+        turn_restarts = st_.steps_since_mag >= kLearnMinSteps;
+        if (turn_restarts) take_learner_sample(f);
     }
-    st_.steps_since_mag = 0;
-    turn_counts_ = linalg::Vector3l();
+    if (turn_restarts) {
+        st_.steps_since_mag = 0;
+        turn_counts_ = linalg::Vector3l();
+    }
     mag_cal_uT_ = f;
     st_.mag_pending = true;
     st_.mag_wait_steps = 0;  // a sample still waiting is replaced by this one
     st_.have_mag = true;
+}
+
+// The field sample f (calibrated) and the turn since the previous one, for the learner's
+// next free step.
+void AttitudePipeline::take_learner_sample(const Vector3f& f) {
+    // The sample is mag_latency_s older than the attitude: turned forward by the
+    // rotation since (dm/dt = m x w), as the estimator does, or a fast turn reads
+    // as an offset.
+    // The learner takes the field without the learned offset: it works from its own
+    // estimate, which is not always the offset in use.
+    const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s());
+    learn_field_uT_ = f + settings_.cal.mag_learned_uT + f.cross(rate) * dcm_.settings().mag_latency_s;
+    // The turn since the previous sample (that one's too, if it never got its step):
+    // the gyro alone, less every bias estimate (the one now stands for the interval's).
+    const Vector3f turn_rad = (turn_counts_.scaled(last_.gyro_rad_s_per_count) -
+                               gyro_bias_rad_s() * (float)st_.steps_since_mag) * kStep_s;
+    learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad : turn_rad;
+    st_.learn_steps = st_.learn_pending ? (uint16_t)(st_.learn_steps + st_.steps_since_mag) : st_.steps_since_mag;
+    st_.learn_pending = true;
 }
 
 // The learner moves the offset that apply_mag subtracts last (when its estimate is

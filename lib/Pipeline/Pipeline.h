@@ -184,6 +184,7 @@ private:
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
+    void take_learner_sample(const linalg::Vector3f& field_uT);
     void learn_mag_offset();
     void forget_mag_reference(bool take_heading);
 
