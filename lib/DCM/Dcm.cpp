@@ -378,17 +378,20 @@ void Dcm::integrate() {
     profile::end(profile::kRenormalisation);
 }
 
-Vector3f Dcm::pending_turn_rad() const {
+Vector3l Dcm::pending_turn_units() const {
     Vector3l sum = first_half_;
     sum += turn_sum_;
-    return sum.scaled(turn_rad_per_unit());
+    return sum;
 }
 
-Vector3f Dcm::last_rate_rad_s() const {
-    const Vector3l units{in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
-                         in_turn_units(last_gyro_.z) - offset_units_.z};
-    return units.scaled(gyro_scale_ * (1.0f / (float)kTurnScale));
+Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(turn_rad_per_unit()); }
+
+Vector3l Dcm::last_rate_units() const {
+    return Vector3l(in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
+                    in_turn_units(last_gyro_.z) - offset_units_.z);
 }
+
+Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(gyro_scale_ * (1.0f / (float)kTurnScale)); }
 
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
@@ -560,12 +563,11 @@ EulerQ24 Dcm::euler_now_q24() const {
     // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
     // times the radians per unit, each factor Q15 (16x16 multiplies: the float path
     // cost ~2.2 k cycles a line).
-    const Vector3l rate{in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
-                        in_turn_units(last_gyro_.z) - offset_units_.z};
+    const Vector3l rate = last_rate_units(), pending = pending_turn_units();
     const uint16_t lead = lead_steps_q15_, k = theta_q26_per_unit_q15_;
-    return euler_carried_q24(r_, scale_q15(first_half_.x + turn_sum_.x + scale_q15(rate.x, lead), k),
-                             scale_q15(first_half_.y + turn_sum_.y + scale_q15(rate.y, lead), k),
-                             scale_q15(first_half_.z + turn_sum_.z + scale_q15(rate.z, lead), k));
+    return euler_carried_q24(r_, scale_q15(pending.x + scale_q15(rate.x, lead), k),
+                             scale_q15(pending.y + scale_q15(rate.y, lead), k),
+                             scale_q15(pending.z + scale_q15(rate.z, lead), k));
 }
 
 bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,

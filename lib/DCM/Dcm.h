@@ -265,8 +265,10 @@ private:
     void set_output_factors();
     linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
     float turn_rad_per_unit() const { return gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale); }
-    linalg::Vector3f pending_turn_rad() const;  // summed since the last integration
-    linalg::Vector3f last_rate_rad_s() const;   // the last sample, corrected
+    linalg::Vector3l pending_turn_units() const;  // summed since the last integration (turn sums' units)
+    linalg::Vector3f pending_turn_rad() const;
+    linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
+    linalg::Vector3f last_rate_rad_s() const;
     void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
     bool renormalise(float& skew);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
