@@ -85,6 +85,32 @@ TEST(Fixed, ToFloatScalesExactly) {
 
 // Every reciprocal entry (the divisor's 8 bits after its leading one) and every
 // t - atan(t) entry (the ratio's 8 bits), at the nodes and between them.
+// mul_q30 is the product over 2^30 truncated toward zero, at most 1 below the exact
+// floor of the magnitude (the partial products it drops are below 2^24 of its unit),
+// over every magnitude the estimator's Q30 operands take and at the extremes.
+TEST(Fixed, MulQ30WithinOneOfTheExactProduct) {
+    std::mt19937 rng(8);
+    std::uniform_int_distribution<int32_t> any(-2147483647, 2147483647);
+    std::uniform_int_distribution<int32_t> q30(-(1 << 30), 1 << 30);
+    auto check = [](int32_t a, int32_t x) {
+        const int64_t exact = (int64_t)a * (int64_t)x;
+        const int64_t floor_magnitude = (exact < 0 ? -exact : exact) >> 30;
+        if (floor_magnitude > 0x7FFFFFFF) return;  // beyond the result's range
+        const int64_t got = linalg::mul_q30(a, x);
+        const int64_t got_magnitude = got < 0 ? -got : got;
+        ASSERT_LE(got_magnitude, floor_magnitude) << a << " * " << x;
+        ASSERT_GE(got_magnitude, floor_magnitude - 1) << a << " * " << x;
+        ASSERT_TRUE(got == 0 || (got < 0) == (exact < 0)) << a << " * " << x;
+    };
+    for (int i = 0; i < 200000; ++i) {
+        check(q30(rng), any(rng));
+        check(q30(rng), q30(rng) >> (i % 24));
+    }
+    const int32_t edges[] = {0, 1, -1, 255, 256, 65535, 65536, -65536, 1 << 30, -(1 << 30), 2147483647, -2147483647};
+    for (int32_t a : edges)
+        for (int32_t x : edges) check(a, x);
+}
+
 TEST(Fixed, AtanOfRatioWithin1p2e5RadEverywhere) {
     double worst = 0.0;
     for (uint32_t i = 0; i < 256; ++i) {

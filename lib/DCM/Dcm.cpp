@@ -25,6 +25,27 @@ constexpr float kReferenceTau_s = 1.32f;
 constexpr float kRestFieldMove_uT = 1.0f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
+// The field samples in earth axes are summed in uT * 2^kFieldQ (the HMC5883L reads at
+// most 810 uT: a few samples' sum stays far below 2^31).
+constexpr uint8_t kFieldQ = 16;
+constexpr int32_t kMaxFieldQ = (int32_t)32767 << kFieldQ;  // 2^15 uT: no compass reads that
+// A squared strength's unit (mul_q30 of two Q16 values): uT^2 * 2^(32 - 30).
+constexpr float kNorm2PerUnit = 0.25f;
+// kRestFieldMove_uT in the field's units.
+constexpr int32_t kRestFieldMoveQ = (int32_t)(kRestFieldMove_uT * (float)(1L << kFieldQ));
+
+// |a - b| > kRestFieldMove_uT for two fields in uT * 2^kFieldQ: an axis beyond it
+// decides at once; else the squares of the differences (each < 2^16: 16x16 products).
+bool moved(const Vector3l& a, const Vector3l& b) {
+    const int32_t d[3] = {a.x - b.x, a.y - b.y, a.z - b.z};
+    uint32_t sum = 0;
+    for (uint8_t i = 0; i < 3; ++i) {
+        if (d[i] >= kRestFieldMoveQ || d[i] <= -kRestFieldMoveQ) return true;
+        const uint16_t m = (uint16_t)linalg::magnitude(d[i]);
+        sum += linalg::mul_u16(m, m) >> 2;  // < 2^30 each: no overflow in three
+    }
+    return sum > (uint32_t)(kRestFieldMoveQ >> 1) * (uint32_t)(kRestFieldMoveQ >> 1);
+}
 }  // namespace
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
@@ -90,7 +111,10 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
         last_mag_field_ = mag_field;
         learn_field(mag_field.length(), down.dot(mag_field.normalized()));
     }
-    r_ = Matrix3f(north, down.cross(north), down);
+    r_ = linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down));
+    // The integer factors of the scales, unless set_sample_scales set them (the float
+    // form's, whose scales are the defaults: the Pipeline sets its own before the start).
+    if (theta_factor_q30_ == 0) set_output_factors();
     accel_lp_ef_ = Vector3f(0.0f, 0.0f, -kGravity_m_s2);
     correction_rad_s_ = Vector3f();
     update_offset();
@@ -103,8 +127,8 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     first_half_ = Vector3l();
     turn_sum_ = Vector3l();
     pending_steps_ = 0;
-    heading_field_sum_ = Vector3f();
-    heading_norm2_sum_ = 0.0f;
+    heading_field_sum_ = Vector3l();
+    heading_norm2_sum_ = 0;
     heading_samples_ = 0;
     heading_steps_ = 0;
     rest_accel_mean_m_s2_ = accel_m_s2;
@@ -128,6 +152,45 @@ void Dcm::set_output_factors() {
     const bool fits = lead_steps >= 0.0f && lead_steps < 1.99f && k > 0.0f && k < 1.99f;
     lead_steps_q15_ = fits ? (uint16_t)(lead_steps * 32768.0f + 0.5f) : 0;
     theta_q26_per_unit_q15_ = fits ? (uint16_t)(k * 32768.0f + 0.5f) : 0;
+    // The integration's factor, Q30 radians per unit as f 2^e with f < 1 in Q30: the sums
+    // are shifted left by e first (exact), then multiplied (theta_q30). e <= 5: a 2000 deg/s
+    // gyro's factor is 22.3, the float form's 1.3.
+    float k30 = gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale) * 1073741824.0f;  // 2^30
+    theta_shift_ = 0;
+    while (k30 >= 1.0f && theta_shift_ <= kMaxThetaShift) {
+        k30 *= 0.5f;
+        ++theta_shift_;
+    }
+    // The compass sample's latency in steps, whole and Q15 fraction.
+    const float latency_steps = linalg::constrain(settings_->mag_latency_s / settings_->step_s, 0.0f, 100.0f);
+    mag_latency_whole_steps_ = (uint8_t)latency_steps;
+    mag_latency_frac_q15_ = (uint16_t)((latency_steps - (float)mag_latency_whole_steps_) * 32768.0f + 0.5f);
+    const bool integer_path = k30 > 0.0f && k30 < 1.0f;
+    theta_factor_q30_ = integer_path ? linalg::fixed_from_float(k30, linalg::kQ30) : 0;
+    // The units that make kMaxTurnAxisQ30 (below 2^31 after the shift: f >= 1/2, or e = 0).
+    const float limit_units = integer_path ? (float)kMaxTurnAxisQ30 / (k30 * (float)(1L << theta_shift_)) : 0.0f;
+    theta_units_limit_ = limit_units < 2.0e9f ? (int32_t)limit_units : 2000000000L;
+}
+
+// The turn sums (units) in Q30 radians, each axis saturated at kMaxTurnAxisQ30: beyond
+// any gyro's range over an integration (2000 deg/s for 20 ms is 0.7 rad), and |theta|^2
+// stays below 2 (Q30's headroom).
+Vector3l Dcm::theta_q30(const Vector3l& units) const {
+    if (theta_factor_q30_ == 0) {  // scales beyond the integer factor: in float
+        const Vector3f t = units.scaled(turn_rad_per_unit());
+        const float limit = (float)kMaxTurnAxisQ30 * (1.0f / 1073741824.0f);
+        return linalg::q30_from_vector(Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit),
+                                                linalg::constrain(t.z, -limit, limit)));
+    }
+    const int32_t* in[3] = {&units.x, &units.y, &units.z};
+    int32_t out[3];
+    for (uint8_t i = 0; i < 3; ++i) {
+        int32_t u = *in[i];
+        if (u > theta_units_limit_) u = theta_units_limit_;
+        if (u < -theta_units_limit_) u = -theta_units_limit_;
+        out[i] = linalg::mul_q30(theta_factor_q30_, (int32_t)((uint32_t)u << theta_shift_));
+    }
+    return Vector3l(out[0], out[1], out[2]);
 }
 
 // 1/n for the few window lengths there are, without the ~500-cycle division.
@@ -322,8 +385,12 @@ void Dcm::correct_gravity() {
                                            accel_sum_of_sums_.z - accel_sum.z * pending}
                                       .to_float();
         const float alpha = starting ? accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left : accel_alpha_;
-        const Vector3f accel_ef = r_ * (accel_sum.to_float() - turn_per_step.cross(weighted));
-        accel_lp_ef_ += (accel_ef * (accel_scale_ * inv_n) - accel_lp_ef_) * alpha;
+        const Vector3f body = accel_sum.to_float() - turn_per_step.cross(weighted);
+        // Into earth axes in integers: counts * 2^8 (|sum| < 2^17 counts) by the Q30 matrix.
+        const Vector3l accel_ef = linalg::mul_q30(r_, Vector3l(linalg::fixed_from_float(body.x, 8),
+                                                               linalg::fixed_from_float(body.y, 8),
+                                                               linalg::fixed_from_float(body.z, 8)));
+        accel_lp_ef_ += (accel_ef.scaled(accel_scale_ * inv_n * (1.0f / 256.0f)) - accel_lp_ef_) * alpha;
         detect_rest(gyro_mean, accel_sum.scaled(accel_scale_ * inv_n), window_samples_ >= kCorrectionDivider);
     }
     gyro_sum_ = Vector3l();
@@ -347,35 +414,56 @@ void Dcm::correct_gravity() {
 // it stretches each row by a^2/2 an update, which renormalising at every update hid.
 void Dcm::integrate() {
     profile::begin(profile::kIntegration);
-    const float turn_per_unit = turn_rad_per_unit();
-    const Vector3f first = first_half_.scaled(turn_per_unit);
-    const Vector3f second = turn_sum_.scaled(turn_per_unit);
-    const Vector3f theta = first + second + first.cross(second) * (2.0f / 3.0f);
+    using linalg::mul_q30;
+    // In Q30 integers (R's entries and the turn, radians): each product is mul_q30, three
+    // 16x16 hardware multiplies (~80 cycles, a float multiply is ~170 and an add ~130).
+    const Vector3l first = theta_q30(first_half_), second = theta_q30(turn_sum_);
     first_half_ = Vector3l();
     turn_sum_ = Vector3l();
     pending_steps_ = 0;
-    const float a2 = theta.length_squared();
-    const float cos_a = 1.0f - a2 * (0.5f - a2 * (1.0f / 24.0f - a2 * (1.0f / 720.0f)));
-    const float sin_ratio = 1.0f - a2 * (1.0f / 6.0f - a2 * (1.0f / 120.0f - a2 * (1.0f / 5040.0f)));
-    const float versine_ratio = 0.5f - a2 * (1.0f / 24.0f - a2 * (1.0f / 720.0f));
-    const Vector3f sin_theta = theta * sin_ratio;
-    const Vector3f versine_theta = theta * versine_ratio;
-    r_.a = r_.a * cos_a + r_.a.cross(sin_theta) + theta * r_.a.dot(versine_theta);
-    r_.b = r_.b * cos_a + r_.b.cross(sin_theta) + theta * r_.b.dot(versine_theta);
+    const Vector3l coning = linalg::cross_q30(first, second);
+    constexpr int32_t kTwoThirds = 715827883L;  // 2/3 in Q30
+    const Vector3l theta(first.x + second.x + mul_q30(kTwoThirds, coning.x),
+                         first.y + second.y + mul_q30(kTwoThirds, coning.y),
+                         first.z + second.z + mul_q30(kTwoThirds, coning.z));
+    // The three factors' series (Q30 constants: 1/6, 1/24, 1/120, 1/720, 1/5040).
+    constexpr int32_t kOne = 1073741824L, kHalf = 536870912L;
+    const int32_t a2 = linalg::dot_q30(theta, theta);
+    const int32_t versine_ratio = kHalf - mul_q30(a2, 44739243L - mul_q30(a2, 1491308L));  // (1 - cos a)/a^2
+    const int32_t one_minus_cos = mul_q30(a2, versine_ratio);
+    const int32_t sin_ratio = kOne - mul_q30(a2, 178956971L - mul_q30(a2, 8947849L - mul_q30(a2, 213044L)));
+    const Vector3l sin_theta(mul_q30(sin_ratio, theta.x), mul_q30(sin_ratio, theta.y), mul_q30(sin_ratio, theta.z));
+    const Vector3l versine_theta(mul_q30(versine_ratio, theta.x), mul_q30(versine_ratio, theta.y),
+                                 mul_q30(versine_ratio, theta.z));
+    turn_row(r_.a, theta, sin_theta, versine_theta, one_minus_cos);
+    turn_row(r_.b, theta, sin_theta, versine_theta, one_minus_cos);
     profile::end(profile::kIntegration);
     profile::begin(profile::kRenormalisation);
     if (++updates_since_renormalise_ >= kRenormaliseEvery) {
         updates_since_renormalise_ = 0;
         // One pass leaves ~(X.Y)^2: a second one, needed only after a large error (a
         // heading taken at once, a rebuilt matrix), keeps it orthonormal to 1e-5.
-        float skew = 0.0f;
+        constexpr int32_t kSecondPassSkew = 2147484L;  // 2e-3 in Q30
+        int32_t skew = 0;
         bool ok = renormalise(skew);
-        if (ok && (skew > 2e-3f || skew < -2e-3f)) ok = renormalise(skew);
+        if (ok && (skew > kSecondPassSkew || skew < -kSecondPassSkew)) ok = renormalise(skew);
         if (!ok) recover();
     } else {
-        r_.c = r_.a.cross(r_.b);
+        r_.c = linalg::cross_q30(r_.a, r_.b);
     }
     profile::end(profile::kRenormalisation);
+}
+
+// One row of R turned by Rodrigues' formula: r cos(a) + r x (theta sin(a)/a) + theta (r .
+// theta (1 - cos a)/a^2), in Q30.
+void Dcm::turn_row(Vector3l& r, const Vector3l& theta, const Vector3l& sin_theta, const Vector3l& versine_theta,
+                   int32_t one_minus_cos) {
+    using linalg::mul_q30;
+    const Vector3l across = linalg::cross_q30(r, sin_theta);
+    const int32_t along = linalg::dot_q30(r, versine_theta);
+    r = Vector3l(r.x - mul_q30(one_minus_cos, r.x) + across.x + mul_q30(along, theta.x),
+                 r.y - mul_q30(one_minus_cos, r.y) + across.y + mul_q30(along, theta.y),
+                 r.z - mul_q30(one_minus_cos, r.z) + across.z + mul_q30(along, theta.z));
 }
 
 Vector3l Dcm::pending_turn_units() const {
@@ -404,7 +492,10 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const float error_n = -accel_lp_ef_.y * inv_lp;
     const float error_e = accel_lp_ef_.x * inv_lp;
     // In body axes: R^T (error_n, error_e, 0).
-    const Vector3f error = r_.a * error_n + r_.b * error_e;
+    const int32_t n = linalg::fixed_from_float(error_n, linalg::kQ30), e = linalg::fixed_from_float(error_e, linalg::kQ30);
+    const Vector3f error = linalg::vector_from_q30(Vector3l(linalg::mul_q30(n, r_.a.x) + linalg::mul_q30(e, r_.b.x),
+                                                            linalg::mul_q30(n, r_.a.y) + linalg::mul_q30(e, r_.b.y),
+                                                            linalg::mul_q30(n, r_.a.z) + linalg::mul_q30(e, r_.b.z)));
     const float kp = startup_left > 0.0f
                          ? settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left
                          : settings_->kp_rp_1_s;
@@ -422,18 +513,34 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
 }
 
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
+    using linalg::fixed_from_float;
     const uint16_t since_last = steps_since_mag_;
     steps_since_mag_ = 0;
-    const float sample_norm2 = mag_field.length_squared();
-    if (!(sample_norm2 > 0.0f) || !linalg::is_finite(sample_norm2)) {
+    if (!mag_field.is_finite()) {
+        status_ |= kStatusMagIgnored;
+        return;
+    }
+    // In integers from here to the mean (~75 Hz): uT * 2^kFieldQ, saturated at 2^15 uT.
+    const Vector3l field(fixed_from_float(mag_field.x, kFieldQ), fixed_from_float(mag_field.y, kFieldQ),
+                         fixed_from_float(mag_field.z, kFieldQ));
+    const int32_t* axis[3] = {&field.x, &field.y, &field.z};
+    uint32_t sample_norm2 = 0;  // uT^2 * 2^(2 kFieldQ - 30)
+    for (uint8_t i = 0; i < 3; ++i) {
+        if (*axis[i] >= kMaxFieldQ || *axis[i] <= -kMaxFieldQ) {  // beyond any compass: garbage
+            status_ |= kStatusMagIgnored;
+            return;
+        }
+        sample_norm2 += (uint32_t)linalg::mul_q30(*axis[i], *axis[i]);
+    }
+    if (sample_norm2 == 0) {
         status_ |= kStatusMagIgnored;
         return;
     }
     last_mag_field_ = mag_field;
     // The rest test's witness: a field that moved in body axes since the rest began
     // means the board turns (or a magnet moved): no rest.
-    if ((mag_field - rest_field_uT_).length_squared() > kRestFieldMove_uT * kRestFieldMove_uT) {
-        rest_field_uT_ = mag_field;
+    if (moved(field, rest_field_)) {
+        rest_field_ = field;
         rest_corrections_ = 0;
     }
     if (!initialised()) return;
@@ -449,29 +556,34 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // The matrix itself is behind the last sample by the turn not yet integrated: the
     // field is brought back by that much (a fixed earth vector seen from the body
     // after a turn p reads v - p x v = v + v x p, so before it v x -p).
-    const Vector3f rate_rad_s = last_rate_rad_s();
-    const Vector3f field_now =
-        mag_field + mag_field.cross(rate_rad_s * (settings_->mag_latency_s + settings_->step_s * (float)age_steps) -
-                                    pending_turn_rad());
+    // Both in the turn sums' units (the rate per step times the latency in steps), then
+    // in Q30 radians as the integration takes them.
+    const Vector3l rate = last_rate_units();
+    Vector3l turn = pending_turn_units();
+    turn = Vector3l(scale_q15(rate.x, mag_latency_frac_q15_) - turn.x, scale_q15(rate.y, mag_latency_frac_q15_) - turn.y,
+                    scale_q15(rate.z, mag_latency_frac_q15_) - turn.z);
+    for (uint8_t n = (uint8_t)(mag_latency_whole_steps_ + age_steps); n > 0; --n) turn += rate;
+    Vector3l field_now = linalg::cross_q30(field, theta_q30(turn));
+    field_now += field;
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
     // The samples are averaged in earth axes over kHeadingSteps (a fixed earth field is
     // the same vector there whatever the board did meanwhile), and the heading is
     // corrected from their mean: each sample costs the rotation into earth axes, the
-    // correction (the rest of this function, ~2/3 of its cycles) runs at 25 Hz.
-    heading_field_sum_ += r_ * field_now;
+    // correction (the rest of this function) runs at 25 Hz.
+    heading_field_sum_ += linalg::mul_q30(r_, field_now);
     heading_norm2_sum_ += sample_norm2;
     ++heading_samples_;
     heading_steps_ = (uint16_t)(heading_steps_ + since_last);
     if (heading_steps_ < kHeadingSteps) return;
     uint16_t interval_steps = heading_steps_;
-    const float inv_samples = heading_samples_ == 1 ? 1.0f : 1.0f / (float)heading_samples_;
-    const Vector3f field_ef = heading_field_sum_ * inv_samples;
+    const float inv_samples = inverse(heading_samples_);
+    const Vector3f field_ef = heading_field_sum_.scaled(inv_samples * (1.0f / (float)(1L << kFieldQ)));
     // The strength and dip tests take the samples' mean strength (the field's strength
     // is the same in every frame; the mean vector's is shorter where the samples differ).
-    const float norm2 = heading_norm2_sum_ * inv_samples;
-    heading_field_sum_ = Vector3f();
-    heading_norm2_sum_ = 0.0f;
+    const float norm2 = (float)heading_norm2_sum_ * (inv_samples * kNorm2PerUnit);
+    heading_field_sum_ = Vector3l();
+    heading_norm2_sum_ = 0;
     heading_samples_ = 0;
     heading_steps_ = 0;
     status_ |= kStatusMagIgnored;
@@ -502,7 +614,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         // the board) is steady too. VQF's rule: a mean rate of 20 deg/s over the window.
         if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
             mag_steady_steps_ += interval_steps;
-            mag_steady_turn_rad_ += sqrtf(rate_rad_s.length_squared()) * settings_->step_s * (float)interval_steps;
+            mag_steady_turn_rad_ += sqrtf(last_rate_rad_s().length_squared()) * settings_->step_s * (float)interval_steps;
         } else {
             mag_steady_steps_ = 0;
             mag_steady_turn_rad_ = 0.0f;
@@ -518,8 +630,13 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         mag_steady_steps_ = 0;
         mag_steady_turn_rad_ = 0.0f;
         const float cos_error = field_ef.x * inv_horizontal;
-        const Vector3f north = r_.a * cos_error + r_.b * sin_error;
-        r_.b = r_.b * cos_error - r_.a * sin_error;
+        using linalg::mul_q30;
+        const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
+        const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
+        const Vector3l north(mul_q30(c, r_.a.x) + mul_q30(sn, r_.b.x), mul_q30(c, r_.a.y) + mul_q30(sn, r_.b.y),
+                             mul_q30(c, r_.a.z) + mul_q30(sn, r_.b.z));
+        r_.b = Vector3l(mul_q30(c, r_.b.x) - mul_q30(sn, r_.a.x), mul_q30(c, r_.b.y) - mul_q30(sn, r_.a.y),
+                        mul_q30(c, r_.b.z) - mul_q30(sn, r_.a.z));
         r_.a = north;
         status_ &= (uint8_t)~kStatusMagIgnored;
         return;
@@ -541,7 +658,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // correction, so its rate is scaled by interval / step.
     if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
     const float steps = (float)interval_steps;
-    const Vector3f error = r_.c * -heading_error;
+    const Vector3f error = linalg::vector_from_q30(r_.c) * -heading_error;
     const bool starting = steps_ < startup_steps_;
     // Into the turn not yet integrated: applied with the next integration.
     turn_sum_ += units_of(error * ((starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps));
@@ -588,28 +705,42 @@ void Dcm::clamp_bias() {
 
 // Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, bring
 // each to unit length, and make Z their cross product (unit to within the square
-// of the remaining error, so it needs no scaling of its own).
-bool Dcm::renormalise(float& skew) {
-    skew = r_.a.dot(r_.b);
-    const float half_error = 0.5f * skew;
-    const Vector3f x = r_.a - r_.b * half_error;
-    const Vector3f y = r_.b - r_.a * half_error;
+// of the remaining error, so it needs no scaling of its own). In Q30.
+bool Dcm::renormalise(int32_t& skew_q30) {
+    using linalg::mul_q30;
+    skew_q30 = linalg::dot_q30(r_.a, r_.b);
+    const int32_t half_error = skew_q30 / 2;
+    const Vector3l x(r_.a.x - mul_q30(half_error, r_.b.x), r_.a.y - mul_q30(half_error, r_.b.y),
+                     r_.a.z - mul_q30(half_error, r_.b.z));
+    const Vector3l y(r_.b.x - mul_q30(half_error, r_.a.x), r_.b.y - mul_q30(half_error, r_.a.y),
+                     r_.b.z - mul_q30(half_error, r_.a.z));
     if (!rescale(x, r_.a) || !rescale(y, r_.b)) return false;
-    r_.c = r_.a.cross(r_.b);
+    r_.c = linalg::cross_q30(r_.a, r_.b);
     return true;
 }
 
 // Near unit length the first-order Taylor factor (3 - r.r)/2 replaces a square root
 // and a division; its residual is 3/8 (r.r - 1)^2, below 2e-6 in this window.
-bool Dcm::rescale(const Vector3f& row, Vector3f& out) {
-    const float length2 = row.length_squared();
-    if (length2 > 0.998f && length2 < 1.002f) {
-        out = row * (1.5f - 0.5f * length2);
+bool Dcm::rescale(const Vector3l& row, Vector3l& out) {
+    constexpr int32_t kOne = 1073741824L;
+    constexpr int32_t kWindow = 2147484L;  // 2e-3 in Q30
+    // Each entry within +-1.4 (its square within Q30's 2); beyond, the matrix is hopeless.
+    constexpr int32_t kMaxEntry = 1518500249L;  // sqrt(2) in Q30
+    const int32_t* entry[3] = {&row.x, &row.y, &row.z};
+    for (uint8_t i = 0; i < 3; ++i)
+        if (*entry[i] >= kMaxEntry || *entry[i] <= -kMaxEntry) return false;
+    const uint32_t length2 = (uint32_t)linalg::mul_q30(row.x, row.x) + (uint32_t)linalg::mul_q30(row.y, row.y) +
+                             (uint32_t)linalg::mul_q30(row.z, row.z);  // < 6 in unsigned Q30: no overflow
+    if (length2 > (uint32_t)(kOne - kWindow) && length2 < (uint32_t)(kOne + kWindow)) {
+        const int32_t factor = kOne + kOne / 2 - (int32_t)(length2 / 2);
+        out = Vector3l(linalg::mul_q30(factor, row.x), linalg::mul_q30(factor, row.y), linalg::mul_q30(factor, row.z));
         return true;
     }
-    // Far from unit length: the exact factor, unless the matrix is hopeless.
-    if (!(length2 > 0.25f && length2 < 4.0f)) return false;
-    out = row * (1.0f / sqrtf(length2));
+    // Far from unit length (a rebuilt matrix, a heading taken at once): the exact factor,
+    // in float, unless the matrix is hopeless.
+    const float length2_f = linalg::float_from_fixed((int32_t)(length2 / 2), 29);
+    if (!(length2_f > 0.25f && length2_f < 4.0f)) return false;
+    out = linalg::q30_from_vector(linalg::vector_from_q30(row) * (1.0f / sqrtf(length2_f)));
     return true;
 }
 
@@ -619,7 +750,7 @@ bool Dcm::rescale(const Vector3f& row, Vector3f& out) {
 void Dcm::recover() {
     ++recoveries_;
     status_ |= kStatusRecovered;
-    if (!init(last_accel_.scaled(accel_scale_), last_mag_field_)) r_ = Matrix3f::identity();
+    if (!init(last_accel_.scaled(accel_scale_), last_mag_field_)) r_ = linalg::q30_from_matrix(Matrix3f::identity());
 }
 
 }  // namespace dcm

@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "Euler.h"
+#include "Fixed.h"
 #include "LinAlg.h"
 
 namespace dcm {
@@ -191,8 +192,8 @@ public:
         mag_ref_norm_ = 0.0f;
         mag_take_heading_ = take_heading;
         // The samples waiting for the heading's mean were calibrated the old way.
-        heading_field_sum_ = linalg::Vector3f();
-        heading_norm2_sum_ = 0.0f;
+        heading_field_sum_ = linalg::Vector3l();
+        heading_norm2_sum_ = 0;
         heading_samples_ = 0;
         heading_steps_ = 0;
     }
@@ -204,14 +205,17 @@ public:
     bool heavy_step() const { return heavy_; }
     uint8_t status() const { return status_; }
     uint16_t recoveries() const { return recoveries_; }
-    const linalg::Matrix3f& matrix() const { return r_; }
+    // R in float (tests, tools, the quaternion output): the estimator keeps it in Q30.
+    linalg::Matrix3f matrix() const { return linalg::matrix_from_q30(r_); }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const { return bias_rad_s_; }
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
     void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
     const DcmSettings& settings() const { return *settings_; }
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
-    EulerAngles euler() const { return euler_from_dcm(r_); }
+    EulerAngles euler() const {
+        return euler_in_rad(euler_q24_from_q30(r_.a.x, r_.a.y, r_.b.x, r_.b.y, r_.c.x, r_.c.y, r_.c.z));
+    }
     // Euler angles of R carried forward by output_lead_s at the last corrected rate:
     // the attitude now rather than when the (low-passed, hence delayed) gyro sample
     // was taken. R (I + [w lead x]), first order: the lead is a few ms. What the
@@ -231,6 +235,10 @@ public:
     // rotation to 4e-7 (Dcm::integrate), so eight leave R orthonormal to ~3e-6, below
     // what a 0.01 deg output shows (1.7e-4).
     static constexpr uint8_t kRenormaliseEvery = 8;
+    // The turn of one integration saturates at 0.75 rad an axis (Q30): beyond any gyro
+    // (2000 deg/s over 20 ms is 0.7 rad), and |theta|^2 < 2 stays within Q30.
+    static constexpr int32_t kMaxTurnAxisQ30 = 805306368L;
+    static constexpr uint8_t kMaxThetaShift = 5;  // the turn sums (< 2^26 units) shifted stay below 2^31
     // The heading is corrected from the mean of the field samples over at least this
     // many steps (25 Hz; the HMC5883L's 75 Hz samples in threes): the correction is
     // slow (1/kp_yaw = 10 s), and the mean keeps every sample's information.
@@ -252,6 +260,8 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void correct_tilt(float startup_left, bool hold_integrator);
     void integrate();
+    static void turn_row(linalg::Vector3l& r, const linalg::Vector3l& theta, const linalg::Vector3l& sin_theta,
+                         const linalg::Vector3l& versine_theta, int32_t one_minus_cos);
     void correct_gravity();
     void update_offset();
     static float inverse(uint8_t n);
@@ -270,8 +280,9 @@ private:
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
     linalg::Vector3f last_rate_rad_s() const;
     void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
-    bool renormalise(float& skew);  // skew: the X.Y it found
-    static bool rescale(const linalg::Vector3f& row, linalg::Vector3f& out);
+    bool renormalise(int32_t& skew_q30);  // skew: the X.Y it found
+    static bool rescale(const linalg::Vector3l& row, linalg::Vector3l& out);
+    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // the turn sums in Q30 radians
     void recover();
     void clamp_bias();
     bool accel_plausible(const linalg::Vector3f& a) const;
@@ -296,7 +307,7 @@ private:
     float startup_accel_alpha_;          // the accel low-pass factor at the start of the ramp, per correction
     float mag_new_min_turn_rad_;         // how far the board must turn while a new field stays steady
 
-    linalg::Matrix3f r_;
+    linalg::Matrix3q30 r_;               // body -> earth, Q30 (integrate: turned in integers)
     linalg::Vector3f bias_rad_s_;        // integrator: gyro-bias estimate
     linalg::Vector3f correction_rad_s_;  // roll/pitch correction, held between corrections
     linalg::Vector3f offset_rad_s_;      // sensor bias + bias - correction: what the step subtracts from the gyro
@@ -307,6 +318,11 @@ private:
     float units_per_rad_s_ = (float)kTurnScale / kFloatGyroScale;  // the turn sums' units
     uint16_t lead_steps_q15_ = 0;        // output_lead_s / step_s, Q15 (set_output_factors)
     uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
+    int32_t theta_factor_q30_ = 0;       // Q30 radians per unit = theta_factor_q30_ * 2^theta_shift_ / 2^30; 0: float
+    uint8_t theta_shift_ = 0;
+    int32_t theta_units_limit_ = 0;     // the turn sums' saturation (kMaxTurnAxisQ30)
+    uint16_t mag_latency_frac_q15_ = 0;  // mag_latency_s in steps: its fraction (Q15) ...
+    uint8_t mag_latency_whole_steps_ = 0;  // ... and whole steps
     linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
@@ -316,15 +332,15 @@ private:
     linalg::Vector3f rest_gyro_mean_rad_s_;  // their low-passed means, for the rest test
     linalg::Vector3f rest_accel_mean_m_s2_;
     uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
-    linalg::Vector3f rest_field_uT_;     // the field (body axes) when the board last seemed to turn
+    linalg::Vector3l rest_field_;        // the field (body axes, uT Q16) when the board last seemed to turn
     linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
     linalg::Vector3l first_half_;        // corrected rates summed over the integration's first half (kTurnScale)
     linalg::Vector3l turn_sum_;          // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
     uint8_t updates_since_renormalise_ = 0;
-    linalg::Vector3f heading_field_sum_; // field samples in earth axes, summed for the heading
-    float heading_norm2_sum_ = 0.0f;     // ... and their squared strengths
+    linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q16)
+    uint32_t heading_norm2_sum_ = 0;     // ... and their squared strengths (uT^2 / 4)
     uint8_t heading_samples_ = 0;
     uint16_t heading_steps_ = 0;         // steps the summed samples stand for
     bool gravity_due_ = false;           // a gravity correction waits for a step without an integration

@@ -103,9 +103,9 @@ FIXED_INLINE int32_t plus_cross(int32_t e, const Theta& t, int16_t p, int16_t tp
     return (int32_t)((uint32_t)e + (uint32_t)cross_term(t, p, tp, q, tq));
 }
 
-// e + p tp - q tq for three entries of a row in float.
-FIXED_INLINE int32_t carried_entry(const Theta& t, float e, float p, int16_t tp, float q, int16_t tq) {
-    return plus_cross(q30(e), t, q14(q30(p)), tp, q14(q30(q)), tq);
+// e + p tp - q tq for three Q30 entries of a row.
+FIXED_INLINE int32_t carried_entry(const Theta& t, int32_t e, int32_t p, int16_t tp, int32_t q, int16_t tq) {
+    return plus_cross(e, t, q14(p), tp, q14(q), tq);
 }
 
 // One conversion per axis (Q26): rounded to Q25 when all three are within 2^-10 rad,
@@ -135,12 +135,13 @@ EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float
     return euler_from_q30(q30(r11), q30(r12), q30(r21), q30(r22), q30(r31), q30(r32), q30(r33));
 }
 
-EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {
+EulerQ24 euler_carried_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                           int32_t theta_z_q26) {
     const Theta t = theta_for(theta_x_q26, theta_y_q26, theta_z_q26);
     // r' = r + r x theta = r + (r_y t_z - r_z t_y, r_z t_x - r_x t_z, r_x t_y - r_y t_x),
     // only the entries the angles read: the third row, then R11 and R21, or at the
     // lock R12 and R22.
-    const int32_t c0 = q30(r.c.x), c1 = q30(r.c.y), c2 = q30(r.c.z);
+    const int32_t c0 = r.c.x, c1 = r.c.y, c2 = r.c.z;
     const int16_t c0h = q14(c0), c1h = q14(c1), c2h = q14(c2);
     EulerQ24 e;
     const bool away_from_lock = roll_pitch(plus_cross(c0, t, c1h, t.z, c2h, t.y),  // R31
@@ -149,7 +150,7 @@ EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta
                                            e);
     // Column 1 (R11 = r_x + r_y t_z - r_z t_y) of the first two rows, or at the lock
     // column 2 (R12 = r_y + r_z t_x - r_x t_z): the entries are chosen first, so that
-    // each row is one inline copy, converted only when it is needed.
+    // each row is one inline copy.
     const int16_t tp = away_from_lock ? t.z : t.x, tq = away_from_lock ? t.y : t.z;
     const int32_t r_1 = away_from_lock ? carried_entry(t, r.a.x, r.a.y, tp, r.a.z, tq)
                                        : carried_entry(t, r.a.y, r.a.z, tp, r.a.x, tq);
@@ -157,6 +158,10 @@ EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta
                                        : carried_entry(t, r.b.y, r.b.z, tp, r.b.x, tq);
     e.yaw_q24 = yaw(away_from_lock, r_1, r_1, r_2, r_2);
     return e;
+}
+
+EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {
+    return euler_carried_q24(linalg::q30_from_matrix(r), theta_x_q26, theta_y_q26, theta_z_q26);
 }
 
 EulerAngles euler_carried(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {

@@ -67,6 +67,8 @@ EulerQ24 euler_q24_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, 
 // and R22 only at the gimbal lock).
 // theta in Q26 radians (2^26 = 1 rad, 1.5e-8 rad steps) for a caller that sums it in
 // integers; the float theta is the same after fixed_from_float(theta, 26).
+EulerQ24 euler_carried_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                           int32_t theta_z_q26);
 EulerQ24 euler_carried_q24(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,
                            int32_t theta_z_q26);
 EulerAngles euler_carried(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,

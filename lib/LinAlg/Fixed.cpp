@@ -2,6 +2,32 @@
 #include "Fixed.h"
 
 namespace linalg {
+
+int32_t dot_q30(const Vector3l& r, const Vector3l& v) { return mul_q30(r.x, v.x) + mul_q30(r.y, v.y) + mul_q30(r.z, v.z); }
+
+Vector3l cross_q30(const Vector3l& r, const Vector3l& v) {
+    return Vector3l(mul_q30(r.y, v.z) - mul_q30(r.z, v.y), mul_q30(r.z, v.x) - mul_q30(r.x, v.z),
+                    mul_q30(r.x, v.y) - mul_q30(r.y, v.x));
+}
+
+Vector3l mul_q30(const Matrix3q30& r, const Vector3l& v) { return Vector3l(dot_q30(r.a, v), dot_q30(r.b, v), dot_q30(r.c, v)); }
+
+Vector3l q30_from_vector(const Vector3f& v) {
+    return Vector3l(fixed_from_float(v.x, kQ30), fixed_from_float(v.y, kQ30), fixed_from_float(v.z, kQ30));
+}
+
+Vector3f vector_from_q30(const Vector3l& v) {
+    return Vector3f(float_from_fixed(v.x, kQ30), float_from_fixed(v.y, kQ30), float_from_fixed(v.z, kQ30));
+}
+
+Matrix3q30 q30_from_matrix(const Matrix3f& m) {
+    return Matrix3q30{q30_from_vector(m.a), q30_from_vector(m.b), q30_from_vector(m.c)};
+}
+
+Matrix3f matrix_from_q30(const Matrix3q30& m) {
+    return Matrix3f(vector_from_q30(m.a), vector_from_q30(m.b), vector_from_q30(m.c));
+}
+
 namespace fixed_detail {
 
 const uint8_t kPowersOfTwo[8] FIXED_PROGMEM = {1, 2, 4, 8, 16, 32, 64, 128};

@@ -116,6 +116,13 @@ struct Vector3l {
     // The vector times a scale, in float (three conversions and three multiplies).
     Vector3f scaled(float s) const { return Vector3f((float)x * s, (float)y * s, (float)z * s); }
 };
+// A rotation matrix in fixed point, rows as in Matrix3f, each entry Q30 (2^30 = 1:
+// steps of 9.3e-10, headroom to 2): the estimator's R, turned with the 2560's hardware
+// multiplier (Fixed.h's mul_q30) instead of float calls.
+struct Matrix3q30 {
+    Vector3l a, b, c;  // rows
+};
+
 inline Vector3f scaled(const Vector3i& v, float s) { return Vector3f((float)v.x * s, (float)v.y * s, (float)v.z * s); }
 
 struct Matrix3f {

@@ -541,6 +541,14 @@ void check_fixed_output() {
         const int32_t c = (int32_t)((m * 375493621ULL + (1ULL << 39)) >> 40);  // round(m 18000/pi / 2^24)
         EXPECT(linalg::centideg_from_q24(q) == ((b & 1u) ? -c : c));
     }
+    // mul_q30's assembly against the sum it implements, and its signs.
+    for (uint16_t i = 0; i < 500; ++i) {
+        const uint32_t a = random_u32() >> (i % 3), x = random_u32() >> (i % 29);
+        EXPECT(linalg::mul_u32_shr30(a, x) == linalg::fixed_detail::mul_u32_shr30_by_bytes(a, x));
+        const int32_t sa = (int32_t)(a >> 2) * ((i & 1) ? -1 : 1), sx = (int32_t)(x >> 1) * ((i & 2) ? -1 : 1);
+        const int32_t m = (int32_t)linalg::fixed_detail::mul_u32_shr30_by_bytes(a >> 2, x >> 1);
+        EXPECT(linalg::mul_q30(sa, sx) == (((i & 1) != 0) != ((i & 2) != 0) ? -m : m));
+    }
     // fixed_from_float's shifts by MUL against a float scaling by 2^q (exact) and the
     // cast's truncation, from 2^-24 to 2 in magnitude.
     for (uint16_t i = 0; i < 500; ++i) {
