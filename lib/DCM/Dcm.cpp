@@ -10,6 +10,10 @@ using linalg::Vector3f;
 using linalg::Vector3l;
 
 namespace {
+// v * 2^8 by byte shifts (a multiply may become avr-gcc's 32x32 routine, ~105 cycles).
+Vector3l times_256(const Vector3l& v) {
+    return Vector3l((int32_t)((uint32_t)v.x << 8), (int32_t)((uint32_t)v.y << 8), (int32_t)((uint32_t)v.z << 8));
+}
 // A mag correction stands for the time since the previous sample, but never more
 // than this many steps (after an outage the first sample must not make a jump).
 constexpr uint16_t kMaxMagIntervalSteps = 20;
@@ -377,20 +381,30 @@ void Dcm::correct_gravity() {
         // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
         // of the running sums, three additions a step. (Weighting each sample, not the
         // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
-        // In counts until the rotation into earth axes; one scale after it.
-        const Vector3f turn_per_step = (gyro_raw_mean - offset_rad_s_) * settings_->step_s;
-        const int32_t pending = pending_steps_;
-        const Vector3f weighted = Vector3l{accel_sum_of_sums_.x - accel_sum.x * pending,
-                                           accel_sum_of_sums_.y - accel_sum.y * pending,
-                                           accel_sum_of_sums_.z - accel_sum.z * pending}
-                                      .to_float();
+        // In integers until the low-pass: counts * 2^8 times n (the window's samples), the
+        // turn per step times n in Q30 radians (from the turn sums' units).
+        const uint8_t n = window_samples_;
+        Vector3l turn_units(in_turn_units(gyro_sum_.x), in_turn_units(gyro_sum_.y), in_turn_units(gyro_sum_.z));
+        Vector3l weighted = accel_sum_of_sums_, body = Vector3l();
+        for (uint8_t i = 0; i < n; ++i) {
+            turn_units.x -= offset_units_.x;
+            turn_units.y -= offset_units_.y;
+            turn_units.z -= offset_units_.z;
+            body += accel_sum;
+        }
+        for (uint8_t i = 0; i < pending_steps_; ++i) {
+            weighted.x -= accel_sum.x;
+            weighted.y -= accel_sum.y;
+            weighted.z -= accel_sum.z;
+        }
+        // |weighted| < 10 * 2^15 and |n sum| < 2^19 counts: times 2^8 within 2^31.
+        const Vector3l turned = linalg::cross_q30(theta_q30(turn_units), times_256(weighted));
+        body = times_256(body);
+        body = Vector3l(body.x - turned.x, body.y - turned.y, body.z - turned.z);
         const float alpha = starting ? accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left : accel_alpha_;
-        const Vector3f body = accel_sum.to_float() - turn_per_step.cross(weighted);
-        // Into earth axes in integers: counts * 2^8 (|sum| < 2^17 counts) by the Q30 matrix.
-        const Vector3l accel_ef = linalg::mul_q30(r_, Vector3l(linalg::fixed_from_float(body.x, 8),
-                                                               linalg::fixed_from_float(body.y, 8),
-                                                               linalg::fixed_from_float(body.z, 8)));
-        accel_lp_ef_ += (accel_ef.scaled(accel_scale_ * inv_n * (1.0f / 256.0f)) - accel_lp_ef_) * alpha;
+        // Into earth axes by the Q30 matrix; one scale after it.
+        const Vector3l accel_ef = linalg::mul_q30(r_, body);
+        accel_lp_ef_ += (accel_ef.scaled(accel_scale_ * (inv_n * inv_n * (1.0f / 256.0f))) - accel_lp_ef_) * alpha;
         detect_rest(gyro_mean, accel_sum.scaled(accel_scale_ * inv_n), window_samples_ >= kCorrectionDivider);
     }
     gyro_sum_ = Vector3l();
