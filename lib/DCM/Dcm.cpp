@@ -10,6 +10,27 @@ using linalg::Vector3f;
 using linalg::Vector3l;
 
 namespace {
+Vector3l rescaled(const Vector3l& v, float ratio) {
+    const Vector3f f = v.scaled(ratio);
+    return Vector3l(linalg::fixed_from_float(f.x, 0), linalg::fixed_from_float(f.y, 0), linalg::fixed_from_float(f.z, 0));
+}
+
+// 1/n and 1/n^2 in Q30 for the window's samples (n = 1..5: a correction late by a step
+// takes five), as code (a table would take RAM on the AVR).
+int32_t inverse_q30(uint8_t n, bool squared) {
+    switch (n) {
+        case 1: return 1073741824L;
+        case 2: return squared ? 268435456L : 536870912L;
+        case 3: return squared ? 119304647L : 357913941L;
+        case 4: return squared ? 67108864L : 268435456L;
+        case 5: return squared ? 42949673L : 214748365L;
+        default: {
+            const float inverse = 1.0f / (float)n;
+            return linalg::fixed_from_float(squared ? inverse * inverse : inverse, linalg::kQ30);
+        }
+    }
+}
+
 // v * 2^8 by byte shifts (a multiply may become avr-gcc's 32x32 routine, ~105 cycles).
 Vector3l times_256(const Vector3l& v) {
     return Vector3l((int32_t)((uint32_t)v.x << 8), (int32_t)((uint32_t)v.y << 8), (int32_t)((uint32_t)v.z << 8));
@@ -29,6 +50,9 @@ constexpr float kReferenceTau_s = 1.32f;
 constexpr float kRestFieldMove_uT = 1.0f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
+// The rest mean's difference from the bias, saturated (units): 2^22 units is 1 900 deg/s
+// on the 2000 deg/s range, and times 2^8 it stays within 31 bits.
+constexpr int32_t kMaxRestDifference = 1L << 22;
 // The field samples in earth axes are summed in uT * 2^kFieldQ (the HMC5883L reads at
 // most 810 uT: a few samples' sum stays far below 2^31).
 constexpr uint8_t kFieldQ = 16;
@@ -54,30 +78,50 @@ bool moved(const Vector3l& a, const Vector3l& b) {
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    bias_rad_s_ = bias;
+    const Vector3f fine = bias * (units_per_rad_s_ * (float)kTurnScale);
+    bias_fine_ = Vector3l(linalg::fixed_from_float(fine.x, 0), linalg::fixed_from_float(fine.y, 0),
+                          linalg::fixed_from_float(fine.z, 0));
     clamp_bias();
     update_offset();
 }
 
+Vector3f Dcm::gyro_bias_rad_s() const { return bias_fine_.scaled(gyro_scale_ * (1.0f / (float)(kTurnScale * kTurnScale))); }
+
+Vector3l Dcm::bias_units() const {
+    return Vector3l((bias_fine_.x + 128) >> 8, (bias_fine_.y + 128) >> 8, (bias_fine_.z + 128) >> 8);
+}
+
 void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    sensor_bias_rad_s_ = bias;
+    sensor_bias_units_ = units_of(bias);
     update_offset();
 }
 
+// The state held in the sensors' units is carried over to the new scales.
 void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count) {
+    const float gyro_ratio = gyro_scale_ / gyro_rad_s_per_count, accel_ratio = accel_scale_ / accel_m_s2_per_count;
     gyro_scale_ = gyro_rad_s_per_count;
     accel_scale_ = accel_m_s2_per_count;
     units_per_rad_s_ = (float)kTurnScale / gyro_rad_s_per_count;
+    if (gyro_ratio != 1.0f) {
+        Vector3l* rates[4] = {&bias_fine_, &correction_units_, &sensor_bias_units_, &rest_gyro_mean_};
+        for (Vector3l* v : rates) *v = rescaled(*v, gyro_ratio);
+    }
+    if (accel_ratio != 1.0f) {
+        accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
+        rest_accel_mean_ = rescaled(rest_accel_mean_, accel_ratio);
+    }
     set_output_factors();
     update_offset();
 }
 
-// What each step subtracts from the gyro: in rad/s for the corrections' arithmetic, and
-// in the integer units of the turn sums (counts * 2^kTurnFraction) for the 200 Hz step.
+// What each step subtracts from the gyro, in the integer units of the turn sums
+// (counts * 2^kTurnFraction).
 void Dcm::update_offset() {
-    offset_rad_s_ = sensor_bias_rad_s_ + bias_rad_s_ - correction_rad_s_;
-    offset_units_ = units_of(offset_rad_s_);
+    const Vector3l bias = bias_units();
+    offset_units_ = Vector3l(sensor_bias_units_.x + bias.x - correction_units_.x,
+                             sensor_bias_units_.y + bias.y - correction_units_.y,
+                             sensor_bias_units_.z + bias.z - correction_units_.z);
 }
 
 Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
@@ -119,8 +163,9 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     // The integer factors of the scales, unless set_sample_scales set them (the float
     // form's, whose scales are the defaults: the Pipeline sets its own before the start).
     if (theta_factor_q30_ == 0) set_output_factors();
-    accel_lp_ef_ = Vector3f(0.0f, 0.0f, -kGravity_m_s2);
-    correction_rad_s_ = Vector3f();
+    const float per_m_s2 = accel_units_per_m_s2();
+    accel_lp_ef_ = Vector3l(0, 0, linalg::fixed_from_float(-kGravity_m_s2 * per_m_s2, 0));
+    correction_units_ = Vector3l();
     update_offset();
     mag_steady_steps_ = 0;
     rest_corrections_ = 0;
@@ -135,7 +180,9 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     heading_norm2_sum_ = 0;
     heading_samples_ = 0;
     heading_steps_ = 0;
-    rest_accel_mean_m_s2_ = accel_m_s2;
+    const Vector3f accel_mean = accel_m_s2 * per_m_s2;
+    rest_accel_mean_ = Vector3l(linalg::fixed_from_float(accel_mean.x, 0), linalg::fixed_from_float(accel_mean.y, 0),
+                                linalg::fixed_from_float(accel_mean.z, 0));
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
@@ -174,6 +221,24 @@ void Dcm::set_output_factors() {
     // The units that make kMaxTurnAxisQ30 (below 2^31 after the shift: f >= 1/2, or e = 0).
     const float limit_units = integer_path ? (float)kMaxTurnAxisQ30 / (k30 * (float)(1L << theta_shift_)) : 0.0f;
     theta_units_limit_ = limit_units < 2.0e9f ? (int32_t)limit_units : 2000000000L;
+    // The limits in the units of the sums they are compared with.
+    hold_rate_ = limit_of(settings_->integrator_hold_rate_rad_s * units_per_rad_s_);
+    rest_gyro_dev_ = limit_of(settings_->rest_gyro_deviation_rad_s * units_per_rad_s_);
+    rest_accel_dev_ = limit_of(settings_->rest_accel_deviation_m_s2 * accel_units_per_m_s2());
+    bias_limit_fine_ = linalg::fixed_from_float(settings_->bias_limit_rad_s * units_per_rad_s_ * (float)kTurnScale, 0);
+}
+
+// |v| >= the limit, from 16x16 products: an axis beyond 16 bits after the shift is.
+bool Dcm::exceeds(const Vector3l& v, const Limit& limit) {
+    const int32_t* axis[3] = {&v.x, &v.y, &v.z};
+    uint32_t sum = 0;  // three squares below 2^30: no overflow
+    for (uint8_t i = 0; i < 3; ++i) {
+        int32_t a = *axis[i];
+        for (uint8_t k = limit.shift; k > 0; --k) a >>= 1;
+        if (a > 32767 || a < -32767) return true;
+        sum += (uint32_t)linalg::mul_s16((int16_t)a, (int16_t)a);
+    }
+    return sum >= limit.limit2;
 }
 
 // The turn sums (units) in Q30 radians, each axis saturated at kMaxTurnAxisQ30: beyond
@@ -317,7 +382,7 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
     } else {
         heavy_ = false;
     }
-    if (steps_ < 0xFFFFFFFFu) ++steps_;
+    if (steps_ < 0xFFFFu) ++steps_;
 }
 
 // Rest detection and the gyro bias at rest (after VQF, Laidig & Seel 2023, sec. 3.4):
@@ -327,7 +392,8 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
 // the compass can measure well: the bias estimate moves to the mean gyro reading with
 // rest_bias_s. The MPU6000's rate noise, 0.005 deg/s/sqrt(Hz), averages to ~0.004 deg/s
 // over the 0.5 s mean; a hand-held board's tremor is below 2 deg/s and 0.5 m/s^2.
-void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, bool whole_window) {
+void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, bool whole_window) {
+    using linalg::mul_q30;
     status_ &= (uint8_t)~kStatusAtRest;
     // A steady turn passes the deviation test too. The compass tells: at rest the field
     // stays put in body axes, in a turn it turns (correct_heading resets the rest when
@@ -335,11 +401,18 @@ void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, boo
     // within the tremor bound of the bias estimate instead (VQF's rule, its 2 deg/s
     // bias clip): a larger vertical bias is then not told from a slow turn.
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
-    const bool still = (gyro_mean - rest_gyro_mean_rad_s_).length_squared() < rest_gyro_dev2_ &&
-                       (compass_watching || (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() < rest_gyro_dev2_) &&
-                       (accel_mean - rest_accel_mean_m_s2_).length_squared() < rest_accel_dev2_;
-    rest_gyro_mean_rad_s_ += (gyro_mean - rest_gyro_mean_rad_s_) * rest_alpha_;
-    rest_accel_mean_m_s2_ += (accel_mean - rest_accel_mean_m_s2_) * rest_alpha_;
+    const Vector3l gyro_change(gyro_mean.x - rest_gyro_mean_.x, gyro_mean.y - rest_gyro_mean_.y,
+                               gyro_mean.z - rest_gyro_mean_.z);
+    const Vector3l accel_change(accel_mean.x - rest_accel_mean_.x, accel_mean.y - rest_accel_mean_.y,
+                                accel_mean.z - rest_accel_mean_.z);
+    const Vector3l bias = bias_units();
+    const Vector3l off_bias(rest_gyro_mean_.x - bias.x, rest_gyro_mean_.y - bias.y, rest_gyro_mean_.z - bias.z);
+    const bool still = !exceeds(gyro_change, rest_gyro_dev_) && (compass_watching || !exceeds(off_bias, rest_gyro_dev_)) &&
+                       !exceeds(accel_change, rest_accel_dev_);
+    rest_gyro_mean_ += Vector3l(mul_q30(rest_alpha_q30_, gyro_change.x), mul_q30(rest_alpha_q30_, gyro_change.y),
+                                mul_q30(rest_alpha_q30_, gyro_change.z));
+    rest_accel_mean_ += Vector3l(mul_q30(rest_alpha_q30_, accel_change.x), mul_q30(rest_alpha_q30_, accel_change.y),
+                                 mul_q30(rest_alpha_q30_, accel_change.z));
     if (!still || !whole_window) {
         rest_corrections_ = 0;
         return;
@@ -349,7 +422,16 @@ void Dcm::detect_rest(const Vector3f& gyro_mean, const Vector3f& accel_mean, boo
         return;
     }
     status_ |= kStatusAtRest;
-    bias_rad_s_ += (rest_gyro_mean_rad_s_ - bias_rad_s_) * rest_bias_alpha_;
+    // bias += alpha (mean - bias), in units * 2^8 (the difference within the bias limit
+    // and the deviation: far below 2^23 units).
+    int32_t* fine[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
+    const int32_t* mean[3] = {&rest_gyro_mean_.x, &rest_gyro_mean_.y, &rest_gyro_mean_.z};
+    for (uint8_t i = 0; i < 3; ++i) {
+        int32_t difference = *mean[i] - (*fine[i] >> 8);
+        if (difference > kMaxRestDifference) difference = kMaxRestDifference;
+        if (difference < -kMaxRestDifference) difference = -kMaxRestDifference;
+        *fine[i] += mul_q30(rest_bias_alpha_q30_, (int32_t)((uint32_t)difference << 8) - (*fine[i] & 0xFF));
+    }
     clamp_bias();
 }
 
@@ -366,13 +448,23 @@ void Dcm::correct_gravity() {
     // error that averages out, while a hand's or a vehicle's turn does not (shake, a
     // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
     // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
+    const Vector3l bias = bias_units();
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 ||
-                     (rest_gyro_mean_rad_s_ - bias_rad_s_).length_squared() > hold_rate2_;
+                     exceeds(Vector3l(rest_gyro_mean_.x - bias.x, rest_gyro_mean_.y - bias.y, rest_gyro_mean_.z - bias.z),
+                             hold_rate_);
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
-        const float inv_n = inverse(window_samples_);
-        const Vector3f gyro_raw_mean = gyro_sum_.scaled(gyro_scale_ * inv_n);
-        const Vector3f gyro_mean = gyro_raw_mean - sensor_bias_rad_s_;
+        using linalg::mul_q30;
+        const uint8_t n = window_samples_;
+        const int32_t inv_n = inverse_q30(n, false), inv_n2 = inverse_q30(n, true);
+        // The means (units, accel counts * 2^8; |sums| < 2^18 counts): the gyro's less the
+        // calibrated bias.
+        const Vector3l gyro_sum = times_256(gyro_sum_), accel_sum_256 = times_256(accel_sum_);
+        const Vector3l gyro_mean(mul_q30(inv_n, gyro_sum.x) - sensor_bias_units_.x,
+                                 mul_q30(inv_n, gyro_sum.y) - sensor_bias_units_.y,
+                                 mul_q30(inv_n, gyro_sum.z) - sensor_bias_units_.z);
+        const Vector3l accel_mean(mul_q30(inv_n, accel_sum_256.x), mul_q30(inv_n, accel_sum_256.y),
+                                  mul_q30(inv_n, accel_sum_256.z));
         const Vector3l accel_sum = accel_sum_;
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
@@ -383,7 +475,6 @@ void Dcm::correct_gravity() {
         // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
         // In integers until the low-pass: counts * 2^8 times n (the window's samples), the
         // turn per step times n in Q30 radians (from the turn sums' units).
-        const uint8_t n = window_samples_;
         Vector3l turn_units(in_turn_units(gyro_sum_.x), in_turn_units(gyro_sum_.y), in_turn_units(gyro_sum_.z));
         Vector3l weighted = accel_sum_of_sums_, body = Vector3l();
         for (uint8_t i = 0; i < n; ++i) {
@@ -401,11 +492,15 @@ void Dcm::correct_gravity() {
         const Vector3l turned = linalg::cross_q30(theta_q30(turn_units), times_256(weighted));
         body = times_256(body);
         body = Vector3l(body.x - turned.x, body.y - turned.y, body.z - turned.z);
-        const float alpha = starting ? accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left : accel_alpha_;
-        // Into earth axes by the Q30 matrix; one scale after it.
+        const int32_t alpha = starting ? q30_of(accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left)
+                                       : q30_of(accel_alpha_);
+        // Into earth axes by the Q30 matrix, the mean (n^2: n samples, each n times), and
+        // the low-pass.
         const Vector3l accel_ef = linalg::mul_q30(r_, body);
-        accel_lp_ef_ += (accel_ef.scaled(accel_scale_ * (inv_n * inv_n * (1.0f / 256.0f))) - accel_lp_ef_) * alpha;
-        detect_rest(gyro_mean, accel_sum.scaled(accel_scale_ * inv_n), window_samples_ >= kCorrectionDivider);
+        accel_lp_ef_ += Vector3l(mul_q30(alpha, mul_q30(inv_n2, accel_ef.x) - accel_lp_ef_.x),
+                                 mul_q30(alpha, mul_q30(inv_n2, accel_ef.y) - accel_lp_ef_.y),
+                                 mul_q30(alpha, mul_q30(inv_n2, accel_ef.z) - accel_lp_ef_.z));
+        detect_rest(gyro_mean, accel_mean, n >= kCorrectionDivider);
     }
     gyro_sum_ = Vector3l();
     accel_sum_ = Vector3l();
@@ -496,34 +591,43 @@ Vector3l Dcm::last_rate_units() const {
 Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(gyro_scale_ * (1.0f / (float)kTurnScale)); }
 
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
-    // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1).
-    const float lp2 = accel_lp_ef_.length_squared();
-    if (!(lp2 > 0.25f * kGravity_m_s2 * kGravity_m_s2)) {
-        correction_rad_s_ = Vector3f();
+    using linalg::fixed_from_float;
+    using linalg::mul_q30;
+    // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). The length
+    // in float (a square root and a division); the rest in Q30.
+    const Vector3f lp = accel_lp_ef_.to_float();
+    const float lp2 = lp.length_squared();
+    const float half_g = 0.5f * kGravity_m_s2 * accel_units_per_m_s2();
+    if (!(lp2 > half_g * half_g)) {
+        correction_units_ = Vector3l();
         return;
     }
     const float inv_lp = 1.0f / sqrtf(lp2);
-    const float error_n = -accel_lp_ef_.y * inv_lp;
-    const float error_e = accel_lp_ef_.x * inv_lp;
+    const int32_t n = fixed_from_float(-lp.y * inv_lp, linalg::kQ30), e = fixed_from_float(lp.x * inv_lp, linalg::kQ30);
     // In body axes: R^T (error_n, error_e, 0).
-    const int32_t n = linalg::fixed_from_float(error_n, linalg::kQ30), e = linalg::fixed_from_float(error_e, linalg::kQ30);
-    const Vector3f error = linalg::vector_from_q30(Vector3l(linalg::mul_q30(n, r_.a.x) + linalg::mul_q30(e, r_.b.x),
-                                                            linalg::mul_q30(n, r_.a.y) + linalg::mul_q30(e, r_.b.y),
-                                                            linalg::mul_q30(n, r_.a.z) + linalg::mul_q30(e, r_.b.z)));
+    const Vector3l error(mul_q30(n, r_.a.x) + mul_q30(e, r_.b.x), mul_q30(n, r_.a.y) + mul_q30(e, r_.b.y),
+                         mul_q30(n, r_.a.z) + mul_q30(e, r_.b.z));
     const float kp = startup_left > 0.0f
                          ? settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left
                          : settings_->kp_rp_1_s;
-    correction_rad_s_ = error * kp;
+    // kp error in units (the gain times units per rad/s: an integer factor on the Q30 error).
+    const int32_t kp_units = fixed_from_float(kp * units_per_rad_s_, 0);
+    correction_units_ = Vector3l(mul_q30(kp_units, error.x), mul_q30(kp_units, error.y), mul_q30(kp_units, error.z));
     if (!hold_integrator) {
-        bias_rad_s_ -= error * (settings_->ki_rp_1_s2 * correction_dt_);
+        const int32_t ki_fine = fixed_from_float(settings_->ki_rp_1_s2 * correction_dt() * units_per_rad_s_ * (float)kTurnScale, 0);
+        bias_fine_.x -= mul_q30(ki_fine, error.x);
+        bias_fine_.y -= mul_q30(ki_fine, error.y);
+        bias_fine_.z -= mul_q30(ki_fine, error.z);
         clamp_bias();
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
     // with it ((e_n, e_e, 0) x lp, scaled).
-    const float turn = kp * correction_dt_;
-    const Vector3f lp = accel_lp_ef_;
-    accel_lp_ef_ += Vector3f(error_e * lp.z, -error_n * lp.z, error_n * lp.y - error_e * lp.x) * turn;
+    const int32_t turn = fixed_from_float(kp * correction_dt(), linalg::kQ30);
+    const int32_t turn_n = mul_q30(turn, n), turn_e = mul_q30(turn, e);
+    const Vector3l old = accel_lp_ef_;
+    accel_lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),
+                             mul_q30(turn_n, old.y) - mul_q30(turn_e, old.x));
 }
 
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
@@ -677,7 +781,11 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // Into the turn not yet integrated: applied with the next integration.
     turn_sum_ += units_of(error * ((starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps));
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
-        bias_rad_s_ -= error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps);
+        const Vector3f fine = error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * units_per_rad_s_ *
+                                       (float)kTurnScale);
+        bias_fine_.x -= linalg::fixed_from_float(fine.x, 0);
+        bias_fine_.y -= linalg::fixed_from_float(fine.y, 0);
+        bias_fine_.z -= linalg::fixed_from_float(fine.z, 0);
         clamp_bias();
         update_offset();
     }
@@ -712,9 +820,11 @@ bool Dcm::field_matches(float norm, float down_component, float ref_norm, float 
 }
 
 void Dcm::clamp_bias() {
-    const float limit = settings_->bias_limit_rad_s;
-    float* axis[3] = {&bias_rad_s_.x, &bias_rad_s_.y, &bias_rad_s_.z};
-    for (uint8_t i = 0; i < 3; ++i) *axis[i] = linalg::constrain(*axis[i], -limit, limit);
+    int32_t* axis[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
+    for (uint8_t i = 0; i < 3; ++i) {
+        if (*axis[i] > bias_limit_fine_) *axis[i] = bias_limit_fine_;
+        if (*axis[i] < -bias_limit_fine_) *axis[i] = -bias_limit_fine_;
+    }
 }
 
 // Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, bring

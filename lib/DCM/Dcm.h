@@ -105,6 +105,13 @@ enum StatusFlags : uint8_t {
 
 class Dcm {
 public:
+    // A rate or specific-force limit for a squared comparison in 16x16 products: the
+    // vector shifted right by `shift`, its squared length against limit2 (limit_of).
+    struct Limit {
+        uint32_t limit2;
+        uint8_t shift;
+    };
+
     // Everything the step needs that depends only on the settings is worked out once
     // here (at compile time for constant settings: no start-up code, and a float
     // division costs ~480 cycles on the 2560).
@@ -112,23 +119,24 @@ public:
         : settings_(&settings),
           startup_steps_((uint16_t)(settings.startup_s / settings.step_s)),
           inv_startup_steps_(settings.step_s / settings.startup_s),
-          hold_rate2_(settings.integrator_hold_rate_rad_s * settings.integrator_hold_rate_rad_s),
           accel_alpha_(settings.step_s * (float)kCorrectionDivider /
                        (settings.accel_lowpass_s + settings.step_s * (float)kCorrectionDivider)),
-          correction_dt_(settings.step_s * (float)kCorrectionDivider),
           mag_recover_steps_((uint16_t)(settings.mag_recover_s / settings.step_s)),
-          rest_gyro_dev2_(settings.rest_gyro_deviation_rad_s * settings.rest_gyro_deviation_rad_s),
-          rest_accel_dev2_(settings.rest_accel_deviation_m_s2 * settings.rest_accel_deviation_m_s2),
           rest_min_corrections_((uint16_t)(settings.rest_min_s / (settings.step_s * (float)kCorrectionDivider))),
-          rest_alpha_(settings.step_s * (float)kCorrectionDivider /
-                      (kRestMeanTau_s + settings.step_s * (float)kCorrectionDivider)),
-          rest_bias_alpha_(settings.rest_bias_s > 0.0f
-                               ? settings.step_s * (float)kCorrectionDivider /
-                                     (settings.rest_bias_s + settings.step_s * (float)kCorrectionDivider)
-                               : 0.0f),
+          rest_alpha_q30_(q30_of(settings.step_s * (float)kCorrectionDivider /
+                                 (kRestMeanTau_s + settings.step_s * (float)kCorrectionDivider))),
+          rest_bias_alpha_q30_(settings.rest_bias_s > 0.0f
+                                   ? q30_of(settings.step_s * (float)kCorrectionDivider /
+                                            (settings.rest_bias_s + settings.step_s * (float)kCorrectionDivider))
+                                   : 0),
           startup_accel_alpha_(settings.step_s * (float)kCorrectionDivider /
                                (kStartupAccelTau_s + settings.step_s * (float)kCorrectionDivider)),
-          mag_new_min_turn_rad_(settings.mag_recover_s * settings.mag_new_min_rate_rad_s) {}
+          mag_new_min_turn_rad_(settings.mag_recover_s * settings.mag_new_min_rate_rad_s),
+          // For the float form's scales until set_sample_scales (set_output_factors).
+          hold_rate_(limit_of(settings.integrator_hold_rate_rad_s * kFloatUnitsPerRad_s)),
+          rest_gyro_dev_(limit_of(settings.rest_gyro_deviation_rad_s * kFloatUnitsPerRad_s)),
+          rest_accel_dev_(limit_of(settings.rest_accel_deviation_m_s2 * ((float)kTurnScale / kFloatAccelScale))),
+          bias_limit_fine_((int32_t)(settings.bias_limit_rad_s * kFloatUnitsPerRad_s * (float)kTurnScale)) {}
 
     // Start-up attitude from one gravity and one field sample (TRIAD):
     // K = -a/|a| (earth down in body), I = (K x m) x K normalised (north), J = K x I.
@@ -208,7 +216,7 @@ public:
     // R in float (tests, tools, the quaternion output): the estimator keeps it in Q30.
     linalg::Matrix3f matrix() const { return linalg::matrix_from_q30(r_); }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
-    linalg::Vector3f gyro_bias_rad_s() const { return bias_rad_s_; }
+    linalg::Vector3f gyro_bias_rad_s() const;
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
     void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
     const DcmSettings& settings() const { return *settings_; }
@@ -255,6 +263,7 @@ public:
     // and 2^-12 m/s^2.
     static constexpr float kFloatGyroScale = 1.0f / 16384.0f;
     static constexpr float kFloatAccelScale = 1.0f / 4096.0f;
+    static constexpr float kFloatUnitsPerRad_s = (float)kTurnScale / kFloatGyroScale;
 
 private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
@@ -279,7 +288,18 @@ private:
     linalg::Vector3f pending_turn_rad() const;
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
     linalg::Vector3f last_rate_rad_s() const;
-    void detect_rest(const linalg::Vector3f& gyro_mean, const linalg::Vector3f& accel_mean, bool whole_window);
+    void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean, bool whole_window);
+    static bool exceeds(const linalg::Vector3l& v, const Limit& limit);
+    // A limit L as a shift s and (L / 2^s)^2 with L / 2^s below 2^14: a vector that stays
+    // within 16 bits after the shift up to twice the limit, and the limit resolved to 2^-13.
+    static constexpr Limit limit_of(float value, uint8_t shift = 0) {
+        return value >= 16384.0f && shift < 31 ? limit_of(value * 0.5f, (uint8_t)(shift + 1))
+                                               : Limit{value > 0.0f ? (uint32_t)(value * value) : 0u, shift};
+    }
+    linalg::Vector3l bias_units() const;  // bias_fine_ rounded to units
+    float correction_dt() const { return settings_->step_s * (float)kCorrectionDivider; }  // s between corrections
+    float accel_units_per_m_s2() const { return (float)kTurnScale / accel_scale_; }
+    static constexpr int32_t q30_of(float x) { return (int32_t)(x * 1073741824.0f); }
     bool renormalise(int32_t& skew_q30);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3l& row, linalg::Vector3l& out);
     linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // the turn sums in Q30 radians
@@ -295,27 +315,27 @@ private:
     const DcmSettings* settings_;
     uint16_t startup_steps_;
     float inv_startup_steps_;
-    float hold_rate2_;                   // (rad/s)^2
     float accel_alpha_;                  // low-pass factor per correction
-    float correction_dt_;                // s between two roll/pitch corrections
     uint16_t mag_recover_steps_;
-    float rest_gyro_dev2_;               // (rad/s)^2
-    float rest_accel_dev2_;              // (m/s^2)^2
     uint16_t rest_min_corrections_;
-    float rest_alpha_;                   // low-pass factor of the rest means, per correction
-    float rest_bias_alpha_;              // bias step towards the rest mean, per correction
+    int32_t rest_alpha_q30_;             // low-pass factor of the rest means, per correction
+    int32_t rest_bias_alpha_q30_;        // bias step towards the rest mean, per correction
     float startup_accel_alpha_;          // the accel low-pass factor at the start of the ramp, per correction
     float mag_new_min_turn_rad_;         // how far the board must turn while a new field stays steady
 
     linalg::Matrix3q30 r_;               // body -> earth, Q30 (integrate: turned in integers)
-    linalg::Vector3f bias_rad_s_;        // integrator: gyro-bias estimate
-    linalg::Vector3f correction_rad_s_;  // roll/pitch correction, held between corrections
-    linalg::Vector3f offset_rad_s_;      // sensor bias + bias - correction: what the step subtracts from the gyro
-    linalg::Vector3l offset_units_;      // ... in the turn sums' units
-    linalg::Vector3f sensor_bias_rad_s_; // set_sensor_bias_rad_s
+    // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
+    linalg::Vector3l bias_fine_;         // integrator: gyro-bias estimate, units * 2^8
+    linalg::Vector3l correction_units_;  // roll/pitch correction, held between corrections
+    linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
+    linalg::Vector3l sensor_bias_units_; // set_sensor_bias_rad_s
+    Limit hold_rate_;                    // integrator_hold_rate_rad_s (units)
+    Limit rest_gyro_dev_;                // rest_gyro_deviation_rad_s (units)
+    Limit rest_accel_dev_;               // rest_accel_deviation_m_s2 (accel counts * 2^8)
+    int32_t bias_limit_fine_;            // bias_limit_rad_s (units * 2^8)
     float gyro_scale_ = kFloatGyroScale; // rad/s per count
     float accel_scale_ = kFloatAccelScale; // m/s^2 per count
-    float units_per_rad_s_ = (float)kTurnScale / kFloatGyroScale;  // the turn sums' units
+    float units_per_rad_s_ = kFloatUnitsPerRad_s;  // the turn sums' units
     uint16_t lead_steps_q15_ = 0;        // output_lead_s / step_s, Q15 (set_output_factors)
     uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
     int32_t theta_factor_q30_ = 0;       // Q30 radians per unit = theta_factor_q30_ * 2^theta_shift_ / 2^30; 0: float
@@ -323,14 +343,14 @@ private:
     int32_t theta_units_limit_ = 0;     // the turn sums' saturation (kMaxTurnAxisQ30)
     uint16_t mag_latency_frac_q15_ = 0;  // mag_latency_s in steps: its fraction (Q15) ...
     uint8_t mag_latency_whole_steps_ = 0;  // ... and whole steps
-    linalg::Vector3f accel_lp_ef_;       // specific force low-passed in earth axes, m/s^2
+    linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
     linalg::Vector3f last_mag_field_;
     linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
     linalg::Vector3l accel_sum_;
-    linalg::Vector3f rest_gyro_mean_rad_s_;  // their low-passed means, for the rest test
-    linalg::Vector3f rest_accel_mean_m_s2_;
+    linalg::Vector3l rest_gyro_mean_;    // their low-passed means, for the rest test (units,
+    linalg::Vector3l rest_accel_mean_;   // ... accel counts * 2^8)
     uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
     linalg::Vector3l rest_field_;        // the field (body axes, uT Q16) when the board last seemed to turn
     linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
@@ -350,7 +370,7 @@ private:
     float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
     float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
     float mag_candidate_down_ = 0.0f;
-    uint32_t steps_ = 0;                 // since init
+    uint16_t steps_ = 0;                 // since init, saturated (the start-up ramp's clock)
     uint16_t steps_since_mag_ = 0;
     uint16_t mag_steady_steps_ = 0;      // how long a different field has stayed the same
     float mag_steady_turn_rad_ = 0.0f;   // how far the board turned meanwhile
