@@ -53,27 +53,47 @@ constexpr uint16_t kRestCompassSteps = 20;
 // The rest mean's difference from the bias, saturated (units): 2^22 units is 1 900 deg/s
 // on the 2000 deg/s range, and times 2^8 it stays within 31 bits.
 constexpr int32_t kMaxRestDifference = 1L << 22;
-// The field samples in earth axes are summed in uT * 2^kFieldQ (the HMC5883L reads at
-// most 810 uT: a few samples' sum stays far below 2^31).
-constexpr uint8_t kFieldQ = 16;
-constexpr int32_t kMaxFieldQ = (int32_t)32767 << kFieldQ;  // 2^15 uT: no compass reads that
-// A squared strength's unit (mul_q30 of two Q16 values): uT^2 * 2^(32 - 30).
-constexpr float kNorm2PerUnit = 0.25f;
+// A field sample in 16 bits, uT * 2^kFieldQ: steps of 0.03 uT, a third of the
+// HMC5883L's finest count and far below its noise (~0.2 uT), up to 1 000 uT (the chip
+// reads at most 810). The latency turn and the rotation into earth axes are then 16x16
+// products (~20 cycles each on the AVR); a matrix entry in 16 bits (Q14) moves the
+// earth-frame field by 6e-5 of its strength at most, 0.004 deg of heading.
+constexpr uint8_t kFieldQ = 5;
+constexpr float kMaxField_uT = 1000.0f;
+// The sums' units: a squared strength in uT^2 * 2^(2 kFieldQ - kNorm2Shift), the field
+// in earth axes in uT * 2^(kFieldQ + 14 - kEarthFieldShift) (eight samples' sums within 32 bits).
+constexpr uint8_t kNorm2Shift = 4;
+constexpr uint8_t kEarthFieldShift = 2;
+constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
+constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
 // kRestFieldMove_uT in the field's units.
-constexpr int32_t kRestFieldMoveQ = (int32_t)(kRestFieldMove_uT * (float)(1L << kFieldQ));
+constexpr int16_t kRestFieldMoveQ = (int16_t)(kRestFieldMove_uT * (float)(1 << kFieldQ));
 
 // |a - b| > kRestFieldMove_uT for two fields in uT * 2^kFieldQ: an axis beyond it
-// decides at once; else the squares of the differences (each < 2^16: 16x16 products).
-bool moved(const Vector3l& a, const Vector3l& b) {
-    const int32_t d[3] = {a.x - b.x, a.y - b.y, a.z - b.z};
-    uint32_t sum = 0;
+// decides at once; else the squares of the differences.
+bool moved(const linalg::Vector3i& a, const linalg::Vector3i& b) {
+    const int16_t d[3] = {(int16_t)(a.x - b.x), (int16_t)(a.y - b.y), (int16_t)(a.z - b.z)};
+    int32_t sum = 0;
     for (uint8_t i = 0; i < 3; ++i) {
         if (d[i] >= kRestFieldMoveQ || d[i] <= -kRestFieldMoveQ) return true;
-        const uint16_t m = (uint16_t)linalg::magnitude(d[i]);
-        sum += linalg::mul_u16(m, m) >> 2;  // < 2^30 each: no overflow in three
+        sum += linalg::mul_s16(d[i], d[i]);
     }
-    return sum > (uint32_t)(kRestFieldMoveQ >> 1) * (uint32_t)(kRestFieldMoveQ >> 1);
+    return sum > linalg::mul_s16(kRestFieldMoveQ, kRestFieldMoveQ);
 }
+
+// A Q30 entry rounded to Q14 (a matrix entry, |e| <= 1 + rounding).
+int16_t q14_of(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
+// Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
+int16_t q16_of(int32_t x_q26) {
+    const int32_t q16 = linalg::opaque((x_q26 + 512) >> 8) >> 2;  // a byte, then two bits
+    return (int16_t)(q16 > 32767 ? 32767 : (q16 < -32767 ? -32767 : q16));
+}
+// A Q21 change of a Q5 field in Q5 (rounded): the two high bytes.
+int16_t q5_of(int32_t x_q21) { return (int16_t)((x_q21 + 0x8000) >> 16); }
+int32_t row_times(const Vector3l& row, const linalg::Vector3i& v) {
+    return linalg::mul_s16(q14_of(row.x), v.x) + linalg::mul_s16(q14_of(row.y), v.y) + linalg::mul_s16(q14_of(row.z), v.z);
+}
+
 }  // namespace
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
@@ -203,23 +223,16 @@ void Dcm::set_output_factors() {
     const bool fits = lead_steps >= 0.0f && lead_steps < 1.99f && k > 0.0f && k < 1.99f;
     lead_steps_q15_ = fits ? (uint16_t)(lead_steps * 32768.0f + 0.5f) : 0;
     theta_q26_per_unit_q15_ = fits ? (uint16_t)(k * 32768.0f + 0.5f) : 0;
-    // The integration's factor, Q30 radians per unit as f 2^e with f < 1 in Q30: the sums
-    // are shifted left by e first (exact), then multiplied (theta_q30). e <= 5: a 2000 deg/s
-    // gyro's factor is 22.3, the float form's 1.3.
-    float k30 = gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale) * 1073741824.0f;  // 2^30
-    theta_shift_ = 0;
-    while (k30 >= 1.0f && theta_shift_ <= kMaxThetaShift) {
-        k30 *= 0.5f;
-        ++theta_shift_;
-    }
+    // The turn's factor: Q26 radians per unit in Q30 (mul_q30's factor; a 2000 deg/s
+    // gyro's 1.40, the float form's 0.08), below 2 for any gyro of 4000 deg/s or less.
     // The compass sample's latency in steps, whole and Q15 fraction.
     const float latency_steps = linalg::constrain(settings_->mag_latency_s / settings_->step_s, 0.0f, 100.0f);
     mag_latency_whole_steps_ = (uint8_t)latency_steps;
     mag_latency_frac_q15_ = (uint16_t)((latency_steps - (float)mag_latency_whole_steps_) * 32768.0f + 0.5f);
-    const bool integer_path = k30 > 0.0f && k30 < 1.0f;
-    theta_factor_q30_ = integer_path ? linalg::fixed_from_float(k30, linalg::kQ30) : 0;
-    // The units that make kMaxTurnAxisQ30 (below 2^31 after the shift: f >= 1/2, or e = 0).
-    const float limit_units = integer_path ? (float)kMaxTurnAxisQ30 / (k30 * (float)(1L << theta_shift_)) : 0.0f;
+    const bool integer_path = k > 0.0f && k < 1.99f;
+    theta_factor_q30_ = integer_path ? linalg::fixed_from_float(k, linalg::kQ30) : 0;
+    // The units that make kMaxTurnAxisQ26.
+    const float limit_units = integer_path ? (float)kMaxTurnAxisQ26 / k : 0.0f;
     theta_units_limit_ = limit_units < 2.0e9f ? (int32_t)limit_units : 2000000000L;
     // The limits in the units of the sums they are compared with.
     hold_rate_ = limit_of(settings_->integrator_hold_rate_rad_s * units_per_rad_s_);
@@ -241,15 +254,16 @@ bool Dcm::exceeds(const Vector3l& v, const Limit& limit) {
     return sum >= limit.limit2;
 }
 
-// The turn sums (units) in Q30 radians, each axis saturated at kMaxTurnAxisQ30: beyond
+// The turn sums (units) in Q26 radians, each axis saturated at kMaxTurnAxisQ26: beyond
 // any gyro's range over an integration (2000 deg/s for 20 ms is 0.7 rad), and |theta|^2
-// stays below 2 (Q30's headroom).
-Vector3l Dcm::theta_q30(const Vector3l& units) const {
+// stays below 2 in Q30. One mul_q30 an axis.
+Vector3l Dcm::theta_q26(const Vector3l& units) const {
     if (theta_factor_q30_ == 0) {  // scales beyond the integer factor: in float
-        const Vector3f t = units.scaled(turn_rad_per_unit());
-        const float limit = (float)kMaxTurnAxisQ30 * (1.0f / 1073741824.0f);
-        return linalg::q30_from_vector(Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit),
-                                                linalg::constrain(t.z, -limit, limit)));
+        const Vector3f t = units.scaled(turn_rad_per_unit() * 67108864.0f);
+        const float limit = (float)kMaxTurnAxisQ26;
+        return Vector3l(linalg::fixed_from_float(linalg::constrain(t.x, -limit, limit), 0),
+                        linalg::fixed_from_float(linalg::constrain(t.y, -limit, limit), 0),
+                        linalg::fixed_from_float(linalg::constrain(t.z, -limit, limit), 0));
     }
     const int32_t* in[3] = {&units.x, &units.y, &units.z};
     int32_t out[3];
@@ -257,9 +271,14 @@ Vector3l Dcm::theta_q30(const Vector3l& units) const {
         int32_t u = *in[i];
         if (u > theta_units_limit_) u = theta_units_limit_;
         if (u < -theta_units_limit_) u = -theta_units_limit_;
-        out[i] = linalg::mul_q30(theta_factor_q30_, (int32_t)((uint32_t)u << theta_shift_));
+        out[i] = linalg::mul_q30(theta_factor_q30_, u);
     }
     return Vector3l(out[0], out[1], out[2]);
+}
+
+Vector3l Dcm::theta_q30(const Vector3l& units) const {
+    const Vector3l t = theta_q26(units);
+    return Vector3l(t.x * 16, t.y * 16, t.z * 16);
 }
 
 // 1/n for the few window lengths there are, without the ~500-cycle division.
@@ -638,18 +657,19 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         status_ |= kStatusMagIgnored;
         return;
     }
-    // In integers from here to the mean (~75 Hz): uT * 2^kFieldQ, saturated at 2^15 uT.
-    const Vector3l field(fixed_from_float(mag_field.x, kFieldQ), fixed_from_float(mag_field.y, kFieldQ),
-                         fixed_from_float(mag_field.z, kFieldQ));
-    const int32_t* axis[3] = {&field.x, &field.y, &field.z};
-    uint32_t sample_norm2 = 0;  // uT^2 * 2^(2 kFieldQ - 30)
+    // In integers from here to the mean (~75 Hz): 16 bits, uT * 2^kFieldQ.
+    const float* in[3] = {&mag_field.x, &mag_field.y, &mag_field.z};
+    int16_t axis[3];
+    uint32_t sample_norm2 = 0;  // uT^2 * 2^(2 kFieldQ - kNorm2Shift)
     for (uint8_t i = 0; i < 3; ++i) {
-        if (*axis[i] >= kMaxFieldQ || *axis[i] <= -kMaxFieldQ) {  // beyond any compass: garbage
+        if (!(*in[i] < kMaxField_uT && *in[i] > -kMaxField_uT)) {  // beyond any compass: garbage
             status_ |= kStatusMagIgnored;
             return;
         }
-        sample_norm2 += (uint32_t)linalg::mul_q30(*axis[i], *axis[i]);
+        axis[i] = (int16_t)fixed_from_float(*in[i], kFieldQ);
+        sample_norm2 += (uint32_t)linalg::mul_s16(axis[i], axis[i]) >> kNorm2Shift;
     }
+    const linalg::Vector3i field(axis[0], axis[1], axis[2]);
     if (sample_norm2 == 0) {
         status_ |= kStatusMagIgnored;
         return;
@@ -681,22 +701,32 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     turn = Vector3l(scale_q15(rate.x, mag_latency_frac_q15_) - turn.x, scale_q15(rate.y, mag_latency_frac_q15_) - turn.y,
                     scale_q15(rate.z, mag_latency_frac_q15_) - turn.z);
     for (uint8_t n = (uint8_t)(mag_latency_whole_steps_ + age_steps); n > 0; --n) turn += rate;
-    Vector3l field_now = linalg::cross_q30(field, theta_q30(turn));
-    field_now += field;
+    // field + field x turn, the turn in Q15 radians (<= 0.75): Q20, then Q5 again.
+    const Vector3l t = theta_q26(turn);
+    const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);
+    using linalg::mul_s16;
+    // The change (Q21) in Q5, then added (a field within 1 000 uT and a turn within
+    // 0.5 rad stay within 16 bits).
+    const linalg::Vector3i field_now(
+        (int16_t)(field.x + q5_of(mul_s16(field.y, tz) - mul_s16(field.z, ty))),
+        (int16_t)(field.y + q5_of(mul_s16(field.z, tx) - mul_s16(field.x, tz))),
+        (int16_t)(field.z + q5_of(mul_s16(field.x, ty) - mul_s16(field.y, tx))));
     // Tilt compensation: the field in earth axes; its horizontal part points to
     // magnetic north when the heading is right (eq. 31-33 in vector form).
     // The samples are averaged in earth axes over kHeadingSteps (a fixed earth field is
     // the same vector there whatever the board did meanwhile), and the heading is
     // corrected from their mean: each sample costs the rotation into earth axes, the
     // correction (the rest of this function) runs at 25 Hz.
-    heading_field_sum_ += linalg::mul_q30(r_, field_now);
+    heading_field_sum_ += Vector3l(row_times(r_.a, field_now) >> kEarthFieldShift,
+                                   row_times(r_.b, field_now) >> kEarthFieldShift,
+                                   row_times(r_.c, field_now) >> kEarthFieldShift);
     heading_norm2_sum_ += sample_norm2;
     ++heading_samples_;
     heading_steps_ = (uint16_t)(heading_steps_ + since_last);
     if (heading_steps_ < kHeadingSteps) return;
     uint16_t interval_steps = heading_steps_;
     const float inv_samples = inverse(heading_samples_);
-    const Vector3f field_ef = heading_field_sum_.scaled(inv_samples * (1.0f / (float)(1L << kFieldQ)));
+    const Vector3f field_ef = heading_field_sum_.scaled(inv_samples * kEarthFieldPerUnit);
     // The strength and dip tests take the samples' mean strength (the field's strength
     // is the same in every frame; the mean vector's is shorter where the samples differ).
     const float norm2 = (float)heading_norm2_sum_ * (inv_samples * kNorm2PerUnit);

@@ -243,10 +243,9 @@ public:
     // rotation to 4e-7 (Dcm::integrate), so eight leave R orthonormal to ~3e-6, below
     // what a 0.01 deg output shows (1.7e-4).
     static constexpr uint8_t kRenormaliseEvery = 8;
-    // The turn of one integration saturates at 0.75 rad an axis (Q30): beyond any gyro
+    // The turn of one integration saturates at 0.75 rad an axis (Q26): beyond any gyro
     // (2000 deg/s over 20 ms is 0.7 rad), and |theta|^2 < 2 stays within Q30.
-    static constexpr int32_t kMaxTurnAxisQ30 = 805306368L;
-    static constexpr uint8_t kMaxThetaShift = 5;  // the turn sums (< 2^26 units) shifted stay below 2^31
+    static constexpr int32_t kMaxTurnAxisQ26 = 50331648L;
     // The heading is corrected from the mean of the field samples over at least this
     // many steps (25 Hz; the HMC5883L's 75 Hz samples in threes): the correction is
     // slow (1/kp_yaw = 10 s), and the mean keeps every sample's information.
@@ -302,7 +301,8 @@ private:
     static constexpr int32_t q30_of(float x) { return (int32_t)(x * 1073741824.0f); }
     bool renormalise(int32_t& skew_q30);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3l& row, linalg::Vector3l& out);
-    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // the turn sums in Q30 radians
+    linalg::Vector3l theta_q26(const linalg::Vector3l& units) const;  // the turn sums in Q26 radians
+    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // ... and in Q30
     void recover();
     void clamp_bias();
     bool accel_plausible(const linalg::Vector3f& a) const;
@@ -338,9 +338,8 @@ private:
     float units_per_rad_s_ = kFloatUnitsPerRad_s;  // the turn sums' units
     uint16_t lead_steps_q15_ = 0;        // output_lead_s / step_s, Q15 (set_output_factors)
     uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
-    int32_t theta_factor_q30_ = 0;       // Q30 radians per unit = theta_factor_q30_ * 2^theta_shift_ / 2^30; 0: float
-    uint8_t theta_shift_ = 0;
-    int32_t theta_units_limit_ = 0;     // the turn sums' saturation (kMaxTurnAxisQ30)
+    int32_t theta_factor_q30_ = 0;       // Q26 radians per unit of the turn sums, Q30; 0: the float path
+    int32_t theta_units_limit_ = 0;      // the turn sums' saturation (kMaxTurnAxisQ26)
     uint16_t mag_latency_frac_q15_ = 0;  // mag_latency_s in steps: its fraction (Q15) ...
     uint8_t mag_latency_whole_steps_ = 0;  // ... and whole steps
     linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
@@ -352,14 +351,14 @@ private:
     linalg::Vector3l rest_gyro_mean_;    // their low-passed means, for the rest test (units,
     linalg::Vector3l rest_accel_mean_;   // ... accel counts * 2^8)
     uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
-    linalg::Vector3l rest_field_;        // the field (body axes, uT Q16) when the board last seemed to turn
+    linalg::Vector3i rest_field_;        // the field (body axes, uT Q5) when the board last seemed to turn
     linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
     linalg::Vector3l first_half_;        // corrected rates summed over the integration's first half (kTurnScale)
     linalg::Vector3l turn_sum_;          // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
     uint8_t updates_since_renormalise_ = 0;
-    linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q16)
+    linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q17)
     uint32_t heading_norm2_sum_ = 0;     // ... and their squared strengths (uT^2 / 4)
     uint8_t heading_samples_ = 0;
     uint16_t heading_steps_ = 0;         // steps the summed samples stand for
