@@ -107,6 +107,8 @@ void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
 
 Vector3f Dcm::gyro_bias_rad_s() const { return bias_fine_.scaled(gyro_scale_ * (1.0f / (float)(kTurnScale * kTurnScale))); }
 
+Vector3f Dcm::last_mag_field() const { return linalg::scaled(last_field_q5_, 1.0f / (float)(1 << kFieldQ)); }
+
 Vector3l Dcm::bias_units() const {
     return Vector3l((bias_fine_.x + 128) >> 8, (bias_fine_.y + 128) >> 8, (bias_fine_.z + 128) >> 8);
 }
@@ -123,6 +125,7 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
     gyro_scale_ = gyro_rad_s_per_count;
     accel_scale_ = accel_m_s2_per_count;
     units_per_rad_s_ = (float)kTurnScale / gyro_rad_s_per_count;
+    accel_units_per_m_s2_ = (float)kTurnScale / accel_m_s2_per_count;
     if (gyro_ratio != 1.0f) {
         Vector3l* rates[4] = {&bias_fine_, &correction_units_, &sensor_bias_units_, &rest_gyro_mean_};
         for (Vector3l* v : rates) *v = rescaled(*v, gyro_ratio);
@@ -176,7 +179,12 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
         if (north.is_zero()) north = (down.cross(Vector3f(0.0f, 1.0f, 0.0f))).cross(down).normalized();
     } else {
         status_ &= (uint8_t)~kStatusNoHeading;
-        last_mag_field_ = mag_field;
+        const Vector3f kept(linalg::constrain(mag_field.x, -kMaxField_uT, kMaxField_uT),
+                            linalg::constrain(mag_field.y, -kMaxField_uT, kMaxField_uT),
+                            linalg::constrain(mag_field.z, -kMaxField_uT, kMaxField_uT));
+        last_field_q5_ = linalg::Vector3i((int16_t)linalg::fixed_from_float(kept.x, kFieldQ),
+                                          (int16_t)linalg::fixed_from_float(kept.y, kFieldQ),
+                                          (int16_t)linalg::fixed_from_float(kept.z, kFieldQ));
         learn_field(mag_field.length(), down.dot(mag_field.normalized()));
     }
     r_ = linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down));
@@ -239,6 +247,7 @@ void Dcm::set_output_factors() {
     rest_gyro_dev_ = limit_of(settings_->rest_gyro_deviation_rad_s * units_per_rad_s_);
     rest_accel_dev_ = limit_of(settings_->rest_accel_deviation_m_s2 * accel_units_per_m_s2());
     bias_limit_fine_ = linalg::fixed_from_float(settings_->bias_limit_rad_s * units_per_rad_s_ * (float)kTurnScale, 0);
+    ki_fine_ = linalg::fixed_from_float(settings_->ki_rp_1_s2 * correction_dt() * units_per_rad_s_ * (float)kTurnScale, 0);
 }
 
 // |v| >= the limit, from 16x16 products: an axis beyond 16 bits after the shift is.
@@ -316,7 +325,7 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
                          linalg::fixed_from_float(accel_m_s2.y * to_accel, 0),
                          linalg::fixed_from_float(accel_m_s2.z * to_accel, 0)};
     if (!initialised()) {
-        init(accel_m_s2, last_mag_field_);
+        init(accel_m_s2, last_mag_field());
         return;
     }
     step(gyro, accel, gyro_ok, accel_ok, line_due);
@@ -327,7 +336,7 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
     const Vector3l gyro{gyro_counts.x, gyro_counts.y, gyro_counts.z};
     const Vector3l accel{accel_counts.x, accel_counts.y, accel_counts.z};
     if (!initialised()) {
-        init(accel.scaled(accel_scale_), last_mag_field_);
+        init(accel.scaled(accel_scale_), last_mag_field());
         return;
     }
     step(gyro, accel, gyro_valid, accel_valid, line_due);
@@ -511,8 +520,9 @@ void Dcm::correct_gravity() {
         const Vector3l turned = linalg::cross_q30(theta_q30(turn_units), times_256(weighted));
         body = times_256(body);
         body = Vector3l(body.x - turned.x, body.y - turned.y, body.z - turned.z);
-        const int32_t alpha = starting ? q30_of(accel_alpha_ + (startup_accel_alpha_ - accel_alpha_) * startup_left)
-                                       : q30_of(accel_alpha_);
+        const int32_t alpha = starting ? q30_of(startup_accel_alpha_ + (linalg::float_from_fixed(accel_alpha_q30_, 30) -
+                                                                        startup_accel_alpha_) * (1.0f - startup_left))
+                                       : accel_alpha_q30_;
         // Into earth axes by the Q30 matrix, the mean (n^2: n samples, each n times), and
         // the low-pass.
         const Vector3l accel_ef = linalg::mul_q30(r_, body);
@@ -612,17 +622,17 @@ Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(gyro_sca
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     using linalg::fixed_from_float;
     using linalg::mul_q30;
-    // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). The length
-    // in float (a square root and a division); the rest in Q30.
-    const Vector3f lp = accel_lp_ef_.to_float();
-    const float lp2 = lp.length_squared();
-    const float half_g = 0.5f * kGravity_m_s2 * accel_units_per_m_s2();
-    if (!(lp2 > half_g * half_g)) {
+    // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). |lp|^2 / 2^30
+    // in integers (a thousandth of its value at least: 1 g is 2^20 units at 8 g full
+    // scale), 2^15 / |lp| in float (a square root and a division), the rest in Q30.
+    const Vector3l& lp = accel_lp_ef_;
+    const uint32_t lp2 = (uint32_t)mul_q30(lp.x, lp.x) + (uint32_t)mul_q30(lp.y, lp.y) + (uint32_t)mul_q30(lp.z, lp.z);
+    const float inv_lp_q15 = lp2 > 0 ? 32768.0f / sqrtf((float)lp2) : 0.0f;
+    if (!(inv_lp_q15 * (kGravity_m_s2 * accel_units_per_m_s2_) < 2.0f * 1073741824.0f)) {  // |lp| < g/2 (or NaN)
         correction_units_ = Vector3l();
         return;
     }
-    const float inv_lp = 1.0f / sqrtf(lp2);
-    const int32_t n = fixed_from_float(-lp.y * inv_lp, linalg::kQ30), e = fixed_from_float(lp.x * inv_lp, linalg::kQ30);
+    const int32_t n = fixed_from_float(-(float)lp.y * inv_lp_q15, 0), e = fixed_from_float((float)lp.x * inv_lp_q15, 0);
     // In body axes: R^T (error_n, error_e, 0).
     const Vector3l error(mul_q30(n, r_.a.x) + mul_q30(e, r_.b.x), mul_q30(n, r_.a.y) + mul_q30(e, r_.b.y),
                          mul_q30(n, r_.a.z) + mul_q30(e, r_.b.z));
@@ -633,16 +643,15 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const int32_t kp_units = fixed_from_float(kp * units_per_rad_s_, 0);
     correction_units_ = Vector3l(mul_q30(kp_units, error.x), mul_q30(kp_units, error.y), mul_q30(kp_units, error.z));
     if (!hold_integrator) {
-        const int32_t ki_fine = fixed_from_float(settings_->ki_rp_1_s2 * correction_dt() * units_per_rad_s_ * (float)kTurnScale, 0);
-        bias_fine_.x -= mul_q30(ki_fine, error.x);
-        bias_fine_.y -= mul_q30(ki_fine, error.y);
-        bias_fine_.z -= mul_q30(ki_fine, error.z);
+        bias_fine_.x -= mul_q30(ki_fine_, error.x);
+        bias_fine_.y -= mul_q30(ki_fine_, error.y);
+        bias_fine_.z -= mul_q30(ki_fine_, error.z);
         clamp_bias();
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
     // with it ((e_n, e_e, 0) x lp, scaled).
-    const int32_t turn = fixed_from_float(kp * correction_dt(), linalg::kQ30);
+    const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt(), linalg::kQ30) : tilt_turn_q30_;
     const int32_t turn_n = mul_q30(turn, n), turn_e = mul_q30(turn, e);
     const Vector3l old = accel_lp_ef_;
     accel_lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),
@@ -674,7 +683,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         status_ |= kStatusMagIgnored;
         return;
     }
-    last_mag_field_ = mag_field;
+    last_field_q5_ = field;
     // The rest test's witness: a field that moved in body axes since the rest began
     // means the board turns (or a magnet moved): no rest.
     if (moved(field, rest_field_)) {
@@ -904,7 +913,7 @@ bool Dcm::rescale(const Vector3l& row, Vector3l& out) {
 void Dcm::recover() {
     ++recoveries_;
     status_ |= kStatusRecovered;
-    if (!init(last_accel_.scaled(accel_scale_), last_mag_field_)) r_ = linalg::q30_from_matrix(Matrix3f::identity());
+    if (!init(last_accel_.scaled(accel_scale_), last_mag_field())) r_ = linalg::q30_from_matrix(Matrix3f::identity());
 }
 
 }  // namespace dcm

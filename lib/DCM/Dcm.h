@@ -119,8 +119,9 @@ public:
         : settings_(&settings),
           startup_steps_((uint16_t)(settings.startup_s / settings.step_s)),
           inv_startup_steps_(settings.step_s / settings.startup_s),
-          accel_alpha_(settings.step_s * (float)kCorrectionDivider /
-                       (settings.accel_lowpass_s + settings.step_s * (float)kCorrectionDivider)),
+          accel_alpha_q30_(q30_of(settings.step_s * (float)kCorrectionDivider /
+                                  (settings.accel_lowpass_s + settings.step_s * (float)kCorrectionDivider))),
+          tilt_turn_q30_(q30_of(settings.kp_rp_1_s * settings.step_s * (float)kCorrectionDivider)),
           mag_recover_steps_((uint16_t)(settings.mag_recover_s / settings.step_s)),
           rest_min_corrections_((uint16_t)(settings.rest_min_s / (settings.step_s * (float)kCorrectionDivider))),
           rest_alpha_q30_(q30_of(settings.step_s * (float)kCorrectionDivider /
@@ -136,7 +137,9 @@ public:
           hold_rate_(limit_of(settings.integrator_hold_rate_rad_s * kFloatUnitsPerRad_s)),
           rest_gyro_dev_(limit_of(settings.rest_gyro_deviation_rad_s * kFloatUnitsPerRad_s)),
           rest_accel_dev_(limit_of(settings.rest_accel_deviation_m_s2 * ((float)kTurnScale / kFloatAccelScale))),
-          bias_limit_fine_((int32_t)(settings.bias_limit_rad_s * kFloatUnitsPerRad_s * (float)kTurnScale)) {}
+          bias_limit_fine_((int32_t)(settings.bias_limit_rad_s * kFloatUnitsPerRad_s * (float)kTurnScale)),
+          ki_fine_((int32_t)(settings.ki_rp_1_s2 * settings.step_s * (float)kCorrectionDivider * kFloatUnitsPerRad_s *
+                             (float)kTurnScale)) {}
 
     // Start-up attitude from one gravity and one field sample (TRIAD):
     // K = -a/|a| (earth down in body), I = (K x m) x K normalised (north), J = K x I.
@@ -297,7 +300,8 @@ private:
     }
     linalg::Vector3l bias_units() const;  // bias_fine_ rounded to units
     float correction_dt() const { return settings_->step_s * (float)kCorrectionDivider; }  // s between corrections
-    float accel_units_per_m_s2() const { return (float)kTurnScale / accel_scale_; }
+    float accel_units_per_m_s2() const { return accel_units_per_m_s2_; }
+    linalg::Vector3f last_mag_field() const;
     static constexpr int32_t q30_of(float x) { return (int32_t)(x * 1073741824.0f); }
     bool renormalise(int32_t& skew_q30);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3l& row, linalg::Vector3l& out);
@@ -315,7 +319,8 @@ private:
     const DcmSettings* settings_;
     uint16_t startup_steps_;
     float inv_startup_steps_;
-    float accel_alpha_;                  // low-pass factor per correction
+    int32_t accel_alpha_q30_;            // low-pass factor per correction
+    int32_t tilt_turn_q30_;              // kp_rp * the correction interval
     uint16_t mag_recover_steps_;
     uint16_t rest_min_corrections_;
     int32_t rest_alpha_q30_;             // low-pass factor of the rest means, per correction
@@ -333,8 +338,10 @@ private:
     Limit rest_gyro_dev_;                // rest_gyro_deviation_rad_s (units)
     Limit rest_accel_dev_;               // rest_accel_deviation_m_s2 (accel counts * 2^8)
     int32_t bias_limit_fine_;            // bias_limit_rad_s (units * 2^8)
+    int32_t ki_fine_;                    // ki_rp * the correction interval, units * 2^8 per rad/s
     float gyro_scale_ = kFloatGyroScale; // rad/s per count
     float accel_scale_ = kFloatAccelScale; // m/s^2 per count
+    float accel_units_per_m_s2_ = (float)kTurnScale / kFloatAccelScale;  // the accel sums' units (counts * 2^8)
     float units_per_rad_s_ = kFloatUnitsPerRad_s;  // the turn sums' units
     uint16_t lead_steps_q15_ = 0;        // output_lead_s / step_s, Q15 (set_output_factors)
     uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
@@ -345,7 +352,7 @@ private:
     linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
-    linalg::Vector3f last_mag_field_;
+    linalg::Vector3i last_field_q5_;     // for a rebuild if the matrix degenerates (uT * 2^5)
     linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
     linalg::Vector3l accel_sum_;
     linalg::Vector3l rest_gyro_mean_;    // their low-passed means, for the rest test (units,
