@@ -261,6 +261,17 @@ FIXED_INLINE int32_t mul_q30(int32_t a, int32_t x) {
     return (a < 0) != (x < 0) ? -(int32_t)m : (int32_t)m;
 }
 
+// r * x / 2^14 for a Q14 factor r (a Q30 matrix entry rounded to 16 bits: q14_of) and
+// any x: two 16x16 products, half of mul_q30's cost, within 4 units of x's scale plus
+// r's rounding (6e-5 of |x|): for the terms of an update, x small (a turn).
+FIXED_INLINE int16_t q14_of(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
+FIXED_INLINE int32_t mul_q14(int16_t r, int32_t x) {
+    const int16_t xl = (int16_t)(uint16_t)x;
+    const int16_t xh = (int16_t)(uint16_t)(((uint32_t)x - (uint32_t)(int32_t)xl) >> 16);
+    const int32_t high = mul_s16(r, xh) + ((mul_s16(r, xl) + 0x8000) >> 16);
+    return (int32_t)((uint32_t)high << 2);
+}
+
 // The rows' dot product and cross product, each term by mul_q30: Q30 rows give a Q30
 // result; a Q30 row with a vector in other units gives that vector's units.
 int32_t dot_q30(const Vector3l& r, const Vector3l& v);
