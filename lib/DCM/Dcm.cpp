@@ -558,29 +558,49 @@ void Dcm::correct_gravity() {
 // it stretches each row by a^2/2 an update, which renormalising at every update hid.
 void Dcm::integrate() {
     profile::begin(profile::kIntegration);
+    using linalg::mul_q14;
     using linalg::mul_q30;
-    // In Q30 integers (R's entries and the turn, radians): each product is mul_q30, three
-    // 16x16 hardware multiplies (~80 cycles, a float multiply is ~170 and an add ~130).
+    using linalg::q14_of;
+    // In Q30 integers (R's entries and the turn, radians). mul_q30 (three 16x16 hardware
+    // multiplies) where the rows' orthonormality depends on the product; mul_q14 (two)
+    // where a rounding only makes the update turn a little more or less (a rotation error
+    // of a few 1e-7 at most: below the gyro's own resolution over the 20 ms).
     const Vector3l first = theta_q30(first_half_), second = theta_q30(turn_sum_);
     first_half_ = Vector3l();
     turn_sum_ = Vector3l();
     pending_steps_ = 0;
-    const Vector3l coning = linalg::cross_q30(first, second);
-    constexpr int32_t kTwoThirds = 715827883L;  // 2/3 in Q30
-    const Vector3l theta(first.x + second.x + mul_q30(kTwoThirds, coning.x),
-                         first.y + second.y + mul_q30(kTwoThirds, coning.y),
-                         first.z + second.z + mul_q30(kTwoThirds, coning.z));
-    // The three factors' series (Q30 constants: 1/6, 1/24, 1/120, 1/720, 1/5040).
-    constexpr int32_t kOne = 1073741824L, kHalf = 536870912L;
+    // The coning term (2/3) A x B, with A in 16 bits and 2/3 in Q14.
+    const int16_t ax = q14_of(first.x), ay = q14_of(first.y), az = q14_of(first.z);
+    constexpr int16_t kTwoThirdsQ14 = 10923;
+    const Vector3l theta(
+        first.x + second.x + mul_q14(kTwoThirdsQ14, mul_q14(ay, second.z) - mul_q14(az, second.y)),
+        first.y + second.y + mul_q14(kTwoThirdsQ14, mul_q14(az, second.x) - mul_q14(ax, second.z)),
+        first.z + second.z + mul_q14(kTwoThirdsQ14, mul_q14(ax, second.y) - mul_q14(ay, second.x)));
+    // The three factors' series (Q30 constants: 1/6, 1/24, 1/120, 1/720, 1/5040); below
+    // a = 0.03 rad (1.6 rad/s) the terms beyond a^2 are below 2e-9 and left out.
+    constexpr int32_t kOne = 1073741824L, kHalf = 536870912L, kSmallA2 = 1048576L;  // 2^-10
     const int32_t a2 = linalg::dot_q30(theta, theta);
-    const int32_t versine_ratio = kHalf - mul_q30(a2, 44739243L - mul_q30(a2, 1491308L));  // (1 - cos a)/a^2
+    int32_t versine_ratio, sin_ratio;  // (1 - cos a)/a^2 and sin(a)/a
+    if (a2 < kSmallA2) {
+        versine_ratio = kHalf - mul_q30(a2, 44739243L);
+        sin_ratio = kOne - mul_q30(a2, 178956971L);
+    } else {
+        versine_ratio = kHalf - mul_q30(a2, 44739243L - mul_q30(a2, 1491308L));
+        sin_ratio = kOne - mul_q30(a2, 178956971L - mul_q30(a2, 8947849L - mul_q30(a2, 213044L)));
+    }
     const int32_t one_minus_cos = mul_q30(a2, versine_ratio);
-    const int32_t sin_ratio = kOne - mul_q30(a2, 178956971L - mul_q30(a2, 8947849L - mul_q30(a2, 213044L)));
-    const Vector3l sin_theta(mul_q30(sin_ratio, theta.x), mul_q30(sin_ratio, theta.y), mul_q30(sin_ratio, theta.z));
-    const Vector3l versine_theta(mul_q30(versine_ratio, theta.x), mul_q30(versine_ratio, theta.y),
-                                 mul_q30(versine_ratio, theta.z));
-    turn_row(r_.a, theta, sin_theta, versine_theta, one_minus_cos);
-    turn_row(r_.b, theta, sin_theta, versine_theta, one_minus_cos);
+    const int16_t sin_q14 = q14_of(sin_ratio);
+    const Vector3l s(mul_q14(sin_q14, theta.x), mul_q14(sin_q14, theta.y), mul_q14(sin_q14, theta.z));
+    const Vector3l v(mul_q30(versine_ratio, theta.x), mul_q30(versine_ratio, theta.y), mul_q30(versine_ratio, theta.z));
+    // exp([theta x]) - I for a row vector r (r' = r M): D_ij = -(1 - cos a) [i = j] +
+    // v_i theta_j + (s x)_ij, with (r (s x))_j = (r x s)_j; v_i theta_j is symmetric.
+    const int32_t xx = mul_q30(v.x, theta.x) - one_minus_cos, yy = mul_q30(v.y, theta.y) - one_minus_cos,
+                  zz = mul_q30(v.z, theta.z) - one_minus_cos;
+    const int32_t xy = mul_q30(v.x, theta.y), xz = mul_q30(v.x, theta.z), yz = mul_q30(v.y, theta.z);
+    const linalg::Matrix3q30 d{Vector3l(xx, xy - s.z, xz + s.y), Vector3l(xy + s.z, yy, yz - s.x),
+                               Vector3l(xz - s.y, yz + s.x, zz)};
+    turn_row(r_.a, d);
+    turn_row(r_.b, d);
     profile::end(profile::kIntegration);
     profile::begin(profile::kRenormalisation);
     if (++updates_since_renormalise_ >= kRenormaliseEvery) {
@@ -598,16 +618,12 @@ void Dcm::integrate() {
     profile::end(profile::kRenormalisation);
 }
 
-// One row of R turned by Rodrigues' formula: r cos(a) + r x (theta sin(a)/a) + theta (r .
-// theta (1 - cos a)/a^2), in Q30.
-void Dcm::turn_row(Vector3l& r, const Vector3l& theta, const Vector3l& sin_theta, const Vector3l& versine_theta,
-                   int32_t one_minus_cos) {
+// One row of R turned: r + r D (D = exp([theta x]) - I, rows as Matrix3q30), in Q30.
+void Dcm::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
     using linalg::mul_q30;
-    const Vector3l across = linalg::cross_q30(r, sin_theta);
-    const int32_t along = linalg::dot_q30(r, versine_theta);
-    r = Vector3l(r.x - mul_q30(one_minus_cos, r.x) + across.x + mul_q30(along, theta.x),
-                 r.y - mul_q30(one_minus_cos, r.y) + across.y + mul_q30(along, theta.y),
-                 r.z - mul_q30(one_minus_cos, r.z) + across.z + mul_q30(along, theta.z));
+    r = Vector3l(r.x + mul_q30(r.x, d.a.x) + mul_q30(r.y, d.b.x) + mul_q30(r.z, d.c.x),
+                 r.y + mul_q30(r.x, d.a.y) + mul_q30(r.y, d.b.y) + mul_q30(r.z, d.c.y),
+                 r.z + mul_q30(r.x, d.a.z) + mul_q30(r.y, d.b.z) + mul_q30(r.z, d.c.z));
 }
 
 Vector3l Dcm::pending_turn_units() const {

@@ -271,8 +271,7 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void correct_tilt(float startup_left, bool hold_integrator);
     void integrate();
-    static void turn_row(linalg::Vector3l& r, const linalg::Vector3l& theta, const linalg::Vector3l& sin_theta,
-                         const linalg::Vector3l& versine_theta, int32_t one_minus_cos);
+    static void turn_row(linalg::Vector3l& r, const linalg::Matrix3q30& d);
     void correct_gravity();
     void update_offset();
     static float inverse(uint8_t n);
