@@ -627,9 +627,7 @@ void Dcm::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
 }
 
 Vector3l Dcm::pending_turn_units() const {
-    Vector3l sum = first_half_;
-    sum += turn_sum_;
-    return sum;
+    return Vector3l(first_half_.x + turn_sum_.x, first_half_.y + turn_sum_.y, first_half_.z + turn_sum_.z);
 }
 
 Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(turn_rad_per_unit()); }
