@@ -839,11 +839,18 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // correction, so its rate is scaled by interval / step.
     if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
     const float steps = (float)interval_steps;
-    const Vector3f error = linalg::vector_from_q30(r_.c) * -heading_error;
     const bool starting = steps_ < startup_steps_;
-    // Into the turn not yet integrated: applied with the next integration.
-    turn_sum_ += units_of(error * ((starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps));
+    // Into the turn not yet integrated (applied with the next integration): the row in
+    // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
+    // = 2.4e7 units: within 31 bits).
+    const int32_t size_units = linalg::fixed_from_float(
+        -heading_error * (starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps * units_per_rad_s_, 0);
+    using linalg::q14_of;
+    turn_sum_.x += linalg::mul_q14(q14_of(r_.c.x), size_units);
+    turn_sum_.y += linalg::mul_q14(q14_of(r_.c.y), size_units);
+    turn_sum_.z += linalg::mul_q14(q14_of(r_.c.z), size_units);
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
+        const Vector3f error = linalg::vector_from_q30(r_.c) * -heading_error;
         const Vector3f fine = error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * units_per_rad_s_ *
                                        (float)kTurnScale);
         bias_fine_.x -= linalg::fixed_from_float(fine.x, 0);
