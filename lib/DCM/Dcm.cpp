@@ -15,20 +15,23 @@ Vector3l rescaled(const Vector3l& v, float ratio) {
     return Vector3l(linalg::fixed_from_float(f.x, 0), linalg::fixed_from_float(f.y, 0), linalg::fixed_from_float(f.z, 0));
 }
 
-// 1/n and 1/n^2 in Q30 for the window's samples (n = 1..5: a correction late by a step
-// takes five), as code (a table would take RAM on the AVR).
-int32_t inverse_q30(uint8_t n, bool squared) {
+// 1/n in Q30 for the window's samples (n = 1..5: a correction late by a step takes
+// five), as code (a table would take RAM on the AVR).
+int32_t inverse_q30(uint8_t n) {
     switch (n) {
         case 1: return 1073741824L;
-        case 2: return squared ? 268435456L : 536870912L;
-        case 3: return squared ? 119304647L : 357913941L;
-        case 4: return squared ? 67108864L : 268435456L;
-        case 5: return squared ? 42949673L : 214748365L;
-        default: {
-            const float inverse = 1.0f / (float)n;
-            return linalg::fixed_from_float(squared ? inverse * inverse : inverse, linalg::kQ30);
-        }
+        case 2: return 536870912L;
+        case 3: return 357913941L;
+        case 4: return 268435456L;
+        case 5: return 214748365L;
+        default: return linalg::fixed_from_float(1.0f / (float)n, linalg::kQ30);
     }
+}
+
+// A sum's mean: v / n, by two bit shifts in the usual case (n = 4), else by 1/n in Q30.
+Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
+    if (n == 4) return Vector3l(v.x >> 2, v.y >> 2, v.z >> 2);
+    return Vector3l(linalg::mul_q30(inverse_q30, v.x), linalg::mul_q30(inverse_q30, v.y), linalg::mul_q30(inverse_q30, v.z));
 }
 
 // v * 2^8 by byte shifts (a multiply may become avr-gcc's 32x32 routine, ~105 cycles).
@@ -481,18 +484,18 @@ void Dcm::correct_gravity() {
                              hold_rate_);
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
+        using linalg::mul_q14;
         using linalg::mul_q30;
+        using linalg::q14_of;
         const uint8_t n = window_samples_;
-        const int32_t inv_n = inverse_q30(n, false), inv_n2 = inverse_q30(n, true);
+        const int32_t inv_n = inverse_q30(n);
         // The means (units, accel counts * 2^8; |sums| < 2^18 counts): the gyro's less the
         // calibrated bias.
-        const Vector3l gyro_sum = times_256(gyro_sum_), accel_sum_256 = times_256(accel_sum_);
-        const Vector3l gyro_mean(mul_q30(inv_n, gyro_sum.x) - sensor_bias_units_.x,
-                                 mul_q30(inv_n, gyro_sum.y) - sensor_bias_units_.y,
-                                 mul_q30(inv_n, gyro_sum.z) - sensor_bias_units_.z);
-        const Vector3l accel_mean(mul_q30(inv_n, accel_sum_256.x), mul_q30(inv_n, accel_sum_256.y),
-                                  mul_q30(inv_n, accel_sum_256.z));
-        const Vector3l accel_sum = accel_sum_;
+        const Vector3l gyro_raw_mean = per(times_256(gyro_sum_), n, inv_n);
+        const Vector3l accel_sum = times_256(accel_sum_);
+        const Vector3l gyro_mean(gyro_raw_mean.x - sensor_bias_units_.x, gyro_raw_mean.y - sensor_bias_units_.y,
+                                 gyro_raw_mean.z - sensor_bias_units_.z);
+        const Vector3l accel_mean = per(accel_sum, n, inv_n);
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
         // step's sample by the steps not yet integrated (this one among them), so the
@@ -500,41 +503,33 @@ void Dcm::correct_gravity() {
         // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
         // of the running sums, three additions a step. (Weighting each sample, not the
         // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
-        // In integers until the low-pass: counts * 2^8 times n (the window's samples), the
-        // turn per step times n in Q30 radians (from the turn sums' units).
-        Vector3l turn_units(in_turn_units(gyro_sum_.x), in_turn_units(gyro_sum_.y), in_turn_units(gyro_sum_.z));
-        Vector3l weighted = accel_sum_of_sums_, body = Vector3l();
-        for (uint8_t i = 0; i < n; ++i) {
-            turn_units.x -= offset_units_.x;
-            turn_units.y -= offset_units_.y;
-            turn_units.z -= offset_units_.z;
-            body += accel_sum;
+        // In integers: counts * 2^8, the turn per step in 16 bits (Q14 radians: the term
+        // is a few percent of the sum, its rounding 6e-5 rad of it).
+        Vector3l weighted = accel_sum_of_sums_;
+        for (uint8_t i = pending_steps_; i > 0; --i) {
+            weighted.x -= accel_sum_.x;
+            weighted.y -= accel_sum_.y;
+            weighted.z -= accel_sum_.z;
         }
-        for (uint8_t i = 0; i < pending_steps_; ++i) {
-            weighted.x -= accel_sum.x;
-            weighted.y -= accel_sum.y;
-            weighted.z -= accel_sum.z;
-        }
-        // |weighted| < 10 * 2^15 and |n sum| < 2^19 counts: times 2^8 within 2^31.
-        const Vector3l turned = linalg::cross_q30(theta_q30(turn_units), times_256(weighted));
-        body = times_256(body);
-        body = Vector3l(body.x - turned.x, body.y - turned.y, body.z - turned.z);
+        weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
+        const Vector3l turn = theta_q30(Vector3l(gyro_raw_mean.x - offset_units_.x, gyro_raw_mean.y - offset_units_.y,
+                                                 gyro_raw_mean.z - offset_units_.z));
+        const int16_t tx = q14_of(turn.x), ty = q14_of(turn.y), tz = q14_of(turn.z);
+        const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
+                            accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
+                            accel_sum.z - mul_q14(tx, weighted.y) + mul_q14(ty, weighted.x));
         const int32_t alpha = starting ? q30_of(startup_accel_alpha_ + (linalg::float_from_fixed(accel_alpha_q30_, 30) -
                                                                         startup_accel_alpha_) * (1.0f - startup_left))
                                        : accel_alpha_q30_;
-        // Into earth axes by the Q30 matrix, the mean (n^2: n samples, each n times), and
-        // the low-pass.
-        // (The matrix in 16 bits: its rounding turns the earth-frame force by 6e-5 rad at
-        // most, 0.003 deg of tilt.)
-        using linalg::mul_q14;
-        using linalg::q14_of;
-        const Vector3l accel_ef(
-            mul_q14(q14_of(r_.a.x), body.x) + mul_q14(q14_of(r_.a.y), body.y) + mul_q14(q14_of(r_.a.z), body.z),
-            mul_q14(q14_of(r_.b.x), body.x) + mul_q14(q14_of(r_.b.y), body.y) + mul_q14(q14_of(r_.b.z), body.z),
-            mul_q14(q14_of(r_.c.x), body.x) + mul_q14(q14_of(r_.c.y), body.y) + mul_q14(q14_of(r_.c.z), body.z));
-        accel_lp_ef_ += Vector3l(mul_q30(alpha, mul_q30(inv_n2, accel_ef.x) - accel_lp_ef_.x),
-                                 mul_q30(alpha, mul_q30(inv_n2, accel_ef.y) - accel_lp_ef_.y),
-                                 mul_q30(alpha, mul_q30(inv_n2, accel_ef.z) - accel_lp_ef_.z));
+        // Into earth axes by the matrix in 16 bits (its rounding turns the earth-frame
+        // force by 6e-5 rad at most, 0.003 deg of tilt), the mean, and the low-pass.
+        const Vector3l accel_ef = per(
+            Vector3l(mul_q14(q14_of(r_.a.x), body.x) + mul_q14(q14_of(r_.a.y), body.y) + mul_q14(q14_of(r_.a.z), body.z),
+                     mul_q14(q14_of(r_.b.x), body.x) + mul_q14(q14_of(r_.b.y), body.y) + mul_q14(q14_of(r_.b.z), body.z),
+                     mul_q14(q14_of(r_.c.x), body.x) + mul_q14(q14_of(r_.c.y), body.y) + mul_q14(q14_of(r_.c.z), body.z)),
+            n, inv_n);
+        accel_lp_ef_ += Vector3l(mul_q30(alpha, accel_ef.x - accel_lp_ef_.x), mul_q30(alpha, accel_ef.y - accel_lp_ef_.y),
+                                 mul_q30(alpha, accel_ef.z - accel_lp_ef_.z));
         detect_rest(gyro_mean, accel_mean, n >= kCorrectionDivider);
     }
     gyro_sum_ = Vector3l();
