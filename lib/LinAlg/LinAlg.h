@@ -86,27 +86,35 @@ struct Vector3f {
 
 inline Vector3f operator*(float s, const Vector3f& v) { return v * s; }
 
+// The integer vectors' few-instruction members, forced inline on the AVR: out of line
+// (avr-gcc at -Os does that for code used often), each call costs more than its work.
+#ifdef __AVR__
+#define LINALG_INLINE __attribute__((always_inline)) inline
+#else
+#define LINALG_INLINE inline
+#endif
+
 // Integer vectors for the estimator's 200 Hz path: a sensor's samples in its own
 // counts, and their sums (a 32-bit add is ~12 cycles on the AVR, a float add ~130).
 struct Vector3i {
     int16_t x, y, z;
 
-    constexpr Vector3i() : x(0), y(0), z(0) {}
-    constexpr Vector3i(int16_t x_, int16_t y_, int16_t z_) : x(x_), y(y_), z(z_) {}
+    LINALG_INLINE constexpr Vector3i() : x(0), y(0), z(0) {}
+    LINALG_INLINE constexpr Vector3i(int16_t x_, int16_t y_, int16_t z_) : x(x_), y(y_), z(z_) {}
 };
 struct Vector3l {
     int32_t x, y, z;
 
-    constexpr Vector3l() : x(0), y(0), z(0) {}
-    constexpr Vector3l(int32_t x_, int32_t y_, int32_t z_) : x(x_), y(y_), z(z_) {}
+    LINALG_INLINE constexpr Vector3l() : x(0), y(0), z(0) {}
+    LINALG_INLINE constexpr Vector3l(int32_t x_, int32_t y_, int32_t z_) : x(x_), y(y_), z(z_) {}
 
-    Vector3l& operator+=(const Vector3i& v) {
+    LINALG_INLINE Vector3l& operator+=(const Vector3i& v) {
         x += v.x;
         y += v.y;
         z += v.z;
         return *this;
     }
-    Vector3l& operator+=(const Vector3l& v) {
+    LINALG_INLINE Vector3l& operator+=(const Vector3l& v) {
         x += v.x;
         y += v.y;
         z += v.z;
