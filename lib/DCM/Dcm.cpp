@@ -658,20 +658,22 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const float kp = startup_left > 0.0f
                          ? settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left
                          : settings_->kp_rp_1_s;
-    // kp error in units (the gain times units per rad/s: an integer factor on the Q30 error).
+    // kp error in units: the error in 16 bits (Q14: steps of 6e-5 rad, 0.003 deg of tilt)
+    // times the gain in units per rad/s.
     const int32_t kp_units = fixed_from_float(kp * units_per_rad_s_, 0);
-    correction_units_ = Vector3l(mul_q30(kp_units, error.x), mul_q30(kp_units, error.y), mul_q30(kp_units, error.z));
+    const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
+    correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
-        bias_fine_.x -= mul_q30(ki_fine_, error.x);
-        bias_fine_.y -= mul_q30(ki_fine_, error.y);
-        bias_fine_.z -= mul_q30(ki_fine_, error.z);
+        bias_fine_.x -= mul_q14(ex, ki_fine_);
+        bias_fine_.y -= mul_q14(ey, ki_fine_);
+        bias_fine_.z -= mul_q14(ez, ki_fine_);
         clamp_bias();
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
     // with it ((e_n, e_e, 0) x lp, scaled).
     const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt(), linalg::kQ30) : tilt_turn_q30_;
-    const int32_t turn_n = mul_q30(turn, n), turn_e = mul_q30(turn, e);
+    const int32_t turn_n = mul_q14(q14_of(n), turn), turn_e = mul_q14(q14_of(e), turn);
     const Vector3l old = accel_lp_ef_;
     accel_lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),
                              mul_q30(turn_n, old.y) - mul_q30(turn_e, old.x));
