@@ -41,6 +41,8 @@ Vector3l times_256(const Vector3l& v) {
 // A mag correction stands for the time since the previous sample, but never more
 // than this many steps (after an outage the first sample must not make a jump).
 constexpr uint16_t kMaxMagIntervalSteps = 20;
+// A field sample's wait before it is used, counted in its latency up to this (steps).
+constexpr uint8_t kMaxMagAgeSteps = 2;
 // The recent disturbed field, for the new-field test, follows the samples with 53 ms
 // (a fifth of the way at each 75 Hz sample); the learned field tracks slow changes
 // (temperature, location) with 1.3 s.
@@ -63,6 +65,7 @@ constexpr int32_t kMaxRestDifference = 1L << 22;
 // earth-frame field by 6e-5 of its strength at most, 0.004 deg of heading.
 constexpr uint8_t kFieldQ = 5;
 constexpr float kMaxField_uT = 1000.0f;
+constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
 // The sums' units: a squared strength in uT^2 * 2^(2 kFieldQ - kNorm2Shift), the field
 // in earth axes in uT * 2^(kFieldQ + 14 - kEarthFieldShift) (eight samples' sums within 32 bits).
 constexpr uint8_t kNorm2Shift = 4;
@@ -235,10 +238,10 @@ void Dcm::set_output_factors() {
     theta_q26_per_unit_q15_ = fits ? (uint16_t)(k * 32768.0f + 0.5f) : 0;
     // The turn's factor: Q26 radians per unit in Q30 (mul_q30's factor; a 2000 deg/s
     // gyro's 1.40, the float form's 0.08), below 2 for any gyro of 4000 deg/s or less.
-    // The compass sample's latency in steps, whole and Q15 fraction.
-    const float latency_steps = linalg::constrain(settings_->mag_latency_s / settings_->step_s, 0.0f, 100.0f);
-    mag_latency_whole_steps_ = (uint8_t)latency_steps;
-    mag_latency_frac_q15_ = (uint16_t)((latency_steps - (float)mag_latency_whole_steps_) * 32768.0f + 0.5f);
+    // The compass sample's latency in steps, Q12 (with the wait of up to kMaxMagAgeSteps,
+    // below 8 steps in 16 bits: 30 ms at most at 200 Hz).
+    const float latency_steps = linalg::constrain(settings_->mag_latency_s / settings_->step_s, 0.0f, 5.9f);
+    mag_latency_steps_q12_ = (int16_t)(latency_steps * 4096.0f + 0.5f);
     const bool integer_path = k > 0.0f && k < 1.99f;
     theta_factor_q30_ = integer_path ? linalg::fixed_from_float(k, linalg::kQ30) : 0;
     // The units that make kMaxTurnAxisQ26.
@@ -688,15 +691,17 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         return;
     }
     // In integers from here to the mean (~75 Hz): 16 bits, uT * 2^kFieldQ.
+    // (NaN was tested above; an infinity saturates and fails the range test.)
     const float* in[3] = {&mag_field.x, &mag_field.y, &mag_field.z};
     int16_t axis[3];
     uint32_t sample_norm2 = 0;  // uT^2 * 2^(2 kFieldQ - kNorm2Shift)
     for (uint8_t i = 0; i < 3; ++i) {
-        if (!(*in[i] < kMaxField_uT && *in[i] > -kMaxField_uT)) {  // beyond any compass: garbage
+        const int32_t q = fixed_from_float(*in[i], kFieldQ);
+        if (q >= kMaxFieldQ || q <= -kMaxFieldQ) {  // beyond any compass: garbage
             status_ |= kStatusMagIgnored;
             return;
         }
-        axis[i] = (int16_t)fixed_from_float(*in[i], kFieldQ);
+        axis[i] = (int16_t)q;
         sample_norm2 += (uint32_t)linalg::mul_s16(axis[i], axis[i]) >> kNorm2Shift;
     }
     const linalg::Vector3i field(axis[0], axis[1], axis[2]);
@@ -724,13 +729,13 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // The matrix itself is behind the last sample by the turn not yet integrated: the
     // field is brought back by that much (a fixed earth vector seen from the body
     // after a turn p reads v - p x v = v + v x p, so before it v x -p).
-    // Both in the turn sums' units (the rate per step times the latency in steps), then
-    // in Q30 radians as the integration takes them.
-    const Vector3l rate = last_rate_units();
-    Vector3l turn = pending_turn_units();
-    turn = Vector3l(scale_q15(rate.x, mag_latency_frac_q15_) - turn.x, scale_q15(rate.y, mag_latency_frac_q15_) - turn.y,
-                    scale_q15(rate.z, mag_latency_frac_q15_) - turn.z);
-    for (uint8_t n = (uint8_t)(mag_latency_whole_steps_ + age_steps); n > 0; --n) turn += rate;
+    // Both in the turn sums' units (the rate per step times the latency in steps, Q12,
+    // less the pending turn), then in radians as the integration takes them.
+    const uint8_t age = age_steps < kMaxMagAgeSteps ? age_steps : kMaxMagAgeSteps;
+    const int16_t latency_q12 = (int16_t)(mag_latency_steps_q12_ + (int16_t)((uint16_t)age << 12));
+    const Vector3l rate = last_rate_units(), pending = pending_turn_units();
+    const Vector3l turn(linalg::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::mul_q14(latency_q12, rate.y) * 4 - pending.y,
+                        linalg::mul_q14(latency_q12, rate.z) * 4 - pending.z);
     // field + field x turn, the turn in Q15 radians (<= 0.75): Q20, then Q5 again.
     const Vector3l t = theta_q26(turn);
     const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);

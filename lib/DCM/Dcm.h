@@ -38,7 +38,7 @@ struct DcmSettings {
     float mag_dip_tolerance;         // field.down/|field| may differ from the learned one by this
     float mag_recover_s;             // a different field steady this long becomes the reference, s
     float mag_new_min_rate_rad_s;    // ... while the board turned at least this fast on average, rad/s
-    float mag_latency_s;             // age of a field sample against the gyro-propagated attitude, s
+    float mag_latency_s;             // age of a field sample against the gyro-propagated attitude, s (<= 5.9 steps)
     float rest_gyro_deviation_rad_s; // at rest the gyro stays this close to its recent mean, rad/s
     float rest_accel_deviation_m_s2; // ... and the accelerometer this close to its own, m/s^2
     float rest_min_s;                // rest must last this long before the bias is taken from it, s
@@ -346,8 +346,7 @@ private:
     uint16_t theta_q26_per_unit_q15_ = 0;  // Q26 radians per unit of the turn sums, Q15; 0: float path
     int32_t theta_factor_q30_ = 0;       // Q26 radians per unit of the turn sums, Q30; 0: the float path
     int32_t theta_units_limit_ = 0;      // the turn sums' saturation (kMaxTurnAxisQ26)
-    uint16_t mag_latency_frac_q15_ = 0;  // mag_latency_s in steps: its fraction (Q15) ...
-    uint8_t mag_latency_whole_steps_ = 0;  // ... and whole steps
+    int16_t mag_latency_steps_q12_ = 0;  // mag_latency_s in steps (below 6), Q12
     linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
