@@ -271,26 +271,26 @@ bool Dcm::exceeds(const Vector3l& v, const Limit& limit) {
 // The turn sums (units) in Q26 radians, each axis saturated at kMaxTurnAxisQ26: beyond
 // any gyro's range over an integration (2000 deg/s for 20 ms is 0.7 rad), and |theta|^2
 // stays below 2 in Q30. One mul_q30 an axis.
-Vector3l Dcm::theta_q26(const Vector3l& units) const {
-    if (theta_factor_q30_ == 0) {  // scales beyond the integer factor: in float
-        const Vector3f t = units.scaled(turn_rad_per_unit() * 67108864.0f);
-        const float limit = (float)kMaxTurnAxisQ26;
-        return Vector3l(linalg::fixed_from_float(linalg::constrain(t.x, -limit, limit), 0),
-                        linalg::fixed_from_float(linalg::constrain(t.y, -limit, limit), 0),
-                        linalg::fixed_from_float(linalg::constrain(t.z, -limit, limit), 0));
-    }
-    const int32_t* in[3] = {&units.x, &units.y, &units.z};
-    int32_t out[3];
-    for (uint8_t i = 0; i < 3; ++i) {
-        int32_t u = *in[i];
-        if (u > theta_units_limit_) u = theta_units_limit_;
-        if (u < -theta_units_limit_) u = -theta_units_limit_;
-        out[i] = linalg::mul_q30(theta_factor_q30_, u);
-    }
-    return Vector3l(out[0], out[1], out[2]);
+Vector3l Dcm::theta_q26_in_float(const Vector3l& units) const {
+    const Vector3f t = units.scaled(turn_rad_per_unit() * 67108864.0f);
+    const float limit = (float)kMaxTurnAxisQ26;
+    return Vector3l(linalg::fixed_from_float(linalg::constrain(t.x, -limit, limit), 0),
+                    linalg::fixed_from_float(linalg::constrain(t.y, -limit, limit), 0),
+                    linalg::fixed_from_float(linalg::constrain(t.z, -limit, limit), 0));
 }
 
-Vector3l Dcm::theta_q30(const Vector3l& units) const {
+FIXED_INLINE int32_t Dcm::theta_axis_q26(int32_t units) const {
+    if (units > theta_units_limit_) units = theta_units_limit_;
+    if (units < -theta_units_limit_) units = -theta_units_limit_;
+    return linalg::mul_q30(theta_factor_q30_, units);
+}
+
+FIXED_INLINE Vector3l Dcm::theta_q26(const Vector3l& units) const {
+    if (theta_factor_q30_ == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
+    return Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
+}
+
+FIXED_INLINE Vector3l Dcm::theta_q30(const Vector3l& units) const {
     const Vector3l t = theta_q26(units);
     return Vector3l(t.x * 16, t.y * 16, t.z * 16);
 }

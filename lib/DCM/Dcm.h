@@ -305,6 +305,8 @@ private:
     bool renormalise(int32_t& skew_q30);  // skew: the X.Y it found
     static bool rescale(const linalg::Vector3l& row, linalg::Vector3l& out);
     linalg::Vector3l theta_q26(const linalg::Vector3l& units) const;  // the turn sums in Q26 radians
+    linalg::Vector3l theta_q26_in_float(const linalg::Vector3l& units) const;
+    int32_t theta_axis_q26(int32_t units) const;
     linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // ... and in Q30
     void recover();
     void clamp_bias();
