@@ -53,6 +53,24 @@ TEST(Dcm, StaysOrthonormalOverManyRandomRateSteps) {
     EXPECT_EQ(filter.recoveries(), 0);
 }
 
+// One integration (four steps, 50 Hz) of a fast turn is a rotation to a few 1e-7: the
+// fixed-point update keeps the rows' lengths and angles (which is why renormalisation
+// can wait eight updates) and turns by the summed angle, at any axis.
+TEST(Dcm, OneIntegrationIsARotationToAFewE7) {
+    const Vector3f axes[] = {Vector3f(1, 0, 0), Vector3f(0, 0.6f, -0.8f), Vector3f(0.48f, -0.6f, 0.64f)};
+    for (const Vector3f& axis : axes) {
+        dcm::Dcm filter;
+        ASSERT_TRUE(filter.init(Vector3f(0, 0, -kG), earth_field_uT()));
+        const Matrix3f before = filter.matrix();
+        const float rate_rad_s = 25.0f;  // 0.5 rad an integration: the series' design limit
+        for (int i = 0; i < dcm::Dcm::kIntegrationSteps; ++i)
+            filter.update(axis * rate_rad_s, Vector3f(0, 0, -3.0f * kG));  // no gravity weight
+        EXPECT_LT(orthonormality_error(filter.matrix()), 1e-6f);
+        const float turned_rad = angle_between_deg(before, filter.matrix()) * linalg::kRadPerDeg;
+        EXPECT_NEAR(turned_rad, rate_rad_s * filter.settings().step_s * dcm::Dcm::kIntegrationSteps, 2e-5f);
+    }
+}
+
 TEST(Dcm, RemovesAConstantGyroBiasAtRest) {
     std::mt19937 rng(4);
     // 2 deg/s on both horizontal axes (learned from gravity) and 1.5 deg/s on the

@@ -559,10 +559,10 @@ void Dcm::integrate() {
     using linalg::mul_q14;
     using linalg::mul_q30;
     using linalg::q14_of;
-    // In Q30 integers (R's entries and the turn, radians). mul_q30 (three 16x16 hardware
-    // multiplies) where the rows' orthonormality depends on the product; mul_q14 (two)
-    // where a rounding only makes the update turn a little more or less (a rotation error
-    // of a few 1e-7 at most: below the gyro's own resolution over the 20 ms).
+    // In Q30 integers (R's entries and the turn, radians): mul_q30 (13 MULs) where the
+    // update's orthonormality depends on the product; mul_q14 (two 16x16 products) in the
+    // coning term, whose rounding only turns the update a little more or less (a rotation
+    // of a few 1e-7 rad at most, below the gyro's own resolution over the 20 ms).
     const Vector3l first = theta_q30(first_half_), second = theta_q30(turn_sum_);
     first_half_ = Vector3l();
     turn_sum_ = Vector3l();
@@ -587,8 +587,7 @@ void Dcm::integrate() {
         sin_ratio = kOne - mul_q30(a2, 178956971L - mul_q30(a2, 8947849L - mul_q30(a2, 213044L)));
     }
     const int32_t one_minus_cos = mul_q30(a2, versine_ratio);
-    const int16_t sin_q14 = q14_of(sin_ratio);
-    const Vector3l s(mul_q14(sin_q14, theta.x), mul_q14(sin_q14, theta.y), mul_q14(sin_q14, theta.z));
+    const Vector3l s(mul_q30(sin_ratio, theta.x), mul_q30(sin_ratio, theta.y), mul_q30(sin_ratio, theta.z));
     const Vector3l v(mul_q30(versine_ratio, theta.x), mul_q30(versine_ratio, theta.y), mul_q30(versine_ratio, theta.z));
     // exp([theta x]) - I for a row vector r (r' = r M): D_ij = -(1 - cos a) [i = j] +
     // v_i theta_j + (s x)_ij, with (r (s x))_j = (r x s)_j; v_i theta_j is symmetric.
