@@ -347,7 +347,19 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
     step(gyro, accel, gyro_valid, accel_valid, line_due);
 }
 
+// One heavy part a step at most: the integration when kIntegrationSteps are summed with
+// this step (or two or more before an output line, line_due), else the gravity correction
+// when one is due or falls due with this step (a step later costs nothing: it follows a
+// 3 s low-pass).
+Dcm::HeavyPart Dcm::next_heavy_part(bool line_due) const {
+    const uint8_t pending = (uint8_t)(pending_steps_ + 1u);
+    if (pending >= kIntegrationSteps || (line_due && pending >= 2)) return HeavyPart::kIntegration;
+    if (gravity_due_ || correction_phase_ + 1u >= kCorrectionDivider) return HeavyPart::kGravity;
+    return HeavyPart::kNone;
+}
+
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
+    const HeavyPart heavy = next_heavy_part(line_due);
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
     if (!gyro_ok) {
@@ -404,16 +416,11 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
         first_half_ = turn_sum_;
         turn_sum_ = Vector3l();
     }
-    // One heavy part a step at most: the integration when due (or before an output
-    // line, line_due, with two or more steps waiting), else the gravity correction
-    // when due (a step later costs nothing: it follows a 3 s low-pass).
-    heavy_ = true;
-    if (pending_steps_ >= kIntegrationSteps || (line_due && pending_steps_ >= 2)) {
+    heavy_ = heavy != HeavyPart::kNone;
+    if (heavy == HeavyPart::kIntegration) {
         integrate();
-    } else if (gravity_due_) {
+    } else if (heavy == HeavyPart::kGravity) {
         correct_gravity();
-    } else {
-        heavy_ = false;
     }
     if (steps_ < 0xFFFFu) ++steps_;
 }

@@ -181,10 +181,7 @@ public:
     void correct_heading(const linalg::Vector3f& mag_field, uint8_t age_steps = 0);
     // The next update (without a line) integrates or corrects gravity: a caller with
     // deferrable work puts it on another step.
-    bool heavy_due() const {
-        return initialised() && (pending_steps_ + 1u >= kIntegrationSteps || gravity_due_ ||
-                                 correction_phase_ + 1u >= kCorrectionDivider);
-    }
+    bool heavy_due() const { return initialised() && next_heavy_part(false) != HeavyPart::kNone; }
     // A field sample given to correct_heading after the next update completes the
     // average of kHeadingSteps and corrects the heading (the costly part): a caller with
     // deferrable work (an output line, the compass learner) puts it on another step.
@@ -268,6 +265,10 @@ public:
     static constexpr float kFloatUnitsPerRad_s = (float)kTurnScale / kFloatGyroScale;
 
 private:
+    // The heavy part of the next step, from the counters before it: step() does what this
+    // says, heavy_due() tells the caller.
+    enum class HeavyPart : uint8_t { kNone, kIntegration, kGravity };
+    HeavyPart next_heavy_part(bool line_due) const;
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void correct_tilt(float startup_left, bool hold_integrator);
     void integrate();
