@@ -74,9 +74,9 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         }
         return;
     }
-    // The learner's pair is worked out in a later step with neither an output line nor a
-    // heading correction (a pair update is ~15 k cycles: on top of either it would
-    // overrun the 5 ms step); the turn it uses is the gyro's up to this sample.
+    // The learner takes the sample on a later step with neither an output line, a heading
+    // correction nor the DCM's heavy parts (see the end of on_imu_sample); the turn it
+    // uses is the gyro's up to this sample.
     bool turn_restarts = true;  // this sample ends the turn the learner sums
     if (st_.turn_doubtful) {
         // The gyro's turn since the last field sample is not the board's (a spike stood
@@ -124,10 +124,16 @@ void AttitudePipeline::take_learner_sample(const Vector3f& f) {
 // Once the offset has moved by kMagReferenceShift_uT since the DCM learned the earth
 // field, the DCM learns its strength and dip again (not its heading: see Dcm).
 void AttitudePipeline::learn_mag_offset() {
-    st_.learn_pending = false;
     Vector3f& learned = settings_.cal.mag_learned_uT;
     const Vector3f before = learned;
-    if (!learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned)) return;
+    if (learner_.solving()) learner_.solve_part(learned);
+    // The sample waits for the solve (the learner composes no turn meanwhile); it follows
+    // the solve's last part on its step (that part is the estimate's update, ~4 k).
+    if (!learner_.solving() && st_.learn_pending) {
+        st_.learn_pending = false;
+        learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned);
+    }
+    if (learned == before) return;
     mag_cal_uT_ -= learned - before;
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
         forget_mag_reference(false);
@@ -316,15 +322,18 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
     }
 
-    // The deferred compass work (the cal mag sums, the learner: each ~20-50 k cycles on
-    // the AVR) goes on a step with neither an output line, a heading correction nor the
-    // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
-    // two heavy parts beyond an integration with a heading correction or a line (of four
-    // steps two are the DCM's; a sample waits at most a few steps).
+    // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
+    // a sample ~8 k, or one part of a completed pair's solve, <= ~15 k) goes on a step
+    // with neither an output line, a heading correction nor the DCM's integration or
+    // gravity correction (Dcm::heavy_step), so that no step carries two heavy parts
+    // beyond an integration with a heading correction or a line. At 50 lines a second
+    // that is one step in eight (tilt_tour); a pair's solve takes three of them, and the
+    // samples that come meanwhile wait (the turn goes on summing: the learner sees one
+    // sample fewer each time).
     if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
-    if (st_.learn_pending) {
+    if (learner_.solving() || st_.learn_pending) {
         profile::begin(profile::kLearner);
         learn_mag_offset();
         profile::end(profile::kLearner);
