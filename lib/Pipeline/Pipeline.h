@@ -181,6 +181,7 @@ public:
 
 private:
     void step_calibration(const mpu6000::Sample& raw);
+    void prepare_estimator();
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
@@ -224,6 +225,7 @@ private:
         bool mag_cal_active;
         bool output_due;
         bool reinit_pending;
+        bool start_pending;             // prepare_estimator() done: the DCM starts on the next step
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
