@@ -230,10 +230,10 @@ constexpr float kLearnMaxOffset_uT = 50.0f;
 constexpr float kLearnPriorUncalibrated_uT = 30.0f;
 constexpr float kLearnPriorCalibrated_uT = 1.0f;
 
-// Cost on the AVR: a pair's update is ~30 k cycles of float arithmetic, more than a
+// Cost on the AVR: a pair's update is ~34 k cycles of float arithmetic, more than a
 // 5 ms step can carry beside the estimator's own work; so a sample only composes the
-// turn (a quaternion product, ~8 k) and stores a pair that completes, and the pair is
-// worked out by solve_part() in kSolveParts parts of at most ~12 k each, on the caller's
+// turn (a quaternion product, ~7 k) and stores a pair that completes, and the pair is
+// worked out by solve_part() in kSolveParts parts (~14 k, ~14 k, ~5 k), on the caller's
 // next steps with room for them (the Pipeline: those without the DCM's heavy parts or a
 // heading correction), before the next sample: the same arithmetic as one update.
 class OffsetLearner {

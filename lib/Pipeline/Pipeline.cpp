@@ -128,7 +128,7 @@ void AttitudePipeline::learn_mag_offset() {
     const Vector3f before = learned;
     if (learner_.solving()) learner_.solve_part(learned);
     // The sample waits for the solve (the learner composes no turn meanwhile); it follows
-    // the solve's last part on its step (that part is the estimate's update, ~4 k).
+    // the solve's last part on its step (that part is the estimate's update, ~5 k).
     if (!learner_.solving() && st_.learn_pending) {
         st_.learn_pending = false;
         learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned);
