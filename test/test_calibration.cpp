@@ -1,6 +1,7 @@
 // Gyro-bias and magnetometer calibration (lib/Calibration).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "Calibration.h"
@@ -412,6 +413,183 @@ TEST(OffsetLearner, StepsAndOffsetAreBounded) {
     EXPECT_TRUE(run.learned == Vector3f());
 }
 
+// The learner as it was written first, straightforwardly: the turn composed as a 3x3
+// matrix at every sample, the pair solved at once when it completes. The learner
+// composes a quaternion and solves a pair in parts (the AVR's step cannot carry the
+// whole solve); both must give the same estimates but for float rounding.
+namespace {
+struct ReferenceLearner {
+    Matrix3f turn;
+    Vector3f field_ref, estimate, start;
+    float info[6] = {};
+    float prior_info = 1.0f;
+    float reject_share = 0.0f;
+    uint16_t age = 0, updates = 0, rejected = 0;
+    uint8_t significant_run = 0;
+    bool have_ref = false;
+
+    void restart(float prior_uT, const Vector3f& in_use) {
+        have_ref = false;
+        prior_info = 1.0f / (prior_uT * prior_uT);
+        for (float& v : info) v = 0.0f;
+        estimate = start = in_use;
+        reject_share = 0.0f;
+        significant_run = 0;
+    }
+    // exp([t x]) exactly; then the pair's update as Premerlani's eq. 11 in information form.
+    bool add(const Vector3f& f2, const Vector3f& t, uint16_t steps, Vector3f& in_use) {
+        age = (uint16_t)std::min<int>(age + steps, calib::kLearnMaxPairSteps);
+        if (!have_ref || age >= calib::kLearnMaxPairSteps) {
+            turn = Matrix3f::identity();
+            field_ref = f2;
+            age = 0;
+            have_ref = true;
+            return false;
+        }
+        turn = turn * rotation(t);
+        const Matrix3f p = turn;
+        if (0.5f * (p.a.x + p.b.y + p.c.z - 1.0f) > calib::kLearnMinCos) return false;
+        turn = Matrix3f::identity();
+        const Vector3f f1 = field_ref;
+        field_ref = f2;
+        age = 0;
+        const Vector3f r = p * (f2 - estimate) - (f1 - estimate);
+        const Vector3f across = p.mul_transpose(r) - r;  // H^T r
+        const float fade = 1.0f - 1.0f / calib::kLearnMemoryPairs;
+        const float inv_noise = 1.0f / (calib::kLearnPairNoise_uT * calib::kLearnPairNoise_uT);
+        const Matrix3f hth = Matrix3f::identity() * 2.0f - p - p.transposed();
+        float a[6] = {hth.a.x, hth.b.y, hth.c.z, hth.a.y, hth.a.z, hth.b.z};
+        for (int e = 0; e < 6; ++e) a[e] = info[e] * fade + a[e] * inv_noise;
+        const Matrix3f info_new(Vector3f(a[0] + prior_info, a[3], a[4]), Vector3f(a[3], a[1] + prior_info, a[5]),
+                                Vector3f(a[4], a[5], a[2] + prior_info));
+        const float det = info_new.determinant();
+        if (!(det > 0.0f)) return false;
+        // C = A^-1 by Cramer's rule: the cross products of A's rows are its cofactors.
+        const Matrix3f cof(info_new.b.cross(info_new.c), info_new.c.cross(info_new.a), info_new.a.cross(info_new.b));
+        const Matrix3f c = cof.transposed() * (1.0f / det);
+        Vector3f step = c * across * inv_noise;
+        const Vector3f n(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y);  // 2 sin(theta) axis
+        step -= n * (n.dot(step) / n.length_squared());
+        const bool consistent = r.length_squared() - across.dot(step) <
+                                calib::kLearnGate * calib::kLearnGate * calib::kLearnPairNoise_uT *
+                                    calib::kLearnPairNoise_uT;
+        reject_share = reject_share * fade + (consistent ? 0.0f : 1.0f / calib::kLearnMemoryPairs);
+        if (!consistent) {
+            ++rejected;
+            return false;
+        }
+        const float s[3] = {step.x, step.y, step.z};
+        const float var[3] = {c.a.x, c.b.y, c.c.z};
+        float* o = &estimate.x;
+        const float* o0 = &start.x;
+        bool cut = false, at_bound = false, significant = false;
+        for (int i = 0; i < 3; ++i) {
+            const float lim = calib::kLearnMaxStep_uT, bound = calib::kLearnMaxOffset_uT;
+            cut = cut || std::fabs(s[i]) >= lim;
+            o[i] = std::min(bound, std::max(-bound, o[i] + std::min(lim, std::max(-lim, s[i]))));
+            at_bound = at_bound || std::fabs(o[i]) >= bound - lim;
+            const float sig = calib::kLearnSignificance, sys = calib::kLearnSystematic_uT;
+            significant = significant || (o[i] - o0[i]) * (o[i] - o0[i]) > sig * sig * (var[i] + sys * sys);
+        }
+        if (!cut)
+            for (int e = 0; e < 6; ++e) info[e] = a[e];
+        ++updates;
+        if (cut) return false;
+        const bool following = !(in_use == start);
+        significant_run = significant ? (uint8_t)std::min(significant_run + 1, 255) : 0;
+        const bool hard_iron = !at_bound && reject_share <= calib::kLearnMaxRejectShare;
+        const Vector3f use =
+            hard_iron && (significant_run >= calib::kLearnConfirmPairs || following) ? estimate : start;
+        if (use == in_use) return false;
+        in_use = use;
+        return true;
+    }
+};
+
+struct Compared {
+    float worst_estimate_uT = 0.0f;  // largest |x - x_ref| after a sample
+    float worst_in_use_uT = 0.0f;
+    int samples = 0, calls_over_one_part = 0;
+    uint16_t updates = 0, updates_ref = 0, rejected = 0, rejected_ref = 0;
+    Vector3f in_use;
+};
+
+// run_learner's board, fed to both learners; the learner's solve is run a part per call
+// between samples, as the Pipeline runs it (or left to the next add(), parts_between false).
+Compared compare_with_reference(const Vector3f& offset, float noise_uT, float seconds, bool parts_between) {
+    const Vector3f earth(20.0f, 0.0f, 45.0f);
+    calib::OffsetLearner learner;
+    ReferenceLearner ref;
+    learner.restart(calib::kLearnPriorUncalibrated_uT, Vector3f());
+    ref.restart(calib::kLearnPriorUncalibrated_uT, Vector3f());
+    Compared out;
+    Vector3f in_use, in_use_ref, turn;
+    Matrix3f r;
+    uint32_t seed = 5;
+    uint16_t since = 0;
+    for (int i = 0; i < (int)(seconds * 200.0f); ++i) {
+        const float t = (float)i * 0.005f;
+        const Vector3f axis = Vector3f(sinf(0.31f * t), cosf(0.23f * t), sinf(0.17f * t + 1.0f)).normalized();
+        const float rate_rad_s = 1.57f * (1.0f + 0.8f * sinf(0.7f * t));  // 18..160 deg/s
+        r = r * rotation(axis * (rate_rad_s * 0.005f));
+        turn += axis * (rate_rad_s * 0.005f);
+        ++since;
+        if (i % 8 != 0) continue;  // the Pipeline's 25 Hz
+        const Vector3f raw = r.mul_transpose(earth) + offset + Vector3f(gauss(seed), gauss(seed), gauss(seed)) * noise_uT;
+        learner.add(raw, turn, since, in_use);
+        ref.add(raw, turn, since, in_use_ref);
+        if (parts_between) {
+            int parts = 0;
+            while (learner.solving()) {
+                learner.solve_part(in_use);
+                ++parts;
+            }
+            if (parts > 0 && parts != calib::OffsetLearner::kSolveParts) ++out.calls_over_one_part;
+            out.worst_estimate_uT = std::max(out.worst_estimate_uT, (learner.estimate_uT() - ref.estimate).length());
+            out.worst_in_use_uT = std::max(out.worst_in_use_uT, (in_use - in_use_ref).length());
+        }
+        turn = Vector3f();
+        since = 0;
+        ++out.samples;
+    }
+    while (learner.solving()) learner.solve_part(in_use);
+    out.worst_estimate_uT = std::max(out.worst_estimate_uT, (learner.estimate_uT() - ref.estimate).length());
+    out.worst_in_use_uT = std::max(out.worst_in_use_uT, (in_use - in_use_ref).length());
+    out.updates = learner.updates();
+    out.updates_ref = ref.updates;
+    out.rejected = learner.rejected();
+    out.rejected_ref = ref.rejected;
+    out.in_use = in_use;
+    return out;
+}
+}  // namespace
+
+// A hard iron learned (and put in use), a magnet's field that is dropped pair after
+// pair, an offset beyond the bound (steps cut short): the split learner follows the
+// reference pair for pair, to float rounding (0.001 uT is 0.004 deg of a 15 uT field).
+TEST(OffsetLearner, SplitSolveGivesTheReferenceEstimates) {
+    struct Case {
+        Vector3f offset;
+        float noise_uT;
+    } cases[] = {{Vector3f(8.0f, -5.0f, 3.0f), 0.2f}, {Vector3f(8.0f, -5.0f, 3.0f), 8.0f}, {Vector3f(120.0f, 0.0f, 0.0f), 0.2f}};
+    for (const Case& c : cases) {
+        for (bool parts_between : {true, false}) {
+            const Compared k = compare_with_reference(c.offset, c.noise_uT, 60.0f, parts_between);
+            SCOPED_TRACE(testing::Message() << "offset x " << c.offset.x << ", noise " << c.noise_uT << " uT, parts "
+                                            << (parts_between ? "between samples" : "in add()"));
+            EXPECT_GT(k.updates_ref + k.rejected_ref, 100);  // pairs completed
+            EXPECT_EQ(k.updates, k.updates_ref);
+            EXPECT_EQ(k.rejected, k.rejected_ref);
+            EXPECT_LT(k.worst_estimate_uT, 1e-3f);
+            EXPECT_LT(k.worst_in_use_uT, 1e-3f);
+            EXPECT_EQ(k.calls_over_one_part, 0);  // every solve took exactly kSolveParts calls
+        }
+    }
+    // The first case puts the hard iron in use, the third never (at the bound).
+    EXPECT_NEAR(compare_with_reference(Vector3f(8.0f, -5.0f, 3.0f), 0.2f, 60.0f, true).in_use.x, 8.0f, 0.3f);
+    EXPECT_TRUE(compare_with_reference(Vector3f(120.0f, 0.0f, 0.0f), 0.2f, 60.0f, true).in_use == Vector3f());
+}
+
 // ---------------------------------------------------------------------------
 // The start-up calibration as the firmware and the replay tool run it (lib/Pipeline).
 #include <string>
@@ -441,7 +619,10 @@ TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
         p.on_imu_sample(imu(kBias, kLevel));
         if (p.output_due() && first_output < 0) first_output = i;
     }
-    EXPECT_EQ(first_output, calib::kGyroWindow - 1);  // the step that finished the calibration
+    // The DCM starts on the step after the one that finished the calibration (the start's
+    // work is spread over the two); the lines fall on the steps a start on that one gave
+    // them (there, and every 4th from 3 steps on), without the line there.
+    EXPECT_EQ(first_output, calib::kGyroWindow - 1 + (pipeline::kRateHz / p.settings().rate_hz - 1));
     EXPECT_EQ(p.phase(), pipeline::Phase::Running);
     // The mean of what the sensor gave: kBias in whole counts.
     EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, imu(kBias, kLevel).gyro_rad_s().x, 1e-6f);
@@ -475,7 +656,7 @@ TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
         p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
         if (p.output_due()) first_output = i;
     }
-    EXPECT_EQ(first_output, pipeline::kStartupDeadlineSteps - 1);
+    EXPECT_EQ(first_output, pipeline::kStartupDeadlineSteps - 1 + (pipeline::kRateHz / p.settings().rate_hz - 1));
     EXPECT_NE(log.find("# calibrating gyro: board moved, retrying"), std::string::npos);
     EXPECT_NE(log.find("# warn: board not still"), std::string::npos);
     EXPECT_TRUE(p.gyro_calibrating());  // measuring on in the background

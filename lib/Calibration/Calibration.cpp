@@ -346,6 +346,7 @@ MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
 // ---------------------------------------------------------------------------
 void OffsetLearner::restart(float prior_uT, const Vector3f& in_use_uT) {
     have_ref_ = false;
+    solve_part_ = 0;  // a completed pair not yet solved goes too
     prior_info_ = 1.0f / (prior_uT * prior_uT);
     for (uint8_t i = 0; i < 6; ++i) info_[i] = 0.0f;
     estimate_uT_ = start_uT_ = in_use_uT;
@@ -354,46 +355,105 @@ void OffsetLearner::restart(float prior_uT, const Vector3f& in_use_uT) {
 }
 
 bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint16_t steps, Vector3f& in_use_uT) {
-    if (!field_uT.is_finite() || !turn_rad.is_finite()) return false;
+    bool changed = false;
+    while (solving()) changed = solve_part(in_use_uT) || changed;
+    if (!field_uT.is_finite() || !turn_rad.is_finite()) return changed;
+    float* q = turn_;
     age_steps_ = (uint16_t)(age_steps_ + steps < kLearnMaxPairSteps ? age_steps_ + steps : kLearnMaxPairSteps);
     if (!have_ref_ || age_steps_ >= kLearnMaxPairSteps) {
-        turn_ = Matrix3f();  // too old, or none: this sample starts the next pair
+        q[0] = 1.0f;  // too old, or none: this sample starts the next pair
+        q[1] = q[2] = q[3] = 0.0f;
         field_ref_ = field_uT;
         age_steps_ = 0;
         have_ref_ = true;
-        return false;
+        return changed;
     }
-    // P <- P exp([t x]), exp([t x]) = (1 - c a^2) I + s [t x] + c t t^T, a = |t|, to
-    // fourth order: s = 1 - a^2 / 6, c = 1/2 - a^2 / 24 (a <= 0.5 rad between samples).
+    // q <- q dq, dq = (cos(a/2), sin(a/2) t / a) the turn t (a = |t| <= 0.5 rad between
+    // samples): cos(a/2) = 1 - a^2/8 + a^4/384 and sin(a/2)/a = 1/2 - a^2/48 leave dq
+    // unit to 4e-6 and its angle right to 1e-6 rad at 0.5 rad, so q stays a unit
+    // quaternion (float rounding: ~1e-7 a product) without renormalising.
     const float a2 = turn_rad.length_squared();
-    const float sn = 1.0f - a2 * (1.0f / 6.0f), cs = 0.5f - a2 * (1.0f / 24.0f);
-    const Vector3f t = turn_rad, ct = turn_rad * cs;
-    const float d = 1.0f - cs * a2;
-    turn_ = turn_ * Matrix3f(Vector3f(d + ct.x * t.x, ct.x * t.y - sn * t.z, ct.x * t.z + sn * t.y),
-                             Vector3f(ct.y * t.x + sn * t.z, d + ct.y * t.y, ct.y * t.z - sn * t.x),
-                             Vector3f(ct.z * t.x - sn * t.y, ct.z * t.y + sn * t.x, d + ct.z * t.z));
-    // cos theta = (trace P - 1) / 2.
-    const float cos_turn = 0.5f * (turn_.a.x + turn_.b.y + turn_.c.z - 1.0f);
-    if (cos_turn > kLearnMinCos) return false;  // not turned enough yet: keep the pair open
-    // The sample that closes this pair opens the next.
-    const Matrix3f p = turn_;
-    turn_ = Matrix3f();
-    const Vector3f f1 = field_ref_;
-    field_ref_ = field_uT;
+    const float dw = 1.0f - a2 * (0.125f - a2 * (1.0f / 384.0f));
+    const Vector3f d = turn_rad * (0.5f - a2 * (1.0f / 48.0f));
+    const float w = q[0], x = q[1], y = q[2], z = q[3];
+    q[0] = w * dw - x * d.x - y * d.y - z * d.z;
+    q[1] = w * d.x + x * dw + y * d.z - z * d.y;
+    q[2] = w * d.y - x * d.z + y * dw + z * d.x;
+    q[3] = w * d.z + x * d.y - y * d.x + z * dw;
+    // cos theta = 2 w^2 - 1: not turned enough yet, the pair stays open.
+    if (2.0f * q[0] * q[0] - 1.0f > kLearnMinCos) return changed;
+    // The sample that closes this pair opens the next, once the pair is solved.
+    field_next_ = field_uT;
     age_steps_ = 0;
-    // Innovation r = P f2 - f1 - (P - I) x = H (e - x); H^T r = P^T r - r.
-    const Vector3f& x = estimate_uT_;
-    const Vector3f residual = p * (field_uT - x) - (f1 - x);
-    const Vector3f across = p.mul_transpose(residual) - residual;
-    // A = I / prior^2 + L (L faded, this pair's H^T H / sigma^2 added; H^T H = 2 I - P - P^T),
-    // and its inverse C (symmetric: cofactors over the determinant), the posterior
-    // covariance, uT^2.
+    solve_part_ = 1;
+    return changed;
+}
+
+bool OffsetLearner::solve_part(Vector3f& in_use_uT) {
+    switch (solve_part_) {
+        case 1:
+            solve_part_ = solve_residual() ? 2 : kSolveParts + 1;
+            return false;
+        case 2:
+            solve_part_ = solve_step() ? 3 : kSolveParts + 1;
+            return false;
+        case 3: return solve_estimate(in_use_uT);
+        default:  // the pair was dropped by the second part: its third only closes the solve
+            end_solve();
+            return false;
+    }
+}
+
+void OffsetLearner::end_solve() {
+    field_ref_ = field_next_;
+    turn_[0] = 1.0f;
+    turn_[1] = turn_[2] = turn_[3] = 0.0f;
+    solve_part_ = 0;
+}
+
+// First part (~14 k cycles on the AVR): the innovation r = P f2 - f1 - (P - I) x =
+// H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn. Leaves r . r in turn_[0]
+// (q's scalar part is not needed again), H^T r in field_ref_ (f1 is not either), and
+// the rotation's axis for the second part: m = 2 u / sigma in turn_[1..3] (the pair's
+// information H^T H / sigma^2 = |m|^2 I - m m^T) and 1 / |m|^2 in inv_axis2_.
+bool OffsetLearner::solve_residual() {
+    const float w = turn_[0], x = turn_[1], y = turn_[2], z = turn_[3];
+    const float x2 = x + x, y2 = y + y, z2 = z + z;
+    const float xx = x * x2, yy = y * y2, zz = z * z2, xy = x * y2, xz = x * z2, yz = y * z2;
+    const float wx = w * x2, wy = w * y2, wz = w * z2;
+    const Matrix3f p(Vector3f(1.0f - (yy + zz), xy - wz, xz + wy), Vector3f(xy + wz, 1.0f - (xx + zz), yz - wx),
+                     Vector3f(xz - wy, yz + wx, 1.0f - (xx + yy)));
+    const Vector3f& e = estimate_uT_;
+    const Vector3f residual = p * (field_next_ - e) - (field_ref_ - e);
+    field_ref_ = p.mul_transpose(residual) - residual;
+    turn_[0] = residual.length_squared();
+    const float k = 2.0f / kLearnPairNoise_uT;
+    turn_[1] = x * k;
+    turn_[2] = y * k;
+    turn_[3] = z * k;
+    // |u|^2 = sin^2(theta/2) >= 0.03 once the pair is turned by 20 deg.
+    const float m2 = turn_[1] * turn_[1] + turn_[2] * turn_[2] + turn_[3] * turn_[3];
+    if (!(m2 > 0.0f)) return false;
+    inv_axis2_ = 1.0f / m2;
+    return true;
+}
+
+// Second part (~14 k): the information, the step, the gate. A = I / prior^2 + L (L
+// faded, this pair's H^T H / sigma^2 added) and its inverse C (symmetric: cofactors
+// over the determinant), the posterior covariance, uT^2. H^T H = 2 I - P - P^T =
+// 4 (|u|^2 I - u u^T) for the unit q = (w, u). info_ holds L already faded (the third
+// part fades what it takes in). Leaves the step in field_ref_, 1 / det A in turn_[0]
+// and C's diagonal cofactors in turn_[1..3]; false when the pair is dropped.
+bool OffsetLearner::solve_step() {
+    const Vector3f m(turn_[1], turn_[2], turn_[3]);
+    const Vector3f across = field_ref_;
+    const float rr = turn_[0];
     const float fade = 1.0f - 1.0f / kLearnMemoryPairs;
     const float inv_noise = 1.0f / (kLearnPairNoise_uT * kLearnPairNoise_uT);
-    const float hth[6] = {2.0f - 2.0f * p.a.x, 2.0f - 2.0f * p.b.y, 2.0f - 2.0f * p.c.z,
-                          -(p.a.y + p.b.x), -(p.a.z + p.c.x), -(p.b.z + p.c.y)};
+    const float xx = m.x * m.x, yy = m.y * m.y, zz = m.z * m.z;
+    const float hth[6] = {yy + zz, xx + zz, xx + yy, -(m.x * m.y), -(m.x * m.z), -(m.y * m.z)};
     float info[6];
-    for (uint8_t e = 0; e < 6; ++e) info[e] = info_[e] * fade + hth[e] * inv_noise;
+    for (uint8_t e = 0; e < 6; ++e) info[e] = info_[e] + hth[e];
     const float axx = info[0] + prior_info_, ayy = info[1] + prior_info_, azz = info[2] + prior_info_;
     const float axy = info[3], axz = info[4], ayz = info[5];
     const float cxx = ayy * azz - ayz * ayz, cyy = axx * azz - axz * axz, czz = axx * ayy - axy * axy;
@@ -404,32 +464,50 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint
     const Vector3f b = across * (inv_noise * inv_det);
     Vector3f step(cxx * b.x + cxy * b.y + cxz * b.z, cxy * b.x + cyy * b.y + cyz * b.z,
                   cxz * b.x + cyz * b.y + czz * b.z);
-    // A pair says nothing along its rotation axis n (P - P^T = 2 sin(theta) [n x]); what
-    // the solve puts there is the weak prior amplifying the pair's error: taken out.
-    // (v = 2 sin(theta) n: step -= v (v . step) / |v|^2, no square root.)
-    const Vector3f v(p.c.y - p.b.z, p.a.z - p.c.x, p.b.x - p.a.y);
-    const float v2 = v.length_squared();
-    if (!(v2 > 0.0f)) return false;
-    step -= v * (v.dot(step) / v2);
+    // A pair says nothing along its rotation axis, m: what the solve puts there is the
+    // weak prior amplifying the pair's error: taken out (no square root).
+    step -= m * (m.dot(step) * inv_axis2_);
     // The innovation's covariance is S = H C0 H^T + sigma^2 I (C0: the covariance before
     // this pair), and what the step leaves of it is sigma^2 S^-1 r: r^T S^-1 r, the
     // innovation in sigmas squared, is r . (r - H step) / sigma^2 = (r . r - H^T r . step)
     // / sigma^2. Beyond kLearnGate^2 no offset near x explains the pair (a magnet passing,
     // the board carried through a gradient): dropped, x and L unchanged.
-    const bool consistent = residual.length_squared() - across.dot(step) <
-                            kLearnGate * kLearnGate * kLearnPairNoise_uT * kLearnPairNoise_uT;
+    const bool consistent =
+        rr - across.dot(step) < kLearnGate * kLearnGate * kLearnPairNoise_uT * kLearnPairNoise_uT;
     reject_share_ = reject_share_ * fade + (consistent ? 0.0f : 1.0f / kLearnMemoryPairs);
     if (!consistent) {
         if (rejected_ < 0xFFFFu) ++rejected_;
         return false;
     }
-    float* s = &step.x;
+    // A step cut short has not taken the pair in: its information is not counted, or the
+    // next pairs would be judged against an estimate that is not there.
+    const float* s = &step.x;
+    step_cut_ = false;
+    for (uint8_t i = 0; i < 3; ++i) step_cut_ = step_cut_ || !(s[i] > -kLearnMaxStep_uT && s[i] < kLearnMaxStep_uT);
+    if (!step_cut_)
+        for (uint8_t e = 0; e < 6; ++e) info_[e] = info[e];
+    field_ref_ = step;
+    turn_[0] = inv_det;
+    turn_[1] = cxx;
+    turn_[2] = cyy;
+    turn_[3] = czz;
+    return true;
+}
+
+// Third part (~5 k): the estimate moves by the step, and the offset in use follows it
+// once it is significant; the information taken in fades for the next pair.
+bool OffsetLearner::solve_estimate(Vector3f& in_use_uT) {
+    const Vector3f step = field_ref_;
+    const float inv_det = turn_[0];
+    const float var[3] = {turn_[1] * inv_det, turn_[2] * inv_det, turn_[3] * inv_det};
+    end_solve();
+    if (!step_cut_)
+        for (uint8_t e = 0; e < 6; ++e) info_[e] *= 1.0f - 1.0f / kLearnMemoryPairs;
+    const float* s = &step.x;
     float* o = &estimate_uT_.x;
     const float* start = &start_uT_.x;
-    const float var[3] = {cxx * inv_det, cyy * inv_det, czz * inv_det};
-    bool step_cut = false, at_bound = false, significant = false;
+    bool at_bound = false, significant = false;
     for (uint8_t i = 0; i < 3; ++i) {
-        step_cut = step_cut || !(s[i] > -kLearnMaxStep_uT && s[i] < kLearnMaxStep_uT);
         o[i] += linalg::constrain(s[i], -kLearnMaxStep_uT, kLearnMaxStep_uT);
         o[i] = linalg::constrain(o[i], -kLearnMaxOffset_uT, kLearnMaxOffset_uT);
         // At the bound, or one pair's step from it: a magnet (it hovers there).
@@ -438,16 +516,11 @@ bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint
         significant = significant || dev * dev > kLearnSignificance * kLearnSignificance *
                                                      (var[i] + kLearnSystematic_uT * kLearnSystematic_uT);
     }
-    // A step cut short has not taken the pair in: its information is not counted, or the
-    // next pairs would be judged against an estimate that is not there; and an estimate
-    // still on its way is not put in use.
-    if (!step_cut)
-        for (uint8_t e = 0; e < 6; ++e) info_[e] = info[e];
     if (updates_ < 0xFFFFu) ++updates_;
     // Once put in use, the offset follows the estimate (no toggling about the threshold:
     // each change makes the estimator learn the field again); an estimate still on its
     // way (a step cut short) changes nothing.
-    if (step_cut) return false;
+    if (step_cut_) return false;
     const bool following = !(in_use_uT == start_uT_);
     const bool hard_iron = !at_bound && reject_share_ <= kLearnMaxRejectShare;
     significant_run_ = significant ? (uint8_t)(significant_run_ < 255 ? significant_run_ + 1 : 255) : 0;

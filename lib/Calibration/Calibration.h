@@ -230,37 +230,67 @@ constexpr float kLearnMaxOffset_uT = 50.0f;
 constexpr float kLearnPriorUncalibrated_uT = 30.0f;
 constexpr float kLearnPriorCalibrated_uT = 1.0f;
 
+// Cost on the AVR: a pair's update is ~34 k cycles of float arithmetic, more than a
+// 5 ms step can carry beside the estimator's own work; so a sample only composes the
+// turn (a quaternion product, ~7 k) and stores a pair that completes, and the pair is
+// worked out by solve_part() in kSolveParts parts (~14 k, ~14 k, ~5 k), on the caller's
+// next steps with room for them (the Pipeline: those without the DCM's heavy parts or a
+// heading correction), before the next sample: the same arithmetic as one update.
 class OffsetLearner {
 public:
     // Starts afresh from the offset in use (in_use_uT: the estimate's start and the
     // offset kept until a significant one is learned); prior_uT: how far off it may be.
     void restart(float prior_uT, const linalg::Vector3f& in_use_uT);
-    // Drops the pair in progress.
+    // Drops the pair in progress (not one already complete and being solved).
     void forget_pair() { have_ref_ = false; }
     // One field sample (uT, body frame, calibrated but with no learned offset removed),
     // the board's turn since the previous sample (rad, body frame: the gyro's rate
-    // integrated) and the estimator steps since. When a pair completes, updates the
-    // estimate and sets `in_use_uT` (the offset that calibration subtracts); returns true
-    // when that changed.
+    // integrated) and the estimator steps since. A pair being solved is finished first
+    // (all its parts at once: a caller that minds the cost calls solve_part() until
+    // solving() is false before the next sample). When a pair completes it is stored for
+    // solve_part(). Returns true when `in_use_uT` (the offset that calibration
+    // subtracts) changed.
     bool add(const linalg::Vector3f& field_uT, const linalg::Vector3f& turn_rad, uint16_t steps,
              linalg::Vector3f& in_use_uT);
+    // A completed pair waits for solve_part().
+    bool solving() const { return solve_part_ != 0; }
+    // The next part of the pending pair's update (nothing when none): the estimate, and
+    // `in_use_uT` as add() describes; returns true when that changed.
+    bool solve_part(linalg::Vector3f& in_use_uT);
     const linalg::Vector3f& estimate_uT() const { return estimate_uT_; }
     uint16_t updates() const { return updates_; }
     uint16_t rejected() const { return rejected_; }
 
+    static constexpr uint8_t kSolveParts = 3;
+
 private:
-    linalg::Matrix3f turn_;          // P: the board's turn since the pair's first sample
-    linalg::Vector3f field_ref_;     // f1
+    bool solve_residual();
+    bool solve_step();
+    bool solve_estimate(linalg::Vector3f& in_use_uT);
+    void end_solve();
+
+    // The board's turn since the pair's first sample as a quaternion (w, x, y, z): P =
+    // R(q), composed by q <- q dq at each sample (16 multiplies where the 3x3 product
+    // took 27). While a completed pair is solved no sample is composed, and these four
+    // floats carry the solve from part to part: w the innovation's r . r after the
+    // first part, then 1 / det A; (x, y, z) the rotation's axis until the second, then
+    // the posterior's diagonal cofactors.
+    float turn_[4];
+    linalg::Vector3f field_ref_;     // f1; while solving, the pair's H^T r, then its step
+    linalg::Vector3f field_next_;    // while solving, f2: the next pair's first sample
+    float inv_axis2_;                // while solving, 1 / |m|^2 (solve_residual)
     linalg::Vector3f estimate_uT_;   // x
     linalg::Vector3f start_uT_;      // the offset in use at restart
-    float info_[6] = {};             // L, 1/uT^2: xx yy zz, then xy xz yz
+    float info_[6] = {};             // L faded for the next pair, 1/uT^2: xx yy zz, then xy xz yz
     float prior_info_ = 1.0f / (kLearnPriorUncalibrated_uT * kLearnPriorUncalibrated_uT);
     float reject_share_ = 0.0f;      // dropped pairs, averaged over ~kLearnMemoryPairs
     uint16_t age_steps_ = 0;
     uint16_t updates_ = 0;
     uint16_t rejected_ = 0;
     uint8_t significant_run_ = 0;    // pairs in a row with x significant
+    uint8_t solve_part_ = 0;         // the next part of a completed pair (1..kSolveParts), 0: none
     bool have_ref_ = false;
+    bool step_cut_ = false;          // the solve's step was cut to kLearnMaxStep_uT
 };
 
 }  // namespace calib

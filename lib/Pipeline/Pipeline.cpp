@@ -74,9 +74,9 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         }
         return;
     }
-    // The learner's pair is worked out in a later step with neither an output line nor a
-    // heading correction (a pair update is ~15 k cycles: on top of either it would
-    // overrun the 5 ms step); the turn it uses is the gyro's up to this sample.
+    // The learner takes the sample on a later step with neither an output line, a heading
+    // correction nor the DCM's heavy parts (see the end of on_imu_sample); the turn it
+    // uses is the gyro's up to this sample.
     bool turn_restarts = true;  // this sample ends the turn the learner sums
     if (st_.turn_doubtful) {
         // The gyro's turn since the last field sample is not the board's (a spike stood
@@ -124,10 +124,16 @@ void AttitudePipeline::take_learner_sample(const Vector3f& f) {
 // Once the offset has moved by kMagReferenceShift_uT since the DCM learned the earth
 // field, the DCM learns its strength and dip again (not its heading: see Dcm).
 void AttitudePipeline::learn_mag_offset() {
-    st_.learn_pending = false;
     Vector3f& learned = settings_.cal.mag_learned_uT;
     const Vector3f before = learned;
-    if (!learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned)) return;
+    if (learner_.solving()) learner_.solve_part(learned);
+    // The sample waits for the solve (the learner composes no turn meanwhile); it follows
+    // the solve's last part on its step (that part is the estimate's update, ~5 k).
+    if (!learner_.solving() && st_.learn_pending) {
+        st_.learn_pending = false;
+        learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned);
+    }
+    if (learned == before) return;
     mag_cal_uT_ -= learned - before;
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
         forget_mag_reference(false);
@@ -189,10 +195,18 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
         .u32(learner_.updates()).str(TXT(" updates)")).end();
 }
 
-void AttitudePipeline::start_estimator(const Vector3f& gravity) {
-    dcm_ = dcm::Dcm(dcm_.settings());
+// The DCM's scales and sensor bias, before init (~6 k cycles on the AVR). A DCM that has
+// run is reset first (~10 k: a fresh object copied in); at the first start it is as the
+// constructor made it (nothing touches it while calibrating).
+void AttitudePipeline::prepare_estimator() {
+    if (st_.phase == Phase::Running) dcm_ = dcm::Dcm(dcm_.settings());
     dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
     dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
+}
+
+// The DCM started from gravity and the latest field (TRIAD, ~20 k cycles), after
+// prepare_estimator().
+void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
     st_.mag_pending = false;
     // How far off the offset in use may be: a fraction of a uT after `cal mag` or
@@ -215,7 +229,10 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
         print_bias(TXT("# gyro bias: "), false);
         if (st_.phase == Phase::Calibrating) {
-            start_estimator(gyro_cal_.mean_accel_m_s2());
+            // The start's ~60 k cycles in one 5 ms step would overrun it: the message and
+            // the DCM's preparation now, its init on the next step (on_imu_sample).
+            prepare_estimator();
+            st_.start_pending = true;
         } else {
             dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
@@ -224,12 +241,14 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     }
     if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz))
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
-    if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
-        // Never still long enough: run with what we have, keep measuring in the background.
+    if (st_.phase == Phase::Calibrating && !st_.start_pending && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
+        // Never still long enough: run with what we have, keep measuring in the background
+        // (the DCM starts on the next step, from that step's gravity).
         Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
             .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
             .str(TXT(" gyro bias, measuring on")).end();
-        start_estimator(raw.accel_m_s2());
+        prepare_estimator();
+        st_.start_pending = true;
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
@@ -248,6 +267,17 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     ++st_.steps;
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);
+    if (st_.start_pending) {
+        // The start prepared on the step before: from the still window's mean gravity, or
+        // (its deadline passed, the calibration measuring on) from that step's sample, the
+        // one guard() took last.
+        st_.start_pending = false;
+        start_estimator(gyro_cal_.done() ? gyro_cal_.mean_accel_m_s2() : last_.accel_m_s2());
+        // The output accumulator as a start on the step before would have left it: the
+        // lines fall on the steps they had then (a start takes two steps since the DCM's
+        // init is ~20 k cycles), without the one on that step.
+        st_.output_acc = settings_.rate_hz < kRateHz ? settings_.rate_hz : 0;
+    }
     const mpu6000::Sample s = guard(raw);
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
@@ -261,6 +291,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
     if (st_.reinit_pending) {
         st_.reinit_pending = false;
+        prepare_estimator();  // a restart after an outage (rare) takes one step: ~50 k cycles
         start_estimator(s.accel_m_s2());
     }
 
@@ -316,15 +347,18 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
     }
 
-    // The deferred compass work (the cal mag sums, the learner: each ~20-50 k cycles on
-    // the AVR) goes on a step with neither an output line, a heading correction nor the
-    // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
-    // two heavy parts beyond an integration with a heading correction or a line (of four
-    // steps two are the DCM's; a sample waits at most a few steps).
+    // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
+    // a sample ~8 k, or one part of a completed pair's solve, <= ~15 k) goes on a step
+    // with neither an output line, a heading correction nor the DCM's integration or
+    // gravity correction (Dcm::heavy_step), so that no step carries two heavy parts
+    // beyond an integration with a heading correction or a line. At 50 lines a second
+    // that is one step in eight (tilt_tour); a pair's solve takes three of them, and the
+    // samples that come meanwhile wait (the turn goes on summing: the learner sees one
+    // sample fewer each time).
     if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
-    if (st_.learn_pending) {
+    if (learner_.solving() || st_.learn_pending) {
         profile::begin(profile::kLearner);
         learn_mag_offset();
         profile::end(profile::kLearner);

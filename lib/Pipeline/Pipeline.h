@@ -59,7 +59,7 @@ constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the b
 // firmware and in the host replay tool.
 constexpr uint8_t kMagReadMinSteps = 2;
 // The offset learner takes a field sample at most every this many steps (25 Hz): a
-// sample costs it ~10 k cycles (its turn composed), and pairs close at 20 deg of turn
+// sample costs it ~8 k cycles (its turn composed), and pairs close at 20 deg of turn
 // (kLearnMinCos) whatever the rate; the gyro's turn between two samples is summed as a
 // rotation vector, whose error over 40 ms (at most 0.2 rad at 300 deg/s) is below 0.003 rad.
 constexpr uint8_t kLearnMinSteps = 8;
@@ -181,6 +181,7 @@ public:
 
 private:
     void step_calibration(const mpu6000::Sample& raw);
+    void prepare_estimator();
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
@@ -224,6 +225,7 @@ private:
         bool mag_cal_active;
         bool output_due;
         bool reinit_pending;
+        bool start_pending;             // prepare_estimator() done: the DCM starts on the next step
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn

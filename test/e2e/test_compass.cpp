@@ -99,17 +99,48 @@ TEST(Compass, CalMagDuringATumbleIsExactAndAppliedAtOnce) {
     EXPECT_LT(worst, 0.5);
 }
 
+// One section's row of an apm25sim --profile file: count and max cycles (0 when absent).
+struct SectionCycles {
+    unsigned long long count = 0, max = 0;
+};
+SectionCycles profile_section(const std::string& csv, int id) {
+    std::istringstream in(csv);
+    std::string line;
+    SectionCycles s;
+    unsigned long long avg = 0, min = 0, total = 0;
+    int row_id = 0;
+    while (std::getline(in, line))
+        if (std::sscanf(line.c_str(), "%d,%llu,%llu,%llu,%llu,%llu", &row_id, &s.count, &avg, &min, &s.max, &total) == 6 &&
+            row_id == id)
+            return s;
+    return SectionCycles();
+}
+
 // Without `cal mag`: the learner finds the hard iron during the tumble, the estimator
 // keeps using the compass (the corrected field is not taken for a magnet), and the
-// heading at rest is within 1 deg. `status` shows the learned offset.
+// heading at rest is within 1 deg. `status` shows the learned offset. The run's profile
+// (simavr's cycle counts are exact): no call of the learner (profile part 11: a sample,
+// or one part of a pair's solve) above 16 000 cycles, where one step solving a pair took
+// 47-50 k; and the start-up (in the checks, part 12) spread over two steps of at most
+// 30 000 (it was one of ~58 k).
 TEST(Compass, LearnedInMotionWithoutCalMag) {
     REQUIRE_FIRMWARE();
     const std::string csv = tumble_csv();
     ASSERT_FALSE(csv.empty());
     const std::string input = e2e::input_file("status", "status\n");
-    const e2e::SimRun run = e2e::run_sim_file(e2e::firmware_elf(), csv, kSeconds, "--input " + input + " --input-at 45");
+    const std::string profile = e2e::work_dir() + "/learner_profile." + std::to_string(getpid()) + ".csv";
+    const e2e::SimRun run = e2e::run_sim_file(e2e::firmware_elf(), csv, kSeconds,
+                                              "--input " + input + " --input-at 45 --profile " + profile);
     unlink(input.c_str());
     ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    const std::string cycles = e2e::read_text(profile);
+    unlink(profile.c_str());
+    const SectionCycles learner = profile_section(cycles, 11), checks = profile_section(cycles, 12);
+    std::printf("# learner: %llu calls, max %llu cycles; checks max %llu\n", learner.count, learner.max, checks.max);
+    EXPECT_GT(learner.count, 500u) << cycles;
+    EXPECT_LE(learner.max, 16000u) << cycles;
+    EXPECT_GT(checks.count, 0u) << cycles;
+    EXPECT_LE(checks.max, 30000u) << cycles;
     EXPECT_FALSE(e2e::has_non_finite(run.lines));
 
     const double truth = final_true_heading_deg(csv);
