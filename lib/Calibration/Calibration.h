@@ -57,23 +57,35 @@ public:
     };
 
     void restart();
-    // Feeds one sample (raw gyro, raw accel); returns what happened.
+    // Feeds one sample in the MPU6000's counts and their scales (rad/s and m/s^2 per
+    // count); returns what happened. In integers (~0.5 k cycles a sample on the AVR where
+    // floats took 6.5 k: it runs at every step while it measures, in the background too).
+    Result add(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, float gyro_rad_s_per_count,
+               float accel_m_s2_per_count);
+    // The same in SI units (tests, tools), held in fine counts (kFloatGyroScale,
+    // kFloatAccelScale: +-4 rad/s and +-16 m/s^2, beyond any still board).
     Result add(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2);
     bool done() const { return done_; }
     // Valid once done(), until the next add().
-    linalg::Vector3f bias() const { return linalg::Vector3f(sum_[0], sum_[1], sum_[2]); }
+    linalg::Vector3f bias() const { return mean(0, gyro_scale_); }
     // Mean specific force over the still window (gravity for the DCM init); likewise.
-    linalg::Vector3f mean_accel_m_s2() const { return linalg::Vector3f(sum_[3], sum_[4], sum_[5]); }
+    linalg::Vector3f mean_accel_m_s2() const { return mean(3, accel_scale_); }
     uint16_t count() const { return n_; }
     uint16_t restarts() const { return restarts_; }
 
+    static constexpr float kFloatGyroScale = 1.0f / 8192.0f;
+    static constexpr float kFloatAccelScale = 1.0f / 2048.0f;
+
 private:
+    linalg::Vector3f mean(uint8_t first, float scale) const;
     // Plain arrays, gyro x y z then accel x y z: one loop does all six channels, and
     // the object needs no constructor code. Valid from the first add() of a window
-    // (n_ == 0 starts them). Once done(), sum_ holds the means (the bias, then the mean
-    // accel): the result needs no RAM of its own.
-    float sum_[6] = {};
-    float lo_[6], hi_[6];
+    // (n_ == 0 starts them, and the limits in counts for the window's scales).
+    int32_t sum_[6] = {};
+    int16_t lo_[6], hi_[6];
+    uint16_t spread_max_[2];     // gyro, accel: the spreads in counts
+    uint32_t norm2_min_, norm2_max_;  // |accel|^2 in counts^2 for 1 g -+ kAccelNormTol_g
+    float gyro_scale_ = 0.0f, accel_scale_ = 0.0f;
     uint16_t n_ = 0;
     uint16_t restarts_ = 0;
     bool done_ = false;

@@ -221,7 +221,8 @@ void AttitudePipeline::start_estimator(const Vector3f& gravity) {
 }
 
 void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
-    const calib::GyroCalibrator::Result r = gyro_cal_.add(raw.gyro_rad_s(), raw.accel_m_s2());
+    const calib::GyroCalibrator::Result r =
+        gyro_cal_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count);
     ++st_.gyro_cal_steps;
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
