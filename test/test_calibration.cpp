@@ -619,10 +619,7 @@ TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
         p.on_imu_sample(imu(kBias, kLevel));
         if (p.output_due() && first_output < 0) first_output = i;
     }
-    // The DCM starts on the step after the one that finished the calibration (the start's
-    // work is spread over the two); the lines fall on the steps a start on that one gave
-    // them (there, and every 4th from 3 steps on), without the line there.
-    EXPECT_EQ(first_output, calib::kGyroWindow - 1 + (pipeline::kRateHz / p.settings().rate_hz - 1));
+    EXPECT_EQ(first_output, calib::kGyroWindow - 1);  // the step that finished the calibration
     EXPECT_EQ(p.phase(), pipeline::Phase::Running);
     // The mean of what the sensor gave: kBias in whole counts.
     EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, imu(kBias, kLevel).gyro_rad_s().x, 1e-6f);
@@ -656,7 +653,7 @@ TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
         p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
         if (p.output_due()) first_output = i;
     }
-    EXPECT_EQ(first_output, pipeline::kStartupDeadlineSteps - 1 + (pipeline::kRateHz / p.settings().rate_hz - 1));
+    EXPECT_EQ(first_output, pipeline::kStartupDeadlineSteps - 1);
     EXPECT_NE(log.find("# calibrating gyro: board moved, retrying"), std::string::npos);
     EXPECT_NE(log.find("# warn: board not still"), std::string::npos);
     EXPECT_TRUE(p.gyro_calibrating());  // measuring on in the background

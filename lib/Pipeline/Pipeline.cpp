@@ -195,12 +195,15 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
         .u32(learner_.updates()).str(TXT(" updates)")).end();
 }
 
-// The DCM's scales and sensor bias, before init (~6 k cycles on the AVR). A DCM that has
-// run is reset first (~10 k: a fresh object copied in); at the first start it is as the
-// constructor made it (nothing touches it while calibrating).
+// The DCM's scales and sensor bias, before init. A DCM that has run is reset first (~10 k
+// cycles: a fresh object copied in) and given its scales; at the first start it is as the
+// constructor made it with the scales set when the calibration began (nothing else
+// touches it while calibrating): only the bias is set (~2 k), on the step that starts it.
 void AttitudePipeline::prepare_estimator() {
-    if (st_.phase == Phase::Running) dcm_ = dcm::Dcm(dcm_.settings());
-    dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
+    if (st_.phase == Phase::Running) {
+        dcm_ = dcm::Dcm(dcm_.settings());
+        dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
+    }
     dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
 }
 
@@ -228,12 +231,12 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
-        print_bias(TXT("# gyro bias: "), false);
+        // The message (~11 k cycles) goes out on the next step: with the start's work this
+        // one would overrun its 5 ms.
+        st_.bias_message_pending = true;
         if (st_.phase == Phase::Calibrating) {
-            // The start's ~60 k cycles in one 5 ms step would overrun it: the message and
-            // the DCM's preparation now, its init on the next step (on_imu_sample).
             prepare_estimator();
-            st_.start_pending = true;
+            start_estimator(gyro_cal_.mean_accel_m_s2());
         } else {
             dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
@@ -242,14 +245,13 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     }
     if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz))
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
-    if (st_.phase == Phase::Calibrating && !st_.start_pending && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
-        // Never still long enough: run with what we have, keep measuring in the background
-        // (the DCM starts on the next step, from that step's gravity).
+    if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
+        // Never still long enough: run with what we have, keep measuring in the background.
         Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
             .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
             .str(TXT(" gyro bias, measuring on")).end();
         prepare_estimator();
-        st_.start_pending = true;
+        start_estimator(raw.accel_m_s2());
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
@@ -268,20 +270,15 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     ++st_.steps;
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);
-    if (st_.start_pending) {
-        // The start prepared on the step before: from the still window's mean gravity, or
-        // (its deadline passed, the calibration measuring on) from that step's sample, the
-        // one guard() took last.
-        st_.start_pending = false;
-        start_estimator(gyro_cal_.done() ? gyro_cal_.mean_accel_m_s2() : last_.accel_m_s2());
-        // The output accumulator as a start on the step before would have left it: the
-        // lines fall on the steps they had then (a start takes two steps since the DCM's
-        // init is ~20 k cycles), without the one on that step.
-        st_.output_acc = settings_.rate_hz < kRateHz ? settings_.rate_hz : 0;
+    if (st_.bias_message_pending) {
+        st_.bias_message_pending = false;
+        print_bias(TXT("# gyro bias: "), false);
     }
     const mpu6000::Sample s = guard(raw);
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
+        // The DCM's scales now (~4 k cycles): the step that ends the calibration starts it.
+        dcm_.set_sample_scales(s.gyro_rad_s_per_count, s.accel_m_s2_per_count);
         Writer(log_).str(TXT("# calibrating gyro: keep the board still")).end();
         start_gyro_calibration();
     }

@@ -225,7 +225,7 @@ private:
         bool mag_cal_active;
         bool output_due;
         bool reinit_pending;
-        bool start_pending;             // prepare_estimator() done: the DCM starts on the next step
+        bool bias_message_pending;      // the calibration's result is printed on the next step
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
