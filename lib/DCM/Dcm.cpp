@@ -170,14 +170,16 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     if (!accel_m_s2.is_finite()) return false;
     const Vector3f down = (-accel_m_s2).normalized();  // specific force points up
     if (down.is_zero()) return false;
-    const Vector3f accel_units = accel_m_s2 * (1.0f / accel_scale_);  // for a rebuild (recover)
+    const Vector3f accel_units = accel_m_s2 * (accel_units_per_m_s2_ * (1.0f / (float)kTurnScale));  // for a rebuild
     last_accel_ = Vector3l(linalg::fixed_from_float(accel_units.x, 0), linalg::fixed_from_float(accel_units.y, 0),
                            linalg::fixed_from_float(accel_units.z, 0));
 
     // North: the field's component perpendicular to down. Without a usable field,
     // the body x axis projected on the horizontal (yaw 0), or body y at pitch 90.
     Vector3f north;
-    if (mag_field.is_finite()) north = (down.cross(mag_field)).cross(down).normalized();
+    // (d x m) x d = m - d (d . m) for a unit d: one dot product where two cross products were.
+    const float field_down = mag_field.is_finite() ? down.dot(mag_field) : 0.0f;
+    if (mag_field.is_finite()) north = (mag_field - down * field_down).normalized();
     if (north.is_zero()) {
         status_ |= kStatusNoHeading;
         north = (down.cross(Vector3f(1.0f, 0.0f, 0.0f))).cross(down).normalized();
@@ -190,7 +192,8 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
         last_field_q5_ = linalg::Vector3i((int16_t)linalg::fixed_from_float(kept.x, kFieldQ),
                                           (int16_t)linalg::fixed_from_float(kept.y, kFieldQ),
                                           (int16_t)linalg::fixed_from_float(kept.z, kFieldQ));
-        learn_field(mag_field.length(), down.dot(mag_field.normalized()));
+        const float norm = mag_field.length();
+        learn_field(norm, field_down / norm);
     }
     r_ = linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down));
     // The integer factors of the scales, unless set_sample_scales set them (the float

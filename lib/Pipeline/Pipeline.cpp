@@ -233,7 +233,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
         // The message (~11 k cycles) goes out on the next step: with the start's work this
         // one would overrun its 5 ms.
-        st_.bias_message_pending = true;
+        st_.start_message = StartMessage::kBias;
         if (st_.phase == Phase::Calibrating) {
             prepare_estimator();
             start_estimator(gyro_cal_.mean_accel_m_s2());
@@ -246,10 +246,9 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz))
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
     if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
-        // Never still long enough: run with what we have, keep measuring in the background.
-        Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
-            .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
-            .str(TXT(" gyro bias, measuring on")).end();
+        // Never still long enough: run with what we have, keep measuring in the background
+        // (the warning on the next step, as the bias message).
+        st_.start_message = StartMessage::kNotStill;
         prepare_estimator();
         start_estimator(raw.accel_m_s2());
         return;
@@ -270,10 +269,13 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     ++st_.steps;
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);
-    if (st_.bias_message_pending) {
-        st_.bias_message_pending = false;
-        print_bias(TXT("# gyro bias: "), false);
+    if (st_.start_message == StartMessage::kBias) print_bias(TXT("# gyro bias: "), false);
+    if (st_.start_message == StartMessage::kNotStill) {
+        Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
+            .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
+            .str(TXT(" gyro bias, measuring on")).end();
     }
+    st_.start_message = StartMessage::kNone;
     const mpu6000::Sample s = guard(raw);
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;

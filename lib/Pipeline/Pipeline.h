@@ -90,6 +90,10 @@ enum class Phase : uint8_t {
     Running,      // estimating
 };
 
+// A message of the start, printed on the step after the one that starts the estimator
+// (with the start's work that step would overrun its 5 ms).
+enum class StartMessage : uint8_t { kNone, kBias, kNotStill };
+
 struct Angles {
     float roll_deg;
     float pitch_deg;
@@ -225,7 +229,7 @@ private:
         bool mag_cal_active;
         bool output_due;
         bool reinit_pending;
-        bool bias_message_pending;      // the calibration's result is printed on the next step
+        StartMessage start_message;     // printed on the step after the calibration's end
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
