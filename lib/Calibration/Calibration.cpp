@@ -73,7 +73,10 @@ GyroCalibrator::Result GyroCalibrator::add(const Vector3f& gyro_rad_s, const Vec
 GyroCalibrator::Result GyroCalibrator::add(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts,
                                            float gyro_rad_s_per_count, float accel_m_s2_per_count) {
     if (done_) restart();
-    if (n_ == 0) {  // a new window: its limits in counts (a few float operations, once)
+    if (gyro_rad_s_per_count != gyro_scale_ || accel_m_s2_per_count != accel_scale_) {
+        // New scales (the first sample): the limits in counts (a few float operations,
+        // once: a board that keeps moving restarts the window every few samples).
+        restart();
         gyro_scale_ = gyro_rad_s_per_count;
         accel_scale_ = accel_m_s2_per_count;
         spread_max_[0] = (uint16_t)linalg::constrain(kGyroSpreadMax_rad_s / gyro_rad_s_per_count, 0.0f, 65535.0f);
@@ -82,9 +85,6 @@ GyroCalibrator::Result GyroCalibrator::add(const linalg::Vector3i& gyro_counts, 
         const float lo = g_counts * (1.0f - kAccelNormTol_g), hi = g_counts * (1.0f + kAccelNormTol_g);
         norm2_min_ = (uint32_t)linalg::constrain(lo * lo, 0.0f, 4.0e9f);
         norm2_max_ = (uint32_t)linalg::constrain(hi * hi, 0.0f, 4.0e9f);
-    } else if (gyro_rad_s_per_count != gyro_scale_ || accel_m_s2_per_count != accel_scale_) {
-        restart();  // the range changed under the window: start again
-        return add(gyro_counts, accel_counts, gyro_rad_s_per_count, accel_m_s2_per_count);
     }
     const int16_t v[6] = {gyro_counts.x, gyro_counts.y, gyro_counts.z, accel_counts.x, accel_counts.y, accel_counts.z};
     const uint32_t norm2 = (uint32_t)linalg::mul_s16(v[3], v[3]) + (uint32_t)linalg::mul_s16(v[4], v[4]) +

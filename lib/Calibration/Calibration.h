@@ -80,7 +80,7 @@ private:
     linalg::Vector3f mean(uint8_t first, float scale) const;
     // Plain arrays, gyro x y z then accel x y z: one loop does all six channels, and
     // the object needs no constructor code. Valid from the first add() of a window
-    // (n_ == 0 starts them, and the limits in counts for the window's scales).
+    // (n_ == 0 starts them); the limits in counts follow the scales (set when they change).
     int32_t sum_[6] = {};
     int16_t lo_[6], hi_[6];
     uint16_t spread_max_[2];     // gyro, accel: the spreads in counts
