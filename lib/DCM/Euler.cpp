@@ -71,11 +71,9 @@ namespace {
 
 FIXED_INLINE int32_t q30(float entry) { return linalg::fixed_from_float(entry, linalg::kQ30); }
 
-// A Q30 entry rounded to its top 16 bits (Q14) for the first-order terms: moves a
-// term by 2^-15 * |theta|, ~3e-7 at the output's typical theta (0.01 rad).
-// (In unsigned arithmetic: the rounding add wraps for an entry saturated at 2^31 - 1,
-// a garbage matrix, instead of overflowing.)
-FIXED_INLINE int16_t q14(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
+// The entries rounded to their top 16 bits (linalg::q14_of) for the first-order terms:
+// a term moves by 2^-15 * |theta|, ~3e-7 at the output's typical theta (0.01 rad).
+using linalg::q14_of;
 
 // theta in int16: Q17 covers +-0.25 rad in steps of 7.6e-6 rad; below 2^-10 rad
 // (0.33 rad/s over the 3 ms lead: a slow turn, a board at rest) Q25 steps of 3e-8 rad.
@@ -105,7 +103,7 @@ FIXED_INLINE int32_t plus_cross(int32_t e, const Theta& t, int16_t p, int16_t tp
 
 // e + p tp - q tq for three Q30 entries of a row.
 FIXED_INLINE int32_t carried_entry(const Theta& t, int32_t e, int32_t p, int16_t tp, int32_t q, int16_t tq) {
-    return plus_cross(e, t, q14(p), tp, q14(q), tq);
+    return plus_cross(e, t, q14_of(p), tp, q14_of(q), tq);
 }
 
 // One conversion per axis (Q26): rounded to Q25 when all three are within 2^-10 rad,
@@ -142,7 +140,7 @@ EulerQ24 euler_carried_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int
     // only the entries the angles read: the third row, then R11 and R21, or at the
     // lock R12 and R22.
     const int32_t c0 = r.c.x, c1 = r.c.y, c2 = r.c.z;
-    const int16_t c0h = q14(c0), c1h = q14(c1), c2h = q14(c2);
+    const int16_t c0h = q14_of(c0), c1h = q14_of(c1), c2h = q14_of(c2);
     EulerQ24 e;
     const bool away_from_lock = roll_pitch(plus_cross(c0, t, c1h, t.z, c2h, t.y),  // R31
                                            plus_cross(c1, t, c2h, t.x, c0h, t.z),  // R32

@@ -264,6 +264,8 @@ FIXED_INLINE int32_t mul_q30(int32_t a, int32_t x) {
 // r * x / 2^14 for a Q14 factor r (a Q30 matrix entry rounded to 16 bits: q14_of) and
 // any x: two 16x16 products, half of mul_q30's cost, within 4 units of x's scale plus
 // r's rounding (6e-5 of |x|): for the terms of an update, x small (a turn).
+// (In unsigned arithmetic: the rounding add wraps for an entry saturated at 2^31 - 1, a
+// garbage matrix, instead of overflowing.)
 FIXED_INLINE int16_t q14_of(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
 FIXED_INLINE int32_t mul_q14(int16_t r, int32_t x) {
     const int16_t xl = (int16_t)(uint16_t)x;
