@@ -10,10 +10,7 @@ using linalg::Vector3f;
 using linalg::Vector3l;
 
 namespace {
-Vector3l rescaled(const Vector3l& v, float ratio) {
-    const Vector3f f = v.scaled(ratio);
-    return Vector3l(linalg::fixed_from_float(f.x, 0), linalg::fixed_from_float(f.y, 0), linalg::fixed_from_float(f.z, 0));
-}
+Vector3l rescaled(const Vector3l& v, float ratio) { return linalg::fixed_from_vector(v.scaled(ratio), 0); }
 
 // 1/n in Q30 for the window's samples (n = 1..5: a correction late by a step takes
 // five), as code (a table would take RAM on the AVR).
@@ -103,9 +100,7 @@ int32_t row_times(const Vector3l& row, const linalg::Vector3i& v) {
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    const Vector3f fine = bias * (units_per_rad_s_ * (float)kTurnScale);
-    bias_fine_ = Vector3l(linalg::fixed_from_float(fine.x, 0), linalg::fixed_from_float(fine.y, 0),
-                          linalg::fixed_from_float(fine.z, 0));
+    bias_fine_ = linalg::fixed_from_vector(bias * (units_per_rad_s_ * (float)kTurnScale), 0);
     clamp_bias();
     update_offset();
 }
@@ -146,15 +141,11 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
 // What each step subtracts from the gyro, in the integer units of the turn sums
 // (counts * 2^kTurnFraction).
 void Dcm::update_offset() {
-    const Vector3l bias = bias_units();
-    offset_units_ = Vector3l(sensor_bias_units_.x + bias.x - correction_units_.x,
-                             sensor_bias_units_.y + bias.y - correction_units_.y,
-                             sensor_bias_units_.z + bias.z - correction_units_.z);
+    offset_units_ = sensor_bias_units_ + bias_units() - correction_units_;
 }
 
 Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
-    const Vector3f u = rate_rad_s * units_per_rad_s_;
-    return Vector3l{linalg::fixed_from_float(u.x, 0), linalg::fixed_from_float(u.y, 0), linalg::fixed_from_float(u.z, 0)};
+    return linalg::fixed_from_vector(rate_rad_s * units_per_rad_s_, 0);
 }
 
 // Each axis within the range of any accelerometer (16 g): three comparisons where
@@ -170,9 +161,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     if (!accel_m_s2.is_finite()) return false;
     const Vector3f down = (-accel_m_s2).normalized();  // specific force points up
     if (down.is_zero()) return false;
-    const Vector3f accel_units = accel_m_s2 * (accel_units_per_m_s2_ * (1.0f / (float)kTurnScale));  // for a rebuild
-    last_accel_ = Vector3l(linalg::fixed_from_float(accel_units.x, 0), linalg::fixed_from_float(accel_units.y, 0),
-                           linalg::fixed_from_float(accel_units.z, 0));
+    last_accel_ = linalg::fixed_from_vector(accel_m_s2 * (accel_units_per_m_s2_ * (1.0f / (float)kTurnScale)), 0);  // for a rebuild
 
     // North: the field's component perpendicular to down. Without a usable field,
     // the body x axis projected on the horizontal (yaw 0), or body y at pitch 90.
@@ -216,9 +205,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     heading_norm2_sum_ = 0;
     heading_samples_ = 0;
     heading_steps_ = 0;
-    const Vector3f accel_mean = accel_m_s2 * per_m_s2;
-    rest_accel_mean_ = Vector3l(linalg::fixed_from_float(accel_mean.x, 0), linalg::fixed_from_float(accel_mean.y, 0),
-                                linalg::fixed_from_float(accel_mean.z, 0));
+    rest_accel_mean_ = linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0);
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
@@ -277,9 +264,9 @@ bool Dcm::exceeds(const Vector3l& v, const Limit& limit) {
 Vector3l Dcm::theta_q26_in_float(const Vector3l& units) const {
     const Vector3f t = units.scaled(turn_rad_per_unit() * 67108864.0f);
     const float limit = (float)kMaxTurnAxisQ26;
-    return Vector3l(linalg::fixed_from_float(linalg::constrain(t.x, -limit, limit), 0),
-                    linalg::fixed_from_float(linalg::constrain(t.y, -limit, limit), 0),
-                    linalg::fixed_from_float(linalg::constrain(t.z, -limit, limit), 0));
+    return linalg::fixed_from_vector(
+        Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit), linalg::constrain(t.z, -limit, limit)),
+        0);
 }
 
 FIXED_INLINE int32_t Dcm::theta_axis_q26(int32_t units) const {
@@ -323,15 +310,8 @@ void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool li
     // NaN and infinity fail these comparisons too: such samples are rejected.
     const bool gyro_ok = gyro_rad_s.length_squared() < kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s;
     const bool accel_ok = accel_plausible(accel_m_s2);
-    const float to_gyro = 1.0f / kFloatGyroScale, to_accel = 1.0f / kFloatAccelScale;
-    Vector3l gyro, accel;
-    if (gyro_ok)
-        gyro = Vector3l{linalg::fixed_from_float(gyro_rad_s.x * to_gyro, 0), linalg::fixed_from_float(gyro_rad_s.y * to_gyro, 0),
-                        linalg::fixed_from_float(gyro_rad_s.z * to_gyro, 0)};
-    if (accel_ok)
-        accel = Vector3l{linalg::fixed_from_float(accel_m_s2.x * to_accel, 0),
-                         linalg::fixed_from_float(accel_m_s2.y * to_accel, 0),
-                         linalg::fixed_from_float(accel_m_s2.z * to_accel, 0)};
+    const Vector3l gyro = gyro_ok ? linalg::fixed_from_vector(gyro_rad_s * (1.0f / kFloatGyroScale), 0) : Vector3l();
+    const Vector3l accel = accel_ok ? linalg::fixed_from_vector(accel_m_s2 * (1.0f / kFloatAccelScale), 0) : Vector3l();
     if (!initialised()) {
         init(accel_m_s2, last_mag_field());
         return;
@@ -435,7 +415,8 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
 // the compass can measure well: the bias estimate moves to the mean gyro reading with
 // rest_bias_s. The MPU6000's rate noise, 0.005 deg/s/sqrt(Hz), averages to ~0.004 deg/s
 // over the 0.5 s mean; a hand-held board's tremor is below 2 deg/s and 0.5 m/s^2.
-void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, bool whole_window) {
+void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, const Vector3l& mean_off_bias,
+                      bool whole_window) {
     using linalg::mul_q30;
     status_ &= (uint8_t)~kStatusAtRest;
     // A steady turn passes the deviation test too. The compass tells: at rest the field
@@ -444,13 +425,8 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, boo
     // within the tremor bound of the bias estimate instead (VQF's rule, its 2 deg/s
     // bias clip): a larger vertical bias is then not told from a slow turn.
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
-    const Vector3l gyro_change(gyro_mean.x - rest_gyro_mean_.x, gyro_mean.y - rest_gyro_mean_.y,
-                               gyro_mean.z - rest_gyro_mean_.z);
-    const Vector3l accel_change(accel_mean.x - rest_accel_mean_.x, accel_mean.y - rest_accel_mean_.y,
-                                accel_mean.z - rest_accel_mean_.z);
-    const Vector3l bias = bias_units();
-    const Vector3l off_bias(rest_gyro_mean_.x - bias.x, rest_gyro_mean_.y - bias.y, rest_gyro_mean_.z - bias.z);
-    const bool still = !exceeds(gyro_change, rest_gyro_dev_) && (compass_watching || !exceeds(off_bias, rest_gyro_dev_)) &&
+    const Vector3l gyro_change = gyro_mean - rest_gyro_mean_, accel_change = accel_mean - rest_accel_mean_;
+    const bool still = !exceeds(gyro_change, rest_gyro_dev_) && (compass_watching || !exceeds(mean_off_bias, rest_gyro_dev_)) &&
                        !exceeds(accel_change, rest_accel_dev_);
     rest_gyro_mean_ += Vector3l(mul_q30(rest_alpha_q30_, gyro_change.x), mul_q30(rest_alpha_q30_, gyro_change.y),
                                 mul_q30(rest_alpha_q30_, gyro_change.z));
@@ -491,10 +467,8 @@ void Dcm::correct_gravity() {
     // error that averages out, while a hand's or a vehicle's turn does not (shake, a
     // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
     // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
-    const Vector3l bias = bias_units();
-    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 ||
-                     exceeds(Vector3l(rest_gyro_mean_.x - bias.x, rest_gyro_mean_.y - bias.y, rest_gyro_mean_.z - bias.z),
-                             hold_rate_);
+    const Vector3l mean_off_bias = rest_gyro_mean_ - bias_units();  // the rest mean's turn (units)
+    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, hold_rate_);
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
         using linalg::mul_q14;
@@ -506,8 +480,7 @@ void Dcm::correct_gravity() {
         // calibrated bias.
         const Vector3l gyro_raw_mean = per(times_256(gyro_sum_), n, inv_n);
         const Vector3l accel_sum = times_256(accel_sum_);
-        const Vector3l gyro_mean(gyro_raw_mean.x - sensor_bias_units_.x, gyro_raw_mean.y - sensor_bias_units_.y,
-                                 gyro_raw_mean.z - sensor_bias_units_.z);
+        const Vector3l gyro_mean = gyro_raw_mean - sensor_bias_units_;
         const Vector3l accel_mean = per(accel_sum, n, inv_n);
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
@@ -525,8 +498,7 @@ void Dcm::correct_gravity() {
             weighted.z -= accel_sum_.z;
         }
         weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
-        const Vector3l turn = theta_q30(Vector3l(gyro_raw_mean.x - offset_units_.x, gyro_raw_mean.y - offset_units_.y,
-                                                 gyro_raw_mean.z - offset_units_.z));
+        const Vector3l turn = theta_q30(gyro_raw_mean - offset_units_);
         const int16_t tx = q14_of(turn.x), ty = q14_of(turn.y), tz = q14_of(turn.z);
         const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
                             accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
@@ -543,7 +515,7 @@ void Dcm::correct_gravity() {
             n, inv_n);
         accel_lp_ef_ += Vector3l(mul_q30(alpha, accel_ef.x - accel_lp_ef_.x), mul_q30(alpha, accel_ef.y - accel_lp_ef_.y),
                                  mul_q30(alpha, accel_ef.z - accel_lp_ef_.z));
-        detect_rest(gyro_mean, accel_mean, n >= kCorrectionDivider);
+        detect_rest(gyro_mean, accel_mean, mean_off_bias, n >= kCorrectionDivider);
     }
     gyro_sum_ = Vector3l();
     accel_sum_ = Vector3l();
@@ -634,7 +606,7 @@ void Dcm::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
 }
 
 Vector3l Dcm::pending_turn_units() const {
-    return Vector3l(first_half_.x + turn_sum_.x, first_half_.y + turn_sum_.y, first_half_.z + turn_sum_.z);
+    return first_half_ + turn_sum_;
 }
 
 Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(turn_rad_per_unit()); }
@@ -862,11 +834,8 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     turn_sum_.z += linalg::mul_q14(q14_of(r_.c.z), size_units);
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
         const Vector3f error = linalg::vector_from_q30(r_.c) * -heading_error;
-        const Vector3f fine = error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * units_per_rad_s_ *
-                                       (float)kTurnScale);
-        bias_fine_.x -= linalg::fixed_from_float(fine.x, 0);
-        bias_fine_.y -= linalg::fixed_from_float(fine.y, 0);
-        bias_fine_.z -= linalg::fixed_from_float(fine.z, 0);
+        bias_fine_ -= linalg::fixed_from_vector(
+            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * units_per_rad_s_ * (float)kTurnScale), 0);
         clamp_bias();
         update_offset();
     }
@@ -945,7 +914,7 @@ bool Dcm::rescale(const Vector3l& row, Vector3l& out) {
     // in float, unless the matrix is hopeless.
     const float length2_f = linalg::float_from_fixed((int32_t)(length2 / 2), 29);
     if (!(length2_f > 0.25f && length2_f < 4.0f)) return false;
-    out = linalg::q30_from_vector(linalg::vector_from_q30(row) * (1.0f / sqrtf(length2_f)));
+    out = linalg::fixed_from_vector(linalg::vector_from_q30(row) * (1.0f / sqrtf(length2_f)), linalg::kQ30);
     return true;
 }
 

@@ -290,7 +290,9 @@ private:
     linalg::Vector3f pending_turn_rad() const;
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
     linalg::Vector3f last_rate_rad_s() const;
-    void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean, bool whole_window);
+    // mean_off_bias: the rest test's gyro mean less the bias estimate (the hold test's too).
+    void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean,
+                     const linalg::Vector3l& mean_off_bias, bool whole_window);
     static bool exceeds(const linalg::Vector3l& v, const Limit& limit);
     // A limit L as a shift s and (L / 2^s)^2 with L / 2^s below 2^14: a vector that stays
     // within 16 bits after the shift up to twice the limit, and the limit resolved to 2^-13.

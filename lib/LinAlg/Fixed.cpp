@@ -12,8 +12,8 @@ Vector3l cross_q30(const Vector3l& r, const Vector3l& v) {
 
 Vector3l mul_q30(const Matrix3q30& r, const Vector3l& v) { return Vector3l(dot_q30(r.a, v), dot_q30(r.b, v), dot_q30(r.c, v)); }
 
-Vector3l q30_from_vector(const Vector3f& v) {
-    return Vector3l(fixed_from_float(v.x, kQ30), fixed_from_float(v.y, kQ30), fixed_from_float(v.z, kQ30));
+Vector3l fixed_from_vector(const Vector3f& v, uint8_t frac_bits) {
+    return Vector3l(fixed_from_float(v.x, frac_bits), fixed_from_float(v.y, frac_bits), fixed_from_float(v.z, frac_bits));
 }
 
 Vector3f vector_from_q30(const Vector3l& v) {
@@ -21,7 +21,7 @@ Vector3f vector_from_q30(const Vector3l& v) {
 }
 
 Matrix3q30 q30_from_matrix(const Matrix3f& m) {
-    return Matrix3q30{q30_from_vector(m.a), q30_from_vector(m.b), q30_from_vector(m.c)};
+    return Matrix3q30{fixed_from_vector(m.a, kQ30), fixed_from_vector(m.b, kQ30), fixed_from_vector(m.c, kQ30)};
 }
 
 Matrix3f matrix_from_q30(const Matrix3q30& m) {

@@ -120,6 +120,14 @@ struct Vector3l {
         z += v.z;
         return *this;
     }
+    LINALG_INLINE Vector3l& operator-=(const Vector3l& v) {
+        x -= v.x;
+        y -= v.y;
+        z -= v.z;
+        return *this;
+    }
+    LINALG_INLINE Vector3l operator+(const Vector3l& v) const { return Vector3l(x + v.x, y + v.y, z + v.z); }
+    LINALG_INLINE Vector3l operator-(const Vector3l& v) const { return Vector3l(x - v.x, y - v.y, z - v.z); }
     Vector3f to_float() const { return Vector3f((float)x, (float)y, (float)z); }
     // The vector times a scale, in float (three conversions and three multiplies).
     Vector3f scaled(float s) const { return Vector3f((float)x * s, (float)y * s, (float)z * s); }
