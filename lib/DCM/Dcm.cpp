@@ -218,20 +218,21 @@ FIXED_INLINE int32_t Dcm::scale_q15(int32_t x, uint16_t c) {
     return x < 0 ? -(int32_t)product : (int32_t)product;
 }
 
-// The output's two factors in Q15 (0: beyond 2, the float path): the lead in steps,
-// and Q26 radians per unit of the turn sums.
+// What follows from the scales: the output's two factors in Q15 (0: beyond 2, the float
+// path), the lead in steps and Q26 radians per unit of the turn sums; the compass
+// latency; the turn's factor; the limits and gains in the sums' units.
 void Dcm::set_output_factors() {
     const float lead_steps = settings_->output_lead_s / settings_->step_s;
     const float k = gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale) * 67108864.0f;  // 2^26
     const bool fits = lead_steps >= 0.0f && lead_steps < 1.99f && k > 0.0f && k < 1.99f;
     lead_steps_q15_ = fits ? (uint16_t)(lead_steps * 32768.0f + 0.5f) : 0;
     theta_q26_per_unit_q15_ = fits ? (uint16_t)(k * 32768.0f + 0.5f) : 0;
-    // The turn's factor: Q26 radians per unit in Q30 (mul_q30's factor; a 2000 deg/s
-    // gyro's 1.40, the float form's 0.08), below 2 for any gyro of 4000 deg/s or less.
     // The compass sample's latency in steps, Q12 (with the wait of up to kMaxMagAgeSteps,
     // below 8 steps in 16 bits: 30 ms at most at 200 Hz).
     const float latency_steps = linalg::constrain(settings_->mag_latency_s / settings_->step_s, 0.0f, 5.9f);
     mag_latency_steps_q12_ = (int16_t)(latency_steps * 4096.0f + 0.5f);
+    // The turn's factor: Q26 radians per unit in Q30 (mul_q30's factor; a 2000 deg/s
+    // gyro's 1.40, the float form's 0.08), below 2 for any gyro of 4000 deg/s or less.
     const bool integer_path = k > 0.0f && k < 1.99f;
     theta_factor_q30_ = integer_path ? linalg::fixed_from_float(k, linalg::kQ30) : 0;
     // The units that make kMaxTurnAxisQ26.
@@ -717,7 +718,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const Vector3l rate = last_rate_units(), pending = pending_turn_units();
     const Vector3l turn(linalg::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::mul_q14(latency_q12, rate.y) * 4 - pending.y,
                         linalg::mul_q14(latency_q12, rate.z) * 4 - pending.z);
-    // field + field x turn, the turn in Q15 radians (<= 0.75): Q20, then Q5 again.
+    // field + field x turn, the turn in Q16 radians (saturated at 0.5): Q21, then Q5 again.
     const Vector3l t = theta_q26(turn);
     const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);
     using linalg::mul_s16;

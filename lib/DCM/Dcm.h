@@ -155,8 +155,8 @@ public:
     // sample gets no weight.
     // line_due: an output line follows this step; the matrix is brought up to date for it
     // (Dcm::integrate when two or more steps wait; one is carried by euler_now()).
-    // The sample in the sensor's counts (the firmware's path: integer sums at 200 Hz,
-    // floats only on the steps that use them), scaled by set_sample_scales; the gyro
+    // The sample in the sensor's counts (the firmware's path: integer sums at 200 Hz and
+    // fixed point in the parts that use them), scaled by set_sample_scales; the gyro
     // counts carry the sensor bias set by set_sensor_bias_rad_s. gyro_valid false: the
     // rate is beyond any MEMS gyro (kMaxCredibleRate_rad_s: every axis at full scale, a
     // stuck or broken read) and is not integrated, nor is the accel sample used.

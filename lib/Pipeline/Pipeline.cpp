@@ -195,21 +195,16 @@ void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
         .u32(learner_.updates()).str(TXT(" updates)")).end();
 }
 
-// The DCM's scales and sensor bias, before init. A DCM that has run is reset first (~10 k
-// cycles: a fresh object copied in) and given its scales; at the first start it is as the
-// constructor made it with the scales set when the calibration began (nothing else
-// touches it while calibrating): only the bias is set (~2 k), on the step that starts it.
-void AttitudePipeline::prepare_estimator() {
+// The DCM started from gravity and the latest field (TRIAD, ~20 k cycles). A DCM that has
+// run is reset first (~10 k: a fresh object copied in) and given its scales; at the first
+// start it is as the constructor made it with the scales set when the calibration began
+// (nothing else touches it while calibrating): only the sensor bias is set (~2 k).
+void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     if (st_.phase == Phase::Running) {
         dcm_ = dcm::Dcm(dcm_.settings());
         dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
     }
     dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
-}
-
-// The DCM started from gravity and the latest field (TRIAD, ~20 k cycles), after
-// prepare_estimator().
-void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
     st_.mag_pending = false;
     // How far off the offset in use may be: a fraction of a uT after `cal mag` or
@@ -235,7 +230,6 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         // one would overrun its 5 ms.
         st_.start_message = StartMessage::kBias;
         if (st_.phase == Phase::Calibrating) {
-            prepare_estimator();
             start_estimator(gyro_cal_.mean_accel_m_s2());
         } else {
             dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
@@ -249,7 +243,6 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         // Never still long enough: run with what we have, keep measuring in the background
         // (the warning on the next step, as the bias message).
         st_.start_message = StartMessage::kNotStill;
-        prepare_estimator();
         start_estimator(raw.accel_m_s2());
         return;
     }
@@ -291,8 +284,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
     if (st_.reinit_pending) {
         st_.reinit_pending = false;
-        prepare_estimator();  // a restart after an outage (rare) takes one step: ~50 k cycles
-        start_estimator(s.accel_m_s2());
+        start_estimator(s.accel_m_s2());  // a restart after an outage (rare): ~50 k cycles
     }
 
     // A clipped accelerometer sample still points roughly the right way: in a violent

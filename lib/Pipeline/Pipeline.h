@@ -185,7 +185,6 @@ public:
 
 private:
     void step_calibration(const mpu6000::Sample& raw);
-    void prepare_estimator();
     void start_estimator(const linalg::Vector3f& gravity);
     mpu6000::Sample guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
