@@ -22,6 +22,7 @@
 #include "Mpu6000.h"
 #include "Mpu6000Model.h"
 #include "Pipeline.h"
+#include "Text.h"
 #include "Trajectory.h"
 
 namespace {
@@ -128,8 +129,9 @@ void log_write(void*, const char* data, uint8_t len) { fwrite(data, 1, len, stde
 
 // Hundredths of a degree as the firmware prints them ("-0.05", never "-0.00").
 void print_centideg(int32_t c, char end) {
-    const long m = c < 0 ? -(long)c : (long)c;
-    printf("%s%ld.%02ld%c", c < 0 ? "-" : "", m / 100, m % 100, end);
+    char buf[16];
+    const uint8_t n = text::format_fixed(buf, c, 2);
+    printf("%.*s%c", (int)n, buf, end);
 }
 
 }  // namespace
