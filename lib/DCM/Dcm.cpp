@@ -244,6 +244,10 @@ void Dcm::set_output_factors() {
     rest_accel_dev_ = limit_of(settings_->rest_accel_deviation_m_s2 * accel_units_per_m_s2());
     bias_limit_fine_ = linalg::fixed_from_float(settings_->bias_limit_rad_s * units_per_rad_s_ * (float)kTurnScale, 0);
     ki_fine_ = linalg::fixed_from_float(settings_->ki_rp_1_s2 * correction_dt() * units_per_rad_s_ * (float)kTurnScale, 0);
+    kp_units_ = linalg::fixed_from_float(settings_->kp_rp_1_s * units_per_rad_s_, 0);
+    // |lp| = g/2 in correct_tilt's |lp|^2 / 2^30 (lp in accel counts * 2^8).
+    const float half_g_units = 0.5f * kGravity_m_s2 * accel_units_per_m_s2_;
+    min_lp2_ = (uint32_t)(half_g_units * half_g_units * (1.0f / 1073741824.0f));
 }
 
 // |v| >= the limit, from 16x16 products: an axis beyond 16 bits after the shift is.
@@ -429,10 +433,12 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     const Vector3l gyro_change = gyro_mean - rest_gyro_mean_, accel_change = accel_mean - rest_accel_mean_;
     const bool still = !exceeds(gyro_change, rest_gyro_dev_) && (compass_watching || !exceeds(mean_off_bias, rest_gyro_dev_)) &&
                        !exceeds(accel_change, rest_accel_dev_);
-    rest_gyro_mean_ += Vector3l(mul_q30(rest_alpha_q30_, gyro_change.x), mul_q30(rest_alpha_q30_, gyro_change.y),
-                                mul_q30(rest_alpha_q30_, gyro_change.z));
-    rest_accel_mean_ += Vector3l(mul_q30(rest_alpha_q30_, accel_change.x), mul_q30(rest_alpha_q30_, accel_change.y),
-                                 mul_q30(rest_alpha_q30_, accel_change.z));
+    // The means' low-pass, its factor in 16 bits (two 16x16 products an axis).
+    using linalg::mul_q14;
+    rest_gyro_mean_ += Vector3l(mul_q14(rest_alpha_q14_, gyro_change.x), mul_q14(rest_alpha_q14_, gyro_change.y),
+                                mul_q14(rest_alpha_q14_, gyro_change.z));
+    rest_accel_mean_ += Vector3l(mul_q14(rest_alpha_q14_, accel_change.x), mul_q14(rest_alpha_q14_, accel_change.y),
+                                 mul_q14(rest_alpha_q14_, accel_change.z));
     if (!still || !whole_window) {
         rest_corrections_ = 0;
         return;
@@ -627,11 +633,11 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // scale), 2^15 / |lp| in float (a square root and a division), the rest in Q30.
     const Vector3l& lp = accel_lp_ef_;
     const uint32_t lp2 = (uint32_t)mul_q30(lp.x, lp.x) + (uint32_t)mul_q30(lp.y, lp.y) + (uint32_t)mul_q30(lp.z, lp.z);
-    const float inv_lp_q15 = lp2 > 0 ? 32768.0f / sqrtf((float)lp2) : 0.0f;
-    if (!(inv_lp_q15 * (kGravity_m_s2 * accel_units_per_m_s2_) < 2.0f * 1073741824.0f)) {  // |lp| < g/2 (or NaN)
+    if (lp2 <= min_lp2_) {  // |lp| < g/2: no direction to trust
         correction_units_ = Vector3l();
         return;
     }
+    const float inv_lp_q15 = 32768.0f / sqrtf((float)lp2);
     const int32_t n = fixed_from_float(-(float)lp.y * inv_lp_q15, 0), e = fixed_from_float((float)lp.x * inv_lp_q15, 0);
     // In body axes: R^T (error_n, error_e, 0), the matrix in 16 bits (an error of 6e-5 of
     // the correction).
@@ -645,7 +651,7 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
                          : settings_->kp_rp_1_s;
     // kp error in units: the error in 16 bits (Q14: steps of 6e-5 rad, 0.003 deg of tilt)
     // times the gain in units per rad/s.
-    const int32_t kp_units = fixed_from_float(kp * units_per_rad_s_, 0);
+    const int32_t kp_units = startup_left > 0.0f ? fixed_from_float(kp * units_per_rad_s_, 0) : kp_units_;
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {

@@ -124,8 +124,8 @@ public:
           tilt_turn_q30_(q30_of(settings.kp_rp_1_s * settings.step_s * (float)kCorrectionDivider)),
           mag_recover_steps_((uint16_t)(settings.mag_recover_s / settings.step_s)),
           rest_min_corrections_((uint16_t)(settings.rest_min_s / (settings.step_s * (float)kCorrectionDivider))),
-          rest_alpha_q30_(q30_of(settings.step_s * (float)kCorrectionDivider /
-                                 (kRestMeanTau_s + settings.step_s * (float)kCorrectionDivider))),
+          rest_alpha_q14_((int16_t)(16384.0f * settings.step_s * (float)kCorrectionDivider /
+                                        (kRestMeanTau_s + settings.step_s * (float)kCorrectionDivider) + 0.5f)),
           rest_bias_alpha_q30_(settings.rest_bias_s > 0.0f
                                    ? q30_of(settings.step_s * (float)kCorrectionDivider /
                                             (settings.rest_bias_s + settings.step_s * (float)kCorrectionDivider))
@@ -327,7 +327,7 @@ private:
     int32_t tilt_turn_q30_;              // kp_rp * the correction interval
     uint16_t mag_recover_steps_;
     uint16_t rest_min_corrections_;
-    int32_t rest_alpha_q30_;             // low-pass factor of the rest means, per correction
+    int16_t rest_alpha_q14_;             // low-pass factor of the rest means, per correction (0.04: 2e-4 rounding)
     int32_t rest_bias_alpha_q30_;        // bias step towards the rest mean, per correction
     float startup_accel_alpha_;          // the accel low-pass factor at the start of the ramp, per correction
     float mag_new_min_turn_rad_;         // how far the board must turn while a new field stays steady
@@ -343,6 +343,8 @@ private:
     Limit rest_accel_dev_;               // rest_accel_deviation_m_s2 (accel counts * 2^8)
     int32_t bias_limit_fine_;            // bias_limit_rad_s (units * 2^8)
     int32_t ki_fine_;                    // ki_rp * the correction interval, units * 2^8 per rad/s
+    int32_t kp_units_ = 0;               // kp_rp in units per rad/s (set_output_factors)
+    uint32_t min_lp2_ = 0;               // (g/2)^2 as correct_tilt's |lp|^2 (set_output_factors)
     float gyro_scale_ = kFloatGyroScale; // rad/s per count
     float accel_scale_ = kFloatAccelScale; // m/s^2 per count
     float accel_units_per_m_s2_ = (float)kTurnScale / kFloatAccelScale;  // the accel sums' units (counts * 2^8)
