@@ -516,7 +516,9 @@ struct Compared {
 
 // run_learner's board, fed to both learners; the learner's solve is run a part per call
 // between samples, as the Pipeline runs it (or left to the next add(), parts_between false).
-Compared compare_with_reference(const Vector3f& offset, float noise_uT, float seconds, bool parts_between) {
+// rate_scale and steps_per_sample make the turn between samples longer (a fast spin).
+Compared compare_with_reference(const Vector3f& offset, float noise_uT, float seconds, bool parts_between,
+                                float rate_scale = 1.0f, int steps_per_sample = 8) {
     const Vector3f earth(20.0f, 0.0f, 45.0f);
     calib::OffsetLearner learner;
     ReferenceLearner ref;
@@ -530,11 +532,11 @@ Compared compare_with_reference(const Vector3f& offset, float noise_uT, float se
     for (int i = 0; i < (int)(seconds * 200.0f); ++i) {
         const float t = (float)i * 0.005f;
         const Vector3f axis = Vector3f(sinf(0.31f * t), cosf(0.23f * t), sinf(0.17f * t + 1.0f)).normalized();
-        const float rate_rad_s = 1.57f * (1.0f + 0.8f * sinf(0.7f * t));  // 18..160 deg/s
+        const float rate_rad_s = rate_scale * 1.57f * (1.0f + 0.8f * sinf(0.7f * t));  // 18..160 deg/s
         r = r * rotation(axis * (rate_rad_s * 0.005f));
         turn += axis * (rate_rad_s * 0.005f);
         ++since;
-        if (i % 8 != 0) continue;  // the Pipeline's 25 Hz
+        if (i % steps_per_sample != 0) continue;  // the Pipeline's 25 Hz
         const Vector3f raw = r.mul_transpose(earth) + offset + Vector3f(gauss(seed), gauss(seed), gauss(seed)) * noise_uT;
         learner.add(raw, turn, since, in_use);
         ref.add(raw, turn, since, in_use_ref);
@@ -584,6 +586,17 @@ TEST(OffsetLearner, SplitSolveGivesTheReferenceEstimates) {
             EXPECT_LT(k.worst_in_use_uT, 1e-3f);
             EXPECT_EQ(k.calls_over_one_part, 0);  // every solve took exactly kSolveParts calls
         }
+    }
+    // A fast spin, 180..1 600 deg/s with a sample every 60 ms: turns of up to 1.7 rad
+    // between samples (as when a sample waits for a step with room for the learner), which
+    // the learner halves to the short turn its series is exact for and squares back.
+    for (bool parts_between : {true, false}) {
+        const Compared k = compare_with_reference(Vector3f(8.0f, -5.0f, 3.0f), 0.2f, 30.0f, parts_between, 10.0f, 12);
+        EXPECT_GT(k.updates_ref, 100);
+        EXPECT_EQ(k.updates, k.updates_ref);
+        EXPECT_EQ(k.rejected, k.rejected_ref);
+        EXPECT_LT(k.worst_estimate_uT, 1e-3f);
+        EXPECT_LT(k.worst_in_use_uT, 1e-3f);
     }
     // The first case puts the hard iron in use, the third never (at the bound).
     EXPECT_NEAR(compare_with_reference(Vector3f(8.0f, -5.0f, 3.0f), 0.2f, 60.0f, true).in_use.x, 8.0f, 0.3f);

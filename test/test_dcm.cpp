@@ -71,6 +71,30 @@ TEST(Dcm, OneIntegrationIsARotationToAFewE7) {
     }
 }
 
+// The compass learner's turn: the gyro's counts summed over some steps, less the
+// calibrated bias and the estimator's, in Q30 radians; saturated at 1.5 rad an axis.
+TEST(Dcm, GyroTurnIsTheCountsLessEveryBias) {
+    dcm::Dcm filter;
+    const float scale_rad_s = 0.001065f;  // a count of the 2000 deg/s range
+    filter.set_sample_scales(scale_rad_s, 0.0024f);
+    const Vector3f sensor_bias(0.02f, -0.01f, 0.005f), estimator_bias(0.001f, 0.002f, -0.003f);
+    filter.set_sensor_bias_rad_s(sensor_bias);
+    filter.set_gyro_bias_rad_s(estimator_bias);
+    const float dt = filter.settings().step_s;
+    const uint16_t steps = 8;
+    const linalg::Vector3l counts(3000L * steps, -1200L * steps, 25L * steps);
+    const Vector3f turn = linalg::vector_from_q30(filter.gyro_turn_q30(counts, steps));
+    const Vector3f expected = (Vector3f(3000.0f, -1200.0f, 25.0f) * scale_rad_s - sensor_bias - estimator_bias) *
+                              ((float)steps * dt);
+    EXPECT_NEAR(turn.x, expected.x, 1e-6f);
+    EXPECT_NEAR(turn.y, expected.y, 1e-6f);
+    EXPECT_NEAR(turn.z, expected.z, 1e-6f);
+    // 32 steps at the full scale: 5.6 rad, saturated.
+    const Vector3f spin = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(32767L * 32, 0, -32767L * 32), 32));
+    EXPECT_NEAR(spin.x, 1.5f, 1e-4f);
+    EXPECT_NEAR(spin.z, -1.5f, 1e-4f);
+}
+
 TEST(Dcm, RemovesAConstantGyroBiasAtRest) {
     std::mt19937 rng(4);
     // 2 deg/s on both horizontal axes (learned from gravity) and 1.5 deg/s on the

@@ -386,33 +386,68 @@ void OffsetLearner::restart(float prior_uT, const Vector3f& in_use_uT) {
 }
 
 bool OffsetLearner::add(const Vector3f& field_uT, const Vector3f& turn_rad, uint16_t steps, Vector3f& in_use_uT) {
+    // The turn in Q30 (saturated beyond 2 rad an axis: no pair survives such a turn).
+    const float limit = 1.99f;
+    const Vector3f t(linalg::constrain(turn_rad.x, -limit, limit), linalg::constrain(turn_rad.y, -limit, limit),
+                     linalg::constrain(turn_rad.z, -limit, limit));
+    if (!turn_rad.is_finite()) {
+        bool changed = false;
+        while (solving()) changed = solve_part(in_use_uT) || changed;
+        return changed;
+    }
+    return add(field_uT, linalg::fixed_from_vector(t, linalg::kQ30), steps, in_use_uT);
+}
+
+bool OffsetLearner::add(const Vector3f& field_uT, const linalg::Vector3l& turn_q30, uint16_t steps,
+                        Vector3f& in_use_uT) {
     bool changed = false;
     while (solving()) changed = solve_part(in_use_uT) || changed;
-    if (!field_uT.is_finite() || !turn_rad.is_finite()) return changed;
-    float* q = turn_;
+    if (!field_uT.is_finite()) return changed;
+    int32_t* q = turn_.q30;
     age_steps_ = (uint16_t)(age_steps_ + steps < kLearnMaxPairSteps ? age_steps_ + steps : kLearnMaxPairSteps);
     if (!have_ref_ || age_steps_ >= kLearnMaxPairSteps) {
-        q[0] = 1.0f;  // too old, or none: this sample starts the next pair
-        q[1] = q[2] = q[3] = 0.0f;
+        end_solve();  // q = 1: this sample starts the next pair
         field_ref_ = field_uT;
         age_steps_ = 0;
         have_ref_ = true;
         return changed;
     }
-    // q <- q dq, dq = (cos(a/2), sin(a/2) t / a) the turn t (a = |t| <= 0.5 rad between
-    // samples): cos(a/2) = 1 - a^2/8 + a^4/384 and sin(a/2)/a = 1/2 - a^2/48 leave dq
-    // unit to 4e-6 and its angle right to 1e-6 rad at 0.5 rad, so q stays a unit
-    // quaternion (float rounding: ~1e-7 a product) without renormalising.
-    const float a2 = turn_rad.length_squared();
-    const float dw = 1.0f - a2 * (0.125f - a2 * (1.0f / 384.0f));
-    const Vector3f d = turn_rad * (0.5f - a2 * (1.0f / 48.0f));
-    const float w = q[0], x = q[1], y = q[2], z = q[3];
-    q[0] = w * dw - x * d.x - y * d.y - z * d.z;
-    q[1] = w * d.x + x * dw + y * d.z - z * d.y;
-    q[2] = w * d.y - x * d.z + y * dw + z * d.x;
-    q[3] = w * d.z + x * d.y - y * d.x + z * dw;
-    // cos theta = 2 w^2 - 1: not turned enough yet, the pair stays open.
-    if (2.0f * q[0] * q[0] - 1.0f > kLearnMinCos) return changed;
+    // q <- q dq, dq = (cos(a/2), sin(a/2) t / a) for the turn t, a = |t|: cos(a/2) = 1 -
+    // a^2/8 + a^4/384 and sin(a/2)/a = 1/2 - a^2/48 leave dq unit to 1e-6 and its angle
+    // right to 1e-6 rad up to a = 0.43 rad (each axis within 0.25 rad). A longer turn (a
+    // fast spin, or a sample that waited for a step with room for the learner) is halved
+    // k times to that and dq squared k times, (w, v)^2 = (w^2 - v.v, 2 w v). In Q30
+    // (mul_q30: ~1e-9 a product), so q stays a unit quaternion without renormalising.
+    using linalg::mul_q30;
+    constexpr int32_t kOne = 1073741824L, kHalf = 536870912L, kEighth = 134217728L;
+    constexpr int32_t kOver48 = 22369621L, kOver384 = 2796203L;  // 2^30/48, 2^30/384
+    constexpr int32_t kMaxAxis = 268435456L;                      // 0.25 rad
+    linalg::Vector3l t = turn_q30;
+    uint8_t halvings = 0;
+    while (linalg::magnitude(t.x) > (uint32_t)kMaxAxis || linalg::magnitude(t.y) > (uint32_t)kMaxAxis ||
+           linalg::magnitude(t.z) > (uint32_t)kMaxAxis) {
+        t = linalg::Vector3l(t.x / 2, t.y / 2, t.z / 2);
+        ++halvings;
+    }
+    const int32_t a2 = linalg::dot_q30(t, t);
+    int32_t dw = kOne - mul_q30(a2, kEighth - mul_q30(a2, kOver384));
+    const int32_t ratio = kHalf - mul_q30(a2, kOver48);
+    int32_t dx = mul_q30(ratio, t.x), dy = mul_q30(ratio, t.y), dz = mul_q30(ratio, t.z);
+    for (; halvings > 0; --halvings) {
+        const int32_t w2 = mul_q30(dw, dw) - mul_q30(dx, dx) - mul_q30(dy, dy) - mul_q30(dz, dz);
+        dx = mul_q30(dw, dx) * 2;
+        dy = mul_q30(dw, dy) * 2;
+        dz = mul_q30(dw, dz) * 2;
+        dw = w2;
+    }
+    const int32_t w = q[0], x = q[1], y = q[2], z = q[3];
+    q[0] = mul_q30(w, dw) - mul_q30(x, dx) - mul_q30(y, dy) - mul_q30(z, dz);
+    q[1] = mul_q30(w, dx) + mul_q30(x, dw) + mul_q30(y, dz) - mul_q30(z, dy);
+    q[2] = mul_q30(w, dy) - mul_q30(x, dz) + mul_q30(y, dw) + mul_q30(z, dx);
+    q[3] = mul_q30(w, dz) + mul_q30(x, dy) - mul_q30(y, dx) + mul_q30(z, dw);
+    // cos theta = 2 w^2 - 1 > kLearnMinCos: not turned enough yet, the pair stays open.
+    constexpr int32_t kMinW2 = (int32_t)((1.0 + (double)kLearnMinCos) * 0.5 * 1073741824.0);
+    if (mul_q30(q[0], q[0]) > kMinW2) return changed;
     // The sample that closes this pair opens the next, once the pair is solved.
     field_next_ = field_uT;
     age_steps_ = 0;
@@ -437,18 +472,20 @@ bool OffsetLearner::solve_part(Vector3f& in_use_uT) {
 
 void OffsetLearner::end_solve() {
     field_ref_ = field_next_;
-    turn_[0] = 1.0f;
-    turn_[1] = turn_[2] = turn_[3] = 0.0f;
+    turn_.q30[0] = 1073741824L;  // the identity, Q30
+    turn_.q30[1] = turn_.q30[2] = turn_.q30[3] = 0;
     solve_part_ = 0;
 }
 
 // First part (~14 k cycles on the AVR): the innovation r = P f2 - f1 - (P - I) x =
-// H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn. Leaves r . r in turn_[0]
+// H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn. Leaves r . r in turn_.f[0]
 // (q's scalar part is not needed again), H^T r in field_ref_ (f1 is not either), and
-// the rotation's axis for the second part: m = 2 u / sigma in turn_[1..3] (the pair's
+// the rotation's axis for the second part: m = 2 u / sigma in turn_.f[1..3] (the pair's
 // information H^T H / sigma^2 = |m|^2 I - m m^T) and 1 / |m|^2 in inv_axis2_.
 bool OffsetLearner::solve_residual() {
-    const float w = turn_[0], x = turn_[1], y = turn_[2], z = turn_[3];
+    using linalg::float_from_fixed;
+    const float w = float_from_fixed(turn_.q30[0], linalg::kQ30), x = float_from_fixed(turn_.q30[1], linalg::kQ30),
+                y = float_from_fixed(turn_.q30[2], linalg::kQ30), z = float_from_fixed(turn_.q30[3], linalg::kQ30);
     const float x2 = x + x, y2 = y + y, z2 = z + z;
     const float xx = x * x2, yy = y * y2, zz = z * z2, xy = x * y2, xz = x * z2, yz = y * z2;
     const float wx = w * x2, wy = w * y2, wz = w * z2;
@@ -457,13 +494,13 @@ bool OffsetLearner::solve_residual() {
     const Vector3f& e = estimate_uT_;
     const Vector3f residual = p * (field_next_ - e) - (field_ref_ - e);
     field_ref_ = p.mul_transpose(residual) - residual;
-    turn_[0] = residual.length_squared();
+    turn_.f[0] = residual.length_squared();
     const float k = 2.0f / kLearnPairNoise_uT;
-    turn_[1] = x * k;
-    turn_[2] = y * k;
-    turn_[3] = z * k;
+    turn_.f[1] = x * k;
+    turn_.f[2] = y * k;
+    turn_.f[3] = z * k;
     // |u|^2 = sin^2(theta/2) >= 0.03 once the pair is turned by 20 deg.
-    const float m2 = turn_[1] * turn_[1] + turn_[2] * turn_[2] + turn_[3] * turn_[3];
+    const float m2 = turn_.f[1] * turn_.f[1] + turn_.f[2] * turn_.f[2] + turn_.f[3] * turn_.f[3];
     if (!(m2 > 0.0f)) return false;
     inv_axis2_ = 1.0f / m2;
     return true;
@@ -473,12 +510,12 @@ bool OffsetLearner::solve_residual() {
 // faded, this pair's H^T H / sigma^2 added) and its inverse C (symmetric: cofactors
 // over the determinant), the posterior covariance, uT^2. H^T H = 2 I - P - P^T =
 // 4 (|u|^2 I - u u^T) for the unit q = (w, u). info_ holds L already faded (the third
-// part fades what it takes in). Leaves the step in field_ref_, 1 / det A in turn_[0]
-// and C's diagonal cofactors in turn_[1..3]; false when the pair is dropped.
+// part fades what it takes in). Leaves the step in field_ref_, 1 / det A in turn_.f[0]
+// and C's diagonal cofactors in turn_.f[1..3]; false when the pair is dropped.
 bool OffsetLearner::solve_step() {
-    const Vector3f m(turn_[1], turn_[2], turn_[3]);
+    const Vector3f m(turn_.f[1], turn_.f[2], turn_.f[3]);
     const Vector3f across = field_ref_;
-    const float rr = turn_[0];
+    const float rr = turn_.f[0];
     const float fade = 1.0f - 1.0f / kLearnMemoryPairs;
     const float inv_noise = 1.0f / (kLearnPairNoise_uT * kLearnPairNoise_uT);
     const float xx = m.x * m.x, yy = m.y * m.y, zz = m.z * m.z;
@@ -518,10 +555,10 @@ bool OffsetLearner::solve_step() {
     if (!step_cut_)
         for (uint8_t e = 0; e < 6; ++e) info_[e] = info[e];
     field_ref_ = step;
-    turn_[0] = inv_det;
-    turn_[1] = cxx;
-    turn_[2] = cyy;
-    turn_[3] = czz;
+    turn_.f[0] = inv_det;
+    turn_.f[1] = cxx;
+    turn_.f[2] = cyy;
+    turn_.f[3] = czz;
     return true;
 }
 
@@ -529,8 +566,8 @@ bool OffsetLearner::solve_step() {
 // once it is significant; the information taken in fades for the next pair.
 bool OffsetLearner::solve_estimate(Vector3f& in_use_uT) {
     const Vector3f step = field_ref_;
-    const float inv_det = turn_[0];
-    const float var[3] = {turn_[1] * inv_det, turn_[2] * inv_det, turn_[3] * inv_det};
+    const float inv_det = turn_.f[0];
+    const float var[3] = {turn_.f[1] * inv_det, turn_.f[2] * inv_det, turn_.f[3] * inv_det};
     end_solve();
     if (!step_cut_)
         for (uint8_t e = 0; e < 6; ++e) info_[e] *= 1.0f - 1.0f / kLearnMemoryPairs;

@@ -244,7 +244,7 @@ constexpr float kLearnPriorCalibrated_uT = 1.0f;
 
 // Cost on the AVR: a pair's update is ~34 k cycles of float arithmetic, more than a
 // 5 ms step can carry beside the estimator's own work; so a sample only composes the
-// turn (a quaternion product, ~7 k) and stores a pair that completes, and the pair is
+// turn (a quaternion product in Q30, ~5 k) and stores a pair that completes, and the pair is
 // worked out by solve_part() in kSolveParts parts (~14 k, ~14 k, ~5 k), on the caller's
 // next steps with room for them (the Pipeline: those without the DCM's heavy parts or a
 // heading correction), before the next sample: the same arithmetic as one update.
@@ -262,6 +262,9 @@ public:
     // solving() is false before the next sample). When a pair completes it is stored for
     // solve_part(). Returns true when `in_use_uT` (the offset that calibration
     // subtracts) changed.
+    bool add(const linalg::Vector3f& field_uT, const linalg::Vector3l& turn_q30, uint16_t steps,
+             linalg::Vector3f& in_use_uT);
+    // The same with the turn in float radians (tools, tests).
     bool add(const linalg::Vector3f& field_uT, const linalg::Vector3f& turn_rad, uint16_t steps,
              linalg::Vector3f& in_use_uT);
     // A completed pair waits for solve_part().
@@ -281,13 +284,16 @@ private:
     bool solve_estimate(linalg::Vector3f& in_use_uT);
     void end_solve();
 
-    // The board's turn since the pair's first sample as a quaternion (w, x, y, z): P =
-    // R(q), composed by q <- q dq at each sample (16 multiplies where the 3x3 product
-    // took 27). While a completed pair is solved no sample is composed, and these four
-    // floats carry the solve from part to part: w the innovation's r . r after the
-    // first part, then 1 / det A; (x, y, z) the rotation's axis until the second, then
-    // the posterior's diagonal cofactors.
-    float turn_[4];
+    // The board's turn since the pair's first sample as a quaternion (w, x, y, z) in Q30:
+    // P = R(q), composed by q <- q dq at each sample (16 products where the 3x3 product
+    // took 27). While a completed pair is solved no sample is composed, and the same 16
+    // bytes carry the solve from part to part as floats: w the innovation's r . r after
+    // the first part, then 1 / det A; (x, y, z) the rotation's axis until the second,
+    // then the posterior's diagonal cofactors.
+    union {
+        int32_t q30[4];
+        float f[4];
+    } turn_;
     linalg::Vector3f field_ref_;     // f1; while solving, the pair's H^T r, then its step
     linalg::Vector3f field_next_;    // while solving, f2: the next pair's first sample
     float inv_axis2_;                // while solving, 1 / |m|^2 (solve_residual)

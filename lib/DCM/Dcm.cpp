@@ -290,6 +290,36 @@ FIXED_INLINE Vector3l Dcm::theta_q30(const Vector3l& units) const {
     return Vector3l(t.x * 16, t.y * 16, t.z * 16);
 }
 
+Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
+    // In the turn sums' units. Beyond 2^22 counts (128 steps at full scale) and 1 024
+    // steps the turn is far beyond the saturation anyway; within, no product overflows.
+    constexpr int32_t kMaxCounts = 1L << 22;
+    const int32_t n = steps < 1024u ? (int32_t)steps : 1024L;
+    const Vector3l bias = sensor_bias_units_ + bias_units();
+    const int32_t* c = &counts.x;
+    const int32_t* b = &bias.x;
+    int32_t units[3];
+    for (uint8_t i = 0; i < 3; ++i) {
+        const int32_t sum = c[i] > kMaxCounts ? kMaxCounts : (c[i] < -kMaxCounts ? -kMaxCounts : c[i]);
+        units[i] = in_turn_units(sum) - b[i] * n;
+    }
+    // Saturated at twice an integration's limit (1.5 rad: still within Q30's 2).
+    if (theta_factor_q30_ == 0) {  // scales beyond the integer factor
+        const float limit = 2.0f * (float)kMaxTurnAxisQ26 / 67108864.0f;
+        const Vector3f t = Vector3l(units[0], units[1], units[2]).scaled(turn_rad_per_unit());
+        return linalg::fixed_from_vector(Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit),
+                                                  linalg::constrain(t.z, -limit, limit)),
+                                         linalg::kQ30);
+    }
+    const int32_t limit = 2 * theta_units_limit_;
+    int32_t q30[3];
+    for (uint8_t i = 0; i < 3; ++i) {
+        const int32_t u = units[i] > limit ? limit : (units[i] < -limit ? -limit : units[i]);
+        q30[i] = linalg::mul_q30(theta_factor_q30_, u) * 16;
+    }
+    return Vector3l(q30[0], q30[1], q30[2]);
+}
+
 // 1/n for the few window lengths there are, without the ~500-cycle division.
 float Dcm::inverse(uint8_t n) {
     switch (n) {

@@ -190,6 +190,11 @@ public:
                (uint16_t)(heading_steps_ + steps_since_mag_ + 1u) >= kHeadingSteps;
     }
 
+    // The gyro's own turn over `steps` steps from its `counts` summed meanwhile, less the
+    // calibrated bias and the estimator's (no drift correction in it: what the compass
+    // learner composes), in Q30 radians, each axis saturated at 1.5 rad (2 kMaxTurnAxisQ26).
+    linalg::Vector3l gyro_turn_q30(const linalg::Vector3l& counts, uint16_t steps) const;
+
     // Forgets the learned earth field (strength and dip): the next field sample is
     // taken as the reference. take_heading: its heading too, at once, as a new steady
     // field's is after mag_recover_s (a new compass calibration, whose fields the old

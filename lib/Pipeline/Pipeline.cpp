@@ -110,11 +110,9 @@ void AttitudePipeline::take_learner_sample(const Vector3f& f) {
     // estimate, which is not always the offset in use.
     const Vector3f rate = calib::apply_gyro(settings_.cal, last_.gyro_rad_s());
     learn_field_uT_ = f + settings_.cal.mag_learned_uT + f.cross(rate) * dcm_.settings().mag_latency_s;
-    // The turn since the previous sample (that one's too, if it never got its step):
-    // the gyro alone, less every bias estimate (the one now stands for the interval's).
-    const Vector3f turn_rad = (turn_counts_.scaled(last_.gyro_rad_s_per_count) -
-                               gyro_bias_rad_s() * (float)st_.steps_since_mag) * kStep_s;
-    learn_turn_rad_ = st_.learn_pending ? learn_turn_rad_ + turn_rad : turn_rad;
+    // The gyro since the previous sample (that one's too, if it never got its step), in
+    // counts: the learner's step makes it a turn (Dcm::gyro_turn_q30).
+    learn_turn_counts_ = st_.learn_pending ? learn_turn_counts_ + turn_counts_ : turn_counts_;
     st_.learn_steps = st_.learn_pending ? (uint16_t)(st_.learn_steps + st_.steps_since_mag) : st_.steps_since_mag;
     st_.learn_pending = true;
 }
@@ -131,7 +129,8 @@ void AttitudePipeline::learn_mag_offset() {
     // the solve's last part on its step (that part is the estimate's update, ~5 k).
     if (!learner_.solving() && st_.learn_pending) {
         st_.learn_pending = false;
-        learner_.add(learn_field_uT_, learn_turn_rad_, st_.learn_steps, learned);
+        // The turn less every bias estimate (the one now stands for the interval's).
+        learner_.add(learn_field_uT_, dcm_.gyro_turn_q30(learn_turn_counts_, st_.learn_steps), st_.learn_steps, learned);
     }
     if (learned == before) return;
     mag_cal_uT_ -= learned - before;
@@ -340,7 +339,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
 
     // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
-    // a sample ~8 k, or one part of a completed pair's solve, <= ~15 k) goes on a step
+    // a sample ~6 k, or one part of a completed pair's solve, <= ~15 k) goes on a step
     // with neither an output line, a heading correction nor the DCM's integration or
     // gravity correction (Dcm::heavy_step), so that no step carries two heavy parts
     // beyond an integration with a heading correction or a line. At 50 lines a second

@@ -59,7 +59,7 @@ constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the b
 // firmware and in the host replay tool.
 constexpr uint8_t kMagReadMinSteps = 2;
 // The offset learner takes a field sample at most every this many steps (25 Hz): a
-// sample costs it ~8 k cycles (its turn composed), and pairs close at 20 deg of turn
+// sample costs it ~6 k cycles (its turn composed), and pairs close at 20 deg of turn
 // (kLearnMinCos) whatever the rate; the gyro's turn between two samples is summed as a
 // rotation vector, whose error over 40 ms (at most 0.2 rad at 300 deg/s) is below 0.003 rad.
 constexpr uint8_t kLearnMinSteps = 8;
@@ -200,8 +200,8 @@ private:
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
     linalg::Vector3l turn_counts_;              // the gyro summed since the last field sample (counts)
-    linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the turn before it
-    linalg::Vector3f learn_turn_rad_;
+    linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the gyro before it
+    linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
     linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
