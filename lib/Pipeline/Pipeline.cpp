@@ -148,7 +148,7 @@ void AttitudePipeline::forget_mag_reference(bool take_heading) {
 // Spikes and non-finite values are replaced by the previous sample; saturation is
 // reported (a saturated gyro is used: the true rate is at least the full scale; a
 // saturated accel is withheld from the DCM by on_imu_sample).
-mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
+const mpu6000::Sample& AttitudePipeline::guard(const mpu6000::Sample& s) {
     bool spike = false;
     if (st_.have_last) {
         spike = jump(s.gyro.x, last_.gyro.x) > kSpikeGyroJumpCounts || jump(s.gyro.y, last_.gyro.y) > kSpikeGyroJumpCounts ||
@@ -162,10 +162,9 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
             Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: previous sample used instead ("))
                 .u32(st_.spikes).str(TXT(" so far)")).end();
         }
-        mpu6000::Sample out = last_;
-        out.temperature_raw = s.temperature_raw;
+        last_.temperature_raw = s.temperature_raw;  // the previous sample, with this one's temperature
         st_.turn_doubtful = true;  // the gyro stood in for, not measured: no learner pair across it
-        return out;
+        return last_;
     }
     // A run longer than kMaxSpikeRun is real (saturation, a crash) and used.
     st_.spike_run = 0;
@@ -176,7 +175,7 @@ mpu6000::Sample AttitudePipeline::guard(const mpu6000::Sample& s) {
         Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated (beyond 8 g)")).end();
     last_ = s;
     st_.have_last = true;
-    return s;
+    return last_;
 }
 
 void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
@@ -268,7 +267,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
             .str(TXT(" gyro bias, measuring on")).end();
     }
     st_.start_message = StartMessage::kNone;
-    const mpu6000::Sample s = guard(raw);
+    const mpu6000::Sample& s = guard(raw);  // last_, the sample the step uses
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
         // The DCM's scales now (~4 k cycles): the step that ends the calibration starts it.

@@ -186,7 +186,7 @@ public:
 private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
-    mpu6000::Sample guard(const mpu6000::Sample& s);
+    const mpu6000::Sample& guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
     void take_learner_sample(const linalg::Vector3f& field_uT);
     void learn_mag_offset();
