@@ -181,7 +181,7 @@ public:
     void correct_heading(const linalg::Vector3f& mag_field, uint8_t age_steps = 0);
     // The next update (without a line) integrates or corrects gravity: a caller with
     // deferrable work puts it on another step.
-    bool heavy_due() const { return initialised() && next_heavy_part(false) != HeavyPart::kNone; }
+    bool heavy_due() const { return initialised() && blocks(next_heavy_part(false)); }
     // A field sample given to correct_heading after the next update completes the
     // average of kHeadingSteps and corrects the heading (the costly part): a caller with
     // deferrable work (an output line, the compass learner) puts it on another step.
@@ -272,11 +272,15 @@ public:
 private:
     // The heavy part of the next step, from the counters before it: step() does what this
     // says, heavy_due() tells the caller.
-    enum class HeavyPart : uint8_t { kNone, kIntegration, kGravity };
+    enum class HeavyPart : uint8_t { kNone, kIntegration, kGravity, kRenormalisation };
     HeavyPart next_heavy_part(bool line_due) const;
+    // The integration and the gravity correction take a step to themselves (heavy_due,
+    // heavy_step); the renormalisation (~5 k) only keeps off the line's step.
+    static bool blocks(HeavyPart p) { return p == HeavyPart::kIntegration || p == HeavyPart::kGravity; }
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void correct_tilt(float startup_left, bool hold_integrator);
     void integrate();
+    void renormalise_rows();  // every kRenormaliseEvery integrations, on a step of its own
     static void turn_row(linalg::Vector3l& r, const linalg::Matrix3q30& d);
     void correct_gravity();
     void update_offset();
@@ -374,7 +378,7 @@ private:
     linalg::Vector3l first_half_;        // corrected rates summed over the integration's first half (kTurnScale)
     linalg::Vector3l turn_sum_;          // ... and since
     uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
-    uint8_t updates_since_renormalise_ = 0;
+    uint8_t updates_since_renormalise_ = 0;  // >= kRenormaliseEvery: renormalisation due
     linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q17)
     uint32_t heading_norm2_sum_ = 0;     // ... and their squared strengths (uT^2 / 4)
     uint8_t heading_samples_ = 0;
