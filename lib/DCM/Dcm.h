@@ -183,11 +183,12 @@ public:
     // deferrable work puts it on another step.
     bool heavy_due() const { return initialised() && blocks(next_heavy_part(false)); }
     // A field sample given to correct_heading after the next update completes the
-    // average of kHeadingSteps and corrects the heading (the costly part): a caller with
-    // deferrable work (an output line, the compass learner) puts it on another step.
+    // average of kHeadingSteps and corrects the heading, or is the first heading after a
+    // start without one (the costly parts, up to ~11 k and ~20 k): a caller with
+    // deferrable work (the compass learner) puts it on another step.
     bool heading_due_next() const {
-        return initialised() && !(status_ & kStatusNoHeading) &&
-               (uint16_t)(heading_steps_ + steps_since_mag_ + 1u) >= kHeadingSteps;
+        return initialised() && ((status_ & kStatusNoHeading) ||
+                                 (uint16_t)(heading_steps_ + steps_since_mag_ + 1u) >= kHeadingSteps);
     }
 
     // The gyro's own turn over `steps` steps from its `counts` summed meanwhile, less the

@@ -314,6 +314,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;
     }
+    const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
     dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
     // The board's turn for the compass learner: the gyro alone (the biases come off when
     // a field sample takes it).
@@ -339,13 +340,14 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
 
     // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
     // a sample ~6 k, or one part of a completed pair's solve, <= ~15 k) goes on a step
-    // with neither an output line, a heading correction nor the DCM's integration or
-    // gravity correction (Dcm::heavy_step), so that no step carries two heavy parts
-    // beyond an integration with a heading correction or a line. At 50 lines a second
-    // that is one step in eight (tilt_tour); a pair's solve takes three of them, and the
-    // samples that come meanwhile wait (the turn goes on summing: the learner sees one
-    // sample fewer each time).
-    if (st_.output_due || heading_corrected || dcm_.heavy_step()) return;
+    // with neither an output line, the heading's correction from its mean or its first
+    // heading (Dcm::heading_due_next; a field sample's own ~3 k leaves room) nor the
+    // DCM's integration or gravity correction (Dcm::heavy_step), so that no step carries
+    // two heavy parts beyond an integration with a heading correction or a line. A pair's
+    // solve takes three such steps, and the samples that come meanwhile wait (the turn
+    // goes on summing: the learner sees one sample fewer each time; BROAD 34 and fast+uncal
+    // lose 0.04 and 0.15 deg when the field samples' steps are kept from the learner too).
+    if (st_.output_due || heading_heavy || dcm_.heavy_step()) return;
     if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
     st_.cal_pending = false;
     if (learner_.solving() || st_.learn_pending) {
