@@ -285,6 +285,15 @@ FIXED_INLINE Vector3l Dcm::theta_q26(const Vector3l& units) const {
     return Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
 }
 
+// The same by the 16-bit factor (scale_q15: two 16x16 products an axis, the factor to
+// 1.5e-5 of itself), for a turn that is used in 16 bits: the compass sample's latency
+// turn and the gravity window's turn per step. Unsaturated: both are a few steps' rates.
+FIXED_INLINE Vector3l Dcm::theta_q26_coarse(const Vector3l& units) const {
+    const uint16_t k = theta_q26_per_unit_q15_;
+    if (k == 0) return theta_q26(units);  // scales beyond the 16-bit factor
+    return Vector3l(scale_q15(units.x, k), scale_q15(units.y, k), scale_q15(units.z, k));
+}
+
 FIXED_INLINE Vector3l Dcm::theta_q30(const Vector3l& units) const {
     const Vector3l t = theta_q26(units);
     return Vector3l(t.x * 16, t.y * 16, t.z * 16);
@@ -539,8 +548,8 @@ void Dcm::correct_gravity() {
             weighted.z -= accel_sum_.z;
         }
         weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
-        const Vector3l turn = theta_q30(gyro_raw_mean - offset_units_);
-        const int16_t tx = q14_of(turn.x), ty = q14_of(turn.y), tz = q14_of(turn.z);
+        const Vector3l turn = theta_q26_coarse(gyro_raw_mean - offset_units_);
+        const int16_t tx = q14_of(turn.x * 16), ty = q14_of(turn.y * 16), tz = q14_of(turn.z * 16);
         const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
                             accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
                             accel_sum.z - mul_q14(tx, weighted.y) + mul_q14(ty, weighted.x));
@@ -764,7 +773,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const Vector3l turn(linalg::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::mul_q14(latency_q12, rate.y) * 4 - pending.y,
                         linalg::mul_q14(latency_q12, rate.z) * 4 - pending.z);
     // field + field x turn, the turn in Q16 radians (saturated at 0.5): Q21, then Q5 again.
-    const Vector3l t = theta_q26(turn);
+    const Vector3l t = theta_q26_coarse(turn);
     const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);
     using linalg::mul_s16;
     // The change (Q21) in Q5, then added (a field within 1 000 uT and a turn within

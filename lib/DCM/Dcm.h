@@ -321,6 +321,7 @@ private:
     linalg::Vector3l theta_q26_in_float(const linalg::Vector3l& units) const;
     int32_t theta_axis_q26(int32_t units) const;
     linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // ... and in Q30
+    linalg::Vector3l theta_q26_coarse(const linalg::Vector3l& units) const;  // Q26 by the 16-bit factor
     void recover();
     void clamp_bias();
     bool accel_plausible(const linalg::Vector3f& a) const;
