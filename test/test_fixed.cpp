@@ -83,6 +83,32 @@ TEST(Fixed, ToFloatScalesExactly) {
     }
 }
 
+// mul_q14 is r x / 2^14 to within 4 units (its result in steps of 4) and mul_q14_unit
+// the same product rounded to the unit, for a factor up to 1 (Q14) and |x| < 2^29 (the
+// rest means' low-pass, whose step in 4-unit multiples stalls short of the mean).
+TEST(Fixed, MulQ14WithinFourUnitsAndMulQ14UnitRoundedToTheUnit) {
+    std::mt19937 rng(14);
+    std::uniform_int_distribution<int32_t> factor(-16384, 16384);
+    std::uniform_int_distribution<int32_t> value(-(1 << 29) + 1, (1 << 29) - 1);
+    for (int i = 0; i < 200000; ++i) {
+        const int16_t r = (int16_t)factor(rng);
+        const int32_t x = value(rng) >> (i % 20);
+        const double exact = (double)r * (double)x / 16384.0;
+        ASSERT_LE(std::fabs((double)linalg::mul_q14(r, x) - exact), 4.0) << r << " * " << x;
+        ASSERT_LE(std::fabs((double)linalg::mul_q14_unit(r, x) - exact), 0.5 + 1.0 / 16384.0) << r << " * " << x;
+    }
+    // A low-pass of 0.04 a step reaches its input to the unit by mul_q14_unit; by
+    // mul_q14 it stops where the step rounds to 0 (input - 50 units and below).
+    const int16_t alpha = 655;  // 0.04 in Q14
+    int32_t mean_unit = 0, mean_coarse = 0;
+    for (int i = 0; i < 1000; ++i) {
+        mean_unit += linalg::mul_q14_unit(alpha, 1000 - mean_unit);
+        mean_coarse += linalg::mul_q14(alpha, 1000 - mean_coarse);
+    }
+    EXPECT_NEAR(mean_unit, 1000, 12);
+    EXPECT_LT(mean_coarse, 1000 - 40);
+}
+
 // Every reciprocal entry (the divisor's 8 bits after its leading one) and every
 // t - atan(t) entry (the ratio's 8 bits), at the nodes and between them.
 // mul_q30 is the product over 2^30 truncated toward zero, at most 1 below the exact

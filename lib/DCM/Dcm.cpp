@@ -476,12 +476,13 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     const Vector3l gyro_change = gyro_mean - rest_gyro_mean_, accel_change = accel_mean - rest_accel_mean_;
     const bool still = !exceeds(gyro_change, rest_gyro_dev_) && (compass_watching || !exceeds(mean_off_bias, rest_gyro_dev_)) &&
                        !exceeds(accel_change, rest_accel_dev_);
-    // The means' low-pass, its factor in 16 bits (two 16x16 products an axis).
-    using linalg::mul_q14;
-    rest_gyro_mean_ += Vector3l(mul_q14(rest_alpha_q14_, gyro_change.x), mul_q14(rest_alpha_q14_, gyro_change.y),
-                                mul_q14(rest_alpha_q14_, gyro_change.z));
-    rest_accel_mean_ += Vector3l(mul_q14(rest_alpha_q14_, accel_change.x), mul_q14(rest_alpha_q14_, accel_change.y),
-                                 mul_q14(rest_alpha_q14_, accel_change.z));
+    // The means' low-pass, its factor in 16 bits (two 16x16 products an axis), its step
+    // rounded to the unit (the changes are counts * 2^8, far below 2^29).
+    using linalg::mul_q14_unit;
+    rest_gyro_mean_ += Vector3l(mul_q14_unit(rest_alpha_q14_, gyro_change.x), mul_q14_unit(rest_alpha_q14_, gyro_change.y),
+                                mul_q14_unit(rest_alpha_q14_, gyro_change.z));
+    rest_accel_mean_ += Vector3l(mul_q14_unit(rest_alpha_q14_, accel_change.x),
+                                 mul_q14_unit(rest_alpha_q14_, accel_change.y), mul_q14_unit(rest_alpha_q14_, accel_change.z));
     if (!still || !whole_window) {
         rest_corrections_ = 0;
         return;

@@ -267,12 +267,18 @@ FIXED_INLINE int32_t mul_q30(int32_t a, int32_t x) {
 // (In unsigned arithmetic: the rounding add wraps for an entry saturated at 2^31 - 1, a
 // garbage matrix, instead of overflowing.)
 FIXED_INLINE int16_t q14_of(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
-FIXED_INLINE int32_t mul_q14(int16_t r, int32_t x) {
+// r * x / 2^16 rounded, from two 16x16 products (x = xh 2^16 + xl, xl signed).
+FIXED_INLINE int32_t mul_s16_shr16(int16_t r, int32_t x) {
     const int16_t xl = (int16_t)(uint16_t)x;
     const int16_t xh = (int16_t)(uint16_t)(((uint32_t)x - (uint32_t)(int32_t)xl) >> 16);
-    const int32_t high = mul_s16(r, xh) + ((mul_s16(r, xl) + 0x8000) >> 16);
-    return (int32_t)((uint32_t)high << 2);
+    return mul_s16(r, xh) + ((mul_s16(r, xl) + 0x8000) >> 16);
 }
+FIXED_INLINE int32_t mul_q14(int16_t r, int32_t x) { return (int32_t)((uint32_t)mul_s16_shr16(r, x) << 2); }
+// mul_q14 rounded to the unit instead of to 4 units, for |x| < 2^29 (the shift moves to
+// x): where the product is a low-pass's step. A step of 0.04 that comes in 4-unit
+// multiples stops 50 units short of the mean it follows (Dcm::detect_rest's rest means:
+// their offset became the gyro bias, rest_bias 0.02 -> 0.09 deg).
+FIXED_INLINE int32_t mul_q14_unit(int16_t r, int32_t x) { return mul_s16_shr16(r, (int32_t)((uint32_t)x << 2)); }
 
 // The rows' dot product and cross product, each term by mul_q30: Q30 rows give a Q30
 // result; a Q30 row with a vector in other units gives that vector's units.

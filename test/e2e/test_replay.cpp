@@ -37,6 +37,22 @@ TEST(Replay, TiltTourScoresWithinBounds) {
     EXPECT_LT(total, 3.0) << r.out;
 }
 
+// Ideal sensors but 2 deg/s of gyro bias on every axis, at rest for 60 s: the bias is
+// learned from gravity and at rest to a small fraction of a count (the rest means follow
+// the gyro to the unit of its sums), so the estimate holds to a few hundredths. When the
+// rest means' steps came in 4-unit multiples they stalled 0.01 deg/s short of the bias:
+// 0.09 deg, yaw drifting.
+TEST(Replay, RestWithAGyroBiasHoldsToAFewHundredths) {
+    E2E_REQUIRE_TOOLS("replay", "scenario", "score");
+    const std::string csv = e2e::scenario_csv("rest_bias", 60);
+    const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " | " +
+                                                  e2e::tool("score") + " --trajectory " + csv + " --estimate -");
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const double total = e2e::score_field(r.out, "total_rmse_deg");
+    ASSERT_TRUE(std::isfinite(total)) << r.out;
+    EXPECT_LT(total, 0.05) << r.out;
+}
+
 TEST(Replay, RealRecordingScoresWithinBounds) {
     E2E_REQUIRE_TOOLS("replay", "score");
     const std::string recording = std::string(SHARED_DIR) + "/data/broad/01_undisturbed_slow_rotation_A.csv.gz";
