@@ -373,6 +373,22 @@ TEST(Dcm, LearnsTheGyroBiasOfEveryAxisAtRestButNotFromTheCompass) {
     EXPECT_EQ(compass_only.filter.gyro_bias_rad_s().z, 0.0f);
 }
 
+// After the field reference is forgotten (a new calibration, or a learned offset that
+// moved), the very next field sample is the new reference and, for a new calibration,
+// gives the heading at once: the heading does not wait for a whole mean of samples
+// calibrated the new way (40 ms of a fast turn on the gyro alone).
+TEST(Dcm, TheFirstFieldSampleAfterAReferenceResetCorrects) {
+    RestRun run(Matrix3f::identity());
+    run.run(2.0f, Vector3f());
+    ASSERT_LT(std::fabs(run.yaw_error_deg()), 0.5f);
+    // The compass now says the board faces 30 deg east of where the estimate does.
+    const Matrix3f turned = dcm::dcm_from_euler(0.0f, 0.0f, 30.0f * linalg::kRadPerDeg);
+    run.filter.reset_mag_reference(true);
+    run.filter.update(Vector3f(), accel_for(turned));
+    run.filter.correct_heading(mag_for(turned));
+    EXPECT_NEAR(run.filter.euler().yaw_rad * linalg::kDegPerRad, 30.0f, 0.5f);
+}
+
 TEST(Dcm, OutputLeadsByTheSensorDelay) {
     // Turning at a steady 100 deg/s in yaw: the printed attitude is the matrix carried
     // forward by output_lead_s (the gyro low-pass delay), the raw one is not.

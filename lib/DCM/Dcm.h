@@ -205,11 +205,14 @@ public:
     void reset_mag_reference(bool take_heading = true) {
         mag_ref_norm_ = 0.0f;
         mag_take_heading_ = take_heading;
-        // The samples waiting for the heading's mean were calibrated the old way.
+        // The samples waiting for the heading's mean were calibrated the old way. The next
+        // sample closes the mean alone: the heading has run on the gyro meanwhile (the
+        // field was rejected, or the mean dropped), and one sample gives the new reference
+        // and the heading's error at once, a whole mean (40 ms) sooner.
         heading_field_sum_ = linalg::Vector3l();
         heading_norm2_sum_ = 0;
         heading_samples_ = 0;
-        heading_steps_ = 0;
+        heading_steps_ = kHeadingSteps - 1;
     }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
