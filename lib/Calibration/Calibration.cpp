@@ -477,28 +477,39 @@ void OffsetLearner::end_solve() {
     solve_part_ = 0;
 }
 
-// First part (~14 k cycles on the AVR): the innovation r = P f2 - f1 - (P - I) x =
-// H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn. Leaves r . r in turn_.f[0]
-// (q's scalar part is not needed again), H^T r in field_ref_ (f1 is not either), and
-// the rotation's axis for the second part: m = 2 u / sigma in turn_.f[1..3] (the pair's
-// information H^T H / sigma^2 = |m|^2 I - m m^T) and 1 / |m|^2 in inv_axis2_.
+// First part (~7 k cycles on the AVR, 14 k in float: short enough for a step that also
+// corrects gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
+// H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn, in fixed point: P in Q30
+// from q's products (mul_q30, ~1e-9 each), the fields less the estimate in Q16 uT (steps
+// of 1.5e-5 uT; fields within 2^15 uT). Leaves r . r in turn_.f[0] (q is not needed
+// again), H^T r in field_ref_ (f1 is not either), and the rotation's axis for the second
+// part: m = 2 u / sigma in turn_.f[1..3] (the pair's information H^T H / sigma^2 =
+// |m|^2 I - m m^T) and 1 / |m|^2 in inv_axis2_.
 bool OffsetLearner::solve_residual() {
-    using linalg::float_from_fixed;
-    const float w = float_from_fixed(turn_.q30[0], linalg::kQ30), x = float_from_fixed(turn_.q30[1], linalg::kQ30),
-                y = float_from_fixed(turn_.q30[2], linalg::kQ30), z = float_from_fixed(turn_.q30[3], linalg::kQ30);
-    const float x2 = x + x, y2 = y + y, z2 = z + z;
-    const float xx = x * x2, yy = y * y2, zz = z * z2, xy = x * y2, xz = x * z2, yz = y * z2;
-    const float wx = w * x2, wy = w * y2, wz = w * z2;
-    const Matrix3f p(Vector3f(1.0f - (yy + zz), xy - wz, xz + wy), Vector3f(xy + wz, 1.0f - (xx + zz), yz - wx),
-                     Vector3f(xz - wy, yz + wx, 1.0f - (xx + yy)));
-    const Vector3f& e = estimate_uT_;
-    const Vector3f residual = p * (field_next_ - e) - (field_ref_ - e);
-    field_ref_ = p.mul_transpose(residual) - residual;
-    turn_.f[0] = residual.length_squared();
+    using linalg::mul_q30;
+    using linalg::Vector3l;
+    const int32_t w = turn_.q30[0], x = turn_.q30[1], y = turn_.q30[2], z = turn_.q30[3];
+    const int32_t xx = mul_q30(x, x), yy = mul_q30(y, y), zz = mul_q30(z, z);
+    const int32_t xy = mul_q30(x, y), xz = mul_q30(x, z), yz = mul_q30(y, z);
+    const int32_t wx = mul_q30(w, x), wy = mul_q30(w, y), wz = mul_q30(w, z);
+    // R(q) = I + 2 w [u x] + 2 [u x]^2; each entry within 1 (the sums doubled by adding
+    // twice: 2 (y^2 + z^2) reaches 2^31 for a half turn).
+    constexpr int32_t kOne = 1073741824L;
+    const linalg::Matrix3q30 p{Vector3l(kOne - (yy + zz) - (yy + zz), (xy - wz) * 2, (xz + wy) * 2),
+                               Vector3l((xy + wz) * 2, kOne - (xx + zz) - (xx + zz), (yz - wx) * 2),
+                               Vector3l((xz - wy) * 2, (yz + wx) * 2, kOne - (xx + yy) - (xx + yy))};
+    const linalg::Matrix3q30 p_transposed{Vector3l(p.a.x, p.b.x, p.c.x), Vector3l(p.a.y, p.b.y, p.c.y),
+                                          Vector3l(p.a.z, p.b.z, p.c.z)};
+    constexpr uint8_t kFieldQ = 16;
+    const Vector3l e = linalg::fixed_from_vector(estimate_uT_, kFieldQ);
+    const Vector3l r = mul_q30(p, linalg::fixed_from_vector(field_next_, kFieldQ) - e) -
+                       (linalg::fixed_from_vector(field_ref_, kFieldQ) - e);
+    field_ref_ = linalg::vector_from_fixed(mul_q30(p_transposed, r) - r, kFieldQ);
+    turn_.f[0] = linalg::vector_from_fixed(r, kFieldQ).length_squared();
     const float k = 2.0f / kLearnPairNoise_uT;
-    turn_.f[1] = x * k;
-    turn_.f[2] = y * k;
-    turn_.f[3] = z * k;
+    turn_.f[1] = linalg::float_from_fixed(x, linalg::kQ30) * k;
+    turn_.f[2] = linalg::float_from_fixed(y, linalg::kQ30) * k;
+    turn_.f[3] = linalg::float_from_fixed(z, linalg::kQ30) * k;
     // |u|^2 = sin^2(theta/2) >= 0.03 once the pair is turned by 20 deg.
     const float m2 = turn_.f[1] * turn_.f[1] + turn_.f[2] * turn_.f[2] + turn_.f[3] * turn_.f[3];
     if (!(m2 > 0.0f)) return false;

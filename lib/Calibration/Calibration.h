@@ -245,9 +245,10 @@ constexpr float kLearnPriorCalibrated_uT = 1.0f;
 // Cost on the AVR: a pair's update is ~34 k cycles of float arithmetic, more than a
 // 5 ms step can carry beside the estimator's own work; so a sample only composes the
 // turn (a quaternion product in Q30, ~5 k) and stores a pair that completes, and the pair is
-// worked out by solve_part() in kSolveParts parts (~14 k, ~14 k, ~5 k), on the caller's
-// next steps with room for them (the Pipeline: those without the DCM's heavy parts or a
-// heading correction), before the next sample: the same arithmetic as one update.
+// worked out by solve_part() in kSolveParts parts (~8-10 k in fixed point, ~14 k, ~5 k), on
+// the caller's next steps with room for them (the Pipeline: the long one on a step without
+// the DCM's heavy parts, none with a heading correction or a line), before the next
+// sample: the same arithmetic as one update.
 class OffsetLearner {
 public:
     // Starts afresh from the offset in use (in_use_uT: the estimate's start and the
@@ -269,6 +270,9 @@ public:
              linalg::Vector3f& in_use_uT);
     // A completed pair waits for solve_part().
     bool solving() const { return solve_part_ != 0; }
+    // The next solve_part() is the second, the long one (~14 k cycles on the AVR: the 3x3
+    // solve in float); the others, like a sample (add), take at most ~10 k.
+    bool long_part_next() const { return solve_part_ == 2; }
     // The next part of the pending pair's update (nothing when none): the estimate, and
     // `in_use_uT` as add() describes; returns true when that changed.
     bool solve_part(linalg::Vector3f& in_use_uT);

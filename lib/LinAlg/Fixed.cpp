@@ -16,9 +16,11 @@ Vector3l fixed_from_vector(const Vector3f& v, uint8_t frac_bits) {
     return Vector3l(fixed_from_float(v.x, frac_bits), fixed_from_float(v.y, frac_bits), fixed_from_float(v.z, frac_bits));
 }
 
-Vector3f vector_from_q30(const Vector3l& v) {
-    return Vector3f(float_from_fixed(v.x, kQ30), float_from_fixed(v.y, kQ30), float_from_fixed(v.z, kQ30));
+Vector3f vector_from_fixed(const Vector3l& v, uint8_t frac_bits) {
+    return Vector3f(float_from_fixed(v.x, frac_bits), float_from_fixed(v.y, frac_bits), float_from_fixed(v.z, frac_bits));
 }
+
+Vector3f vector_from_q30(const Vector3l& v) { return vector_from_fixed(v, kQ30); }
 
 Matrix3q30 q30_from_matrix(const Matrix3f& m) {
     return Matrix3q30{fixed_from_vector(m.a, kQ30), fixed_from_vector(m.b, kQ30), fixed_from_vector(m.c, kQ30)};

@@ -292,6 +292,7 @@ Matrix3q30 q30_from_matrix(const Matrix3f& m);
 Matrix3f matrix_from_q30(const Matrix3q30& m);
 // Each axis by fixed_from_float (Q frac_bits: 0 for whole units, kQ30 for a row of R).
 Vector3l fixed_from_vector(const Vector3f& v, uint8_t frac_bits);
+Vector3f vector_from_fixed(const Vector3l& v, uint8_t frac_bits);
 Vector3f vector_from_q30(const Vector3l& v);
 
 // (x * g) >> 16 for a 32-bit x and a 16-bit g, from two 16 x 16 products (the bits

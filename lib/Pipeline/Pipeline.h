@@ -189,7 +189,7 @@ private:
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
     void take_learner_sample(const linalg::Vector3f& field_uT);
-    void learn_mag_offset();
+    void learn_mag_offset(bool one_piece);
     void forget_mag_reference(bool take_heading);
 
     const text::Sink* log_;

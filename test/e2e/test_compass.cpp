@@ -121,8 +121,9 @@ SectionCycles profile_section(const std::string& csv, int id) {
 // heading at rest is within 1 deg. `status` shows the learned offset. The run's profile
 // (simavr's cycle counts are exact): no call of the learner (profile part 11: a sample,
 // or one part of a pair's solve) above 16 000 cycles, where one step solving a pair took
-// 47-50 k; and the start-up (in the checks, part 12) spread over two steps of at most
-// 30 000 (it was one of ~58 k).
+// 47-50 k; the start-up (in the checks, part 12) spread over two steps of at most
+// 30 000 (it was one of ~58 k); and no estimator step (section 1) above 30 000, the
+// learner's short pieces beside the DCM's gravity correction included.
 TEST(Compass, LearnedInMotionWithoutCalMag) {
     REQUIRE_FIRMWARE();
     const std::string csv = tumble_csv();
@@ -135,12 +136,16 @@ TEST(Compass, LearnedInMotionWithoutCalMag) {
     ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
     const std::string cycles = e2e::read_text(profile);
     unlink(profile.c_str());
-    const SectionCycles learner = profile_section(cycles, 11), checks = profile_section(cycles, 12);
-    std::printf("# learner: %llu calls, max %llu cycles; checks max %llu\n", learner.count, learner.max, checks.max);
+    const SectionCycles learner = profile_section(cycles, 11), checks = profile_section(cycles, 12),
+                        step = profile_section(cycles, 1);
+    std::printf("# learner: %llu calls, max %llu cycles; checks max %llu; step max %llu\n", learner.count, learner.max,
+                checks.max, step.max);
     EXPECT_GT(learner.count, 500u) << cycles;
     EXPECT_LE(learner.max, 16000u) << cycles;
     EXPECT_GT(checks.count, 0u) << cycles;
     EXPECT_LE(checks.max, 30000u) << cycles;
+    EXPECT_GT(step.count, 0u) << cycles;
+    EXPECT_LE(step.max, 30000u) << cycles;
     EXPECT_FALSE(e2e::has_non_finite(run.lines));
 
     const double truth = final_true_heading_deg(csv);
