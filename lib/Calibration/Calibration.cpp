@@ -477,8 +477,8 @@ void OffsetLearner::end_solve() {
     solve_part_ = 0;
 }
 
-// First part (~7 k cycles on the AVR, 14 k in float: short enough for a step that also
-// corrects gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
+// First part (8-10.5 k cycles on the AVR, 14-15 k in float: short enough for a step
+// that also corrects gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
 // H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn, in fixed point: P in Q30
 // from q's products (mul_q30, ~1e-9 each), the fields less the estimate in Q16 uT (steps
 // of 1.5e-5 uT; fields within 2^15 uT). Leaves r . r in turn_.f[0] (q is not needed
