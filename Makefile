@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # APM 2.5 attitude firmware: build, simulate, test, benchmark.
 #
 #   make            the firmware (build/firmware.elf, .hex; prints flash and RAM use) and

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`make bench`: cycles, size and accuracy of the firmware, with the peers beside it.
 
     python3 bench/bench.py [--build DIR] [--data DIR] [--jobs N] [--no-peers] [--seconds S]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Cost of lib/MavLink on the ATmega2560: a bare program (no Arduino core) that packs
 // each message between the cycle markers apm25sim --profile counts (section id to GPIOR0
 // at the start, GPIOR1 at the end). Built twice by `make mavlink-cost`: with

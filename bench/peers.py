@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The peer filters from PyPI, run on a trajectory exactly as recorded, and the
 dataset's error metric in numpy.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Plots for the benchmark: estimated vs true roll, pitch, heading over time, and the error."""
 import numpy as np
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Cross-validation of the estimator's settings: tune on one half of the recordings, score on the other.
 
     python3 bench/tune.py [--build DIR] [--data DIR] [--jobs N] [--set NAME=VALUE ...]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The APM 2.5 board as the sketch sees it: its pins, the two sensor buses on the
 // Arduino core's SPI and Wire libraries, the LEDs and the benchmark markers.
 // Everything here is a small named piece; the sketch (firmware.ino) composes them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The HMC5883L as the sketch uses it: bring-up (with the self-test at power-up),
 // reads paced by its DRDY pin, the faults the user is told about (silent or stuck
 // DRDY, overflow, a compass that stops answering) and health. Its samples go to the

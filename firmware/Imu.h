@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The MPU6000 as the sketch uses it: bring-up with its messages, the data-ready pacing
 // of the 200 Hz loop, the burst read, missed-sample accounting and health.
 #pragma once

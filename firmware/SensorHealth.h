@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One sensor's health as the user sees it: a failure is reported once, the sensor is
 // tried again once a second while it is down, and its return is reported.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Text to the serial port without ever stalling the 200 Hz loop.
 //
 // The Arduino core's Serial has a 64-byte transmit ring (what the Arduino IDE builds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The settings record (lib/Console/Settings.h) in the ATmega2560's EEPROM.
 //
 // Loading happens once at start. Saving writes one byte per loop iteration while the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Hooks for your own code, defined in user.ino (the sketch's second file). The
 // firmware calls them; they run in the same loop as the estimator, so keep each call
 // short: the next MPU6000 sample is due 5 ms after the previous one.

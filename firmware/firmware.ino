@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // apm25-attitude: roll, pitch and heading from the ArduPilot Mega 2.5's own sensors,
 // printed on the serial port (115200 baud) 50 times a second:
 //

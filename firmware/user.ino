@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Your code beside the attitude firmware: this file is yours to extend.
 //
 // The firmware uses Serial (115200 baud, its text goes through SerialText.h so it

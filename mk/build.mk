@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The build, run by the Makefile once the toolchain is installed (make -f mk/build.mk GOAL
 # works too when it is). V=1 shows every command.
 

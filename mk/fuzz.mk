@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Fuzzing and sanitizers (issue 11). Included by the Makefile (`include mk/fuzz.mk`), or
 # on its own: `make -f mk/fuzz.mk fuzz`.
 #

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # MAVLink headers, the project's Python environment, and the live attitude view.
 #
 # Included at the end of mk/build.mk (it uses BUILD, SCENARIO, SECONDS, PORT, BAUD, AVR_INC,

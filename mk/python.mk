@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The project's Python environment: build/venv, from requirements.txt (PyPI). Used by
 # make bench (the peers), make mavlink (mavgen), make view and the Python tests.
 # Included by mk/build.mk; the stamp is a copy of requirements.txt, so editing the list

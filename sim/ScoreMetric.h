@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The orientation error metric of the BROAD dataset (Laidig et al., "BROAD - A
 // Benchmark for Robust Inertial Orientation Estimation", Data 6(7):72, 2021), as
 // used by build/score and the benchmark. Host-only, header-only, double precision.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Trajectory files (../shared/SIM.md): CSV, optionally gzip-compressed, header
 // `t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz[,movement]`, body frame x forward,
 // y right, z down; rad/s, m/s^2, uT; quaternion body->earth (NED), scalar first.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // build/apm25sim: the firmware ELF on a simulated APM 2.5 (simavr ATmega2560 at 16 MHz,
 // MPU6000 on SPI, HMC5883L on I2C), sensors fed from a trajectory file. The command
 // line and output are the contract in ../shared/SIM.md; --help lists the extensions.

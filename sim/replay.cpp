@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
 //
 //   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // build/scenario: synthetic trajectories in the format of ../shared/SIM.md.
 //
 //   build/scenario NAME [--seconds S] [--rate HZ] [sensor-error options]   CSV on stdout

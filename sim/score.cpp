@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // build/score: the BROAD dataset's orientation error metric for one estimate file.
 //
 //   build/score --trajectory FILE.csv[.gz] --estimate EST.csv [--skip S] [--all] [--csv]

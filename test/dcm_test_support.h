@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Helpers for the estimator tests: a true attitude and the ideal sensor readings
 // it produces (body frame: x forward, y right, z down; earth NED).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Gyro-bias and magnetometer calibration (lib/Calibration).
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The serial console parser and the settings commands (lib/Console/Console).
 #include <gtest/gtest.h>
 

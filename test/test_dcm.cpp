@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Properties of the DCM estimator: orthonormality, drift correction of a gyro
 // bias, TRIAD start-up, and robustness to absurd input.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Register decoding: known bytes -> known body-frame SI values, per axis and range;
 // overflow and absent-sensor patterns are flagged, not decoded.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The MPU6000 and HMC5883L bus drivers against fake buses (lib/MPU6000/Mpu6000,
 // lib/HMC5883/Hmc5883): the same seam the firmware fills with SPI/Wire and the replay
 // tool with the simulator's register models.

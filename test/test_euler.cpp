@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Euler extraction: aerospace Z-Y-X, finite and exact through pitch +-90 deg.
 #include <gtest/gtest.h>
 

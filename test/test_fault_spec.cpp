@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // apm25sim's --fault language (sim/harness/FaultSpec): the grammar, any number of
 // windows per kind, and an error for an overlap or a malformed SPEC.
 #include <gtest/gtest.h>

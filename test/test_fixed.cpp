@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-point output path (lib/LinAlg/Fixed.h, dcm::euler_carried): conversions exact,
 // atan2 and hypot within their stated error over the whole domain (every table entry
 // is visited at its node and between nodes), and the Euler angles within 0.005 deg

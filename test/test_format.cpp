@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-point formatting of the output lines (lib/Console/Format, Text).
 #include <gtest/gtest.h>
 

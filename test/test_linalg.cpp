@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LinAlg against hand-computed values, degenerate inputs included.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // lib/MavLink: the frames checked byte by byte against the MAVLink 2 wire format, with a
 // CRC computed here independently of the generated code (CRC-16/MCRF4XX over header and
 // payload, then the message's CRC_EXTRA). pymavlink decodes the same frames in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The simulator's sensor register models (sim/models): their bytes, decoded with the
 // firmware's own decoders (lib/MPU6000, lib/HMC5883), give back the trajectory's
 // body-frame values within one count; ranges, saturation, overflow, identity, timing.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The BROAD error metric (sim/ScoreMetric.h) on hand-computed cases.
 #include <gtest/gtest.h>
 

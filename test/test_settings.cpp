@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The EEPROM settings record (lib/Console/Settings).
 #include <gtest/gtest.h>
 

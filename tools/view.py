@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Live attitude view: an artificial horizon with a heading tape, and roll, pitch and
 heading over the last 20 s.
 

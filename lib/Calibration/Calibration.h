@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sensor calibration, applied in one place (apply_gyro / apply_mag), and the two
 // procedures that measure it: gyro bias at rest and magnetometer hard iron + per-axis
 // scale from the extremes of a rotation.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The serial console: one command per line, answered with "# " lines.
 //
 //   help                 the command list

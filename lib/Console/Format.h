@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The serial output lines (../shared/SIM.md contract), formatted with integers only:
 // Serial.print(float, 2) costs ~6 700 cycles a value on the 2560, this ~1/10 of it.
 //

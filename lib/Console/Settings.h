@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The persistent settings: output rate, declination, output mode and the sensor
 // calibration, stored in EEPROM as one record:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Text output seam: a tiny function-pointer sink plus a writer that formats integers
 // and fixed-point numbers without printf or float printing.
 //

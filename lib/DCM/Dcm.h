@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-step Direction Cosine Matrix attitude estimator with drift correction,
 // after W. Premerlani and P. Bizard, "Direction Cosine Matrix IMU: Theory" (2009).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Euler angles from a body->earth rotation matrix, aerospace Z-Y-X (yaw psi, pitch
 // theta, roll phi): R = Rz(psi) Ry(theta) Rx(phi), earth = north-east-down.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "Hmc5883.h"
 
 #ifdef __AVR__

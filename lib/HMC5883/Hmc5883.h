@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // HMC5883L bus driver: moves bytes over I2C; register meaning and decoding live in
 // Hmc5883Registers.h. No Arduino include: the firmware implements the I2cBus seam with
 // the core's Wire (with its timeout), the host tests with a fake, the replay tool with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // HMC5883L register map and decoding (Honeywell HMC5883L datasheet, rev E).
 //
 // Pure: no bus access, no Arduino include. Shared by the bus driver (Hmc5883.h), the

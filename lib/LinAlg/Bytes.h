@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Byte helpers shared by the sensor drivers and the simulator's register models.
 #pragma once
 

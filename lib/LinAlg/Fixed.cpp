@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The tables of the fixed-point atan2 and hypot (Fixed.h, whose routines are inline).
 #include "Fixed.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-point helpers for the output path (Euler angles): integer arithmetic on the
 // 2560's hardware multiplier instead of float calls (a float multiply is ~170 cycles,
 // a division ~510, a 16x16->32 integer multiply ~25), and bit-identical results on the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LinAlg: small float value types for 3-vectors and 3x3 matrices.
 //
 // Plain C++11, no Arduino include: the same code builds for the host tests and the

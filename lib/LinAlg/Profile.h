@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Cycle markers for the simulator's profiler (apm25sim --profile, ../shared/SIM.md):
 // a section id written to GPIOR0 where the section starts and to GPIOR1 where it
 // ends, one OUT instruction each on the AVR and nothing on the host. The firmware's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // MPU6000 bus driver: moves bytes over SPI; register meaning and decoding live in
 // Mpu6000Registers.h (decode_burst). No Arduino include: the firmware implements the
 // SpiDevice seam with the core's SPI library, the host tests with a fake, and the

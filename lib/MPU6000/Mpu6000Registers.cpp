@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "Mpu6000Registers.h"
 
 namespace mpu6000 {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // MPU6000 register map and decoding (InvenSense MPU-6000 Register Map rev 4.2).
 //
 // Pure: no bus access, no Arduino include. The bus driver (Mpu6000.h) moves bytes;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // MAVLink 2 for ground stations (Mission Planner, QGroundControl): the four messages an
 // attitude-only board sends, packed into the caller's byte buffer, and the separation
 // of incoming MAVLink frames from console text on the same UART.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // AttitudePipeline: decoded sensor samples in, estimator state and output timing out.
 // The firmware and the host replay tool run exactly this; the firmware adds only the
 // Arduino set-up, the buses, the data-ready pacing, serial I/O, LEDs and EEPROM.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The APM 2.5 board around a simavr ATmega2560 (../shared/SIM.md, ../shared/APM25.md):
 // MPU6000 on SPI (CS pin 53 = PB0, INT on PE6), HMC5883L on TWI (7-bit 0x1E, DRDY on
 // pin 31 = PC6), the barometer chip select (pin 40 = PG1) watched, UART0 to a sink.

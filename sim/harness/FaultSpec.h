@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The --fault SPEC language of build/apm25sim: parsing and applying to the models.
 //
 //   SPEC   := TARGET ':' KIND [ '=' VALUE ] [ '@' T1 [ '-' T2 ] ]

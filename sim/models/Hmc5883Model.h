@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // HMC5883L register model on I2C (Honeywell HMC5883L datasheet rev E), driven by a
 // trajectory's body-frame field.
 //

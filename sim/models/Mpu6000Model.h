@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // MPU6000 register model on SPI (InvenSense MPU-6000 Product Specification rev 3.3,
 // Register Map rev 4.2), driven by a trajectory's body-frame values.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Spans of simulated time during which a fault is active.
 // Shared by the sensor register models and the simavr harness's fault parser.
 #pragma once

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Issue 13: without `cal mag`, the heading at rest after a tumble is within 1 deg of the
 truth and no worse than VQF's on the same file.
 

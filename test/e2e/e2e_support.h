@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Helpers for the end-to-end tests: run the project's tools (TOOLS_DIR: firmware.elf,
 // apm25sim, replay, scenario, score), generate scenarios, parse the serial output.
 // A test whose tool is missing skips (GTEST_SKIP), it does not fail.

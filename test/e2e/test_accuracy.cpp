@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Accuracy guards and the host/target equivalence:
 // - the same trajectory through build/replay and through the firmware in simavr gives
 //   the same angles (the host tests stand for the target only if this holds);

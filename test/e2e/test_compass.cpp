@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The compass calibration through the firmware in simavr (issue 13): a board with hard
 // iron (8, -5, 3) uT and 3 % soft iron on x, still 5 s, tumbled through every
 // orientation for 30 s (build/scenario tumble), then still 15 s.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Console input at the full 115200 baud (issue 11): an eight-command paste, and a 20 KB
 // stream of random bytes with valid commands between them. What must happen is computed
 // on the host with the firmware's own console code (lib/Console: LineReader, parse_line,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Long replies go out a line at a time (firmware.ino: run_console_command): `status` and
 // `help` asked in the output mode with the longest lines (raw, 104 bytes) and in `mode
 // mavlink` (STATUSTEXT, two frames a line) are answered whole and in order, while the

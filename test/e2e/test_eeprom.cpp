@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Settings in the ATmega2560's EEPROM through a simulated power cycle (apm25sim --eeprom):
 // `save` then a new run from the same chip brings the settings back; a flipped byte, a
 // half-written record, a record of another version or a save cut short by power loss

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Every fault of apm25sim's --fault language against the firmware on a level board at
 // rest: the firmware says so on serial (`# error:` / `# warn:` naming the part), keeps
 // running, never prints nan/inf, and is back within bounds once the fault clears.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The firmware in simavr on synthetic scenarios: start-up, accuracy at rest, gyro bias
 // correction, a loop through pitch +-90 degrees, and the serial console (SIM.md serial
 // format).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The simulated board itself, checked with a probe AVR program (test/e2e/support/avr/probe.cpp)
 // rather than the firmware: sensors answer on the real buses, faults reach the bus,
 // bus timing is the board's, the chip-select rule is enforced, console input arrives.

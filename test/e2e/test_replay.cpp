@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The host replay tool and the scorer on scenarios and (when ../shared/data is present) a
 // real recording, and the simavr run scored with the same metric.
 #include "e2e_support.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The host unit tests' checks on the target: test/e2e/support/avr/selftest.cpp, built by
 // avr-gcc from the same lib/ sources as the firmware, run as an ATmega2560 in apm25sim.
 // Every check must report "ok", each exactly once, and the summary must count them all

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A fault storm (issue 11): a 2-minute moving run, three tilt tours in a row, the second
 // one under 14 fault windows that cover every windowed kind of apm25sim's --fault
 // language, the two `absent` kinds twice (mpu:whoami and mag:id are whole-run identity

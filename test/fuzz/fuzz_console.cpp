@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: the console's input path (lib/Console) on arbitrary bytes, as a
 // serial line would deliver them: LineReader -> parse_line -> print_error /
 // apply_setting into a string sink, plus parse_line and parse_centi on the raw input.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: the EEPROM settings record (lib/Console/Settings).
 // Built by mk/fuzz.mk with clang -fsanitize=fuzzer,address,undefined.
 //

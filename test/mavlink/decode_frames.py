@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """pymavlink, as a ground station would, decodes the frames of test/mavlink/support/mavlink_frames.cpp.
 
     build/venv/bin/python test/mavlink/decode_frames.py PATH/TO/mavlink_frames

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The firmware's MAVLink stream, decoded by pymavlink as a ground station would (issue 12).
 
     build/venv/bin/python test/mavlink/firmware_stream.py --tools build --work DIR

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The sketch as the Arduino IDE builds it: Debian's arduino-builder compiles
 # firmware/firmware.ino with lib/ and the MAVLink headers (build/mavlink, as a library
 # named MAVLink, as the README installs them) as its libraries (and, in a second build, with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A user's second sketch file, as README.md ("Your own code") describes it: a GPS on
 // Serial1, a message on Serial, the I2C clock set again, and an SPI device whose
 // interrupt the SPI library must mask during transactions. The sketch test puts this

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Non-fatal assertions for the Python tests: a failed soft_assert records its reason and
 the test goes on, so that one run lists every failure; finish() prints them and returns
 the exit status (1 if any failed)."""

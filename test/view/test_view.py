@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """tools/view.py renders frames headlessly (Agg) from recorded streams that this test writes
 itself, in each form the firmware can send (plot, csv, quat lines and MAVLink 2 ATTITUDE
 frames packed by pymavlink, with "# " lines and STATUSTEXT mixed in), and the horizon is

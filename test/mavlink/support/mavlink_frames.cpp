@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Writes a fixed set of frames from lib/MavLink to stdout for decode_frames.py, which
 // decodes them with pymavlink (a real ground-station parser) and checks every field.
 // The values here and the expectations there are one list: change both together.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Builds the AVR programs the e2e tests run in apm25sim, against the Arduino core
 # archive the project's Makefile builds, into OUT_DIR:
 #   test/e2e/support/avr/build.sh OUT_DIR   ->  OUT_DIR/probe.elf, OUT_DIR/probe_violation.elf,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A tiny AVR program that exercises the simulated board (sim/apm25sim) without the
 // firmware: MPU6000 over SPI, HMC5883L over Wire, the INT and DRDY lines, the serial
 // console input and the GPIOR profiling markers. Built by test/e2e/support/avr/build.sh.

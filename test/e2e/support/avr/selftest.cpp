@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The host unit tests' checks, on the ATmega2560: the lib/ routines the firmware runs,
 // compiled by avr-gcc (test/e2e/support/avr/build.sh) and run in apm25sim by
 // test/e2e/test_selftest.cpp, so that "host-tested" also means "works on the target"
