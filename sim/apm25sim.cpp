@@ -12,6 +12,7 @@
 
 #include "Board.h"
 #include "FaultSpec.h"
+#include "RcLink.h"
 #include "Trajectory.h"
 
 namespace {
@@ -19,7 +20,7 @@ namespace {
 const char* const kUsage =
     "usage: apm25sim --elf FILE.elf --trajectory FILE.csv[.gz] [--seconds S] [--stamp]\n"
     "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--profile FILE]\n"
-    "                [--verbose]\n"
+    "                [--rc FILE] [--servo-log FILE] [--verbose]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
@@ -43,6 +44,25 @@ const char* const kUsage =
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
     "                   run,1,C,C,C,C with C = cycles from the first start to the last end of section 6\n"
+    "  --rc FILE        the receiver: CSV header t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8 (s, us), rows\n"
+    "                   in increasing time, widths 500-3000 us; a row holds from its time until\n"
+    "                   the next; a row with every channel empty (12.0,,,,,,,,) is a dead\n"
+    "                   receiver: no PPM until the next full row; before the first row, no\n"
+    "                   signal. Sent as the APM 2.5's PPM encoder does on ICP5 = PL1 (pin 48):\n"
+    "                   8 channels in a 22.5 ms frame (longer only if the widths leave less\n"
+    "                   than 4.5 ms of sync), each a 400 us low pre-pulse then high, so the\n"
+    "                   rising edges (ArduPilot's ICES5 capture) are one width apart; the line\n"
+    "                   idles high. A frame takes the widths in force at its start and is sent\n"
+    "                   whole; a full row after a dead one starts a frame at its time\n"
+    "  --servo-log FILE one row per pulse on OUT1-OUT8, CSV header t,out,width_us: the rising\n"
+    "                   edge's time (s, 6 decimals), the output 1-8, the width (us, 2 decimals),\n"
+    "                   in rising-edge order; measured from the pins OUT1 OC1B/PB6, OUT2\n"
+    "                   OC1A/PB5, OUT3 OC4C/PH5, OUT4 OC4B/PH4, OUT5 OC4A/PH3, OUT6 OC3C/PE5,\n"
+    "                   OUT7 OC3B/PE4, OUT8 OC3A/PE3 (the timer drives a pin its COM bits\n"
+    "                   connect, else PORT does); edges are stamped at the instruction\n"
+    "                   boundary (within 0.3 us); a pulse still high at the end is not written.\n"
+    "                   Fast PWM (mode 14, TOP = ICRn) sets the pin at BOTTOM and clears it\n"
+    "                   at the match, so OCRn = 2 x width reads width + 0.5 us, as on the chip\n"
     "  --verbose        print the sensor models' protocol counters on stderr at the end\n"
     "\n"
     "Bus check: the barometer chip select (pin 40 = PG1, PORTG bit 1) must be high whenever the\n"
@@ -67,7 +87,7 @@ bool read_file(const std::string& path, std::string& out) {
 
 int main(int argc, char** argv) {
     sim::BoardOptions options;
-    std::string trajectory_path, input_path, profile_path;
+    std::string trajectory_path, input_path, profile_path, rc_path, servo_log_path;
     std::vector<std::string> faults;
     double seconds = -1.0;
     bool verbose = false;
@@ -103,6 +123,10 @@ int main(int argc, char** argv) {
             options.eeprom_path = value("--eeprom");
         } else if (arg == "--profile") {
             profile_path = value("--profile");
+        } else if (arg == "--rc") {
+            rc_path = value("--rc");
+        } else if (arg == "--servo-log") {
+            servo_log_path = value("--servo-log");
         } else if (arg == "--verbose") {
             verbose = true;
         } else {
@@ -123,6 +147,23 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "apm25sim: cannot read the input file '%s'\n", input_path.c_str());
         return 1;
     }
+    sim::RcScript rc;
+    if (!rc_path.empty()) {
+        if (!rc.load(rc_path)) {
+            std::fprintf(stderr, "apm25sim: %s\n", rc.error().c_str());
+            return 1;
+        }
+        options.rc = &rc;
+    }
+    FILE* servo_log = nullptr;
+    if (!servo_log_path.empty()) {
+        servo_log = std::fopen(servo_log_path.c_str(), "w");
+        if (!servo_log) {
+            std::fprintf(stderr, "apm25sim: cannot write the servo log '%s'\n", servo_log_path.c_str());
+            return 1;
+        }
+        options.servo_log = servo_log;
+    }
     options.profile = !profile_path.empty();
     if (seconds < 0.0) seconds = trajectory.duration_s();
 
@@ -140,6 +181,10 @@ int main(int argc, char** argv) {
     }
     const bool ran = board.run(seconds);
     board.finish_output();
+    if (servo_log && std::fclose(servo_log) != 0) {
+        std::fprintf(stderr, "apm25sim: cannot write the servo log '%s'\n", servo_log_path.c_str());
+        return 1;
+    }
     if (!board.save_eeprom()) {
         std::fprintf(stderr, "apm25sim: cannot write the EEPROM file '%s'\n", options.eeprom_path.c_str());
         return 1;
