@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdarg>
 #include <cstring>
 
@@ -107,8 +108,15 @@ void uart_xoff_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(par
 void uart_xon_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->set_uart_input_held(false); }
 
 avr_cycle_count_t uart_input_timer(avr_t*, avr_cycle_count_t, void* param) {
-    return static_cast<Board*>(param)->on_uart_input_tick();
+    Board* board = static_cast<Board*>(param);
+    const uint64_t next = board->on_uart_input_tick();
+    if (next == 0) board->on_uart_input_timer_ended();
+    return next;
 }
+avr_cycle_count_t link_timer(avr_t*, avr_cycle_count_t, void* param) {
+    return static_cast<Board*>(param)->on_link_tick();
+}
+volatile std::sig_atomic_t g_stop_requested = 0;
 avr_cycle_count_t uart_input_start_timer(avr_t*, avr_cycle_count_t, void* param) {
     static_cast<Board*>(param)->on_uart_input_tick();  // starts the input if not yet
     return 0;
@@ -156,6 +164,9 @@ void port_hook(avr_irq_t*, uint32_t value, void* param) {
 }
 
 }  // namespace
+
+void request_stop() { g_stop_requested = 1; }
+bool stop_requested() { return g_stop_requested != 0; }
 
 Board::Board(const Trajectory& trajectory, const BoardOptions& options)
     : mpu_(trajectory), mag_(trajectory), options_(options) {}
@@ -262,6 +273,12 @@ bool Board::init() {
     if (options_.servo_log) init_servo_outputs();
 
     avr_cycle_timer_register(avr_, 1, sensor_timer, this);
+    if (options_.serial || options_.speed > 0.0) {
+        pacer_ = Pacer(options_.speed);
+        avr_cycle_timer_register(avr_, 1, link_timer, this);
+    }
+    // A client's bytes go to RX as they come; a --input file still waits for its start.
+    if (options_.serial && options_.input.empty()) start_input();
     if (!options_.input.empty()) {
         avr_cycle_timer_register(avr_, (avr_cycle_count_t)(options_.input_start_s * kCpuHz), uart_input_start_timer,
                                  this);
@@ -272,7 +289,7 @@ bool Board::init() {
 
 bool Board::run(double seconds) {
     const avr_cycle_count_t end = (avr_cycle_count_t)std::llround(seconds * kCpuHz);
-    while (avr_->cycle < end) {
+    while (avr_->cycle < end && !g_stop_requested) {
         const int state = avr_run(avr_);
         if (state == cpu_Done || state == cpu_Crashed) {
             error_ = state == cpu_Crashed ? "the AVR core crashed" : "the AVR core stopped";
@@ -457,6 +474,7 @@ void Board::on_twi_message(uint32_t value) {
 // --- UART ---------------------------------------------------------------------
 
 void Board::on_uart_byte(uint8_t byte) {
+    if (options_.serial) options_.serial->send(byte);
     if (!options_.stamp) std::fputc(byte, stdout);
     if (byte == '\n') {
         if (options_.stamp) {
@@ -487,9 +505,31 @@ void Board::finish_output() {
 }
 
 void Board::start_input() {
-    if (input_started_ || options_.input.empty()) return;
+    if (input_started_ || (options_.input.empty() && !options_.serial)) return;
     input_started_ = true;
+    arm_input();
+}
+
+void Board::arm_input() {
+    if (input_timer_armed_ || input_pos_ >= options_.input.size()) return;
+    input_timer_armed_ = true;
     avr_cycle_timer_register(avr_, 1, uart_input_timer, this);
+}
+
+// Every millisecond of simulated time: the TCP client's bytes in and out, and the wait
+// that keeps simulated time from running ahead of the wall clock.
+uint64_t Board::on_link_tick() {
+    pacer_.wait_until(time_s());
+    if (options_.serial) {
+        std::string received;
+        const std::string event = options_.serial->poll(received);
+        if (!event.empty()) std::fprintf(stderr, "apm25sim: t=%.3f s: tcp:%d %s\n", time_s(), options_.serial->port(), event.c_str());
+        if (!received.empty()) {
+            options_.input += received;
+            if (input_started_) arm_input();
+        }
+    }
+    return avr_->cycle + kCpuHz / 1000;
 }
 
 uint64_t Board::on_uart_input_tick() {

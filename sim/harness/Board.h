@@ -24,6 +24,7 @@
 #include "Hmc5883Model.h"
 #include "Mpu6000Model.h"
 #include "RcLink.h"
+#include "SerialLink.h"
 #include "Trajectory.h"
 
 struct avr_t;
@@ -45,7 +46,14 @@ struct BoardOptions {
     std::string eeprom_path;        // --eeprom: the EEPROM's bytes at start and written back at exit
     const RcScript* rc = nullptr;   // --rc: the sticks, sent as PPM on ICP5 (PL1); none: PL1 untouched
     FILE* servo_log = nullptr;      // --servo-log: one row per pulse on OUT1-OUT8
+    TcpSerial* serial = nullptr;    // --serial tcp:PORT: UART0 also to and from a TCP client
+    double speed = 0.0;             // simulated seconds per wall second; 0: unpaced
 };
+
+// Asks a running Board::run to return at its next instruction boundary (async-signal-safe:
+// for SIGINT/SIGTERM handlers).
+void request_stop();
+bool stop_requested();
 
 // Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
 struct SectionProfile {
@@ -88,6 +96,8 @@ public:
     void on_uart_byte(uint8_t byte);
     uint64_t on_sensor_tick();
     uint64_t on_uart_input_tick();
+    void on_uart_input_timer_ended() { input_timer_armed_ = false; }
+    uint64_t on_link_tick();
     void set_uart_input_held(bool held) { uart_input_held_ = held; }
     void on_gpior_write(bool end, uint8_t value);
     uint64_t on_ppm_edge();
@@ -106,6 +116,7 @@ private:
     bool baro_deselected() const;
     void check_bus(const char* when);
     void start_input();
+    void arm_input();
     bool load_eeprom();
     uint8_t* eeprom_bytes() const;
     double sck_hz() const;
@@ -145,6 +156,8 @@ private:
     bool uart_input_held_ = false;        // simavr's receive FIFO is full (XOFF)
     uint64_t uart_input_held_chars_ = 0;  // character times the input waited for it
     size_t input_pos_ = 0;
+    bool input_timer_armed_ = false;      // uart_input_timer is registered
+    Pacer pacer_{0.0};
 
     // --rc: the PPM line on PL1 (and Timer5's capture input when simavr does not wire it).
     std::unique_ptr<PpmEncoder> ppm_;
