@@ -602,9 +602,10 @@ void Board::rc_changed() { schedule_ppm_edge(); }
 // Each output's level is the OCnx unit's while TCCRnA's COMnx bits connect it to the pin
 // (as the hardware overrides PORT), else the PORT bit when the pin is an output, else
 // low. The compare units report through the timer's OUT_COMP IRQs (simavr 1.6 sets bit 8,
-// AVR_IOPORT_OUTPUT, on a toggle: the level is bit 0); a PORT write in simavr 1.6
-// re-raises every output pin of the port with its PORT bit, which is why the pin IRQ is
-// only a cue to look again and not the level.
+// AVR_IOPORT_OUTPUT, on a toggle: the level is bit 0). The level is worked out by the
+// chip's rule rather than taken from the pin IRQ's value, so that a PORT bit written on a
+// pin the timer owns (no effect on the chip) can never count as an edge; the pin IRQ is
+// the cue to look again.
 void Board::init_servo_outputs() {
     for (int i = 0; i < kServoOutputs; ++i) {
         const ServoOutputPin& pin = kServoPins[i];
