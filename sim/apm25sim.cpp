@@ -316,12 +316,13 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
             return 1;
         }
+        link.set_stop_check(sim::stop_requested);
         options.measure_servos = true;
         if (rc_from_backend) options.rc = &rc;
         const uint16_t none[sim::kSitlServoChannels] = {};
         if (!link.exchange(0, none, first)) {
             std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
-            return 4;
+            return link.stopped() ? 0 : 4;
         }
         trajectory.append(sim::physics_sample(first, 0.0, earth_field_uT));
         if (!physics_log_path.empty()) {
@@ -366,6 +367,7 @@ int main(int argc, char** argv) {
             sim::PhysicsState state;
             std::string error;
             if (!link.exchange(frame, pwm, state)) {
+                if (link.stopped()) break;  // a clean end, as any SIGINT/SIGTERM
                 error = link.error();
             } else {
                 const double t = state.timestamp_s - first.timestamp_s;

@@ -137,8 +137,9 @@ TEST(HarnessPhysics, PacketsCarryThePinsWidthsAndRcDrivesThePpm) {
 }
 
 // A backend that stops answering: the frame is sent again every second, said on stderr,
-// and after --physics-timeout the run stops with exit status 4 (not a hang); one that
-// answers with something else than a state stops it at once, saying what is wrong.
+// and after --physics-timeout the run stops with exit status 4 (not a hang), or at once on
+// SIGTERM (exit 0); one that answers with something else than a state stops it at once,
+// saying what is wrong.
 TEST(HarnessPhysics, ASilentOrConfusedBackendStopsTheRunWithAReason) {
     E2E_REQUIRE_TOOLS("apm25sim", "firmware.elf");
     {
@@ -154,6 +155,19 @@ TEST(HarnessPhysics, ASilentOrConfusedBackendStopsTheRunWithAReason) {
         ASSERT_GE(sent.size(), 203u);
         EXPECT_EQ(sent[201][1], 201);
         EXPECT_EQ(sent[202][1], 201) << "a resend keeps the frame count";
+    }
+    {
+        // SIGTERM while waiting for a silent backend: a clean end at once, not after the timeout.
+        Backend backend;
+        ASSERT_TRUE(backend.start({"--silent-after", "50"})) << backend.process.text;
+        e2e::LiveProcess sim;
+        const std::string out = e2e::work_dir() + "/physics_stdout." + std::to_string(getpid()) + ".txt";
+        ASSERT_TRUE(sim.start({e2e::tool("apm25sim"), "--elf", e2e::firmware_elf(), "--physics",
+                               "json:127.0.0.1:" + backend.port, "--physics-timeout", "600"},
+                              2, out));
+        EXPECT_FALSE(sim.wait_line("has not answered frame 51").empty()) << sim.text;
+        EXPECT_EQ(sim.stop(), 0) << sim.text;
+        unlink(out.c_str());
     }
     {
         Backend backend;
