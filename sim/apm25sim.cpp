@@ -145,6 +145,7 @@ bool take_backend_rc(const sim::PhysicsState& state, double t_s, bool from_backe
     for (int c = 0; same && row.signal && c < sim::kRcChannels; ++c) same = last->width_us[c] == row.width_us[c];
     if (same) return true;
     rc.push(row);
+    if (rc.rows().size() > 4096) rc.drop_before(t_s - 1.0);  // a backend whose sticks move every frame
     if (board) board->rc_changed();
     return true;
 }
