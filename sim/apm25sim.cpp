@@ -15,6 +15,7 @@
 
 #include "Board.h"
 #include "FaultSpec.h"
+#include "Mpxv7002dpModel.h"
 #include "PhysicsLink.h"
 #include "RcLink.h"
 #include "Rotation.h"
@@ -102,8 +103,10 @@ const char* const kUsage =
     "                   frames, so a run is deterministic. rc_1..rc_8 drive the PPM on ICP5 (an\n"
     "                   rc with none of them, or all 0, is a dead receiver; --rc, if given,\n"
     "                   drives it instead). A frame unanswered for 1 s is sent again (same\n"
-    "                   frame_count, said on stderr); position, velocity, airspeed and wind are\n"
-    "                   read but no sensor uses them yet. Runs until SIGINT/SIGTERM unless\n"
+    "                   frame_count, said on stderr); airspeed, when sent, is the pitot's: the\n"
+    "                   APM 2.5's MPXV7002DP on A0 (ADC0), 2.5 V + 1 V/kPa of 1/2 1.225 v^2,\n"
+    "                   held within 0.5..4.5 V; position, velocity and wind are read but no\n"
+    "                   sensor uses them yet. Runs until SIGINT/SIGTERM unless\n"
     "                   --seconds. Exit status 4 when the backend stops answering or answers\n"
     "                   something that is not a state\n"
     "  --physics-rate HZ  the frame_rate asked of the backend, 400..10000 (default 1000)\n"
@@ -354,6 +357,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "apm25sim: %s\n", board.error().c_str());
         return 1;
     }
+    if (use_physics && first.has_airspeed) board.set_a0_mV(sim::Mpxv7002dpModel::output_mV(first.airspeed_m_s));
     bool ran = true;
     int physics_status = 0;
     if (!use_physics) {
@@ -380,6 +384,7 @@ int main(int argc, char** argv) {
                 } else {
                     const sim::TrajectorySample sample = sim::physics_sample(state, t, earth_field_uT);
                     board.append_sample(sample, 1.0);
+                    if (state.has_airspeed) board.set_a0_mV(sim::Mpxv7002dpModel::output_mV(state.airspeed_m_s));
                     if (physics_log) std::fputs(sim::format_trajectory_row(sample).c_str(), physics_log);
                     if (take_backend_rc(state, t, rc_from_backend, rc, &board, error)) {
                         ran = board.run(std::min(t, seconds));
