@@ -117,6 +117,7 @@ class FlightModel:
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
         self.lat0, self.lon0 = math.radians(latitude_deg), math.radians(longitude_deg)
         self.gust_level, self.seed = gust, seed
+        jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
         self.fdm.set_debug_level(0)
         self.fdm.set_aircraft_path("aircraft")

@@ -58,7 +58,7 @@ def flights(cruise_throttle_us, airspeed_m_s=18.0):
     def row(t, roll_us=1500, pitch_us=1500, throttle_us=thr, yaw_us=1500):
         return (float(t), (round(roll_us), round(pitch_us), round(throttle_us), round(yaw_us), 1500, 1500, 1500, 1500))
 
-    circle = turn_seconds(30.0, airspeed_m_s)
+    circle = turn_seconds(30.0, airspeed_m_s + 1.5)  # the turn's power setting flies it faster
     out = {}
     out["cruise"] = ("60 s of level cruise, hands off", 60.0, 0, [row(0)])
     out["gusty"] = ("60 s of cruise in moderate Dryden turbulence, hands off", 60.0, 2, [row(0)])
@@ -74,7 +74,7 @@ def flights(cruise_throttle_us, airspeed_m_s=18.0):
     eight.append(row(t))
     out["figure8"] = ("two figure-eights of 30 deg bank circles, right then left", t + 5.0, 0, eight)
     out["climb"] = ("5 s level, 20 s climbing at 10 deg, 15 s level, 15 s descending at -5 deg, 10 s level",
-                    65.0, 0, [row(0), row(5, pitch_us=stick_for_pitch(10), throttle_us=1700), row(25),
+                    65.0, 0, [row(0), row(5, pitch_us=stick_for_pitch(10), throttle_us=1400), row(25),
                               row(40, pitch_us=stick_for_pitch(-5), throttle_us=1000), row(55)])
     return out
 
