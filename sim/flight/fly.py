@@ -7,6 +7,7 @@ trajectory (../shared/SIM.md) and a true-state log.
     build/venv/bin/python sim/flight/fly.py --flight turn --out build/flights/turn.csv [--log L.csv]
         [--gust 0|1|2] [--seed N] [--seconds S] [--rc FILE] [--mode stabilize|manual]
     build/venv/bin/python sim/flight/fly.py --list
+    build/venv/bin/python sim/flight/fly.py --all DIR      every flight: DIR/NAME.csv.gz, DIR/NAME_log.csv
     build/venv/bin/python sim/flight/fly.py --write-pilots DIR     the flights' stick scripts
 
 The stand-in does what the firmware's STABILIZE does (issue 21): the sticks from the
@@ -185,6 +186,7 @@ def main():
     p.add_argument("--log", help="true-state log")
     p.add_argument("--list", action="store_true")
     p.add_argument("--write-pilots", metavar="DIR")
+    p.add_argument("--all", metavar="DIR", help="fly every flight into DIR")
     p.add_argument("--quiet", action="store_true")
     args = p.parse_args()
 
@@ -198,6 +200,21 @@ def main():
         os.makedirs(args.write_pilots, exist_ok=True)
         for name, (_, _, _, rows) in table.items():
             flightio.RcScript(rows).save(os.path.join(args.write_pilots, name + ".csv"))
+        return 0
+    if args.all:
+        os.makedirs(args.all, exist_ok=True)
+        for name, (_, seconds, gust, rows) in table.items():
+            args.out = os.path.join(args.all, name + ".csv.gz")
+            args.log = os.path.join(args.all, name + "_log.csv")
+            with tempfile.TemporaryDirectory(prefix="fly-") as work:
+                rc_path = os.path.join(work, name + ".csv")
+                flightio.RcScript(rows).save(rc_path)
+                try:
+                    fly(args, trim, rc_path, args.seconds or seconds, gust if args.gust is None else args.gust, work)
+                except (OSError, RuntimeError, ValueError) as e:
+                    print("fly.py: %s: %s" % (name, e), file=sys.stderr)
+                    return 1
+            print("%s: %s" % (name, args.out))
         return 0
     if bool(args.flight) == bool(args.rc):
         p.error("give --flight NAME or --rc FILE")

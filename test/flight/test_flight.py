@@ -13,7 +13,8 @@ GROUP is one of:
   signs         OUT1 above 1500 rolls right, below rolls left; OUT2 above its trim pitches the
                 nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed
   trajectory    a flown turn as a trajectory file: integrating its gyro reproduces its truth
-                quaternion, level flight reads -g on z, the turn holds 30 deg of bank with
+                quaternion, its specific force rotated to earth plus g is the velocity's
+                derivative in the true-state log, level flight reads -g on z, the turn holds 30 deg of bank with
                 |f| = g / cos(bank) and no side force, the field is the stated one; with
                 --tools, build/replay runs on it and build/score scores it
   determinism   the same seed gives the same bytes (gzip included), another seed does not
@@ -282,6 +283,21 @@ def check_trajectory(args, work):
     soft_assert(side < 0.3, "turn: side force up to %.2f m/s^2 (not coordinated)" % side)
     with open(log) as f:
         state = list(csv.DictReader(f))
+    # The specific force is the acceleration less gravity: R f + g = dv/dt (velocities from the log).
+    velocity = [[float(s[k]) for k in ("vn_m_s", "ve_m_s", "vd_m_s")] for s in state]
+    worst_force = 0.0
+    for i in range(400, len(rows) - 1, 97):
+        w, x, y, z = rows[i][10:14]
+        f = rows[i][4:7]
+        rot = ((1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+               (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+               (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)))
+        h = rows[i + 1][0] - rows[i - 1][0]
+        for k in range(3):
+            accel = (velocity[i + 1][k] - velocity[i - 1][k]) / h
+            earth = sum(rot[k][j] * f[j] for j in range(3)) + (G if k == 2 else 0.0)
+            worst_force = max(worst_force, abs(earth - accel))
+    soft_assert(worst_force < 0.05, "R f + g differs from dv/dt by %.3f m/s^2" % worst_force)
     yaw = [float(s["yaw_deg"]) for s in state if 20.0 <= float(s["t"]) <= 30.0]
     turned = sum((b - a + 180) % 360 - 180 for a, b in zip(yaw, yaw[1:]))
     speed = sum(float(s["airspeed_m_s"]) for s in state if 20.0 <= float(s["t"]) <= 30.0) / \
@@ -289,6 +305,7 @@ def check_trajectory(args, work):
     rate_expect = math.degrees(G * math.tan(math.radians(mean_bank)) / speed)
     soft_assert(abs(turned / 10.0 - rate_expect) < 0.05 * rate_expect,
                 "turn rate %.2f deg/s, not g tan(bank) / V = %.2f" % (turned / 10.0, rate_expect))
+    print("trajectory: R f + g = dv/dt within %.4f m/s^2" % worst_force)
     print("trajectory: gyro integration within %.4f deg over 40 s; turn bank %.2f deg (%.1f..%.1f), |f| %.2f m/s^2,"
           " turn rate %.2f deg/s at %.2f m/s" % (worst, mean_bank, min(banks), max(banks), mean_force, turned / 10, speed))
     if args.tools:
