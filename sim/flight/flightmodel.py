@@ -16,6 +16,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FT = 0.3048
+NM_PER_LBSFT = 1.3558179483
 G0 = 9.80665
 EARTH_RADIUS_M = 6378137.0
 # The project's earth field (sim/scenario.cpp): 49 uT at 66 deg inclination, declination 0.
@@ -111,12 +112,15 @@ class Trim:
 
 class FlightModel:
     def __init__(self, airspeed_m_s=18.0, altitude_m=100.0, heading_deg=0.0, gust=0, seed=1,
-                 latitude_deg=52.5, longitude_deg=13.4):
+                 latitude_deg=52.5, longitude_deg=13.4, upsets=()):
+        """upsets: (start_s, duration_s, roll_moment_Nm) tuples, a roll moment applied from
+        start_s for duration_s (positive rolls right)."""
         if gust not in GUST_LEVELS:
             raise ValueError("gust level %r: 0 (none), 1 (light) or 2 (moderate)" % (gust,))
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
         self.lat0, self.lon0 = math.radians(latitude_deg), math.radians(longitude_deg)
         self.gust_level, self.seed = gust, seed
+        self.upsets = [tuple(float(v) for v in u) for u in upsets]
         jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
         self.fdm.set_debug_level(0)
@@ -229,7 +233,10 @@ class FlightModel:
         f = self.fdm
         if abs(f.get_delta_t() - h) > 1e-15:
             f.set_dt(h)
-        for _ in range(n):
+        for i in range(n):
+            t = self.time_s + i * h
+            moment = sum(m for start, length, m in self.upsets if start - 1e-9 <= t < start + length - 1e-9)
+            f["external_reactions/upset/magnitude-lbsft"] = moment / NM_PER_LBSFT
             if self.gust_level:
                 self.gust_body = self.dryden.step(f["velocities/vt-fps"] * FT, h)
                 rot = body_to_ned_matrix(f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"])

@@ -14,7 +14,8 @@ The stand-in does what the firmware's STABILIZE does (issue 21): the sticks from
 backend's rc channels command a bank (full stick 45 deg) and a pitch (full stick 25 deg, about
 the trim pitch), PI-D loops on the attitude from the reply's quaternion and the gyro, turn
 coordination on the elevator, the rudder against side acceleration, throttle passed
-through; outputs update at 50 Hz as servo pulses do. MANUAL passes the sticks through.
+through; outputs update at 50 Hz as servo pulses do. MANUAL passes the sticks through
+about the servo trims.
 """
 import argparse
 import math
@@ -52,7 +53,7 @@ def turn_seconds(bank_deg, airspeed_m_s, degrees=360.0):
 
 
 def flights(cruise_throttle_us, airspeed_m_s=18.0):
-    """name -> (description, seconds, gust level, rc rows)."""
+    """name -> (description, seconds, gust level, rc rows, extra backend arguments)."""
     thr = round(cruise_throttle_us)
     turn_thr = thr + 40  # a 30 deg bank needs 1/cos(30) = 1.15 g of lift, so more power
 
@@ -61,10 +62,12 @@ def flights(cruise_throttle_us, airspeed_m_s=18.0):
 
     circle = turn_seconds(30.0, airspeed_m_s + 1.5)  # the turn's power setting flies it faster
     out = {}
-    out["cruise"] = ("60 s of level cruise, hands off", 60.0, 0, [row(0)])
-    out["gusty"] = ("60 s of cruise in moderate Dryden turbulence, hands off", 60.0, 2, [row(0)])
+    out["cruise"] = ("60 s of level cruise, hands off", 60.0, 0, [row(0)], [])
+    out["gusty"] = ("60 s of cruise in moderate Dryden turbulence, hands off", 60.0, 2, [row(0)], [])
+    out["upset"] = ("cruise, hands off; at 5 s a 20 N m roll moment for 0.5 s (45 deg of bank if nothing resists)", 30.0, 0,
+                    [row(0)], ["--upset", "5,0.5,20"])
     out["turn"] = ("5 s level, 60 s in a 30 deg bank to the right, 10 s level", 75.0, 0,
-                   [row(0), row(5, stick_for_bank(30), throttle_us=turn_thr), row(65)])
+                   [row(0), row(5, stick_for_bank(30), throttle_us=turn_thr), row(65)], [])
     t = 5.0
     eight = [row(0)]
     for _ in range(2):
@@ -73,10 +76,10 @@ def flights(cruise_throttle_us, airspeed_m_s=18.0):
         eight.append(row(t, stick_for_bank(-30), throttle_us=turn_thr))
         t += circle
     eight.append(row(t))
-    out["figure8"] = ("two figure-eights of 30 deg bank circles, right then left", t + 5.0, 0, eight)
+    out["figure8"] = ("two figure-eights of 30 deg bank circles, right then left", t + 5.0, 0, eight, [])
     out["climb"] = ("5 s level, 20 s climbing at 10 deg, 15 s level, 15 s descending at -5 deg, 10 s level",
                     65.0, 0, [row(0), row(5, pitch_us=stick_for_pitch(10), throttle_us=1400), row(25),
-                              row(40, pitch_us=stick_for_pitch(-5), throttle_us=1000), row(55)])
+                              row(40, pitch_us=stick_for_pitch(-5), throttle_us=1000), row(55)], [])
     return out
 
 
@@ -98,8 +101,9 @@ class StandIn:
             sticks = (1500.0, 1500.0, self.trim_us[2], 1500.0)
         else:
             sticks = (rc["rc_1"], rc["rc_2"], rc["rc_3"], rc["rc_4"])
-        if self.mode == "manual":
-            self.outputs = [round(w) for w in sticks]
+        if self.mode == "manual":  # pass-through about the servo trims, throttle as is
+            self.outputs = [round(self.trim_us[i] + sticks[i] - 1500.0) if i != 2 else round(sticks[2])
+                            for i in range(4)]
             return self.outputs
         qw, qx, qy, qz = reply["quaternion"]
         roll = math.atan2(2 * (qw * qx + qy * qz), 1 - 2 * (qx * qx + qy * qy))
@@ -123,7 +127,7 @@ class StandIn:
         return self.outputs
 
 
-def start_backend(args, rc_path, seconds, gust, work):
+def start_backend(args, rc_path, seconds, gust, work, extra):
     port_file = os.path.join(work, "port")
     cmd = [sys.executable, os.path.join(HERE, "jsbsim_backend.py"), "--port", "0", "--port-file", port_file,
            "--rc", rc_path, "--gust", str(gust), "--seed", str(args.seed), "--seconds", repr(seconds),
@@ -134,6 +138,7 @@ def start_backend(args, rc_path, seconds, gust, work):
         cmd += ["--log", args.log]
     if args.quiet:
         cmd.append("--quiet")
+    cmd += list(extra) + [a for u in args.upset for a in ("--upset", u)]
     proc = subprocess.Popen(cmd)
     deadline = time.monotonic() + 60.0
     while not (os.path.exists(port_file) and open(port_file).read().endswith("\n")):
@@ -143,8 +148,8 @@ def start_backend(args, rc_path, seconds, gust, work):
     return proc, int(open(port_file).read())
 
 
-def fly(args, trim, rc_path, seconds, gust, work):
-    proc, port = start_backend(args, rc_path, seconds, gust, work)
+def fly(args, trim, rc_path, seconds, gust, work, extra=()):
+    proc, port = start_backend(args, rc_path, seconds, gust, work, extra)
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.settimeout(5.0)
     pilot = StandIn(trim, args.mode)
@@ -182,6 +187,7 @@ def main():
     p.add_argument("--airspeed", type=float, default=18.0)
     p.add_argument("--altitude", type=float, default=100.0)
     p.add_argument("--mode", choices=("stabilize", "manual"), default="stabilize")
+    p.add_argument("--upset", action="append", default=[], metavar="T,SECONDS,NM", help="passed to the backend")
     p.add_argument("--out", help="trajectory file (.csv or .csv.gz)")
     p.add_argument("--log", help="true-state log")
     p.add_argument("--list", action="store_true")
@@ -193,24 +199,25 @@ def main():
     trim = flightmodel.FlightModel(args.airspeed, args.altitude).trim
     table = flights(trim.widths_us()[2], args.airspeed)
     if args.list:
-        for name, (text, seconds, gust, _) in table.items():
+        for name, (text, seconds, gust, _, _) in table.items():
             print("%-8s %5.1f s  gust %s  %s" % (name, seconds, flightmodel.GUST_NAMES[gust], text))
         return 0
     if args.write_pilots:
         os.makedirs(args.write_pilots, exist_ok=True)
-        for name, (_, _, _, rows) in table.items():
+        for name, (_, _, _, rows, _) in table.items():
             flightio.RcScript(rows).save(os.path.join(args.write_pilots, name + ".csv"))
         return 0
     if args.all:
         os.makedirs(args.all, exist_ok=True)
-        for name, (_, seconds, gust, rows) in table.items():
+        for name, (_, seconds, gust, rows, extra) in table.items():
             args.out = os.path.join(args.all, name + ".csv.gz")
             args.log = os.path.join(args.all, name + "_log.csv")
             with tempfile.TemporaryDirectory(prefix="fly-") as work:
                 rc_path = os.path.join(work, name + ".csv")
                 flightio.RcScript(rows).save(rc_path)
                 try:
-                    fly(args, trim, rc_path, args.seconds or seconds, gust if args.gust is None else args.gust, work)
+                    fly(args, trim, rc_path, args.seconds or seconds, gust if args.gust is None else args.gust, work,
+                        extra)
                 except (OSError, RuntimeError, ValueError) as e:
                     print("fly.py: %s: %s" % (name, e), file=sys.stderr)
                     return 1
@@ -221,8 +228,9 @@ def main():
     if args.flight and args.flight not in table:
         p.error("unknown flight %r (--list)" % args.flight)
     with tempfile.TemporaryDirectory(prefix="fly-") as work:
+        extra = []
         if args.flight:
-            _, seconds, gust, rows = table[args.flight]
+            _, seconds, gust, rows, extra = table[args.flight]
             rc_path = os.path.join(work, args.flight + ".csv")
             flightio.RcScript(rows).save(rc_path)
         else:
@@ -230,7 +238,7 @@ def main():
         seconds = args.seconds or seconds
         gust = gust if args.gust is None else args.gust
         try:
-            fly(args, trim, rc_path, seconds, gust, work)
+            fly(args, trim, rc_path, seconds, gust, work, extra)
         except (OSError, RuntimeError, ValueError) as e:
             print("fly.py: %s" % e, file=sys.stderr)
             return 1

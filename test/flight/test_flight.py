@@ -11,7 +11,8 @@ GROUP is one of:
   trim          20 s with no pulses on any output from the trimmed start: height within 1 m,
                 bank and pitch change within 1 deg, airspeed within 0.5 m/s
   signs         OUT1 above 1500 rolls right, below rolls left; OUT2 above its trim pitches the
-                nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed
+                nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed; a
+                positive upset moment rolls right, and only from its start time
   trajectory    a flown turn as a trajectory file: integrating its gyro reproduces its truth
                 quaternion, its specific force rotated to earth plus g is the velocity's
                 derivative in the true-state log, level flight reads -g on z, the turn holds 30 deg of bank with
@@ -208,6 +209,12 @@ def check_signs(work):
                 % math.degrees(down["euler"][1]))
     yaw = pulse(3, 2000, 0.5)
     soft_assert(yaw["gyro"][2] > 0.05, "OUT4 2000 us: yaw rate %.3f rad/s (want nose right)" % yaw["gyro"][2])
+    upset = flightmodel.FlightModel(upsets=[(0.5, 0.5, 20.0)])
+    calm = fly_model(upset, 0.5, trim)
+    after = fly_model(upset, 1.5, trim)
+    soft_assert(abs(math.degrees(calm["euler"][0])) < 0.5 and math.degrees(after["euler"][0]) > 30,
+                "--upset 0.5,0.5,20: bank %.1f deg before, %.1f deg 1.5 s after (want calm, then > 30 right)"
+                % (math.degrees(calm["euler"][0]), math.degrees(after["euler"][0])))
     fast = pulse(2, 1600, 5.0)
     soft_assert(fast["airspeed"] > 19.0, "OUT3 1600 us for 5 s: airspeed %.2f m/s" % fast["airspeed"])
     print("signs: OUT1 2000 us 1 s -> bank %+.1f deg; 1000 us -> %+.1f deg; OUT2 +200 us 0.5 s -> pitch %+.1f deg;"
