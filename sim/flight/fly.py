@@ -64,7 +64,7 @@ def flights(cruise_throttle_us, airspeed_m_s=18.0):
     out = {}
     out["cruise"] = ("60 s of level cruise, hands off", 60.0, 0, [row(0)], [])
     out["gusty"] = ("60 s of cruise in moderate Dryden turbulence, hands off", 60.0, 2, [row(0)], [])
-    out["upset"] = ("cruise, hands off; at 5 s a 20 N m roll moment for 0.5 s (45 deg of bank if nothing resists)", 30.0, 0,
+    out["upset"] = ("cruise, hands off; at 5 s a 20 N m roll moment for 0.5 s (48 deg of bank if nothing resists)", 30.0, 0,
                     [row(0)], ["--upset", "5,0.5,20"])
     out["turn"] = ("5 s level, 60 s in a 30 deg bank to the right, 10 s level", 75.0, 0,
                    [row(0), row(5, stick_for_bank(30), throttle_us=turn_thr), row(65)], [])
