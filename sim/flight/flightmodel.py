@@ -112,15 +112,17 @@ class Trim:
 
 class FlightModel:
     def __init__(self, airspeed_m_s=18.0, altitude_m=100.0, heading_deg=0.0, gust=0, seed=1,
-                 latitude_deg=52.5, longitude_deg=13.4, upsets=()):
+                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0):
         """upsets: (start_s, duration_s, roll_moment_Nm) tuples, a roll moment applied from
-        start_s for duration_s (positive rolls right)."""
+        start_s for duration_s (positive rolls right). vibration_m_s2: the amplitude of the
+        propeller's vibration at the IMU at the trim's propeller speed (see vibration())."""
         if gust not in GUST_LEVELS:
             raise ValueError("gust level %r: 0 (none), 1 (light) or 2 (moderate)" % (gust,))
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
         self.lat0, self.lon0 = math.radians(latitude_deg), math.radians(longitude_deg)
         self.gust_level, self.seed = gust, seed
         self.upsets = [tuple(float(v) for v in u) for u in upsets]
+        self.vibration_m_s2 = float(vibration_m_s2)
         jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
         self.fdm.set_debug_level(0)
@@ -211,6 +213,8 @@ class FlightModel:
         self.surfaces = [t.aileron, t.elevator, t.throttle, t.rudder]
         self.dryden = Dryden(self.gust_level, self.seed)
         self.gust_body = np.zeros(3)
+        self.trim_rpm = self.fdm["propulsion/engine/propeller-rpm"]
+        self.prop_angle_rad = 0.0
 
     def set_widths(self, widths_us):
         """OUT1..OUT4 widths in us (more are ignored); 0 or implausible = no pulse: hold."""
@@ -245,7 +249,23 @@ class FlightModel:
                 f["atmosphere/gust-east-fps"] = gust_ned[1]
                 f["atmosphere/gust-down-fps"] = gust_ned[2]
             f.run()
+            self.prop_angle_rad = (self.prop_angle_rad +
+                                   f["propulsion/engine/propeller-rpm"] * 2 * math.pi / 60 * h) % (2 * math.pi)
         self.time_s += dt_s
+
+    def vibration(self):
+        """The propeller's vibration at the IMU, m/s^2 body axes: a rotating imbalance at the
+        shaft's frequency in y and z, and a blade-passing (twice the shaft) component a third
+        as large in x, the amplitude growing with the square of the propeller's speed (a
+        centrifugal force) from vibration_m_s2 at the trim's speed. A vibration of the board,
+        not of the aeroplane: it is added to the specific force the IMU reads, not to the
+        dynamics."""
+        if not self.vibration_m_s2:
+            return (0.0, 0.0, 0.0)
+        rpm = self.fdm["propulsion/engine/propeller-rpm"]
+        amplitude = self.vibration_m_s2 * (rpm / self.trim_rpm) ** 2
+        a = self.prop_angle_rad
+        return (amplitude / 3 * math.sin(2 * a), amplitude * math.sin(a), amplitude * math.cos(a))
 
     def state(self):
         """The true state and the ideal sensor values, SI, as a dict."""
@@ -254,7 +274,7 @@ class FlightModel:
         q = quat_from_euler(roll, pitch, yaw)
         mass_slug = f["inertia/mass-slugs"]
         # Specific force: every force but gravity (aerodynamics, thrust, ground) over the mass.
-        accel = [f["forces/fb%s-total-lbs" % a] / mass_slug * FT for a in "xyz"]
+        accel = [f["forces/fb%s-total-lbs" % a] / mass_slug * FT + v for a, v in zip("xyz", self.vibration())]
         # Body rates relative to the earth: integrating them gives the NED attitude exactly.
         gyro = [f["velocities/%s-rad_sec" % a] for a in "pqr"]
         rot = body_to_ned_matrix(roll, pitch, yaw)

@@ -139,6 +139,8 @@ def start_backend(args, rc_path, seconds, gust, work, extra):
     if args.quiet:
         cmd.append("--quiet")
     cmd += list(extra) + [a for u in args.upset for a in ("--upset", u)]
+    if args.vibration:
+        cmd += ["--vibration", repr(args.vibration)]
     proc = subprocess.Popen(cmd)
     deadline = time.monotonic() + 60.0
     while not (os.path.exists(port_file) and open(port_file).read().endswith("\n")):
@@ -187,6 +189,7 @@ def main():
     p.add_argument("--airspeed", type=float, default=18.0)
     p.add_argument("--altitude", type=float, default=100.0)
     p.add_argument("--mode", choices=("stabilize", "manual"), default="stabilize")
+    p.add_argument("--vibration", type=float, default=0.0, metavar="M_S2", help="passed to the backend")
     p.add_argument("--upset", action="append", default=[], metavar="T,SECONDS,NM", help="passed to the backend")
     p.add_argument("--out", help="trajectory file (.csv or .csv.gz)")
     p.add_argument("--log", help="true-state log")

@@ -7,6 +7,7 @@ autopilot speaks the protocol (build/apm25sim --physics json, ArduPilot SITL wit
     build/venv/bin/python sim/flight/jsbsim_backend.py [--port 9002] [--rc FILE|none]
         [--gust 0|1|2] [--seed N] [--trajectory FILE.csv[.gz]] [--log FILE.csv[.gz]]
         [--seconds S] [--airspeed 18] [--altitude 100] [--heading 0] [--upset T,SECONDS,NM ...]
+        [--vibration M_S2]
 
 Lock-step: one physics frame (1 / frame_rate of the packet, in JSBSim steps of at most
 2.5 ms) per servo packet received, no wall clock, so a flight is the same every time.
@@ -41,6 +42,8 @@ def parse_args(argv):
     p.add_argument("--upset", action="append", default=[], metavar="T,SECONDS,NM",
                    help="a roll moment of NM newton-metres (positive rolls right) from T for SECONDS "
                         "of simulated time; repeatable")
+    p.add_argument("--vibration", type=float, default=0.0, metavar="M_S2",
+                   help="propeller vibration at the IMU, amplitude at the trim's propeller speed (m/s^2)")
     p.add_argument("--trajectory", help="write the flight as a trajectory (../shared/SIM.md)")
     p.add_argument("--log", help="write the true state, one row a frame")
     p.add_argument("--seconds", type=float, default=0.0, help="stop after S simulated seconds")
@@ -62,7 +65,7 @@ class Backend:
                 raise ValueError("--upset %r: want T,SECONDS,NM (three numbers)" % spec)
             upsets.append((start, length, moment))
         self.model = flightmodel.FlightModel(args.airspeed, args.altitude, args.heading, args.gust, args.seed,
-                                             upsets=upsets)
+                                             upsets=upsets, vibration_m_s2=args.vibration)
         trim = self.model.trim
         widths = trim.widths_us()
         if args.rc == "none":

@@ -9,7 +9,8 @@ GROUP is one of:
                 readme (layout, magic, newline framing, fields, frame count: repeat, reset,
                 frame rate), the rc script, and one real UDP round trip to the backend
   trim          20 s with no pulses on any output from the trimmed start: height within 1 m,
-                bank and pitch change within 1 deg, airspeed within 0.5 m/s
+                bank and pitch change within 1 deg, airspeed within 0.5 m/s; the propeller's
+                vibration has the stated amplitude and leaves the flight itself alone
   signs         OUT1 above 1500 rolls right, below rolls left; OUT2 above its trim pitches the
                 nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed; a
                 positive upset moment rolls right, and only from its start time
@@ -178,6 +179,20 @@ def check_trim(work):
     soft_assert(worst["pitch"] < 1.0, "trim: pitch moved %.2f deg" % worst["pitch"])
     soft_assert(worst["speed"] < 0.5, "trim: airspeed moved %.2f m/s" % worst["speed"])
     soft_assert(model.trim.residual < 1e-3, "trim residual %.2e" % model.trim.residual)
+    # Propeller vibration: at the IMU only, of the stated amplitude, not in the dynamics.
+    shaken = flightmodel.FlightModel(vibration_m_s2=2.0)
+    still = flightmodel.FlightModel()
+    trim_widths = [round(w) for w in still.trim.widths_us()]
+    ays, azs, same = [], [], True
+    for _ in range(400):
+        a, b = fly_model(shaken, 1 / 400, trim_widths), fly_model(still, 1 / 400, trim_widths)
+        ays.append(a["accel"][1] - b["accel"][1])
+        azs.append(a["accel"][2] - b["accel"][2])
+        same = same and a["quat"] == b["quat"] and a["position"] == b["position"]
+    rms = math.sqrt(sum(v * v for v in ays) / len(ays))
+    soft_assert(abs(rms - 2.0 / math.sqrt(2)) < 0.05, "vibration 2 m/s^2: y rms %.3f, not 1.414" % rms)
+    soft_assert(abs(sum(azs) / len(azs)) < 0.05, "vibration has a mean of %.3f m/s^2 on z" % (sum(azs) / len(azs)))
+    soft_assert(same, "the vibration changed the flight itself")
     print("trim: throttle %.3f, OUT1..4 %s us, alpha %.2f deg; 20 s hands off: height %.3f m, bank %.3f deg,"
           " pitch %.3f deg, speed %.3f m/s" % (model.trim.throttle, [round(w) for w in model.trim.widths_us()],
                                                 math.degrees(model.trim.alpha_rad), worst["height"], worst["roll"],
