@@ -33,6 +33,7 @@ import socket
 import struct
 import subprocess
 import sys
+import time
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 sys.path.insert(0, os.path.join(ROOT, "test", "support"))
@@ -130,6 +131,8 @@ def check_protocol(work):
 
     # One real round trip over UDP: the reply goes back to the sender's address and port.
     port_file = os.path.join(work, "port")
+    if os.path.exists(port_file):
+        os.remove(port_file)  # a previous run's port
     proc = subprocess.Popen([sys.executable, BACKEND, "--quiet", "--port", "0", "--port-file", port_file,
                              "--seconds", "0.01", "--idle-timeout", "20"])
     try:
@@ -138,7 +141,7 @@ def check_protocol(work):
                 break
             if proc.poll() is not None:
                 break
-            subprocess.run(["sleep", "0.01"])
+            time.sleep(0.01)
         port = int(open(port_file).read())
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         sock.settimeout(20)
