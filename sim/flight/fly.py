@@ -97,7 +97,7 @@ class StandIn:
 
     def update(self, reply, dt_s):
         rc = reply.get("rc")
-        if rc is None:  # no receiver: wings level, trim throttle (a failsafe of sorts)
+        if not rc:  # no receiver: wings level, trim throttle (a failsafe of sorts)
             sticks = (1500.0, 1500.0, self.trim_us[2], 1500.0)
         else:
             sticks = (rc["rc_1"], rc["rc_2"], rc["rc_3"], rc["rc_4"])

@@ -13,8 +13,9 @@ Lock-step: one physics frame (1 / frame_rate of the packet, in JSBSim steps of a
 2.5 ms) per servo packet received, no wall clock, so a flight is the same every time.
 The aeroplane starts trimmed for level flight at the given airspeed and height (north,
 wings level); outputs without pulses (width 0) hold the trim. The pilot's sticks from
---rc are sent as the reply's rc channels (default: hands off, sticks centred, throttle
-at the trim, ch5-ch8 1500; `--rc none` sends no rc field).
+--rc are sent as the reply's rc channels, and no signal as an empty rc object (default:
+hands off, sticks centred, throttle at the trim, ch5-ch8 1500; `--rc none` sends no rc
+field).
 Exits after --seconds of simulated time, or after --idle-timeout s without a packet.
 """
 import argparse
@@ -102,7 +103,7 @@ class Backend:
             self.log.write(state)
 
     def rc_at(self, t_s):
-        return None if self.pilot is None else self.pilot.at(t_s)
+        return jsonlink.NO_RC if self.pilot is None else self.pilot.at(t_s)
 
     def handle(self, data):
         """The reply to one packet (bytes), or None for a packet that is not a servo packet."""

@@ -109,7 +109,7 @@ def check_protocol(work):
                 "trimmed level flight: accel_body z %.3f, not -g cos(pitch)" % obj["imu"]["accel_body"][2])
     soft_assert(abs(obj["position"][2] + 100.0) < 0.01, "position down %.3f, not -100 m" % obj["position"][2])
     soft_assert(abs(obj["airspeed"] - 18.0) < 0.05, "airspeed %.3f, not 18" % obj["airspeed"])
-    soft_assert("rc" not in obj, "rc sent before the script's first row")
+    soft_assert(obj.get("rc") == {}, "before the script's first row rc is %r, not {} (no signal)" % obj.get("rc"))
     soft_assert(ask(400, 0) == first, "a repeated frame count was not answered with the same reply")
     t1 = json.loads(ask(400, 1))["timestamp"]
     soft_assert(abs(t1 - 2 / 400) < 1e-12, "after a repeat, the next frame is at %r s, not 2/400" % t1)
@@ -120,7 +120,10 @@ def check_protocol(work):
     soft_assert(obj.get("rc", {}).get("rc_1") == 1600 and obj["rc"].get("rc_8") == 1900 and len(obj["rc"]) == 8,
                 "rc at %.3f s is %r, not the script's row" % (obj["timestamp"], obj.get("rc")))
     soft_assert(backend.tracker.missed == 0, "frames counted missed: %d" % backend.tracker.missed)
-    ask(400, 310)
+    for count in range(300, 440):
+        obj = json.loads(ask(400, count))
+    soft_assert(obj.get("rc") == {}, "rc at %.3f s (the script's empty row) is %r, not {}" % (obj["timestamp"], obj.get("rc")))
+    ask(400, 450)
     soft_assert(backend.tracker.missed == 10, "10 skipped counts gave missed = %d" % backend.tracker.missed)
     reset = json.loads(ask(400, 0))
     soft_assert(abs(reset["timestamp"] - 1 / 400) < 1e-12 and abs(reset["position"][0]) < 0.1,
@@ -128,6 +131,9 @@ def check_protocol(work):
                 % (reset["timestamp"], reset["position"][0]))
     soft_assert(backend.handle(b"\x00" * 40) is None, "a packet with a bad magic got a reply")
     backend.close_outputs()
+    silent = jsbsim_backend.Backend(jsbsim_backend.parse_args(["--quiet", "--rc", "none"]))
+    soft_assert("rc" not in json.loads(silent.handle(packet(400, 0, trim_pwm))), "--rc none still sent an rc field")
+    silent.close_outputs()
 
     # One real round trip over UDP: the reply goes back to the sender's address and port.
     port_file = os.path.join(work, "port")
