@@ -10,7 +10,8 @@ GROUP is one of:
                 frame rate), the rc script, and one real UDP round trip to the backend
   trim          20 s with no pulses on any output from the trimmed start: height within 1 m,
                 bank and pitch change within 1 deg, airspeed within 0.5 m/s; the propeller's
-                vibration has the stated amplitude and leaves the flight itself alone
+                vibration has the stated amplitude and leaves the flight itself alone; the
+                aircraft's lift and drag tables are make_aero_tables.py's
   signs         OUT1 above 1500 rolls right, below rolls left; OUT2 above its trim pitches the
                 nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed; a
                 positive upset moment rolls right, and only from its start time
@@ -173,7 +174,24 @@ def fly_model(model, seconds, widths):
     return model.state()
 
 
+def check_aero_tables():
+    """The XML's lift and drag tables are what make_aero_tables.py computes from the cited
+    coefficients (a coefficient edited in one place and not the other fails here)."""
+    import xml.etree.ElementTree as et
+    import make_aero_tables
+    root = et.parse(os.path.join(ROOT, "sim", "flight", "aircraft", "rascal110", "rascal110.xml")).getroot()
+    for name, formula in (("aero/force/lift_alpha", make_aero_tables.lift), ("aero/force/drag_alpha", make_aero_tables.drag)):
+        function = [f for f in root.iter("function") if f.get("name") == name]
+        if not soft_assert(len(function) == 1, "no function %s in the aircraft" % name):
+            continue
+        values = [float(v) for v in function[0].find(".//tableData").text.split()]
+        pairs = list(zip(values[0::2], values[1::2]))
+        worst = max(abs(value - formula(alpha)) for alpha, value in pairs)
+        soft_assert(len(pairs) > 50 and worst < 1e-3, "%s: %d rows, off the formula by %.4f" % (name, len(pairs), worst))
+
+
 def check_trim(work):
+    check_aero_tables()
     model = flightmodel.FlightModel()
     start = model.state()
     worst = {"height": 0.0, "roll": 0.0, "pitch": 0.0, "speed": 0.0}
