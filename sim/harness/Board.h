@@ -41,6 +41,9 @@ struct BoardOptions {
     bool input_start_fixed = false; // start exactly at input_start_s (--input-at)
     bool profile = false;
     std::string eeprom_path;        // --eeprom: the EEPROM's bytes at start and written back at exit
+    // --eeprom-cuts T1:T2:STEP: the EEPROM as a power cut at T1, T1+STEP, ... <= T2 leaves
+    // it, written to eeprom_path.cut0, .cut1, ... (cuts_step_s 0: none)
+    double eeprom_cuts_from_s = 0.0, eeprom_cuts_to_s = 0.0, eeprom_cuts_step_s = 0.0;
 };
 
 // Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
@@ -95,6 +98,8 @@ private:
     void check_bus(const char* when);
     void start_input();
     bool load_eeprom();
+    bool write_eeprom(const std::string& path) const;
+    void take_eeprom_cuts();
     uint8_t* eeprom_bytes() const;
     double sck_hz() const;
 
@@ -122,6 +127,7 @@ private:
     bool twi_selected_ = false;
     int int_level_ = -1, drdy_level_ = -1;
     uint32_t bus_violations_ = 0;
+    uint32_t eeprom_cuts_taken_ = 0;
 
     std::string line_;
     bool first_angle_line_seen_ = false;
