@@ -27,7 +27,8 @@ namespace {
 const char* const kUsage =
     "usage: apm25sim --elf FILE.elf (--trajectory FILE.csv[.gz] | --physics json[:HOST[:PORT]])\n"
     "                [--seconds S] [--stamp]\n"
-    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--profile FILE]\n"
+    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE]\n"
+    "                [--eeprom-cuts T1:T2:STEP] [--profile FILE]\n"
     "                [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X]\n"
     "                [--physics-rate HZ] [--physics-timeout S] [--physics-log FILE]\n"
     "                [--earth-field N,E,D] [--verbose]\n"
@@ -52,6 +53,9 @@ const char* const kUsage =
     "                   an error) and write all 4096 bytes back to FILE when the run ends (also\n"
     "                   after a crash), so settings saved survive the next run as a power cycle;\n"
     "                   the run's end is a power cut: an EEPROM write in progress stays partial\n"
+    "  --eeprom-cuts T1:T2:STEP  with --eeprom FILE: also write the chip as a power cut at\n"
+    "                   T1, T1+STEP, ... (<= T2, simulated seconds) leaves it (what --seconds\n"
+    "                   at that time writes) to FILE.cut0, FILE.cut1, ...: one run for many cuts\n"
     "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..15 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
@@ -197,6 +201,15 @@ int main(int argc, char** argv) {
             options.input_start_fixed = true;
         } else if (arg == "--eeprom") {
             options.eeprom_path = value("--eeprom");
+        } else if (arg == "--eeprom-cuts") {
+            const char* spec = value("--eeprom-cuts");
+            if (std::sscanf(spec, "%lf:%lf:%lf", &options.eeprom_cuts_from_s, &options.eeprom_cuts_to_s,
+                            &options.eeprom_cuts_step_s) != 3 ||
+                !(options.eeprom_cuts_step_s > 0.0) || !(options.eeprom_cuts_to_s >= options.eeprom_cuts_from_s)) {
+                std::fprintf(stderr, "apm25sim: --eeprom-cuts wants T1:T2:STEP with T1 <= T2, STEP > 0, not '%s'\n",
+                             spec);
+                return 1;
+            }
         } else if (arg == "--profile") {
             profile_path = value("--profile");
         } else if (arg == "--rc") {
@@ -285,6 +298,10 @@ int main(int argc, char** argv) {
             return 1;
         }
         options.servo_log = servo_log;
+    }
+    if (options.eeprom_cuts_step_s > 0.0 && options.eeprom_path.empty()) {
+        std::fprintf(stderr, "apm25sim: --eeprom-cuts needs --eeprom FILE\n");
+        return 1;
     }
     options.profile = !profile_path.empty();
     sim::TcpSerial serial;

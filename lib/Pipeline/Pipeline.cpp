@@ -27,6 +27,9 @@ constexpr uint32_t kNormalAccelCounts2 =
 // 2000 deg/s full scale make 60 rad/s) is a broken read, not a rotation.
 constexpr uint32_t kMaxCredibleRateCounts2 = (uint32_t)((dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s) *
                                                         (dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s));
+// A part of the `cal mag` fit, for the simulator's profiler: the next id after
+// profile::Part's (lib/LinAlg/Profile.h).
+constexpr uint8_t kMagFitSection = 13;
 // |a - b| of two counts.
 int32_t jump(int16_t a, int16_t b) {
     const int32_t d = (int32_t)a - b;
@@ -40,13 +43,22 @@ uint32_t norm2(const linalg::Vector3i& v) {
 }  // namespace
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
-    if (ever && now - last < interval) {
+    // Events held back go out first, in deferred()'s line, which counts this one too.
+    if (ever && (now - last < interval || held != 0)) {
         if (held < 0xFFFFu) ++held;
         return false;
     }
     ever = true;
     last = now;
     return true;
+}
+
+uint16_t RateLimiter::deferred(uint32_t now, uint16_t interval) {
+    if (held == 0 || now - last < interval) return 0;
+    const uint16_t n = held;
+    held = 0;
+    last = now;
+    return n;
 }
 
 AttitudePipeline::AttitudePipeline(const text::Sink* log, const dcm::DcmSettings& dcm_settings)
@@ -62,10 +74,8 @@ void AttitudePipeline::set_mag_present(bool present) {
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
     // The fit's sums (~10 k cycles) wait for a step free of heavy work, as the learner does.
-    if (st_.mag_cal_active) {
-        cal_field_uT_ = field_uT;
-        st_.cal_pending = true;
-    }
+    cal_field_uT_ = field_uT;
+    if (st_.mag_cal_active) st_.cal_pending = true;
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
@@ -238,8 +248,11 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         }
         return;
     }
-    if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz))
+    if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz)) {
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
+    } else if (const uint16_t n = st_.warn_moved.deferred(st_.steps, kRateHz)) {
+        Writer(log_).str(TXT("# calibrating gyro: board moved ")).u32(n).str(TXT(" more times, retrying")).end();
+    }
     if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
         // Never still long enough: run with what we have, keep measuring in the background
         // (the warning on the next step, as the bias message).
@@ -338,7 +351,13 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
                 .str(TXT(" s left, keep turning ("))
                 .u32(mag_cal_.count()).str(TXT(" samples)")).end();
         }
-        if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
+        if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) {
+            // The fit (several steps' worth) goes a part a step, on steps with room.
+            st_.mag_cal_active = false;
+            st_.cal_pending = false;
+            st_.mag_fit_active = true;
+            mag_cal_.begin_fit();
+        }
     }
 
     // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
@@ -355,15 +374,41 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // the learner, 2.92 with its short pieces on them).
     if (st_.output_due || heading_heavy) return;
     const bool short_room = dcm_.heavy_step();
+    bool fit_step = false;
     if (!short_room) {
+        fit_step = st_.mag_fit_active;
         if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
+        else if (fit_step) step_mag_fit();
+        else report_deferred();
         st_.cal_pending = false;
     }
-    if ((learner_.solving() || st_.learn_pending) && !(short_room && learner_.long_part_next())) {
+    // A part of the `cal mag` fit leaves no room for the learner: it waits a step.
+    if ((learner_.solving() || st_.learn_pending) && !fit_step && !(short_room && learner_.long_part_next())) {
         profile::begin(profile::kLearner);
         learn_mag_offset(short_room);
         profile::end(profile::kLearner);
     }
+}
+
+// The warnings the rate limits held back, each kind once its quiet time is over (one
+// line a step at most: a line is a few thousand cycles).
+void AttitudePipeline::report_deferred() {
+    uint16_t n = st_.warn_spike.deferred(st_.steps, kWarnIntervalSteps);
+    if (n != 0) {
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: ")).u32(n).str(TXT(" more samples replaced ("))
+            .u32(st_.spikes).str(TXT(" so far)")).end();
+        return;
+    }
+    if ((n = st_.warn_gyro_sat.deferred(st_.steps, kWarnIntervalSteps)) != 0) {
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated: ")).u32(n).str(TXT(" more samples")).end();
+        return;
+    }
+    if ((n = st_.warn_accel_sat.deferred(st_.steps, kWarnIntervalSteps)) != 0) {
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated: ")).u32(n).str(TXT(" more samples")).end();
+        return;
+    }
+    if ((n = st_.warn_mag.deferred(st_.steps, kWarnIntervalSteps)) != 0)
+        Writer(log_).str(TXT(TXT_WARN TXT_HMC " field not the Earth's: ")).u32(n).str(TXT(" more samples dropped")).end();
 }
 
 Angles AttitudePipeline::angles() const {
@@ -412,16 +457,31 @@ void AttitudePipeline::start_mag_calibration() {
     mag_cal_.restart(settings_.cal.mag_offset_uT + settings_.cal.mag_learned_uT);
     st_.mag_cal_steps = 0;
     st_.mag_cal_active = true;
+    st_.mag_fit_active = false;  // a fit under way is dropped
     Writer(log_).str(TXT("# cal mag: turn the board every way for 30 s")).end();
 }
 
+// A part of the fit, or (on the step after its last) the verdict.
+void AttitudePipeline::step_mag_fit() {
+    if (mag_cal_.fitting()) {
+        profile::begin(kMagFitSection);
+        mag_cal_.fit_part();
+        profile::end(kMagFitSection);
+        return;
+    }
+    st_.mag_fit_active = false;
+    finish_mag_calibration();
+}
+
 void AttitudePipeline::finish_mag_calibration() {
-    st_.mag_cal_active = false;
-    calib::Calibration c = settings_.cal;
-    const calib::MagCalibrator::Quality q = mag_cal_.finish(c);
+    const calib::MagCalibrator::Quality q = mag_cal_.quality();
     Writer w(log_);
     if (q == calib::MagCalibrator::Quality::Ok) {
-        settings_.cal = c;
+        calib::Calibration& c = settings_.cal;
+        mag_cal_.result(c);
+        // The latest field (and a sample waiting for the heading's correction) was
+        // calibrated the old way: the DCM takes the heading from the new one.
+        mag_cal_uT_ = calib::apply_mag(c, cal_field_uT_);
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
         w.str(TXT("# cal mag: offset ")).vec(c.mag_offset_uT).str(TXT(" uT, scale ")).vec(c.mag_scale)
             .str(TXT(", cross ")).vec(c.mag_cross).str(TXT(", residual ")).fixed2(mag_cal_.residual_uT())

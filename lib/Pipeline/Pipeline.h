@@ -31,9 +31,10 @@
 // those of the calibrated field from then on.
 //
 // Messages (to the sink, each a "# " line): gyro calibration progress and result,
-// "# warn: MPU6000 ..." for spikes and saturation (at most one per kWarnIntervalSteps
-// per kind, with the count), "# warn: HMC5883L ..." for absurd fields, the `cal mag`
-// progress and verdict.
+// "# warn: MPU6000 ..." for spikes and saturation, "# warn: HMC5883L ..." for absurd
+// fields (at most one per kWarnIntervalSteps per kind; what came meanwhile is told once
+// that time is over: "# warn: MPU6000 spike: 10 more samples replaced (12 so far)"),
+// the `cal mag` progress and verdict.
 #pragma once
 
 #include <stdint.h>
@@ -104,15 +105,17 @@ struct Angles {
 // The same rounded to the hundredths the output lines print (fmt::format_plot_line_centideg).
 using AnglesCentideg = dcm::AnglesCentideg;
 
-// A per-kind rate limiter for warnings: allow() is true at most once per interval,
-// suppressed() tells how many were held back in all. A plain struct that starts
-// zeroed: declare it static or value-initialise it (`RateLimiter r{};`).
+// A per-kind rate limiter for warnings: allow() is true at most once per interval; what
+// it holds back is not lost: once the interval since the last line is over, deferred()
+// gives how many were held (and zero again), for a "N more" line that starts the next
+// interval (while some are held, allow() holds the next ones too: that line counts them). A plain struct that starts zeroed: declare it static or value-initialise it
+// (`RateLimiter r{};`).
 struct RateLimiter {
     bool allow(uint32_t now_steps, uint16_t interval_steps);
-    uint16_t suppressed() const { return held; }
+    uint16_t deferred(uint32_t now_steps, uint16_t interval_steps);
 
-    uint32_t last;  // when allow() last said yes
-    uint16_t held;  // how many were suppressed (saturates)
+    uint32_t last;  // when the last line (allowed or deferred) went out
+    uint16_t held;  // how many were held back since (saturates)
     bool ever;      // allow() has said yes before
 };
 
@@ -170,7 +173,7 @@ public:
 
     Phase phase() const { return st_.phase; }
     bool gyro_calibrating() const { return st_.gyro_cal_active; }
-    bool mag_calibrating() const { return st_.mag_cal_active; }
+    bool mag_calibrating() const { return st_.mag_cal_active || st_.mag_fit_active; }
     uint32_t steps() const { return st_.steps; }
     uint32_t time_ms() const { return st_.steps * 5u; }
     const dcm::Dcm& estimator() const { return dcm_; }
@@ -188,7 +191,9 @@ private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
+    void step_mag_fit();
     void finish_mag_calibration();
+    void report_deferred();
     void take_learner_sample(const linalg::Vector3f& field_uT);
     void learn_mag_offset(bool one_piece);
     void forget_mag_reference(bool take_heading);
@@ -203,7 +208,7 @@ private:
     linalg::Vector3l turn_counts_;              // the gyro summed since the last field sample (counts)
     linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the gyro before it
     linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
-    linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
+    linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
@@ -226,7 +231,8 @@ private:
         bool mag_pending;
         bool have_mag;
         bool gyro_cal_active;
-        bool mag_cal_active;
+        bool mag_cal_active;            // `cal mag` collecting
+        bool mag_fit_active;            // its fit, a part a step
         bool output_due;
         bool reinit_pending;
         StartMessage start_message;     // printed on the step after the calibration's end
