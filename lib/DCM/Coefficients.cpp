@@ -17,6 +17,8 @@ bool exceeds(const linalg::Vector3l& v, const Limit& limit) {
     return sum >= limit.limit2;
 }
 
+linalg::Vector3l rescaled(const linalg::Vector3l& v, float ratio) { return linalg::fixed_from_vector(v.scaled(ratio), 0); }
+
 // A low-pass's factor per correction for the time constant tau_s: dt / (tau + dt).
 static float lowpass_alpha(float tau_s, float dt_s) { return dt_s / (tau_s + dt_s); }
 

@@ -52,6 +52,14 @@ constexpr float kFloatGyroScale = 1.0f / 16384.0f;
 constexpr float kFloatAccelScale = 1.0f / 4096.0f;
 constexpr float kFloatUnitsPerRad_s = (float)kTurnScale / kFloatGyroScale;
 
+// A field sample in 16 bits, uT * 2^kFieldQ: steps of 0.03 uT, a third of the
+// HMC5883L's finest count and far below its noise (~0.2 uT), up to 1 000 uT (the chip
+// reads at most 810). The latency turn and the rotation into earth axes are then 16x16
+// products; a matrix entry in 16 bits (Q14) moves the earth-frame field by 6e-5 of its
+// strength at most, 0.004 deg of heading.
+constexpr uint8_t kFieldQ = 5;
+constexpr float kMaxField_uT = 1000.0f;
+
 // A value as Q30 (truncated toward zero), for constants written as their value:
 // q30_of(1.0 / 6.0).
 constexpr int32_t q30_of(float x) { return (int32_t)(x * 1073741824.0f); }
@@ -155,6 +163,9 @@ FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26_coarse(const linalg::Ve
     if (factor_q15 == 0) return theta_q26(units);  // scales beyond the 16-bit factor
     return linalg::Vector3l(scale_q15(units.x, factor_q15), scale_q15(units.y, factor_q15), scale_q15(units.z, factor_q15));
 }
+
+// v * ratio, rounded toward zero (state carried over to new sensor scales).
+linalg::Vector3l rescaled(const linalg::Vector3l& v, float ratio);
 
 // Seconds between two gravity corrections.
 inline float correction_dt_s(const DcmSettings& settings) { return settings.step_s * (float)kCorrectionDivider; }

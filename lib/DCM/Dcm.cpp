@@ -11,7 +11,6 @@ using linalg::Vector3f;
 using linalg::Vector3l;
 
 namespace {
-Vector3l rescaled(const Vector3l& v, float ratio) { return linalg::fixed_from_vector(v.scaled(ratio), 0); }
 
 // 1/n in Q30 for the window's samples (n = 1..5: a correction late by a step takes
 // five), as code (a table would take RAM on the AVR).
@@ -46,23 +45,8 @@ constexpr uint8_t kMaxMagAgeSteps = 2;
 // (temperature, location) with 1.3 s.
 constexpr float kCandidateTau_s = 0.053f;
 constexpr float kReferenceTau_s = 1.32f;
-// The field may move this much in body axes during a rest: the HMC5883L's noise is
-// ~0.2 uT with its 8-sample average; a turn of 3 deg moves a 20 uT horizontal field by
-// 1 uT, so a steady turn of more than 2 deg/s ends a rest within its first 1.5 s, and
-// a slower one before it has lasted 1 uT / (20 uT x rate).
-constexpr float kRestFieldMove_uT = 1.0f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
-// The rest mean's difference from the bias, saturated (units): 2^22 units is 1 900 deg/s
-// on the 2000 deg/s range, and times 2^8 it stays within 31 bits.
-constexpr int32_t kMaxRestDifference = 1L << 22;
-// A field sample in 16 bits, uT * 2^kFieldQ: steps of 0.03 uT, a third of the
-// HMC5883L's finest count and far below its noise (~0.2 uT), up to 1 000 uT (the chip
-// reads at most 810). The latency turn and the rotation into earth axes are then 16x16
-// products (~20 cycles each on the AVR); a matrix entry in 16 bits (Q14) moves the
-// earth-frame field by 6e-5 of its strength at most, 0.004 deg of heading.
-constexpr uint8_t kFieldQ = 5;
-constexpr float kMaxField_uT = 1000.0f;
 constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
 // The sums' units: a squared strength in uT^2 * 2^(2 kFieldQ - kNorm2Shift), the field
 // in earth axes in uT * 2^(kFieldQ + 14 - kEarthFieldShift) (eight samples' sums within 32 bits).
@@ -70,20 +54,6 @@ constexpr uint8_t kNorm2Shift = 4;
 constexpr uint8_t kEarthFieldShift = 2;
 constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
 constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
-// kRestFieldMove_uT in the field's units.
-constexpr int16_t kRestFieldMoveQ = (int16_t)(kRestFieldMove_uT * (float)(1 << kFieldQ));
-
-// |a - b| > kRestFieldMove_uT for two fields in uT * 2^kFieldQ: an axis beyond it
-// decides at once; else the squares of the differences.
-bool moved(const linalg::Vector3i& a, const linalg::Vector3i& b) {
-    const int16_t d[3] = {(int16_t)(a.x - b.x), (int16_t)(a.y - b.y), (int16_t)(a.z - b.z)};
-    int32_t sum = 0;
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (d[i] >= kRestFieldMoveQ || d[i] <= -kRestFieldMoveQ) return true;
-        sum += linalg::mul_s16(d[i], d[i]);
-    }
-    return sum > linalg::mul_s16(kRestFieldMoveQ, kRestFieldMoveQ);
-}
 
 // Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
 int16_t q16_of(int32_t x_q26) {
@@ -103,22 +73,18 @@ Dcm::Dcm(const DcmSettings& settings) : settings_(&settings) { k_.from_settings(
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    bias_fine_ = linalg::fixed_from_vector(bias * (k_.units_per_rad_s * (float)kTurnScale), 0);
-    clamp_bias();
+    bias_.set_estimate_rad_s(bias, k_);
     update_offset();
 }
 
-Vector3f Dcm::gyro_bias_rad_s() const { return bias_fine_.scaled(k_.gyro_rad_s_per_count * (1.0f / (float)(kTurnScale * kTurnScale))); }
+Vector3f Dcm::gyro_bias_rad_s() const { return bias_.estimate_rad_s(k_); }
 
 Vector3f Dcm::last_mag_field() const { return linalg::scaled(last_field_q5_, 1.0f / (float)(1 << kFieldQ)); }
 
-Vector3l Dcm::bias_units() const {
-    return Vector3l((bias_fine_.x + 128) >> 8, (bias_fine_.y + 128) >> 8, (bias_fine_.z + 128) >> 8);
-}
 
 void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    sensor_bias_units_ = units_of(bias);
+    bias_.set_sensor_rad_s(bias, k_);
     update_offset();
 }
 
@@ -126,13 +92,11 @@ void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
 void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count) {
     const float gyro_ratio = k_.gyro_rad_s_per_count / gyro_rad_s_per_count, accel_ratio = k_.accel_m_s2_per_count / accel_m_s2_per_count;
     if (gyro_ratio != 1.0f) {
-        Vector3l* rates[4] = {&bias_fine_, &correction_units_, &sensor_bias_units_, &rest_gyro_mean_};
-        for (Vector3l* v : rates) *v = rescaled(*v, gyro_ratio);
+        bias_.rescale(gyro_ratio);
+        correction_units_ = rescaled(correction_units_, gyro_ratio);
     }
-    if (accel_ratio != 1.0f) {
-        accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
-        rest_accel_mean_ = rescaled(rest_accel_mean_, accel_ratio);
-    }
+    if (accel_ratio != 1.0f) accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
+    rest_.rescale(gyro_ratio, accel_ratio);
     k_.set_scales(*settings_, gyro_rad_s_per_count, accel_m_s2_per_count);
     update_offset();
 }
@@ -140,12 +104,9 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
 // What each step subtracts from the gyro, in the integer units of the turn sums
 // (counts * 2^kTurnFraction).
 void Dcm::update_offset() {
-    offset_units_ = sensor_bias_units_ + bias_units() - correction_units_;
+    offset_units_ = bias_.offset_units(correction_units_);
 }
 
-Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
-    return linalg::fixed_from_vector(rate_rad_s * k_.units_per_rad_s, 0);
-}
 
 // Each axis within the range of any accelerometer (16 g): three comparisons where
 // |a|^2 would cost five float operations. NaN fails them too.
@@ -192,7 +153,6 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     correction_units_ = Vector3l();
     update_offset();
     mag_steady_steps_ = 0;
-    rest_corrections_ = 0;
     gyro_sum_ = Vector3l();
     accel_sum_ = Vector3l();
     window_samples_ = 0;
@@ -201,15 +161,11 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     heading_norm2_sum_ = 0;
     heading_samples_ = 0;
     heading_steps_ = 0;
-    rest_accel_mean_ = linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0);
+    rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
 }
-
-
-
-
 
 
 
@@ -218,7 +174,7 @@ Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
     // steps the turn is far beyond the saturation anyway; within, no product overflows.
     constexpr int32_t kMaxCounts = 1L << 22;
     const int32_t n = steps < 1024u ? (int32_t)steps : 1024L;
-    const Vector3l bias = sensor_bias_units_ + bias_units();
+    const Vector3l bias = bias_.sensor_units() + bias_.units();
     const int32_t* c = &counts.x;
     const int32_t* b = &bias.x;
     int32_t units[3];
@@ -318,7 +274,7 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
         last_accel_ = accel;
     } else {
         status_ |= kStatusAccelIgnored;
-        rest_corrections_ = 0;  // a broken read is no rest
+        rest_.interrupt();  // a broken read is no rest
     }
     // The roll/pitch error (Premerlani & Bizard eq. 27) moves slowly once low-passed:
     // it is worked out every kCorrectionDivider steps and applied at every step in
@@ -350,53 +306,16 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
     if (steps_ < 0xFFFFu) ++steps_;
 }
 
-// Rest detection and the gyro bias at rest (after VQF, Laidig & Seel 2023, sec. 3.4):
-// the board is still when, for rest_min_s, the gyro and the accelerometer stay close to
-// their recent means (deviations, so that any bias passes the test). There the gyro
-// reads its bias alone, on every axis, the vertical one too, which neither gravity nor
-// the compass can measure well: the bias estimate moves to the mean gyro reading with
-// rest_bias_s. The MPU6000's rate noise, 0.005 deg/s/sqrt(Hz), averages to ~0.004 deg/s
-// over the 0.5 s mean; a hand-held board's tremor is below 2 deg/s and 0.5 m/s^2.
+// Rest detection (RestDetector) and, at rest, the bias estimate from the rest mean.
+// A steady turn passes the deviation test too: the compass tells (correct_heading
+// watches the field) while one delivers.
 void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, const Vector3l& mean_off_bias,
                       bool whole_window) {
-    using linalg::mul_q30;
     status_ &= (uint8_t)~kStatusAtRest;
-    // A steady turn passes the deviation test too. The compass tells: at rest the field
-    // stays put in body axes, in a turn it turns (correct_heading resets the rest when
-    // it moves by kRestFieldMove_uT). Without a compass delivering, the mean must be
-    // within the tremor bound of the bias estimate instead (VQF's rule, its 2 deg/s
-    // bias clip): a larger vertical bias is then not told from a slow turn.
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
-    const Vector3l gyro_change = gyro_mean - rest_gyro_mean_, accel_change = accel_mean - rest_accel_mean_;
-    const bool still = !exceeds(gyro_change, k_.rest_gyro_dev) && (compass_watching || !exceeds(mean_off_bias, k_.rest_gyro_dev)) &&
-                       !exceeds(accel_change, k_.rest_accel_dev);
-    // The means' low-pass, its factor in 16 bits (two 16x16 products an axis), its step
-    // rounded to the unit (the changes are counts * 2^8, far below 2^29).
-    using linalg::hot::mul_q14_unit;
-    rest_gyro_mean_ += Vector3l(mul_q14_unit(k_.rest_alpha_q14, gyro_change.x), mul_q14_unit(k_.rest_alpha_q14, gyro_change.y),
-                                mul_q14_unit(k_.rest_alpha_q14, gyro_change.z));
-    rest_accel_mean_ += Vector3l(mul_q14_unit(k_.rest_alpha_q14, accel_change.x),
-                                 mul_q14_unit(k_.rest_alpha_q14, accel_change.y), mul_q14_unit(k_.rest_alpha_q14, accel_change.z));
-    if (!still || !whole_window) {
-        rest_corrections_ = 0;
-        return;
-    }
-    if (rest_corrections_ < k_.rest_min_corrections) {
-        ++rest_corrections_;
-        return;
-    }
+    if (!rest_.update(gyro_mean, accel_mean, mean_off_bias, whole_window, compass_watching, k_)) return;
     status_ |= kStatusAtRest;
-    // bias += alpha (mean - bias), in units * 2^8 (the difference within the bias limit
-    // and the deviation: far below 2^23 units).
-    int32_t* fine[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
-    const int32_t* mean[3] = {&rest_gyro_mean_.x, &rest_gyro_mean_.y, &rest_gyro_mean_.z};
-    for (uint8_t i = 0; i < 3; ++i) {
-        int32_t difference = *mean[i] - (*fine[i] >> 8);
-        if (difference > kMaxRestDifference) difference = kMaxRestDifference;
-        if (difference < -kMaxRestDifference) difference = -kMaxRestDifference;
-        *fine[i] += mul_q30(k_.rest_bias_alpha_q30, (int32_t)((uint32_t)difference << 8) - (*fine[i] & 0xFF));
-    }
-    clamp_bias();
+    bias_.follow_rest_mean(rest_.gyro_mean(), k_);
 }
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
@@ -412,7 +331,7 @@ void Dcm::correct_gravity() {
     // error that averages out, while a hand's or a vehicle's turn does not (shake, a
     // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
     // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
-    const Vector3l mean_off_bias = rest_gyro_mean_ - bias_units();  // the rest mean's turn (units)
+    const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
@@ -425,7 +344,7 @@ void Dcm::correct_gravity() {
         // calibrated bias.
         const Vector3l gyro_raw_mean = per(times_256(gyro_sum_), n, inv_n);
         const Vector3l accel_sum = times_256(accel_sum_);
-        const Vector3l gyro_mean = gyro_raw_mean - sensor_bias_units_;
+        const Vector3l gyro_mean = gyro_raw_mean - bias_.sensor_units();
         const Vector3l accel_mean = per(accel_sum, n, inv_n);
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
@@ -470,8 +389,6 @@ void Dcm::correct_gravity() {
     update_offset();
     profile::end(profile::kGravity);
 }
-
-
 
 
 Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
@@ -520,10 +437,7 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
-        bias_fine_.x -= mul_q14(ex, k_.ki_fine);
-        bias_fine_.y -= mul_q14(ey, k_.ki_fine);
-        bias_fine_.z -= mul_q14(ez, k_.ki_fine);
-        clamp_bias();
+        bias_.integrate_tilt_error(ex, ey, ez, k_);
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
@@ -565,10 +479,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     last_field_q5_ = field;
     // The rest test's witness: a field that moved in body axes since the rest began
     // means the board turns (or a magnet moved): no rest.
-    if (moved(field, rest_field_)) {
-        rest_field_ = field;
-        rest_corrections_ = 0;
-    }
+    rest_.watch_field(field);
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
         // The first field sample after a start without one: take its heading as is.
@@ -705,9 +616,8 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
                                  linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
         const Vector3f error = linalg::vector_from_q30(strapdown_.r().c) * -heading_error;
-        bias_fine_ -= linalg::fixed_from_vector(
-            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0);
-        clamp_bias();
+        bias_.subtract_fine(linalg::fixed_from_vector(
+            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0), k_);
         update_offset();
     }
 }
@@ -739,15 +649,6 @@ bool Dcm::field_matches(float norm, float down_component, float ref_norm, float 
     return norm_error < norm_tolerance && norm_error > -norm_tolerance && dip_error < dip_tolerance &&
            dip_error > -dip_tolerance;
 }
-
-void Dcm::clamp_bias() {
-    int32_t* axis[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (*axis[i] > k_.bias_limit_fine) *axis[i] = k_.bias_limit_fine;
-        if (*axis[i] < -k_.bias_limit_fine) *axis[i] = -k_.bias_limit_fine;
-    }
-}
-
 
 
 // A matrix that renormalisation cannot save (NaN, or rows far from unit length)

@@ -20,6 +20,8 @@
 #include "Coefficients.h"
 #include "DcmSettings.h"
 #include "Euler.h"
+#include "GyroBias.h"
+#include "Rest.h"
 #include "Schedule.h"
 #include "Strapdown.h"
 #include "Fixed.h"
@@ -178,7 +180,6 @@ private:
         static_assert(kTurnFraction == 8, "a byte shift");
         return (int32_t)((uint32_t)counts << 8);
     }
-    linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
     linalg::Vector3l pending_turn_units() const;  // summed since the last integration (turn sums' units)
     linalg::Vector3f pending_turn_rad() const;
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
@@ -186,10 +187,8 @@ private:
     // mean_off_bias: the rest test's gyro mean less the bias estimate (the hold test's too).
     void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean,
                      const linalg::Vector3l& mean_off_bias, bool whole_window);
-    linalg::Vector3l bias_units() const;  // bias_fine_ rounded to units
     linalg::Vector3f last_mag_field() const;
     void recover();
-    void clamp_bias();
     bool accel_plausible(const linalg::Vector3f& a) const;
     void learn_field(float norm, float down_component);
     bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
@@ -202,21 +201,17 @@ private:
 
     Strapdown strapdown_;                // R and the turn summed for it
     HeavySchedule schedule_;             // which heavy part a step runs
+    GyroBias bias_;                      // the calibrated bias and the estimate
+    RestDetector rest_;                  // rest, when the gyro reads its bias alone
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
-    linalg::Vector3l bias_fine_;         // integrator: gyro-bias estimate, units * 2^8
     linalg::Vector3l correction_units_;  // roll/pitch correction, held between corrections
     linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
-    linalg::Vector3l sensor_bias_units_; // set_sensor_bias_rad_s
     linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
     linalg::Vector3i last_field_q5_;     // for a rebuild if the matrix degenerates (uT * 2^5)
     linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
     linalg::Vector3l accel_sum_;
-    linalg::Vector3l rest_gyro_mean_;    // their low-passed means, for the rest test (units,
-    linalg::Vector3l rest_accel_mean_;   // ... accel counts * 2^8)
-    uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
-    linalg::Vector3i rest_field_;        // the field (body axes, uT Q5) when the board last seemed to turn
     linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
     linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q17)
