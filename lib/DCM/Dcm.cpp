@@ -40,20 +40,9 @@ Vector3l times_256(const Vector3l& v) {
 constexpr uint16_t kMaxMagIntervalSteps = 20;
 // A field sample's wait before it is used, counted in its latency up to this (steps).
 constexpr uint8_t kMaxMagAgeSteps = 2;
-// The recent disturbed field, for the new-field test, follows the samples with 53 ms
-// (a fifth of the way at each 75 Hz sample); the learned field tracks slow changes
-// (temperature, location) with 1.3 s.
-constexpr float kCandidateTau_s = 0.053f;
-constexpr float kReferenceTau_s = 1.32f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
 constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
-// The sums' units: a squared strength in uT^2 * 2^(2 kFieldQ - kNorm2Shift), the field
-// in earth axes in uT * 2^(kFieldQ + 14 - kEarthFieldShift) (eight samples' sums within 32 bits).
-constexpr uint8_t kNorm2Shift = 4;
-constexpr uint8_t kEarthFieldShift = 2;
-constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
-constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
 
 // Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
 int16_t q16_of(int32_t x_q26) {
@@ -142,7 +131,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
                                           (int16_t)linalg::fixed_from_float(kept.y, kFieldQ),
                                           (int16_t)linalg::fixed_from_float(kept.z, kFieldQ));
         const float norm = mag_field.length();
-        learn_field(norm, field_down / norm);
+        gate_.learn(norm, field_down / norm);
     }
     strapdown_.reset(linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down)));
     // The integer factors of the scales, unless set_sample_scales set them (the float
@@ -152,15 +141,12 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     accel_lp_ef_ = Vector3l(0, 0, linalg::fixed_from_float(-kGravity_m_s2 * per_m_s2, 0));
     correction_units_ = Vector3l();
     update_offset();
-    mag_steady_steps_ = 0;
+    gate_.restart_steady_count();
     gyro_sum_ = Vector3l();
     accel_sum_ = Vector3l();
     window_samples_ = 0;
     accel_sum_of_sums_ = Vector3l();
-    heading_field_sum_ = Vector3l();
-    heading_norm2_sum_ = 0;
-    heading_samples_ = 0;
-    heading_steps_ = 0;
+    field_mean_.clear();
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     status_ |= kStatusInitialised;
@@ -199,22 +185,7 @@ Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
     return Vector3l(q30[0], q30[1], q30[2]);
 }
 
-// 1/n for the few window lengths there are, without the ~500-cycle division.
-float Dcm::inverse(uint8_t n) {
-    switch (n) {
-        case 1: return 1.0f;
-        case 2: return 0.5f;
-        case 3: return 1.0f / 3.0f;
-        case 4: return 0.25f;
-        case 5: return 0.2f;
-        default: return 1.0f / (float)n;
-    }
-}
 
-void Dcm::learn_field(float norm, float down_component) {
-    mag_ref_norm_ = mag_candidate_norm_ = norm;
-    mag_ref_down_ = mag_candidate_down_ = down_component;
-}
 
 // The float form: the sample in SI units, held in the integer units of the step
 // (kFloatGyroScale, kFloatAccelScale), after the checks a float sample needs.
@@ -516,23 +487,15 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // the same vector there whatever the board did meanwhile), and the heading is
     // corrected from their mean: each sample costs the rotation into earth axes, the
     // correction (the rest of this function) runs at 25 Hz.
-    heading_field_sum_ += Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
-                                   row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
-                                   row_times(strapdown_.r().c, field_now) >> kEarthFieldShift);
-    heading_norm2_sum_ += sample_norm2;
-    ++heading_samples_;
-    heading_steps_ = (uint16_t)(heading_steps_ + since_last);
-    if (heading_steps_ < kHeadingSteps) return;
-    uint16_t interval_steps = heading_steps_;
-    const float inv_samples = inverse(heading_samples_);
-    const Vector3f field_ef = heading_field_sum_.scaled(inv_samples * kEarthFieldPerUnit);
-    // The strength and dip tests take the samples' mean strength (the field's strength
-    // is the same in every frame; the mean vector's is shorter where the samples differ).
-    const float norm2 = (float)heading_norm2_sum_ * (inv_samples * kNorm2PerUnit);
-    heading_field_sum_ = Vector3l();
-    heading_norm2_sum_ = 0;
-    heading_samples_ = 0;
-    heading_steps_ = 0;
+    field_mean_.add(Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
+                             row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
+                             row_times(strapdown_.r().c, field_now) >> kEarthFieldShift),
+                    sample_norm2, since_last);
+    if (!field_mean_.complete()) return;
+    uint16_t interval_steps = field_mean_.steps();
+    Vector3f field_ef;
+    float norm2;
+    field_mean_.take(field_ef, norm2);
     status_ |= kStatusMagIgnored;
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
@@ -549,54 +512,25 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // for mag_recover_s is a new environment (the board was moved): it becomes the
     // reference, and its heading is taken at once. A magnet fixed to a rotating
     // board never looks the same twice, so it never gets in.
-    bool forgotten = !(mag_ref_norm_ > 0.0f);  // reset_mag_reference(): adopt this one
-    if (forgotten && !mag_take_heading_) {
-        learn_field(norm, down_component);  // the strength and dip only; the heading as usual
-        mag_take_heading_ = true;
-        forgotten = false;
-    }
-    if (forgotten || !field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
-        // Only a field that stays the same while the board turns is shown to be fixed
-        // in the earth frame: at rest any disturbance (a magnet on the desk, one fixed to
-        // the board) is steady too. VQF's rule: a mean rate of 20 deg/s over the window.
-        if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
-            mag_steady_steps_ += interval_steps;
-            mag_steady_turn_rad_ += sqrtf(last_rate_rad_s().length_squared()) * settings_->step_s * (float)interval_steps;
-        } else {
-            mag_steady_steps_ = 0;
-            mag_steady_turn_rad_ = 0.0f;
-        }
-        const float candidate_alpha = sample_dt / (kCandidateTau_s + sample_dt);
-        mag_candidate_norm_ += candidate_alpha * (norm - mag_candidate_norm_);
-        mag_candidate_down_ += candidate_alpha * (down_component - mag_candidate_down_);
-        if (!forgotten && (mag_steady_steps_ < k_.mag_recover_steps ||
-                           mag_steady_turn_rad_ < k_.mag_new_min_turn_rad)) return;
-        // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
-        // (the rotation that puts the field's horizontal part on north).
-        learn_field(norm, down_component);
-        mag_steady_steps_ = 0;
-        mag_steady_turn_rad_ = 0.0f;
+    const FieldVerdict verdict =
+        gate_.judge(norm, down_component, interval_steps, sample_dt, last_rate_units(), *settings_, k_);
+    if (verdict == FieldVerdict::kDisturbed) return;
+    status_ &= (uint8_t)~kStatusMagIgnored;
+    if (verdict == FieldVerdict::kNewField) {
+        // Its heading at once: R <- Rz(-error) R (the rotation that puts the field's
+        // horizontal part on north).
         const float cos_error = field_ef.x * inv_horizontal;
         using linalg::mul_q30;
         const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
         const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
-        const Vector3l north(mul_q30(c, strapdown_.r().a.x) + mul_q30(sn, strapdown_.r().b.x), mul_q30(c, strapdown_.r().a.y) + mul_q30(sn, strapdown_.r().b.y),
-                             mul_q30(c, strapdown_.r().a.z) + mul_q30(sn, strapdown_.r().b.z));
-        strapdown_.r().b = Vector3l(mul_q30(c, strapdown_.r().b.x) - mul_q30(sn, strapdown_.r().a.x), mul_q30(c, strapdown_.r().b.y) - mul_q30(sn, strapdown_.r().a.y),
-                        mul_q30(c, strapdown_.r().b.z) - mul_q30(sn, strapdown_.r().a.z));
-        strapdown_.r().a = north;
-        status_ &= (uint8_t)~kStatusMagIgnored;
+        linalg::Matrix3q30& r = strapdown_.r();
+        const Vector3l north(mul_q30(c, r.a.x) + mul_q30(sn, r.b.x), mul_q30(c, r.a.y) + mul_q30(sn, r.b.y),
+                             mul_q30(c, r.a.z) + mul_q30(sn, r.b.z));
+        r.b = Vector3l(mul_q30(c, r.b.x) - mul_q30(sn, r.a.x), mul_q30(c, r.b.y) - mul_q30(sn, r.a.y),
+                       mul_q30(c, r.b.z) - mul_q30(sn, r.a.z));
+        r.a = north;
         return;
     }
-    mag_steady_steps_ = 0;
-    mag_steady_turn_rad_ = 0.0f;
-    mag_candidate_norm_ = norm;
-    mag_candidate_down_ = down_component;
-    status_ &= (uint8_t)~kStatusMagIgnored;
-    // Track slow changes of the local field (temperature, location): ~1.3 s at 75 Hz.
-    const float reference_alpha = sample_dt * (1.0f / kReferenceTau_s);  // <= 0.08: first order
-    mag_ref_norm_ += reference_alpha * (norm - mag_ref_norm_);
-    mag_ref_down_ += reference_alpha * (down_component - mag_ref_down_);
 
     // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
     const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
@@ -640,15 +574,6 @@ EulerQ24 Dcm::euler_now_q24() const {
                              scale_q15(pending.z + scale_q15(rate.z, lead), k));
 }
 
-bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,
-                        float tolerance_scale) const {
-    const float norm_tolerance = settings_->mag_norm_tolerance * tolerance_scale * ref_norm;
-    const float dip_tolerance = settings_->mag_dip_tolerance * tolerance_scale;
-    const float norm_error = norm - ref_norm;
-    const float dip_error = down_component - ref_down;
-    return norm_error < norm_tolerance && norm_error > -norm_tolerance && dip_error < dip_tolerance &&
-           dip_error > -dip_tolerance;
-}
 
 
 // A matrix that renormalisation cannot save (NaN, or rows far from unit length)

@@ -21,6 +21,7 @@
 #include "DcmSettings.h"
 #include "Euler.h"
 #include "GyroBias.h"
+#include "Heading.h"
 #include "Rest.h"
 #include "Schedule.h"
 #include "Strapdown.h"
@@ -94,7 +95,7 @@ public:
     // deferrable work (the compass learner) puts it on another step.
     bool heading_due_next() const {
         return initialised() && ((status_ & kStatusNoHeading) ||
-                                 (uint16_t)(heading_steps_ + steps_since_mag_ + 1u) >= kHeadingSteps);
+                                 field_mean_.complete_after(steps_since_mag_));
     }
 
     // The gyro's own turn over `steps` steps from its `counts` summed meanwhile, less the
@@ -109,16 +110,12 @@ public:
     // rate (a learned offset that moved by a few uT: a small, uncertain change that
     // must not turn the heading in one step).
     void reset_mag_reference(bool take_heading = true) {
-        mag_ref_norm_ = 0.0f;
-        mag_take_heading_ = take_heading;
+        gate_.forget(take_heading);
         // The samples waiting for the heading's mean were calibrated the old way. The next
         // sample closes the mean alone: the heading has run on the gyro meanwhile (the
         // field was rejected, or the mean dropped), and one sample gives the new reference
         // and the heading's error at once, a whole mean (40 ms) sooner.
-        heading_field_sum_ = linalg::Vector3l();
-        heading_norm2_sum_ = 0;
-        heading_samples_ = 0;
-        heading_steps_ = kHeadingSteps - 1;
+        field_mean_.restart_with_one_sample();
     }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
@@ -173,7 +170,6 @@ private:
     void correct_tilt(float startup_left, bool hold_integrator);
     void correct_gravity();
     void update_offset();
-    static float inverse(uint8_t n);
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
     // 32x32 routine, ~105 cycles).
     static int32_t in_turn_units(int32_t counts) {
@@ -190,9 +186,6 @@ private:
     linalg::Vector3f last_mag_field() const;
     void recover();
     bool accel_plausible(const linalg::Vector3f& a) const;
-    void learn_field(float norm, float down_component);
-    bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
-                       float tolerance_scale) const;
 
     // The settings (not a copy: 84 bytes of RAM; they must outlive the estimator, as
     // kDefaultDcmSettings and a tool's own set do) and what follows from them, once.
@@ -203,6 +196,8 @@ private:
     HeavySchedule schedule_;             // which heavy part a step runs
     GyroBias bias_;                      // the calibrated bias and the estimate
     RestDetector rest_;                  // rest, when the gyro reads its bias alone
+    EarthFieldMean field_mean_;          // the field samples in earth axes, for the heading
+    MagneticGate gate_;                  // the disturbance gate: which means are the earth field
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
     linalg::Vector3l correction_units_;  // roll/pitch correction, held between corrections
     linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
@@ -214,20 +209,9 @@ private:
     linalg::Vector3l accel_sum_;
     linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
-    linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q17)
-    uint32_t heading_norm2_sum_ = 0;     // ... and their squared strengths (uT^2 / 4)
-    uint8_t heading_samples_ = 0;
-    uint16_t heading_steps_ = 0;         // steps the summed samples stand for
     bool heavy_ = false;                 // the last update integrated or corrected gravity
-    float mag_ref_norm_ = 0.0f;          // learned field strength
-    bool mag_take_heading_ = true;       // reset_mag_reference's take_heading
-    float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
-    float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
-    float mag_candidate_down_ = 0.0f;
     uint16_t steps_ = 0;                 // since init, saturated (the start-up ramp's clock)
     uint16_t steps_since_mag_ = 0;
-    uint16_t mag_steady_steps_ = 0;      // how long a different field has stayed the same
-    float mag_steady_turn_rad_ = 0.0f;   // how far the board turned meanwhile
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
