@@ -20,6 +20,7 @@
 #include "Coefficients.h"
 #include "DcmSettings.h"
 #include "Euler.h"
+#include "Gravity.h"
 #include "GyroBias.h"
 #include "Heading.h"
 #include "Rest.h"
@@ -167,7 +168,6 @@ private:
         return schedule_.next(strapdown_.pending_steps(), strapdown_.renormalisation_due(), line_due);
     }
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
-    void correct_tilt(float startup_left, bool hold_integrator);
     void correct_gravity();
     void update_offset();
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
@@ -195,20 +195,15 @@ private:
     Strapdown strapdown_;                // R and the turn summed for it
     HeavySchedule schedule_;             // which heavy part a step runs
     GyroBias bias_;                      // the calibrated bias and the estimate
+    GravityCorrection gravity_;          // the accel window, its low-pass and the roll/pitch correction
     RestDetector rest_;                  // rest, when the gyro reads its bias alone
     EarthFieldMean field_mean_;          // the field samples in earth axes, for the heading
     MagneticGate gate_;                  // the disturbance gate: which means are the earth field
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
-    linalg::Vector3l correction_units_;  // roll/pitch correction, held between corrections
     linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
-    linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
     linalg::Vector3i last_field_q5_;     // for a rebuild if the matrix degenerates (uT * 2^5)
-    linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
-    linalg::Vector3l accel_sum_;
-    linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
-    uint8_t window_samples_ = 0;         // samples in the sums
     bool heavy_ = false;                 // the last update integrated or corrected gravity
     uint16_t steps_ = 0;                 // since init, saturated (the start-up ramp's clock)
     uint16_t steps_since_mag_ = 0;
