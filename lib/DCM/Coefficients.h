@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What the estimator's step needs that follows from the settings and the sensor's
 // scales, worked out once where they change (VQF's coefficients struct): the step
-// then does no float division (~480 cycles on the 2560) and no trigonometry.
+// then does no float division and no trigonometry.
 //
 // Units of the integer state (the table the other Dcm files refer to):
 //   units            the turn sums': gyro counts * 2^kTurnFraction (2^8) per step

@@ -187,8 +187,26 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
 }
 
 
+// The step as ArduPilot's update() reads: the sample into the sums, then at most one
+// heavy part (HeavySchedule): the strapdown integration (matrix_update), the gravity
+// correction with the rest test and the bias (drift_correction), or the
+// renormalisation (normalize, with check_matrix's rebuild).
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
     const HeavyPart heavy = next_heavy_part(line_due);
+    take_sample(gyro, accel, gyro_ok, accel_ok);
+    heavy_ = HeavySchedule::blocks(heavy);
+    if (heavy == HeavyPart::kIntegration) {
+        strapdown_.integrate(k_);
+    } else if (heavy == HeavyPart::kGravity) {
+        correct_gravity();
+    } else if (heavy == HeavyPart::kRenormalisation) {
+        if (!strapdown_.renormalise()) recover();
+    }
+    if (steps_ < 0xFFFFu) ++steps_;
+}
+
+// The sample's checks (status), then into the gravity window and the strapdown's turn.
+void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok) {
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
     if (!gyro_ok) {
@@ -234,15 +252,6 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
                                      in_turn_units(gyro.z) - offset_units_.z));
     }
     strapdown_.end_step();
-    heavy_ = HeavySchedule::blocks(heavy);
-    if (heavy == HeavyPart::kIntegration) {
-        strapdown_.integrate(k_);
-    } else if (heavy == HeavyPart::kGravity) {
-        correct_gravity();
-    } else if (heavy == HeavyPart::kRenormalisation) {
-        if (!strapdown_.renormalise()) recover();
-    }
-    if (steps_ < 0xFFFFu) ++steps_;
 }
 
 // Rest detection (RestDetector) and, at rest, the bias estimate from the rest mean.
@@ -441,8 +450,7 @@ EulerQ24 Dcm::euler_now_q24() const {
                                  linalg::fixed_from_float(theta_rad.y, 26), linalg::fixed_from_float(theta_rad.z, 26));
     }
     // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
-    // times the radians per unit, each factor Q15 (16x16 multiplies: the float path
-    // cost ~2.2 k cycles a line).
+    // times the radians per unit, each factor Q15 (16x16 multiplies, no float).
     const Vector3l rate = last_rate_units(), pending = pending_turn_units();
     const uint16_t lead = k_.lead_steps_q15, k = k_.theta_q26_per_unit_q15;
     return euler_carried_q24(strapdown_.r(), scale_q15(pending.x + scale_q15(rate.x, lead), k),

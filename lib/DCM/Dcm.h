@@ -11,6 +11,24 @@
 // any consistent unit (uT), time in seconds. Gains are per second and scaled by the
 // step, so the step rate can change without retuning.
 //
+// Dcm is the facade; each mechanism is a part with its own file and tests:
+//   DcmSettings.h    DcmSettings            the tuning values with units (VQF's params)
+//   Coefficients.h   DcmCoefficients        what follows from them and the scales (VQF's coefficients)
+//   Strapdown.h      Strapdown              integration and renormalisation (AP's matrix_update, normalize)
+//   Schedule.h       HeavySchedule          one heavy part a step
+//   Gravity.h        GravityCorrection      accel window, earth-frame low-pass, roll/pitch (VQF's updateAcc)
+//   Rest.h           RestDetector           rest detection (VQF's rest, Fusion's FusionOffset)
+//   GyroBias.h       GyroBias               the calibrated bias and the estimate
+//   Heading.h        EarthFieldMean,        the heading's mean and the disturbance gate (VQF's updateMag)
+//                    MagneticGate
+//   Euler.h          euler_*                the output angles
+// Dcm keeps the sample's checks, the field sample's latency turn and the heading error
+// (correct_heading), the start-up (TRIAD) and the rebuild.
+//
+// Formats of the integer state (table in Coefficients.h): R Q30; rates and turns in
+// units (gyro counts * 2^8 per step); the bias in fine units (units * 2^8); accel in
+// accel units (counts * 2^8); turns in radians Q26/Q30; fields uT Q5.
+//
 // Plain C++ with no Arduino include: the host tests, the host replay tool and the
 // firmware run this very code.
 #pragma once
@@ -92,7 +110,7 @@ public:
     bool heavy_due() const { return initialised() && HeavySchedule::blocks(next_heavy_part(false)); }
     // A field sample given to correct_heading after the next update completes the
     // average of kHeadingSteps and corrects the heading, or is the first heading after a
-    // start without one (the costly parts, up to ~11 k and ~20 k): a caller with
+    // start without one (the costly parts): a caller with
     // deferrable work (the compass learner) puts it on another step.
     bool heading_due_next() const {
         return initialised() && ((status_ & kStatusNoHeading) ||
@@ -121,7 +139,7 @@ public:
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     // The last update turned the matrix or worked out the gravity correction (the
-    // step's two heavy parts, ~8.5 k and ~12-15 k cycles on the AVR, each on its own
+    // step's two heavy parts, each on its own
     // step): a caller with deferrable work (the compass learner) puts only a short piece
     // of it on this step, so that the step stays under 30 k.
     bool heavy_step() const { return heavy_; }
@@ -168,10 +186,11 @@ private:
         return schedule_.next(strapdown_.pending_steps(), strapdown_.renormalisation_due(), line_due);
     }
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
+    void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
     void update_offset();
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
-    // 32x32 routine, ~105 cycles).
+    // 32x32 routine).
     static int32_t in_turn_units(int32_t counts) {
         static_assert(kTurnFraction == 8, "a byte shift");
         return (int32_t)((uint32_t)counts << 8);

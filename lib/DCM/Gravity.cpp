@@ -13,11 +13,11 @@ namespace {
 // five), as code (a table would take RAM on the AVR).
 int32_t inverse_q30(uint8_t n) {
     switch (n) {
-        case 1: return 1073741824L;
-        case 2: return 536870912L;
-        case 3: return 357913941L;
-        case 4: return 268435456L;
-        case 5: return 214748365L;
+        case 1: return linalg::q30_ratio(1, 1);
+        case 2: return linalg::q30_ratio(1, 2);
+        case 3: return linalg::q30_ratio(1, 3);
+        case 4: return linalg::q30_ratio(1, 4);
+        case 5: return linalg::q30_ratio(1, 5);
         default: return linalg::fixed_from_float(1.0f / (float)n, linalg::kQ30);
     }
 }
@@ -28,7 +28,7 @@ Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
     return Vector3l(linalg::mul_q30(inverse_q30, v.x), linalg::mul_q30(inverse_q30, v.y), linalg::mul_q30(inverse_q30, v.z));
 }
 
-// v * 2^8 by byte shifts (a multiply may become avr-gcc's 32x32 routine, ~105 cycles).
+// v * 2^8 by byte shifts (a multiply may become avr-gcc's 32x32 routine).
 Vector3l times_256(const Vector3l& v) {
     return Vector3l((int32_t)((uint32_t)v.x << 8), (int32_t)((uint32_t)v.y << 8), (int32_t)((uint32_t)v.z << 8));
 }

@@ -15,7 +15,7 @@ constexpr float kReferenceTau_s = 1.32f;
 constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
 constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
 
-// 1/n for the few window lengths there are, without the ~500-cycle division.
+// 1/n for the few window lengths there are, without a float division.
 float inverse(uint8_t n) {
     switch (n) {
         case 1: return 1.0f;
