@@ -15,13 +15,6 @@ using linalg::Vector3l;
 
 namespace {
 
-dcm::DcmCoefficients float_form_coefficients() {
-    dcm::DcmCoefficients k;
-    k.from_settings(dcm::kDefaultDcmSettings);
-    k.derive_from_scales(dcm::kDefaultDcmSettings);
-    return k;
-}
-
 struct Loop {
     dcm::DcmCoefficients k = float_form_coefficients();
     dcm::GravityCorrection gravity;

@@ -12,14 +12,9 @@
 using linalg::Vector3f;
 using linalg::Vector3l;
 
-namespace {
+using dcm_test::float_form_coefficients;
 
-dcm::DcmCoefficients float_form_coefficients() {
-    dcm::DcmCoefficients k;
-    k.from_settings(dcm::kDefaultDcmSettings);
-    k.derive_from_scales(dcm::kDefaultDcmSettings);
-    return k;
-}
+namespace {
 
 // A field in the earth-frame sum's units (uT * 2^17) and a squared strength in the
 // norm sum's (uT^2 * 2^6).
