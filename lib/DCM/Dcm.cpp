@@ -297,7 +297,7 @@ Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
 
 Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit()); }
 
-Vector3l Dcm::last_rate_units() const {
+FIXED_INLINE Vector3l Dcm::last_rate_units() const {
     return Vector3l(in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
                     in_turn_units(last_gyro_.z) - offset_units_.z);
 }
