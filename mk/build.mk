@@ -143,3 +143,4 @@ upload: firmware
 include mk/python.mk
 include mk/mavlink.mk
 include mk/fuzz.mk
+include mk/mutate.mk
