@@ -177,7 +177,7 @@ def renames_identifier(orig, mutant):
     return bool(inside and (ident.search(orig[max(0, p - 1):len(orig) - s + 1]) or before == "_"))
 
 
-def generate(out, files):
+def generate(out, files, mutate_bin):
     """Every mutant of every selected file: a list of dicts."""
     mutants = []
     for path in files:
@@ -187,7 +187,7 @@ def generate(out, files):
             shutil.rmtree(mdir)
         os.makedirs(mdir)
         lang = "cpp"
-        r = run([os.path.join(ROOT, "build/venv/bin/mutate"), os.path.abspath(path), lang, "--noCheck",
+        r = run([mutate_bin, os.path.abspath(path), lang, "--noCheck",
                  "--mutantDir", mdir])
         if r.returncode != 0:
             sys.exit("mutate: universalmutator failed on %s:\n%s" % (path, r.stdout[-2000:]))
@@ -236,7 +236,7 @@ def load_equivalent():
 # One mutant: the mutated file in the worker's copy, its dependents recompiled, the
 # binary linked and run.
 
-def test_mutant(m, worker, lib_objs, test_objs, deps, obj_dir, timeout_s):
+def test_mutant(m, worker, base, lib_objs, test_objs, deps, obj_dir, timeout_s):
     src_path = os.path.join(worker, m["file"])
     shutil.copyfile(m["mutant"], src_path)
     try:
@@ -259,16 +259,17 @@ def test_mutant(m, worker, lib_objs, test_objs, deps, obj_dir, timeout_s):
         if not ok:
             return "invalid", ""
         try:
-            r = subprocess.run([binary, "--gtest_brief=1"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            # The first failure ends the run (a trap): a killed mutant costs less.
+            r = subprocess.run([binary, "--gtest_break_on_failure"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                universal_newlines=True, timeout=timeout_s, cwd=ROOT)
         except subprocess.TimeoutExpired:
             return "killed", "timeout"
         if r.returncode == 0:
             return "survived", ""
-        failed = re.findall(r"^\[  FAILED  \] ([\w./]+)", r.stdout, re.M)
-        return "killed", failed[0] if failed else "exit %d" % r.returncode
+        failed = re.findall(r"^\[ RUN      \] ([\w./]+)", r.stdout, re.M)
+        return "killed", failed[-1] if failed else "exit %d" % r.returncode
     finally:
-        shutil.copyfile(os.path.join(ROOT, m["file"]), src_path)
+        shutil.copyfile(os.path.join(base, m["file"]), src_path)
 
 
 def main():
@@ -284,10 +285,19 @@ def main():
     start = time.time()
     out = os.path.join(args.build, "mutate")
     os.makedirs(out, exist_ok=True)
+    # A snapshot of the sources: the run never reads the working tree again (it may be
+    # edited meanwhile).
+    base = os.path.abspath(os.path.join(out, "base"))
+    if os.path.isdir(base):
+        shutil.rmtree(base)
+    for d in ("lib", "test"):
+        shutil.copytree(d, os.path.join(base, d))
+    os.chdir(base)
     files = selected_files()
     if args.library:
         files = collections.OrderedDict((f, l) for f, l in files.items() if l in args.library)
 
+    out = os.path.join(ROOT, out)
     lib_objs, test_objs, deps = base_build(out, files, args.jobs)
     obj_dir = os.path.join(out, "obj")
     base_bin = os.path.join(out, "tests")
@@ -303,7 +313,7 @@ def main():
     print("# mutate: test binary of %s (%.1f s a run, timeout %.0f s)" % (
         " ".join(os.path.basename(t) for t in test_objs), base_s, timeout_s))
 
-    mutants = generate(out, files)
+    mutants = generate(out, files, os.path.join(ROOT, args.build, "venv", "bin", "mutate"))
     equivalent = load_equivalent()
     pool = collections.OrderedDict((lib, []) for lib in LIBRARIES if lib in files.values())
     n_equivalent = collections.Counter()
@@ -332,7 +342,7 @@ def main():
             shutil.rmtree(wdir)
         os.makedirs(wdir)
         for d in ("lib", "test"):
-            shutil.copytree(d, os.path.join(wdir, d))
+            shutil.copytree(os.path.join(base, d), os.path.join(wdir, d))
         workers.append(wdir)
 
     results = collections.defaultdict(collections.Counter)
@@ -361,7 +371,7 @@ def main():
                     break
                 lib, m = nm
                 w = free.pop()
-                fut = ex.submit(test_mutant, m, w, lib_objs, test_objs, deps, obj_dir, timeout_s)
+                fut = ex.submit(test_mutant, m, w, base, lib_objs, test_objs, deps, obj_dir, timeout_s)
                 in_flight[fut] = (lib, m, w)
             if not in_flight:
                 break
