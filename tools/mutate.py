@@ -327,12 +327,16 @@ def main():
     if os.path.exists(archive):
         os.remove(archive)
     run(["ar", "rcs", archive] + [os.path.join(obj_dir, obj_name(s)) for s in lib_objs])
+    link_map = os.path.join(out, "tests.map")
     r = run(["g++", "-o", base_bin] + [os.path.join(obj_dir, obj_name(s)) for s in test_objs] +
-            [archive, "-lgtest", "-lgtest_main", "-pthread", "-Wl,--trace"])
+            [archive, "-lgtest", "-lgtest_main", "-pthread", "-Wl,-Map=" + link_map])
     if r.returncode != 0:
         sys.exit("mutate: the test binary does not link:\n" + r.stdout[-3000:])
-    used = set(re.findall(r"\(([^()]+\.o)\)", r.stdout))
+    used = set(re.findall(r"libs\.a\(([^()]+\.o)\)", open(link_map).read()))
     lib_objs = [s for s in lib_objs if obj_name(s) in used]
+    ok, log = link(base_bin, [os.path.join(obj_dir, obj_name(s)) for s in lib_objs + test_objs])
+    if not ok:  # the objects alone, as each mutant links them
+        sys.exit("mutate: the test binary does not link from the objects it uses:\n" + log[-3000:])
     t0 = time.time()
     r = run([base_bin, "--gtest_brief=1"], cwd=ROOT)
     base_s = time.time() - t0
@@ -384,6 +388,7 @@ def main():
     viable_started = collections.Counter()
     in_flight = {}
     done_count = 0
+    invalid_in_a_row = 0
 
     def next_mutant():
         for lib in queues:
@@ -413,7 +418,12 @@ def main():
                 results[lib][status] += 1
                 if status == "invalid":
                     viable_started[lib] -= 1
-                elif status == "survived":
+                    invalid_in_a_row += 1
+                    if invalid_in_a_row >= 100:
+                        sys.exit("mutate: 100 mutants in a row did not compile or link: the build is broken")
+                else:
+                    invalid_in_a_row = 0
+                if status == "survived":
                     survivors.append((lib, m))
                     print("#   survived: %s:%d: %s -> %s" % (m["file"], m["line"], m["orig"], m["new"]))
                 done_count += 1
