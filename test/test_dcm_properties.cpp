@@ -225,3 +225,35 @@ TEST(DcmProperties, HeadingDueNextMarksEveryMeansLastSample) {
     }
     EXPECT_NEAR((float)due, (float)samples / 3.0f, 2.0f);
 }
+
+// A field sample that arrives before the first accel sample is kept (uT) and becomes the
+// start-up heading and the learned field: the next samples match it.
+TEST(DcmProperties, AFieldBeforeTheFirstSampleIsTheReference) {
+    dcm::Dcm filter;
+    const Matrix3f truth = dcm::dcm_from_euler(0.0f, 0.0f, 0.7f);
+    filter.correct_heading(mag_for(truth));
+    filter.update(Vector3f(), accel_for(truth));  // the first sample starts it
+    ASSERT_TRUE(filter.initialised());
+    for (int i = 0; i < 600; ++i) {
+        if (i % 3 == 0) filter.correct_heading(mag_for(truth));
+        filter.update(Vector3f(), accel_for(truth));
+    }
+    EXPECT_FALSE(filter.status() & dcm::kStatusMagIgnored);
+    EXPECT_LT(angle_between_deg(truth, filter.matrix()), 0.5f);
+}
+
+// With a yaw integral gain (ki_yaw, off by default) the compass's heading error teaches
+// the vertical gyro bias, in the right direction.
+TEST(DcmProperties, AYawIntegralLearnsTheVerticalBiasFromTheCompass) {
+    dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
+    settings.ki_yaw_1_s2 = 0.02f;
+    settings.rest_bias_s = 0.0f;  // not from the rest test
+    dcm::Dcm filter(settings);
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const float bias_rad_s = 0.5f * linalg::kRadPerDeg;
+    for (int i = 0; i < 200 * 120; ++i) {
+        if (i % 3 == 0) filter.correct_heading(earth_field_uT());
+        filter.update(Vector3f(0, 0, bias_rad_s), accel_for(Matrix3f::identity()));
+    }
+    EXPECT_NEAR(filter.gyro_bias_rad_s().z * linalg::kDegPerRad, 0.5f, 0.1f);
+}

@@ -66,3 +66,11 @@ TEST(FixedTables, HeadingFoldsIntoAFullTurn) {
     EXPECT_NEAR(dcm::heading_deg(90.0f * linalg::kRadPerDeg, 0.0f), 90.0f, 1e-3f);
     EXPECT_EQ(dcm::heading_deg(NAN, 0.0f), 0.0f);
 }
+
+// The printed heading in hundredths: north is 0, never 36000; just west of north 35999.
+TEST(FixedTables, HeadingCentidegFoldsAtNorth) {
+    EXPECT_EQ(dcm::heading_centideg(0, 0), 0);
+    EXPECT_EQ(dcm::heading_centideg(0, -1), 35999);
+    EXPECT_EQ(dcm::heading_centideg(0, 1), 1);
+    EXPECT_EQ(dcm::heading_centideg(-linalg::kHalfPiQ24, 0), 27000);
+}
