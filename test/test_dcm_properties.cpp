@@ -257,3 +257,16 @@ TEST(DcmProperties, AYawIntegralLearnsTheVerticalBiasFromTheCompass) {
     }
     EXPECT_NEAR(filter.gyro_bias_rad_s().z * linalg::kDegPerRad, 0.5f, 0.1f);
 }
+
+// A compass sampled at the step rate (more samples in a heading mean than the usual
+// three): the mean is still a mean, the heading converges to the compass's.
+TEST(DcmProperties, ACompassAtTheStepRateStillGivesTheHeading) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const Matrix3f turned = dcm::dcm_from_euler(0.0f, 0.0f, 20.0f * linalg::kRadPerDeg);
+    for (int i = 0; i < 200 * 60; ++i) {
+        filter.correct_heading(mag_for(i < 1000 ? Matrix3f::identity() : turned));
+        filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+    }
+    EXPECT_NEAR(filter.euler().yaw_rad * linalg::kDegPerRad, 20.0f, 0.5f);
+}
