@@ -74,3 +74,11 @@ TEST(FixedTables, HeadingCentidegFoldsAtNorth) {
     EXPECT_EQ(dcm::heading_centideg(0, 1), 1);
     EXPECT_EQ(dcm::heading_centideg(-linalg::kHalfPiQ24, 0), 27000);
 }
+
+// hypot at the end of its table (the two sides equal: ratio 1, or beyond by rounding).
+TEST(FixedTables, HypotOfEqualSidesIsRootTwoTimesTheSide) {
+    for (uint32_t ratio : {0x80000000u, 0xFFFFFFFFu}) {
+        const uint32_t h = linalg::hypot_from_ratio(1000000000u, ratio);
+        EXPECT_NEAR((double)h, 1000000000.0 * std::sqrt(2.0), 1000000000.0 * 2.5e-5) << ratio;
+    }
+}
