@@ -97,6 +97,11 @@ bool Imu::read(mpu6000::Sample& out, uint32_t now_us, uint32_t now_ms) {
             }
         }
     }
+    // Overruns the rate limit held back, told once its time is over.
+    const uint16_t held = warn_missed_.deferred(now_ms, kWarnMs);
+    if (held != 0)
+        Writer(out_).str(TXT(TXT_WARN "loop overrun: ")).u32(held).str(TXT(" more time(s), "))
+            .u32(missed_).str(TXT(" sample(s) missed in all")).end();
     last_sample_us_ = now_us;
     have_sample_time_ = true;
 

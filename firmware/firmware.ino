@@ -365,6 +365,8 @@ void loop() {
         window_start_us = now_us;
         update_leds();
         if (mavlink_mode()) send_heartbeat_and_status();
+        if (const uint16_t n = warn_angle.deferred(millis(), 2000))
+            Writer(out).str(TXT(TXT_WARN "output not finite: ")).u32(n).str(TXT(" more lines skipped")).end();
     }
     if (!imu.sample_ready(now_us)) return;
     step(now_us);

@@ -21,8 +21,8 @@ namespace {
 
 const char* const kUsage =
     "usage: apm25sim --elf FILE.elf --trajectory FILE.csv[.gz] [--seconds S] [--stamp]\n"
-    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--profile FILE]\n"
-    "                [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X] [--verbose]\n"
+    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--eeprom-cuts T1:T2:STEP]\n"
+    "                [--profile FILE] [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X] [--verbose]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
@@ -42,6 +42,9 @@ const char* const kUsage =
     "                   an error) and write all 4096 bytes back to FILE when the run ends (also\n"
     "                   after a crash), so settings saved survive the next run as a power cycle;\n"
     "                   the run's end is a power cut: an EEPROM write in progress stays partial\n"
+    "  --eeprom-cuts T1:T2:STEP  with --eeprom FILE: also write the chip as a power cut at\n"
+    "                   T1, T1+STEP, ... (<= T2, simulated seconds) leaves it (what --seconds\n"
+    "                   at that time writes) to FILE.cut0, FILE.cut1, ...: one run for many cuts\n"
     "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..15 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
@@ -138,6 +141,15 @@ int main(int argc, char** argv) {
             options.input_start_fixed = true;
         } else if (arg == "--eeprom") {
             options.eeprom_path = value("--eeprom");
+        } else if (arg == "--eeprom-cuts") {
+            const char* spec = value("--eeprom-cuts");
+            if (std::sscanf(spec, "%lf:%lf:%lf", &options.eeprom_cuts_from_s, &options.eeprom_cuts_to_s,
+                            &options.eeprom_cuts_step_s) != 3 ||
+                !(options.eeprom_cuts_step_s > 0.0) || !(options.eeprom_cuts_to_s >= options.eeprom_cuts_from_s)) {
+                std::fprintf(stderr, "apm25sim: --eeprom-cuts wants T1:T2:STEP with T1 <= T2, STEP > 0, not '%s'\n",
+                             spec);
+                return 1;
+            }
         } else if (arg == "--profile") {
             profile_path = value("--profile");
         } else if (arg == "--rc") {
@@ -190,6 +202,10 @@ int main(int argc, char** argv) {
             return 1;
         }
         options.servo_log = servo_log;
+    }
+    if (options.eeprom_cuts_step_s > 0.0 && options.eeprom_path.empty()) {
+        std::fprintf(stderr, "apm25sim: --eeprom-cuts needs --eeprom FILE\n");
+        return 1;
     }
     options.profile = !profile_path.empty();
     sim::TcpSerial serial;

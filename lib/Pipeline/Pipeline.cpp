@@ -49,6 +49,14 @@ bool RateLimiter::allow(uint32_t now, uint16_t interval) {
     return true;
 }
 
+uint16_t RateLimiter::deferred(uint32_t now, uint16_t interval) {
+    if (held == 0 || now - last < interval) return 0;
+    const uint16_t n = held;
+    held = 0;
+    last = now;
+    return n;
+}
+
 AttitudePipeline::AttitudePipeline(const text::Sink* log, const dcm::DcmSettings& dcm_settings)
     : log_(log), settings_(settings::defaults()), dcm_(dcm_settings), st_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f);
@@ -357,6 +365,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     const bool short_room = dcm_.heavy_step();
     if (!short_room) {
         if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
+        else report_deferred();
         st_.cal_pending = false;
     }
     if ((learner_.solving() || st_.learn_pending) && !(short_room && learner_.long_part_next())) {
@@ -364,6 +373,27 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         learn_mag_offset(short_room);
         profile::end(profile::kLearner);
     }
+}
+
+// The warnings the rate limits held back, each kind once its quiet time is over (one
+// line a step at most: a line is a few thousand cycles).
+void AttitudePipeline::report_deferred() {
+    uint16_t n = st_.warn_spike.deferred(st_.steps, kWarnIntervalSteps);
+    if (n != 0) {
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: ")).u32(n).str(TXT(" more samples replaced ("))
+            .u32(st_.spikes).str(TXT(" so far)")).end();
+        return;
+    }
+    if ((n = st_.warn_gyro_sat.deferred(st_.steps, kWarnIntervalSteps)) != 0) {
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated: ")).u32(n).str(TXT(" more samples")).end();
+        return;
+    }
+    if ((n = st_.warn_accel_sat.deferred(st_.steps, kWarnIntervalSteps)) != 0) {
+        Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated: ")).u32(n).str(TXT(" more samples")).end();
+        return;
+    }
+    if ((n = st_.warn_mag.deferred(st_.steps, kWarnIntervalSteps)) != 0)
+        Writer(log_).str(TXT(TXT_WARN TXT_HMC " field not the Earth's: ")).u32(n).str(TXT(" more samples dropped")).end();
 }
 
 Angles AttitudePipeline::angles() const {

@@ -31,9 +31,10 @@
 // those of the calibrated field from then on.
 //
 // Messages (to the sink, each a "# " line): gyro calibration progress and result,
-// "# warn: MPU6000 ..." for spikes and saturation (at most one per kWarnIntervalSteps
-// per kind, with the count), "# warn: HMC5883L ..." for absurd fields, the `cal mag`
-// progress and verdict.
+// "# warn: MPU6000 ..." for spikes and saturation, "# warn: HMC5883L ..." for absurd
+// fields (at most one per kWarnIntervalSteps per kind; what came meanwhile is told once
+// that time is over: "# warn: MPU6000 spike: 10 more samples replaced (12 so far)"),
+// the `cal mag` progress and verdict.
 #pragma once
 
 #include <stdint.h>
@@ -104,15 +105,17 @@ struct Angles {
 // The same rounded to the hundredths the output lines print (fmt::format_plot_line_centideg).
 using AnglesCentideg = dcm::AnglesCentideg;
 
-// A per-kind rate limiter for warnings: allow() is true at most once per interval,
-// suppressed() tells how many were held back in all. A plain struct that starts
-// zeroed: declare it static or value-initialise it (`RateLimiter r{};`).
+// A per-kind rate limiter for warnings: allow() is true at most once per interval; what
+// it holds back is not lost: once the interval since the last line is over, deferred()
+// gives how many were held (and zero again), for a "N more" line that starts the next
+// interval. A plain struct that starts zeroed: declare it static or value-initialise it
+// (`RateLimiter r{};`).
 struct RateLimiter {
     bool allow(uint32_t now_steps, uint16_t interval_steps);
-    uint16_t suppressed() const { return held; }
+    uint16_t deferred(uint32_t now_steps, uint16_t interval_steps);
 
-    uint32_t last;  // when allow() last said yes
-    uint16_t held;  // how many were suppressed (saturates)
+    uint32_t last;  // when the last line (allowed or deferred) went out
+    uint16_t held;  // how many were held back since (saturates)
     bool ever;      // allow() has said yes before
 };
 
@@ -189,6 +192,7 @@ private:
     void start_estimator(const linalg::Vector3f& gravity);
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
     void finish_mag_calibration();
+    void report_deferred();
     void take_learner_sample(const linalg::Vector3f& field_uT);
     void learn_mag_offset(bool one_piece);
     void forget_mag_reference(bool take_heading);

@@ -290,6 +290,7 @@ bool Board::init() {
 bool Board::run(double seconds) {
     const avr_cycle_count_t end = (avr_cycle_count_t)std::llround(seconds * kCpuHz);
     while (avr_->cycle < end && !g_stop_requested) {
+        if (options_.eeprom_cuts_step_s > 0.0) take_eeprom_cuts();
         const int state = avr_run(avr_);
         if (state == cpu_Done || state == cpu_Crashed) {
             error_ = state == cpu_Crashed ? "the AVR core crashed" : "the AVR core stopped";
@@ -683,16 +684,31 @@ bool Board::load_eeprom() {
 
 bool Board::save_eeprom() {
     if (options_.eeprom_path.empty() || !avr_) return true;
+    return write_eeprom(options_.eeprom_path);
+}
+
+// Before each instruction: the chip as a run cut at this instant (--seconds) leaves it,
+// at each cut time reached (a write holds its byte from its start: on_eecr_write).
+void Board::take_eeprom_cuts() {
+    const double at_s = options_.eeprom_cuts_from_s + options_.eeprom_cuts_step_s * eeprom_cuts_taken_;
+    if (at_s > options_.eeprom_cuts_to_s + 1e-9 || avr_->cycle < (avr_cycle_count_t)std::llround(at_s * kCpuHz))
+        return;
+    const std::string path = options_.eeprom_path + ".cut" + std::to_string(eeprom_cuts_taken_);
+    if (!write_eeprom(path)) std::fprintf(stderr, "apm25sim: cannot write '%s'\n", path.c_str());
+    ++eeprom_cuts_taken_;
+}
+
+bool Board::write_eeprom(const std::string& path) const {
     const uint8_t* chip = eeprom_bytes();
     if (!chip) return false;
     const std::vector<uint8_t> bytes(chip, chip + kEepromSize);
     // Through a temporary file and a rename: an interrupted write never leaves half a chip.
-    const std::string tmp = options_.eeprom_path + ".tmp";
+    const std::string tmp = path + ".tmp";
     FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f) return false;
     const bool ok = std::fwrite(bytes.data(), 1, kEepromSize, f) == kEepromSize;
     if (std::fclose(f) != 0 || !ok) return false;
-    return std::rename(tmp.c_str(), options_.eeprom_path.c_str()) == 0;
+    return std::rename(tmp.c_str(), path.c_str()) == 0;
 }
 
 // --- profiling ----------------------------------------------------------------

@@ -48,6 +48,9 @@ struct BoardOptions {
     FILE* servo_log = nullptr;      // --servo-log: one row per pulse on OUT1-OUT8
     TcpSerial* serial = nullptr;    // --serial tcp:PORT: UART0 also to and from a TCP client
     double speed = 0.0;             // simulated seconds per wall second; 0: unpaced
+    // --eeprom-cuts T1:T2:STEP: the EEPROM as a power cut at T1, T1+STEP, ... <= T2 leaves
+    // it, written to eeprom_path.cut0, .cut1, ... (cuts_step_s 0: none)
+    double eeprom_cuts_from_s = 0.0, eeprom_cuts_to_s = 0.0, eeprom_cuts_step_s = 0.0;
 };
 
 // Asks a running Board::run to return at its next instruction boundary (async-signal-safe:
@@ -118,6 +121,8 @@ private:
     void start_input();
     void arm_input();
     bool load_eeprom();
+    bool write_eeprom(const std::string& path) const;
+    void take_eeprom_cuts();
     uint8_t* eeprom_bytes() const;
     double sck_hz() const;
     bool init_rc();
@@ -149,6 +154,7 @@ private:
     bool twi_selected_ = false;
     int int_level_ = -1, drdy_level_ = -1;
     uint32_t bus_violations_ = 0;
+    uint32_t eeprom_cuts_taken_ = 0;
 
     std::string line_;
     bool first_angle_line_seen_ = false;

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Settings in the ATmega2560's EEPROM through a simulated power cycle (apm25sim --eeprom):
 // `save` then a new run from the same chip brings the settings back; a flipped byte, a
-// half-written record, a record of another version or a save cut short by power loss
-// give the defaults and a message, never garbage. The records are built on the host with
-// the firmware's own settings::encode (lib/Console/Settings), not from fixed offsets.
+// half-written slot, a record of another version or a first save cut short by power loss
+// give the defaults and a message, never garbage; a slot cut short beside a whole one
+// gives the whole one's settings. A board upgraded from the firmware before the slots
+// (one record at address 0) keeps its settings. The chips are built on the host with the
+// firmware's own settings::encode and slots::encode (lib/Console), not from fixed offsets.
 #include <cstring>
+#include <map>
 
+#include "RecordSlots.h"
 #include "Settings.h"
 #include "e2e_support.h"
 
@@ -21,24 +25,49 @@ std::string eeprom_path(const std::string& name) {
     return path;
 }
 
-// A 4096-byte chip: `record` at settings::kEepromAddress, the rest erased.
-void write_chip(const std::string& path, const std::vector<uint8_t>& record) {
+// A 4096-byte chip, erased but for `bytes` at `address`.
+void write_chip(const std::string& path, const std::vector<std::pair<uint16_t, std::vector<uint8_t>>>& parts) {
     std::string chip(4096, '\xFF');
-    for (size_t i = 0; i < record.size(); ++i) chip[settings::kEepromAddress + i] = (char)record[i];
+    for (const auto& part : parts)
+        for (size_t i = 0; i < part.second.size(); ++i) chip[part.first + i] = (char)part.second[i];
     std::ofstream(path, std::ios::binary) << chip;
 }
 
-std::vector<uint8_t> read_record(const std::string& path) {
+// The slot `slot` of the chip file (empty when the file is short).
+std::vector<uint8_t> read_slot(const std::string& path, uint8_t slot) {
     const std::string chip = e2e::read_text(path);
-    if (chip.size() < settings::kEepromAddress + kRecordSize) return {};
-    return std::vector<uint8_t>(chip.begin() + settings::kEepromAddress,
-                                chip.begin() + settings::kEepromAddress + kRecordSize);
+    const uint16_t at = slots::slot_address(slot);
+    if (chip.size() < at + slots::kSlotSize) return {};
+    return std::vector<uint8_t>(chip.begin() + at, chip.begin() + at + slots::kSlotSize);
+}
+
+// What the firmware's load (the same lib/Console code) makes of the chip file.
+std::string g_chip_bytes;
+void read_chip_bytes(uint16_t address, uint8_t* out, uint16_t n) {
+    for (uint16_t i = 0; i < n; ++i) out[i] = address + i < g_chip_bytes.size() ? (uint8_t)g_chip_bytes[address + i] : 0xFFu;
+}
+slots::Loaded load_chip(const std::string& path, settings::Settings& s) {
+    g_chip_bytes = e2e::read_text(path);
+    return slots::load(read_chip_bytes, s);
 }
 
 std::vector<uint8_t> encoded(const settings::Settings& s) {
     std::vector<uint8_t> r(kRecordSize);
     settings::encode(s, r.data());
     return r;
+}
+
+// A slot holding `record` with `sequence`, as the firmware writes it.
+std::vector<uint8_t> slot_of(const std::vector<uint8_t>& record, uint16_t sequence) {
+    std::vector<uint8_t> slot(slots::kSlotSize);
+    slots::encode(record.data(), sequence, slot.data());
+    return slot;
+}
+
+// A slot's bytes padded to kMaxSlotSize for slots::inspect.
+std::vector<uint8_t> slot_bytes(std::vector<uint8_t> slot) {
+    slot.resize(slots::kMaxSlotSize, 0xFF);
+    return slot;
 }
 
 settings::Settings stored_sample() {
@@ -79,11 +108,16 @@ TEST(Eeprom, SavedSettingsSurviveAPowerCycle) {
     EXPECT_TRUE(find_line(first.lines, "EEPROM blank")) << e2e::dump(first);
     ASSERT_TRUE(find_line(first.lines, "# saved")) << e2e::dump(first, 200);
 
-    // The chip holds the record the host library encodes for these settings.
+    // The chip holds, in its first slot, the record the host library encodes for these
+    // settings; the firmware's load (the same code on the host) finds it.
     settings::Settings on_chip;
-    const std::vector<uint8_t> record = read_record(chip);
-    ASSERT_EQ(record.size(), kRecordSize);
-    ASSERT_EQ(settings::decode(record.data(), on_chip), settings::LoadResult::Ok);
+    const std::vector<uint8_t> slot = read_slot(chip, 0);
+    ASSERT_EQ(slot.size(), slots::kSlotSize);
+    EXPECT_EQ(slots::inspect(slot_bytes(slot).data()).state, slots::SlotState::Valid);
+    EXPECT_EQ(slots::inspect(slot_bytes(slot).data()).sequence, 1);
+    const slots::Loaded loaded = load_chip(chip, on_chip);
+    ASSERT_EQ(loaded.result, settings::LoadResult::Ok);
+    EXPECT_FALSE(loaded.from_legacy);
     EXPECT_EQ(on_chip.rate_hz, 25);
     EXPECT_EQ(on_chip.declination_centideg, 850);
     EXPECT_EQ(on_chip.mode, fmt::OutputMode::Csv);
@@ -102,71 +136,103 @@ TEST(Eeprom, SavedSettingsSurviveAPowerCycle) {
     unlink(chip.c_str());
 }
 
+// A flipped byte in the only slot: the slot's CRC fails it.
 TEST(Eeprom, FlippedByteGivesDefaultsAndAMessage) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
-    const std::vector<uint8_t> good = encoded(stored_sample());
-    // The first byte, one in the middle of the payload, the last (the CRC's high byte).
-    for (const size_t i : {size_t{0}, size_t{kRecordSize / 2}, size_t{kRecordSize - 1}}) {
+    const std::vector<uint8_t> good = slot_of(encoded(stored_sample()), 1);
+    // The first byte, one in the middle of the record, the last (the slot CRC's high byte).
+    for (const size_t i : {size_t{0}, size_t{slots::kSlotSize / 2}, size_t{slots::kSlotSize - 1}}) {
         std::vector<uint8_t> bad = good;
         bad[i] = (uint8_t)(bad[i] ^ 0x10u);
-        settings::Settings s;
-        ASSERT_NE(settings::decode(bad.data(), s), settings::LoadResult::Ok) << i;  // the premise
         const std::string chip = eeprom_path("flip");
-        write_chip(chip, bad);
+        write_chip(chip, {{slots::slot_address(0), bad}});
+        settings::Settings s;
+        ASSERT_NE(load_chip(chip, s).result, settings::LoadResult::Ok) << i;  // the premise
         expect_defaults_and_message(boot(chip), "byte " + std::to_string(i) + " flipped");
         unlink(chip.c_str());
     }
 }
 
-// A save interrupted half way: the first half of the new record over the old one (the
-// firmware writes byte by byte from the start), and over an erased chip.
-TEST(Eeprom, HalfWrittenRecordGivesDefaultsAndAMessage) {
+// A save interrupted half way (the firmware writes a slot byte by byte from the start):
+// over an erased chip, the defaults and a message; beside a whole slot with the settings
+// before, those settings and a word that the last save was cut.
+TEST(Eeprom, HalfWrittenSlotGivesThePreviousSettingsOrDefaults) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     settings::Settings old_settings = settings::defaults();
     old_settings.rate_hz = 10;
     old_settings.declination_centideg = -4500;
-    const std::vector<uint8_t> old_record = encoded(old_settings);
-    const std::vector<uint8_t> new_record = encoded(stored_sample());
-    const size_t half = kRecordSize / 2;
-    std::vector<uint8_t> over_old = old_record, over_erased(kRecordSize, 0xFF);
-    std::copy(new_record.begin(), new_record.begin() + (long)half, over_old.begin());
-    std::copy(new_record.begin(), new_record.begin() + (long)half, over_erased.begin());
-    for (const auto& c : {std::make_pair(std::string("over the old record"), over_old),
-                          std::make_pair(std::string("over an erased chip"), over_erased)}) {
-        const std::string chip = eeprom_path("half");
-        write_chip(chip, c.second);
-        expect_defaults_and_message(boot(chip), c.first);
-        unlink(chip.c_str());
-    }
+    const std::vector<uint8_t> old_slot = slot_of(encoded(old_settings), 4);
+    const std::vector<uint8_t> new_slot = slot_of(encoded(stored_sample()), 5);
+    std::vector<uint8_t> half(new_slot.begin(), new_slot.begin() + (long)(slots::kSlotSize / 2));
+    const std::string chip = eeprom_path("half");
+    write_chip(chip, {{slots::slot_address(0), half}});
+    expect_defaults_and_message(boot(chip), "half a slot on an erased chip");
+
+    // The new slot half over an older record (what the firmware overwrites: not the newest).
+    std::vector<uint8_t> over_older = slot_of(encoded(settings::defaults()), 3);
+    std::copy(half.begin(), half.end(), over_older.begin());
+    write_chip(chip, {{slots::slot_address(0), over_older}, {slots::slot_address(1), old_slot}});
+    const e2e::SimRun run = boot(chip);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    EXPECT_TRUE(find_line(run.lines, "# warn: the last save to EEPROM was cut short")) << e2e::dump(run);
+    EXPECT_TRUE(find_line(run.lines, "# settings loaded from EEPROM")) << e2e::dump(run);
+    EXPECT_TRUE(find_line(run.lines, "# settings: rate 10 Hz, decl -45.00 deg, mode plot")) << e2e::dump(run);
+    unlink(chip.c_str());
 }
 
-// A record that another firmware version wrote: its version byte differs and its CRC is
-// right for it. The version's place is the one the record's own layout gives
-// (Settings.h: magic, magic, version), found in the encoded bytes.
-TEST(Eeprom, RecordOfAnotherVersionGivesDefaultsAndAMessage) {
-    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+// A record with another version byte and a CRC right for it. The version's place is the
+// one the record's own layout gives (Settings.h: magic, magic, version).
+std::vector<uint8_t> record_of_version(uint8_t version) {
     std::vector<uint8_t> rec = encoded(stored_sample());
     const size_t version_at = 2;
-    ASSERT_EQ(rec[0], settings::kMagic0);
-    ASSERT_EQ(rec[1], settings::kMagic1);
-    ASSERT_EQ(rec[version_at], settings::kSettingsVersion);
-    rec[version_at] = (uint8_t)(settings::kSettingsVersion - 1u);
+    EXPECT_EQ(rec[0], settings::kMagic0);
+    EXPECT_EQ(rec[1], settings::kMagic1);
+    EXPECT_EQ(rec[version_at], settings::kSettingsVersion);
+    rec[version_at] = version;
     const uint16_t crc = settings::crc16(rec.data(), (uint16_t)(kRecordSize - 2u));
     rec[kRecordSize - 2] = (uint8_t)(crc & 0xFFu);
     rec[kRecordSize - 1] = (uint8_t)(crc >> 8);
+    return rec;
+}
+
+// A record that another firmware version wrote into a slot.
+TEST(Eeprom, RecordOfAnotherVersionGivesDefaultsAndAMessage) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    const std::vector<uint8_t> rec = record_of_version((uint8_t)(settings::kSettingsVersion - 1u));
     settings::Settings s;
     ASSERT_EQ(settings::decode(rec.data(), s), settings::LoadResult::OldVersion);
     const std::string chip = eeprom_path("version");
-    write_chip(chip, rec);
+    write_chip(chip, {{slots::slot_address(0), slot_of(rec, 1)}});
     const e2e::SimRun run = boot(chip);
     expect_defaults_and_message(run, "older version");
     EXPECT_TRUE(find_line(run.lines, "another version")) << e2e::dump(run);
     unlink(chip.c_str());
 }
 
-// The power goes while `save` writes (the end of the run is the power cut): from an erased
-// chip, a part of the record is on it, and the next start says so and uses the defaults.
-TEST(Eeprom, PowerCutDuringSaveGivesDefaultsAndAMessage) {
+// A board upgraded from the firmware before the slots: its one record at address 0, of
+// version 2. Loaded while the record is still of version 2 here; once the record's
+// version is another, refused with a message, never misread. A save then writes a slot.
+TEST(Eeprom, UpgradedBoardsSingleVersion2Record) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    const uint8_t kSingleRecordVersion = 2;
+    const std::string chip = eeprom_path("upgrade");
+    write_chip(chip, {{settings::kEepromAddress, record_of_version(kSingleRecordVersion)}});
+    const e2e::SimRun run = boot(chip);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    if (settings::kSettingsVersion == kSingleRecordVersion) {
+        EXPECT_TRUE(find_line(run.lines, "# settings loaded from EEPROM (an earlier firmware's record)")) << e2e::dump(run);
+        EXPECT_TRUE(find_line(run.lines, "# settings: rate 25 Hz, decl 8.50 deg, mode csv")) << e2e::dump(run);
+    } else {
+        expect_defaults_and_message(run, "version 2 record");
+        EXPECT_TRUE(find_line(run.lines, "another version")) << e2e::dump(run);
+    }
+    unlink(chip.c_str());
+}
+
+// The power goes while the first `save` writes (the end of the run is the power cut):
+// from an erased chip, a part of the slot is on it, and the next start says so and uses
+// the defaults.
+TEST(Eeprom, PowerCutDuringFirstSaveGivesDefaultsAndAMessage) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     const std::string text = "rate 25\r\ndecl 8.5\r\nsave\r\n";
     const std::string input = e2e::input_file("eeprom_cut", text);
@@ -186,14 +252,155 @@ TEST(Eeprom, PowerCutDuringSaveGivesDefaultsAndAMessage) {
                                                     seconds + " --eeprom " + chip + " --input " + input);
     unlink(input.c_str());
     ASSERT_EQ(cut.exit_code, 0) << cut.err;
-    const std::vector<uint8_t> partial = read_record(chip);
-    ASSERT_EQ(partial.size(), kRecordSize);
+    const std::vector<uint8_t> partial = read_slot(chip, 0);
+    ASSERT_EQ(partial.size(), slots::kSlotSize);
     settings::Settings s;
-    EXPECT_NE(settings::decode(partial.data(), s), settings::LoadResult::Ok);
-    EXPECT_NE(partial, std::vector<uint8_t>(kRecordSize, 0xFF)) << "nothing was written before the cut";
+    EXPECT_NE(load_chip(chip, s).result, settings::LoadResult::Ok);
+    EXPECT_NE(partial, std::vector<uint8_t>(slots::kSlotSize, 0xFF)) << "nothing was written before the cut";
     expect_defaults_and_message(boot(chip), "save cut at " + std::string(seconds) + " s");
     unlink(chip.c_str());
     unlink(probe_chip.c_str());
+}
+
+// --- a power cut at every 1 ms across a save ------------------------------------------
+
+// The "# settings: ..." line a start prints, and whether it said the settings were loaded.
+struct Boot {
+    std::string settings_line;
+    bool loaded = false;
+};
+Boot boot_line(const std::string& chip) {
+    const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "rest", 0.05, "--eeprom " + chip);
+    Boot b;
+    EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    const e2e::Line* line = find_line(run.lines, "# settings: ");
+    if (line) b.settings_line = line->text;
+    b.loaded = find_line(run.lines, "# settings loaded from EEPROM") != nullptr;
+    return b;
+}
+
+struct SweepResult {
+    int cuts = 0, cuts_during_save = 0, distinct_chips = 0, old_boots = 0, new_boots = 0;
+};
+
+// One simavr run from the chip `start` that types `input` (at input_at_s) ending with a
+// save; apm25sim --eeprom-cuts writes the chip as a power cut at every 1 ms from from_s
+// to to_s leaves it. Every cut must start with the settings before the save or those
+// after it, whole: the firmware's own load, run on the host, gives one of the two
+// records byte for byte, and a start in simavr prints that one's settings line and
+// "settings loaded". Chips alike give the same start (simavr is deterministic): each
+// distinct one is started once.
+SweepResult sweep(const std::string& name, const std::string& csv, double seconds, const std::string& input_text,
+                  double input_at_s, const std::vector<std::pair<uint16_t, std::vector<uint8_t>>>& start, double from_s,
+                  double to_s) {
+    SweepResult r;
+    const std::string chip = eeprom_path(name);
+    write_chip(chip, start);
+    settings::Settings old_settings, new_settings;
+    EXPECT_EQ(load_chip(chip, old_settings).result, settings::LoadResult::Ok);
+    const Boot old_boot = boot_line(chip);
+    EXPECT_TRUE(old_boot.loaded);
+
+    const std::string input = e2e::input_file(name, input_text);
+    char window[96];
+    std::snprintf(window, sizeof window, " --eeprom-cuts %.3f:%.3f:0.001 --input-at %.3f", from_s, to_s, input_at_s);
+    const e2e::SimRun run = e2e::run_sim_file(e2e::firmware_elf(), csv, seconds,
+                                              "--eeprom " + chip + " --input " + input + window);
+    unlink(input.c_str());
+    EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    const e2e::Line* saving = find_line(run.lines, "# saving to EEPROM");
+    const e2e::Line* saved = find_line(run.lines, "# saved");
+    EXPECT_TRUE(saving && saved) << e2e::dump(run, 400);
+    if (!saving || !saved) return r;
+    EXPECT_GT(saving->t_s, from_s + 0.01) << "the cuts begin before the save";
+    EXPECT_LT(saved->t_s, to_s - 0.01) << "the cuts end before the save has ended";
+    EXPECT_EQ(load_chip(chip, new_settings).result, settings::LoadResult::Ok);
+    const std::vector<uint8_t> old_record = encoded(old_settings), new_record = encoded(new_settings);
+    EXPECT_NE(old_record, new_record);
+    const Boot new_boot = boot_line(chip);
+    EXPECT_TRUE(new_boot.loaded);
+    EXPECT_NE(old_boot.settings_line, new_boot.settings_line) << "the starts must tell the two apart";
+    std::printf("# %s: save from %.4f to %.4f s; before: %s; after: %s\n", name.c_str(), saving->t_s, saved->t_s,
+                old_boot.settings_line.c_str(), new_boot.settings_line.c_str());
+
+    std::map<std::string, bool> is_new_of_chip;  // distinct chip -> booted with the new settings
+    const int expected_cuts = (int)std::lround((to_s - from_s) / 0.001) + 1;
+    for (int k = 0;; ++k) {
+        const std::string cut_path = chip + ".cut" + std::to_string(k);
+        if (!e2e::file_exists(cut_path)) break;
+        ++r.cuts;
+        const double t_s = from_s + 0.001 * k;
+        const std::string bytes = e2e::read_text(cut_path);
+        auto known = is_new_of_chip.find(bytes);
+        if (known == is_new_of_chip.end()) {
+            settings::Settings s;
+            EXPECT_EQ(load_chip(cut_path, s).result, settings::LoadResult::Ok) << "cut at " << t_s;
+            const std::vector<uint8_t> rec = encoded(s);
+            const bool is_new = rec == new_record;
+            EXPECT_TRUE(is_new || rec == old_record) << "cut at " << t_s << ": neither record";
+            const Boot b = boot_line(cut_path);
+            EXPECT_TRUE(b.loaded) << "cut at " << t_s;
+            EXPECT_EQ(b.settings_line, is_new ? new_boot.settings_line : old_boot.settings_line) << "cut at " << t_s;
+            known = is_new_of_chip.emplace(bytes, is_new).first;
+        }
+        (known->second ? r.new_boots : r.old_boots)++;
+        if (t_s < saving->t_s) EXPECT_FALSE(known->second) << "cut at " << t_s;
+        if (t_s > saved->t_s) EXPECT_TRUE(known->second) << "cut at " << t_s;
+        if (t_s >= saving->t_s && t_s <= saved->t_s) ++r.cuts_during_save;
+        unlink(cut_path.c_str());
+    }
+    r.distinct_chips = (int)is_new_of_chip.size();
+    EXPECT_EQ(r.cuts, expected_cuts);
+    std::printf("# %s: %d cuts (%d during the save), %d distinct chips started: %d old, %d new settings\n",
+                name.c_str(), r.cuts, r.cuts_during_save, r.distinct_chips, r.old_boots, r.new_boots);
+    unlink(chip.c_str());
+    return r;
+}
+
+settings::Settings numbered_settings(uint8_t n, bool mag_cal) {
+    settings::Settings s = settings::defaults();
+    s.rate_hz = (uint8_t)(10 + n);
+    s.declination_centideg = (int16_t)(-2000 + 333 * n);
+    if (mag_cal) {
+        s.flags = settings::kFlagMagCalibrated;
+        s.cal.mag_offset_uT = linalg::Vector3f(2.5f * n, -1.25f * n, 4.0f);
+        s.cal.mag_scale = linalg::Vector3f(1.02f, 0.99f, 0.99f);
+        s.cal.mag_cross = linalg::Vector3f(0.01f, -0.005f, 0.002f);
+    }
+    return s;
+}
+
+// `save` of three changed settings, with both slots whole (the older one is written over).
+TEST(Eeprom, PowerCutAtEveryMillisecondOfASettingsSave) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    const SweepResult r =
+        sweep("sweep_settings", e2e::scenario_csv("rest", 2.0), 2.0, "rate 40\r\ndecl -3\r\nmode csv\r\nsave\r\n", 1.4,
+              {{slots::slot_address(0), slot_of(encoded(numbered_settings(1, false)), 7)},
+               {slots::slot_address(1), slot_of(encoded(numbered_settings(2, true)), 8)}},
+              1.35, 1.8);
+    // The slot's changed bytes at 3.4 ms each.
+    EXPECT_GE(r.cuts_during_save, 100);
+    EXPECT_GT(r.old_boots, 0);
+    EXPECT_GT(r.new_boots, 0);
+}
+
+// `cal mag` on a tumble, then `save`: the calibration's floats all change. The console
+// waits through the 30 s of turning on empty lines (ignored) before the declination and
+// the save (the characters come a little slower than the baud rate: the save starts near
+// 36.1 s and ends near 36.3 s).
+TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    const double input_at_s = 5.5, char_s = 10.0 / 115200.0;
+    std::string text = "cal mag\r\n";
+    text += std::string((size_t)(28.4 / char_s), '\r');  // past the fit's result (35.5 s)
+    text += "decl 12.5\r\nsave\r\n";
+    const SweepResult r = sweep("sweep_cal_mag", e2e::scenario_csv("tumble", 37.0), 36.8, text, input_at_s,
+                                {{slots::slot_address(1), slot_of(encoded(numbered_settings(3, true)), 3)},
+                                 {slots::slot_address(0), slot_of(encoded(numbered_settings(4, false)), 2)}},
+                                35.8, 36.7);
+    EXPECT_GE(r.cuts_during_save, 100);
+    EXPECT_GT(r.old_boots, 0);
+    EXPECT_GT(r.new_boots, 0);
 }
 
 }  // namespace

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "RecordSlots.h"
+
+#include <string.h>
+
+namespace slots {
+
+static_assert(kSlots == 2, "plan() writes the slot it does not load");
+static_assert(slot_address(1) >= slot_address(0) + kMaxSlotSize, "slots of any length apart");
+
+SlotInfo inspect(const uint8_t* b) {
+    SlotInfo info;
+    info.sequence = (uint16_t)(b[0] | (uint16_t)((uint16_t)b[1] << 8));
+    info.record_length = b[2];
+    const uint16_t covered = (uint16_t)(kHeaderSize + info.record_length);
+    const uint16_t crc = (uint16_t)(b[covered] | (uint16_t)((uint16_t)b[covered + 1u] << 8));
+    if (b[0] == 0xFFu && b[1] == 0xFFu && b[2] == 0xFFu && crc == 0xFFFFu) info.state = SlotState::Blank;
+    else info.state = crc == settings::crc16(b, covered) ? SlotState::Valid : SlotState::Bad;
+    return info;
+}
+
+bool newer(uint16_t a, uint16_t b) { return (int16_t)(uint16_t)(a - b) > 0; }
+
+Plan plan(const SlotInfo info[kSlots]) {
+    Plan p;
+    p.load = -1;
+    for (uint8_t i = 0; i < kSlots; ++i) {
+        if (info[i].state != SlotState::Valid) continue;
+        if (p.load < 0 || newer(info[i].sequence, info[(uint8_t)p.load].sequence)) p.load = (int8_t)i;
+    }
+    // Two slots: the other one. (A Bad slot's sequence means nothing: its bytes may be
+    // any mixture of two saves.)
+    p.write = p.load < 0 ? 0 : (uint8_t)(1 - p.load);
+    p.next_sequence = p.load < 0 ? 1u : (uint16_t)(info[(uint8_t)p.load].sequence + 1u);
+    // The slot written last is the one not loaded (any, when none is valid); when it is
+    // Bad the last save was cut.
+    p.newest_cut = false;
+    for (uint8_t i = 0; i < kSlots; ++i)
+        if ((int8_t)i != p.load && info[i].state == SlotState::Bad) p.newest_cut = true;
+    return p;
+}
+
+Loaded load(ReadBlock read, settings::Settings& s) {
+    uint8_t bytes[kMaxSlotSize];
+    SlotInfo info[kSlots];
+    for (uint8_t i = 0; i < kSlots; ++i) {
+        read(slot_address(i), bytes, kMaxSlotSize);
+        info[i] = inspect(bytes);
+    }
+    const Plan p = plan(info);
+    Loaded out;
+    out.from_legacy = p.load < 0;
+    out.newest_cut = p.newest_cut;
+    out.write = p.write;
+    out.next_sequence = p.next_sequence;
+    if (p.load >= 0 && info[(uint8_t)p.load].record_length != settings::kRecordSize) {
+        s = settings::defaults();
+        out.result = settings::LoadResult::OldVersion;  // another firmware's record layout
+        return out;
+    }
+    read(p.load >= 0 ? (uint16_t)(slot_address((uint8_t)p.load) + kHeaderSize) : kLegacyAddress, bytes,
+         settings::kRecordSize);
+    out.result = settings::decode(bytes, s);
+    if (out.from_legacy && out.result == settings::LoadResult::Blank && p.newest_cut)
+        out.result = settings::LoadResult::BadCrc;
+    return out;
+}
+
+void encode(const uint8_t record[settings::kRecordSize], uint16_t sequence, uint8_t out[kSlotSize]) {
+    out[0] = (uint8_t)(sequence & 0xFFu);
+    out[1] = (uint8_t)(sequence >> 8);
+    out[2] = settings::kRecordSize;
+    memcpy(out + kHeaderSize, record, settings::kRecordSize);
+    const uint16_t crc = settings::crc16(out, (uint16_t)(kHeaderSize + settings::kRecordSize));
+    out[kHeaderSize + settings::kRecordSize] = (uint8_t)(crc & 0xFFu);
+    out[kHeaderSize + settings::kRecordSize + 1u] = (uint8_t)(crc >> 8);
+}
+
+}  // namespace slots
