@@ -15,10 +15,19 @@ of requirements.txt, among them numpy, matplotlib and the peers vqf, ahrs, imufu
 
 Writes DIR/bench/report.md, DIR/bench/figures.json, DIR/bench/*.png; peer results are
 cached by file hash in DIR/bench/cache so that reruns are fast.
+
+Accuracy bounds: every file's total RMSE (each BROAD recording, their mean, each scenario
+and scenario variant) plus a margin (BOUND_MARGIN) is the bound the e2e tests hold it to,
+in the committed table test/e2e/accuracy_bounds.txt. Each run writes today's table to
+DIR/bench/accuracy_bounds.txt and reports the files beyond the committed bounds;
+--write-bounds (or `make bench WRITE_BOUNDS=1`) writes it over the committed one (rows of
+files not measured, the recordings when absent, are kept). Commit a new table only with
+the reason the figures moved.
 """
 import argparse
 import hashlib
 import json
+import math
 import os
 import subprocess
 import sys
@@ -64,6 +73,14 @@ TARGET_BROAD_WORST = 15.0
 TARGET_REST = 0.5
 
 OURS = "ours: DCM (replay)"
+
+# The accuracy bounds' table and margin: a bound is today's total RMSE times 1 + rel plus
+# abs degrees, rounded up to 0.01. replay is deterministic, so the margin only has to
+# cover another compiler's float rounding; a regression the tests must catch moves a
+# figure by far more (issue 25: BROAD's mean 1.59 -> 1.94, `fast` 0.97 -> 2.06).
+BOUNDS_FILE = os.path.join(REPO, "test", "e2e", "accuracy_bounds.txt")
+BOUND_MARGIN = {"rel": 0.05, "abs_deg": 0.02}
+BROAD_MEAN_ROW = "broad_mean"
 
 # The cross-validation's grid (bench/tune.py): the two correction gains at half, once and
 # twice their physical values (1/s: gravity within ~1 s of the 3 s low-pass; 0.1/s: the
@@ -386,6 +403,60 @@ def worst_of(results, trials):
     return max(vals) if vals else (None, None)
 
 
+def bound_of(total_deg):
+    return math.ceil((total_deg * (1.0 + BOUND_MARGIN["rel"]) + BOUND_MARGIN["abs_deg"]) * 100.0 - 1e-6) / 100.0
+
+
+def read_bounds(path):
+    """{name: row} of a bounds table (see write_bounds)."""
+    rows = {}
+    if not os.path.exists(path):
+        return rows
+    for line in open(path):
+        if line.startswith("#") or not line.strip():
+            continue
+        f = line.split()
+        rows[f[0]] = {"name": f[0], "kind": f[1], "total": float(f[2]), "incl": float(f[3]),
+                      "heading": float(f[4]), "bound": float(f[5]), "options": " ".join(f[6:])}
+    return rows
+
+
+def bounds_rows(ours, trials, scen_names, scen_options):
+    """The table's rows from this run's figures: each recording, their mean, each scenario."""
+    rows = {}
+    for t in trials:
+        if t in ours:
+            rows[t] = dict(name=t, kind="broad", options="", **{k: ours[t][k] for k in ("total", "incl", "heading")})
+    if trials and all(t in ours for t in trials):
+        rows[BROAD_MEAN_ROW] = dict(name=BROAD_MEAN_ROW, kind="mean", options="",
+                                    **{k: mean_of(ours, trials, k) for k in ("total", "incl", "heading")})
+    for n in scen_names:
+        if n in ours:
+            rows[n] = dict(name=n, kind="scenario", options=scen_options.get(n, ""),
+                           **{k: ours[n][k] for k in ("total", "incl", "heading")})
+    for r in rows.values():
+        r["bound"] = bound_of(r["total"])
+    return rows
+
+
+def write_bounds(path, rows):
+    lines = ["# SPDX-License-Identifier: GPL-3.0-or-later",
+             "# Accuracy bounds of the e2e tests (test_accuracy.cpp, test_replay.cpp), written by `make bench`",
+             "# (bench/bench.py --write-bounds): replay's total RMSE per file, scored by build/score, and the bound",
+             "# the tests hold it to: total * %.2f + %.2f deg, rounded up. Change it only with the reason the" % (
+                 1.0 + BOUND_MARGIN["rel"], BOUND_MARGIN["abs_deg"]),
+             "# figures moved in the commit. kind: broad (../shared/data/broad/NAME.csv.gz), mean (of the",
+             "# recordings), scenario (`build/scenario NAME OPTIONS`, its default length).",
+             "# name kind total_deg incl_deg heading_deg bound_total_deg scenario_options"]
+    order = {"broad": 0, "mean": 1, "scenario": 2}
+    width = max([len(r["name"]) for r in rows.values()] + [4])
+    for r in sorted(rows.values(), key=lambda r: (order.get(r["kind"], 3), r["name"])):
+        lines.append(("%-*s %-8s %6.3f %6.3f %6.3f %6.2f %s" % (
+            width, r["name"], r["kind"], r["total"], r["incl"], r["heading"], r["bound"], r["options"])).rstrip())
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.environ.get("BENCH_BUILD") or os.environ.get("BUILD") or "build")
@@ -395,6 +466,8 @@ def main():
     ap.add_argument("--seconds", type=float, default=20.0, help="simulated seconds profiled in simavr")
     ap.add_argument("--no-venv", action="store_true", help="use the current interpreter as it is")
     ap.add_argument("--no-cv", action="store_true", help="skip the cross-validation (bench/tune.py's grid)")
+    ap.add_argument("--write-bounds", action="store_true", default=os.environ.get("WRITE_BOUNDS") == "1",
+                    help="write today's figures as the accuracy bounds (test/e2e/accuracy_bounds.txt)")
     args = ap.parse_args()
     build = os.path.abspath(os.path.join(REPO, args.build))
     if not args.no_venv:
@@ -697,6 +770,34 @@ def main():
             rows.append(row)
         rep.append(md_table(["scenario", "ours"] + peer_names + ["ours/VQF"], rows))
         rep.append("")
+
+    # accuracy bounds (the e2e tests read the committed table)
+    scen_options = {n: "" for n in scen_names}
+    for suffix, options in tune.SENSOR_ERRORS:
+        for n in scen_names:
+            if n.endswith(suffix):
+                scen_options[n] = " ".join(options)
+    today = bounds_rows(results[OURS], trials, scen_names, scen_options)
+    committed = read_bounds(BOUNDS_FILE)
+    write_bounds(os.path.join(out_dir, "accuracy_bounds.txt"), today)
+    beyond = ["%s: %.3f > %.2f" % (n, r["total"], committed[n]["bound"]) for n, r in sorted(today.items())
+              if n in committed and r["total"] > committed[n]["bound"]]
+    unbounded = sorted(n for n in today if n not in committed)
+    rep += ["## Accuracy bounds", "",
+            "The e2e tests hold each file's total RMSE to the committed table `%s` (today's figure x %.2f + %.2f deg). "
+            "This run: %d files, %s beyond their bound%s." % (
+                os.path.relpath(BOUNDS_FILE, REPO), 1.0 + BOUND_MARGIN["rel"], BOUND_MARGIN["abs_deg"], len(today),
+                len(beyond), (": " + ", ".join(beyond)) if beyond else ""), ""]
+    if unbounded:
+        rep += ["Not in the table: %s." % ", ".join(unbounded), ""]
+    if args.write_bounds:
+        merged = dict(committed)
+        merged.update(today)
+        write_bounds(BOUNDS_FILE, merged)
+        log("wrote %d accuracy bounds to %s: commit them with the reason" % (len(merged), os.path.relpath(BOUNDS_FILE, REPO)))
+    else:
+        log("today's accuracy bounds in %s (WRITE_BOUNDS=1 writes them to %s)" % (
+            os.path.relpath(os.path.join(out_dir, "accuracy_bounds.txt"), REPO), os.path.relpath(BOUNDS_FILE, REPO)))
 
     # targets
     rep += ["## Targets (issue 10 for the cost; issue 5 for accuracy)", ""]

@@ -146,3 +146,4 @@ upload: firmware
 include mk/python.mk
 include mk/mavlink.mk
 include mk/fuzz.mk
+include mk/mutate.mk

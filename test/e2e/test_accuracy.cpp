@@ -8,6 +8,7 @@
 // Recordings absent (a clone without ../shared): those tests skip with a message.
 #include <algorithm>
 
+#include "accuracy_bounds.h"
 #include "e2e_support.h"
 
 namespace {
@@ -101,6 +102,9 @@ TEST(Broad, ReplayOnEveryRecording) {
         "32_disturbed_attached_magnet_1cm", "34_disturbed_attached_magnet_3cm",
     };
     if (!e2e::file_exists(recording(names[0]))) GTEST_SKIP() << recording(names[0]) << " is absent: skipped";
+    // Each recording's bound and the mean's: today's figures plus a margin (make bench).
+    const std::map<std::string, e2e::AccuracyBound> bounds = e2e::accuracy_bounds();
+    ASSERT_TRUE(bounds.count("broad_mean")) << "test/e2e/accuracy_bounds.txt has no broad_mean row";
     double sum_total = 0.0, sum_incl = 0.0, sum_heading = 0.0;
     for (const char* name : names) {
         const std::string f = recording(name);
@@ -112,6 +116,9 @@ TEST(Broad, ReplayOnEveryRecording) {
         ASSERT_TRUE(std::isfinite(total)) << name << ": " << r.out;
         // Today's worst trial is ~2.7 deg; the bound is 15.
         EXPECT_LT(total, 6.0) << name << ": " << r.out;
+        ASSERT_TRUE(bounds.count(name)) << "test/e2e/accuracy_bounds.txt has no row for " << name;
+        EXPECT_LE(total, bounds.at(name).bound_deg)
+            << name << ": " << total << " deg, was " << bounds.at(name).total_deg << " (accuracy_bounds.txt)";
         sum_total += total;
         sum_incl += e2e::score_field(r.out, "incl_rmse_deg");
         sum_heading += e2e::score_field(r.out, "heading_rmse_deg");
@@ -119,6 +126,8 @@ TEST(Broad, ReplayOnEveryRecording) {
     const double n = sizeof names / sizeof names[0];
     // Today ~1.6 / 0.7 / 1.4 deg. The target is 4.5; VQF scores 2.37 / 0.75 / 2.20.
     EXPECT_LT(sum_total / n, 2.5);
+    EXPECT_LE(sum_total / n, bounds.at("broad_mean").bound_deg)
+        << "mean " << sum_total / n << " deg, was " << bounds.at("broad_mean").total_deg << " (accuracy_bounds.txt)";
     EXPECT_LT(sum_incl / n, 1.5);
     EXPECT_LT(sum_heading / n, 2.2);
     RecordProperty("broad_total_deg", std::to_string(sum_total / n));

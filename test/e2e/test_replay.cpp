@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The host replay tool and the scorer on scenarios and (when ../shared/data is present) a
 // real recording, and the simavr run scored with the same metric.
+#include "accuracy_bounds.h"
 #include "e2e_support.h"
 
 namespace {
@@ -41,6 +42,32 @@ TEST(Replay, TiltTourScoresWithinBounds) {
     const double total = e2e::score_field(r.out, "total_rmse_deg");
     ASSERT_TRUE(std::isfinite(total)) << r.out;
     EXPECT_LT(total, 3.0) << r.out;
+    const std::map<std::string, e2e::AccuracyBound> bounds = e2e::accuracy_bounds();
+    ASSERT_TRUE(bounds.count("tilt_tour")) << "test/e2e/accuracy_bounds.txt has no row for tilt_tour";
+    EXPECT_LE(total, bounds.at("tilt_tour").bound_deg) << r.out;
+}
+
+// Every scenario and scenario variant of the bounds table (as `make bench` runs them:
+// the default length, the variant's sensor errors) within its bound: today's figure
+// plus a margin. A regression of a tenth of a degree on a clean scenario fails here.
+TEST(Replay, EveryScenarioWithinItsAccuracyBound) {
+    E2E_REQUIRE_TOOLS("replay", "scenario", "score");
+    const std::map<std::string, e2e::AccuracyBound> bounds = e2e::accuracy_bounds();
+    size_t scenarios = 0;
+    for (const auto& row : bounds) {
+        const e2e::AccuracyBound& b = row.second;
+        if (b.kind != "scenario") continue;
+        ++scenarios;
+        const std::string csv = e2e::scenario_variant_csv(b);
+        ASSERT_FALSE(csv.empty()) << b.name << ": scenario " << b.options << " failed";
+        const e2e::CommandResult r = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " | " +
+                                                      e2e::tool("score") + " --trajectory " + csv + " --estimate -");
+        ASSERT_EQ(r.exit_code, 0) << b.name << ": " << r.out << r.err;
+        const double total = e2e::score_field(r.out, "total_rmse_deg");
+        EXPECT_LE(total, b.bound_deg) << b.name << ": " << total << " deg, was " << b.total_deg
+                                      << " (accuracy_bounds.txt)";  // NaN fails too
+    }
+    EXPECT_GE(scenarios, 10u) << "test/e2e/accuracy_bounds.txt: the scenarios' rows are missing";
 }
 
 // Ideal sensors but 2 deg/s of gyro bias on every axis, at rest for 60 s: the bias is

@@ -1,0 +1,414 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Mutation testing of the estimator's libraries (issue 25): `make mutate`.
+
+universalmutator (`mutate`, PyPI) writes every mutant of each selected source file; a
+seeded sample of them is compiled, one at a time, into a test binary of only the host
+unit tests that include a selected library (build/mutate/), and run with a timeout.
+A mutant the tests fail on (or that hangs) is killed; one they pass survives. The
+kill score is printed per library, then each survivor (file, line, original, mutant).
+
+Mutants that cannot change behaviour (equivalent ones) are listed in
+test/mutants_equivalent.txt, keyed by the file, the mutated line's text and its
+replacement (never by line number: the files change), each with its reason; they are
+left out of the sample and the score.
+
+Not mutated: lines the host does not compile (#ifdef __AVR__ blocks), preprocessor
+lines, and mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
+not compile). A mutant that does not compile is not counted either.
+"""
+import argparse
+import collections
+import concurrent.futures
+import glob
+import os
+import random
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# The libraries and their files (globs: the files may be split and renamed).
+LIBRARIES = collections.OrderedDict([
+    ("lib/DCM", ["lib/DCM/*.cpp", "lib/DCM/*.h"]),
+    ("lib/LinAlg/Fixed", ["lib/LinAlg/Fixed.*"]),
+    ("lib/Calibration", ["lib/Calibration/*.cpp", "lib/Calibration/*.h"]),
+])
+EQUIVALENT_FILE = "test/mutants_equivalent.txt"
+LIB_FLAGS = ["-O1"]
+TEST_FLAGS = ["-O0"]
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, **kw)
+
+
+def include_flags():
+    return ["-I" + d.rstrip("/") for d in sorted(glob.glob("lib/*/"))] + ["-Itest"]
+
+
+def compile_cmd(src, obj, is_test):
+    return (["g++", "-std=c++14", "-g0", "-MMD", "-w"] + (TEST_FLAGS if is_test else LIB_FLAGS) + include_flags() +
+            ["-c", src, "-o", obj])
+
+
+def obj_name(src):
+    return src.replace("/", "__") + ".o"
+
+
+# ---------------------------------------------------------------------------
+# The base build: every lib/*.cpp and the relevant tests, compiled once.
+
+def selected_files():
+    files = collections.OrderedDict()
+    for lib, patterns in LIBRARIES.items():
+        for p in patterns:
+            for f in sorted(glob.glob(p)):
+                files[f] = lib
+    return files
+
+
+def dependencies(dep_file):
+    text = open(dep_file).read().replace("\\\n", " ")
+    _, _, deps = text.partition(":")
+    return [os.path.normpath(d) for d in deps.split()]
+
+
+def base_build(out, files, jobs):
+    """Compiles every lib source and the test files that include a selected file (and
+    nothing of sim/, which the binary does not link) into out/obj; returns
+    (lib objects, test objects, {source: its dependencies})."""
+    obj_dir = os.path.join(out, "obj")
+    os.makedirs(obj_dir, exist_ok=True)
+    lib_srcs = sorted(glob.glob("lib/*/*.cpp"))
+    lib_srcs = [s for s in lib_srcs if not s.startswith("lib/MavLink/")]  # generated headers
+    test_srcs = sorted(glob.glob("test/test_*.cpp"))
+    jobs_list = [(s, False) for s in lib_srcs] + [(s, True) for s in test_srcs]
+
+    def build(item):
+        src, is_test = item
+        obj = os.path.join(obj_dir, obj_name(src))
+        r = run(compile_cmd(src, obj, is_test))
+        return src, r.returncode == 0, r.stdout
+
+    deps = {}
+    lib_objs, test_objs = [], []
+    with concurrent.futures.ThreadPoolExecutor(jobs) as pool:
+        for src, ok, log in pool.map(build, jobs_list):
+            if not ok:
+                if src in lib_srcs:
+                    sys.exit("mutate: %s does not compile:\n%s" % (src, log))
+                continue  # a test that needs what is not linked here (sim/, mavlink)
+            d = dependencies(os.path.join(obj_dir, obj_name(src)[:-2] + ".d"))
+            deps[src] = d
+            if src in lib_srcs:
+                lib_objs.append(src)
+            elif any(f in d for f in files) and not any(x.startswith("sim/") for x in d):
+                test_objs.append(src)
+    return lib_objs, test_objs, deps
+
+
+def link(out_bin, objs):
+    r = run(["g++", "-o", out_bin] + objs + ["-lgtest", "-lgtest_main", "-pthread"])
+    return r.returncode == 0, r.stdout
+
+
+# ---------------------------------------------------------------------------
+# Mutants: universalmutator's, less what the host never compiles.
+
+def host_lines(path):
+    """Line numbers (1-based) the host compiles: outside #ifdef __AVR__ ... #else/#endif,
+    and not preprocessor lines."""
+    keep = set()
+    stack = []  # for each open #if: True when its current branch is AVR-only
+    for n, line in enumerate(open(path), 1):
+        s = line.strip()
+        if s.startswith("#"):
+            word = s[1:].strip().split(" ")[0] if len(s) > 1 else ""
+            if word in ("if", "ifdef", "ifndef"):
+                stack.append(word == "ifdef" and "__AVR__" in s or (word == "if" and "defined(__AVR__)" in s
+                                                                     and "!" not in s))
+            elif word in ("else", "elif") and stack:
+                stack[-1] = False
+            elif word == "endif" and stack:
+                stack.pop()
+            continue
+        if not any(stack):
+            keep.add(n)
+    return keep
+
+
+def changed_line(orig_lines, mutant_lines):
+    """(line number, original text, mutant text) of a one-line mutant, or None."""
+    if len(mutant_lines) == len(orig_lines):
+        diff = [i for i, (a, b) in enumerate(zip(orig_lines, mutant_lines)) if a != b]
+        if len(diff) == 1:
+            i = diff[0]
+            return i + 1, orig_lines[i], mutant_lines[i]
+    elif len(mutant_lines) == len(orig_lines) + 1:  # a line inserted (break; continue;)
+        for i in range(len(orig_lines) + 1):
+            if i == len(orig_lines) or orig_lines[i] != mutant_lines[i]:
+                return i + 1, "", mutant_lines[i]
+    elif len(mutant_lines) == len(orig_lines) - 1:  # a line deleted
+        for i in range(len(orig_lines)):
+            if i == len(mutant_lines) or orig_lines[i] != mutant_lines[i]:
+                return i + 1, orig_lines[i], ""
+    return None
+
+
+def renames_identifier(orig, mutant):
+    """A change inside a name (int32_t -> int(32+1)_t, kPiQ24 -> kPiQ1)."""
+    p = 0
+    while p < min(len(orig), len(mutant)) and orig[p] == mutant[p]:
+        p += 1
+    s = 0
+    while s < min(len(orig), len(mutant)) - p and orig[-1 - s] == mutant[-1 - s]:
+        s += 1
+    before = orig[p - 1] if p > 0 else " "
+    after = orig[len(orig) - s] if s > 0 else " "
+    changed = orig[p:len(orig) - s]
+    ident = re.compile(r"[A-Za-z_]")
+    word = re.compile(r"[A-Za-z0-9_]")
+    inside = word.match(before) and word.match(changed[:1] or " ") or \
+        word.match(after) and word.match(changed[-1:] or " ")
+    # A digit run inside a name: its first character is not a digit or a name precedes it.
+    return bool(inside and (ident.search(orig[max(0, p - 1):len(orig) - s + 1]) or before == "_"))
+
+
+def generate(out, files, mutate_bin):
+    """Every mutant of every selected file: a list of dicts."""
+    mutants = []
+    for path in files:
+        base = os.path.basename(path)
+        mdir = os.path.join(out, "mutants", path.replace("/", "__"))
+        if os.path.isdir(mdir):
+            shutil.rmtree(mdir)
+        os.makedirs(mdir)
+        lang = "cpp"
+        r = run([mutate_bin, os.path.abspath(path), lang, "--noCheck",
+                 "--mutantDir", mdir])
+        if r.returncode != 0:
+            sys.exit("mutate: universalmutator failed on %s:\n%s" % (path, r.stdout[-2000:]))
+        orig = open(path).read().split("\n")
+        keep = host_lines(path)
+        stem, ext = os.path.splitext(base)
+        for m in sorted(glob.glob(os.path.join(mdir, stem + ".mutant.*" + ext)),
+                        key=lambda f: int(f.rsplit(".", 2)[-2])):
+            c = changed_line(orig, open(m).read().split("\n"))
+            if c is None:
+                continue
+            line, before, after = c
+            if line not in keep and (before or line - 1 not in keep):
+                continue
+            if before and after and renames_identifier(before, after):
+                continue
+            mutants.append({"file": path, "mutant": m, "line": line, "orig": before.strip(),
+                            "new": after.strip()})
+    return mutants
+
+
+def load_equivalent():
+    """{(file, original, mutant): reason} from test/mutants_equivalent.txt: blocks of
+    `file:`, `original:`, `mutant:`, `reason:` lines, a blank line between blocks."""
+    out = {}
+    if not os.path.exists(EQUIVALENT_FILE):
+        return out
+    block = {}
+    for line in open(EQUIVALENT_FILE).read().split("\n") + [""]:
+        if line.startswith("#"):
+            continue
+        if not line.strip():
+            if block:
+                key = (block.get("file", ""), block.get("original", ""), block.get("mutant", ""))
+                out[key] = block.get("reason", "")
+                if not block.get("reason"):
+                    sys.exit("mutate: %s: no reason for %s" % (EQUIVALENT_FILE, key))
+            block = {}
+            continue
+        k, _, v = line.partition(":")
+        block[k.strip()] = v.strip()
+    return out
+
+
+# ---------------------------------------------------------------------------
+# One mutant: the mutated file in the worker's copy, its dependents recompiled, the
+# binary linked and run.
+
+def test_mutant(m, worker, base, lib_objs, test_objs, deps, obj_dir, timeout_s):
+    src_path = os.path.join(worker, m["file"])
+    shutil.copyfile(m["mutant"], src_path)
+    try:
+        wobj = os.path.abspath(os.path.join(worker, "obj"))
+        os.makedirs(wobj, exist_ok=True)
+        dependents = [s for s in lib_objs + test_objs if m["file"] in deps[s]]
+        # The mutated file's own translation unit first: most invalid mutants fail there.
+        dependents.sort(key=lambda s: (s != m["file"], s.startswith("test/")))
+        changed = {}
+        for s in dependents:
+            o = os.path.join(wobj, obj_name(s))
+            cmd = compile_cmd(s, o, s.startswith("test/"))
+            r = run(cmd, cwd=worker)
+            if r.returncode != 0:
+                return "invalid", ""
+            changed[s] = o
+        objs = [changed.get(s, os.path.abspath(os.path.join(obj_dir, obj_name(s)))) for s in lib_objs + test_objs]
+        binary = os.path.abspath(os.path.join(worker, "tests"))
+        ok, log = link(binary, objs)
+        if not ok:
+            return "invalid", ""
+        try:
+            # The first failure ends the run (a trap): a killed mutant costs less.
+            r = subprocess.run([binary, "--gtest_break_on_failure"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               universal_newlines=True, timeout=timeout_s, cwd=ROOT)
+        except subprocess.TimeoutExpired:
+            return "killed", "timeout"
+        if r.returncode == 0:
+            return "survived", ""
+        failed = re.findall(r"^\[ RUN      \] ([\w./]+)", r.stdout, re.M)
+        return "killed", failed[-1] if failed else "exit %d" % r.returncode
+    finally:
+        shutil.copyfile(os.path.join(base, m["file"]), src_path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--mutants", default="300", help="how many viable mutants in all (split evenly over the "
+                    "libraries), or 'all'")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("-j", "--jobs", type=int, default=2)
+    ap.add_argument("--library", action="append", help="only this library (lib/DCM, lib/LinAlg/Fixed, ...)")
+    args = ap.parse_args()
+    os.chdir(ROOT)
+    start = time.time()
+    out = os.path.join(args.build, "mutate")
+    os.makedirs(out, exist_ok=True)
+    # A snapshot of the sources: the run never reads the working tree again (it may be
+    # edited meanwhile).
+    base = os.path.abspath(os.path.join(out, "base"))
+    if os.path.isdir(base):
+        shutil.rmtree(base)
+    for d in ("lib", "test"):
+        shutil.copytree(d, os.path.join(base, d))
+    os.chdir(base)
+    files = selected_files()
+    if args.library:
+        files = collections.OrderedDict((f, l) for f, l in files.items() if l in args.library)
+
+    out = os.path.join(ROOT, out)
+    lib_objs, test_objs, deps = base_build(out, files, args.jobs)
+    obj_dir = os.path.join(out, "obj")
+    base_bin = os.path.join(out, "tests")
+    ok, log = link(base_bin, [os.path.join(obj_dir, obj_name(s)) for s in lib_objs + test_objs])
+    if not ok:
+        sys.exit("mutate: the test binary does not link:\n" + log[-3000:])
+    t0 = time.time()
+    r = run([base_bin, "--gtest_brief=1"], cwd=ROOT)
+    base_s = time.time() - t0
+    if r.returncode != 0:
+        sys.exit("mutate: the tests fail without a mutant:\n" + r.stdout[-3000:])
+    timeout_s = max(20.0, 10.0 * base_s)
+    print("# mutate: test binary of %s (%.1f s a run, timeout %.0f s)" % (
+        " ".join(os.path.basename(t) for t in test_objs), base_s, timeout_s))
+
+    mutants = generate(out, files, os.path.join(ROOT, args.build, "venv", "bin", "mutate"))
+    equivalent = load_equivalent()
+    pool = collections.OrderedDict((lib, []) for lib in LIBRARIES if lib in files.values())
+    n_equivalent = collections.Counter()
+    for m in mutants:
+        lib = files[m["file"]]
+        if (m["file"], m["orig"], m["new"]) in equivalent:
+            n_equivalent[lib] += 1
+            continue
+        pool[lib].append(m)
+    rng = random.Random(args.seed)
+    for lib in pool:
+        rng.shuffle(pool[lib])
+    quota = None if args.mutants == "all" else int(args.mutants)
+    per_lib = {lib: (None if quota is None else quota // len(pool) + (1 if i < quota % len(pool) else 0))
+               for i, lib in enumerate(pool)}
+    print("# mutate: %s mutants (universalmutator), %s; seed %d, %s" % (
+        len(mutants), ", ".join("%s %d (%d equivalent)" % (l, len(pool[l]), n_equivalent[l]) for l in pool),
+        args.seed, "every mutant" if quota is None else "%d viable a library" % (quota // len(pool))))
+    sys.stdout.flush()
+
+    # Workers: each its own copy of lib/ and test/.
+    workers = []
+    for w in range(args.jobs):
+        wdir = os.path.join(out, "w%d" % w)
+        if os.path.isdir(wdir):
+            shutil.rmtree(wdir)
+        os.makedirs(wdir)
+        for d in ("lib", "test"):
+            shutil.copytree(os.path.join(base, d), os.path.join(wdir, d))
+        workers.append(wdir)
+
+    results = collections.defaultdict(collections.Counter)
+    survivors = []
+    free = list(workers)
+    # Draw mutants per library until its quota of viable ones is met (invalid ones are
+    # drawn again from the rest).
+    queues = {lib: collections.deque(pool[lib]) for lib in pool}
+    viable_started = collections.Counter()
+    in_flight = {}
+    done_count = 0
+
+    def next_mutant():
+        for lib in queues:
+            q = queues[lib]
+            if q and (per_lib[lib] is None or viable_started[lib] < per_lib[lib]):
+                viable_started[lib] += 1
+                return lib, q.popleft()
+        return None
+
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as ex:
+        while True:
+            while free:
+                nm = next_mutant()
+                if nm is None:
+                    break
+                lib, m = nm
+                w = free.pop()
+                fut = ex.submit(test_mutant, m, w, base, lib_objs, test_objs, deps, obj_dir, timeout_s)
+                in_flight[fut] = (lib, m, w)
+            if not in_flight:
+                break
+            done, _ = concurrent.futures.wait(in_flight, return_when=concurrent.futures.FIRST_COMPLETED)
+            for fut in done:
+                lib, m, w = in_flight.pop(fut)
+                free.append(w)
+                status, how = fut.result()
+                results[lib][status] += 1
+                if status == "invalid":
+                    viable_started[lib] -= 1
+                elif status == "survived":
+                    survivors.append((lib, m))
+                done_count += 1
+                if done_count % 25 == 0:
+                    print("#   %d mutants run (%.0f s)" % (done_count, time.time() - start))
+                    sys.stdout.flush()
+
+    elapsed = time.time() - start
+    report = []
+    report.append("# mutate: kill score per library (equivalent mutants listed in %s left out)" % EQUIVALENT_FILE)
+    for lib in pool:
+        c = results[lib]
+        viable = c["killed"] + c["survived"]
+        score = 100.0 * c["killed"] / viable if viable else 0.0
+        report.append("%-20s %5.1f %%  killed %d of %d (not compiling: %d, equivalent left out: %d)" % (
+            lib, score, c["killed"], viable, c["invalid"], n_equivalent[lib]))
+    report.append("# survivors (file:line: original -> mutant); list an equivalent one in %s" % EQUIVALENT_FILE)
+    for lib, m in sorted(survivors, key=lambda x: (x[1]["file"], x[1]["line"])):
+        report.append("%s:%d: %s\n    -> %s" % (m["file"], m["line"], m["orig"] or "(new line)",
+                                                m["new"] or "(line deleted)"))
+    report.append("# mutate: %.0f s on %d jobs, seed %d" % (elapsed, args.jobs, args.seed))
+    text = "\n".join(report)
+    print(text)
+    with open(os.path.join(out, "report.txt"), "w") as f:
+        f.write(text + "\n")
+
+
+if __name__ == "__main__":
+    main()
