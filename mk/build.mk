@@ -8,6 +8,7 @@ PORT        ?= /dev/ttyACM0
 BAUD        := 115200
 SCENARIO    ?= tilt_tour
 SECONDS     ?=
+SERIAL      ?=
 
 ifeq ($(V),1)
 Q :=
@@ -117,12 +118,14 @@ else
 	 { grep -E -B2 -A12 'error|Error' $(HOST_LOG) | head -80; echo "# host build failed: see $(HOST_LOG)"; exit 1; }
 endif
 
+# SERIAL=tcp:5760: a live board, UART0 served on TCP 127.0.0.1:5760 in real time (as
+# ArduPilot's SITL) until Ctrl-C, the scenario's last state held after its end.
 sim: firmware tools
 	@mkdir -p $(BUILD)/scenarios
 	@$(BUILD)/scenario $(SCENARIO) > $(BUILD)/scenarios/$(SCENARIO).csv
-	@echo "# simavr: build/firmware.elf on scenario '$(SCENARIO)' (SCENARIO=name, SECONDS=s to change)"
+	@echo "# simavr: build/firmware.elf on scenario '$(SCENARIO)' (SCENARIO=name, SECONDS=s, SERIAL=tcp:5760 to change)"
 	@$(BUILD)/apm25sim --elf $(BUILD)/firmware.elf --trajectory $(BUILD)/scenarios/$(SCENARIO).csv \
-	  $(if $(SECONDS),--seconds $(SECONDS))
+	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL))
 
 test: firmware tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)

@@ -5,12 +5,14 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdarg>
 #include <cstring>
 
 #include "avr_eeprom.h"
 #include "avr_ioport.h"
 #include "avr_spi.h"
+#include "avr_timer.h"
 #include "avr_twi.h"
 #include "avr_uart.h"
 #include "sim_avr.h"
@@ -42,6 +44,29 @@ constexpr uint16_t kGpior1 = 0x4A;  // profiling: section end
 constexpr uint8_t kMpuCsBit = 0;    // PB0, Arduino pin 53
 constexpr uint8_t kBaroCsBit = 1;   // PG1, Arduino pin 40
 constexpr int kMaxViolationsPrinted = 10;
+
+// The servo outputs as the APM 2.5 wires them (APM25.md "Flying", ArduPilot's APM2 HAL):
+// the timer, its compare unit (0 A, 1 B, 2 C), the port and bit of the OCnx pin, and
+// TCCRnA's data address, whose COMnx1:0 bits (A 7:6, B 5:4, C 3:2) connect the pin.
+struct ServoOutputPin {
+    char timer;
+    int compare;
+    char port;
+    uint8_t bit;
+    uint16_t tccra;
+    uint16_t ddr, port_reg;
+};
+constexpr ServoOutputPin kServoPins[kServoOutputs] = {
+    {'1', 1, 'B', 6, 0x80, 0x24, 0x25},   // OUT1 OC1B PB6
+    {'1', 0, 'B', 5, 0x80, 0x24, 0x25},   // OUT2 OC1A PB5
+    {'4', 2, 'H', 5, 0xA0, 0x101, 0x102}, // OUT3 OC4C PH5
+    {'4', 1, 'H', 4, 0xA0, 0x101, 0x102}, // OUT4 OC4B PH4
+    {'4', 0, 'H', 3, 0xA0, 0x101, 0x102}, // OUT5 OC4A PH3
+    {'3', 2, 'E', 5, 0x90, 0x2D, 0x2E},   // OUT6 OC3C PE5
+    {'3', 1, 'E', 4, 0x90, 0x2D, 0x2E},   // OUT7 OC3B PE4
+    {'3', 0, 'E', 3, 0x90, 0x2D, 0x2E},   // OUT8 OC3A PE3
+};
+constexpr uint8_t kPpmBit = 1;  // ICP5 = PL1, Arduino pin 48
 
 Board* g_board = nullptr;  // simavr's logger has no context pointer
 
@@ -83,8 +108,15 @@ void uart_xoff_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(par
 void uart_xon_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->set_uart_input_held(false); }
 
 avr_cycle_count_t uart_input_timer(avr_t*, avr_cycle_count_t, void* param) {
-    return static_cast<Board*>(param)->on_uart_input_tick();
+    Board* board = static_cast<Board*>(param);
+    const uint64_t next = board->on_uart_input_tick();
+    if (next == 0) board->on_uart_input_timer_ended();
+    return next;
 }
+avr_cycle_count_t link_timer(avr_t*, avr_cycle_count_t, void* param) {
+    return static_cast<Board*>(param)->on_link_tick();
+}
+volatile std::sig_atomic_t g_stop_requested = 0;
 avr_cycle_count_t uart_input_start_timer(avr_t*, avr_cycle_count_t, void* param) {
     static_cast<Board*>(param)->on_uart_input_tick();  // starts the input if not yet
     return 0;
@@ -92,6 +124,32 @@ avr_cycle_count_t uart_input_start_timer(avr_t*, avr_cycle_count_t, void* param)
 void gpior_write_hook(avr_t* avr, avr_io_addr_t addr, uint8_t v, void* param) {
     avr->data[addr] = v;
     static_cast<Board*>(param)->on_gpior_write(addr == kGpior1, v);
+}
+
+avr_cycle_count_t ppm_edge_timer(avr_t*, avr_cycle_count_t, void* param) {
+    return static_cast<Board*>(param)->on_ppm_edge();
+}
+
+struct ServoHook {
+    Board* board;
+    int output;  // 1..8
+};
+ServoHook g_servo_hooks[kServoOutputs];
+void servo_compare_hook(avr_irq_t*, uint32_t value, void* param) {
+    const ServoHook* hook = static_cast<ServoHook*>(param);
+    hook->board->on_servo_compare(hook->output, value);
+}
+void servo_pin_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->on_servo_pin(); }
+
+// simavr's timer module for Timer n ('5' ...): the io list holds each module, an
+// avr_timer_t begins with its avr_io_t.
+avr_timer_t* find_timer(avr_t* avr, char name) {
+    for (avr_io_t* port = avr->io_port; port != nullptr; port = port->next) {
+        if (port->kind == nullptr || std::strcmp(port->kind, "timer") != 0) continue;
+        avr_timer_t* timer = reinterpret_cast<avr_timer_t*>(port);
+        if (timer->name == name) return timer;
+    }
+    return nullptr;
 }
 
 struct PortHook {
@@ -106,6 +164,9 @@ void port_hook(avr_irq_t*, uint32_t value, void* param) {
 }
 
 }  // namespace
+
+void request_stop() { g_stop_requested = 1; }
+bool stop_requested() { return g_stop_requested != 0; }
 
 Board::Board(const Trajectory& trajectory, const BoardOptions& options)
     : mpu_(trajectory), mag_(trajectory), options_(options) {}
@@ -208,7 +269,16 @@ bool Board::init() {
         avr_register_io_write(avr_, kGpior1, gpior_write_hook, this);
     }
 
+    if (!init_rc()) return false;
+    if (options_.servo_log) init_servo_outputs();
+
     avr_cycle_timer_register(avr_, 1, sensor_timer, this);
+    if (options_.serial || options_.speed > 0.0) {
+        pacer_ = Pacer(options_.speed);
+        avr_cycle_timer_register(avr_, 1, link_timer, this);
+    }
+    // A client's bytes go to RX as they come; a --input file still waits for its start.
+    if (options_.serial && options_.input.empty()) start_input();
     if (!options_.input.empty()) {
         avr_cycle_timer_register(avr_, (avr_cycle_count_t)(options_.input_start_s * kCpuHz), uart_input_start_timer,
                                  this);
@@ -219,7 +289,7 @@ bool Board::init() {
 
 bool Board::run(double seconds) {
     const avr_cycle_count_t end = (avr_cycle_count_t)std::llround(seconds * kCpuHz);
-    while (avr_->cycle < end) {
+    while (avr_->cycle < end && !g_stop_requested) {
         const int state = avr_run(avr_);
         if (state == cpu_Done || state == cpu_Crashed) {
             error_ = state == cpu_Crashed ? "the AVR core crashed" : "the AVR core stopped";
@@ -404,6 +474,7 @@ void Board::on_twi_message(uint32_t value) {
 // --- UART ---------------------------------------------------------------------
 
 void Board::on_uart_byte(uint8_t byte) {
+    if (options_.serial) options_.serial->send(byte);
     if (!options_.stamp) std::fputc(byte, stdout);
     if (byte == '\n') {
         if (options_.stamp) {
@@ -423,6 +494,8 @@ void Board::on_uart_byte(uint8_t byte) {
 }
 
 void Board::finish_output() {
+    write_servo_pulses(true);
+    if (options_.servo_log) std::fflush(options_.servo_log);
     if (options_.stamp && !line_.empty()) {
         std::printf("%.6f ", time_s());
         std::fwrite(line_.data(), 1, line_.size(), stdout);
@@ -432,9 +505,31 @@ void Board::finish_output() {
 }
 
 void Board::start_input() {
-    if (input_started_ || options_.input.empty()) return;
+    if (input_started_ || (options_.input.empty() && !options_.serial)) return;
     input_started_ = true;
+    arm_input();
+}
+
+void Board::arm_input() {
+    if (input_timer_armed_ || input_pos_ >= options_.input.size()) return;
+    input_timer_armed_ = true;
     avr_cycle_timer_register(avr_, 1, uart_input_timer, this);
+}
+
+// Every millisecond of simulated time: the TCP client's bytes in and out, and the wait
+// that keeps simulated time from running ahead of the wall clock.
+uint64_t Board::on_link_tick() {
+    pacer_.wait_until(time_s());
+    if (options_.serial) {
+        std::string received;
+        const std::string event = options_.serial->poll(received);
+        if (!event.empty()) std::fprintf(stderr, "apm25sim: t=%.3f s: tcp:%d %s\n", time_s(), options_.serial->port(), event.c_str());
+        if (!received.empty()) {
+            options_.input += received;
+            if (input_started_) arm_input();
+        }
+    }
+    return avr_->cycle + kCpuHz / 1000;
 }
 
 uint64_t Board::on_uart_input_tick() {
@@ -455,6 +550,95 @@ uint64_t Board::on_uart_input_tick() {
     const unsigned divisor = (avr_->data[kUcsr0a] & 0x02) ? 8u : 16u;  // U2X0
     const uint64_t cycles_per_char = 10u * (uint64_t)divisor * (ubrr + 1u);
     return avr_->cycle + cycles_per_char;
+}
+
+// --- receiver (PPM on ICP5) and servo outputs -----------------------------------
+
+// The PPM line is PL1's pin IRQ. simavr connects a timer's capture input to its ICP pin
+// only when the core names the pin (avr_timer_t.icp) and the edge-select bit (ices);
+// where the ATmega2560 core leaves Timer5's unnamed, the capture IRQ is raised with the
+// pin, and simavr's own capture (ICR5 <- TCNT5, ICF5, on the ICES5 edge) does the rest.
+bool Board::init_rc() {
+    if (!options_.rc) return true;
+    avr_timer_t* timer5 = find_timer(avr_, '5');
+    if (!timer5) {
+        error_ = "simavr's atmega2560 has no Timer5";
+        return false;
+    }
+    if (timer5->ices.reg == 0) {
+        error_ = "simavr's atmega2560 Timer5 has no ICES5 bit: its input capture cannot work";
+        return false;
+    }
+    ppm_pin_irq_ = avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ('L'), kPpmBit);
+    const bool wired = timer5->icp.reg != 0;
+    if (!wired) ppm_icp_irq_ = avr_io_getirq(avr_, AVR_IOCTL_TIMER_GETIRQ('5'), TIMER_IRQ_IN_ICP);
+    // The encoder's line idles high before the first frame (no edge the firmware could
+    // capture: it has not configured Timer5 yet).
+    avr_raise_irq(ppm_pin_irq_, 1);
+    if (ppm_icp_irq_) avr_raise_irq(ppm_icp_irq_, 1);
+    ppm_.reset(new PpmEncoder(*options_.rc));
+    schedule_ppm_edge();
+    return true;
+}
+
+void Board::schedule_ppm_edge() {
+    if (ppm_pending_ || !ppm_ || !ppm_->next_edge(ppm_next_)) return;
+    ppm_pending_ = true;
+    uint64_t when = (uint64_t)std::llround(ppm_next_.t_s * kCpuHz);
+    if (when <= avr_->cycle) when = avr_->cycle + 1;
+    avr_cycle_timer_register(avr_, when - avr_->cycle, ppm_edge_timer, this);
+}
+
+uint64_t Board::on_ppm_edge() {
+    ppm_pending_ = false;
+    avr_raise_irq(ppm_pin_irq_, ppm_next_.high ? 1 : 0);
+    if (ppm_icp_irq_) avr_raise_irq(ppm_icp_irq_, ppm_next_.high ? 1 : 0);
+    schedule_ppm_edge();
+    return 0;
+}
+
+void Board::rc_changed() { schedule_ppm_edge(); }
+
+// Each output's level is the OCnx unit's while TCCRnA's COMnx bits connect it to the pin
+// (as the hardware overrides PORT), else the PORT bit when the pin is an output, else
+// low. The compare units report through the timer's OUT_COMP IRQs (simavr 1.6 sets bit 8,
+// AVR_IOPORT_OUTPUT, on a toggle: the level is bit 0); a PORT write in simavr 1.6
+// re-raises every output pin of the port with its PORT bit, which is why the pin IRQ is
+// only a cue to look again and not the level.
+void Board::init_servo_outputs() {
+    for (int i = 0; i < kServoOutputs; ++i) {
+        const ServoOutputPin& pin = kServoPins[i];
+        g_servo_hooks[i] = ServoHook{this, i + 1};
+        avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_TIMER_GETIRQ(pin.timer), TIMER_IRQ_OUT_COMP + pin.compare),
+                                servo_compare_hook, &g_servo_hooks[i]);
+        avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(pin.port), pin.bit), servo_pin_hook, this);
+    }
+    std::fputs(ServoPulseLog::header(), options_.servo_log);
+}
+
+void Board::on_servo_compare(int output, uint32_t value) {
+    servo_oc_level_[output - 1] = (uint8_t)(value & 1);
+    on_servo_pin();
+}
+
+void Board::on_servo_pin() {
+    const double t_s = time_s();
+    for (int i = 0; i < kServoOutputs; ++i) {
+        const ServoOutputPin& pin = kServoPins[i];
+        const uint8_t com = (uint8_t)((avr_->data[pin.tccra] >> (6 - 2 * pin.compare)) & 0x03);
+        const bool output = (avr_->data[pin.ddr] >> pin.bit) & 1;
+        bool high = false;
+        if (output) high = com != 0 ? servo_oc_level_[i] != 0 : ((avr_->data[pin.port_reg] >> pin.bit) & 1) != 0;
+        servo_pulses_.level(i + 1, t_s, high);
+    }
+    write_servo_pulses(false);
+}
+
+void Board::write_servo_pulses(bool all) {
+    if (!options_.servo_log) return;
+    servo_ready_.clear();
+    servo_pulses_.take(servo_ready_, all);
+    for (const ServoPulse& p : servo_ready_) std::fputs(ServoPulseLog::format(p).c_str(), options_.servo_log);
 }
 
 // --- EEPROM -------------------------------------------------------------------
@@ -575,6 +759,10 @@ void Board::print_counters(FILE* out) const {
                  profile_errors_);
     std::fprintf(out, "# apm25sim: UART0 input %zu of %zu bytes typed, %llu character times held by XOFF\n",
                  input_pos_, options_.input.size(), (unsigned long long)uart_input_held_chars_);
+    if (ppm_)
+        std::fprintf(out, "# apm25sim: PPM frames begun %lu; ICP5 fed %s\n", ppm_->frames(),
+                     ppm_icp_irq_ ? "through Timer5's capture IRQ (the core leaves the pin unwired)"
+                                  : "through PL1 (the core wires it to Timer5's capture)");
 }
 
 }  // namespace sim

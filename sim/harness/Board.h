@@ -16,12 +16,15 @@
 #include <stdint.h>
 
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "FaultSpec.h"
 #include "Hmc5883Model.h"
 #include "Mpu6000Model.h"
+#include "RcLink.h"
+#include "SerialLink.h"
 #include "Trajectory.h"
 
 struct avr_t;
@@ -41,7 +44,16 @@ struct BoardOptions {
     bool input_start_fixed = false; // start exactly at input_start_s (--input-at)
     bool profile = false;
     std::string eeprom_path;        // --eeprom: the EEPROM's bytes at start and written back at exit
+    const RcScript* rc = nullptr;   // --rc: the sticks, sent as PPM on ICP5 (PL1); none: PL1 untouched
+    FILE* servo_log = nullptr;      // --servo-log: one row per pulse on OUT1-OUT8
+    TcpSerial* serial = nullptr;    // --serial tcp:PORT: UART0 also to and from a TCP client
+    double speed = 0.0;             // simulated seconds per wall second; 0: unpaced
 };
+
+// Asks a running Board::run to return at its next instruction boundary (async-signal-safe:
+// for SIGINT/SIGTERM handlers).
+void request_stop();
+bool stop_requested();
 
 // Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
 struct SectionProfile {
@@ -84,8 +96,18 @@ public:
     void on_uart_byte(uint8_t byte);
     uint64_t on_sensor_tick();
     uint64_t on_uart_input_tick();
+    void on_uart_input_timer_ended() { input_timer_armed_ = false; }
+    uint64_t on_link_tick();
     void set_uart_input_held(bool held) { uart_input_held_ = held; }
     void on_gpior_write(bool end, uint8_t value);
+    uint64_t on_ppm_edge();
+    void on_servo_compare(int output, uint32_t value);
+    void on_servo_pin();
+
+    // The last pulse width measured on output 1..8 (us; 0 before any).
+    double servo_width_us(int output) const { return servo_pulses_.last_width_us(output); }
+    // After RcScript::push: restarts the PPM line if it had gone quiet.
+    void rc_changed();
 
 private:
     void advance_models();
@@ -94,9 +116,14 @@ private:
     bool baro_deselected() const;
     void check_bus(const char* when);
     void start_input();
+    void arm_input();
     bool load_eeprom();
     uint8_t* eeprom_bytes() const;
     double sck_hz() const;
+    bool init_rc();
+    void init_servo_outputs();
+    void schedule_ppm_edge();
+    void write_servo_pulses(bool all);
 
     Mpu6000Model mpu_;
     Hmc5883Model mag_;
@@ -129,6 +156,20 @@ private:
     bool uart_input_held_ = false;        // simavr's receive FIFO is full (XOFF)
     uint64_t uart_input_held_chars_ = 0;  // character times the input waited for it
     size_t input_pos_ = 0;
+    bool input_timer_armed_ = false;      // uart_input_timer is registered
+    Pacer pacer_{0.0};
+
+    // --rc: the PPM line on PL1 (and Timer5's capture input when simavr does not wire it).
+    std::unique_ptr<PpmEncoder> ppm_;
+    PpmEdge ppm_next_;
+    bool ppm_pending_ = false;         // a cycle timer is armed for ppm_next_
+    avr_irq_t* ppm_pin_irq_ = nullptr;
+    avr_irq_t* ppm_icp_irq_ = nullptr; // raised too when the ATmega2560 core leaves ICP5 unwired
+
+    // --servo-log: the output-compare level of each output and the pulses measured.
+    uint8_t servo_oc_level_[kServoOutputs] = {};
+    ServoPulseLog servo_pulses_;
+    std::vector<ServoPulse> servo_ready_;
 
     SectionProfile sections_[16];
     uint64_t run_first_start_ = 0, run_last_end_ = 0;

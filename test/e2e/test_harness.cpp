@@ -22,7 +22,10 @@ TEST(Harness, HelpDocumentsTheFaultLanguage) {
     EXPECT_EQ(r.exit_code, 0);
     for (const char* spec : {"mpu:absent", "mpu:whoami=", "mag:absent", "mag:drdy-stuck-low", "mag:overflow",
                              "gyro:saturate", "accel:saturate", "imu:spike", "i2c:sda-low", "--profile", "--input",
-                             "--eeprom", "overlap"})
+                             "--eeprom", "overlap",
+                             // the receiver and the servo outputs (test_harness_io.cpp)
+                             "--rc FILE", "t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8", "12.0,,,,,,,,", "PL1", "22.5 ms",
+                             "400 us", "--servo-log FILE", "t,out,width_us", "OC1B/PB6", "OC3A/PE3"})
         EXPECT_NE(r.out.find(spec), std::string::npos) << spec;
     const e2e::CommandResult bad = e2e::run_command(e2e::tool("apm25sim") + " --elf x --trajectory " +
                                                     e2e::scenario_csv("rest", 1) + " --fault mpu:melted");

@@ -3,8 +3,9 @@
 # Builds the AVR programs the e2e tests run in apm25sim, against the Arduino core
 # archive the project's Makefile builds, into OUT_DIR:
 #   test/e2e/support/avr/build.sh OUT_DIR   ->  OUT_DIR/probe.elf, OUT_DIR/probe_violation.elf,
-#                                       OUT_DIR/selftest.elf
-# probe: the simulated board without the firmware; selftest: the host unit tests' checks
+#                                       OUT_DIR/selftest.elf, OUT_DIR/io_probe.elf
+# probe: the simulated board without the firmware; io_probe: its servo pins and PPM
+# receiver without the firmware; selftest: the host unit tests' checks
 # on the ATmega2560, compiled from the same lib/ sources as the firmware.
 # Flags follow the Makefile's firmware flags (../shared/SIM.md, "Building with Debian's
 # Arduino core"). Each ELF is linked to a temporary name and renamed into place, so a
@@ -40,6 +41,8 @@ probe_deps="$here/probe.cpp $here/build.sh $out/core/avr/core.a"
 up_to_date "$out/probe.elf" $probe_deps || link "$out/probe.elf" "$here/probe.cpp"
 up_to_date "$out/probe_violation.elf" $probe_deps ||
   link "$out/probe_violation.elf" -DPROBE_BUS_VIOLATION "$here/probe.cpp"
+io_probe_deps="$here/io_probe.cpp $here/build.sh $out/core/avr/core.a"
+up_to_date "$out/io_probe.elf" $io_probe_deps || link "$out/io_probe.elf" "$here/io_probe.cpp"
 if [ -f "$here/selftest.cpp" ]; then
   lib_inc=""
   for d in "$project"/lib/*/; do lib_inc="$lib_inc -I$d"; done
