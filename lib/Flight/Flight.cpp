@@ -147,7 +147,6 @@ void FlightControl::hold_neutral() {
 
 void FlightControl::choose(Mode m) {
     if (m != Mode::Stabilize) m = Mode::Manual;
-    if (m != chosen_) events_ |= kEvModeChanged;
     chosen_ = m;
     if (state_ == State::Manual || state_ == State::Stabilize) {
         if (state_ != state_of(m)) {
@@ -171,7 +170,9 @@ void FlightControl::on_frame(const uint16_t width_us[kChannels], uint32_t now_ms
         const uint8_t pos = switch_position(width_us[ch - 1u]);
         if (pos != switch_pos_) {
             switch_pos_ = pos;
+            const Mode before = chosen_;
             choose((Mode)s_.fltmode[pos - 1u]);
+            if (chosen_ != before) events_ |= kEvModeChanged;
         }
     }
 }

@@ -107,7 +107,7 @@ enum Event : uint8_t {
     kEvFailsafeEncoder = 0x02,  // the encoder's own failsafe (throttle below THR_FS_VALUE)
     kEvFailsafeEnd = 0x04,      // good frames again: back to the mode before
     kEvSensorFallback = 0x08,   // STABILIZE without an attitude: MANUAL
-    kEvModeChanged = 0x10,
+    kEvModeChanged = 0x10,      // the mode switch chose another mode
 };
 
 enum class FailsafeCause : uint8_t { None, Lost, Encoder };
