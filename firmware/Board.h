@@ -39,6 +39,7 @@ enum Section : uint8_t {
     kSecMpuRead = 4,
     kSecMagRead = 5,
     kSecLoop = 6,       // one loop iteration's work, from data-ready seen to work done
+    kSecControl = 13,   // the flight control step (every 4th loop step: 50 Hz, the servo frame)
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

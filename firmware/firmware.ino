@@ -15,6 +15,10 @@
 // read when its DRDY pin says so. Every line that is not angle data begins with "# ".
 // Other output modes (`mode csv|quat|raw|mavlink|quiet`): README.md; in `mode mavlink`
 // the board speaks MAVLink 2 to a ground station and its "# " lines go as STATUSTEXT.
+//
+// It also flies (README "Flying"): the receiver's PPM (RcInput) and the attitude go
+// through lib/Flight's modes, controllers and mixer to the eight servo outputs
+// (ServoOutputs), 50 times a second.
 #include <SPI.h>
 #include <Wire.h>
 
@@ -22,11 +26,14 @@
 #include "Board.h"
 #include "Compass.h"
 #include "Console.h"
+#include "Flight.h"
 #include "Format.h"
 #include "Imu.h"
 #include "MavLink.h"
 #include "Pipeline.h"
+#include "RcInput.h"
 #include "SerialText.h"
+#include "ServoOutputs.h"
 #include "SettingsStore.h"
 #include "UserCode.h"
 
@@ -43,6 +50,8 @@ Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
 console::LineReader reader;
+flight::PpmDecoder ppm;
+flight::FlightControl flight_control(pipe.settings().flight);
 mav::FrameFilter mavlink_input;  // a ground station's frames, kept from the console
 
 // Loop load: the share of each second spent on samples (measured, shown by `status`).
@@ -65,6 +74,75 @@ static void print_settings_line() {
 }
 
 static Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
+
+// ---------------------------------------------------------------------------
+// Flying (lib/Flight): the state, the receiver, the outputs.
+
+static Flash flight_mode_name(flight::Mode m) { return m == flight::Mode::Stabilize ? TXT("STABILIZE") : TXT("MANUAL"); }
+
+// "<prefix>MODE, receiver ok|no signal yet|FAILSAFE (lost|encoder failsafe)"
+static void print_flight_line(Flash prefix) {
+    Writer w(out);
+    w.str(prefix);
+    const flight::State st = flight_control.state();
+    if (st == flight::State::Failsafe) {
+        w.str(TXT("FAILSAFE ("))
+            .str(flight_control.failsafe_cause() == flight::FailsafeCause::Lost ? TXT("receiver lost")
+                                                                                 : TXT("receiver's encoder failsafe"))
+            .str(TXT("), then "));
+    }
+    w.str(flight_mode_name(flight_control.chosen()));
+    if (st == flight::State::NoSignal) w.str(TXT(", no receiver signal yet: outputs at trim"));
+    w.end();
+}
+
+// "# rc 1500 ..." or "# servo 1500 ...": eight widths, us.
+static void print_widths(Flash prefix, const uint16_t* widths) {
+    Writer w(out);
+    w.str(prefix);
+    for (uint8_t i = 0; i < flight::kChannels; ++i) w.chr(' ').u32(widths[i]);
+    w.end();
+}
+
+// The flight control's events, said as "# " lines (STATUSTEXT in `mode mavlink`).
+static void say_flight_events() {
+    const uint8_t e = flight_control.take_events();
+    if (e == 0) return;
+    if (e & flight::kEvFailsafeLost)
+        say(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT"));
+    if (e & flight::kEvFailsafeEncoder)
+        say(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding"));
+    if (e & flight::kEvFailsafeEnd) print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
+    if (e & flight::kEvSensorFallback)
+        say(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): flight MANUAL"));
+    if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
+}
+
+// The control step, every 4th loop step (50 Hz): the servo pulse only changes once a
+// 20 ms period, so a faster step would compute widths that are never sent.
+constexpr uint8_t kControlDivider = 4;
+constexpr float kControlDt_s = 0.02f;
+static uint8_t control_count = 0;
+
+static void control_step(uint32_t now_ms) {
+    while (rc_input::poll(ppm)) flight_control.on_frame(ppm.frame_us(), now_ms);
+    if (++control_count < kControlDivider) return;
+    control_count = 0;
+    board::mark_begin(board::kSecControl);
+    flight::Attitude att{0, 0, 0.0f, 0.0f, imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    if (att.valid) {
+        const pipeline::AnglesCentideg a = pipe.angles_centideg();
+        const linalg::Vector3f rate = pipe.body_rate_rad_s();
+        att.roll_cd = a.roll_centideg;
+        att.pitch_cd = a.pitch_centideg;
+        att.roll_rate_deg_s = rate.x * linalg::kDegPerRad;
+        att.pitch_rate_deg_s = rate.y * linalg::kDegPerRad;
+    }
+    flight_control.step(now_ms, att, kControlDt_s);
+    servo_outputs::set(flight_control.outputs_us());
+    board::mark_end(board::kSecControl);
+    say_flight_events();
+}
 
 // `status`, a line (a part: console::kPartReply) at a time: false past the last part.
 // Parts 2 and 3 are the pipeline's gyro bias and compass lines, the long ones to format
@@ -96,6 +174,7 @@ static bool print_status(uint8_t part) {
         case kStatusBiasPart: print_bias_line(0); return true;
         case kStatusCompassPart: print_bias_line(1); return true;
         case 4: print_settings_line(); return true;
+        case 5: print_flight_line(TXT("# flight ")); return true;
         default: return false;
     }
 }
@@ -222,6 +301,9 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Error: return console::print_error(c, part, out);
         case console::CommandId::Help: return console::print_help(part, out);
         case console::CommandId::Status: return print_status(part);
+        case console::CommandId::Show:
+            if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            break;
         default: break;
     }
     if (part > 0) return false;
@@ -233,7 +315,15 @@ static bool answer(const console::Command& c, uint8_t part) {
             pipe.restore_defaults();
             console::print_defaults(out);
             break;
-        default: console::apply_setting(c, pipe.settings(), out); break;  // rate, decl, mode
+        case console::CommandId::Flight:
+            flight_control.choose(c.arg != 0 ? flight::Mode::Stabilize : flight::Mode::Manual);
+            print_flight_line(TXT("# flight "));
+            break;
+        case console::CommandId::Show:
+            if (c.arg == console::kShowRc) print_widths(TXT("# rc"), flight_control.rc_us());
+            else print_widths(TXT("# servo"), flight_control.outputs_us());
+            break;
+        default: console::apply_setting(c, pipe.settings(), out); break;  // rate, decl, mode, set, get
     }
     return true;
 }
@@ -304,6 +394,7 @@ static void step(uint32_t now_us) {
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
         if (pipe.output_due()) emit_output(now_ms);
     }
+    control_step(now_ms);  // with or without a sample: a failed IMU still flies MANUAL
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
 }
@@ -329,7 +420,16 @@ void setup() {
     say(TXT("# apm25-attitude 0.2.0: APM 2.5, 200 Hz loop\n"
             "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     store.load(pipe.settings());
+    // The outputs from here on, at trim and the throttle at its failsafe value until the
+    // receiver's first frame (the loaded settings' end points).
+    flight_control.step(0, flight::Attitude{0, 0, 0.0f, 0.0f, false}, kControlDt_s);
+    servo_outputs::begin(flight_control.outputs_us());
+    rc_input::begin();
     print_settings_line();
+    if (pipe.settings().flags & settings::kFlagUpgraded) {
+        pipe.settings().flags = (uint8_t)(pipe.settings().flags & ~settings::kFlagUpgraded);
+        say(TXT("# settings: a version 2 record: flight settings at their defaults (save to keep)"));
+    }
 
     board::spi_begin();
     wait_until_ms(pipeline::kMpuStartMs);

@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "Params.h"
+
 namespace settings {
 
 Settings defaults() {
@@ -12,6 +14,7 @@ Settings defaults() {
     s.mode = fmt::OutputMode::Plot;
     s.flags = 0;
     s.cal = calib::default_calibration();
+    params::apply_defaults(s);  // the flight settings (and the declination again: 0)
     return s;
 }
 
@@ -29,7 +32,8 @@ uint16_t crc16(const uint8_t* data, uint16_t len) {
 // The payload: rate, declination (2), mode, flags, then the calibration's fifteen floats
 // (IEEE-754, little-endian on both the AVR and x86/ARM hosts: memcpy is the layout).
 static_assert(sizeof(calib::Calibration) == 60, "Calibration is fifteen packed floats");
-static_assert(kPayloadLength == 5 + sizeof(calib::Calibration), "payload = header bytes + calibration");
+static_assert(kV2PayloadLength == 5 + sizeof(calib::Calibration), "version 2 payload = header bytes + calibration");
+static_assert(kRecordSize <= 255, "the record's size is a byte");
 
 void encode(const Settings& s, uint8_t out[kRecordSize]) {
     out[0] = kMagic0;
@@ -40,8 +44,9 @@ void encode(const Settings& s, uint8_t out[kRecordSize]) {
     out[5] = (uint8_t)((uint16_t)s.declination_centideg & 0xFFu);
     out[6] = (uint8_t)((uint16_t)s.declination_centideg >> 8);
     out[7] = (uint8_t)s.mode;
-    out[8] = s.flags;
+    out[8] = (uint8_t)(s.flags & ~kFlagUpgraded);
     memcpy(out + 9, &s.cal, sizeof s.cal);
+    params::encode_flight(s, out + 4 + kV2PayloadLength);
     const uint16_t crc = crc16(out, (uint16_t)(4u + kPayloadLength));
     out[4 + kPayloadLength] = (uint8_t)(crc & 0xFFu);
     out[5 + kPayloadLength] = (uint8_t)(crc >> 8);
@@ -50,8 +55,8 @@ void encode(const Settings& s, uint8_t out[kRecordSize]) {
 bool is_valid(const Settings& s) {
     return s.rate_hz >= kRateMinHz && s.rate_hz <= kRateMaxHz &&
            s.declination_centideg >= kDeclMinCentideg && s.declination_centideg <= kDeclMaxCentideg &&
-           (uint8_t)s.mode <= (uint8_t)fmt::kLastOutputMode && (s.flags & ~0x03u) == 0u &&
-           calib::is_plausible(s.cal);
+           (uint8_t)s.mode <= (uint8_t)fmt::kLastOutputMode && (s.flags & ~0x07u) == 0u &&
+           calib::is_plausible(s.cal) && params::all_valid(s);
 }
 
 LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
@@ -60,16 +65,21 @@ LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     for (uint8_t i = 0; i < kRecordSize; ++i) blank = blank && (in[i] == 0xFFu || in[i] == 0x00u);
     if (blank) return LoadResult::Blank;
     if (in[0] != kMagic0 || in[1] != kMagic1) return LoadResult::BadMagic;
-    if (in[2] != kSettingsVersion || in[3] != kPayloadLength) return LoadResult::OldVersion;
-    const uint16_t crc = (uint16_t)(in[4 + kPayloadLength] | (uint16_t)((uint16_t)in[5 + kPayloadLength] << 8));
-    if (crc != crc16(in, (uint16_t)(4u + kPayloadLength))) return LoadResult::BadCrc;
-    Settings s;
+    // Version 2's payload is version 3's first part: read it, flight settings at defaults.
+    const bool v2 = in[2] == 2u && in[3] == kV2PayloadLength;
+    if (!v2 && (in[2] != kSettingsVersion || in[3] != kPayloadLength)) return LoadResult::OldVersion;
+    const uint8_t len = in[3];
+    const uint16_t crc = (uint16_t)(in[4 + len] | (uint16_t)((uint16_t)in[5 + len] << 8));
+    if (crc != crc16(in, (uint16_t)(4u + len))) return LoadResult::BadCrc;
+    Settings s = out;
     s.rate_hz = in[4];
     s.declination_centideg = (int16_t)(uint16_t)(in[5] | (uint16_t)((uint16_t)in[6] << 8));
     s.mode = (fmt::OutputMode)in[7];
     s.flags = in[8];
     memcpy(&s.cal, in + 9, sizeof s.cal);
-    if (!is_valid(s)) return LoadResult::BadValue;
+    if (v2) s.flags = (uint8_t)(s.flags | kFlagUpgraded);
+    else params::decode_flight(in + 4 + kV2PayloadLength, s);
+    if ((in[8] & kFlagUpgraded) != 0u || !is_valid(s)) return LoadResult::BadValue;
     out = s;
     return LoadResult::Ok;
 }
