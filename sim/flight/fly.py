@@ -97,7 +97,7 @@ class StandIn:
 
     def update(self, reply, dt_s):
         rc = reply.get("rc")
-        if rc is None:  # no receiver: wings level, trim throttle (a failsafe of sorts)
+        if not rc:  # no receiver: wings level, trim throttle (a failsafe of sorts)
             sticks = (1500.0, 1500.0, self.trim_us[2], 1500.0)
         else:
             sticks = (rc["rc_1"], rc["rc_2"], rc["rc_3"], rc["rc_4"])
@@ -131,7 +131,7 @@ def start_backend(args, rc_path, seconds, gust, work, extra):
     port_file = os.path.join(work, "port")
     cmd = [sys.executable, os.path.join(HERE, "jsbsim_backend.py"), "--port", "0", "--port-file", port_file,
            "--rc", rc_path, "--gust", str(gust), "--seed", str(args.seed), "--seconds", repr(seconds),
-           "--idle-timeout", "20", "--airspeed", repr(args.airspeed), "--altitude", repr(args.altitude)]
+           "--idle-timeout", "20", "--linger", "0.1", "--airspeed", repr(args.airspeed), "--altitude", repr(args.altitude)]
     if args.out:
         cmd += ["--trajectory", args.out]
     if args.log:

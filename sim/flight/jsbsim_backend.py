@@ -13,9 +13,12 @@ Lock-step: one physics frame (1 / frame_rate of the packet, in JSBSim steps of a
 2.5 ms) per servo packet received, no wall clock, so a flight is the same every time.
 The aeroplane starts trimmed for level flight at the given airspeed and height (north,
 wings level); outputs without pulses (width 0) hold the trim. The pilot's sticks from
---rc are sent as the reply's rc channels (default: hands off, sticks centred, throttle
-at the trim, ch5-ch8 1500; `--rc none` sends no rc field).
-Exits after --seconds of simulated time, or after --idle-timeout s without a packet.
+--rc are sent as the reply's rc channels, and no signal as an empty rc object (default:
+hands off, sticks centred, throttle at the trim, ch5-ch8 1500; `--rc none` sends no rc
+field).
+The files hold --seconds of simulated time; after it the backend still answers (an
+autopilot may run a frame longer) and exits once no packet came for --linger s (default 1);
+--idle-timeout s without a packet before that stops it too.
 """
 import argparse
 import select
@@ -46,9 +49,12 @@ def parse_args(argv):
                    help="propeller vibration at the IMU, amplitude at the trim's propeller speed (m/s^2)")
     p.add_argument("--trajectory", help="write the flight as a trajectory (../shared/SIM.md)")
     p.add_argument("--log", help="write the true state, one row a frame")
-    p.add_argument("--seconds", type=float, default=0.0, help="stop after S simulated seconds")
+    p.add_argument("--seconds", type=float, default=0.0,
+                   help="record S simulated seconds, then stop (see --linger; 0: no end)")
     p.add_argument("--idle-timeout", type=float, default=0.0,
                    help="stop after this many wall-clock seconds without a packet (0: never)")
+    p.add_argument("--linger", type=float, default=1.0,
+                   help="after --seconds, stop once no packet came for this many wall-clock seconds")
     p.add_argument("--port-file", help="write the bound port number here once listening")
     p.add_argument("--quiet", action="store_true")
     return p.parse_args(argv)
@@ -96,13 +102,15 @@ class Backend:
                 out.close()
 
     def record(self, state):
+        if self.args.seconds > 0 and state["t"] > self.args.seconds + 1e-9:
+            return  # the files hold --seconds; frames after it are answered, not recorded
         if self.trajectory:
             self.trajectory.write(state)
         if self.log:
             self.log.write(state)
 
     def rc_at(self, t_s):
-        return None if self.pilot is None else self.pilot.at(t_s)
+        return jsonlink.NO_RC if self.pilot is None else self.pilot.at(t_s)
 
     def handle(self, data):
         """The reply to one packet (bytes), or None for a packet that is not a servo packet."""
@@ -140,11 +148,15 @@ class Backend:
                 f.write("%d\n" % port)
         self.say("# listening on %s:%d (UDP)" % (self.args.bind, port))
         try:
-            while not self.done():
-                if self.args.idle_timeout > 0:
-                    ready, _, _ = select.select([sock], [], [], self.args.idle_timeout)
+            while True:
+                # After --seconds, the autopilot's last frames (it may run a frame or two
+                # longer) are still answered, until it falls silent for --linger s.
+                wait_s = self.args.linger if self.done() else self.args.idle_timeout
+                if wait_s > 0:
+                    ready, _, _ = select.select([sock], [], [], wait_s)
                     if not ready:
-                        self.say("# no packet for %.0f s: stopping" % self.args.idle_timeout)
+                        if not self.done():
+                            self.say("# no packet for %.0f s: stopping" % wait_s)
                         break
                 data, address = sock.recvfrom(512)
                 reply = self.handle(data)

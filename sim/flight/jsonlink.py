@@ -53,9 +53,14 @@ def pack_servo_packet(frame_rate, frame_count, pwm):
     return PACKET_32.pack(MAGIC_32, frame_rate, frame_count & 0xFFFFFFFF, *pwm)
 
 
-def make_reply(state, rc=None):
-    """The JSON frame for a state dict of flightmodel.FlightModel.state(); rc: channel widths
-    (us) or None for no receiver signal (the field is then left out)."""
+NO_RC = "no rc field"
+
+
+def make_reply(state, rc=NO_RC):
+    """The JSON frame for a state dict of flightmodel.FlightModel.state(). rc: the channel
+    widths (us); None for a receiver without signal, sent as an rc object with no channels
+    (the readme has no word for a lost receiver; apm25sim --physics reads an empty rc as a
+    dead one, ArduPilot's SITL keeps its last channels); NO_RC for no rc field at all."""
     body = {
         "timestamp": state["t"],
         "imu": {"gyro": list(state["gyro"]), "accel_body": list(state["accel"])},
@@ -66,7 +71,9 @@ def make_reply(state, rc=None):
         "airspeed": state["airspeed"],
         "velocity_wind": list(state["wind"]),
     }
-    if rc is not None:
+    if rc is None:
+        body["rc"] = {}
+    elif rc is not NO_RC:
         body["rc"] = {"rc_%d" % (i + 1): int(round(w)) for i, w in enumerate(rc)}
     return ("\n" + json.dumps(body, separators=(",", ":")) + "\n").encode("ascii")
 

@@ -10,7 +10,8 @@ GROUP is one of:
                 frame rate), the rc script, and one real UDP round trip to the backend
   trim          20 s with no pulses on any output from the trimmed start: height within 1 m,
                 bank and pitch change within 1 deg, airspeed within 0.5 m/s; the propeller's
-                vibration has the stated amplitude and leaves the flight itself alone
+                vibration has the stated amplitude and leaves the flight itself alone; the
+                aircraft's lift and drag tables are make_aero_tables.py's
   signs         OUT1 above 1500 rolls right, below rolls left; OUT2 above its trim pitches the
                 nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed; a
                 positive upset moment rolls right, and only from its start time
@@ -109,7 +110,7 @@ def check_protocol(work):
                 "trimmed level flight: accel_body z %.3f, not -g cos(pitch)" % obj["imu"]["accel_body"][2])
     soft_assert(abs(obj["position"][2] + 100.0) < 0.01, "position down %.3f, not -100 m" % obj["position"][2])
     soft_assert(abs(obj["airspeed"] - 18.0) < 0.05, "airspeed %.3f, not 18" % obj["airspeed"])
-    soft_assert("rc" not in obj, "rc sent before the script's first row")
+    soft_assert(obj.get("rc") == {}, "before the script's first row rc is %r, not {} (no signal)" % obj.get("rc"))
     soft_assert(ask(400, 0) == first, "a repeated frame count was not answered with the same reply")
     t1 = json.loads(ask(400, 1))["timestamp"]
     soft_assert(abs(t1 - 2 / 400) < 1e-12, "after a repeat, the next frame is at %r s, not 2/400" % t1)
@@ -120,7 +121,10 @@ def check_protocol(work):
     soft_assert(obj.get("rc", {}).get("rc_1") == 1600 and obj["rc"].get("rc_8") == 1900 and len(obj["rc"]) == 8,
                 "rc at %.3f s is %r, not the script's row" % (obj["timestamp"], obj.get("rc")))
     soft_assert(backend.tracker.missed == 0, "frames counted missed: %d" % backend.tracker.missed)
-    ask(400, 310)
+    for count in range(300, 440):
+        obj = json.loads(ask(400, count))
+    soft_assert(obj.get("rc") == {}, "rc at %.3f s (the script's empty row) is %r, not {}" % (obj["timestamp"], obj.get("rc")))
+    ask(400, 450)
     soft_assert(backend.tracker.missed == 10, "10 skipped counts gave missed = %d" % backend.tracker.missed)
     reset = json.loads(ask(400, 0))
     soft_assert(abs(reset["timestamp"] - 1 / 400) < 1e-12 and abs(reset["position"][0]) < 0.1,
@@ -128,6 +132,9 @@ def check_protocol(work):
                 % (reset["timestamp"], reset["position"][0]))
     soft_assert(backend.handle(b"\x00" * 40) is None, "a packet with a bad magic got a reply")
     backend.close_outputs()
+    silent = jsbsim_backend.Backend(jsbsim_backend.parse_args(["--quiet", "--rc", "none"]))
+    soft_assert("rc" not in json.loads(silent.handle(packet(400, 0, trim_pwm))), "--rc none still sent an rc field")
+    silent.close_outputs()
 
     # One real round trip over UDP: the reply goes back to the sender's address and port.
     port_file = os.path.join(work, "port")
@@ -167,7 +174,24 @@ def fly_model(model, seconds, widths):
     return model.state()
 
 
+def check_aero_tables():
+    """The XML's lift and drag tables are what make_aero_tables.py computes from the cited
+    coefficients (a coefficient edited in one place and not the other fails here)."""
+    import xml.etree.ElementTree as et
+    import make_aero_tables
+    root = et.parse(os.path.join(ROOT, "sim", "flight", "aircraft", "rascal110", "rascal110.xml")).getroot()
+    for name, formula in (("aero/force/lift_alpha", make_aero_tables.lift), ("aero/force/drag_alpha", make_aero_tables.drag)):
+        function = [f for f in root.iter("function") if f.get("name") == name]
+        if not soft_assert(len(function) == 1, "no function %s in the aircraft" % name):
+            continue
+        values = [float(v) for v in function[0].find(".//tableData").text.split()]
+        pairs = list(zip(values[0::2], values[1::2]))
+        worst = max(abs(value - formula(alpha)) for alpha, value in pairs)
+        soft_assert(len(pairs) > 50 and worst < 1e-3, "%s: %d rows, off the formula by %.4f" % (name, len(pairs), worst))
+
+
 def check_trim(work):
+    check_aero_tables()
     model = flightmodel.FlightModel()
     start = model.state()
     worst = {"height": 0.0, "roll": 0.0, "pitch": 0.0, "speed": 0.0}
