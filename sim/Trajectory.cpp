@@ -84,6 +84,14 @@ bool Trajectory::load(const std::string& path) {
     return ok;
 }
 
+void Trajectory::drop_before(double t_s) {
+    size_t keep_from = 0;
+    while (keep_from + 1 < samples_.size() && samples_[keep_from + 1].t_s <= t_s) ++keep_from;
+    if (keep_from == 0) return;
+    samples_.erase(samples_.begin(), samples_.begin() + (long)keep_from);
+    cursor_ = 0;
+}
+
 TrajectorySample Trajectory::at(double t_s) const {
     if (samples_.empty()) return TrajectorySample{};
     if (t_s <= samples_.front().t_s) return samples_.front();

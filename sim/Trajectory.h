@@ -36,6 +36,12 @@ public:
 
     std::vector<TrajectorySample>& samples() { return samples_; }
 
+    // Appends a sample at or after the last one (the physics link's states as they come).
+    void append(const TrajectorySample& s) { samples_.push_back(s); }
+    // Forgets the samples before t_s but the last one before it (still needed to
+    // interpolate at t_s), so that a long live run keeps a bounded history.
+    void drop_before(double t_s);
+
 private:
     std::vector<TrajectorySample> samples_;
     std::string error_;

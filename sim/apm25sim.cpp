@@ -3,9 +3,11 @@
 // MPU6000 on SPI, HMC5883L on I2C), sensors fed from a trajectory file. The command
 // line and output are the contract in ../shared/SIM.md; --help lists the extensions.
 #include <csignal>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -13,16 +15,25 @@
 
 #include "Board.h"
 #include "FaultSpec.h"
+#include "PhysicsLink.h"
 #include "RcLink.h"
+#include "Rotation.h"
 #include "SerialLink.h"
 #include "Trajectory.h"
 
 namespace {
 
 const char* const kUsage =
-    "usage: apm25sim --elf FILE.elf --trajectory FILE.csv[.gz] [--seconds S] [--stamp]\n"
-    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--eeprom-cuts T1:T2:STEP]\n"
-    "                [--profile FILE] [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X] [--verbose]\n"
+    "usage: apm25sim --elf FILE.elf (--trajectory FILE.csv[.gz] | --physics json[:HOST[:PORT]])
+"
+    "                [--seconds S] [--stamp]
+"
+    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--eeprom-cuts T1:T2:STEP]
+"
+    "                [--profile FILE] [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X]
+"
+    "                [--physics-rate HZ] [--physics-timeout S] [--earth-field N,E,D] [--verbose]
+"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
@@ -82,6 +93,29 @@ const char* const kUsage =
     "  --speed X        pace simulated time at X simulated seconds per wall second (1 = real time,\n"
     "                   the default with --serial; 0 = as fast as the host runs, the default\n"
     "                   otherwise); a slower host runs behind, never ahead\n"
+    "  --physics json[:HOST[:PORT]]  instead of a trajectory, a flight dynamics backend that\n"
+    "                   speaks ArduPilot's SITL JSON interface (ArduPilot's libraries/SITL/examples/\n"
+    "                   JSON/readme.md; default 127.0.0.1:9002), apm25sim on ArduPilot's side.\n"
+    "                   Each physics frame it sends the UDP servo packet (uint16 magic 18458,\n"
+    "                   uint16 frame_rate, uint32 frame_count from 0, uint16 pwm[16], little-endian)\n"
+    "                   with pwm 1-8 = OUT1-OUT8 as measured on their pins, rounded to the us\n"
+    "                   (0 before the first pulse and when none came for 60 ms), pwm 9-16 = 0;\n"
+    "                   then waits for the JSON reply (timestamp, imu.gyro, imu.accel_body,\n"
+    "                   position, velocity, quaternion or attitude; optional rc, airspeed,\n"
+    "                   velocity_wind) and runs the board to its timestamp (less the first\n"
+    "                   reply's) with the sensors on that state: the MPU6000 on the gyro and the\n"
+    "                   specific force, the HMC5883L on the earth field turned by the attitude,\n"
+    "                   linear in between frames. Lock-step: time moves only with the backend's\n"
+    "                   frames, so a run is deterministic. rc_1..rc_8 drive the PPM on ICP5 (an\n"
+    "                   rc with none of them, or all 0, is a dead receiver; --rc, if given,\n"
+    "                   drives it instead). A frame unanswered for 1 s is sent again (same\n"
+    "                   frame_count, said on stderr); position, velocity, airspeed and wind are\n"
+    "                   read but no sensor uses them yet. Runs until SIGINT/SIGTERM unless\n"
+    "                   --seconds. Exit status 4 when the backend stops answering or answers\n"
+    "                   something that is not a state\n"
+    "  --physics-rate HZ  the frame_rate asked of the backend, 400..10000 (default 1000)\n"
+    "  --physics-timeout S  give up on a silent backend after S s (default 30)\n"
+    "  --earth-field N,E,D  the earth field for --physics, uT NED (default 20,0,45)\n"
     "  --verbose        print the sensor models' protocol counters on stderr at the end\n"
     "\n"
     "Bus check: the barometer chip select (pin 40 = PG1, PORTG bit 1) must be high whenever the\n"
@@ -90,7 +124,8 @@ const char* const kUsage =
     "Timing: an SPI byte takes 8 SCK periods at the divider SPCR/SPSR set; an I2C bit takes\n"
     "16 + 2*TWBR*4^TWPS CPU cycles; an EEPROM byte write keeps EEPE set for 3.4 ms\n"
     "(simavr 1.6's fixed times corrected).\n"
-    "Exit status: 0 run completed, 1 usage or file error, 2 the core crashed, 3 bus violation.\n"
+    "Exit status: 0 run completed, 1 usage or file error, 2 the core crashed, 3 bus violation,\n"
+    "4 the physics backend failed.\n"
     "\n";
 
 bool read_file(const std::string& path, std::string& out) {
@@ -102,12 +137,30 @@ bool read_file(const std::string& path, std::string& out) {
     return true;
 }
 
+// The backend's `rc` as the receiver's next row (only when it changes; the --rc file, when
+// given, drives the receiver instead). False with `error` when `rc` is malformed.
+bool take_backend_rc(const sim::PhysicsState& state, double t_s, bool from_backend, sim::RcScript& rc,
+                     sim::Board* board, std::string& error) {
+    if (!from_backend || !state.has_rc) return true;
+    sim::RcRow row;
+    if (!sim::physics_rc_row(state, t_s, row, error)) return false;
+    const sim::RcRow* last = rc.rows().empty() ? nullptr : &rc.rows().back();
+    bool same = last && last->signal == row.signal;
+    for (int c = 0; same && row.signal && c < sim::kRcChannels; ++c) same = last->width_us[c] == row.width_us[c];
+    if (same) return true;
+    rc.push(row);
+    if (board) board->rc_changed();
+    return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     sim::BoardOptions options;
-    std::string trajectory_path, input_path, profile_path, rc_path, servo_log_path, serial_spec;
+    std::string trajectory_path, input_path, profile_path, rc_path, servo_log_path, serial_spec, physics_spec;
     double speed = -1.0;
+    sim::PhysicsOptions physics;
+    double earth_field_uT[3] = {sim::kEarthFieldNed_uT[0], sim::kEarthFieldNed_uT[1], sim::kEarthFieldNed_uT[2]};
     std::vector<std::string> faults;
     double seconds = -1.0;
     bool verbose = false;
@@ -166,6 +219,39 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "apm25sim: --speed '%s': a number >= 0 (1 = real time)\n", text);
                 return 1;
             }
+        } else if (arg == "--physics") {
+            physics_spec = value("--physics");
+            std::string error;
+            if (!sim::parse_physics_spec(physics_spec, physics, error)) {
+                std::fprintf(stderr, "apm25sim: %s\n", error.c_str());
+                return 1;
+            }
+        } else if (arg == "--physics-rate") {
+            const char* text = value("--physics-rate");
+            char* end = nullptr;
+            const long hz = std::strtol(text, &end, 10);
+            if (*end != '\0' || hz < 400 || hz > 10000) {
+                std::fprintf(stderr, "apm25sim: --physics-rate '%s': a whole number of Hz, 400..10000\n", text);
+                return 1;
+            }
+            physics.frame_rate_hz = (int)hz;
+        } else if (arg == "--physics-timeout") {
+            const char* text = value("--physics-timeout");
+            char* end = nullptr;
+            physics.give_up_s = std::strtod(text, &end);
+            if (*end != '\0' || !(physics.give_up_s >= 1.0) || physics.give_up_s > 86400.0) {
+                std::fprintf(stderr, "apm25sim: --physics-timeout '%s': seconds, 1..86400\n", text);
+                return 1;
+            }
+        } else if (arg == "--earth-field") {
+            const char* text = value("--earth-field");
+            char tail = 0;
+            if (std::sscanf(text, "%lf,%lf,%lf%c", &earth_field_uT[0], &earth_field_uT[1], &earth_field_uT[2], &tail) != 3 ||
+                !std::isfinite(earth_field_uT[0] + earth_field_uT[1] + earth_field_uT[2]) ||
+                std::fabs(earth_field_uT[0]) + std::fabs(earth_field_uT[1]) + std::fabs(earth_field_uT[2]) > 1000.0) {
+                std::fprintf(stderr, "apm25sim: --earth-field '%s': N,E,D in uT (e.g. 20,0,45)\n", text);
+                return 1;
+            }
         } else if (arg == "--verbose") {
             verbose = true;
         } else {
@@ -173,12 +259,13 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
-    if (options.elf_path.empty() || trajectory_path.empty()) {
-        std::fprintf(stderr, "apm25sim: --elf and --trajectory are required\n%s", kUsage);
+    const bool use_physics = !physics_spec.empty();
+    if (options.elf_path.empty() || trajectory_path.empty() == !use_physics) {
+        std::fprintf(stderr, "apm25sim: --elf and one of --trajectory or --physics are required\n%s", kUsage);
         return 1;
     }
     sim::Trajectory trajectory;
-    if (!trajectory.load(trajectory_path)) {
+    if (!use_physics && !trajectory.load(trajectory_path)) {
         std::fprintf(stderr, "apm25sim: %s\n", trajectory.error().c_str());
         return 1;
     }
@@ -222,13 +309,40 @@ int main(int argc, char** argv) {
         }
         options.serial = &serial;
         std::fprintf(stderr, "apm25sim: serving UART0 on tcp:127.0.0.1:%d\n", serial.port());
-        // A live board runs until stopped; the stop is a clean end (EEPROM written back).
+    }
+    if (options.serial || use_physics) {
+        // A live board or a flight runs until stopped; the stop is a clean end (EEPROM
+        // written back).
         std::signal(SIGINT, [](int) { sim::request_stop(); });
         std::signal(SIGTERM, [](int) { sim::request_stop(); });
         if (seconds < 0.0) seconds = 1e9;
     }
     options.speed = speed >= 0.0 ? speed : (options.serial ? 1.0 : 0.0);
     if (seconds < 0.0) seconds = trajectory.duration_s();
+
+    // --physics: the first state before the board starts (the sensors need one at t = 0).
+    sim::PhysicsLink link(physics);
+    sim::PhysicsState first;
+    const bool rc_from_backend = use_physics && rc_path.empty();
+    if (use_physics) {
+        if (!link.open()) {
+            std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
+            return 1;
+        }
+        options.measure_servos = true;
+        if (rc_from_backend) options.rc = &rc;
+        const uint16_t none[sim::kSitlServoChannels] = {};
+        if (!link.exchange(0, none, first)) {
+            std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
+            return 4;
+        }
+        trajectory.append(sim::physics_sample(first, 0.0, earth_field_uT));
+        std::string error;
+        if (!take_backend_rc(first, 0.0, rc_from_backend, rc, nullptr, error)) {
+            std::fprintf(stderr, "apm25sim: the physics backend's answer to frame 0: %s\n", error.c_str());
+            return 4;
+        }
+    }
 
     sim::Board board(trajectory, options);
     for (const std::string& spec : faults) {
@@ -242,7 +356,45 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "apm25sim: %s\n", board.error().c_str());
         return 1;
     }
-    const bool ran = board.run(seconds);
+    bool ran = true;
+    int physics_status = 0;
+    if (!use_physics) {
+        ran = board.run(seconds);
+    } else {
+        // Lock-step: each frame sends the outputs as the pins show them now, then runs the
+        // board to the backend's new time on the state it answered.
+        double last_t = 0.0;
+        for (uint32_t frame = 1; ran && !sim::stop_requested() && board.time_s() < seconds; ++frame) {
+            uint16_t pwm[sim::kSitlServoChannels] = {};  // OUT9-16 do not exist: 0
+            for (int out = 1; out <= sim::kServoOutputs; ++out) pwm[out - 1] = board.servo_width_now_us(out);
+            sim::PhysicsState state;
+            std::string error;
+            if (!link.exchange(frame, pwm, state)) {
+                error = link.error();
+            } else {
+                const double t = state.timestamp_s - first.timestamp_s;
+                if (!(t > last_t)) {
+                    char why[160];
+                    std::snprintf(why, sizeof why, "the physics backend's timestamp %.6f s (frame %u) is not after %.6f s",
+                                  state.timestamp_s, (unsigned)frame, last_t + first.timestamp_s);
+                    error = why;
+                } else {
+                    board.append_sample(sim::physics_sample(state, t, earth_field_uT), 1.0);
+                    if (take_backend_rc(state, t, rc_from_backend, rc, &board, error)) {
+                        ran = board.run(std::min(t, seconds));
+                        last_t = t;
+                    } else {
+                        error = "the physics backend's answer to frame " + std::to_string(frame) + ": " + error;
+                    }
+                }
+            }
+            if (!error.empty()) {
+                std::fprintf(stderr, "apm25sim: %s; stopping at t=%.6f s\n", error.c_str(), board.time_s());
+                physics_status = 4;
+                break;
+            }
+        }
+    }
     board.finish_output();
     if (servo_log && std::fclose(servo_log) != 0) {
         std::fprintf(stderr, "apm25sim: cannot write the servo log '%s'\n", servo_log_path.c_str());
@@ -259,6 +411,7 @@ int main(int argc, char** argv) {
         return 1;
     }
     if (!ran) return 2;
+    if (physics_status) return physics_status;
     if (board.bus_violations() > 0) {
         std::fprintf(stderr, "apm25sim: %u bus violation(s): pin 40 must be high while pin 53 is low\n",
                      board.bus_violations());

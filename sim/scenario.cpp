@@ -26,39 +26,22 @@
 #include <string>
 #include <vector>
 
+#include "Rotation.h"
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kGravity_m_s2 = 9.80665;
-constexpr double kEarthField_uT[3] = {20.0, 0.0, 45.0};  // NED
+constexpr const double* kEarthField_uT = sim::kEarthFieldNed_uT;  // NED
 constexpr double kGyroNoise_rad_s = 0.03 * kDeg;
 constexpr double kAccelNoise_m_s2 = 0.025;
 constexpr double kMagNoise_uT = 0.2;
 constexpr double kStartup_s = 2.0;
 
-struct Quat {
-    double w, x, y, z;
-    Quat operator*(const Quat& q) const {
-        return Quat{w * q.w - x * q.x - y * q.y - z * q.z, w * q.x + x * q.w + y * q.z - z * q.y,
-                    w * q.y - x * q.z + y * q.w + z * q.x, w * q.z + x * q.y - y * q.x + z * q.w};
-    }
-    Quat conj() const { return Quat{w, -x, -y, -z}; }
-};
-
-Quat axis_angle(int axis, double angle_rad) {
-    const double c = std::cos(angle_rad / 2), s = std::sin(angle_rad / 2);
-    return Quat{c, axis == 0 ? s : 0.0, axis == 1 ? s : 0.0, axis == 2 ? s : 0.0};
-}
-
-// v_body = R^T v_earth with R the body -> earth rotation of q.
-void earth_to_body(const Quat& q, const double v[3], double out[3]) {
-    const Quat p{0.0, v[0], v[1], v[2]};
-    const Quat r = q.conj() * p * q;
-    out[0] = r.x;
-    out[1] = r.y;
-    out[2] = r.z;
-}
+using sim::axis_angle;
+using sim::earth_to_body;
+using sim::Quat;
 
 // Angles in degrees at keyframes; between keyframes a cosine ease (zero rate at both ends).
 struct Key {
@@ -192,7 +175,7 @@ Quat attitude(const Scenario& s, double t_s) {
         roll += s.extras.wobble_deg * std::sin(2 * kPi * 8.0 * t_s);
         pitch += s.extras.wobble_deg * std::cos(2 * kPi * 8.0 * t_s + 0.3);
     }
-    return axis_angle(2, yaw * kDeg) * axis_angle(1, pitch * kDeg) * axis_angle(0, roll * kDeg);
+    return sim::from_euler(roll * kDeg, pitch * kDeg, yaw * kDeg);
 }
 
 // Deterministic Gaussian noise: xorshift64* and Box-Muller (same numbers on every libc).

@@ -270,7 +270,7 @@ bool Board::init() {
     }
 
     if (!init_rc()) return false;
-    if (options_.servo_log) init_servo_outputs();
+    if (options_.servo_log || options_.measure_servos) init_servo_outputs();
 
     avr_cycle_timer_register(avr_, 1, sensor_timer, this);
     if (options_.serial || options_.speed > 0.0) {
@@ -603,9 +603,10 @@ void Board::rc_changed() { schedule_ppm_edge(); }
 // Each output's level is the OCnx unit's while TCCRnA's COMnx bits connect it to the pin
 // (as the hardware overrides PORT), else the PORT bit when the pin is an output, else
 // low. The compare units report through the timer's OUT_COMP IRQs (simavr 1.6 sets bit 8,
-// AVR_IOPORT_OUTPUT, on a toggle: the level is bit 0); a PORT write in simavr 1.6
-// re-raises every output pin of the port with its PORT bit, which is why the pin IRQ is
-// only a cue to look again and not the level.
+// AVR_IOPORT_OUTPUT, on a toggle: the level is bit 0). The level is worked out by the
+// chip's rule rather than taken from the pin IRQ's value, so that a PORT bit written on a
+// pin the timer owns (no effect on the chip) can never count as an edge; the pin IRQ is
+// the cue to look again.
 void Board::init_servo_outputs() {
     for (int i = 0; i < kServoOutputs; ++i) {
         const ServoOutputPin& pin = kServoPins[i];
@@ -614,7 +615,7 @@ void Board::init_servo_outputs() {
                                 servo_compare_hook, &g_servo_hooks[i]);
         avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(pin.port), pin.bit), servo_pin_hook, this);
     }
-    std::fputs(ServoPulseLog::header(), options_.servo_log);
+    if (options_.servo_log) std::fputs(ServoPulseLog::header(), options_.servo_log);
 }
 
 void Board::on_servo_compare(int output, uint32_t value) {
@@ -636,10 +637,18 @@ void Board::on_servo_pin() {
 }
 
 void Board::write_servo_pulses(bool all) {
-    if (!options_.servo_log) return;
     servo_ready_.clear();
-    servo_pulses_.take(servo_ready_, all);
+    servo_pulses_.take(servo_ready_, all);  // taken also without a log: they would pile up
+    if (!options_.servo_log) return;
     for (const ServoPulse& p : servo_ready_) std::fputs(ServoPulseLog::format(p).c_str(), options_.servo_log);
+}
+
+void Board::append_sample(const TrajectorySample& sample, double keep_s) {
+    for (Trajectory* t : {&mpu_.trajectory(), &mag_.trajectory()}) {
+        t->append(sample);
+        // Trimmed now and then, not at every sample (the erase moves the whole history).
+        if (t->size() > 4096 && (*t)[0].t_s < sample.t_s - 2.0 * keep_s) t->drop_before(sample.t_s - keep_s);
+    }
 }
 
 // --- EEPROM -------------------------------------------------------------------

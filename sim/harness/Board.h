@@ -47,6 +47,7 @@ struct BoardOptions {
     const RcScript* rc = nullptr;   // --rc: the sticks, sent as PPM on ICP5 (PL1); none: PL1 untouched
     FILE* servo_log = nullptr;      // --servo-log: one row per pulse on OUT1-OUT8
     TcpSerial* serial = nullptr;    // --serial tcp:PORT: UART0 also to and from a TCP client
+    bool measure_servos = false;    // the outputs' pulses measured even without a servo log
     double speed = 0.0;             // simulated seconds per wall second; 0: unpaced
     // --eeprom-cuts T1:T2:STEP: the EEPROM as a power cut at T1, T1+STEP, ... <= T2 leaves
     // it, written to eeprom_path.cut0, .cut1, ... (cuts_step_s 0: none)
@@ -107,8 +108,11 @@ public:
     void on_servo_compare(int output, uint32_t value);
     void on_servo_pin();
 
-    // The last pulse width measured on output 1..8 (us; 0 before any).
-    double servo_width_us(int output) const { return servo_pulses_.last_width_us(output); }
+    // What a servo on output 1..8 receives now (us; 0 when no pulse came in 3 periods).
+    uint16_t servo_width_now_us(int output) const { return servo_pulses_.width_now_us(output, time_s(), 0.06); }
+    // Appends a state to the sensor models' samples (--physics), and forgets those older
+    // than `keep_s` before it.
+    void append_sample(const TrajectorySample& sample, double keep_s);
     // After RcScript::push: restarts the PPM line if it had gone quiet.
     void rc_changed();
 

@@ -7,12 +7,13 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <sys/socket.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+
+#include "WallClock.h"
 
 namespace sim {
 
@@ -118,23 +119,16 @@ void TcpSerial::send(uint8_t byte) {
     out_.push_back((char)byte);
 }
 
-namespace {
-double wall_s() {
-    timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-}  // namespace
 
 void Pacer::wait_until(double sim_s) {
     if (speed_ <= 0.0) return;
     if (!started_) {
         started_ = true;
-        wall_start_s_ = wall_s();
+        wall_start_s_ = wall_clock_s();
         sim_start_s_ = sim_s;
         return;
     }
-    const double ahead_s = (sim_s - sim_start_s_) / speed_ - (wall_s() - wall_start_s_);
+    const double ahead_s = (sim_s - sim_start_s_) / speed_ - (wall_clock_s() - wall_start_s_);
     if (ahead_s <= 0.0) return;
     timespec ts;
     ts.tv_sec = (time_t)ahead_s;

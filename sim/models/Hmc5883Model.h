@@ -59,6 +59,8 @@ struct Hmc5883Counters {
 
 class Hmc5883Model {
 public:
+    // The samples the model reads; the physics link appends to them as states come.
+    Trajectory& trajectory() { return trajectory_; }
     static constexpr double kMeasurementDelay_s = 0.006;  // datasheet: ~6 ms after a mode write
     static constexpr double kAveragedSampleSpacing_s = 0.0007;
 

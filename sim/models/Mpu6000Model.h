@@ -70,6 +70,8 @@ struct Mpu6000Counters {
 
 class Mpu6000Model {
 public:
+    // The samples the model reads; the physics link appends to them as states come.
+    Trajectory& trajectory() { return trajectory_; }
     static constexpr double kResetDuration_s = 0.05;  // no datasheet figure; ArduPilot waits 100 ms
     static constexpr double kIntPulse_s = 50e-6;      // Register Map 4.15: 50 us pulse unless latched
     static constexpr float kTemperature_c = 30.0f;

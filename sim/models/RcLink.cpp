@@ -189,6 +189,7 @@ void ServoPulseLog::level(int output, double t_s, bool high) {
     p.output = output;
     p.width_us = (t_s - rise_s_[i]) * 1e6;
     last_width_us_[i] = p.width_us;
+    last_end_s_[i] = t_s;
     ended_.push_back(p);
 }
 
@@ -209,6 +210,14 @@ void ServoPulseLog::take(std::vector<ServoPulse>& out, bool all) {
 
 double ServoPulseLog::last_width_us(int output) const {
     return output >= 1 && output <= kServoOutputs ? last_width_us_[output - 1] : 0.0;
+}
+
+uint16_t ServoPulseLog::width_now_us(int output, double t_s, double stale_s) const {
+    if (output < 1 || output > kServoOutputs) return 0;
+    const int i = output - 1;
+    if (last_width_us_[i] <= 0.0 || t_s - last_end_s_[i] > stale_s) return 0;
+    const double w = std::round(last_width_us_[i]);
+    return (uint16_t)std::min(w, 65535.0);
 }
 
 std::string ServoPulseLog::format(const ServoPulse& pulse) {

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include <string>
 #include <vector>
@@ -116,6 +117,10 @@ public:
     void take(std::vector<ServoPulse>& out, bool all = false);
     // The width of the last pulse that ended on the output (0 before any).
     double last_width_us(int output) const;
+    // The width a servo on the output is being sent at t_s, rounded to the microsecond: the
+    // last pulse's while pulses keep coming (one ended within `stale_s`), else 0 (no
+    // signal, as ArduPilot sends for an output that is off).
+    uint16_t width_now_us(int output, double t_s, double stale_s) const;
     // "t,out,width_us" and one row: rise time (s, six decimals), output, width (us,
     // two decimals).
     static const char* header() { return "t,out,width_us\n"; }
@@ -125,6 +130,7 @@ private:
     bool high_[kServoOutputs] = {};
     double rise_s_[kServoOutputs] = {};
     double last_width_us_[kServoOutputs] = {};
+    double last_end_s_[kServoOutputs] = {};
     std::vector<ServoPulse> ended_;
 };
 

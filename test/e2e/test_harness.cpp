@@ -25,7 +25,10 @@ TEST(Harness, HelpDocumentsTheFaultLanguage) {
                              "--eeprom", "overlap",
                              // the receiver and the servo outputs (test_harness_io.cpp)
                              "--rc FILE", "t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8", "12.0,,,,,,,,", "PL1", "22.5 ms",
-                             "400 us", "--servo-log FILE", "t,out,width_us", "OC1B/PB6", "OC3A/PE3"})
+                             "400 us", "--servo-log FILE", "t,out,width_us", "OC1B/PB6", "OC3A/PE3",
+                             // the live board and the physics link (test_harness_serial/physics.cpp)
+                             "--serial tcp:PORT", "--speed X", "--physics json[:HOST[:PORT]]", "18458",
+                             "--physics-rate HZ", "--physics-timeout S", "--earth-field N,E,D"})
         EXPECT_NE(r.out.find(spec), std::string::npos) << spec;
     const e2e::CommandResult bad = e2e::run_command(e2e::tool("apm25sim") + " --elf x --trajectory " +
                                                     e2e::scenario_csv("rest", 1) + " --fault mpu:melted");

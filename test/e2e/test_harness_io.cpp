@@ -46,9 +46,10 @@ bool read_servo_log(const std::string& path, std::vector<PulseRow>& rows, std::s
 
 // The probe writes output k's width, 900 + 100 k + 25 j us with j = (overflows / 10) mod 8,
 // in TIMERn_OVF (OCRn = 2 x width: the pin is high for OCRn + 1 ticks, width + 0.5 us) and
-// toggles other bits of the same ports all the time. Every pulse of every output is in the
+// toggles the servo pins' PORT bits (no effect while the timer owns them) and other bits of
+// the same ports all the time. Every pulse of every output is in the
 // log, in rising-edge order, at 50 Hz, within 1 us of a width the probe wrote, each width
-// held for 10 periods: no glitched pulse, and a PORT write never cuts a pulse.
+// held for 10 periods: no glitched pulse, and no PORT write taken for an edge.
 TEST(HarnessIo, ServoLogMeasuresEveryOutputsPulsesFromItsPin) {
     E2E_REQUIRE_TOOLS("apm25sim", "scenario");
     E2E_REQUIRE_AVR_PROGRAMS(dir);

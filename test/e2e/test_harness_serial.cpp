@@ -12,73 +12,9 @@
 #include <cstring>
 #include <regex>
 
-#include "e2e_support.h"
+#include "harness_live.h"
 
 namespace {
-
-// Guards against a hang only (never asserted as a duration): the reads below wait at
-// most this long for something the simulated board must send.
-constexpr int kGuard_ms = 90000;
-
-// apm25sim running in the background, its stderr on a pipe.
-struct LiveSim {
-    pid_t pid = -1;
-    int err_fd = -1;
-    std::string err;
-
-    bool start(const std::vector<std::string>& args, const std::string& stdout_path) {
-        int fds[2];
-        if (pipe(fds) != 0) return false;
-        pid = fork();
-        if (pid == 0) {
-            dup2(fds[1], 2);
-            const int out = open(stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-            if (out >= 0) dup2(out, 1);
-            close(fds[0]);
-            std::vector<char*> argv;
-            for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-            argv.push_back(nullptr);
-            execv(argv[0], argv.data());
-            _exit(127);
-        }
-        close(fds[1]);
-        err_fd = fds[0];
-        return pid > 0;
-    }
-    // Reads stderr until a line matches `pattern` (its first group returned) or EOF.
-    std::string wait_stderr(const std::string& pattern) {
-        const std::regex re(pattern);
-        for (;;) {
-            std::smatch m;
-            size_t start = 0;
-            for (size_t nl; (nl = err.find('\n', start)) != std::string::npos; start = nl + 1) {
-                const std::string line = err.substr(start, nl - start);
-                if (std::regex_search(line, m, re)) return m.size() > 1 ? m[1].str() : line;
-            }
-            pollfd p{err_fd, POLLIN, 0};
-            if (::poll(&p, 1, kGuard_ms) <= 0) return "";
-            char buffer[512];
-            const ssize_t n = read(err_fd, buffer, sizeof buffer);
-            if (n <= 0) return "";
-            err.append(buffer, (size_t)n);
-        }
-    }
-    int stop() {
-        if (pid <= 0) return -1;
-        kill(pid, SIGTERM);
-        int status = 0;
-        waitpid(pid, &status, 0);
-        pid = -1;
-        char buffer[512];
-        ssize_t n;
-        while ((n = read(err_fd, buffer, sizeof buffer)) > 0) err.append(buffer, (size_t)n);
-        close(err_fd);
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    }
-    ~LiveSim() {
-        if (pid > 0) stop();
-    }
-};
 
 int connect_to(int port) {
     const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -100,7 +36,7 @@ std::string read_until(int fd, Done done) {
     std::string text;
     while (!done(text)) {
         pollfd p{fd, POLLIN, 0};
-        if (::poll(&p, 1, kGuard_ms) <= 0) break;
+        if (::poll(&p, 1, e2e::kGuard_ms) <= 0) break;
         char buffer[4096];
         const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
         if (n <= 0) break;
@@ -121,12 +57,12 @@ int count_angle_lines(const std::string& text) {
 TEST(HarnessSerial, AClientOverTcpReadsTheBoardAndTypesCommands) {
     E2E_REQUIRE_TOOLS("apm25sim", "scenario", "firmware.elf");
     const std::string out_path = e2e::work_dir() + "/serial_stdout." + std::to_string(getpid()) + ".txt";
-    LiveSim sim;
+    e2e::LiveProcess sim;
     ASSERT_TRUE(sim.start({e2e::tool("apm25sim"), "--elf", e2e::firmware_elf(), "--trajectory",
                            e2e::scenario_csv("rest", 30), "--serial", "tcp:0", "--seconds", "60"},
-                          out_path));
-    const std::string port_text = sim.wait_stderr("serving UART0 on tcp:127\\.0\\.0\\.1:([0-9]+)");
-    ASSERT_FALSE(port_text.empty()) << sim.err;
+                          2, out_path));
+    const std::string port_text = sim.wait_line("serving UART0 on tcp:127\\.0\\.0\\.1:([0-9]+)");
+    ASSERT_FALSE(port_text.empty()) << sim.text;
     const int port = std::atoi(port_text.c_str());
 
     // First client: the board's lines, then `rate 10` and its reply.
@@ -139,7 +75,7 @@ TEST(HarnessSerial, AClientOverTcpReadsTheBoardAndTypesCommands) {
     const std::string reply = read_until(fd, [](const std::string& t) { return t.find("# rate 10 Hz\n") != std::string::npos; });
     EXPECT_NE(reply.find("# rate 10 Hz\n"), std::string::npos) << reply.substr(0, 2000);
     close(fd);
-    EXPECT_FALSE(sim.wait_stderr("tcp:[0-9]+ client disconnected").empty()) << sim.err;
+    EXPECT_FALSE(sim.wait_line("tcp:[0-9]+ client disconnected").empty()) << sim.text;
 
     // A second client gets the port, the lines and the console.
     fd = connect_to(port);
@@ -159,7 +95,7 @@ TEST(HarnessSerial, AClientOverTcpReadsTheBoardAndTypesCommands) {
 
     close(fd);
     // SIGTERM: a clean end; stdout carried the same bytes, both replies included.
-    EXPECT_EQ(sim.stop(), 0) << sim.err;
+    EXPECT_EQ(sim.stop(), 0) << sim.text;
     const std::string out = e2e::read_text(out_path);
     unlink(out_path.c_str());
     EXPECT_NE(out.find("# rate 10 Hz\n"), std::string::npos);

@@ -5,8 +5,10 @@
 // Servo outputs as ArduPilot's APM2 HAL drives them: Timers 1, 4 and 3 in fast PWM mode 14
 // (TOP = ICRn = 40000, prescaler 8: 0.5 us ticks, 50 Hz), OCRn written in TIMERn_OVF. Output
 // k (1..8) pulses 900 + 100 k + 25 j us, j = (overflows / 10) mod 8: each width held for 10
-// periods, then the next. The main loop toggles other bits of the same ports all the time
-// (a PORT write must not cut a pulse the timer drives).
+// periods, then the next. The main loop toggles the PORT bits of the servo pins and of
+// other pins of the same ports all the time: while COMnx connects a pin to its timer, PORT
+// has no effect on it (ATmega2560 datasheet, 16-bit Timer/Counter, "Compare Match Output
+// Unit").
 //
 // Receiver as the APM2 HAL reads it: Timer5 mode 15 (TOP = OCR5A = 39999), prescaler 8,
 // input capture on the rising edge (ICES5) of ICP5 = PL1; a rising-to-rising interval over
@@ -102,9 +104,9 @@ void setup() {
 static uint32_t last_ms = 0;
 
 void loop() {
-    PORTB ^= 1 << 7;
-    PORTH ^= 1 << 6;
-    PORTE ^= 1 << 7;
+    PORTB ^= (1 << 5) | (1 << 6) | (1 << 7);
+    PORTH ^= (1 << 3) | (1 << 4) | (1 << 5) | (1 << 6);
+    PORTE ^= (1 << 3) | (1 << 4) | (1 << 5) | (1 << 7);
     const uint32_t now = millis();
     if (now - last_ms < 50) return;
     last_ms = now;
