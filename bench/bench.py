@@ -51,6 +51,7 @@ SECTIONS = [
     (4, "mpu", "MPU6000 burst read", ("mpu",)),
     (5, "hmc", "HMC5883L read", ("hmc", "compass", "mag")),
     (6, "loop", "one loop iteration's work", ("loop",)),
+    (13, "control", "flight control step (50 Hz: every 4th loop step)", ("control", "flight")),
     # The parts of the estimator step (lib/LinAlg/Profile.h), inside section 1.
     (12, "checks", "step part: sample checks, calibration", ()),
     (7, "integration", "step part: gyro integration", ()),
@@ -221,6 +222,12 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
     if os.path.exists(prof):
         os.remove(prof)
     cmd = [sim, "--elf", elf, "--trajectory", traj, "--seconds", str(seconds), "--profile", prof]
+    # Control on: a receiver from 0.5 s with the mode switch high (STABILIZE), so that the
+    # flight control step (section 13) runs its controllers, not the idle neutral outputs.
+    rc = os.path.join(out_dir, "scenarios", "stabilize_rc.csv")
+    with open(rc, "w") as f:
+        f.write("t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8\n0.5,1500,1500,1500,1500,1500,1500,1500,2000\n")
+    cmd += ["--rc", rc]
     log("cycles: %s (simavr, %g simulated s)" % (" ".join(os.path.relpath(c, REPO) if os.sep in c else c
                                                             for c in cmd), seconds))
     t0 = time.time()

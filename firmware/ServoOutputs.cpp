@@ -29,6 +29,12 @@ void fill(const uint16_t width_us[kOutputs]) {
 
 void set(const uint16_t width_us[kOutputs]) { fill(width_us); }
 
+uint16_t width_us(uint8_t output) {
+    uint16_t ocr;
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { ocr = next_ocr[output]; }
+    return (uint16_t)((ocr + 1u) / 2u);
+}
+
 void begin(const uint16_t width_us[kOutputs]) {
     fill(width_us);
     // Stopped in normal mode, the first widths and TOP are written (OCRn is not double

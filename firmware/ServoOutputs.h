@@ -30,5 +30,7 @@ constexpr uint8_t kOutputs = 8;
 void begin(const uint16_t width_us[kOutputs]);
 // The widths from the next period on.
 void set(const uint16_t width_us[kOutputs]);
+// The width output (0..7) has from the next period on, us.
+uint16_t width_us(uint8_t output);
 
 }  // namespace servo_outputs

@@ -92,6 +92,7 @@ static void print_flight_line(Flash prefix) {
             .str(TXT("), then "));
     }
     w.str(flight_mode_name(flight_control.chosen()));
+    if (flight_control.without_attitude()) w.str(TXT(" (no attitude: MANUAL)"));
     if (st == flight::State::NoSignal) w.str(TXT(", no receiver signal yet: outputs at trim"));
     w.end();
 }
@@ -114,22 +115,30 @@ static void say_flight_events() {
         say(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding"));
     if (e & flight::kEvFailsafeEnd) print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
     if (e & flight::kEvSensorFallback)
-        say(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): flight MANUAL"));
+        say(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): MANUAL until it returns"));
+    if (e & flight::kEvAttitudeBack) say(TXT("# attitude back: flight STABILIZE"));
     if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
 }
 
-// The control step, every 4th loop step (50 Hz): the servo pulse only changes once a
-// 20 ms period, so a faster step would compute widths that are never sent.
+// The control step, every 4th loop step (50 Hz) right after the estimator's: the servo
+// pulse only changes once a 20 ms period, so a faster step would compute widths that are
+// never sent. Without samples (the MPU6000 gone) the loop runs it on its own every
+// 20 ms, without an attitude: the receiver, MANUAL and the failsafe go on.
 constexpr uint8_t kControlDivider = 4;
+constexpr uint16_t kControlPeriodUs = 20000;
 constexpr float kControlDt_s = 0.02f;
 static uint8_t control_count = 0;
+static uint32_t last_control_us = 0;
 
-static void control_step(uint32_t now_ms) {
+static void take_receiver_frames(uint32_t now_ms) {
     while (rc_input::poll(ppm)) flight_control.on_frame(ppm.frame_us(), now_ms);
-    if (++control_count < kControlDivider) return;
+}
+
+static void control_step(uint32_t now_us, uint32_t now_ms, bool have_sample) {
+    last_control_us = now_us;
     control_count = 0;
     board::mark_begin(board::kSecControl);
-    flight::Attitude att{0, 0, 0.0f, 0.0f, imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    flight::Attitude att{0, 0, 0.0f, 0.0f, have_sample && imu.ok() && pipe.phase() == pipeline::Phase::Running};
     if (att.valid) {
         const pipeline::AnglesCentideg a = pipe.angles_centideg();
         const linalg::Vector3f rate = pipe.body_rate_rad_s();
@@ -138,8 +147,9 @@ static void control_step(uint32_t now_ms) {
         att.roll_rate_deg_s = rate.x * linalg::kDegPerRad;
         att.pitch_rate_deg_s = rate.y * linalg::kDegPerRad;
     }
-    flight_control.step(now_ms, att, kControlDt_s);
-    servo_outputs::set(flight_control.outputs_us());
+    uint16_t widths[flight::kChannels];
+    flight_control.step(now_ms, att, kControlDt_s, widths);
+    servo_outputs::set(widths);
     board::mark_end(board::kSecControl);
     say_flight_events();
 }
@@ -321,7 +331,11 @@ static bool answer(const console::Command& c, uint8_t part) {
             break;
         case console::CommandId::Show:
             if (c.arg == console::kShowRc) print_widths(TXT("# rc"), flight_control.rc_us());
-            else print_widths(TXT("# servo"), flight_control.outputs_us());
+            else {
+                uint16_t widths[flight::kChannels];
+                for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
+                print_widths(TXT("# servo"), widths);
+            }
             break;
         default: console::apply_setting(c, pipe.settings(), out); break;  // rate, decl, mode, set, get
     }
@@ -393,8 +407,9 @@ static void step(uint32_t now_us) {
         take_console_input();
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
         if (pipe.output_due()) emit_output(now_ms);
+        take_receiver_frames(now_ms);
+        if (++control_count >= kControlDivider) control_step(now_us, now_ms, true);
     }
-    control_step(now_ms);  // with or without a sample: a failed IMU still flies MANUAL
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
 }
@@ -422,8 +437,9 @@ void setup() {
     store.load(pipe.settings());
     // The outputs from here on, at trim and the throttle at its failsafe value until the
     // receiver's first frame (the loaded settings' end points).
-    flight_control.step(0, flight::Attitude{0, 0, 0.0f, 0.0f, false}, kControlDt_s);
-    servo_outputs::begin(flight_control.outputs_us());
+    uint16_t widths[flight::kChannels];
+    flight_control.step(0, flight::Attitude{0, 0, 0.0f, 0.0f, false}, kControlDt_s, widths);
+    servo_outputs::begin(widths);
     rc_input::begin();
     print_settings_line();
     if (pipe.settings().flags & settings::kFlagUpgraded) {
@@ -445,6 +461,7 @@ void setup() {
     user_setup();
     wait_until_ms(pipeline::kLoopStartMs);
     window_start_us = micros();
+    last_control_us = window_start_us;
     update_leds();
 }
 
@@ -459,6 +476,10 @@ void loop() {
     user_loop();
 
     const uint32_t now_us = micros();
+    if (now_us - last_control_us >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
+        take_receiver_frames(now_ms);
+        control_step(now_us, now_ms, false);
+    }
     if (now_us - window_start_us >= 1000000u) {  // load over the last second
         load_pct = (uint8_t)(work_us / ((now_us - window_start_us) / 100u));
         work_us = 0;

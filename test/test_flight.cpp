@@ -279,6 +279,7 @@ struct Rig {
     uint16_t rc[8] = {1500, 1500, 1100, 1500, 1500, 1500, 1500, 1000};  // mode switch low: MANUAL
     uint32_t now_ms = 0;
     flight::Attitude att{0, 0, 0.0f, 0.0f, true};
+    uint16_t out[8] = {};
 
     // Runs `seconds` of 50 Hz steps with frames every 22 ms while `signal`.
     void run(float seconds, bool signal = true) {
@@ -289,7 +290,7 @@ struct Rig {
                 fc.on_frame(rc, now_ms);
                 next_frame += 22;
             }
-            if (now_ms % 20u == 0u) fc.step(now_ms, att, 0.02f);
+            if (now_ms % 20u == 0u) fc.step(now_ms, att, 0.02f, out);
             ++now_ms;
         }
     }
@@ -300,15 +301,15 @@ struct Rig {
 TEST(FlightModes, NeutralBeforeTheFirstFrameThenManualPassThrough) {
     Rig r;
     r.s.flight.thr_fs_pct = 0;
-    r.fc.step(0, r.att, 0.02f);
+    r.fc.step(0, r.att, 0.02f, r.out);
     EXPECT_EQ(r.fc.state(), flight::State::NoSignal);
     const uint16_t neutral[8] = {1500, 1500, 1000, 1500, 1500, 1500, 1500, 1500};
-    EXPECT_EQ(0, std::memcmp(r.fc.outputs_us(), neutral, sizeof neutral));
+    EXPECT_EQ(0, std::memcmp(r.out, neutral, sizeof neutral));
     const uint16_t sticks[8] = {1700, 1234, 1456, 1999, 1100, 1900, 1510, 1000};
     std::memcpy(r.rc, sticks, sizeof sticks);
     r.run(0.1f);
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
-    for (int i = 0; i < 7; ++i) EXPECT_EQ(r.fc.outputs_us()[i], sticks[i]) << i;  // OUT8 = ch8, the switch
+    for (int i = 0; i < 7; ++i) EXPECT_EQ(r.out[i], sticks[i]) << i;  // OUT8 = ch8, the switch
     EXPECT_EQ(r.fc.take_events() & flight::kEvFailsafeLost, 0);
 }
 
@@ -318,22 +319,22 @@ TEST(FlightModes, RightWingDownMakesStabilizeRollLeftAndNoseDownPitchUp) {
     r.att.roll_cd = 1500;  // right wing down 15 deg
     r.run(0.1f);
     ASSERT_EQ(r.fc.state(), flight::State::Stabilize);
-    EXPECT_LT(r.fc.outputs_us()[0], 1500) << "aileron below trim: roll left";
+    EXPECT_LT(r.out[0], 1500) << "aileron below trim: roll left";
     r.att.roll_cd = 0;
     r.att.pitch_cd = -1000;  // nose down 10 deg
     r.run(0.1f);
-    EXPECT_GT(r.fc.outputs_us()[1], 1500) << "elevator above trim: nose up";
+    EXPECT_GT(r.out[1], 1500) << "elevator above trim: nose up";
     // A stick right demands a bank right: level wings get aileron right.
     r.att.pitch_cd = 0;
     r.rc[0] = 2000;
     r.run(0.1f);
-    EXPECT_GT(r.fc.outputs_us()[0], 1500);
+    EXPECT_GT(r.out[0], 1500);
     // Throttle and rudder pass through.
     r.rc[2] = 1600;
     r.rc[3] = 1300;
     r.run(0.05f);
-    EXPECT_EQ(r.fc.outputs_us()[2], 1600);
-    EXPECT_EQ(r.fc.outputs_us()[3], 1300);
+    EXPECT_EQ(r.out[2], 1600);
+    EXPECT_EQ(r.out[3], 1300);
 }
 
 TEST(FlightModes, SwitchAndConsoleChooseTheMode) {
@@ -373,11 +374,11 @@ TEST(FlightModes, LossEntersFailsafeWithinASecondAndTheModeReturns) {
     EXPECT_EQ(r.fc.state(), flight::State::Failsafe);
     EXPECT_EQ(r.fc.failsafe_cause(), flight::FailsafeCause::Lost);
     EXPECT_EQ(r.fc.take_events() & flight::kEvFailsafeLost, flight::kEvFailsafeLost);
-    EXPECT_GT(r.fc.outputs_us()[0], 1500) << "wings level: roll right";
-    EXPECT_EQ(r.fc.outputs_us()[2], 1000) << "throttle at THR_FS_OUT 0 %";
+    EXPECT_GT(r.out[0], 1500) << "wings level: roll right";
+    EXPECT_EQ(r.out[2], 1000) << "throttle at THR_FS_OUT 0 %";
     r.att.roll_cd = 0;
     r.run(0.5f, false);
-    EXPECT_LT(r.fc.outputs_us()[1], 1500) << "level: the glide's nose-down pitch";
+    EXPECT_LT(r.out[1], 1500) << "level: the glide's nose-down pitch";
     r.run(0.1f);
     EXPECT_EQ(r.fc.state(), flight::State::Stabilize);
     EXPECT_TRUE(r.fc.take_events() & flight::kEvFailsafeEnd);
@@ -397,7 +398,7 @@ TEST(FlightModes, EncoderFailsafeThrottleBelowThrFsValue) {
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
 }
 
-TEST(FlightModes, SensorFaultInStabilizeFallsBackToManual) {
+TEST(FlightModes, SensorFaultInStabilizeFallsBackToManualUntilTheAttitudeReturns) {
     Rig r;
     r.rc[7] = 2000;
     r.run(0.2f);
@@ -405,9 +406,19 @@ TEST(FlightModes, SensorFaultInStabilizeFallsBackToManual) {
     r.att.valid = false;
     r.rc[0] = 1700;
     r.run(0.1f);
-    EXPECT_EQ(r.fc.state(), flight::State::Manual);
-    EXPECT_TRUE(r.fc.take_events() & flight::kEvSensorFallback);
-    EXPECT_EQ(r.fc.outputs_us()[0], 1700);
+    EXPECT_TRUE(r.fc.without_attitude());
+    EXPECT_EQ(r.fc.take_events(), flight::kEvSensorFallback);
+    EXPECT_EQ(r.out[0], 1700) << "the stick passes through";
+    r.run(0.5f);
+    EXPECT_EQ(r.fc.take_events(), 0) << "said once";
+    r.att.valid = true;
+    r.rc[0] = 1500;
+    r.att.roll_cd = 1000;
+    r.run(0.1f);
+    EXPECT_FALSE(r.fc.without_attitude());
+    EXPECT_EQ(r.fc.take_events(), flight::kEvAttitudeBack);
+    EXPECT_EQ(r.fc.state(), flight::State::Stabilize);
+    EXPECT_LT(r.out[0], 1500) << "stabilising again";
 }
 
 // --- Parameters ---------------------------------------------------------------------------

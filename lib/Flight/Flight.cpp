@@ -140,9 +140,9 @@ State state_of(Mode m) { return m == Mode::Stabilize ? State::Stabilize : State:
 
 }  // namespace
 
-void FlightControl::hold_neutral() {
+void FlightControl::hold_neutral(uint16_t out_us[kChannels]) const {
     const Surfaces neutral{0, 0, (int16_t)(s_.thr_fs_pct * 10u), 0};
-    mix(s_, neutral, nullptr, out_us_);
+    mix(s_, neutral, nullptr, out_us);
 }
 
 void FlightControl::choose(Mode m) {
@@ -208,16 +208,21 @@ Surfaces FlightControl::stabilize(const Attitude& att, int32_t roll_demand_cd, i
     return out;
 }
 
-void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s) {
+void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s, uint16_t out_us[kChannels]) {
     update_signal(now_ms);
     if (state_ == State::NoSignal) {
-        hold_neutral();
+        hold_neutral(out_us);
         return;
     }
-    if (state_ == State::Stabilize && !att.valid) {
-        chosen_ = Mode::Manual;
-        state_ = State::Manual;
-        events_ |= kEvSensorFallback;
+    // STABILIZE without an attitude (the estimator starting, the IMU failed) flies as
+    // MANUAL, and STABILIZE resumes when the attitude does (the estimator restarts from
+    // gravity): said both ways.
+    const bool fallback = state_ == State::Stabilize && !att.valid;
+    if (fallback != no_attitude_) {
+        events_ |= fallback ? kEvSensorFallback : kEvAttitudeBack;
+        no_attitude_ = fallback;
+        roll_.reset();
+        pitch_.reset();
     }
     const int16_t fs_throttle = (int16_t)(s_.thr_fs_pct * 10u);
     if (state_ == State::Failsafe) {
@@ -225,7 +230,7 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s) {
         if (att.valid) sf = stabilize(att, 0, s_.fs_pitch_cd, dt_s);
         sf.throttle = fs_throttle;
         sf.rudder_cd = 0;
-        mix(s_, sf, nullptr, out_us_);
+        mix(s_, sf, nullptr, out_us);
         return;
     }
     int16_t in[kChannels];
@@ -234,7 +239,7 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s) {
     const uint8_t thr = (uint8_t)(map[kThrottle] - 1u);
     Surfaces sf{in[map[kRoll] - 1u], in[map[kPitch] - 1u],
                 width_to_throttle(rc_us_[thr], s_.rc[thr], bit(s_.rc_reversed, thr)), in[map[kYaw] - 1u]};
-    if (state_ == State::Stabilize) {
+    if (state_ == State::Stabilize && !fallback) {
         const int32_t roll_demand = div_round((int32_t)sf.aileron_cd * s_.lim_roll_cd, kFullThrow_cd);
         const int32_t pitch_demand = sf.elevator_cd >= 0
                                          ? div_round((int32_t)sf.elevator_cd * s_.lim_pitch_max_cd, kFullThrow_cd)
@@ -243,7 +248,7 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s) {
         sf.aileron_cd = c.aileron_cd;
         sf.elevator_cd = c.elevator_cd;
     }
-    mix(s_, sf, in + 4, out_us_);
+    mix(s_, sf, in + 4, out_us);
 }
 
 }  // namespace flight

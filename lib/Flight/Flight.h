@@ -106,7 +106,8 @@ enum Event : uint8_t {
     kEvFailsafeLost = 0x01,     // the receiver's frames stopped
     kEvFailsafeEncoder = 0x02,  // the encoder's own failsafe (throttle below THR_FS_VALUE)
     kEvFailsafeEnd = 0x04,      // good frames again: back to the mode before
-    kEvSensorFallback = 0x08,   // STABILIZE without an attitude: MANUAL
+    kEvSensorFallback = 0x08,   // STABILIZE without an attitude: the sticks pass through (MANUAL) until it returns
+    kEvAttitudeBack = 0x20,     // ... it returned: STABILIZE again
     kEvModeChanged = 0x10,      // the mode switch chose another mode
 };
 
@@ -114,20 +115,21 @@ enum class FailsafeCause : uint8_t { None, Lost, Encoder };
 
 class FlightControl {
 public:
-    explicit FlightControl(const FlightSettings& s) : s_(s) { hold_neutral(); }
+    explicit FlightControl(const FlightSettings& s) : s_(s) {}
 
     // An accepted receiver frame, at now_ms.
     void on_frame(const uint16_t width_us[kChannels], uint32_t now_ms);
     // The console's choice; the mode switch's next move overrides it.
     void choose(Mode m);
-    // One control step, every dt_s; fills outputs_us().
-    void step(uint32_t now_ms, const Attitude& att, float dt_s);
+    // One control step, every dt_s: the eight output widths, within their limits.
+    void step(uint32_t now_ms, const Attitude& att, float dt_s, uint16_t out_us[kChannels]);
 
     State state() const { return state_; }
+    // STABILIZE chosen, but flying as MANUAL for want of an attitude.
+    bool without_attitude() const { return no_attitude_; }
     Mode chosen() const { return chosen_; }
     FailsafeCause failsafe_cause() const { return cause_; }
     const uint16_t* rc_us() const { return rc_us_; }
-    const uint16_t* outputs_us() const { return out_us_; }
     // Events since the last call (Event bits), cleared.
     uint8_t take_events() {
         const uint8_t e = events_;
@@ -136,7 +138,7 @@ public:
     }
 
 private:
-    void hold_neutral();
+    void hold_neutral(uint16_t out_us[kChannels]) const;
     void update_signal(uint32_t now_ms);
     Surfaces stabilize(const Attitude& att, int32_t roll_demand_cd, int32_t pitch_demand_cd, float dt_s);
 
@@ -144,7 +146,6 @@ private:
     AxisController roll_;
     AxisController pitch_;
     uint16_t rc_us_[kChannels] = {};
-    uint16_t out_us_[kChannels] = {};
     uint32_t last_good_ms_ = 0;   // the last frame with the throttle above THR_FS_VALUE
     uint32_t last_frame_ms_ = 0;  // the last frame of any kind
     State state_ = State::NoSignal;
@@ -153,6 +154,7 @@ private:
     uint8_t switch_pos_ = 0;      // 1..6, 0 before the first frame
     uint8_t events_ = 0;
     bool have_frame_ = false;
+    bool no_attitude_ = false;    // STABILIZE flying as MANUAL: the attitude is not valid
 };
 
 }  // namespace flight
