@@ -501,6 +501,11 @@ def main():
     # Issue 10 measures a shaking board too (the vibration keeps the rest test and the
     # integrator hold busy).
     cycles_shake = measure_cycles(build, out_dir, args.seconds, "shake")
+    # Flash beside the cycles: the inlining decisions trade one for the other (Fixed.h).
+    for name, c in (("tilt_tour", cycles), ("shake", cycles_shake)):
+        st = c["sections"].get(1) if c else None
+        log("flash %s B | %s: estimator step %s avg / %s max cycles" % (
+            fmt(size["flash"]) if size else "–", name, fmt(st["avg"], 0) if st else "–", fmt(st["max"], 0) if st else "–"))
 
     # 2. accuracy
     replay = tool(build, "replay")
@@ -661,6 +666,10 @@ def main():
             per_step = fmt(s["total"] / steps, 0) if s and steps else "–"
             rows.append([label] + ([fmt(s["count"]), fmt(s["avg"], 0), fmt(s["min"], 0), fmt(s["max"], 0), per_step]
                                    if s else ["–"] * 5))
+        if size:
+            rep.append("Flash %s bytes beside these cycles (the inlining decisions trade one for the other: "
+                       "lib/LinAlg/Fixed.h)." % fmt(size["flash"]))
+            rep.append("")
         rep.append("Scenario `tilt_tour`, %g simulated seconds through `apm25sim --profile`. *per step*: the "
                    "section's cycles over the run divided by the estimator steps (what it adds to the step's "
                    "average)." % cycles["seconds"])

@@ -12,6 +12,9 @@
 # calibrated compass), through `build/replay --log`: the angle lines (stdout) and the
 # pipeline's messages (stderr) are kept apart. The scenario files themselves are
 # compared too (they are the inputs). BUILD (default build) holds replay and scenario.
+# With SIM=1 the firmware's own output in simavr as well (build/apm25sim on ELF, default
+# BUILD/firmware.elf, SIM_SECONDS of fast, shake+uncal and tumble+uncal, default 12 s):
+# the AVR-only code (inline assembly) is checked there, the host cannot run it.
 # Exit status: 0 when every file is identical, 1 when one differs or is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -59,6 +62,18 @@ export -f run_one
 export replay out
 printf '%s\n' "${inputs[@]}" | xargs -P 2 -I{} bash -c 'run_one "$@"' _ {}
 
+if [[ ${SIM:-0} == 1 ]]; then
+    mkdir -p "$out/simavr"
+    elf=${ELF:-$build/firmware.elf}
+    sim_one() {
+        "$build/apm25sim" --elf "$elf" --trajectory "$out/scenarios/$1.csv" --seconds "${SIM_SECONDS:-12}" \
+            > "$out/simavr/$1.out"
+    }
+    export -f sim_one
+    export build elf
+    printf '%s\n' fast shake+uncal tumble+uncal | xargs -P 2 -I{} bash -c 'sim_one "$@"' _ {}
+fi
+
 if [[ $mode == record ]]; then
     echo "recorded $(find "$dir" -type f | wc -l) files in $dir"
     exit 0
@@ -71,7 +86,7 @@ while IFS= read -r ref; do
         echo "DIFFERS: $rel"
         bad=$((bad + 1))
     fi
-done < <(find "$dir" -type f | sort)
+done < <(find "$dir" -type f | { if [[ ${SIM:-0} == 1 ]]; then cat; else grep -v /simavr/; fi; } | sort)
 extra=$(cd "$out" && find . -type f | sed 's|^\./||' | while read -r f; do [[ -e $dir/$f ]] || echo "$f"; done)
 [[ -n $extra ]] && { echo "NEW (not in the reference): $extra"; bad=$((bad + 1)); }
 echo "compared $n files: $bad differ"

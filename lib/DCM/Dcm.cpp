@@ -99,14 +99,16 @@ int32_t row_times(const Vector3l& row, const linalg::Vector3i& v) {
 
 }  // namespace
 
+Dcm::Dcm(const DcmSettings& settings) : settings_(&settings) { k_.from_settings(settings); }
+
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    bias_fine_ = linalg::fixed_from_vector(bias * (units_per_rad_s_ * (float)kTurnScale), 0);
+    bias_fine_ = linalg::fixed_from_vector(bias * (k_.units_per_rad_s * (float)kTurnScale), 0);
     clamp_bias();
     update_offset();
 }
 
-Vector3f Dcm::gyro_bias_rad_s() const { return bias_fine_.scaled(gyro_scale_ * (1.0f / (float)(kTurnScale * kTurnScale))); }
+Vector3f Dcm::gyro_bias_rad_s() const { return bias_fine_.scaled(k_.gyro_rad_s_per_count * (1.0f / (float)(kTurnScale * kTurnScale))); }
 
 Vector3f Dcm::last_mag_field() const { return linalg::scaled(last_field_q5_, 1.0f / (float)(1 << kFieldQ)); }
 
@@ -122,11 +124,7 @@ void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
 
 // The state held in the sensors' units is carried over to the new scales.
 void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count) {
-    const float gyro_ratio = gyro_scale_ / gyro_rad_s_per_count, accel_ratio = accel_scale_ / accel_m_s2_per_count;
-    gyro_scale_ = gyro_rad_s_per_count;
-    accel_scale_ = accel_m_s2_per_count;
-    units_per_rad_s_ = (float)kTurnScale / gyro_rad_s_per_count;
-    accel_units_per_m_s2_ = (float)kTurnScale / accel_m_s2_per_count;
+    const float gyro_ratio = k_.gyro_rad_s_per_count / gyro_rad_s_per_count, accel_ratio = k_.accel_m_s2_per_count / accel_m_s2_per_count;
     if (gyro_ratio != 1.0f) {
         Vector3l* rates[4] = {&bias_fine_, &correction_units_, &sensor_bias_units_, &rest_gyro_mean_};
         for (Vector3l* v : rates) *v = rescaled(*v, gyro_ratio);
@@ -135,7 +133,7 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
         accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
         rest_accel_mean_ = rescaled(rest_accel_mean_, accel_ratio);
     }
-    set_output_factors();
+    k_.set_scales(*settings_, gyro_rad_s_per_count, accel_m_s2_per_count);
     update_offset();
 }
 
@@ -146,7 +144,7 @@ void Dcm::update_offset() {
 }
 
 Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
-    return linalg::fixed_from_vector(rate_rad_s * units_per_rad_s_, 0);
+    return linalg::fixed_from_vector(rate_rad_s * k_.units_per_rad_s, 0);
 }
 
 // Each axis within the range of any accelerometer (16 g): three comparisons where
@@ -162,7 +160,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     if (!accel_m_s2.is_finite()) return false;
     const Vector3f down = (-accel_m_s2).normalized();  // specific force points up
     if (down.is_zero()) return false;
-    last_accel_ = linalg::fixed_from_vector(accel_m_s2 * (accel_units_per_m_s2_ * (1.0f / (float)kTurnScale)), 0);  // for a rebuild
+    last_accel_ = linalg::fixed_from_vector(accel_m_s2 * (k_.accel_units_per_m_s2 * (1.0f / (float)kTurnScale)), 0);  // for a rebuild
 
     // North: the field's component perpendicular to down. Without a usable field,
     // the body x axis projected on the horizontal (yaw 0), or body y at pitch 90.
@@ -188,8 +186,8 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     r_ = linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down));
     // The integer factors of the scales, unless set_sample_scales set them (the float
     // form's, whose scales are the defaults: the Pipeline sets its own before the start).
-    if (theta_factor_q30_ == 0) set_output_factors();
-    const float per_m_s2 = accel_units_per_m_s2();
+    if (k_.theta_factor_q30 == 0) k_.derive_from_scales(*settings_);
+    const float per_m_s2 = k_.accel_units_per_m_s2;
     accel_lp_ef_ = Vector3l(0, 0, linalg::fixed_from_float(-kGravity_m_s2 * per_m_s2, 0));
     correction_units_ = Vector3l();
     update_offset();
@@ -219,56 +217,11 @@ FIXED_INLINE int32_t Dcm::scale_q15(int32_t x, uint16_t c) {
     return x < 0 ? -(int32_t)product : (int32_t)product;
 }
 
-// What follows from the scales: the output's two factors in Q15 (0: beyond 2, the float
-// path), the lead in steps and Q26 radians per unit of the turn sums; the compass
-// latency; the turn's factor; the limits and gains in the sums' units.
-void Dcm::set_output_factors() {
-    const float lead_steps = settings_->output_lead_s / settings_->step_s;
-    const float k = gyro_scale_ * settings_->step_s * (1.0f / (float)kTurnScale) * 67108864.0f;  // 2^26
-    const bool fits = lead_steps >= 0.0f && lead_steps < 1.99f && k > 0.0f && k < 1.99f;
-    lead_steps_q15_ = fits ? (uint16_t)(lead_steps * 32768.0f + 0.5f) : 0;
-    theta_q26_per_unit_q15_ = fits ? (uint16_t)(k * 32768.0f + 0.5f) : 0;
-    // The compass sample's latency in steps, Q12 (with the wait of up to kMaxMagAgeSteps,
-    // below 8 steps in 16 bits: 30 ms at most at 200 Hz).
-    const float latency_steps = linalg::constrain(settings_->mag_latency_s / settings_->step_s, 0.0f, 5.9f);
-    mag_latency_steps_q12_ = (int16_t)(latency_steps * 4096.0f + 0.5f);
-    // The turn's factor: Q26 radians per unit in Q30 (mul_q30's factor; a 2000 deg/s
-    // gyro's 1.40, the float form's 0.08), below 2 for any gyro of 4000 deg/s or less.
-    const bool integer_path = k > 0.0f && k < 1.99f;
-    theta_factor_q30_ = integer_path ? linalg::fixed_from_float(k, linalg::kQ30) : 0;
-    // The units that make kMaxTurnAxisQ26.
-    const float limit_units = integer_path ? (float)kMaxTurnAxisQ26 / k : 0.0f;
-    theta_units_limit_ = limit_units < 2.0e9f ? (int32_t)limit_units : 2000000000L;
-    // The limits in the units of the sums they are compared with.
-    hold_rate_ = limit_of(settings_->integrator_hold_rate_rad_s * units_per_rad_s_);
-    rest_gyro_dev_ = limit_of(settings_->rest_gyro_deviation_rad_s * units_per_rad_s_);
-    rest_accel_dev_ = limit_of(settings_->rest_accel_deviation_m_s2 * accel_units_per_m_s2());
-    bias_limit_fine_ = linalg::fixed_from_float(settings_->bias_limit_rad_s * units_per_rad_s_ * (float)kTurnScale, 0);
-    ki_fine_ = linalg::fixed_from_float(settings_->ki_rp_1_s2 * correction_dt() * units_per_rad_s_ * (float)kTurnScale, 0);
-    kp_units_ = linalg::fixed_from_float(settings_->kp_rp_1_s * units_per_rad_s_, 0);
-    // |lp| = g/2 in correct_tilt's |lp|^2 / 2^30 (lp in accel counts * 2^8).
-    const float half_g_units = 0.5f * kGravity_m_s2 * accel_units_per_m_s2_;
-    min_lp2_ = (uint32_t)(half_g_units * half_g_units * (1.0f / 1073741824.0f));
-}
-
-// |v| >= the limit, from 16x16 products: an axis beyond 16 bits after the shift is.
-bool Dcm::exceeds(const Vector3l& v, const Limit& limit) {
-    const int32_t* axis[3] = {&v.x, &v.y, &v.z};
-    uint32_t sum = 0;  // three squares below 2^30: no overflow
-    for (uint8_t i = 0; i < 3; ++i) {
-        int32_t a = *axis[i];
-        for (uint8_t k = limit.shift; k > 0; --k) a >>= 1;
-        if (a > 32767 || a < -32767) return true;
-        sum += (uint32_t)linalg::mul_s16((int16_t)a, (int16_t)a);
-    }
-    return sum >= limit.limit2;
-}
-
 // The turn sums (units) in Q26 radians, each axis saturated at kMaxTurnAxisQ26: beyond
 // any gyro's range over an integration (2000 deg/s for 20 ms is 0.7 rad), and |theta|^2
 // stays below 2 in Q30. One mul_q30 an axis.
 Vector3l Dcm::theta_q26_in_float(const Vector3l& units) const {
-    const Vector3f t = units.scaled(turn_rad_per_unit() * 67108864.0f);
+    const Vector3f t = units.scaled(k_.turn_rad_per_unit(*settings_) * 67108864.0f);
     const float limit = (float)kMaxTurnAxisQ26;
     return linalg::fixed_from_vector(
         Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit), linalg::constrain(t.z, -limit, limit)),
@@ -276,13 +229,13 @@ Vector3l Dcm::theta_q26_in_float(const Vector3l& units) const {
 }
 
 FIXED_INLINE int32_t Dcm::theta_axis_q26(int32_t units) const {
-    if (units > theta_units_limit_) units = theta_units_limit_;
-    if (units < -theta_units_limit_) units = -theta_units_limit_;
-    return linalg::mul_q30(theta_factor_q30_, units);
+    if (units > k_.theta_units_limit) units = k_.theta_units_limit;
+    if (units < -k_.theta_units_limit) units = -k_.theta_units_limit;
+    return linalg::hot::mul_q30(k_.theta_factor_q30, units);
 }
 
 FIXED_INLINE Vector3l Dcm::theta_q26(const Vector3l& units) const {
-    if (theta_factor_q30_ == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
+    if (k_.theta_factor_q30 == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
     return Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
 }
 
@@ -290,7 +243,7 @@ FIXED_INLINE Vector3l Dcm::theta_q26(const Vector3l& units) const {
 // 1.5e-5 of itself), for a turn that is used in 16 bits: the compass sample's latency
 // turn and the gravity window's turn per step. Unsaturated: both are a few steps' rates.
 FIXED_INLINE Vector3l Dcm::theta_q26_coarse(const Vector3l& units) const {
-    const uint16_t k = theta_q26_per_unit_q15_;
+    const uint16_t k = k_.theta_q26_per_unit_q15;
     if (k == 0) return theta_q26(units);  // scales beyond the 16-bit factor
     return Vector3l(scale_q15(units.x, k), scale_q15(units.y, k), scale_q15(units.z, k));
 }
@@ -314,18 +267,18 @@ Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
         units[i] = in_turn_units(sum) - b[i] * n;
     }
     // Saturated at twice an integration's limit (1.5 rad: still within Q30's 2).
-    if (theta_factor_q30_ == 0) {  // scales beyond the integer factor
+    if (k_.theta_factor_q30 == 0) {  // scales beyond the integer factor
         const float limit = 2.0f * (float)kMaxTurnAxisQ26 / 67108864.0f;
-        const Vector3f t = Vector3l(units[0], units[1], units[2]).scaled(turn_rad_per_unit());
+        const Vector3f t = Vector3l(units[0], units[1], units[2]).scaled(k_.turn_rad_per_unit(*settings_));
         return linalg::fixed_from_vector(Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit),
                                                   linalg::constrain(t.z, -limit, limit)),
                                          linalg::kQ30);
     }
-    const int32_t limit = 2 * theta_units_limit_;
+    const int32_t limit = 2 * k_.theta_units_limit;
     int32_t q30[3];
     for (uint8_t i = 0; i < 3; ++i) {
         const int32_t u = units[i] > limit ? limit : (units[i] < -limit ? -limit : units[i]);
-        q30[i] = linalg::mul_q30(theta_factor_q30_, u) * 16;
+        q30[i] = linalg::mul_q30(k_.theta_factor_q30, u) * 16;
     }
     return Vector3l(q30[0], q30[1], q30[2]);
 }
@@ -350,7 +303,7 @@ void Dcm::learn_field(float norm, float down_component) {
 // The float form: the sample in SI units, held in the integer units of the step
 // (kFloatGyroScale, kFloatAccelScale), after the checks a float sample needs.
 void Dcm::update(const Vector3f& gyro_rad_s, const Vector3f& accel_m_s2, bool line_due) {
-    if (gyro_scale_ != kFloatGyroScale || accel_scale_ != kFloatAccelScale)
+    if (k_.gyro_rad_s_per_count != kFloatGyroScale || k_.accel_m_s2_per_count != kFloatAccelScale)
         set_sample_scales(kFloatGyroScale, kFloatAccelScale);
     // NaN and infinity fail these comparisons too: such samples are rejected.
     const bool gyro_ok = gyro_rad_s.length_squared() < kMaxCredibleRate_rad_s * kMaxCredibleRate_rad_s;
@@ -369,7 +322,7 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
     const Vector3l gyro{gyro_counts.x, gyro_counts.y, gyro_counts.z};
     const Vector3l accel{accel_counts.x, accel_counts.y, accel_counts.z};
     if (!initialised()) {
-        init(accel.scaled(accel_scale_), last_mag_field());
+        init(accel.scaled(k_.accel_m_s2_per_count), last_mag_field());
         return;
     }
     step(gyro, accel, gyro_valid, accel_valid, line_due);
@@ -396,8 +349,8 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
         status_ |= kStatusGyroRejected;
         rotating_fast_ = true;  // a broken gyro read: no bias learning on it (below, correct_gravity)
     }
-    // Start-up (steps_ < startup_steps_): faster gains, no bias learning (correct_gravity).
-    if (rotating_fast_ || steps_ < startup_steps_) status_ |= kStatusBiasHeld;
+    // Start-up (steps_ < k_.startup_steps): faster gains, no bias learning (correct_gravity).
+    if (rotating_fast_ || steps_ < k_.startup_steps) status_ |= kStatusBiasHeld;
 
     // Gravity. The specific force is low-passed in the (estimated) earth frame, as
     // VQF does: there a linear acceleration averages out over the filter's time,
@@ -475,20 +428,20 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     // bias clip): a larger vertical bias is then not told from a slow turn.
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
     const Vector3l gyro_change = gyro_mean - rest_gyro_mean_, accel_change = accel_mean - rest_accel_mean_;
-    const bool still = !exceeds(gyro_change, rest_gyro_dev_) && (compass_watching || !exceeds(mean_off_bias, rest_gyro_dev_)) &&
-                       !exceeds(accel_change, rest_accel_dev_);
+    const bool still = !exceeds(gyro_change, k_.rest_gyro_dev) && (compass_watching || !exceeds(mean_off_bias, k_.rest_gyro_dev)) &&
+                       !exceeds(accel_change, k_.rest_accel_dev);
     // The means' low-pass, its factor in 16 bits (two 16x16 products an axis), its step
     // rounded to the unit (the changes are counts * 2^8, far below 2^29).
-    using linalg::mul_q14_unit;
-    rest_gyro_mean_ += Vector3l(mul_q14_unit(rest_alpha_q14_, gyro_change.x), mul_q14_unit(rest_alpha_q14_, gyro_change.y),
-                                mul_q14_unit(rest_alpha_q14_, gyro_change.z));
-    rest_accel_mean_ += Vector3l(mul_q14_unit(rest_alpha_q14_, accel_change.x),
-                                 mul_q14_unit(rest_alpha_q14_, accel_change.y), mul_q14_unit(rest_alpha_q14_, accel_change.z));
+    using linalg::hot::mul_q14_unit;
+    rest_gyro_mean_ += Vector3l(mul_q14_unit(k_.rest_alpha_q14, gyro_change.x), mul_q14_unit(k_.rest_alpha_q14, gyro_change.y),
+                                mul_q14_unit(k_.rest_alpha_q14, gyro_change.z));
+    rest_accel_mean_ += Vector3l(mul_q14_unit(k_.rest_alpha_q14, accel_change.x),
+                                 mul_q14_unit(k_.rest_alpha_q14, accel_change.y), mul_q14_unit(k_.rest_alpha_q14, accel_change.z));
     if (!still || !whole_window) {
         rest_corrections_ = 0;
         return;
     }
-    if (rest_corrections_ < rest_min_corrections_) {
+    if (rest_corrections_ < k_.rest_min_corrections) {
         ++rest_corrections_;
         return;
     }
@@ -501,7 +454,7 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
         int32_t difference = *mean[i] - (*fine[i] >> 8);
         if (difference > kMaxRestDifference) difference = kMaxRestDifference;
         if (difference < -kMaxRestDifference) difference = -kMaxRestDifference;
-        *fine[i] += mul_q30(rest_bias_alpha_q30_, (int32_t)((uint32_t)difference << 8) - (*fine[i] & 0xFF));
+        *fine[i] += mul_q30(k_.rest_bias_alpha_q30, (int32_t)((uint32_t)difference << 8) - (*fine[i] & 0xFF));
     }
     clamp_bias();
 }
@@ -511,8 +464,8 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
 void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
     gravity_due_ = false;
-    const bool starting = steps_ < startup_steps_;
-    const float startup_left = starting ? 1.0f - (float)steps_ * inv_startup_steps_ : 0.0f;
+    const bool starting = steps_ < k_.startup_steps;
+    const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
     // No bias learning while rotating fast: gyro scale errors look like bias there
     // (ArduPilot's rule). What counts is the turn that lasts, the 0.5 s mean rate of
     // the rest test: a scale error on a vibration (an 8 Hz wobble at 50 deg/s) makes an
@@ -520,10 +473,10 @@ void Dcm::correct_gravity() {
     // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
     // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
     const Vector3l mean_off_bias = rest_gyro_mean_ - bias_units();  // the rest mean's turn (units)
-    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, hold_rate_);
+    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
-        using linalg::mul_q14;
+        using linalg::hot::mul_q14;
         using linalg::mul_q30;
         using linalg::q14_of;
         const uint8_t n = window_samples_;
@@ -555,9 +508,9 @@ void Dcm::correct_gravity() {
         const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
                             accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
                             accel_sum.z - mul_q14(tx, weighted.y) + mul_q14(ty, weighted.x));
-        const int32_t alpha = starting ? q30_of(startup_accel_alpha_ + (linalg::float_from_fixed(accel_alpha_q30_, 30) -
-                                                                        startup_accel_alpha_) * (1.0f - startup_left))
-                                       : accel_alpha_q30_;
+        const int32_t alpha = starting ? q30_of(k_.startup_accel_alpha + (linalg::float_from_fixed(k_.accel_alpha_q30, 30) -
+                                                                        k_.startup_accel_alpha) * (1.0f - startup_left))
+                                       : k_.accel_alpha_q30;
         // Into earth axes by the matrix in 16 bits (its rounding turns the earth-frame
         // force by 6e-5 rad at most, 0.003 deg of tilt), the mean, and the low-pass.
         const Vector3l accel_ef = per(
@@ -590,8 +543,8 @@ void Dcm::correct_gravity() {
 // it stretches each row by a^2/2 an update, which renormalising at every update hid.
 void Dcm::integrate() {
     profile::begin(profile::kIntegration);
-    using linalg::mul_q14;
-    using linalg::mul_q30;
+    using linalg::hot::mul_q14;
+    using linalg::hot::mul_q30;
     using linalg::q14_of;
     // In Q30 integers (R's entries and the turn, radians): mul_q30 (13 MULs) where the
     // update's orthonormality depends on the product; mul_q14 (two 16x16 products) in the
@@ -656,7 +609,7 @@ void Dcm::renormalise_rows() {
 
 // One row of R turned: r + r D (D = exp([theta x]) - I, rows as Matrix3q30), in Q30.
 void Dcm::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
-    using linalg::mul_q30;
+    using linalg::hot::mul_q30;
     r = Vector3l(r.x + mul_q30(r.x, d.a.x) + mul_q30(r.y, d.b.x) + mul_q30(r.z, d.c.x),
                  r.y + mul_q30(r.x, d.a.y) + mul_q30(r.y, d.b.y) + mul_q30(r.z, d.c.y),
                  r.z + mul_q30(r.x, d.a.z) + mul_q30(r.y, d.b.z) + mul_q30(r.z, d.c.z));
@@ -666,17 +619,17 @@ Vector3l Dcm::pending_turn_units() const {
     return first_half_ + turn_sum_;
 }
 
-Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(turn_rad_per_unit()); }
+Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit(*settings_)); }
 
 Vector3l Dcm::last_rate_units() const {
     return Vector3l(in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
                     in_turn_units(last_gyro_.z) - offset_units_.z);
 }
 
-Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(gyro_scale_ * (1.0f / (float)kTurnScale)); }
+Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(k_.gyro_rad_s_per_count * (1.0f / (float)kTurnScale)); }
 
 void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
-    using linalg::fixed_from_float;
+    using linalg::hot::fixed_from_float;
     using linalg::mul_q30;
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). |lp|^2 / 2^30
     // in integers (a thousandth of its value at least: 1 g is 2^20 units at 8 g full
@@ -684,7 +637,7 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // rest in Q30.
     const Vector3l& lp = accel_lp_ef_;
     const uint32_t lp2 = (uint32_t)mul_q30(lp.x, lp.x) + (uint32_t)mul_q30(lp.y, lp.y) + (uint32_t)mul_q30(lp.z, lp.z);
-    if (lp2 <= min_lp2_) {  // |lp| < g/2: no direction to trust
+    if (lp2 <= k_.min_lp2) {  // |lp| < g/2: no direction to trust
         correction_units_ = Vector3l();
         return;
     }
@@ -696,7 +649,7 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const int32_t e = (int32_t)((uint32_t)mul_q30(lp.x, inv_lp_q34) << 11);
     // In body axes: R^T (error_n, error_e, 0), the matrix in 16 bits (an error of 6e-5 of
     // the correction).
-    using linalg::mul_q14;
+    using linalg::hot::mul_q14;
     using linalg::q14_of;
     const Vector3l error(mul_q14(q14_of(r_.a.x), n) + mul_q14(q14_of(r_.b.x), e),
                          mul_q14(q14_of(r_.a.y), n) + mul_q14(q14_of(r_.b.y), e),
@@ -706,19 +659,19 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
                          : settings_->kp_rp_1_s;
     // kp error in units: the error in 16 bits (Q14: steps of 6e-5 rad, 0.003 deg of tilt)
     // times the gain in units per rad/s.
-    const int32_t kp_units = startup_left > 0.0f ? fixed_from_float(kp * units_per_rad_s_, 0) : kp_units_;
+    const int32_t kp_units = startup_left > 0.0f ? fixed_from_float(kp * k_.units_per_rad_s, 0) : k_.kp_units;
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
-        bias_fine_.x -= mul_q14(ex, ki_fine_);
-        bias_fine_.y -= mul_q14(ey, ki_fine_);
-        bias_fine_.z -= mul_q14(ez, ki_fine_);
+        bias_fine_.x -= mul_q14(ex, k_.ki_fine);
+        bias_fine_.y -= mul_q14(ey, k_.ki_fine);
+        bias_fine_.z -= mul_q14(ez, k_.ki_fine);
         clamp_bias();
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
     // with it ((e_n, e_e, 0) x lp, scaled).
-    const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt(), linalg::kQ30) : tilt_turn_q30_;
+    const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt_s(*settings_), linalg::kQ30) : k_.tilt_turn_q30;
     const int32_t turn_n = mul_q14(q14_of(n), turn), turn_e = mul_q14(q14_of(e), turn);
     const Vector3l old = accel_lp_ef_;
     accel_lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),
@@ -739,7 +692,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     int16_t axis[3];
     uint32_t sample_norm2 = 0;  // uT^2 * 2^(2 kFieldQ - kNorm2Shift)
     for (uint8_t i = 0; i < 3; ++i) {
-        const int32_t q = fixed_from_float(*in[i], kFieldQ);
+        const int32_t q = linalg::hot::fixed_from_float(*in[i], kFieldQ);
         if (q >= kMaxFieldQ || q <= -kMaxFieldQ) {  // beyond any compass: garbage
             status_ |= kStatusMagIgnored;
             return;
@@ -762,7 +715,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
         // The first field sample after a start without one: take its heading as is.
-        init(last_accel_.scaled(accel_scale_), mag_field);
+        init(last_accel_.scaled(k_.accel_m_s2_per_count), mag_field);
         return;
     }
 
@@ -775,10 +728,10 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // Both in the turn sums' units (the rate per step times the latency in steps, Q12,
     // less the pending turn), then in radians as the integration takes them.
     const uint8_t age = age_steps < kMaxMagAgeSteps ? age_steps : kMaxMagAgeSteps;
-    const int16_t latency_q12 = (int16_t)(mag_latency_steps_q12_ + (int16_t)((uint16_t)age << 12));
+    const int16_t latency_q12 = (int16_t)(k_.mag_latency_steps_q12 + (int16_t)((uint16_t)age << 12));
     const Vector3l rate = last_rate_units(), pending = pending_turn_units();
-    const Vector3l turn(linalg::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::mul_q14(latency_q12, rate.y) * 4 - pending.y,
-                        linalg::mul_q14(latency_q12, rate.z) * 4 - pending.z);
+    const Vector3l turn(linalg::hot::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::hot::mul_q14(latency_q12, rate.y) * 4 - pending.y,
+                        linalg::hot::mul_q14(latency_q12, rate.z) * 4 - pending.z);
     // field + field x turn, the turn in Q16 radians (saturated at 0.5): Q21, then Q5 again.
     const Vector3l t = theta_q26_coarse(turn);
     const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);
@@ -848,8 +801,8 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         const float candidate_alpha = sample_dt / (kCandidateTau_s + sample_dt);
         mag_candidate_norm_ += candidate_alpha * (norm - mag_candidate_norm_);
         mag_candidate_down_ += candidate_alpha * (down_component - mag_candidate_down_);
-        if (!forgotten && (mag_steady_steps_ < mag_recover_steps_ ||
-                           mag_steady_turn_rad_ < mag_new_min_turn_rad_)) return;
+        if (!forgotten && (mag_steady_steps_ < k_.mag_recover_steps ||
+                           mag_steady_turn_rad_ < k_.mag_new_min_turn_rad)) return;
         // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
         // (the rotation that puts the field's horizontal part on north).
         learn_field(norm, down_component);
@@ -884,12 +837,12 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // correction, so its rate is scaled by interval / step.
     if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
     const float steps = (float)interval_steps;
-    const bool starting = steps_ < startup_steps_;
+    const bool starting = steps_ < k_.startup_steps;
     // Into the turn not yet integrated (applied with the next integration): the row in
     // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
     // = 2.4e7 units: within 31 bits).
     const int32_t size_units = linalg::fixed_from_float(
-        -heading_error * (starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps * units_per_rad_s_, 0);
+        -heading_error * (starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps * k_.units_per_rad_s, 0);
     using linalg::q14_of;
     turn_sum_.x += linalg::mul_q14(q14_of(r_.c.x), size_units);
     turn_sum_.y += linalg::mul_q14(q14_of(r_.c.y), size_units);
@@ -897,7 +850,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
         const Vector3f error = linalg::vector_from_q30(r_.c) * -heading_error;
         bias_fine_ -= linalg::fixed_from_vector(
-            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * units_per_rad_s_ * (float)kTurnScale), 0);
+            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0);
         clamp_bias();
         update_offset();
     }
@@ -906,7 +859,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
 EulerQ24 Dcm::euler_now_q24() const {
     // R carried forward by the lead and any turn not yet integrated (at most one step
     // when the update was told a line is due), in fixed point.
-    if (theta_q26_per_unit_q15_ == 0) {  // scales beyond the integer path's factors: in float
+    if (k_.theta_q26_per_unit_q15 == 0) {  // scales beyond the integer path's factors: in float
         const Vector3f theta_rad = last_rate_rad_s() * settings_->output_lead_s + pending_turn_rad();
         return euler_carried_q24(r_, linalg::fixed_from_float(theta_rad.x, 26),
                                  linalg::fixed_from_float(theta_rad.y, 26), linalg::fixed_from_float(theta_rad.z, 26));
@@ -915,7 +868,7 @@ EulerQ24 Dcm::euler_now_q24() const {
     // times the radians per unit, each factor Q15 (16x16 multiplies: the float path
     // cost ~2.2 k cycles a line).
     const Vector3l rate = last_rate_units(), pending = pending_turn_units();
-    const uint16_t lead = lead_steps_q15_, k = theta_q26_per_unit_q15_;
+    const uint16_t lead = k_.lead_steps_q15, k = k_.theta_q26_per_unit_q15;
     return euler_carried_q24(r_, scale_q15(pending.x + scale_q15(rate.x, lead), k),
                              scale_q15(pending.y + scale_q15(rate.y, lead), k),
                              scale_q15(pending.z + scale_q15(rate.z, lead), k));
@@ -934,8 +887,8 @@ bool Dcm::field_matches(float norm, float down_component, float ref_norm, float 
 void Dcm::clamp_bias() {
     int32_t* axis[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
     for (uint8_t i = 0; i < 3; ++i) {
-        if (*axis[i] > bias_limit_fine_) *axis[i] = bias_limit_fine_;
-        if (*axis[i] < -bias_limit_fine_) *axis[i] = -bias_limit_fine_;
+        if (*axis[i] > k_.bias_limit_fine) *axis[i] = k_.bias_limit_fine;
+        if (*axis[i] < -k_.bias_limit_fine) *axis[i] = -k_.bias_limit_fine;
     }
 }
 
@@ -986,7 +939,7 @@ bool Dcm::rescale(const Vector3l& row, Vector3l& out) {
 void Dcm::recover() {
     ++recoveries_;
     status_ |= kStatusRecovered;
-    if (!init(last_accel_.scaled(accel_scale_), last_mag_field())) r_ = linalg::q30_from_matrix(Matrix3f::identity());
+    if (!init(last_accel_.scaled(k_.accel_m_s2_per_count), last_mag_field())) r_ = linalg::q30_from_matrix(Matrix3f::identity());
 }
 
 }  // namespace dcm

@@ -4,6 +4,70 @@
 
 namespace linalg {
 
+// The ordinary (called) forms of the hot list's inline helpers (Fixed.h).
+int32_t fixed_from_float(float x, uint8_t frac_bits) { return hot::fixed_from_float(x, frac_bits); }
+#ifdef __AVR__
+// The called form in the registers the call brings its operands in (a in r22..r25,
+// x in r18..r21, the result in r22..r25) and the call-clobbered r26, r27, r30, r31
+// for the sum: no register to save, where the inline form's register choice made the
+// called copy save fourteen. The same sums as mul_u32_shr30 in another order: the
+// products of a's and x's low bytes first, so that those two registers take the
+// sum's two high bytes. The sign of the product waits in the T flag.
+int32_t mul_q30(int32_t a, int32_t x) {
+    register int32_t ra asm("r22") = a;
+    register int32_t rx asm("r18") = x;
+    __asm__(
+        "mov  r26, %D[a]\n\t" "eor r26, %D[x]\n\t" "bst r26, 7\n\t"       // T: the product's sign
+        "sbrs %D[a], 7\n\t" "rjmp 1f\n\t"                                   // a = |a|
+        "com  %D[a]\n\t" "com %C[a]\n\t" "com %B[a]\n\t" "neg %A[a]\n\t"
+        "sbci %B[a], 0xFF\n\t" "sbci %C[a], 0xFF\n\t" "sbci %D[a], 0xFF\n"
+        "1:\n\t"
+        "sbrs %D[x], 7\n\t" "rjmp 2f\n\t"                                   // x = |x|
+        "com  %D[x]\n\t" "com %C[x]\n\t" "com %B[x]\n\t" "neg %A[x]\n\t"
+        "sbci %B[x], 0xFF\n\t" "sbci %C[x], 0xFF\n\t" "sbci %D[x], 0xFF\n"
+        "2:\n\t"
+        // bytes 3, 4, 5 of the product in r26, r27, r30; r31 zero
+        "clr  r26\n\t" "clr r27\n\t" "clr r30\n\t" "clr r31\n\t"
+        // i + j = 2: the high bytes into byte 3
+        "mul  %A[a], %C[x]\n\t" "add r26, r1\n\t" "adc r27, r31\n\t"
+        "mul  %B[a], %B[x]\n\t" "add r26, r1\n\t" "adc r27, r31\n\t"
+        "mul  %C[a], %A[x]\n\t" "add r26, r1\n\t" "adc r27, r31\n\t"
+        // i + j = 3 at byte 3
+        "mul  %A[a], %D[x]\n\t" "add r26, r0\n\t" "adc r27, r1\n\t" "adc r30, r31\n\t"
+        "mul  %B[a], %C[x]\n\t" "add r26, r0\n\t" "adc r27, r1\n\t" "adc r30, r31\n\t"
+        "mul  %C[a], %B[x]\n\t" "add r26, r0\n\t" "adc r27, r1\n\t" "adc r30, r31\n\t"
+        "mul  %D[a], %A[x]\n\t" "add r26, r0\n\t" "adc r27, r1\n\t" "adc r30, r31\n\t"
+        // a's and x's low bytes are done with: byte 6 in %A[x], byte 7 in %A[a]
+        "clr  %A[x]\n\t" "clr %A[a]\n\t"
+        // i + j = 4 at byte 4
+        "mul  %B[a], %D[x]\n\t" "add r27, r0\n\t" "adc r30, r1\n\t" "adc %A[x], r31\n\t"
+        "mul  %C[a], %C[x]\n\t" "add r27, r0\n\t" "adc r30, r1\n\t" "adc %A[x], r31\n\t"
+        "mul  %D[a], %B[x]\n\t" "add r27, r0\n\t" "adc r30, r1\n\t" "adc %A[x], r31\n\t"
+        // i + j = 5 at byte 5
+        "mul  %C[a], %D[x]\n\t" "add r30, r0\n\t" "adc %A[x], r1\n\t" "adc %A[a], r31\n\t"
+        "mul  %D[a], %C[x]\n\t" "add r30, r0\n\t" "adc %A[x], r1\n\t" "adc %A[a], r31\n\t"
+        // i + j = 6 at byte 6
+        "mul  %D[a], %D[x]\n\t" "add %A[x], r0\n\t" "adc %A[a], r1\n\t"
+        // bits 30..61: (bytes 3..7) << 2, bytes 4..7
+        "lsl  r26\n\t" "rol r27\n\t" "rol r30\n\t" "rol %A[x]\n\t" "rol %A[a]\n\t"
+        "lsl  r26\n\t" "rol r27\n\t" "rol r30\n\t" "rol %A[x]\n\t" "rol %A[a]\n\t"
+        "mov  %D[a], %A[a]\n\t" "mov %C[a], %A[x]\n\t" "mov %B[a], r30\n\t" "mov %A[a], r27\n\t"
+        "brtc 3f\n\t"                                                         // the sign
+        "com  %D[a]\n\t" "com %C[a]\n\t" "com %B[a]\n\t" "neg %A[a]\n\t"
+        "sbci %B[a], 0xFF\n\t" "sbci %C[a], 0xFF\n\t" "sbci %D[a], 0xFF\n"
+        "3:\n\t"
+        "clr  r1"
+        : [a] "+r"(ra), [x] "+r"(rx)
+        :
+        : "r26", "r27", "r30", "r31", "cc");
+    return ra;
+}
+#else
+int32_t mul_q30(int32_t a, int32_t x) { return hot::mul_q30(a, x); }
+#endif
+int32_t mul_q14(int16_t r, int32_t x) { return hot::mul_q14(r, x); }
+int32_t mul_q14_unit(int16_t r, int32_t x) { return hot::mul_q14_unit(r, x); }
+
 int32_t dot_q30(const Vector3l& r, const Vector3l& v) { return mul_q30(r.x, v.x) + mul_q30(r.y, v.y) + mul_q30(r.z, v.z); }
 
 Vector3l cross_q30(const Vector3l& r, const Vector3l& v) {

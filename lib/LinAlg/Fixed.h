@@ -1,13 +1,30 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Fixed-point helpers for the output path (Euler angles): integer arithmetic on the
-// 2560's hardware multiplier instead of float calls (a float multiply is ~170 cycles,
-// a division ~510, a 16x16->32 integer multiply ~25), and bit-identical results on the
-// board and on the host (the replay tool).
+// Fixed-point helpers: integer arithmetic on the 2560's hardware multiplier instead of
+// float calls (a float multiply is ~170 cycles, a division ~510, a 16x16->32 integer
+// multiply ~25), with bit-identical results on the board and on the host (replay).
+// The estimator (lib/DCM) and the Euler output run on them.
 //
-// Formats: Qn means value * 2^n in an int32_t. Rotation-matrix entries are Q30
-// (|entry| <= 1, headroom to 2); angles are Q24 radians (6e-8 rad steps; a whole
-// number of bytes from the Q32 the tables give: shifts by 8 are register moves on
-// the AVR, other constant shifts of 32-bit words a loop of ~6 cycles per bit).
+// Formats: Qn is value * 2^n in an int32_t (or int16_t where it says so).
+//   Q30   rotation-matrix entries and factors, |v| < 2 (1 = 2^30)      mul_q30, q30_of
+//   Q26   turns in radians, |theta| < 32 (the DCM's integration)
+//   Q24   angles in radians (6e-8 rad steps), kPiQ24 ...             atan2_q24, centideg_from_q24
+//   Q14   a Q30 entry rounded to 16 bits (int16_t)                   q14_of, mul_q14
+//   Q31   ratios in [0, 1] (unsigned)                                atan_of_ratio_q24, hypot_from_ratio
+//   Q0    whole units: fixed_from_float(x, 0)
+// Whole bytes of a shift are register moves on the AVR, other constant shifts of a
+// 32-bit word a loop of ~6 cycles a bit: the formats are chosen for byte shifts.
+//
+// Inlining is decided per call site, by the profile (`make bench`'s step parts):
+//   - FIXED_INLINE helpers are a few instructions (mul_s16, mul_u16, q14_of ...): forced
+//     inline everywhere, cheaper than a call.
+//   - mul_q30, mul_q14, mul_q14_unit and fixed_from_float are ordinary calls
+//     (linalg::mul_q30 ...; mul_q30's called form keeps to the call-clobbered
+//     registers, Fixed.cpp); the hot list takes their forced-inline copies from
+//     namespace linalg::hot, one `using linalg::hot::...` at the top of the function:
+//     the DCM's integration (Strapdown), the gravity window's products and the field
+//     sample's latency turn (each runs at 50 to 200 Hz). Cold code (start-up, the
+//     float paths, renormalisation, a new field's heading, the learner's solve) calls.
+//   - The Euler output (atan2_q24 ...) runs once a line, all inline (its own target).
 #pragma once
 
 #include <stdint.h>
@@ -15,15 +32,17 @@
 
 #include "LinAlg.h"
 
-// Small helpers on the output path forced inline on the AVR: out of line, -mcall-prologues
-// gives each one the register-saving routines (~40 cycles a call) whatever the
-// optimisation level.
+// FIXED_INLINE: forced inline on the AVR (out of line, -mcall-prologues gives each call
+// the register-saving routines). FIXED_COLD: never inline (one copy of cold code that
+// would otherwise be copied into each caller).
 #ifdef __AVR__
 #define FIXED_INLINE __attribute__((always_inline)) inline
+#define FIXED_COLD __attribute__((noinline))
 #include <avr/pgmspace.h>
 #define FIXED_PROGMEM PROGMEM
 #else
 #define FIXED_INLINE inline
+#define FIXED_COLD
 #define FIXED_PROGMEM
 #endif
 
@@ -88,6 +107,7 @@ FIXED_INLINE uint32_t mul_u24_u8(uint32_t m, uint8_t p) {
 // x * 2^frac_bits, truncated toward zero, read from the float's bits (no float call;
 // inline, ~55 cycles on the AVR: whole bytes are register moves, the remaining 0..7
 // bits one mul_u24_u8): saturates at +-(2^31 - 1) (infinities too); NaN gives 0.
+namespace hot {
 FIXED_INLINE int32_t fixed_from_float(float x, uint8_t frac_bits) {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
@@ -113,6 +133,9 @@ FIXED_INLINE int32_t fixed_from_float(float x, uint8_t frac_bits) {
     }
     return (bits & 0x80000000u) ? -(int32_t)m : (int32_t)m;
 }
+}  // namespace hot
+// The same as an ordinary call (Fixed.cpp): where no cycle matters.
+int32_t fixed_from_float(float x, uint8_t frac_bits);
 
 // q * 2^-frac_bits (frac_bits <= 100), rounded to float's 24 bits.
 inline float float_from_fixed(int32_t q, uint8_t frac_bits) {
@@ -257,10 +280,13 @@ FIXED_INLINE uint32_t mul_u32_shr30(uint32_t a, uint32_t x) {
 // fit in 31 bits), within 1 unit of the exact product (toward zero): mul_u32_shr30 on the
 // magnitudes, ~100 cycles on the AVR where a float multiply is ~170 and a float add
 // ~130; the same bits on the host.
+namespace hot {
 FIXED_INLINE int32_t mul_q30(int32_t a, int32_t x) {
     const uint32_t m = mul_u32_shr30(magnitude(a), magnitude(x));
     return (a < 0) != (x < 0) ? -(int32_t)m : (int32_t)m;
 }
+}  // namespace hot
+int32_t mul_q30(int32_t a, int32_t x);  // Fixed.cpp: an ordinary call
 
 // r * x / 2^14 for a Q14 factor r (a Q30 matrix entry rounded to 16 bits: q14_of) and
 // any x: two 16x16 products, half of mul_q30's cost, within 4 units of x's scale plus
@@ -269,6 +295,7 @@ FIXED_INLINE int32_t mul_q30(int32_t a, int32_t x) {
 // garbage matrix, instead of overflowing.)
 FIXED_INLINE int16_t q14_of(int32_t e_q30) { return (int16_t)(uint16_t)(((uint32_t)e_q30 + 0x8000u) >> 16); }
 // r * x / 2^16 rounded, from two 16x16 products (x = xh 2^16 + xl, xl signed).
+namespace hot {
 FIXED_INLINE int32_t mul_s16_shr16(int16_t r, int32_t x) {
     const int16_t xl = (int16_t)(uint16_t)x;
     const int16_t xh = (int16_t)(uint16_t)(((uint32_t)x - (uint32_t)(int32_t)xl) >> 16);
@@ -280,6 +307,10 @@ FIXED_INLINE int32_t mul_q14(int16_t r, int32_t x) { return (int32_t)((uint32_t)
 // multiples stops 50 units short of the mean it follows (Dcm::detect_rest's rest means:
 // their offset became the gyro bias, rest_bias 0.02 -> 0.09 deg).
 FIXED_INLINE int32_t mul_q14_unit(int16_t r, int32_t x) { return mul_s16_shr16(r, (int32_t)((uint32_t)x << 2)); }
+}  // namespace hot
+// The same as ordinary calls (Fixed.cpp).
+int32_t mul_q14(int16_t r, int32_t x);
+int32_t mul_q14_unit(int16_t r, int32_t x);
 
 // The rows' dot product and cross product, each term by mul_q30: Q30 rows give a Q30
 // result; a Q30 row with a vector in other units gives that vector's units.
