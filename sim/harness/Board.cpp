@@ -526,6 +526,11 @@ uint64_t Board::on_link_tick() {
         const std::string event = options_.serial->poll(received);
         if (!event.empty()) std::fprintf(stderr, "apm25sim: t=%.3f s: tcp:%d %s\n", time_s(), options_.serial->port(), event.c_str());
         if (!received.empty()) {
+            if (input_pos_ > 65536) {  // a long session: what has been typed is not kept
+                options_.input.erase(0, input_pos_);
+                input_consumed_ += input_pos_;
+                input_pos_ = 0;
+            }
             options_.input += received;
             if (input_started_) arm_input();
         }
@@ -782,8 +787,12 @@ void Board::print_counters(FILE* out) const {
                  h.transactions, h.bytes_written, h.bytes_read, h.samples, h.samples_dropped_by_lock,
                  h.nacked_while_absent, h.writes_to_read_only, h.reads_of_invalid_register, bus_violations_,
                  profile_errors_);
-    std::fprintf(out, "# apm25sim: UART0 input %zu of %zu bytes typed, %llu character times held by XOFF\n",
-                 input_pos_, options_.input.size(), (unsigned long long)uart_input_held_chars_);
+    std::fprintf(out, "# apm25sim: UART0 input %llu of %llu bytes typed, %llu character times held by XOFF\n",
+                 (unsigned long long)(input_consumed_ + input_pos_),
+                 (unsigned long long)(input_consumed_ + options_.input.size()), (unsigned long long)uart_input_held_chars_);
+    if (options_.serial)
+        std::fprintf(out, "# apm25sim: tcp:%d: %llu TX bytes dropped (client not reading)\n", options_.serial->port(),
+                     (unsigned long long)options_.serial->dropped());
     if (ppm_)
         std::fprintf(out, "# apm25sim: PPM frames begun %lu; ICP5 fed %s\n", ppm_->frames(),
                      ppm_icp_irq_ ? "through Timer5's capture IRQ (the core leaves the pin unwired)"

@@ -166,6 +166,7 @@ private:
     bool uart_input_held_ = false;        // simavr's receive FIFO is full (XOFF)
     uint64_t uart_input_held_chars_ = 0;  // character times the input waited for it
     size_t input_pos_ = 0;
+    uint64_t input_consumed_ = 0;         // bytes typed and dropped from `input` (a live client's)
     bool input_timer_armed_ = false;      // uart_input_timer is registered
     Pacer pacer_{0.0};
 
