@@ -775,8 +775,9 @@ TEST(Pipeline, MagCalibrationCommand) {
     for (int i = 0; i < 250; ++i) p.on_imu_sample(imu(kBias, kLevel));
     p.start_mag_calibration();
     EXPECT_TRUE(p.mag_calibrating());
-    // Only turned about z: the check must fail and keep the old calibration.
-    for (int i = 0; i < calib::kMagCalSeconds * 200; ++i) {
+    // Only turned about z: the check must fail and keep the old calibration (the fit
+    // goes a part a step after the 30 s: a few more steps).
+    for (int i = 0; i < calib::kMagCalSeconds * 200 + 2 * calib::MagCalibrator::kFitParts; ++i) {
         const float a = (float)i * 0.01f;
         if (i % 3 == 0) p.on_mag_sample(Vector3f(30.0f * cosf(a), 30.0f * sinf(a), 40.0f));
         p.on_imu_sample(imu(kBias, kLevel));

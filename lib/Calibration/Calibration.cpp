@@ -164,7 +164,7 @@ constexpr uint8_t kX = 1, kY = 4, kZ = 16, kOne = 0;
 // Solves the n x n system held as an augmented matrix a[n][n+1] (Gaussian elimination
 // with partial pivoting); the solution replaces column n. False when a pivot is below
 // 1e-6 of the largest diagonal term: the fit is not determined.
-constexpr uint8_t kMaxUnknowns = 9;
+constexpr uint8_t kMaxUnknowns = 4;
 bool solve(float a[][kMaxUnknowns + 1], uint8_t n) {
     float scale = 0.0f;
     for (uint8_t i = 0; i < n; ++i) scale = a[i][i] > scale ? a[i][i] : scale;
@@ -199,33 +199,37 @@ Matrix3f newton_schulz_t(const Matrix3f& zy) {
                     Vector3f(-0.5f * zy.b.x, 1.5f - 0.5f * zy.b.y, -0.5f * zy.b.z),
                     Vector3f(-0.5f * zy.c.x, -0.5f * zy.c.y, 1.5f - 0.5f * zy.c.z));
 }
-bool sqrt_near_identity(const Matrix3f& a, Matrix3f& root) {
-    // The first step, from Z = I, written out: T = (3I - A) / 2 and Z = T (an identity
-    // matrix object would be a 36-byte constant in the AVR's SRAM).
-    Matrix3f z = newton_schulz_t(a);
-    Matrix3f y = a * z;
-    for (uint8_t it = 1; it < 8; ++it) {
-        const Matrix3f t = newton_schulz_t(z * y);
-        y = y * t;
-        z = t * z;
-    }
-    root = y;
-    const Matrix3f d = y * y - a;
-    const float err = d.a.length_squared() + d.b.length_squared() + d.c.length_squared();
-    return err < 1e-8f && y.is_finite();
+// A 3x3 matrix kept as nine floats, row by row (the fit's working memory is a union).
+Matrix3f matrix_of(const float* m) {
+    return Matrix3f(Vector3f(m[0], m[1], m[2]), Vector3f(m[3], m[4], m[5]), Vector3f(m[6], m[7], m[8]));
 }
+void store(const Matrix3f& x, float* m) {
+    const Vector3f rows[3] = {x.a, x.b, x.c};
+    for (uint8_t r = 0; r < 3; ++r) {
+        m[3 * r] = rows[r].x;
+        m[3 * r + 1] = rows[r].y;
+        m[3 * r + 2] = rows[r].z;
+    }
+}
+
+// Row i's first entry in a packed lower triangle.
+uint8_t row_start(uint8_t i) { return (uint8_t)((i * (i + 1u)) >> 1); }
 
 }  // namespace
 
 void MagCalibrator::restart(const Vector3f& pivot_uT) {
-    for (uint8_t i = 0; i < kMoments; ++i) sums_[i] = 0.0f;
+    for (uint8_t i = 0; i < kMoments; ++i) work_.sums[i] = 0.0f;
+    count_ = 0;
+    stage_ = kStageDone;
+    quality_ = Quality::TooFewSamples;
     for (uint8_t& b : cell_samples_) b = 0;
     pivot_uT_ = cover_centre_uT_ = pivot_uT.is_finite() ? pivot_uT : Vector3f();
     residual_uT_ = sphere_residual_uT_ = radius_uT_ = 0.0f;
 }
 
 void MagCalibrator::add(const Vector3f& field_uT) {
-    if (!field_uT.is_finite() || count() == 0xFFFFu) return;
+    if (!field_uT.is_finite() || count_ == 0xFFFFu || stage_ != kStageDone) return;
+    ++count_;
     // The monomials in index order, each one a product of a lower one: 31 multiplies.
     const Vector3f u = (field_uT - pivot_uT_) * kFitInvScale;
     const float var[3] = {u.x, u.y, u.z};
@@ -243,7 +247,7 @@ void MagCalibrator::add(const Vector3f& field_uT) {
             }
         }
     }
-    for (uint8_t i = 0; i < kMoments; ++i) sums_[i] += m[i];
+    for (uint8_t i = 0; i < kMoments; ++i) work_.sums[i] += m[i];
 
     // Coverage: the direction from the centre (the sphere fit so far, refreshed each
     // kCoverageRefitSamples; the pivot before), quantised to one of 26 cells by the
@@ -287,12 +291,12 @@ bool MagCalibrator::fit_sphere() {
     float tt;  // sum |u|^4
     for (uint8_t p = 0; p < 4; ++p) {
         const uint8_t rp = table_byte(kReg, p);
-        for (uint8_t q = 0; q < 4; ++q) a[p][q] = sums_[moment_of_sum(rp, table_byte(kReg, q))];
-        a[p][4] = sums_[moment_of_sum(rp, 2 * kX)] + sums_[moment_of_sum(rp, 2 * kY)] +
-                  sums_[moment_of_sum(rp, 2 * kZ)];
+        for (uint8_t q = 0; q < 4; ++q) a[p][q] = work_.sums[moment_of_sum(rp, table_byte(kReg, q))];
+        a[p][4] = work_.sums[moment_of_sum(rp, 2 * kX)] + work_.sums[moment_of_sum(rp, 2 * kY)] +
+                  work_.sums[moment_of_sum(rp, 2 * kZ)];
     }
-    tt = sums_[moment_index(4, 0, 0)] + sums_[moment_index(0, 4, 0)] + sums_[moment_index(0, 0, 4)] +
-         2.0f * (sums_[moment_index(2, 2, 0)] + sums_[moment_index(2, 0, 2)] + sums_[moment_index(0, 2, 2)]);
+    tt = work_.sums[moment_index(4, 0, 0)] + work_.sums[moment_index(0, 4, 0)] + work_.sums[moment_index(0, 0, 4)] +
+         2.0f * (work_.sums[moment_index(2, 2, 0)] + work_.sums[moment_index(2, 0, 2)] + work_.sums[moment_index(0, 2, 2)]);
     float rhs[4];
     for (uint8_t p = 0; p < 4; ++p) rhs[p] = a[p][4];
     if (!solve(a, 4)) return false;
@@ -303,7 +307,7 @@ bool MagCalibrator::fit_sphere() {
     for (uint8_t p = 0; p < 4; ++p) sse -= a[p][4] * rhs[p];
     const float r = sqrtf(r2);
     cover_centre_uT_ = pivot_uT_ + centre * kFitScale_uT;
-    sphere_residual_uT_ = safe_sqrt(sse / sums_[0]) / (2.0f * r) * kFitScale_uT;
+    sphere_residual_uT_ = safe_sqrt(sse / work_.sums[0]) / (2.0f * r) * kFitScale_uT;
     radius_uT_ = r * kFitScale_uT;
     return true;
 }
@@ -313,21 +317,78 @@ bool MagCalibrator::fit_sphere() {
 // centre keeps the constant term away from zero). Centre c = -Q^-1 g / 2; then
 // (u - c)^T Q (u - c) = k = 1 + c^T Q c. W = sqrt(Q / det(Q)^(1/3)) has det 1 and
 // maps the ellipsoid onto a sphere of radius sqrt(k / det(Q)^(1/3)).
-bool MagCalibrator::fit_ellipsoid(Calibration& cal) {
-    static const uint8_t kReg[9] CALIB_PROGMEM = {2 * kX, 2 * kY, 2 * kZ, kY + kZ, kX + kZ, kX + kY, kX, kY, kZ};
-    float a[9][kMaxUnknowns + 1];
-    float rhs[9];
-    for (uint8_t p = 0; p < 9; ++p) {
-        const uint8_t rp = table_byte(kReg, p);
-        for (uint8_t q = 0; q < 9; ++q) a[p][q] = sums_[moment_of_sum(rp, table_byte(kReg, q))];
-        a[p][9] = rhs[p] = sums_[moment_of(rp)];
+// The least-squares normal equations A t = b (A = sum r r^T over the regressors r, b =
+// sum r) are symmetric positive definite when the fit is determined: solved by Cholesky
+// (A = L L^T) in the sums' memory, a few columns a part. Then the sum of squares left is
+// count - b^T t = count - |L^-1 b|^2.
+static const uint8_t kEllipsoidRegressors[MagCalibrator::kUnknowns] CALIB_PROGMEM = {
+    2 * kX, 2 * kY, 2 * kZ, kY + kZ, kX + kZ, kX + kY, kX, kY, kZ};
+void MagCalibrator::normal_equations() {
+    Work::Normal n;  // built apart: the sums are read while it is written
+    float largest = 0.0f;
+    for (uint8_t p = 0; p < kUnknowns; ++p) {
+        const uint8_t rp = table_byte(kEllipsoidRegressors, p);
+        for (uint8_t q = 0; q <= p; ++q)
+            n.l[row_start(p) + q] = work_.sums[moment_of_sum(rp, table_byte(kEllipsoidRegressors, q))];
+        n.b[p] = work_.sums[moment_of(rp)];
+        if (n.l[row_start(p) + p] > largest) largest = n.l[row_start(p) + p];
     }
-    if (!solve(a, 9)) return false;
+    n.tiny = largest * 1e-6f;
+    work_.normal = n;
+}
+
+// Columns first_column .. first_column + kCholeskyColumns - 1 of L (Cholesky-Banachiewicz
+// by columns: each needs the ones before it). False when a pivot is not above tiny.
+bool MagCalibrator::cholesky_part(uint8_t first_column) {
+    float* l = work_.normal.l;
+    for (uint8_t j = first_column; j < first_column + kCholeskyColumns && j < kUnknowns; ++j) {
+        float d = l[row_start(j) + j];
+        for (uint8_t k = 0; k < j; ++k) d -= l[row_start(j) + k] * l[row_start(j) + k];
+        if (!(d > work_.normal.tiny)) return false;
+        const float ljj = sqrtf(d);
+        l[row_start(j) + j] = ljj;
+        const float inv = 1.0f / ljj;
+        for (uint8_t i = (uint8_t)(j + 1); i < kUnknowns; ++i) {
+            float v = l[row_start(i) + j];
+            for (uint8_t k = 0; k < j; ++k) v -= l[row_start(i) + k] * l[row_start(j) + k];
+            l[row_start(i) + j] = v * inv;
+        }
+    }
+    return true;
+}
+
+// b <- L^-1 b, and |L^-1 b|^2.
+void MagCalibrator::forward_substitution() {
+    const float* l = work_.normal.l;
+    float* b = work_.normal.b;
+    fit_yy_ = 0.0f;
+    for (uint8_t i = 0; i < kUnknowns; ++i) {
+        float v = b[i];
+        for (uint8_t k = 0; k < i; ++k) v -= l[row_start(i) + k] * b[k];
+        b[i] = v / l[row_start(i) + i];
+        fit_yy_ += b[i] * b[i];
+    }
+}
+
+// b <- L^-T b: the solution t.
+void MagCalibrator::back_substitution() {
+    const float* l = work_.normal.l;
+    float* b = work_.normal.b;
+    for (uint8_t i = kUnknowns; i-- > 0;) {
+        float v = b[i];
+        for (uint8_t k = (uint8_t)(i + 1); k < kUnknowns; ++k) v -= l[row_start(k) + i] * b[k];
+        b[i] = v / l[row_start(i) + i];
+    }
+}
+
+// The quadric's centre, k and det(Q)^(1/3); Q / det(Q)^(1/3) for the root. False when it
+// is not an ellipsoid.
+bool MagCalibrator::quadric() {
     // A pivot outside the ellipsoid flips the sign of the whole quadric: then
     // -u^T Q u - g.u = -1, with -Q positive.
-    const float side = a[0][9] < 0.0f ? -1.0f : 1.0f;
-    float t[9];
-    for (uint8_t p = 0; p < 9; ++p) t[p] = a[p][9] * side;
+    const float side = work_.normal.b[0] < 0.0f ? -1.0f : 1.0f;
+    float t[kUnknowns];
+    for (uint8_t p = 0; p < kUnknowns; ++p) t[p] = work_.normal.b[p] * side;  // read before root is written
     const Matrix3f q(Vector3f(t[0], 0.5f * t[5], 0.5f * t[4]), Vector3f(0.5f * t[5], t[1], 0.5f * t[3]),
                      Vector3f(0.5f * t[4], 0.5f * t[3], t[2]));
     const float det = q.determinant();
@@ -338,41 +399,119 @@ bool MagCalibrator::fit_ellipsoid(Calibration& cal) {
     if (!solve(c3, 3)) return false;
     const Vector3f centre(c3[0][3], c3[1][3], c3[2][3]);
     const float k = side + centre.dot(q * centre);
-    const float cube_root_det = cbrtf(det);
     if (!(k > 0.0f)) return false;
-    Matrix3f w;
-    if (!sqrt_near_identity(q * (1.0f / cube_root_det), w)) return false;
-    float sse = sums_[0];
-    for (uint8_t p = 0; p < 9; ++p) sse -= side * t[p] * rhs[p];
-    const float r = sqrtf(k / cube_root_det);
-    radius_uT_ = r * kFitScale_uT;
-    residual_uT_ = r * safe_sqrt(sse / sums_[0]) / (2.0f * k) * kFitScale_uT;
-    cal.mag_offset_uT = pivot_uT_ + centre * kFitScale_uT;
-    cal.mag_scale = Vector3f(w.a.x, w.b.y, w.c.z);
-    cal.mag_cross = Vector3f(w.a.y, w.a.z, w.b.z);
-    cal.mag_learned_uT = Vector3f();
+    Work::Root& r = work_.root;
+    r.cube_root_det = cbrtf(det);
+    r.k = k;
+    r.centre[0] = centre.x;
+    r.centre[1] = centre.y;
+    r.centre[2] = centre.z;
+    store(q * (1.0f / r.cube_root_det), r.a);
     return true;
+}
+
+// Symmetric square root of a symmetric positive matrix near I (Newton-Schulz:
+// Y -> Y T, Z -> T Z, T = (3I - Z Y) / 2; quadratic convergence while |I - A| < 1). The
+// first step, from Z = I, written out: T = (3I - A) / 2 and Z = T (an identity matrix
+// object would be a 36-byte constant in the AVR's SRAM).
+void MagCalibrator::root_start() {
+    Work::Root& r = work_.root;
+    const Matrix3f a = matrix_of(r.a);
+    const Matrix3f z = newton_schulz_t(a);
+    store(z, r.z);
+    store(a * z, r.y);
+}
+
+// One Newton-Schulz step in two halves: T and Y, then Z.
+void MagCalibrator::root_part(bool second_half) {
+    Work::Root& r = work_.root;
+    if (!second_half) {
+        const Matrix3f t = newton_schulz_t(matrix_of(r.z) * matrix_of(r.y));
+        store(t, r.t);
+        store(matrix_of(r.y) * t, r.y);
+    } else {
+        store(matrix_of(r.t) * matrix_of(r.z), r.z);
+    }
 }
 
 static bool within_box(const Vector3f& v, float limit) {
     return within(v.x, -limit, limit) && within(v.y, -limit, limit) && within(v.z, -limit, limit);
 }
 
-MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
-    if (count() < kMagCalMinSamples) return Quality::TooFewSamples;
-    if (coverage_pct() < kMagMinCoveragePct) return Quality::ThinCoverage;
-    if (!fit_sphere()) return Quality::FitFailed;
-    if (!within(radius_uT_, kMagMinRadius_uT, kMagMaxRadius_uT)) return Quality::NotEarthField;
-    Calibration c = cal;
-    if (!fit_ellipsoid(c)) return Quality::FitFailed;
+MagCalibrator::Quality MagCalibrator::final_checks() {
+    const Work::Root& r = work_.root;
+    // The root has not converged: A too far from I, soft iron beyond any limit.
+    const Matrix3f y = matrix_of(r.y);
+    const Matrix3f d = y * y - matrix_of(r.a);
+    const float err = d.a.length_squared() + d.b.length_squared() + d.c.length_squared();
+    if (!(err < 1e-8f && y.is_finite())) return Quality::FitFailed;
+    const float sse = (float)count_ - fit_yy_;
+    const float radius = sqrtf(r.k / r.cube_root_det);
+    radius_uT_ = radius * kFitScale_uT;
+    residual_uT_ = radius * safe_sqrt(sse / (float)count_) / (2.0f * r.k) * kFitScale_uT;
+    Calibration c;
+    result(c);
     if (!within(radius_uT_, kMagMinRadius_uT, kMagMaxRadius_uT) || !within_box(c.mag_offset_uT, kMagMaxOffset_uT))
         return Quality::NotEarthField;
     if (!within(c.mag_scale.x, kMagMinDiag, kMagMaxDiag) || !within(c.mag_scale.y, kMagMinDiag, kMagMaxDiag) ||
         !within(c.mag_scale.z, kMagMinDiag, kMagMaxDiag) || !within_box(c.mag_cross, kMagMaxCross))
         return Quality::SoftIronTooLarge;
     if (!(residual_uT_ <= kMagMaxResidual_uT)) return Quality::PoorFit;
-    cal = c;
     return Quality::Ok;
+}
+
+void MagCalibrator::result(Calibration& cal) const {
+    const Work::Root& r = work_.root;
+    cal.mag_offset_uT = pivot_uT_ + Vector3f(r.centre[0], r.centre[1], r.centre[2]) * kFitScale_uT;
+    cal.mag_scale = Vector3f(r.y[0], r.y[4], r.y[8]);
+    cal.mag_cross = Vector3f(r.y[1], r.y[2], r.y[5]);
+    cal.mag_learned_uT = Vector3f();
+}
+
+void MagCalibrator::end_fit(Quality q) {
+    quality_ = q;
+    stage_ = kStageDone;
+}
+
+void MagCalibrator::begin_fit() {
+    stage_ = kStageCheck;
+    quality_ = Quality::FitFailed;
+}
+
+void MagCalibrator::fit_part() {
+    const uint8_t stage = stage_;
+    if (stage == kStageCheck) {
+        if (count_ < kMagCalMinSamples) return end_fit(Quality::TooFewSamples);
+        if (coverage_pct() < kMagMinCoveragePct) return end_fit(Quality::ThinCoverage);
+        if (!fit_sphere()) return end_fit(Quality::FitFailed);
+        if (!within(radius_uT_, kMagMinRadius_uT, kMagMaxRadius_uT)) return end_fit(Quality::NotEarthField);
+    } else if (stage == kStageNormal) {
+        normal_equations();
+    } else if (stage < kStageForward) {
+        if (!cholesky_part((uint8_t)((stage - kStageCholesky) * kCholeskyColumns))) return end_fit(Quality::FitFailed);
+    } else if (stage == kStageForward) {
+        forward_substitution();
+    } else if (stage == kStageBack) {
+        back_substitution();
+    } else if (stage == kStageQuadric) {
+        if (!quadric()) return end_fit(Quality::FitFailed);
+    } else if (stage == kStageRootStart) {
+        root_start();
+    } else if (stage < kStageFinal) {
+        root_part(((stage - kStageRoot) & 1u) != 0);
+    } else if (stage == kStageFinal) {
+        return end_fit(final_checks());
+    } else {
+        return;
+    }
+    ++stage_;
+}
+
+MagCalibrator::Quality MagCalibrator::finish(Calibration& cal) {
+    begin_fit();
+    while (fitting()) fit_part();
+    if (quality_ == Quality::Ok) result(cal);
+    return quality_;
 }
 
 // ---------------------------------------------------------------------------

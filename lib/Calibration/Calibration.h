@@ -142,14 +142,26 @@ public:
     // samples are centred on (any value works; closer is more precise).
     void restart(const linalg::Vector3f& pivot_uT);
     // Feeds one field sample (uT, body frame, BEFORE calibration); non-finite ignored.
+    // Not between begin_fit() and the next restart().
     void add(const linalg::Vector3f& field_uT);
-    uint16_t count() const { return (uint16_t)sums_[0]; }
+    uint16_t count() const { return count_; }
     // Share of the 26 direction cells seen at least kMagCellMinSamples times, percent.
     uint8_t coverage_pct() const;
-    // Fits; on Ok writes the offset, the soft-iron terms and a zero learned offset
-    // into cal (gyro bias untouched). The figures below are valid after any finish()
-    // that got as far as the fit (Ok, NotEarthField, SoftIronTooLarge, PoorFit).
+    // Fits all at once (tools, tests: the parts below, one after the other); on Ok writes
+    // result() into cal. The figures below are valid after any fit that got as far as
+    // the ellipsoid (Ok, NotEarthField, SoftIronTooLarge, PoorFit).
     Quality finish(Calibration& cal);
+    // The same fit in kFitParts (25) parts for a caller with a few thousand cycles a step to
+    // spare (the whole is several 5 ms steps' worth on the AVR): begin_fit() once the
+    // samples are in, then fit_part() while fitting(); then quality() and, on Ok,
+    // result(). The fit works in the sums' memory: no add() until restart().
+    void begin_fit();
+    void fit_part();
+    bool fitting() const { return stage_ < kStageDone; }
+    Quality quality() const { return quality_; }
+    // The offset, the soft-iron terms and a zero learned offset into cal (gyro bias
+    // untouched); valid when quality() is Ok.
+    void result(Calibration& cal) const;
     float residual_uT() const { return residual_uT_; }
     float radius_uT() const { return radius_uT_; }
     // The sphere fit's offset and residual (the first stage).
@@ -158,14 +170,59 @@ public:
 
     static constexpr uint8_t kMoments = 35;  // monomials of degree <= 4 in x, y, z
     static constexpr uint8_t kCells = 26;
+    static constexpr uint8_t kUnknowns = 9;  // the ellipsoid's terms
+    static constexpr uint8_t kPacked = kUnknowns * (kUnknowns + 1) / 2;
+    static constexpr uint8_t kRootIterations = 7;  // Newton-Schulz steps after the first
+    static constexpr uint8_t kCholeskyColumns = 2;  // of the factor, a part
+
+private:
+    // The parts: checks and sphere, normal equations, Cholesky, the two substitutions,
+    // the quadric, the root's first step, its iterations (two parts each), final checks.
+    enum Stage : uint8_t {
+        kStageCheck,
+        kStageNormal,
+        kStageCholesky,
+        kStageForward = kStageCholesky + (kUnknowns + kCholeskyColumns - 1) / kCholeskyColumns,
+        kStageBack,
+        kStageQuadric,
+        kStageRootStart,
+        kStageRoot,      // 2 kRootIterations parts
+        kStageFinal = kStageRoot + 2 * kRootIterations,
+        kStageDone,
+    };
+
+public:
+    static constexpr uint8_t kFitParts = kStageDone;
 
 private:
     // On success the centre goes to cover_centre_uT_ (it is sphere_offset_uT()).
     bool fit_sphere();
-    bool fit_ellipsoid(Calibration& cal);
+    void normal_equations();
+    bool cholesky_part(uint8_t first_column);
+    void forward_substitution();
+    void back_substitution();
+    bool quadric();
+    void root_start();
+    void root_part(bool second_half);
+    Quality final_checks();
+    void end_fit(Quality q);
     uint8_t cell_samples(uint8_t cell) const;
 
-    float sums_[kMoments];          // sums of x^i y^j z^k of the centred, scaled samples; [0] = count
+    // The sums while collecting; the fit's working memory after begin_fit() (restart()
+    // clears it).
+    union Work {
+        float sums[kMoments];  // sums of x^i y^j z^k of the centred, scaled samples; [0] = count
+        struct Normal {        // the ellipsoid's normal equations A t = b
+            float l[kPacked];  // A's lower triangle row by row, then its Cholesky factor L
+            float b[kUnknowns];  // b, then L^-1 b, then the solution t
+            float tiny;          // a pivot below this: the fit is not determined
+        } normal;
+        struct Root {          // W = sqrt(Q / det(Q)^(1/3)) by Newton-Schulz, 3x3 row by row
+            float a[9], y[9], z[9], t[9];
+            float centre[3];
+            float k, cube_root_det;
+        } root;
+    } work_;
     linalg::Vector3f pivot_uT_;
     linalg::Vector3f cover_centre_uT_;  // the coverage cells' centre: the latest sphere fit
     // Each cell's samples, counted up to kMagCellMinSamples (all coverage needs): 2 bits
@@ -174,6 +231,10 @@ private:
     float sphere_residual_uT_ = 0.0f;
     float residual_uT_ = 0.0f;
     float radius_uT_ = 0.0f;
+    float fit_yy_ = 0.0f;   // b^T A^-1 b = |L^-1 b|^2: the fit's residual is count - this
+    uint16_t count_ = 0;
+    uint8_t stage_ = kStageDone;
+    Quality quality_ = Quality::TooFewSamples;
 };
 
 // ---------------------------------------------------------------------------

@@ -27,6 +27,9 @@ constexpr uint32_t kNormalAccelCounts2 =
 // 2000 deg/s full scale make 60 rad/s) is a broken read, not a rotation.
 constexpr uint32_t kMaxCredibleRateCounts2 = (uint32_t)((dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s) *
                                                         (dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s));
+// A part of the `cal mag` fit, for the simulator's profiler: the next id after
+// profile::Part's (lib/LinAlg/Profile.h).
+constexpr uint8_t kMagFitSection = 13;
 // |a - b| of two counts.
 int32_t jump(int16_t a, int16_t b) {
     const int32_t d = (int32_t)a - b;
@@ -70,10 +73,8 @@ void AttitudePipeline::set_mag_present(bool present) {
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
     // The fit's sums (~10 k cycles) wait for a step free of heavy work, as the learner does.
-    if (st_.mag_cal_active) {
-        cal_field_uT_ = field_uT;
-        st_.cal_pending = true;
-    }
+    cal_field_uT_ = field_uT;
+    if (st_.mag_cal_active) st_.cal_pending = true;
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
@@ -346,7 +347,13 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
                 .str(TXT(" s left, keep turning ("))
                 .u32(mag_cal_.count()).str(TXT(" samples)")).end();
         }
-        if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) finish_mag_calibration();
+        if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) {
+            // The fit (several steps' worth) goes a part a step, on steps with room.
+            st_.mag_cal_active = false;
+            st_.cal_pending = false;
+            st_.mag_fit_active = true;
+            mag_cal_.begin_fit();
+        }
     }
 
     // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
@@ -363,12 +370,16 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // the learner, 2.92 with its short pieces on them).
     if (st_.output_due || heading_heavy) return;
     const bool short_room = dcm_.heavy_step();
+    bool fit_step = false;
     if (!short_room) {
+        fit_step = st_.mag_fit_active;
         if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
+        else if (fit_step) step_mag_fit();
         else report_deferred();
         st_.cal_pending = false;
     }
-    if ((learner_.solving() || st_.learn_pending) && !(short_room && learner_.long_part_next())) {
+    // A part of the `cal mag` fit leaves no room for the learner: it waits a step.
+    if ((learner_.solving() || st_.learn_pending) && !fit_step && !(short_room && learner_.long_part_next())) {
         profile::begin(profile::kLearner);
         learn_mag_offset(short_room);
         profile::end(profile::kLearner);
@@ -442,16 +453,31 @@ void AttitudePipeline::start_mag_calibration() {
     mag_cal_.restart(settings_.cal.mag_offset_uT + settings_.cal.mag_learned_uT);
     st_.mag_cal_steps = 0;
     st_.mag_cal_active = true;
+    st_.mag_fit_active = false;  // a fit under way is dropped
     Writer(log_).str(TXT("# cal mag: turn the board every way for 30 s")).end();
 }
 
+// A part of the fit, or (on the step after its last) the verdict.
+void AttitudePipeline::step_mag_fit() {
+    if (mag_cal_.fitting()) {
+        profile::begin(kMagFitSection);
+        mag_cal_.fit_part();
+        profile::end(kMagFitSection);
+        return;
+    }
+    st_.mag_fit_active = false;
+    finish_mag_calibration();
+}
+
 void AttitudePipeline::finish_mag_calibration() {
-    st_.mag_cal_active = false;
-    calib::Calibration c = settings_.cal;
-    const calib::MagCalibrator::Quality q = mag_cal_.finish(c);
+    const calib::MagCalibrator::Quality q = mag_cal_.quality();
     Writer w(log_);
     if (q == calib::MagCalibrator::Quality::Ok) {
-        settings_.cal = c;
+        calib::Calibration& c = settings_.cal;
+        mag_cal_.result(c);
+        // The latest field (and a sample waiting for the heading's correction) was
+        // calibrated the old way: the DCM takes the heading from the new one.
+        mag_cal_uT_ = calib::apply_mag(c, cal_field_uT_);
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
         w.str(TXT("# cal mag: offset ")).vec(c.mag_offset_uT).str(TXT(" uT, scale ")).vec(c.mag_scale)
             .str(TXT(", cross ")).vec(c.mag_cross).str(TXT(", residual ")).fixed2(mag_cal_.residual_uT())

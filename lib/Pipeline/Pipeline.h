@@ -173,7 +173,7 @@ public:
 
     Phase phase() const { return st_.phase; }
     bool gyro_calibrating() const { return st_.gyro_cal_active; }
-    bool mag_calibrating() const { return st_.mag_cal_active; }
+    bool mag_calibrating() const { return st_.mag_cal_active || st_.mag_fit_active; }
     uint32_t steps() const { return st_.steps; }
     uint32_t time_ms() const { return st_.steps * 5u; }
     const dcm::Dcm& estimator() const { return dcm_; }
@@ -191,6 +191,7 @@ private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
+    void step_mag_fit();
     void finish_mag_calibration();
     void report_deferred();
     void take_learner_sample(const linalg::Vector3f& field_uT);
@@ -207,7 +208,7 @@ private:
     linalg::Vector3l turn_counts_;              // the gyro summed since the last field sample (counts)
     linalg::Vector3f learn_field_uT_;           // the sample waiting for the learner, and the gyro before it
     linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
-    linalg::Vector3f cal_field_uT_;             // the raw sample waiting for the `cal mag` sums
+    linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
@@ -230,7 +231,8 @@ private:
         bool mag_pending;
         bool have_mag;
         bool gyro_cal_active;
-        bool mag_cal_active;
+        bool mag_cal_active;            // `cal mag` collecting
+        bool mag_fit_active;            // its fit, a part a step
         bool output_due;
         bool reinit_pending;
         StartMessage start_message;     // printed on the step after the calibration's end
