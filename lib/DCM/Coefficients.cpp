@@ -17,11 +17,14 @@ bool exceeds(const linalg::Vector3l& v, const Limit& limit) {
     return sum >= limit.limit2;
 }
 
+linalg::Vector3l rescaled(const linalg::Vector3l& v, float ratio) { return linalg::fixed_from_vector(v.scaled(ratio), 0); }
+
 // A low-pass's factor per correction for the time constant tau_s: dt / (tau + dt).
 static float lowpass_alpha(float tau_s, float dt_s) { return dt_s / (tau_s + dt_s); }
 
 // From the settings alone: each figure in the unit the step compares or multiplies.
 FIXED_COLD void DcmCoefficients::from_settings(const DcmSettings& settings) {
+    step_s = settings.step_s;
     startup_steps = (uint16_t)(settings.startup_s / settings.step_s);
     inv_startup_steps = settings.step_s / settings.startup_s;
     accel_alpha_q30 = q30_of(lowpass_alpha(settings.accel_lowpass_s, correction_dt_s(settings)));
@@ -53,7 +56,7 @@ void DcmCoefficients::set_scales(const DcmSettings& settings, float gyro_scale, 
 // the sums' units.
 void DcmCoefficients::derive_from_scales(const DcmSettings& settings) {
     const float lead_steps = settings.output_lead_s / settings.step_s;
-    const float q26_per_unit = turn_rad_per_unit(settings) * 67108864.0f;  // 2^26
+    const float q26_per_unit = turn_rad_per_unit() * 67108864.0f;  // 2^26
     const bool fits = lead_steps >= 0.0f && lead_steps < 1.99f && q26_per_unit > 0.0f && q26_per_unit < 1.99f;
     lead_steps_q15 = fits ? (uint16_t)(lead_steps * 32768.0f + 0.5f) : 0;
     theta_q26_per_unit_q15 = fits ? (uint16_t)(q26_per_unit * 32768.0f + 0.5f) : 0;
@@ -77,6 +80,14 @@ void DcmCoefficients::derive_from_scales(const DcmSettings& settings) {
     // |lp| = g/2 in correct_tilt's |lp|^2 / 2^30 (lp in accel units).
     const float half_g_units = 0.5f * kGravity_m_s2 * accel_units_per_m_s2;
     min_lp2 = (uint32_t)(half_g_units * half_g_units * (1.0f / 1073741824.0f));
+}
+
+linalg::Vector3l DcmCoefficients::theta_q26_in_float(const linalg::Vector3l& units) const {
+    const linalg::Vector3f t = units.scaled(turn_rad_per_unit() * 67108864.0f);
+    const float limit = (float)kMaxTurnAxisQ26;
+    return linalg::fixed_from_vector(linalg::Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit),
+                                                      linalg::constrain(t.z, -limit, limit)),
+                                     0);
 }
 
 }  // namespace dcm

@@ -52,6 +52,14 @@ constexpr float kFloatGyroScale = 1.0f / 16384.0f;
 constexpr float kFloatAccelScale = 1.0f / 4096.0f;
 constexpr float kFloatUnitsPerRad_s = (float)kTurnScale / kFloatGyroScale;
 
+// A field sample in 16 bits, uT * 2^kFieldQ: steps of 0.03 uT, a third of the
+// HMC5883L's finest count and far below its noise (~0.2 uT), up to 1 000 uT (the chip
+// reads at most 810). The latency turn and the rotation into earth axes are then 16x16
+// products; a matrix entry in 16 bits (Q14) moves the earth-frame field by 6e-5 of its
+// strength at most, 0.004 deg of heading.
+constexpr uint8_t kFieldQ = 5;
+constexpr float kMaxField_uT = 1000.0f;
+
 // A value as Q30 (truncated toward zero), for constants written as their value:
 // q30_of(1.0 / 6.0).
 constexpr int32_t q30_of(float x) { return (int32_t)(x * 1073741824.0f); }
@@ -73,6 +81,7 @@ bool exceeds(const linalg::Vector3l& v, const Limit& limit);
 
 struct DcmCoefficients {
     // From the settings alone (from_settings).
+    float step_s = 0.0f;                 // the fixed step, s
     uint16_t startup_steps = 0;              // startup_s in steps
     float inv_startup_steps = 0;             // 1 / startup_steps
     int32_t accel_alpha_q30 = 0;             // the accel low-pass factor per correction, Q30
@@ -110,10 +119,53 @@ struct DcmCoefficients {
     // ... from the scales in use (set_scales, or the float form's).
     void derive_from_scales(const DcmSettings& settings);
     // Radians per unit of the turn sums.
-    float turn_rad_per_unit(const DcmSettings& settings) const {
-        return gyro_rad_s_per_count * settings.step_s * (1.0f / (float)kTurnScale);
+    float turn_rad_per_unit() const { return gyro_rad_s_per_count * step_s * (1.0f / (float)kTurnScale); }
+
+    // A turn in units (the turn sums) in Q26 radians, each axis saturated at
+    // kMaxTurnAxisQ26: beyond any gyro's range over an integration (2000 deg/s for 20 ms
+    // is 0.7 rad), and |theta|^2 stays below 2 in Q30. One mul_q30 an axis.
+    linalg::Vector3l theta_q26(const linalg::Vector3l& units) const;
+    // ... in Q30 (the integration's).
+    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const {
+        const linalg::Vector3l t_q26 = theta_q26(units);
+        return linalg::Vector3l(t_q26.x * 16, t_q26.y * 16, t_q26.z * 16);
     }
+    // The same by the 16-bit factor (scale_q15: two 16x16 products an axis, the factor
+    // to 1.5e-5 of itself), for a turn used in 16 bits: the compass sample's latency turn
+    // and the gravity window's turn per step. Unsaturated: both are a few steps' rates.
+    linalg::Vector3l theta_q26_coarse(const linalg::Vector3l& units) const;
+    // The float path's theta_q26 (scales whose factor is beyond Q30's 2: the float form).
+    linalg::Vector3l theta_q26_in_float(const linalg::Vector3l& units) const;
+    int32_t theta_axis_q26(int32_t units) const;
 };
+
+// x * c / 2^15 for |x| < 2^31, c < 2^16 (a Q15 factor), rounded toward zero: two 16x16
+// multiplies.
+FIXED_INLINE int32_t scale_q15(int32_t x, uint16_t c_q15) {
+    const uint32_t m = linalg::magnitude(x);
+    const uint32_t product = (linalg::mul_u16((uint16_t)(m >> 16), c_q15) << 1) + (linalg::mul_u16((uint16_t)m, c_q15) >> 15);
+    return x < 0 ? -(int32_t)product : (int32_t)product;
+}
+
+FIXED_INLINE int32_t DcmCoefficients::theta_axis_q26(int32_t units) const {
+    if (units > theta_units_limit) units = theta_units_limit;
+    if (units < -theta_units_limit) units = -theta_units_limit;
+    return linalg::hot::mul_q30(theta_factor_q30, units);
+}
+
+FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26(const linalg::Vector3l& units) const {
+    if (theta_factor_q30 == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
+    return linalg::Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
+}
+
+FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26_coarse(const linalg::Vector3l& units) const {
+    const uint16_t factor_q15 = theta_q26_per_unit_q15;
+    if (factor_q15 == 0) return theta_q26(units);  // scales beyond the 16-bit factor
+    return linalg::Vector3l(scale_q15(units.x, factor_q15), scale_q15(units.y, factor_q15), scale_q15(units.z, factor_q15));
+}
+
+// v * ratio, rounded toward zero (state carried over to new sensor scales).
+linalg::Vector3l rescaled(const linalg::Vector3l& v, float ratio);
 
 // Seconds between two gravity corrections.
 inline float correction_dt_s(const DcmSettings& settings) { return settings.step_s * (float)kCorrectionDivider; }

@@ -11,7 +11,6 @@ using linalg::Vector3f;
 using linalg::Vector3l;
 
 namespace {
-Vector3l rescaled(const Vector3l& v, float ratio) { return linalg::fixed_from_vector(v.scaled(ratio), 0); }
 
 // 1/n in Q30 for the window's samples (n = 1..5: a correction late by a step takes
 // five), as code (a table would take RAM on the AVR).
@@ -46,23 +45,8 @@ constexpr uint8_t kMaxMagAgeSteps = 2;
 // (temperature, location) with 1.3 s.
 constexpr float kCandidateTau_s = 0.053f;
 constexpr float kReferenceTau_s = 1.32f;
-// The field may move this much in body axes during a rest: the HMC5883L's noise is
-// ~0.2 uT with its 8-sample average; a turn of 3 deg moves a 20 uT horizontal field by
-// 1 uT, so a steady turn of more than 2 deg/s ends a rest within its first 1.5 s, and
-// a slower one before it has lasted 1 uT / (20 uT x rate).
-constexpr float kRestFieldMove_uT = 1.0f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
-// The rest mean's difference from the bias, saturated (units): 2^22 units is 1 900 deg/s
-// on the 2000 deg/s range, and times 2^8 it stays within 31 bits.
-constexpr int32_t kMaxRestDifference = 1L << 22;
-// A field sample in 16 bits, uT * 2^kFieldQ: steps of 0.03 uT, a third of the
-// HMC5883L's finest count and far below its noise (~0.2 uT), up to 1 000 uT (the chip
-// reads at most 810). The latency turn and the rotation into earth axes are then 16x16
-// products (~20 cycles each on the AVR); a matrix entry in 16 bits (Q14) moves the
-// earth-frame field by 6e-5 of its strength at most, 0.004 deg of heading.
-constexpr uint8_t kFieldQ = 5;
-constexpr float kMaxField_uT = 1000.0f;
 constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
 // The sums' units: a squared strength in uT^2 * 2^(2 kFieldQ - kNorm2Shift), the field
 // in earth axes in uT * 2^(kFieldQ + 14 - kEarthFieldShift) (eight samples' sums within 32 bits).
@@ -70,20 +54,6 @@ constexpr uint8_t kNorm2Shift = 4;
 constexpr uint8_t kEarthFieldShift = 2;
 constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
 constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
-// kRestFieldMove_uT in the field's units.
-constexpr int16_t kRestFieldMoveQ = (int16_t)(kRestFieldMove_uT * (float)(1 << kFieldQ));
-
-// |a - b| > kRestFieldMove_uT for two fields in uT * 2^kFieldQ: an axis beyond it
-// decides at once; else the squares of the differences.
-bool moved(const linalg::Vector3i& a, const linalg::Vector3i& b) {
-    const int16_t d[3] = {(int16_t)(a.x - b.x), (int16_t)(a.y - b.y), (int16_t)(a.z - b.z)};
-    int32_t sum = 0;
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (d[i] >= kRestFieldMoveQ || d[i] <= -kRestFieldMoveQ) return true;
-        sum += linalg::mul_s16(d[i], d[i]);
-    }
-    return sum > linalg::mul_s16(kRestFieldMoveQ, kRestFieldMoveQ);
-}
 
 // Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
 int16_t q16_of(int32_t x_q26) {
@@ -103,22 +73,18 @@ Dcm::Dcm(const DcmSettings& settings) : settings_(&settings) { k_.from_settings(
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    bias_fine_ = linalg::fixed_from_vector(bias * (k_.units_per_rad_s * (float)kTurnScale), 0);
-    clamp_bias();
+    bias_.set_estimate_rad_s(bias, k_);
     update_offset();
 }
 
-Vector3f Dcm::gyro_bias_rad_s() const { return bias_fine_.scaled(k_.gyro_rad_s_per_count * (1.0f / (float)(kTurnScale * kTurnScale))); }
+Vector3f Dcm::gyro_bias_rad_s() const { return bias_.estimate_rad_s(k_); }
 
 Vector3f Dcm::last_mag_field() const { return linalg::scaled(last_field_q5_, 1.0f / (float)(1 << kFieldQ)); }
 
-Vector3l Dcm::bias_units() const {
-    return Vector3l((bias_fine_.x + 128) >> 8, (bias_fine_.y + 128) >> 8, (bias_fine_.z + 128) >> 8);
-}
 
 void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
     if (!bias.is_finite()) return;
-    sensor_bias_units_ = units_of(bias);
+    bias_.set_sensor_rad_s(bias, k_);
     update_offset();
 }
 
@@ -126,13 +92,11 @@ void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
 void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_count) {
     const float gyro_ratio = k_.gyro_rad_s_per_count / gyro_rad_s_per_count, accel_ratio = k_.accel_m_s2_per_count / accel_m_s2_per_count;
     if (gyro_ratio != 1.0f) {
-        Vector3l* rates[4] = {&bias_fine_, &correction_units_, &sensor_bias_units_, &rest_gyro_mean_};
-        for (Vector3l* v : rates) *v = rescaled(*v, gyro_ratio);
+        bias_.rescale(gyro_ratio);
+        correction_units_ = rescaled(correction_units_, gyro_ratio);
     }
-    if (accel_ratio != 1.0f) {
-        accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
-        rest_accel_mean_ = rescaled(rest_accel_mean_, accel_ratio);
-    }
+    if (accel_ratio != 1.0f) accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
+    rest_.rescale(gyro_ratio, accel_ratio);
     k_.set_scales(*settings_, gyro_rad_s_per_count, accel_m_s2_per_count);
     update_offset();
 }
@@ -140,12 +104,9 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
 // What each step subtracts from the gyro, in the integer units of the turn sums
 // (counts * 2^kTurnFraction).
 void Dcm::update_offset() {
-    offset_units_ = sensor_bias_units_ + bias_units() - correction_units_;
+    offset_units_ = bias_.offset_units(correction_units_);
 }
 
-Vector3l Dcm::units_of(const Vector3f& rate_rad_s) const {
-    return linalg::fixed_from_vector(rate_rad_s * k_.units_per_rad_s, 0);
-}
 
 // Each axis within the range of any accelerometer (16 g): three comparisons where
 // |a|^2 would cost five float operations. NaN fails them too.
@@ -183,7 +144,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
         const float norm = mag_field.length();
         learn_field(norm, field_down / norm);
     }
-    r_ = linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down));
+    strapdown_.reset(linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down)));
     // The integer factors of the scales, unless set_sample_scales set them (the float
     // form's, whose scales are the defaults: the Pipeline sets its own before the start).
     if (k_.theta_factor_q30 == 0) k_.derive_from_scales(*settings_);
@@ -192,73 +153,28 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     correction_units_ = Vector3l();
     update_offset();
     mag_steady_steps_ = 0;
-    rest_corrections_ = 0;
     gyro_sum_ = Vector3l();
     accel_sum_ = Vector3l();
     window_samples_ = 0;
     accel_sum_of_sums_ = Vector3l();
-    first_half_ = Vector3l();
-    turn_sum_ = Vector3l();
-    pending_steps_ = 0;
     heading_field_sum_ = Vector3l();
     heading_norm2_sum_ = 0;
     heading_samples_ = 0;
     heading_steps_ = 0;
-    rest_accel_mean_ = linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0);
+    rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     status_ |= kStatusInitialised;
     return true;
 }
 
-// x * c / 2^15 for |x| < 2^31, c < 2^16, rounded toward zero: two 16x16 multiplies.
-FIXED_INLINE int32_t Dcm::scale_q15(int32_t x, uint16_t c) {
-    const uint32_t m = linalg::magnitude(x);
-    const uint32_t product = (linalg::mul_u16((uint16_t)(m >> 16), c) << 1) + (linalg::mul_u16((uint16_t)m, c) >> 15);
-    return x < 0 ? -(int32_t)product : (int32_t)product;
-}
 
-// The turn sums (units) in Q26 radians, each axis saturated at kMaxTurnAxisQ26: beyond
-// any gyro's range over an integration (2000 deg/s for 20 ms is 0.7 rad), and |theta|^2
-// stays below 2 in Q30. One mul_q30 an axis.
-Vector3l Dcm::theta_q26_in_float(const Vector3l& units) const {
-    const Vector3f t = units.scaled(k_.turn_rad_per_unit(*settings_) * 67108864.0f);
-    const float limit = (float)kMaxTurnAxisQ26;
-    return linalg::fixed_from_vector(
-        Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit), linalg::constrain(t.z, -limit, limit)),
-        0);
-}
-
-FIXED_INLINE int32_t Dcm::theta_axis_q26(int32_t units) const {
-    if (units > k_.theta_units_limit) units = k_.theta_units_limit;
-    if (units < -k_.theta_units_limit) units = -k_.theta_units_limit;
-    return linalg::hot::mul_q30(k_.theta_factor_q30, units);
-}
-
-FIXED_INLINE Vector3l Dcm::theta_q26(const Vector3l& units) const {
-    if (k_.theta_factor_q30 == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
-    return Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
-}
-
-// The same by the 16-bit factor (scale_q15: two 16x16 products an axis, the factor to
-// 1.5e-5 of itself), for a turn that is used in 16 bits: the compass sample's latency
-// turn and the gravity window's turn per step. Unsaturated: both are a few steps' rates.
-FIXED_INLINE Vector3l Dcm::theta_q26_coarse(const Vector3l& units) const {
-    const uint16_t k = k_.theta_q26_per_unit_q15;
-    if (k == 0) return theta_q26(units);  // scales beyond the 16-bit factor
-    return Vector3l(scale_q15(units.x, k), scale_q15(units.y, k), scale_q15(units.z, k));
-}
-
-FIXED_INLINE Vector3l Dcm::theta_q30(const Vector3l& units) const {
-    const Vector3l t = theta_q26(units);
-    return Vector3l(t.x * 16, t.y * 16, t.z * 16);
-}
 
 Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
     // In the turn sums' units. Beyond 2^22 counts (128 steps at full scale) and 1 024
     // steps the turn is far beyond the saturation anyway; within, no product overflows.
     constexpr int32_t kMaxCounts = 1L << 22;
     const int32_t n = steps < 1024u ? (int32_t)steps : 1024L;
-    const Vector3l bias = sensor_bias_units_ + bias_units();
+    const Vector3l bias = bias_.sensor_units() + bias_.units();
     const int32_t* c = &counts.x;
     const int32_t* b = &bias.x;
     int32_t units[3];
@@ -269,7 +185,7 @@ Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
     // Saturated at twice an integration's limit (1.5 rad: still within Q30's 2).
     if (k_.theta_factor_q30 == 0) {  // scales beyond the integer factor
         const float limit = 2.0f * (float)kMaxTurnAxisQ26 / 67108864.0f;
-        const Vector3f t = Vector3l(units[0], units[1], units[2]).scaled(k_.turn_rad_per_unit(*settings_));
+        const Vector3f t = Vector3l(units[0], units[1], units[2]).scaled(k_.turn_rad_per_unit());
         return linalg::fixed_from_vector(Vector3f(linalg::constrain(t.x, -limit, limit), linalg::constrain(t.y, -limit, limit),
                                                   linalg::constrain(t.z, -limit, limit)),
                                          linalg::kQ30);
@@ -328,18 +244,6 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
     step(gyro, accel, gyro_valid, accel_valid, line_due);
 }
 
-// One heavy part a step at most: the integration when kIntegrationSteps are summed with
-// this step (or two or more before an output line, line_due), else the gravity correction
-// when one is due or falls due with this step (a step later costs nothing: it follows a
-// 3 s low-pass), else the renormalisation when due, on a step without a line (a few steps
-// later: eight integrations leave R orthonormal to ~3e-6, nine no worse).
-Dcm::HeavyPart Dcm::next_heavy_part(bool line_due) const {
-    const uint8_t pending = (uint8_t)(pending_steps_ + 1u);
-    if (pending >= kIntegrationSteps || (line_due && pending >= 2)) return HeavyPart::kIntegration;
-    if (gravity_due_ || correction_phase_ + 1u >= kCorrectionDivider) return HeavyPart::kGravity;
-    if (updates_since_renormalise_ >= kRenormaliseEvery && !line_due) return HeavyPart::kRenormalisation;
-    return HeavyPart::kNone;
-}
 
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
     const HeavyPart heavy = next_heavy_part(line_due);
@@ -370,15 +274,12 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
         last_accel_ = accel;
     } else {
         status_ |= kStatusAccelIgnored;
-        rest_corrections_ = 0;  // a broken read is no rest
+        rest_.interrupt();  // a broken read is no rest
     }
     // The roll/pitch error (Premerlani & Bizard eq. 27) moves slowly once low-passed:
     // it is worked out every kCorrectionDivider steps and applied at every step in
     // between (below, on a step without an integration).
-    if (++correction_phase_ >= kCorrectionDivider) {
-        correction_phase_ = 0;
-        gravity_due_ = true;
-    }
+    schedule_.count_step();
 
     // Gyro integration, multi-rate (Savage, "Strapdown Inertial Navigation Integration
     // Algorithm Design", part 1): the corrected rates are summed at every step, and
@@ -390,80 +291,38 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
     // 200 Hz update on BROAD's fast rotations: README, Performance.
     if (gyro_ok) {
         last_gyro_ = gyro;
-        turn_sum_.x += in_turn_units(gyro.x) - offset_units_.x;
-        turn_sum_.y += in_turn_units(gyro.y) - offset_units_.y;
-        turn_sum_.z += in_turn_units(gyro.z) - offset_units_.z;
+        strapdown_.add_turn(Vector3l(in_turn_units(gyro.x) - offset_units_.x, in_turn_units(gyro.y) - offset_units_.y,
+                                     in_turn_units(gyro.z) - offset_units_.z));
     }
-    ++pending_steps_;
-    if (pending_steps_ == kIntegrationSteps / 2) {
-        first_half_ = turn_sum_;
-        turn_sum_ = Vector3l();
-    }
-    heavy_ = blocks(heavy);
+    strapdown_.end_step();
+    heavy_ = HeavySchedule::blocks(heavy);
     if (heavy == HeavyPart::kIntegration) {
-        integrate();
+        strapdown_.integrate(k_);
     } else if (heavy == HeavyPart::kGravity) {
         correct_gravity();
     } else if (heavy == HeavyPart::kRenormalisation) {
-        renormalise_rows();
+        if (!strapdown_.renormalise()) recover();
     }
     if (steps_ < 0xFFFFu) ++steps_;
 }
 
-// Rest detection and the gyro bias at rest (after VQF, Laidig & Seel 2023, sec. 3.4):
-// the board is still when, for rest_min_s, the gyro and the accelerometer stay close to
-// their recent means (deviations, so that any bias passes the test). There the gyro
-// reads its bias alone, on every axis, the vertical one too, which neither gravity nor
-// the compass can measure well: the bias estimate moves to the mean gyro reading with
-// rest_bias_s. The MPU6000's rate noise, 0.005 deg/s/sqrt(Hz), averages to ~0.004 deg/s
-// over the 0.5 s mean; a hand-held board's tremor is below 2 deg/s and 0.5 m/s^2.
+// Rest detection (RestDetector) and, at rest, the bias estimate from the rest mean.
+// A steady turn passes the deviation test too: the compass tells (correct_heading
+// watches the field) while one delivers.
 void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, const Vector3l& mean_off_bias,
                       bool whole_window) {
-    using linalg::mul_q30;
     status_ &= (uint8_t)~kStatusAtRest;
-    // A steady turn passes the deviation test too. The compass tells: at rest the field
-    // stays put in body axes, in a turn it turns (correct_heading resets the rest when
-    // it moves by kRestFieldMove_uT). Without a compass delivering, the mean must be
-    // within the tremor bound of the bias estimate instead (VQF's rule, its 2 deg/s
-    // bias clip): a larger vertical bias is then not told from a slow turn.
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
-    const Vector3l gyro_change = gyro_mean - rest_gyro_mean_, accel_change = accel_mean - rest_accel_mean_;
-    const bool still = !exceeds(gyro_change, k_.rest_gyro_dev) && (compass_watching || !exceeds(mean_off_bias, k_.rest_gyro_dev)) &&
-                       !exceeds(accel_change, k_.rest_accel_dev);
-    // The means' low-pass, its factor in 16 bits (two 16x16 products an axis), its step
-    // rounded to the unit (the changes are counts * 2^8, far below 2^29).
-    using linalg::hot::mul_q14_unit;
-    rest_gyro_mean_ += Vector3l(mul_q14_unit(k_.rest_alpha_q14, gyro_change.x), mul_q14_unit(k_.rest_alpha_q14, gyro_change.y),
-                                mul_q14_unit(k_.rest_alpha_q14, gyro_change.z));
-    rest_accel_mean_ += Vector3l(mul_q14_unit(k_.rest_alpha_q14, accel_change.x),
-                                 mul_q14_unit(k_.rest_alpha_q14, accel_change.y), mul_q14_unit(k_.rest_alpha_q14, accel_change.z));
-    if (!still || !whole_window) {
-        rest_corrections_ = 0;
-        return;
-    }
-    if (rest_corrections_ < k_.rest_min_corrections) {
-        ++rest_corrections_;
-        return;
-    }
+    if (!rest_.update(gyro_mean, accel_mean, mean_off_bias, whole_window, compass_watching, k_)) return;
     status_ |= kStatusAtRest;
-    // bias += alpha (mean - bias), in units * 2^8 (the difference within the bias limit
-    // and the deviation: far below 2^23 units).
-    int32_t* fine[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
-    const int32_t* mean[3] = {&rest_gyro_mean_.x, &rest_gyro_mean_.y, &rest_gyro_mean_.z};
-    for (uint8_t i = 0; i < 3; ++i) {
-        int32_t difference = *mean[i] - (*fine[i] >> 8);
-        if (difference > kMaxRestDifference) difference = kMaxRestDifference;
-        if (difference < -kMaxRestDifference) difference = -kMaxRestDifference;
-        *fine[i] += mul_q30(k_.rest_bias_alpha_q30, (int32_t)((uint32_t)difference << 8) - (*fine[i] & 0xFF));
-    }
-    clamp_bias();
+    bias_.follow_rest_mean(rest_.gyro_mean(), k_);
 }
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
 // and the roll/pitch error (correct_tilt).
 void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
-    gravity_due_ = false;
+    schedule_.gravity_done();
     const bool starting = steps_ < k_.startup_steps;
     const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
     // No bias learning while rotating fast: gyro scale errors look like bias there
@@ -472,7 +331,7 @@ void Dcm::correct_gravity() {
     // error that averages out, while a hand's or a vehicle's turn does not (shake, a
     // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
     // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
-    const Vector3l mean_off_bias = rest_gyro_mean_ - bias_units();  // the rest mean's turn (units)
+    const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
     const bool hold_integrator = rotating_fast_ || starting;
     if (window_samples_ > 0) {
@@ -485,7 +344,7 @@ void Dcm::correct_gravity() {
         // calibrated bias.
         const Vector3l gyro_raw_mean = per(times_256(gyro_sum_), n, inv_n);
         const Vector3l accel_sum = times_256(accel_sum_);
-        const Vector3l gyro_mean = gyro_raw_mean - sensor_bias_units_;
+        const Vector3l gyro_mean = gyro_raw_mean - bias_.sensor_units();
         const Vector3l accel_mean = per(accel_sum, n, inv_n);
         // Sample j of the window meets the matrix of the step before it, R_(j-1) =
         // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
@@ -497,13 +356,13 @@ void Dcm::correct_gravity() {
         // In integers: counts * 2^8, the turn per step in 16 bits (Q14 radians: the term
         // is a few percent of the sum, its rounding 6e-5 rad of it).
         Vector3l weighted = accel_sum_of_sums_;
-        for (uint8_t i = pending_steps_; i > 0; --i) {
+        for (uint8_t i = strapdown_.pending_steps(); i > 0; --i) {
             weighted.x -= accel_sum_.x;
             weighted.y -= accel_sum_.y;
             weighted.z -= accel_sum_.z;
         }
         weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
-        const Vector3l turn = theta_q26_coarse(gyro_raw_mean - offset_units_);
+        const Vector3l turn = k_.theta_q26_coarse(gyro_raw_mean - offset_units_);
         const int16_t tx = q14_of(turn.x * 16), ty = q14_of(turn.y * 16), tz = q14_of(turn.z * 16);
         const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
                             accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
@@ -514,9 +373,9 @@ void Dcm::correct_gravity() {
         // Into earth axes by the matrix in 16 bits (its rounding turns the earth-frame
         // force by 6e-5 rad at most, 0.003 deg of tilt), the mean, and the low-pass.
         const Vector3l accel_ef = per(
-            Vector3l(mul_q14(q14_of(r_.a.x), body.x) + mul_q14(q14_of(r_.a.y), body.y) + mul_q14(q14_of(r_.a.z), body.z),
-                     mul_q14(q14_of(r_.b.x), body.x) + mul_q14(q14_of(r_.b.y), body.y) + mul_q14(q14_of(r_.b.z), body.z),
-                     mul_q14(q14_of(r_.c.x), body.x) + mul_q14(q14_of(r_.c.y), body.y) + mul_q14(q14_of(r_.c.z), body.z)),
+            Vector3l(mul_q14(q14_of(strapdown_.r().a.x), body.x) + mul_q14(q14_of(strapdown_.r().a.y), body.y) + mul_q14(q14_of(strapdown_.r().a.z), body.z),
+                     mul_q14(q14_of(strapdown_.r().b.x), body.x) + mul_q14(q14_of(strapdown_.r().b.y), body.y) + mul_q14(q14_of(strapdown_.r().b.z), body.z),
+                     mul_q14(q14_of(strapdown_.r().c.x), body.x) + mul_q14(q14_of(strapdown_.r().c.y), body.y) + mul_q14(q14_of(strapdown_.r().c.z), body.z)),
             n, inv_n);
         accel_lp_ef_ += Vector3l(mul_q30(alpha, accel_ef.x - accel_lp_ef_.x), mul_q30(alpha, accel_ef.y - accel_lp_ef_.y),
                                  mul_q30(alpha, accel_ef.z - accel_lp_ef_.z));
@@ -531,95 +390,10 @@ void Dcm::correct_gravity() {
     profile::end(profile::kGravity);
 }
 
-// R <- R exp([theta x]) with theta the summed turn and its coning term. For a row r
-// and a = |theta|, Rodrigues' formula is
-//   r exp([theta x]) = cos(a) r + (sin(a)/a) (r x theta) + ((1 - cos a)/a^2) theta (r . theta),
-// with the three factors from their series to a^6 (sin(a)/a, cos a) and a^4 ((1 - cos a)
-// /a^2): below 4e-7 an update up to a = 0.5 rad (1 430 deg/s at 50 Hz). The update is
-// then a rotation to that order and keeps R orthonormal by itself: rounding leaves
-// ~1e-7 an update, so renormalisation (which costs half an update) runs every
-// kRenormaliseEvery updates, and row c is rebuilt as a x b at each (rows a and b are
-// what the update turns). The paper's first-order R (I + [theta x]) is not a rotation:
-// it stretches each row by a^2/2 an update, which renormalising at every update hid.
-void Dcm::integrate() {
-    profile::begin(profile::kIntegration);
-    using linalg::hot::mul_q14;
-    using linalg::hot::mul_q30;
-    using linalg::q14_of;
-    // In Q30 integers (R's entries and the turn, radians): mul_q30 (13 MULs) where the
-    // update's orthonormality depends on the product; mul_q14 (two 16x16 products) in the
-    // coning term, whose rounding only turns the update a little more or less (a rotation
-    // of a few 1e-7 rad at most, below the gyro's own resolution over the 20 ms).
-    const Vector3l first = theta_q30(first_half_), second = theta_q30(turn_sum_);
-    first_half_ = Vector3l();
-    turn_sum_ = Vector3l();
-    pending_steps_ = 0;
-    // The coning term (2/3) A x B, with A in 16 bits and 2/3 in Q14.
-    const int16_t ax = q14_of(first.x), ay = q14_of(first.y), az = q14_of(first.z);
-    constexpr int16_t kTwoThirdsQ14 = 10923;
-    const Vector3l theta(
-        first.x + second.x + mul_q14(kTwoThirdsQ14, mul_q14(ay, second.z) - mul_q14(az, second.y)),
-        first.y + second.y + mul_q14(kTwoThirdsQ14, mul_q14(az, second.x) - mul_q14(ax, second.z)),
-        first.z + second.z + mul_q14(kTwoThirdsQ14, mul_q14(ax, second.y) - mul_q14(ay, second.x)));
-    // The three factors' series (Q30 constants: 1/6, 1/24, 1/120, 1/720, 1/5040); below
-    // a = 0.03 rad (1.6 rad/s) the terms beyond a^2 are below 2e-9 and left out.
-    constexpr int32_t kOne = 1073741824L, kHalf = 536870912L, kSmallA2 = 1048576L;  // 2^-10
-    const int32_t a2 = linalg::dot_q30(theta, theta);
-    int32_t versine_ratio, sin_ratio;  // (1 - cos a)/a^2 and sin(a)/a
-    if (a2 < kSmallA2) {
-        versine_ratio = kHalf - mul_q30(a2, 44739243L);
-        sin_ratio = kOne - mul_q30(a2, 178956971L);
-    } else {
-        versine_ratio = kHalf - mul_q30(a2, 44739243L - mul_q30(a2, 1491308L));
-        sin_ratio = kOne - mul_q30(a2, 178956971L - mul_q30(a2, 8947849L - mul_q30(a2, 213044L)));
-    }
-    const int32_t one_minus_cos = mul_q30(a2, versine_ratio);
-    const Vector3l s(mul_q30(sin_ratio, theta.x), mul_q30(sin_ratio, theta.y), mul_q30(sin_ratio, theta.z));
-    const Vector3l v(mul_q30(versine_ratio, theta.x), mul_q30(versine_ratio, theta.y), mul_q30(versine_ratio, theta.z));
-    // exp([theta x]) - I for a row vector r (r' = r M): D_ij = -(1 - cos a) [i = j] +
-    // v_i theta_j + (s x)_ij, with (r (s x))_j = (r x s)_j; v_i theta_j is symmetric.
-    const int32_t xx = mul_q30(v.x, theta.x) - one_minus_cos, yy = mul_q30(v.y, theta.y) - one_minus_cos,
-                  zz = mul_q30(v.z, theta.z) - one_minus_cos;
-    const int32_t xy = mul_q30(v.x, theta.y), xz = mul_q30(v.x, theta.z), yz = mul_q30(v.y, theta.z);
-    const linalg::Matrix3q30 d{Vector3l(xx, xy - s.z, xz + s.y), Vector3l(xy + s.z, yy, yz - s.x),
-                               Vector3l(xz - s.y, yz + s.x, zz)};
-    turn_row(r_.a, d);
-    turn_row(r_.b, d);
-    profile::end(profile::kIntegration);
-    // Row c follows as a x b; the renormalisation, when due, takes a step of its own
-    // (next_heavy_part): on this one the output line may follow.
-    profile::begin(profile::kRenormalisation);
-    r_.c = linalg::cross_q30(r_.a, r_.b);
-    if (updates_since_renormalise_ < 0xFF) ++updates_since_renormalise_;
-    profile::end(profile::kRenormalisation);
-}
 
-void Dcm::renormalise_rows() {
-    profile::begin(profile::kRenormalisation);
-    updates_since_renormalise_ = 0;
-    // One pass leaves ~(X.Y)^2: a second one, needed only after a large error (a
-    // heading taken at once, a rebuilt matrix), keeps it orthonormal to 1e-5.
-    constexpr int32_t kSecondPassSkew = 2147484L;  // 2e-3 in Q30
-    int32_t skew = 0;
-    bool ok = renormalise(skew);
-    if (ok && (skew > kSecondPassSkew || skew < -kSecondPassSkew)) ok = renormalise(skew);
-    if (!ok) recover();
-    profile::end(profile::kRenormalisation);
-}
+Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
 
-// One row of R turned: r + r D (D = exp([theta x]) - I, rows as Matrix3q30), in Q30.
-void Dcm::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
-    using linalg::hot::mul_q30;
-    r = Vector3l(r.x + mul_q30(r.x, d.a.x) + mul_q30(r.y, d.b.x) + mul_q30(r.z, d.c.x),
-                 r.y + mul_q30(r.x, d.a.y) + mul_q30(r.y, d.b.y) + mul_q30(r.z, d.c.y),
-                 r.z + mul_q30(r.x, d.a.z) + mul_q30(r.y, d.b.z) + mul_q30(r.z, d.c.z));
-}
-
-Vector3l Dcm::pending_turn_units() const {
-    return first_half_ + turn_sum_;
-}
-
-Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit(*settings_)); }
+Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit()); }
 
 Vector3l Dcm::last_rate_units() const {
     return Vector3l(in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
@@ -651,9 +425,9 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     // the correction).
     using linalg::hot::mul_q14;
     using linalg::q14_of;
-    const Vector3l error(mul_q14(q14_of(r_.a.x), n) + mul_q14(q14_of(r_.b.x), e),
-                         mul_q14(q14_of(r_.a.y), n) + mul_q14(q14_of(r_.b.y), e),
-                         mul_q14(q14_of(r_.a.z), n) + mul_q14(q14_of(r_.b.z), e));
+    const Vector3l error(mul_q14(q14_of(strapdown_.r().a.x), n) + mul_q14(q14_of(strapdown_.r().b.x), e),
+                         mul_q14(q14_of(strapdown_.r().a.y), n) + mul_q14(q14_of(strapdown_.r().b.y), e),
+                         mul_q14(q14_of(strapdown_.r().a.z), n) + mul_q14(q14_of(strapdown_.r().b.z), e));
     const float kp = startup_left > 0.0f
                          ? settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left
                          : settings_->kp_rp_1_s;
@@ -663,10 +437,7 @@ void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
-        bias_fine_.x -= mul_q14(ex, k_.ki_fine);
-        bias_fine_.y -= mul_q14(ey, k_.ki_fine);
-        bias_fine_.z -= mul_q14(ez, k_.ki_fine);
-        clamp_bias();
+        bias_.integrate_tilt_error(ex, ey, ez, k_);
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
@@ -708,10 +479,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     last_field_q5_ = field;
     // The rest test's witness: a field that moved in body axes since the rest began
     // means the board turns (or a magnet moved): no rest.
-    if (moved(field, rest_field_)) {
-        rest_field_ = field;
-        rest_corrections_ = 0;
-    }
+    rest_.watch_field(field);
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
         // The first field sample after a start without one: take its heading as is.
@@ -733,7 +501,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const Vector3l turn(linalg::hot::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::hot::mul_q14(latency_q12, rate.y) * 4 - pending.y,
                         linalg::hot::mul_q14(latency_q12, rate.z) * 4 - pending.z);
     // field + field x turn, the turn in Q16 radians (saturated at 0.5): Q21, then Q5 again.
-    const Vector3l t = theta_q26_coarse(turn);
+    const Vector3l t = k_.theta_q26_coarse(turn);
     const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);
     using linalg::mul_s16;
     // The change (Q21) in Q5, then added (a field within 1 000 uT and a turn within
@@ -748,9 +516,9 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // the same vector there whatever the board did meanwhile), and the heading is
     // corrected from their mean: each sample costs the rotation into earth axes, the
     // correction (the rest of this function) runs at 25 Hz.
-    heading_field_sum_ += Vector3l(row_times(r_.a, field_now) >> kEarthFieldShift,
-                                   row_times(r_.b, field_now) >> kEarthFieldShift,
-                                   row_times(r_.c, field_now) >> kEarthFieldShift);
+    heading_field_sum_ += Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
+                                   row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
+                                   row_times(strapdown_.r().c, field_now) >> kEarthFieldShift);
     heading_norm2_sum_ += sample_norm2;
     ++heading_samples_;
     heading_steps_ = (uint16_t)(heading_steps_ + since_last);
@@ -812,11 +580,11 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
         using linalg::mul_q30;
         const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
         const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
-        const Vector3l north(mul_q30(c, r_.a.x) + mul_q30(sn, r_.b.x), mul_q30(c, r_.a.y) + mul_q30(sn, r_.b.y),
-                             mul_q30(c, r_.a.z) + mul_q30(sn, r_.b.z));
-        r_.b = Vector3l(mul_q30(c, r_.b.x) - mul_q30(sn, r_.a.x), mul_q30(c, r_.b.y) - mul_q30(sn, r_.a.y),
-                        mul_q30(c, r_.b.z) - mul_q30(sn, r_.a.z));
-        r_.a = north;
+        const Vector3l north(mul_q30(c, strapdown_.r().a.x) + mul_q30(sn, strapdown_.r().b.x), mul_q30(c, strapdown_.r().a.y) + mul_q30(sn, strapdown_.r().b.y),
+                             mul_q30(c, strapdown_.r().a.z) + mul_q30(sn, strapdown_.r().b.z));
+        strapdown_.r().b = Vector3l(mul_q30(c, strapdown_.r().b.x) - mul_q30(sn, strapdown_.r().a.x), mul_q30(c, strapdown_.r().b.y) - mul_q30(sn, strapdown_.r().a.y),
+                        mul_q30(c, strapdown_.r().b.z) - mul_q30(sn, strapdown_.r().a.z));
+        strapdown_.r().a = north;
         status_ &= (uint8_t)~kStatusMagIgnored;
         return;
     }
@@ -844,14 +612,12 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     const int32_t size_units = linalg::fixed_from_float(
         -heading_error * (starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps * k_.units_per_rad_s, 0);
     using linalg::q14_of;
-    turn_sum_.x += linalg::mul_q14(q14_of(r_.c.x), size_units);
-    turn_sum_.y += linalg::mul_q14(q14_of(r_.c.y), size_units);
-    turn_sum_.z += linalg::mul_q14(q14_of(r_.c.z), size_units);
+    strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
+                                 linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
-        const Vector3f error = linalg::vector_from_q30(r_.c) * -heading_error;
-        bias_fine_ -= linalg::fixed_from_vector(
-            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0);
-        clamp_bias();
+        const Vector3f error = linalg::vector_from_q30(strapdown_.r().c) * -heading_error;
+        bias_.subtract_fine(linalg::fixed_from_vector(
+            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0), k_);
         update_offset();
     }
 }
@@ -861,7 +627,7 @@ EulerQ24 Dcm::euler_now_q24() const {
     // when the update was told a line is due), in fixed point.
     if (k_.theta_q26_per_unit_q15 == 0) {  // scales beyond the integer path's factors: in float
         const Vector3f theta_rad = last_rate_rad_s() * settings_->output_lead_s + pending_turn_rad();
-        return euler_carried_q24(r_, linalg::fixed_from_float(theta_rad.x, 26),
+        return euler_carried_q24(strapdown_.r(), linalg::fixed_from_float(theta_rad.x, 26),
                                  linalg::fixed_from_float(theta_rad.y, 26), linalg::fixed_from_float(theta_rad.z, 26));
     }
     // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
@@ -869,7 +635,7 @@ EulerQ24 Dcm::euler_now_q24() const {
     // cost ~2.2 k cycles a line).
     const Vector3l rate = last_rate_units(), pending = pending_turn_units();
     const uint16_t lead = k_.lead_steps_q15, k = k_.theta_q26_per_unit_q15;
-    return euler_carried_q24(r_, scale_q15(pending.x + scale_q15(rate.x, lead), k),
+    return euler_carried_q24(strapdown_.r(), scale_q15(pending.x + scale_q15(rate.x, lead), k),
                              scale_q15(pending.y + scale_q15(rate.y, lead), k),
                              scale_q15(pending.z + scale_q15(rate.z, lead), k));
 }
@@ -884,54 +650,6 @@ bool Dcm::field_matches(float norm, float down_component, float ref_norm, float 
            dip_error > -dip_tolerance;
 }
 
-void Dcm::clamp_bias() {
-    int32_t* axis[3] = {&bias_fine_.x, &bias_fine_.y, &bias_fine_.z};
-    for (uint8_t i = 0; i < 3; ++i) {
-        if (*axis[i] > k_.bias_limit_fine) *axis[i] = k_.bias_limit_fine;
-        if (*axis[i] < -k_.bias_limit_fine) *axis[i] = -k_.bias_limit_fine;
-    }
-}
-
-// Orthonormalisation (eq. 18-21): share the X.Y error between the two rows, bring
-// each to unit length, and make Z their cross product (unit to within the square
-// of the remaining error, so it needs no scaling of its own). In Q30.
-bool Dcm::renormalise(int32_t& skew_q30) {
-    using linalg::mul_q30;
-    skew_q30 = linalg::dot_q30(r_.a, r_.b);
-    const int32_t half_error = skew_q30 / 2;
-    const Vector3l x(r_.a.x - mul_q30(half_error, r_.b.x), r_.a.y - mul_q30(half_error, r_.b.y),
-                     r_.a.z - mul_q30(half_error, r_.b.z));
-    const Vector3l y(r_.b.x - mul_q30(half_error, r_.a.x), r_.b.y - mul_q30(half_error, r_.a.y),
-                     r_.b.z - mul_q30(half_error, r_.a.z));
-    if (!rescale(x, r_.a) || !rescale(y, r_.b)) return false;
-    r_.c = linalg::cross_q30(r_.a, r_.b);
-    return true;
-}
-
-// Near unit length the first-order Taylor factor (3 - r.r)/2 replaces a square root
-// and a division; its residual is 3/8 (r.r - 1)^2, below 2e-6 in this window.
-bool Dcm::rescale(const Vector3l& row, Vector3l& out) {
-    constexpr int32_t kOne = 1073741824L;
-    constexpr int32_t kWindow = 2147484L;  // 2e-3 in Q30
-    // Each entry within +-1.4 (its square within Q30's 2); beyond, the matrix is hopeless.
-    constexpr int32_t kMaxEntry = 1518500249L;  // sqrt(2) in Q30
-    const int32_t* entry[3] = {&row.x, &row.y, &row.z};
-    for (uint8_t i = 0; i < 3; ++i)
-        if (*entry[i] >= kMaxEntry || *entry[i] <= -kMaxEntry) return false;
-    const uint32_t length2 = (uint32_t)linalg::mul_q30(row.x, row.x) + (uint32_t)linalg::mul_q30(row.y, row.y) +
-                             (uint32_t)linalg::mul_q30(row.z, row.z);  // < 6 in unsigned Q30: no overflow
-    if (length2 > (uint32_t)(kOne - kWindow) && length2 < (uint32_t)(kOne + kWindow)) {
-        const int32_t factor = kOne + kOne / 2 - (int32_t)(length2 / 2);
-        out = Vector3l(linalg::mul_q30(factor, row.x), linalg::mul_q30(factor, row.y), linalg::mul_q30(factor, row.z));
-        return true;
-    }
-    // Far from unit length (a rebuilt matrix, a heading taken at once): the exact factor,
-    // in float, unless the matrix is hopeless.
-    const float length2_f = linalg::float_from_fixed((int32_t)(length2 / 2), 29);
-    if (!(length2_f > 0.25f && length2_f < 4.0f)) return false;
-    out = linalg::fixed_from_vector(linalg::vector_from_q30(row) * (1.0f / sqrtf(length2_f)), linalg::kQ30);
-    return true;
-}
 
 // A matrix that renormalisation cannot save (NaN, or rows far from unit length)
 // is rebuilt from the last good gravity and field, as at start-up; the bias
@@ -939,7 +657,7 @@ bool Dcm::rescale(const Vector3l& row, Vector3l& out) {
 void Dcm::recover() {
     ++recoveries_;
     status_ |= kStatusRecovered;
-    if (!init(last_accel_.scaled(k_.accel_m_s2_per_count), last_mag_field())) r_ = linalg::q30_from_matrix(Matrix3f::identity());
+    if (!init(last_accel_.scaled(k_.accel_m_s2_per_count), last_mag_field())) strapdown_.reset(linalg::q30_from_matrix(Matrix3f::identity()));
 }
 
 }  // namespace dcm

@@ -20,6 +20,10 @@
 #include "Coefficients.h"
 #include "DcmSettings.h"
 #include "Euler.h"
+#include "GyroBias.h"
+#include "Rest.h"
+#include "Schedule.h"
+#include "Strapdown.h"
 #include "Fixed.h"
 #include "LinAlg.h"
 
@@ -83,7 +87,7 @@ public:
     void correct_heading(const linalg::Vector3f& mag_field, uint8_t age_steps = 0);
     // The next update (without a line) integrates or corrects gravity: a caller with
     // deferrable work puts it on another step.
-    bool heavy_due() const { return initialised() && blocks(next_heavy_part(false)); }
+    bool heavy_due() const { return initialised() && HeavySchedule::blocks(next_heavy_part(false)); }
     // A field sample given to correct_heading after the next update completes the
     // average of kHeadingSteps and corrects the heading, or is the first heading after a
     // start without one (the costly parts, up to ~11 k and ~20 k): a caller with
@@ -126,7 +130,7 @@ public:
     uint8_t status() const { return status_; }
     uint16_t recoveries() const { return recoveries_; }
     // R in float (tests, tools, the quaternion output): the estimator keeps it in Q30.
-    linalg::Matrix3f matrix() const { return linalg::matrix_from_q30(r_); }
+    linalg::Matrix3f matrix() const { return linalg::matrix_from_q30(strapdown_.r()); }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
@@ -134,7 +138,7 @@ public:
     const DcmSettings& settings() const { return *settings_; }
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const {
-        return euler_in_rad(euler_q24_from_q30(r_.a.x, r_.a.y, r_.b.x, r_.b.y, r_.c.x, r_.c.y, r_.c.z));
+        return euler_in_rad(euler_q24_from_q30(strapdown_.r().a.x, strapdown_.r().a.y, strapdown_.r().b.x, strapdown_.r().b.y, strapdown_.r().c.x, strapdown_.r().c.y, strapdown_.r().c.z));
     }
     // Euler angles of R carried forward by output_lead_s at the last corrected rate:
     // the attitude now rather than when the (low-passed, hence delayed) gyro sample
@@ -160,29 +164,22 @@ public:
     static constexpr float kFloatUnitsPerRad_s = dcm::kFloatUnitsPerRad_s;
 
 private:
-    // The heavy part of the next step, from the counters before it: step() does what this
-    // says, heavy_due() tells the caller.
-    enum class HeavyPart : uint8_t { kNone, kIntegration, kGravity, kRenormalisation };
-    HeavyPart next_heavy_part(bool line_due) const;
-    // The integration and the gravity correction take a step to themselves (heavy_due,
-    // heavy_step); the renormalisation (~5 k) only keeps off the line's step.
-    static bool blocks(HeavyPart p) { return p == HeavyPart::kIntegration || p == HeavyPart::kGravity; }
+    // The heavy part of the next step (HeavySchedule): step() does what this says,
+    // heavy_due() tells the caller.
+    HeavyPart next_heavy_part(bool line_due) const {
+        return schedule_.next(strapdown_.pending_steps(), strapdown_.renormalisation_due(), line_due);
+    }
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void correct_tilt(float startup_left, bool hold_integrator);
-    void integrate();
-    void renormalise_rows();  // every kRenormaliseEvery integrations, on a step of its own
-    static void turn_row(linalg::Vector3l& r, const linalg::Matrix3q30& d);
     void correct_gravity();
     void update_offset();
     static float inverse(uint8_t n);
-    static int32_t scale_q15(int32_t x, uint16_t c);
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
     // 32x32 routine, ~105 cycles).
     static int32_t in_turn_units(int32_t counts) {
         static_assert(kTurnFraction == 8, "a byte shift");
         return (int32_t)((uint32_t)counts << 8);
     }
-    linalg::Vector3l units_of(const linalg::Vector3f& rate_rad_s) const;  // in the turn sums' units
     linalg::Vector3l pending_turn_units() const;  // summed since the last integration (turn sums' units)
     linalg::Vector3f pending_turn_rad() const;
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
@@ -190,17 +187,8 @@ private:
     // mean_off_bias: the rest test's gyro mean less the bias estimate (the hold test's too).
     void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean,
                      const linalg::Vector3l& mean_off_bias, bool whole_window);
-    linalg::Vector3l bias_units() const;  // bias_fine_ rounded to units
     linalg::Vector3f last_mag_field() const;
-    bool renormalise(int32_t& skew_q30);  // skew: the X.Y it found
-    static bool rescale(const linalg::Vector3l& row, linalg::Vector3l& out);
-    linalg::Vector3l theta_q26(const linalg::Vector3l& units) const;  // the turn sums in Q26 radians
-    linalg::Vector3l theta_q26_in_float(const linalg::Vector3l& units) const;
-    int32_t theta_axis_q26(int32_t units) const;
-    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;  // ... and in Q30
-    linalg::Vector3l theta_q26_coarse(const linalg::Vector3l& units) const;  // Q26 by the 16-bit factor
     void recover();
-    void clamp_bias();
     bool accel_plausible(const linalg::Vector3f& a) const;
     void learn_field(float norm, float down_component);
     bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
@@ -211,33 +199,25 @@ private:
     const DcmSettings* settings_;
     DcmCoefficients k_;
 
-    linalg::Matrix3q30 r_;               // body -> earth, Q30 (integrate: turned in integers)
+    Strapdown strapdown_;                // R and the turn summed for it
+    HeavySchedule schedule_;             // which heavy part a step runs
+    GyroBias bias_;                      // the calibrated bias and the estimate
+    RestDetector rest_;                  // rest, when the gyro reads its bias alone
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
-    linalg::Vector3l bias_fine_;         // integrator: gyro-bias estimate, units * 2^8
     linalg::Vector3l correction_units_;  // roll/pitch correction, held between corrections
     linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
-    linalg::Vector3l sensor_bias_units_; // set_sensor_bias_rad_s
     linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
     linalg::Vector3i last_field_q5_;     // for a rebuild if the matrix degenerates (uT * 2^5)
     linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
     linalg::Vector3l accel_sum_;
-    linalg::Vector3l rest_gyro_mean_;    // their low-passed means, for the rest test (units,
-    linalg::Vector3l rest_accel_mean_;   // ... accel counts * 2^8)
-    uint16_t rest_corrections_ = 0;      // how long the board has been still, in corrections
-    linalg::Vector3i rest_field_;        // the field (body axes, uT Q5) when the board last seemed to turn
     linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
     uint8_t window_samples_ = 0;         // samples in the sums
-    linalg::Vector3l first_half_;        // corrected rates summed over the integration's first half (kTurnScale)
-    linalg::Vector3l turn_sum_;          // ... and since
-    uint8_t pending_steps_ = 0;          // steps summed, not yet integrated
-    uint8_t updates_since_renormalise_ = 0;  // >= kRenormaliseEvery: renormalisation due
     linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q17)
     uint32_t heading_norm2_sum_ = 0;     // ... and their squared strengths (uT^2 / 4)
     uint8_t heading_samples_ = 0;
     uint16_t heading_steps_ = 0;         // steps the summed samples stand for
-    bool gravity_due_ = false;           // a gravity correction waits for a step without an integration
     bool heavy_ = false;                 // the last update integrated or corrected gravity
     float mag_ref_norm_ = 0.0f;          // learned field strength
     bool mag_take_heading_ = true;       // reset_mag_reference's take_heading
@@ -249,7 +229,6 @@ private:
     uint16_t mag_steady_steps_ = 0;      // how long a different field has stayed the same
     float mag_steady_turn_rad_ = 0.0f;   // how far the board turned meanwhile
     uint16_t recoveries_ = 0;
-    uint8_t correction_phase_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
 };

@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Rest detection and the gyro bias alone (Rest.h, GyroBias.h): when the rest test
+// passes and what ends a rest (each of its inputs), and how the bias estimate follows
+// the rest mean, integrates the tilt error and stays bounded.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "GyroBias.h"
+#include "Rest.h"
+#include "dcm_test_support.h"
+
+using linalg::Vector3f;
+using linalg::Vector3i;
+using linalg::Vector3l;
+
+namespace {
+
+dcm::DcmCoefficients float_form_coefficients() {
+    dcm::DcmCoefficients k;
+    k.from_settings(dcm::kDefaultDcmSettings);
+    k.derive_from_scales(dcm::kDefaultDcmSettings);
+    return k;
+}
+
+Vector3l units(const dcm::DcmCoefficients& k, const Vector3f& rate_rad_s) {
+    return linalg::fixed_from_vector(rate_rad_s * k.units_per_rad_s, 0);
+}
+
+constexpr float kDegPerS = linalg::kRadPerDeg;
+
+struct RestFixture {
+    dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::RestDetector rest;
+    Vector3l gyro_mean, accel_mean;
+    RestFixture() {
+        gyro_mean = units(k, Vector3f(1.0f, -0.5f, 0.3f) * kDegPerS);  // a bias, read at rest
+        accel_mean = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, -9.81f) * k.accel_units_per_m_s2, 0);
+        rest.reset(accel_mean);
+    }
+    // Updates until the rest test passes; the number of updates it took (or -1).
+    int updates_to_rest(const Vector3l& mean_off_bias, bool compass_watching, int limit = 400) {
+        for (int i = 1; i <= limit; ++i)
+            if (rest.update(gyro_mean, accel_mean, mean_off_bias, true, compass_watching, k)) return i;
+        return -1;
+    }
+};
+
+}  // namespace
+
+TEST(DcmRest, StillForRestMinSecondsIsRest) {
+    RestFixture f;
+    EXPECT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
+    EXPECT_EQ(f.k.rest_min_corrections, (uint16_t)(1.5f / 0.02f));
+}
+
+// Without a compass watching, a gyro mean far from the bias estimate is a slow turn,
+// not rest; with one, the field decides (watch_field).
+TEST(DcmRest, WithoutACompassTheMeanMustBeNearTheBiasEstimate) {
+    RestFixture f;
+    const Vector3l far_from_bias = units(f.k, Vector3f(0.0f, 0.0f, 5.0f * kDegPerS));
+    EXPECT_EQ(f.updates_to_rest(far_from_bias, false), -1);
+    EXPECT_GT(f.updates_to_rest(far_from_bias, true), 0);
+    RestFixture g;
+    const Vector3l near_bias = units(g.k, Vector3f(0.0f, 0.0f, 1.0f * kDegPerS));
+    EXPECT_GT(g.updates_to_rest(near_bias, false), 0);
+}
+
+TEST(DcmRest, AMovingGyroOrAccelOrAShortWindowIsNoRest) {
+    RestFixture f;
+    int n = 0;
+    for (int i = 0; i < 300; ++i) {  // a 3 deg/s swing every other update
+        const Vector3l swing = units(f.k, Vector3f((i & 1) ? 6.0f * kDegPerS : 0.0f, 0.0f, 0.0f));
+        n += f.rest.update(f.gyro_mean + swing, f.accel_mean, Vector3l(), true, true, f.k);
+    }
+    EXPECT_EQ(n, 0);
+    RestFixture g;
+    const Vector3l shove = linalg::fixed_from_vector(Vector3f(2.0f, 0.0f, 0.0f) * g.k.accel_units_per_m_s2, 0);
+    for (int i = 0; i < 300; ++i) n += g.rest.update(g.gyro_mean, g.accel_mean + ((i & 1) ? shove : Vector3l()), Vector3l(), true, true, g.k);
+    EXPECT_EQ(n, 0);
+    RestFixture h;
+    for (int i = 0; i < 300; ++i) n += h.rest.update(h.gyro_mean, h.accel_mean, Vector3l(), false, true, h.k);
+    EXPECT_EQ(n, 0);
+}
+
+// The field moving by more than 1 uT in body axes ends a rest; the HMC5883L's noise
+// (0.2 uT) does not.
+TEST(DcmRest, AFieldThatMovesEndsTheRest) {
+    RestFixture f;
+    const Vector3i field(20 * 32, 0, 45 * 32);  // uT Q5
+    f.rest.watch_field(field);
+    ASSERT_GT(f.updates_to_rest(Vector3l(), true), 0);
+    f.rest.watch_field(Vector3i(field.x + 6, field.y - 6, field.z));  // 0.27 uT
+    EXPECT_TRUE(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k));
+    f.rest.watch_field(Vector3i(field.x + 48, field.y, field.z));  // 1.5 uT
+    EXPECT_FALSE(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k));
+    f.rest.interrupt();
+    EXPECT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
+}
+
+TEST(DcmGyroBias, FollowsTheRestMeanWithRestBiasSeconds) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::GyroBias bias;
+    const Vector3f truth(0.02f, -0.01f, 0.015f);  // rad/s
+    const Vector3l mean = units(k, truth);
+    // One rest_bias_s (1 s) of corrections: 1 - 1/e of the way.
+    const int corrections = (int)std::lround(1.0f / 0.02f);
+    for (int i = 0; i < corrections; ++i) bias.follow_rest_mean(mean, k);
+    const Vector3f got = bias.estimate_rad_s(k);
+    EXPECT_NEAR(got.x / truth.x, 1.0f - std::exp(-1.0f), 0.01f);
+    EXPECT_NEAR(got.z / truth.z, 1.0f - std::exp(-1.0f), 0.01f);
+    for (int i = 0; i < 20 * corrections; ++i) bias.follow_rest_mean(mean, k);
+    EXPECT_NEAR(bias.estimate_rad_s(k).y, truth.y, 1e-6f);
+}
+
+TEST(DcmGyroBias, StaysWithinTheLimitAndComposesTheOffset) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::GyroBias bias;
+    const float limit = dcm::kDefaultDcmSettings.bias_limit_rad_s;
+    bias.set_estimate_rad_s(Vector3f(1.0f, -1.0f, 0.05f), k);
+    EXPECT_NEAR(bias.estimate_rad_s(k).x, limit, 1e-5f);
+    EXPECT_NEAR(bias.estimate_rad_s(k).y, -limit, 1e-5f);
+    EXPECT_NEAR(bias.estimate_rad_s(k).z, 0.05f, 1e-5f);
+    for (int i = 0; i < 100000; ++i) bias.integrate_tilt_error(-16384, 16384, 0, k);  // 1 rad of error
+    EXPECT_NEAR(bias.estimate_rad_s(k).x, limit, 1e-5f);
+    EXPECT_NEAR(bias.estimate_rad_s(k).y, -limit, 1e-5f);
+    bias.set_sensor_rad_s(Vector3f(0.01f, 0.0f, 0.0f), k);
+    const Vector3l correction(5, 6, 7);
+    const Vector3l offset = bias.offset_units(correction);
+    EXPECT_EQ(offset.x, bias.sensor_units().x + bias.units().x - 5);
+    EXPECT_EQ(offset.z, bias.units().z - 7);
+    EXPECT_EQ(bias.sensor_units().x, units(k, Vector3f(0.01f, 0.0f, 0.0f)).x);
+}
+
+// The tilt error's integral: ki_rp_1_s2 * error * dt per correction, against the error.
+TEST(DcmGyroBias, IntegratesTheTiltErrorAgainstIt) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::GyroBias bias;
+    const int16_t error_q14 = 164;  // 0.01 rad
+    for (int i = 0; i < 50; ++i) bias.integrate_tilt_error(error_q14, 0, -error_q14, k);  // 1 s
+    const float expected = -dcm::kDefaultDcmSettings.ki_rp_1_s2 * 0.01f * 1.0f;
+    EXPECT_NEAR(bias.estimate_rad_s(k).x, expected, 0.02f * std::fabs(expected));
+    EXPECT_NEAR(bias.estimate_rad_s(k).z, -expected, 0.02f * std::fabs(expected));
+}
