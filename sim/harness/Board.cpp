@@ -9,6 +9,7 @@
 #include <cstdarg>
 #include <cstring>
 
+#include "avr_adc.h"
 #include "avr_eeprom.h"
 #include "avr_ioport.h"
 #include "avr_spi.h"
@@ -208,6 +209,9 @@ bool Board::init() {
         return false;
     }
     avr_->frequency = kCpuHz;
+    // The APM 2.5's ATmega2560 runs at 5 V, AVCC and the default reference too (simavr's
+    // default: 3.3 V); only the ADC reads these.
+    avr_->vcc = avr_->avcc = avr_->aref = 5000;
     if (!load_eeprom()) return false;
     avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
     avr_->log = LOG_WARNING;
@@ -604,6 +608,11 @@ uint64_t Board::on_ppm_edge() {
 }
 
 void Board::rc_changed() { schedule_ppm_edge(); }
+
+// simavr's ADC converts the millivolts last raised on the channel's IRQ.
+void Board::set_a0_mV(double mV) {
+    avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0), (uint32_t)std::lround(mV));
+}
 
 // Each output's level is the OCnx unit's while TCCRnA's COMnx bits connect it to the pin
 // (as the hardware overrides PORT), else the PORT bit when the pin is an output, else

@@ -113,6 +113,8 @@ public:
     // Appends a state to the sensor models' samples (--physics), and forgets those older
     // than `keep_s` before it.
     void append_sample(const TrajectorySample& sample, double keep_s);
+    // The voltage on analog input A0 (ADC0), in millivolts: the airspeed sensor (--physics).
+    void set_a0_mV(double mV);
     // After RcScript::push: restarts the PPM line if it had gone quiet.
     void rc_changed();
 
