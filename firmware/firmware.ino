@@ -135,20 +135,25 @@ static void take_receiver_frames(uint32_t now_ms) {
     while (rc_input::poll(ppm)) flight_control.on_frame(ppm.frame_us(), now_ms);
 }
 
-// angles: the output line's, or nullptr.
-static void control_step(uint32_t now_us, uint32_t now_ms, bool have_sample, const pipeline::AnglesCentideg* angles) {
+// angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
+// The rates are the sample's body-frame counts less the calibrated bias, in integers (the
+// pipeline's float rates cost several times as much; the D term needs no more).
+static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
+                         const pipeline::AnglesCentideg* angles) {
     last_control_us = now_us;
     control_count = 0;
     board::mark_begin(board::kSecControl);
-    flight::Attitude att{0, 0, 0, 0, have_sample && imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
     flight_control.update_signal(now_ms);
     if (att.valid && flight_control.wants_attitude()) {  // MANUAL and no receiver yet need none
         const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
-        const linalg::Vector3f rate = pipe.body_rate_rad_s();
         att.roll_cd = a.roll_centideg;
         att.pitch_cd = a.pitch_centideg;
-        att.roll_rate_cds = (int32_t)(rate.x * (100.0f * linalg::kDegPerRad));
-        att.pitch_rate_cds = (int32_t)(rate.y * (100.0f * linalg::kDegPerRad));
+        constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
+        const int32_t k_q10 = (int32_t)(sample->gyro_rad_s_per_count * (kCdsPerRad_s * 1024.0f) + 0.5f);
+        const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
+        att.roll_rate_cds = (((int32_t)sample->gyro.x * k_q10) >> 10) - (int32_t)(bias.x * kCdsPerRad_s);
+        att.pitch_rate_cds = (((int32_t)sample->gyro.y * k_q10) >> 10) - (int32_t)(bias.y * kCdsPerRad_s);
     }
     uint16_t widths[flight::kChannels];
     flight_control.step(now_ms, att, widths);
@@ -420,7 +425,7 @@ static void step(uint32_t now_us) {
         ++control_count;
         if (control_count >= kControlDivider ||
             (output && control_count >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
-            control_step(now_us, now_ms, true, have_angles ? &c : nullptr);
+            control_step(now_us, now_ms, &sample, have_angles ? &c : nullptr);
     }
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
@@ -491,7 +496,7 @@ void loop() {
     const uint32_t now_us = micros();
     take_receiver_frames(now_ms);
     if (now_us - last_control_us >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
-        control_step(now_us, now_ms, false, nullptr);
+        control_step(now_us, now_ms, nullptr, nullptr);
     }
     if (now_us - window_start_us >= 1000000u) {  // load over the last second
         load_pct = (uint8_t)(work_us / ((now_us - window_start_us) / 100u));

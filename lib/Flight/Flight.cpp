@@ -14,10 +14,13 @@ int32_t clamp32(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > h
 
 bool bit(uint8_t mask, uint8_t index) { return ((mask >> index) & 1u) != 0u; }
 
-// A stick's command (-4500..4500) as a demanded angle, full stick = limit_cd (a float
-// multiply: cheaper than a 32-bit division on the AVR).
+// A stick's command (-4500..4500) as a demanded angle, full stick = limit_cd: |stick x
+// limit| (< 2^26) / 4500 as (x >> 7) x (2^24 / 4500) >> 17, within 1 cd and no division.
 int32_t demand_cd(int16_t stick_cd, int16_t limit_cd) {
-    return (int32_t)((float)((int32_t)stick_cd * limit_cd) * (1.0f / 4500.0f));
+    const int32_t x = (int32_t)stick_cd * limit_cd;
+    const uint32_t m = (uint32_t)(x < 0 ? -x : x);
+    const int32_t d = (int32_t)(((m >> 7) * 3728u) >> 17);
+    return x < 0 ? -d : d;
 }
 
 constexpr float kDegPerRad = 57.2957795f;
@@ -167,19 +170,20 @@ uint16_t table_word(const uint16_t* p) { return pgm_read_word(p); }
 uint16_t table_word(const uint16_t* p) { return *p; }
 #endif
 
-// tan(x) sin(x) at 0, 5, ... 80 deg, Q12; cos(x) at 0, 5, ... 90 deg, Q15.
-const uint16_t kTanSinQ12[17] FLIGHT_TABLE = {0, 31, 125, 284, 510, 807, 1182, 1645, 2209, 2896, 3739, 4792, 6144, 7961, 10575, 14766, 22877};
-const uint16_t kCosQ15[19] FLIGHT_TABLE = {32768, 32643, 32270, 31651, 30792, 29698, 28378, 26842, 25102, 23170, 21063, 18795, 16384, 13848, 11207, 8481, 5690, 2856, 0};
+// tan(x) sin(x) at 0, 5.12, ... 81.92 deg (steps of 512 cd: the index a shift), Q12;
+// cos(x) at 0, 5.12, ... 92.16 deg, Q15 (0 past 90).
+const uint16_t kTanSinQ12[17] FLIGHT_TABLE = {0, 33, 132, 298, 535, 848, 1243, 1732, 2331, 3064, 3970, 5115, 6609, 8668, 11744, 17002, 28566};
+const uint16_t kCosQ15[19] FLIGHT_TABLE = {32768, 32637, 32246, 31598, 30697, 29551, 28170, 26564, 24745, 22730, 20533, 18172, 15666, 13035, 10300, 7483, 4606, 1692, 0};
 
-// A table at 5 deg steps, linearly between them, at |angle_cd| (within the table).
+// A table at 512 cd steps, linearly between them, at |angle_cd| (within the table).
 uint16_t lookup(const uint16_t* table, int32_t angle_cd) {
     const uint16_t a = (uint16_t)(angle_cd < 0 ? -angle_cd : angle_cd);
-    const uint8_t i = (uint8_t)(a / 500u);
-    const uint16_t frac = (uint16_t)(a - i * 500u);
-    const uint16_t y0 = table_word(table + i);
-    if (frac == 0u) return y0;
+    const uint8_t i = (uint8_t)(a >> 9);
+    const uint16_t frac = (uint16_t)(a & 511u);
+    const int32_t y0 = table_word(table + i);
+    if (frac == 0u) return (uint16_t)y0;
     const int32_t y1 = table_word(table + i + 1);
-    return (uint16_t)(y0 + ((y1 - y0) * (int32_t)frac) / 500);
+    return (uint16_t)(y0 + (((y1 - y0) * (int32_t)frac) >> 9));
 }
 
 }  // namespace
