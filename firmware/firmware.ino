@@ -137,7 +137,14 @@ static void take_receiver_frames(uint32_t now_ms) {
 
 // angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
 // The rates are the sample's body-frame counts less the calibrated bias, in integers (the
-// pipeline's float rates cost several times as much; the D term needs no more).
+// pipeline's float rates cost several times as much; the D term needs no more); the
+// bias in those units is worked out again once a second (`cal gyro` changes it).
+constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
+constexpr int32_t kCdsPerCountQ10 =
+    (int32_t)(mpu6000::gyro_rad_s_per_count(mpu6000::kGyroRange) * kCdsPerRad_s * 1024.0f + 0.5f);
+static int16_t bias_cds[2];
+static uint8_t bias_age = 0xFF;
+
 static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
                          const pipeline::AnglesCentideg* angles) {
     last_control_us = now_us;
@@ -149,11 +156,14 @@ static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample
         const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
         att.roll_cd = a.roll_centideg;
         att.pitch_cd = a.pitch_centideg;
-        constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
-        const int32_t k_q10 = (int32_t)(sample->gyro_rad_s_per_count * (kCdsPerRad_s * 1024.0f) + 0.5f);
-        const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
-        att.roll_rate_cds = (((int32_t)sample->gyro.x * k_q10) >> 10) - (int32_t)(bias.x * kCdsPerRad_s);
-        att.pitch_rate_cds = (((int32_t)sample->gyro.y * k_q10) >> 10) - (int32_t)(bias.y * kCdsPerRad_s);
+        if (++bias_age >= 50u) {
+            const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
+            bias_cds[0] = (int16_t)(bias.x * kCdsPerRad_s);
+            bias_cds[1] = (int16_t)(bias.y * kCdsPerRad_s);
+            bias_age = 0;
+        }
+        att.roll_rate_cds = (((int32_t)sample->gyro.x * kCdsPerCountQ10) >> 10) - bias_cds[0];
+        att.pitch_rate_cds = (((int32_t)sample->gyro.y * kCdsPerCountQ10) >> 10) - bias_cds[1];
     }
     uint16_t widths[flight::kChannels];
     flight_control.step(now_ms, att, widths);
