@@ -3,6 +3,7 @@
 // limit holds back is told, with its count, once the quiet time is over.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <string>
 
 #include "Pipeline.h"
@@ -37,6 +38,10 @@ TEST(RateLimiter, HeldEventsAreCountedAndToldOnceTheIntervalIsOver) {
     EXPECT_EQ(r.deferred(120, 10), 1);
     // After a quiet interval, the next event is said at once.
     EXPECT_TRUE(r.allow(131, 10));
+    // While some are held, the next one after the interval joins them: one line for all.
+    EXPECT_FALSE(r.allow(135, 10));
+    EXPECT_FALSE(r.allow(141, 10));
+    EXPECT_EQ(r.deferred(141, 10), 2);
 }
 
 TEST(RateLimiter, HeldCountSaturates) {
@@ -89,6 +94,23 @@ TEST(RateLimiter, HeldSaturationWarningsAreTold) {
     EXPECT_EQ(count_of(log, "# warn: MPU6000 accel saturated"), 2) << log;
     EXPECT_NE(log.find("# warn: MPU6000 accel saturated: 9 more samples"), std::string::npos) << log;
     EXPECT_EQ(p.spikes(), 0u);
+}
+
+// The start-up calibration's "board moved" (once a second at most): the restarts in
+// between are counted on the next line.
+TEST(RateLimiter, BoardMovedCountsTheRestartsBetweenLines) {
+    std::string log;
+    const text::Sink sink{&log, sink_write};
+    pipeline::AttitudePipeline p(&sink);
+    for (int i = 0; i < 230; ++i) {
+        const float wobble = (i % 2 == 0) ? 1.0f : -1.0f;  // restarts again and again
+        p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
+    }
+    EXPECT_EQ(count_of(log, "# calibrating gyro: board moved, retrying"), 1) << log;
+    EXPECT_EQ(count_of(log, "# calibrating gyro: board moved"), 2) << log;  // 230 steps: two lines
+    const size_t more = log.find(" more times, retrying");
+    ASSERT_NE(more, std::string::npos) << log;
+    EXPECT_GT(std::atoi(log.c_str() + log.rfind("board moved ", more) + 12), 1) << log;
 }
 
 }  // namespace

@@ -99,7 +99,7 @@ private:
 // ArduPilot's CompassCalibrator does, but without storing the samples: the fits are
 // linear in their parameters, so their normal equations are sums of the monomials
 // x^i y^j z^k (i + j + k <= 4) of the samples, 35 sums accumulated as they come
-// (140 B). The samples are centred on a pivot (the centre already in use) and scaled
+// (140 B; the fit then works in the same memory, grown to 220 B). The samples are centred on a pivot (the centre already in use) and scaled
 // by 1/64 uT, so that the float32 sums (AVR's double is 32-bit too) keep their
 // precision. A fit is refused, with the reason, when the board did not see enough
 // directions, when the residual is larger than a clean compass gives, or when the

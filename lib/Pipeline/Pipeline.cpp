@@ -43,7 +43,8 @@ uint32_t norm2(const linalg::Vector3i& v) {
 }  // namespace
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
-    if (ever && now - last < interval) {
+    // Events held back go out first, in deferred()'s line, which counts this one too.
+    if (ever && (now - last < interval || held != 0)) {
         if (held < 0xFFFFu) ++held;
         return false;
     }
@@ -247,8 +248,11 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         }
         return;
     }
-    if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz))
+    if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz)) {
         Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
+    } else if (const uint16_t n = st_.warn_moved.deferred(st_.steps, kRateHz)) {
+        Writer(log_).str(TXT("# calibrating gyro: board moved ")).u32(n).str(TXT(" more times, retrying")).end();
+    }
     if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
         // Never still long enough: run with what we have, keep measuring in the background
         // (the warning on the next step, as the bias message).

@@ -108,7 +108,7 @@ using AnglesCentideg = dcm::AnglesCentideg;
 // A per-kind rate limiter for warnings: allow() is true at most once per interval; what
 // it holds back is not lost: once the interval since the last line is over, deferred()
 // gives how many were held (and zero again), for a "N more" line that starts the next
-// interval. A plain struct that starts zeroed: declare it static or value-initialise it
+// interval (while some are held, allow() holds the next ones too: that line counts them). A plain struct that starts zeroed: declare it static or value-initialise it
 // (`RateLimiter r{};`).
 struct RateLimiter {
     bool allow(uint32_t now_steps, uint16_t interval_steps);

@@ -281,6 +281,9 @@ Boot boot_line(const std::string& chip) {
 
 struct SweepResult {
     int cuts = 0, cuts_during_save = 0, distinct_chips = 0, old_boots = 0, new_boots = 0;
+    double saving_s = 0.0;                 // when "# saving to EEPROM" came
+    std::vector<e2e::Line> lines;          // the run's output
+    settings::Settings before, after;      // the chip's settings before and after the save
 };
 
 // One simavr run from the chip `start` that types `input` (at input_at_s) ending with a
@@ -311,7 +314,9 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
     const e2e::Line* saving = find_line(run.lines, "# saving to EEPROM");
     const e2e::Line* saved = find_line(run.lines, "# saved");
     EXPECT_TRUE(saving && saved) << e2e::dump(run, 400);
+    r.lines = run.lines;
     if (!saving || !saved) return r;
+    r.saving_s = saving->t_s;
     EXPECT_GT(saving->t_s, from_s + 0.01) << "the cuts begin before the save";
     EXPECT_LT(saved->t_s, to_s - 0.01) << "the cuts end before the save has ended";
     EXPECT_EQ(load_chip(chip, new_settings).result, settings::LoadResult::Ok);
@@ -350,6 +355,8 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
         unlink(cut_path.c_str());
     }
     r.distinct_chips = (int)is_new_of_chip.size();
+    r.before = old_settings;
+    r.after = new_settings;
     EXPECT_EQ(r.cuts, expected_cuts);
     std::printf("# %s: %d cuts (%d during the save), %d distinct chips started: %d old, %d new settings\n",
                 name.c_str(), r.cuts, r.cuts_during_save, r.distinct_chips, r.old_boots, r.new_boots);
@@ -398,6 +405,12 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
                                 {{slots::slot_address(1), slot_of(encoded(numbered_settings(3, true)), 3)},
                                  {slots::slot_address(0), slot_of(encoded(numbered_settings(4, false)), 2)}},
                                 35.8, 36.7);
+    // The save is the new calibration's: the fit's verdict came before it.
+    const e2e::Line* fit = find_line(r.lines, "# cal mag: offset");
+    ASSERT_TRUE(fit) << "no cal mag result";
+    EXPECT_LT(fit->t_s, r.saving_s);
+    EXPECT_FALSE(r.after.cal.mag_offset_uT == r.before.cal.mag_offset_uT);
+    EXPECT_FALSE(r.after.cal.mag_scale == r.before.cal.mag_scale);
     EXPECT_GE(r.cuts_during_save, 100);
     EXPECT_GT(r.old_boots, 0);
     EXPECT_GT(r.new_boots, 0);
