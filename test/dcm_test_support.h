@@ -48,6 +48,15 @@ inline Matrix3f random_rotation(std::mt19937& rng) {
     return dcm::dcm_from_euler(angle(rng), std::asin(u(rng)), angle(rng));
 }
 
+// The coefficients of the default settings at the float form's scales (the parts'
+// tests: DcmSettings' units through kFloatGyroScale and kFloatAccelScale).
+inline dcm::DcmCoefficients float_form_coefficients() {
+    dcm::DcmCoefficients k;
+    k.from_settings(dcm::kDefaultDcmSettings);
+    k.derive_from_scales(dcm::kDefaultDcmSettings);
+    return k;
+}
+
 inline float orthonormality_error(const Matrix3f& r) {
     const Matrix3f p = r * r.transposed();
     const Matrix3f d = p - Matrix3f::identity();

@@ -14,14 +14,9 @@ using linalg::Vector3f;
 using linalg::Vector3i;
 using linalg::Vector3l;
 
-namespace {
+using dcm_test::float_form_coefficients;
 
-dcm::DcmCoefficients float_form_coefficients() {
-    dcm::DcmCoefficients k;
-    k.from_settings(dcm::kDefaultDcmSettings);
-    k.derive_from_scales(dcm::kDefaultDcmSettings);
-    return k;
-}
+namespace {
 
 Vector3l units(const dcm::DcmCoefficients& k, const Vector3f& rate_rad_s) {
     return linalg::fixed_from_vector(rate_rad_s * k.units_per_rad_s, 0);

@@ -24,13 +24,6 @@ float largest_entry(const Matrix3f& d) {
 
 bool same(const Vector3l& a, const Vector3l& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
-dcm::DcmCoefficients float_form_coefficients() {
-    dcm::DcmCoefficients k;
-    k.from_settings(dcm::kDefaultDcmSettings);
-    k.derive_from_scales(dcm::kDefaultDcmSettings);
-    return k;
-}
-
 // exp([theta x]) by Rodrigues: I + sin a K + (1 - cos a) K^2. The strapdown turns R
 // by R <- R exp([theta x]), so from I it is this.
 Matrix3f rotation_of(const Vector3f& theta) {

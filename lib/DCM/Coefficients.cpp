@@ -19,6 +19,12 @@ bool exceeds(const linalg::Vector3l& v, const Limit& limit) {
 
 linalg::Vector3l rescaled(const linalg::Vector3l& v, float ratio) { return linalg::fixed_from_vector(v.scaled(ratio), 0); }
 
+Limit limit_of(float value) {
+    uint8_t shift = 0;
+    for (; value >= 16384.0f && shift < 31; ++shift) value *= 0.5f;  // exact: a power of two
+    return Limit{value > 0.0f ? (uint32_t)(value * value) : 0u, shift};
+}
+
 // A low-pass's factor per correction for the time constant tau_s: dt / (tau + dt).
 static float lowpass_alpha(float tau_s, float dt_s) { return dt_s / (tau_s + dt_s); }
 

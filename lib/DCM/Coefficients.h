@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What the estimator's step needs that follows from the settings and the sensor's
 // scales, worked out once where they change (VQF's coefficients struct): the step
-// then does no float division (~480 cycles on the 2560) and no trigonometry.
+// then does no float division and no trigonometry.
 //
 // Units of the integer state (the table the other Dcm files refer to):
 //   units            the turn sums': gyro counts * 2^kTurnFraction (2^8) per step
@@ -72,10 +72,7 @@ struct Limit {
 };
 // A limit L as a shift s and (L / 2^s)^2 with L / 2^s below 2^14: a vector that stays
 // within 16 bits after the shift up to twice the limit, and the limit resolved to 2^-13.
-constexpr Limit limit_of(float value, uint8_t shift = 0) {
-    return value >= 16384.0f && shift < 31 ? limit_of(value * 0.5f, (uint8_t)(shift + 1))
-                                           : Limit{value > 0.0f ? (uint32_t)(value * value) : 0u, shift};
-}
+Limit limit_of(float value);
 // |v| >= the limit, from 16x16 products: an axis beyond 16 bits after the shift is.
 bool exceeds(const linalg::Vector3l& v, const Limit& limit);
 
@@ -126,10 +123,7 @@ struct DcmCoefficients {
     // is 0.7 rad), and |theta|^2 stays below 2 in Q30. One mul_q30 an axis.
     linalg::Vector3l theta_q26(const linalg::Vector3l& units) const;
     // ... in Q30 (the integration's).
-    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const {
-        const linalg::Vector3l t_q26 = theta_q26(units);
-        return linalg::Vector3l(t_q26.x * 16, t_q26.y * 16, t_q26.z * 16);
-    }
+    linalg::Vector3l theta_q30(const linalg::Vector3l& units) const;
     // The same by the 16-bit factor (scale_q15: two 16x16 products an axis, the factor
     // to 1.5e-5 of itself), for a turn used in 16 bits: the compass sample's latency turn
     // and the gravity window's turn per step. Unsaturated: both are a few steps' rates.
@@ -156,6 +150,11 @@ FIXED_INLINE int32_t DcmCoefficients::theta_axis_q26(int32_t units) const {
 FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26(const linalg::Vector3l& units) const {
     if (theta_factor_q30 == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
     return linalg::Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
+}
+
+FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q30(const linalg::Vector3l& units) const {
+    const linalg::Vector3l t_q26 = theta_q26(units);
+    return linalg::Vector3l(t_q26.x * 16, t_q26.y * 16, t_q26.z * 16);
 }
 
 FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26_coarse(const linalg::Vector3l& units) const {

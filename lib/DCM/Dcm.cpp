@@ -12,48 +12,14 @@ using linalg::Vector3l;
 
 namespace {
 
-// 1/n in Q30 for the window's samples (n = 1..5: a correction late by a step takes
-// five), as code (a table would take RAM on the AVR).
-int32_t inverse_q30(uint8_t n) {
-    switch (n) {
-        case 1: return 1073741824L;
-        case 2: return 536870912L;
-        case 3: return 357913941L;
-        case 4: return 268435456L;
-        case 5: return 214748365L;
-        default: return linalg::fixed_from_float(1.0f / (float)n, linalg::kQ30);
-    }
-}
-
-// A sum's mean: v / n, by two bit shifts in the usual case (n = 4), else by 1/n in Q30.
-Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
-    if (n == 4) return Vector3l(v.x >> 2, v.y >> 2, v.z >> 2);
-    return Vector3l(linalg::mul_q30(inverse_q30, v.x), linalg::mul_q30(inverse_q30, v.y), linalg::mul_q30(inverse_q30, v.z));
-}
-
-// v * 2^8 by byte shifts (a multiply may become avr-gcc's 32x32 routine, ~105 cycles).
-Vector3l times_256(const Vector3l& v) {
-    return Vector3l((int32_t)((uint32_t)v.x << 8), (int32_t)((uint32_t)v.y << 8), (int32_t)((uint32_t)v.z << 8));
-}
 // A mag correction stands for the time since the previous sample, but never more
 // than this many steps (after an outage the first sample must not make a jump).
 constexpr uint16_t kMaxMagIntervalSteps = 20;
 // A field sample's wait before it is used, counted in its latency up to this (steps).
 constexpr uint8_t kMaxMagAgeSteps = 2;
-// The recent disturbed field, for the new-field test, follows the samples with 53 ms
-// (a fifth of the way at each 75 Hz sample); the learned field tracks slow changes
-// (temperature, location) with 1.3 s.
-constexpr float kCandidateTau_s = 0.053f;
-constexpr float kReferenceTau_s = 1.32f;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
 constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
-// The sums' units: a squared strength in uT^2 * 2^(2 kFieldQ - kNorm2Shift), the field
-// in earth axes in uT * 2^(kFieldQ + 14 - kEarthFieldShift) (eight samples' sums within 32 bits).
-constexpr uint8_t kNorm2Shift = 4;
-constexpr uint8_t kEarthFieldShift = 2;
-constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
-constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
 
 // Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
 int16_t q16_of(int32_t x_q26) {
@@ -93,9 +59,8 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
     const float gyro_ratio = k_.gyro_rad_s_per_count / gyro_rad_s_per_count, accel_ratio = k_.accel_m_s2_per_count / accel_m_s2_per_count;
     if (gyro_ratio != 1.0f) {
         bias_.rescale(gyro_ratio);
-        correction_units_ = rescaled(correction_units_, gyro_ratio);
     }
-    if (accel_ratio != 1.0f) accel_lp_ef_ = rescaled(accel_lp_ef_, accel_ratio);
+    gravity_.rescale(gyro_ratio, accel_ratio);
     rest_.rescale(gyro_ratio, accel_ratio);
     k_.set_scales(*settings_, gyro_rad_s_per_count, accel_m_s2_per_count);
     update_offset();
@@ -104,7 +69,7 @@ void Dcm::set_sample_scales(float gyro_rad_s_per_count, float accel_m_s2_per_cou
 // What each step subtracts from the gyro, in the integer units of the turn sums
 // (counts * 2^kTurnFraction).
 void Dcm::update_offset() {
-    offset_units_ = bias_.offset_units(correction_units_);
+    offset_units_ = bias_.offset_units(gravity_.correction_units());
 }
 
 
@@ -142,25 +107,17 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
                                           (int16_t)linalg::fixed_from_float(kept.y, kFieldQ),
                                           (int16_t)linalg::fixed_from_float(kept.z, kFieldQ));
         const float norm = mag_field.length();
-        learn_field(norm, field_down / norm);
+        gate_.learn(norm, field_down / norm);
     }
     strapdown_.reset(linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down)));
     // The integer factors of the scales, unless set_sample_scales set them (the float
     // form's, whose scales are the defaults: the Pipeline sets its own before the start).
     if (k_.theta_factor_q30 == 0) k_.derive_from_scales(*settings_);
     const float per_m_s2 = k_.accel_units_per_m_s2;
-    accel_lp_ef_ = Vector3l(0, 0, linalg::fixed_from_float(-kGravity_m_s2 * per_m_s2, 0));
-    correction_units_ = Vector3l();
+    gravity_.reset(linalg::fixed_from_float(-kGravity_m_s2 * per_m_s2, 0));
     update_offset();
-    mag_steady_steps_ = 0;
-    gyro_sum_ = Vector3l();
-    accel_sum_ = Vector3l();
-    window_samples_ = 0;
-    accel_sum_of_sums_ = Vector3l();
-    heading_field_sum_ = Vector3l();
-    heading_norm2_sum_ = 0;
-    heading_samples_ = 0;
-    heading_steps_ = 0;
+    gate_.restart_steady_count();
+    field_mean_.clear();
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     status_ |= kStatusInitialised;
@@ -199,22 +156,7 @@ Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
     return Vector3l(q30[0], q30[1], q30[2]);
 }
 
-// 1/n for the few window lengths there are, without the ~500-cycle division.
-float Dcm::inverse(uint8_t n) {
-    switch (n) {
-        case 1: return 1.0f;
-        case 2: return 0.5f;
-        case 3: return 1.0f / 3.0f;
-        case 4: return 0.25f;
-        case 5: return 0.2f;
-        default: return 1.0f / (float)n;
-    }
-}
 
-void Dcm::learn_field(float norm, float down_component) {
-    mag_ref_norm_ = mag_candidate_norm_ = norm;
-    mag_ref_down_ = mag_candidate_down_ = down_component;
-}
 
 // The float form: the sample in SI units, held in the integer units of the step
 // (kFloatGyroScale, kFloatAccelScale), after the checks a float sample needs.
@@ -245,8 +187,26 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
 }
 
 
+// The step as ArduPilot's update() reads: the sample into the sums, then at most one
+// heavy part (HeavySchedule): the strapdown integration (matrix_update), the gravity
+// correction with the rest test and the bias (drift_correction), or the
+// renormalisation (normalize, with check_matrix's rebuild).
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
     const HeavyPart heavy = next_heavy_part(line_due);
+    take_sample(gyro, accel, gyro_ok, accel_ok);
+    heavy_ = HeavySchedule::blocks(heavy);
+    if (heavy == HeavyPart::kIntegration) {
+        strapdown_.integrate(k_);
+    } else if (heavy == HeavyPart::kGravity) {
+        correct_gravity();
+    } else if (heavy == HeavyPart::kRenormalisation) {
+        if (!strapdown_.renormalise()) recover();
+    }
+    if (steps_ < 0xFFFFu) ++steps_;
+}
+
+// The sample's checks (status), then into the gravity window and the strapdown's turn.
+void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok) {
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
     if (!gyro_ok) {
@@ -267,10 +227,7 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
     // The samples are summed here, in integers, and low-passed at the correction's pace
     // (50 Hz): the low-pass is seconds long, so the mean of four samples loses nothing.
     if (gyro_ok && accel_ok) {
-        gyro_sum_ += gyro;
-        accel_sum_ += accel;
-        accel_sum_of_sums_ += accel_sum_;  // sum of (samples from this one on) a_j
-        ++window_samples_;
+        gravity_.add(gyro, accel);
         last_accel_ = accel;
     } else {
         status_ |= kStatusAccelIgnored;
@@ -295,15 +252,6 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
                                      in_turn_units(gyro.z) - offset_units_.z));
     }
     strapdown_.end_step();
-    heavy_ = HeavySchedule::blocks(heavy);
-    if (heavy == HeavyPart::kIntegration) {
-        strapdown_.integrate(k_);
-    } else if (heavy == HeavyPart::kGravity) {
-        correct_gravity();
-    } else if (heavy == HeavyPart::kRenormalisation) {
-        if (!strapdown_.renormalise()) recover();
-    }
-    if (steps_ < 0xFFFFu) ++steps_;
 }
 
 // Rest detection (RestDetector) and, at rest, the bias estimate from the rest mean.
@@ -334,58 +282,12 @@ void Dcm::correct_gravity() {
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
     const bool hold_integrator = rotating_fast_ || starting;
-    if (window_samples_ > 0) {
-        using linalg::hot::mul_q14;
-        using linalg::mul_q30;
-        using linalg::q14_of;
-        const uint8_t n = window_samples_;
-        const int32_t inv_n = inverse_q30(n);
-        // The means (units, accel counts * 2^8; |sums| < 2^18 counts): the gyro's less the
-        // calibrated bias.
-        const Vector3l gyro_raw_mean = per(times_256(gyro_sum_), n, inv_n);
-        const Vector3l accel_sum = times_256(accel_sum_);
-        const Vector3l gyro_mean = gyro_raw_mean - bias_.sensor_units();
-        const Vector3l accel_mean = per(accel_sum, n, inv_n);
-        // Sample j of the window meets the matrix of the step before it, R_(j-1) =
-        // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
-        // step's sample by the steps not yet integrated (this one among them), so the
-        // steps are (n - j + 1) - pending, and sum_j phi_j x a_j is
-        // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
-        // of the running sums, three additions a step. (Weighting each sample, not the
-        // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
-        // In integers: counts * 2^8, the turn per step in 16 bits (Q14 radians: the term
-        // is a few percent of the sum, its rounding 6e-5 rad of it).
-        Vector3l weighted = accel_sum_of_sums_;
-        for (uint8_t i = strapdown_.pending_steps(); i > 0; --i) {
-            weighted.x -= accel_sum_.x;
-            weighted.y -= accel_sum_.y;
-            weighted.z -= accel_sum_.z;
-        }
-        weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
-        const Vector3l turn = k_.theta_q26_coarse(gyro_raw_mean - offset_units_);
-        const int16_t tx = q14_of(turn.x * 16), ty = q14_of(turn.y * 16), tz = q14_of(turn.z * 16);
-        const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
-                            accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
-                            accel_sum.z - mul_q14(tx, weighted.y) + mul_q14(ty, weighted.x));
-        const int32_t alpha = starting ? q30_of(k_.startup_accel_alpha + (linalg::float_from_fixed(k_.accel_alpha_q30, 30) -
-                                                                        k_.startup_accel_alpha) * (1.0f - startup_left))
-                                       : k_.accel_alpha_q30;
-        // Into earth axes by the matrix in 16 bits (its rounding turns the earth-frame
-        // force by 6e-5 rad at most, 0.003 deg of tilt), the mean, and the low-pass.
-        const Vector3l accel_ef = per(
-            Vector3l(mul_q14(q14_of(strapdown_.r().a.x), body.x) + mul_q14(q14_of(strapdown_.r().a.y), body.y) + mul_q14(q14_of(strapdown_.r().a.z), body.z),
-                     mul_q14(q14_of(strapdown_.r().b.x), body.x) + mul_q14(q14_of(strapdown_.r().b.y), body.y) + mul_q14(q14_of(strapdown_.r().b.z), body.z),
-                     mul_q14(q14_of(strapdown_.r().c.x), body.x) + mul_q14(q14_of(strapdown_.r().c.y), body.y) + mul_q14(q14_of(strapdown_.r().c.z), body.z)),
-            n, inv_n);
-        accel_lp_ef_ += Vector3l(mul_q30(alpha, accel_ef.x - accel_lp_ef_.x), mul_q30(alpha, accel_ef.y - accel_lp_ef_.y),
-                                 mul_q30(alpha, accel_ef.z - accel_lp_ef_.z));
-        detect_rest(gyro_mean, accel_mean, mean_off_bias, n >= kCorrectionDivider);
-    }
-    gyro_sum_ = Vector3l();
-    accel_sum_ = Vector3l();
-    accel_sum_of_sums_ = Vector3l();
-    window_samples_ = 0;
-    correct_tilt(startup_left, hold_integrator);
+    Vector3l gyro_mean, accel_mean;
+    bool whole_window = false;
+    if (gravity_.low_pass_window(strapdown_.r(), strapdown_.pending_steps(), offset_units_, bias_.sensor_units(), starting,
+                                 startup_left, k_, gyro_mean, accel_mean, whole_window))
+        detect_rest(gyro_mean, accel_mean, mean_off_bias, whole_window);
+    gravity_.correct_tilt(strapdown_.r(), startup_left, hold_integrator, *settings_, k_, bias_);
     update_offset();
     profile::end(profile::kGravity);
 }
@@ -395,59 +297,13 @@ Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
 
 Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit()); }
 
-Vector3l Dcm::last_rate_units() const {
+FIXED_INLINE Vector3l Dcm::last_rate_units() const {
     return Vector3l(in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
                     in_turn_units(last_gyro_.z) - offset_units_.z);
 }
 
 Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(k_.gyro_rad_s_per_count * (1.0f / (float)kTurnScale)); }
 
-void Dcm::correct_tilt(float startup_left, bool hold_integrator) {
-    using linalg::hot::fixed_from_float;
-    using linalg::mul_q30;
-    // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). |lp|^2 / 2^30
-    // in integers (a thousandth of its value at least: 1 g is 2^20 units at 8 g full
-    // scale), 2^15 / |lp| in float (a square root and a division) made a Q19 factor, the
-    // rest in Q30.
-    const Vector3l& lp = accel_lp_ef_;
-    const uint32_t lp2 = (uint32_t)mul_q30(lp.x, lp.x) + (uint32_t)mul_q30(lp.y, lp.y) + (uint32_t)mul_q30(lp.z, lp.z);
-    if (lp2 <= k_.min_lp2) {  // |lp| < g/2: no direction to trust
-        correction_units_ = Vector3l();
-        return;
-    }
-    // The unit vector's components in Q30: lp times 2^15 / sqrt(lp2) (at most 2^11 for
-    // |lp| >= g/2), that factor in Q19 (within 2^30), the products' low 11 bits dropped
-    // (2e-6 rad, below the Q14 the error is used in).
-    const int32_t inv_lp_q34 = fixed_from_float(32768.0f / sqrtf((float)lp2), 19);
-    const int32_t n = -(int32_t)((uint32_t)mul_q30(lp.y, inv_lp_q34) << 11);
-    const int32_t e = (int32_t)((uint32_t)mul_q30(lp.x, inv_lp_q34) << 11);
-    // In body axes: R^T (error_n, error_e, 0), the matrix in 16 bits (an error of 6e-5 of
-    // the correction).
-    using linalg::hot::mul_q14;
-    using linalg::q14_of;
-    const Vector3l error(mul_q14(q14_of(strapdown_.r().a.x), n) + mul_q14(q14_of(strapdown_.r().b.x), e),
-                         mul_q14(q14_of(strapdown_.r().a.y), n) + mul_q14(q14_of(strapdown_.r().b.y), e),
-                         mul_q14(q14_of(strapdown_.r().a.z), n) + mul_q14(q14_of(strapdown_.r().b.z), e));
-    const float kp = startup_left > 0.0f
-                         ? settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left
-                         : settings_->kp_rp_1_s;
-    // kp error in units: the error in 16 bits (Q14: steps of 6e-5 rad, 0.003 deg of tilt)
-    // times the gain in units per rad/s.
-    const int32_t kp_units = startup_left > 0.0f ? fixed_from_float(kp * k_.units_per_rad_s, 0) : k_.kp_units;
-    const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
-    correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
-    if (!hold_integrator) {
-        bias_.integrate_tilt_error(ex, ey, ez, k_);
-    }
-    // The correction turns the estimated earth frame by kp dt error_ef over the
-    // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
-    // with it ((e_n, e_e, 0) x lp, scaled).
-    const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt_s(*settings_), linalg::kQ30) : k_.tilt_turn_q30;
-    const int32_t turn_n = mul_q14(q14_of(n), turn), turn_e = mul_q14(q14_of(e), turn);
-    const Vector3l old = accel_lp_ef_;
-    accel_lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),
-                             mul_q30(turn_n, old.y) - mul_q30(turn_e, old.x));
-}
 
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     using linalg::fixed_from_float;
@@ -516,23 +372,15 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // the same vector there whatever the board did meanwhile), and the heading is
     // corrected from their mean: each sample costs the rotation into earth axes, the
     // correction (the rest of this function) runs at 25 Hz.
-    heading_field_sum_ += Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
-                                   row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
-                                   row_times(strapdown_.r().c, field_now) >> kEarthFieldShift);
-    heading_norm2_sum_ += sample_norm2;
-    ++heading_samples_;
-    heading_steps_ = (uint16_t)(heading_steps_ + since_last);
-    if (heading_steps_ < kHeadingSteps) return;
-    uint16_t interval_steps = heading_steps_;
-    const float inv_samples = inverse(heading_samples_);
-    const Vector3f field_ef = heading_field_sum_.scaled(inv_samples * kEarthFieldPerUnit);
-    // The strength and dip tests take the samples' mean strength (the field's strength
-    // is the same in every frame; the mean vector's is shorter where the samples differ).
-    const float norm2 = (float)heading_norm2_sum_ * (inv_samples * kNorm2PerUnit);
-    heading_field_sum_ = Vector3l();
-    heading_norm2_sum_ = 0;
-    heading_samples_ = 0;
-    heading_steps_ = 0;
+    field_mean_.add(Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
+                             row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
+                             row_times(strapdown_.r().c, field_now) >> kEarthFieldShift),
+                    sample_norm2, since_last);
+    if (!field_mean_.complete()) return;
+    uint16_t interval_steps = field_mean_.steps();
+    Vector3f field_ef;
+    float norm2;
+    field_mean_.take(field_ef, norm2);
     status_ |= kStatusMagIgnored;
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
@@ -549,54 +397,25 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     // for mag_recover_s is a new environment (the board was moved): it becomes the
     // reference, and its heading is taken at once. A magnet fixed to a rotating
     // board never looks the same twice, so it never gets in.
-    bool forgotten = !(mag_ref_norm_ > 0.0f);  // reset_mag_reference(): adopt this one
-    if (forgotten && !mag_take_heading_) {
-        learn_field(norm, down_component);  // the strength and dip only; the heading as usual
-        mag_take_heading_ = true;
-        forgotten = false;
-    }
-    if (forgotten || !field_matches(norm, down_component, mag_ref_norm_, mag_ref_down_, 1.0f)) {
-        // Only a field that stays the same while the board turns is shown to be fixed
-        // in the earth frame: at rest any disturbance (a magnet on the desk, one fixed to
-        // the board) is steady too. VQF's rule: a mean rate of 20 deg/s over the window.
-        if (field_matches(norm, down_component, mag_candidate_norm_, mag_candidate_down_, 0.5f)) {
-            mag_steady_steps_ += interval_steps;
-            mag_steady_turn_rad_ += sqrtf(last_rate_rad_s().length_squared()) * settings_->step_s * (float)interval_steps;
-        } else {
-            mag_steady_steps_ = 0;
-            mag_steady_turn_rad_ = 0.0f;
-        }
-        const float candidate_alpha = sample_dt / (kCandidateTau_s + sample_dt);
-        mag_candidate_norm_ += candidate_alpha * (norm - mag_candidate_norm_);
-        mag_candidate_down_ += candidate_alpha * (down_component - mag_candidate_down_);
-        if (!forgotten && (mag_steady_steps_ < k_.mag_recover_steps ||
-                           mag_steady_turn_rad_ < k_.mag_new_min_turn_rad)) return;
-        // A new steady field: learn it and take its heading at once, R <- Rz(-error) R
-        // (the rotation that puts the field's horizontal part on north).
-        learn_field(norm, down_component);
-        mag_steady_steps_ = 0;
-        mag_steady_turn_rad_ = 0.0f;
+    const FieldVerdict verdict =
+        gate_.judge(norm, down_component, interval_steps, sample_dt, last_rate_units(), *settings_, k_);
+    if (verdict == FieldVerdict::kDisturbed) return;
+    status_ &= (uint8_t)~kStatusMagIgnored;
+    if (verdict == FieldVerdict::kNewField) {
+        // Its heading at once: R <- Rz(-error) R (the rotation that puts the field's
+        // horizontal part on north).
         const float cos_error = field_ef.x * inv_horizontal;
         using linalg::mul_q30;
         const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
         const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
-        const Vector3l north(mul_q30(c, strapdown_.r().a.x) + mul_q30(sn, strapdown_.r().b.x), mul_q30(c, strapdown_.r().a.y) + mul_q30(sn, strapdown_.r().b.y),
-                             mul_q30(c, strapdown_.r().a.z) + mul_q30(sn, strapdown_.r().b.z));
-        strapdown_.r().b = Vector3l(mul_q30(c, strapdown_.r().b.x) - mul_q30(sn, strapdown_.r().a.x), mul_q30(c, strapdown_.r().b.y) - mul_q30(sn, strapdown_.r().a.y),
-                        mul_q30(c, strapdown_.r().b.z) - mul_q30(sn, strapdown_.r().a.z));
-        strapdown_.r().a = north;
-        status_ &= (uint8_t)~kStatusMagIgnored;
+        linalg::Matrix3q30& r = strapdown_.r();
+        const Vector3l north(mul_q30(c, r.a.x) + mul_q30(sn, r.b.x), mul_q30(c, r.a.y) + mul_q30(sn, r.b.y),
+                             mul_q30(c, r.a.z) + mul_q30(sn, r.b.z));
+        r.b = Vector3l(mul_q30(c, r.b.x) - mul_q30(sn, r.a.x), mul_q30(c, r.b.y) - mul_q30(sn, r.a.y),
+                       mul_q30(c, r.b.z) - mul_q30(sn, r.a.z));
+        r.a = north;
         return;
     }
-    mag_steady_steps_ = 0;
-    mag_steady_turn_rad_ = 0.0f;
-    mag_candidate_norm_ = norm;
-    mag_candidate_down_ = down_component;
-    status_ &= (uint8_t)~kStatusMagIgnored;
-    // Track slow changes of the local field (temperature, location): ~1.3 s at 75 Hz.
-    const float reference_alpha = sample_dt * (1.0f / kReferenceTau_s);  // <= 0.08: first order
-    mag_ref_norm_ += reference_alpha * (norm - mag_ref_norm_);
-    mag_ref_down_ += reference_alpha * (down_component - mag_ref_down_);
 
     // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
     const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
@@ -631,8 +450,7 @@ EulerQ24 Dcm::euler_now_q24() const {
                                  linalg::fixed_from_float(theta_rad.y, 26), linalg::fixed_from_float(theta_rad.z, 26));
     }
     // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
-    // times the radians per unit, each factor Q15 (16x16 multiplies: the float path
-    // cost ~2.2 k cycles a line).
+    // times the radians per unit, each factor Q15 (16x16 multiplies, no float).
     const Vector3l rate = last_rate_units(), pending = pending_turn_units();
     const uint16_t lead = k_.lead_steps_q15, k = k_.theta_q26_per_unit_q15;
     return euler_carried_q24(strapdown_.r(), scale_q15(pending.x + scale_q15(rate.x, lead), k),
@@ -640,15 +458,6 @@ EulerQ24 Dcm::euler_now_q24() const {
                              scale_q15(pending.z + scale_q15(rate.z, lead), k));
 }
 
-bool Dcm::field_matches(float norm, float down_component, float ref_norm, float ref_down,
-                        float tolerance_scale) const {
-    const float norm_tolerance = settings_->mag_norm_tolerance * tolerance_scale * ref_norm;
-    const float dip_tolerance = settings_->mag_dip_tolerance * tolerance_scale;
-    const float norm_error = norm - ref_norm;
-    const float dip_error = down_component - ref_down;
-    return norm_error < norm_tolerance && norm_error > -norm_tolerance && dip_error < dip_tolerance &&
-           dip_error > -dip_tolerance;
-}
 
 
 // A matrix that renormalisation cannot save (NaN, or rows far from unit length)

@@ -11,6 +11,24 @@
 // any consistent unit (uT), time in seconds. Gains are per second and scaled by the
 // step, so the step rate can change without retuning.
 //
+// Dcm is the facade; each mechanism is a part with its own file and tests:
+//   DcmSettings.h    DcmSettings            the tuning values with units (VQF's params)
+//   Coefficients.h   DcmCoefficients        what follows from them and the scales (VQF's coefficients)
+//   Strapdown.h      Strapdown              integration and renormalisation (AP's matrix_update, normalize)
+//   Schedule.h       HeavySchedule          one heavy part a step
+//   Gravity.h        GravityCorrection      accel window, earth-frame low-pass, roll/pitch (VQF's updateAcc)
+//   Rest.h           RestDetector           rest detection (VQF's rest, Fusion's FusionOffset)
+//   GyroBias.h       GyroBias               the calibrated bias and the estimate
+//   Heading.h        EarthFieldMean,        the heading's mean and the disturbance gate (VQF's updateMag)
+//                    MagneticGate
+//   Euler.h          euler_*                the output angles
+// Dcm keeps the sample's checks, the field sample's latency turn and the heading error
+// (correct_heading), the start-up (TRIAD) and the rebuild.
+//
+// Formats of the integer state (table in Coefficients.h): R Q30; rates and turns in
+// units (gyro counts * 2^8 per step); the bias in fine units (units * 2^8); accel in
+// accel units (counts * 2^8); turns in radians Q26/Q30; fields uT Q5.
+//
 // Plain C++ with no Arduino include: the host tests, the host replay tool and the
 // firmware run this very code.
 #pragma once
@@ -20,7 +38,9 @@
 #include "Coefficients.h"
 #include "DcmSettings.h"
 #include "Euler.h"
+#include "Gravity.h"
 #include "GyroBias.h"
+#include "Heading.h"
 #include "Rest.h"
 #include "Schedule.h"
 #include "Strapdown.h"
@@ -90,11 +110,11 @@ public:
     bool heavy_due() const { return initialised() && HeavySchedule::blocks(next_heavy_part(false)); }
     // A field sample given to correct_heading after the next update completes the
     // average of kHeadingSteps and corrects the heading, or is the first heading after a
-    // start without one (the costly parts, up to ~11 k and ~20 k): a caller with
+    // start without one (the costly parts): a caller with
     // deferrable work (the compass learner) puts it on another step.
     bool heading_due_next() const {
         return initialised() && ((status_ & kStatusNoHeading) ||
-                                 (uint16_t)(heading_steps_ + steps_since_mag_ + 1u) >= kHeadingSteps);
+                                 field_mean_.complete_after(steps_since_mag_));
     }
 
     // The gyro's own turn over `steps` steps from its `counts` summed meanwhile, less the
@@ -109,21 +129,17 @@ public:
     // rate (a learned offset that moved by a few uT: a small, uncertain change that
     // must not turn the heading in one step).
     void reset_mag_reference(bool take_heading = true) {
-        mag_ref_norm_ = 0.0f;
-        mag_take_heading_ = take_heading;
+        gate_.forget(take_heading);
         // The samples waiting for the heading's mean were calibrated the old way. The next
         // sample closes the mean alone: the heading has run on the gyro meanwhile (the
         // field was rejected, or the mean dropped), and one sample gives the new reference
         // and the heading's error at once, a whole mean (40 ms) sooner.
-        heading_field_sum_ = linalg::Vector3l();
-        heading_norm2_sum_ = 0;
-        heading_samples_ = 0;
-        heading_steps_ = kHeadingSteps - 1;
+        field_mean_.restart_with_one_sample();
     }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     // The last update turned the matrix or worked out the gravity correction (the
-    // step's two heavy parts, ~8.5 k and ~12-15 k cycles on the AVR, each on its own
+    // step's two heavy parts, each on its own
     // step): a caller with deferrable work (the compass learner) puts only a short piece
     // of it on this step, so that the step stays under 30 k.
     bool heavy_step() const { return heavy_; }
@@ -170,12 +186,11 @@ private:
         return schedule_.next(strapdown_.pending_steps(), strapdown_.renormalisation_due(), line_due);
     }
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
-    void correct_tilt(float startup_left, bool hold_integrator);
+    void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
     void update_offset();
-    static float inverse(uint8_t n);
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
-    // 32x32 routine, ~105 cycles).
+    // 32x32 routine).
     static int32_t in_turn_units(int32_t counts) {
         static_assert(kTurnFraction == 8, "a byte shift");
         return (int32_t)((uint32_t)counts << 8);
@@ -190,9 +205,6 @@ private:
     linalg::Vector3f last_mag_field() const;
     void recover();
     bool accel_plausible(const linalg::Vector3f& a) const;
-    void learn_field(float norm, float down_component);
-    bool field_matches(float norm, float down_component, float ref_norm, float ref_down,
-                       float tolerance_scale) const;
 
     // The settings (not a copy: 84 bytes of RAM; they must outlive the estimator, as
     // kDefaultDcmSettings and a tool's own set do) and what follows from them, once.
@@ -202,32 +214,18 @@ private:
     Strapdown strapdown_;                // R and the turn summed for it
     HeavySchedule schedule_;             // which heavy part a step runs
     GyroBias bias_;                      // the calibrated bias and the estimate
+    GravityCorrection gravity_;          // the accel window, its low-pass and the roll/pitch correction
     RestDetector rest_;                  // rest, when the gyro reads its bias alone
+    EarthFieldMean field_mean_;          // the field samples in earth axes, for the heading
+    MagneticGate gate_;                  // the disturbance gate: which means are the earth field
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
-    linalg::Vector3l correction_units_;  // roll/pitch correction, held between corrections
     linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
-    linalg::Vector3l accel_lp_ef_;       // specific force low-passed in earth axes, accel counts * 2^8
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
     linalg::Vector3l last_gyro_;         // the last sample's rate (counts)
     linalg::Vector3i last_field_q5_;     // for a rebuild if the matrix degenerates (uT * 2^5)
-    linalg::Vector3l gyro_sum_;          // gyro and accel counts summed over the correction period
-    linalg::Vector3l accel_sum_;
-    linalg::Vector3l accel_sum_of_sums_; // the running sums summed: weights n - j + 1
-    uint8_t window_samples_ = 0;         // samples in the sums
-    linalg::Vector3l heading_field_sum_; // field samples in earth axes, summed for the heading (uT, Q17)
-    uint32_t heading_norm2_sum_ = 0;     // ... and their squared strengths (uT^2 / 4)
-    uint8_t heading_samples_ = 0;
-    uint16_t heading_steps_ = 0;         // steps the summed samples stand for
     bool heavy_ = false;                 // the last update integrated or corrected gravity
-    float mag_ref_norm_ = 0.0f;          // learned field strength
-    bool mag_take_heading_ = true;       // reset_mag_reference's take_heading
-    float mag_ref_down_ = 0.0f;          // learned sine of the dip (field . down / |field|)
-    float mag_candidate_norm_ = 0.0f;    // the recent disturbed field, for the new-field test
-    float mag_candidate_down_ = 0.0f;
     uint16_t steps_ = 0;                 // since init, saturated (the start-up ramp's clock)
     uint16_t steps_since_mag_ = 0;
-    uint16_t mag_steady_steps_ = 0;      // how long a different field has stayed the same
-    float mag_steady_turn_rad_ = 0.0f;   // how far the board turned meanwhile
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;

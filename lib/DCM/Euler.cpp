@@ -4,7 +4,7 @@
 #include "Fixed.h"
 
 // -O2 here (the build is -Os): the output path (Fixed.h's routines inline into
-// euler_carried_q24 and angles_centideg) is ~100 cycles shorter than at -Os.
+// euler_carried_q24 and angles_centideg) is shorter than at -Os (make bench).
 #ifdef __AVR__
 #pragma GCC optimize("O2")
 #endif

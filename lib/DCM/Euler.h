@@ -20,8 +20,8 @@
 // output prints, of the same formulas in double (test_fixed.cpp, up to 80 deg pitch:
 // nearer the lock roll and yaw are ill-conditioned for any arithmetic), and the same
 // bits on the host. The output path (euler_carried_q24 then angles_centideg) has no
-// float after the nine entries: ~2 800 + 460 cycles on the 2560 (the float version with
-// its float tail took ~5 900), and the lines print its hundredths as they are.
+// float after the nine entries (README, Performance), and the lines print its hundredths
+// as they are.
 #pragma once
 
 #include <stdint.h>
@@ -56,8 +56,7 @@ EulerAngles euler_from_dcm(const linalg::Matrix3f& r);
 // have those without a whole matrix.
 EulerAngles euler_from_entries(float r11, float r12, float r21, float r22, float r31, float r32, float r33);
 // The same from the seven entries in Q30 (1.0 = 2^30, lib/LinAlg/Fixed.h), for a caller
-// that keeps R in fixed point and so skips the conversions (~60 cycles an entry on
-// the AVR). Any int32 values give finite angles.
+// that keeps R in fixed point and so skips the conversions. Any int32 values give finite angles.
 EulerAngles euler_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32, int32_t r33);
 EulerQ24 euler_q24_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, int32_t r31, int32_t r32,
                             int32_t r33);

@@ -47,22 +47,27 @@ void Strapdown::integrate(const DcmCoefficients& k) {
     pending_steps_ = 0;
     // The coning term (2/3) A x B, with A in 16 bits and 2/3 in Q14.
     const int16_t ax = q14_of(first.x), ay = q14_of(first.y), az = q14_of(first.z);
-    constexpr int16_t kTwoThirdsQ14 = 10923;
+    constexpr int16_t kTwoThirdsQ14 = linalg::q14_ratio(2, 3);
     const Vector3l theta(
         first.x + second.x + mul_q14(kTwoThirdsQ14, mul_q14(ay, second.z) - mul_q14(az, second.y)),
         first.y + second.y + mul_q14(kTwoThirdsQ14, mul_q14(az, second.x) - mul_q14(ax, second.z)),
         first.z + second.z + mul_q14(kTwoThirdsQ14, mul_q14(ax, second.y) - mul_q14(ay, second.x)));
-    // The three factors' series (Q30 constants: 1/6, 1/24, 1/120, 1/720, 1/5040); below
-    // a = 0.03 rad (1.6 rad/s) the terms beyond a^2 are below 2e-9 and left out.
-    constexpr int32_t kOne = 1073741824L, kHalf = 536870912L, kSmallA2 = 1048576L;  // 2^-10
+    // The three factors' series; below a = 0.03 rad (1.6 rad/s) the terms beyond a^2
+    // are below 2e-9 and left out.
+    using linalg::q30_ratio;
+    constexpr int32_t kOne = linalg::kOneQ30, kHalf = q30_ratio(1, 2), kSmallA2 = q30_ratio(1, 1024);
+    constexpr int32_t k1_6 = q30_ratio(1, 6), k1_24 = q30_ratio(1, 24), k1_120 = q30_ratio(1, 120),
+                      k1_720 = q30_ratio(1, 720), k1_5040 = q30_ratio(1, 5040);
     const int32_t a2 = linalg::dot_q30(theta, theta);
     int32_t versine_ratio, sin_ratio;  // (1 - cos a)/a^2 and sin(a)/a
     if (a2 < kSmallA2) {
-        versine_ratio = kHalf - mul_q30(a2, 44739243L);
-        sin_ratio = kOne - mul_q30(a2, 178956971L);
+        // (1 - cos a)/a^2 = 1/2 - a^2/24, sin(a)/a = 1 - a^2/6
+        versine_ratio = kHalf - mul_q30(a2, k1_24);
+        sin_ratio = kOne - mul_q30(a2, k1_6);
     } else {
-        versine_ratio = kHalf - mul_q30(a2, 44739243L - mul_q30(a2, 1491308L));
-        sin_ratio = kOne - mul_q30(a2, 178956971L - mul_q30(a2, 8947849L - mul_q30(a2, 213044L)));
+        // (1 - cos a)/a^2 = 1/2 - a^2 (1/24 - a^2/720), sin(a)/a = 1 - a^2 (1/6 - a^2 (1/120 - a^2/5040))
+        versine_ratio = kHalf - mul_q30(a2, k1_24 - mul_q30(a2, k1_720));
+        sin_ratio = kOne - mul_q30(a2, k1_6 - mul_q30(a2, k1_120 - mul_q30(a2, k1_5040)));
     }
     const int32_t one_minus_cos = mul_q30(a2, versine_ratio);
     const Vector3l s(mul_q30(sin_ratio, theta.x), mul_q30(sin_ratio, theta.y), mul_q30(sin_ratio, theta.z));
@@ -90,7 +95,7 @@ bool Strapdown::renormalise() {
     updates_since_renormalise_ = 0;
     // One pass leaves ~(X.Y)^2: a second one, needed only after a large error (a
     // heading taken at once, a rebuilt matrix), keeps it orthonormal to 1e-5.
-    constexpr int32_t kSecondPassSkew = 2147484L;  // 2e-3 in Q30
+    constexpr int32_t kSecondPassSkew = linalg::q30_ratio(2, 1000);
     int32_t skew = 0;
     bool ok = renormalise_once(skew);
     if (ok && (skew > kSecondPassSkew || skew < -kSecondPassSkew)) ok = renormalise_once(skew);
@@ -125,10 +130,10 @@ bool Strapdown::renormalise_once(int32_t& skew_q30) {
 // Near unit length the first-order Taylor factor (3 - r.r)/2 replaces a square root
 // and a division; its residual is 3/8 (r.r - 1)^2, below 2e-6 in this window.
 bool Strapdown::rescale(const Vector3l& row, Vector3l& out) {
-    constexpr int32_t kOne = 1073741824L;
-    constexpr int32_t kWindow = 2147484L;  // 2e-3 in Q30
+    constexpr int32_t kOne = linalg::kOneQ30;
+    constexpr int32_t kWindow = linalg::q30_ratio(2, 1000);
     // Each entry within +-1.4 (its square within Q30's 2); beyond, the matrix is hopeless.
-    constexpr int32_t kMaxEntry = 1518500249L;  // sqrt(2) in Q30
+    constexpr int32_t kMaxEntry = 1518500249L;  // floor(sqrt(2) 2^30): sqrt(2) in Q30
     const int32_t* entry[3] = {&row.x, &row.y, &row.z};
     for (uint8_t i = 0; i < 3; ++i)
         if (*entry[i] >= kMaxEntry || *entry[i] <= -kMaxEntry) return false;

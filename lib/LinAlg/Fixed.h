@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-point helpers: integer arithmetic on the 2560's hardware multiplier instead of
-// float calls (a float multiply is ~170 cycles, a division ~510, a 16x16->32 integer
-// multiply ~25), with bit-identical results on the board and on the host (replay).
+// float calls (a float multiply or division is a library call; a 16x16->32 integer
+// multiply is four MUL instructions), with bit-identical results on the board and on the host (replay).
 // The estimator (lib/DCM) and the Euler output run on them.
 //
 // Formats: Qn is value * 2^n in an int32_t (or int16_t where it says so).
@@ -12,7 +12,7 @@
 //   Q31   ratios in [0, 1] (unsigned)                                atan_of_ratio_q24, hypot_from_ratio
 //   Q0    whole units: fixed_from_float(x, 0)
 // Whole bytes of a shift are register moves on the AVR, other constant shifts of a
-// 32-bit word a loop of ~6 cycles a bit: the formats are chosen for byte shifts.
+// 32-bit word a loop, one bit a turn: the formats are chosen for byte shifts.
 //
 // Inlining is decided per call site, by the profile (`make bench`'s step parts):
 //   - FIXED_INLINE helpers are a few instructions (mul_s16, mul_u16, q14_of ...): forced
@@ -49,6 +49,13 @@
 namespace linalg {
 
 constexpr uint8_t kQ30 = 30;
+constexpr int32_t kOneQ30 = 1L << 30;
+// Constants written as the ratio they are: round(num / den) in Q30 or Q14, in integers
+// (the AVR's double is a float: a ratio in double would round differently there).
+constexpr int32_t q30_ratio(int32_t num, int32_t den) {
+    return (int32_t)((((int64_t)num << 30) + den / 2) / den);
+}
+constexpr int16_t q14_ratio(int32_t num, int32_t den) { return (int16_t)((((int32_t)num << 14) + den / 2) / den); }
 constexpr uint8_t kAngleQ = 24;              // angles: radians * 2^24
 constexpr int32_t kQuarterPiQ24 = 13176795;  // round(pi/4 * 2^24)
 constexpr int32_t kHalfPiQ24 = 26353589;     // round(pi/2 * 2^24)
@@ -56,8 +63,8 @@ constexpr int32_t kPiQ24 = 52707179;         // round(pi * 2^24)
 
 namespace fixed_detail {
 // Bit fields of a 32-bit word from its bytes: at -Os avr-gcc shifts a 32-bit word by
-// a constant that is not a multiple of 8 in a loop, one bit (~6 cycles) per turn
-// (x >> 23 was ~150 cycles); whole bytes are only register moves.
+// a constant that is not a multiple of 8 in a loop, one bit per turn; whole bytes are
+// only register moves.
 inline uint8_t byte3(uint32_t x) { return (uint8_t)(x >> 24); }
 inline uint8_t byte2(uint32_t x) { return (uint8_t)(x >> 16); }
 // (x >> 23) & 0xFF
@@ -82,8 +89,8 @@ FIXED_INLINE uint8_t power_of_two(uint8_t n) {
 }  // namespace fixed_detail
 
 // m * p for a 24-bit m and an 8-bit p (< 2^32): on the AVR three MUL instructions, a
-// shift by 0..7 bits with p = 2^n in ~12 cycles where avr-gcc shifts a 32-bit word by a
-// variable count in a loop, ~6 cycles a bit.
+// shift by 0..7 bits with p = 2^n, where avr-gcc shifts a 32-bit word by a variable
+// count in a loop, one bit a turn.
 FIXED_INLINE uint32_t mul_u24_u8(uint32_t m, uint8_t p) {
 #ifdef __AVR__
     uint32_t r;
@@ -104,8 +111,8 @@ FIXED_INLINE uint32_t mul_u24_u8(uint32_t m, uint8_t p) {
 #endif
 }
 
-// x * 2^frac_bits, truncated toward zero, read from the float's bits (no float call;
-// inline, ~55 cycles on the AVR: whole bytes are register moves, the remaining 0..7
+// x * 2^frac_bits, truncated toward zero, read from the float's bits (no float call:
+// whole bytes are register moves, the remaining 0..7
 // bits one mul_u24_u8): saturates at +-(2^31 - 1) (infinities too); NaN gives 0.
 namespace hot {
 FIXED_INLINE int32_t fixed_from_float(float x, uint8_t frac_bits) {
@@ -150,7 +157,7 @@ inline float float_from_fixed(int32_t q, uint8_t frac_bits) {
 
 
 // x unchanged, but opaque to the optimiser: avr-gcc folds (x >> 8) >> 1 into x >> 9,
-// a loop of nine 4-byte shifts (~55 cycles), where a shift by a whole byte is register
+// a loop of nine 4-byte shifts, where a shift by a whole byte is register
 // moves and one more bit four instructions.
 FIXED_INLINE int32_t opaque(int32_t x) {
 #ifdef __AVR__
@@ -162,9 +169,9 @@ FIXED_INLINE int32_t opaque(int32_t x) {
 // |q| as an unsigned magnitude (|-2^31| fits).
 inline uint32_t magnitude(int32_t q) { return q < 0 ? (uint32_t)0 - (uint32_t)q : (uint32_t)q; }
 
-// a * b, 16 x 16 -> 32 bits. On the AVR four MUL instructions inline (~20 cycles):
+// a * b, 16 x 16 -> 32 bits. On the AVR four MUL instructions inline:
 // avr-gcc calls a library routine for a widening multiply (and for a product of casts
-// often its 32 x 32 one, __mulsi3, ~105 cycles), and a call makes the caller save
+// often its 32 x 32 one, __mulsi3), and a call makes the caller save
 // registers. Signed as in Atmel's AVR201 (MULS/MULSU need r16..r23: constraint "a").
 FIXED_INLINE uint32_t mul_u16(uint16_t a, uint16_t b) {
 #ifdef __AVR__
@@ -236,7 +243,7 @@ inline uint32_t mul_u32_shr30_by_bytes(uint32_t a, uint32_t x) {
 // The bits 30..61 of a * x for magnitudes a, x (< 2^32): the partial products of their
 // bytes a_i x_j with i + j >= 3, and the high bytes of those with i + j = 2 (the rest
 // is below 2^24 of the 2^30 unit: the result is at most 1 below the exact floor).
-// On the AVR 13 MULs in one accumulator, ~80 cycles; the host computes the same sum.
+// On the AVR 13 MULs in one accumulator; the host computes the same sum.
 FIXED_INLINE uint32_t mul_u32_shr30(uint32_t a, uint32_t x) {
 #ifdef __AVR__
     // acc: bytes 3..7 of the product, in %A..%D[hi] (3..6) and %[b7] (7).
@@ -278,8 +285,7 @@ FIXED_INLINE uint32_t mul_u32_shr30(uint32_t a, uint32_t x) {
 
 // a * x / 2^30: a Q30 factor (|a| < 2) times any x, in x's own units (the result must
 // fit in 31 bits), within 1 unit of the exact product (toward zero): mul_u32_shr30 on the
-// magnitudes, ~100 cycles on the AVR where a float multiply is ~170 and a float add
-// ~130; the same bits on the host.
+// magnitudes, a fraction of a float multiply's cost on the AVR; the same bits on the host.
 namespace hot {
 FIXED_INLINE int32_t mul_q30(int32_t a, int32_t x) {
     const uint32_t m = mul_u32_shr30(magnitude(a), magnitude(x));
@@ -335,7 +341,7 @@ FIXED_INLINE uint32_t mul_u32_u16_shr16(uint32_t x, uint16_t g) {
 
 // The tables (Fixed.cpp), in flash on the AVR; what follows is inline so that the
 // output path is one function without calls (each call with -mcall-prologues saves
-// and restores the registers it uses, ~40-80 cycles).
+// and restores the registers it uses).
 namespace fixed_detail {
 extern const uint16_t kReciprocalMinusOne[257] FIXED_PROGMEM;
 extern const uint16_t kTMinusAtan[257] FIXED_PROGMEM;
@@ -432,7 +438,7 @@ FIXED_INLINE uint32_t hypot_from_ratio(uint32_t larger, uint32_t ratio_q31) {
 
 // An angle in Q24 radians in hundredths of a degree, rounded to nearest (half away
 // from zero): round(|a| * 18000/pi / 2^24) from four 16x16 multiplies, no float
-// (~150 cycles on the 2560 with the sign; the float path took ~700). The
+// (a fraction of the float path's cost). The
 // constant is 18000/pi in Q16 rounded (relative error 1.3e-9): the result is the
 // exact rounding of the Q24 value except within 2^-15 of a count of a half. For
 // |a| < 2^26 (4 rad; atan2_q24 gives at most pi).
@@ -443,8 +449,8 @@ FIXED_INLINE int32_t centideg_from_q24(int32_t angle_q24) {
     const uint32_t m = magnitude(angle_q24);
     uint16_t c;
 #ifdef __AVR__
-    // The same sums byte by byte in one accumulator (16 MULs, ~80 cycles where the four
-    // mul_u16 with avr-gcc's moves between them took ~130): acc = lo, then its top half
+    // The same sums byte by byte in one accumulator (16 MULs, shorter than the four
+    // mul_u16 with avr-gcc's moves between them): acc = lo, then its top half
     // plus the two middle products (mid), then mid's top half plus the high product (hi).
     uint32_t acc;
     uint8_t zero;

@@ -18,7 +18,7 @@ namespace linalg {
 
 // True if x is neither NaN nor infinite: the exponent bits are not all ones (IEEE
 // 754 single, on the host and on the AVR alike). A bit test, not float arithmetic:
-// ~20 cycles on the 2560 where x == x && x - x == 0 costs ~250.
+// a few instructions where x == x && x - x == 0 is two float calls.
 inline bool is_finite(float x) {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
@@ -46,7 +46,7 @@ constexpr float kDegPerRad = 57.2957795130823f;
 constexpr float kRadPerDeg = 0.0174532925199433f;
 
 // atan2 to within 1.2e-5 rad (0.0007 deg) for any finite input, in about a third
-// of avr-libc's atan2f cycles (~2 960 on the 2560): one division and an odd
+// of avr-libc's atan2f time: one division and an odd
 // degree-9 polynomial fitted (least maximum error) to atan on [0, 1], with the
 // octant folded in by symmetry. atan2(0, 0) = 0; NaN in gives 0 out.
 float fast_atan2(float y, float x);
@@ -96,7 +96,8 @@ inline Vector3f operator*(float s, const Vector3f& v) { return v * s; }
 #endif
 
 // Integer vectors for the estimator's 200 Hz path: a sensor's samples in its own
-// counts, and their sums (a 32-bit add is ~12 cycles on the AVR, a float add ~130).
+// counts, and their sums (a 32-bit add is a few instructions on the AVR, a float add a
+// library call).
 struct Vector3i {
     int16_t x, y, z;
 
@@ -188,8 +189,7 @@ struct Quaternion {
 // the largest of 1 + trace and 1 + 2 m_ii - trace, so it never divides by a small
 // number, whatever the attitude. The result is normalised (a DCM between
 // renormalisations is orthonormal only to ~1e-6). Two sqrtf, two divisions and ~20
-// multiplies: ~4 500 cycles on the 2560 by the table in APM25.md, paid only in
-// `mode quat`. A non-finite matrix gives the identity.
+// multiplies, paid only in `mode quat`. A non-finite matrix gives the identity.
 Quaternion quat_from_rotation(const Matrix3f& m);
 
 // q turned about the earth's down axis by an angle a given as cos(a/2), sin(a/2)

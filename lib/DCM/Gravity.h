@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The gravity correction (VQF's updateAcc with the DCM's PI loop): the specific force
+// is low-passed in the estimated earth frame, where a linear acceleration averages out
+// (velocity stays bounded) while in body axes it does not; its direction's error
+// against earth down (Premerlani & Bizard eq. 27) is the roll/pitch correction, a rate
+// applied at every step until the next correction, and its integral the horizontal
+// gyro bias (GyroBias).
+//
+// The samples are summed at every step (add) and low-passed every kCorrectionDivider
+// steps (low_pass_window): the low-pass is seconds long, so the window's mean loses
+// nothing; each sample is turned to the matrix's time (the window's turn term).
+//
+// Formats: the sums in counts, the means and the low-pass in accel units (counts *
+// 2^8), the correction in units (Coefficients.h); R's entries in 16 bits (Q14) where
+// they turn a vector, Q30 factors; the error Q14 radians.
+#pragma once
+
+#include <stdint.h>
+
+#include "Coefficients.h"
+#include "GyroBias.h"
+
+namespace dcm {
+
+class GravityCorrection {
+public:
+    // At start-up: the low-pass at gravity (accel units, earth down), no correction.
+    void reset(int32_t down_accel_units);
+    // One step's sample (counts), a usable one.
+    void add(const linalg::Vector3l& gyro_counts, const linalg::Vector3l& accel_counts) {
+        gyro_sum_ += gyro_counts;
+        accel_sum_ += accel_counts;
+        accel_sum_of_sums_ += accel_sum_;  // sum of (samples from this one on) a_j
+        ++window_samples_;
+    }
+    // The window into the earth-frame low-pass (R body to earth, the steps not yet
+    // integrated, what the step subtracts and the calibrated bias, in units); the window's
+    // gyro mean less the calibrated bias (units) and accel mean (accel units) for the rest
+    // test, whole_window when it holds kCorrectionDivider samples. False: no sample.
+    bool low_pass_window(const linalg::Matrix3q30& r, uint8_t pending_steps, const linalg::Vector3l& offset_units,
+                         const linalg::Vector3l& sensor_bias_units, bool starting, float startup_left,
+                         const DcmCoefficients& k, linalg::Vector3l& gyro_mean, linalg::Vector3l& accel_mean,
+                         bool& whole_window);
+    // The low-pass's direction against earth down: the correction (units per step) and,
+    // unless held, the bias's integral; the low-pass turns with the correction.
+    // startup_left: the share of the start-up ramp still to run (1 at start, 0 after).
+    void correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator, const DcmSettings& settings,
+                      const DcmCoefficients& k, GyroBias& bias);
+    const linalg::Vector3l& correction_units() const { return correction_units_; }
+    const linalg::Vector3l& low_pass_ef() const { return lp_ef_; }
+    void rescale(float gyro_ratio, float accel_ratio);
+
+private:
+    void clear_window();
+
+    linalg::Vector3l gyro_sum_;           // gyro and accel counts summed over the window
+    linalg::Vector3l accel_sum_;
+    linalg::Vector3l accel_sum_of_sums_;  // the running sums summed: weights n - j + 1
+    uint8_t window_samples_ = 0;          // samples in the sums
+    linalg::Vector3l lp_ef_;              // specific force low-passed in earth axes, accel units
+    linalg::Vector3l correction_units_;   // roll/pitch correction, units per step, held between corrections
+};
+
+}  // namespace dcm

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The heading's two parts (VQF's updateMag): the field samples' mean in earth axes
+// (EarthFieldMean: each sample brought up to date and turned into earth axes by Dcm,
+// summed here; the heading is corrected from the mean of kHeadingSteps), and the
+// magnetic disturbance gate (MagneticGate): a field whose strength or dip differs from
+// the learned earth field is a magnet or iron nearby, not north, and is not used; a
+// different field that stays the same for mag_recover_s while the board turns is a new
+// environment and becomes the reference, its heading taken at once.
+//
+// Formats: the sums in integers (the earth-frame field in uT * 2^(kFieldQ + 14 -
+// kEarthFieldShift), the squared strengths in uT^2 * 2^(2 kFieldQ - kNorm2Shift));
+// the mean and everything the gate compares in float (uT; the dip as a sine): it runs
+// at 25 Hz.
+#pragma once
+
+#include <stdint.h>
+
+#include "Coefficients.h"
+
+namespace dcm {
+
+// The sums' shifts: eight samples' sums within 32 bits.
+constexpr uint8_t kNorm2Shift = 4;
+constexpr uint8_t kEarthFieldShift = 2;
+
+class EarthFieldMean {
+public:
+    // One sample: the field in earth axes (sum units), its squared strength (sum units),
+    // and the steps since the previous sample.
+    void add(const linalg::Vector3l& earth_field, uint32_t norm2, uint16_t steps) {
+        field_sum_ += earth_field;
+        norm2_sum_ += norm2;
+        ++samples_;
+        steps_ = (uint16_t)(steps_ + steps);
+    }
+    // The samples stand for kHeadingSteps or more: the mean is due.
+    bool complete() const { return steps_ >= kHeadingSteps; }
+    // ... after `steps` more steps and one more sample.
+    bool complete_after(uint16_t steps) const { return (uint16_t)(steps_ + steps + 1u) >= kHeadingSteps; }
+    uint16_t steps() const { return steps_; }
+    // The mean field in earth axes (uT) and the samples' mean squared strength (uT^2:
+    // the field's strength is the same in every frame; the mean vector's is shorter where
+    // the samples differ); the sums start again.
+    void take(linalg::Vector3f& field_ef_uT, float& norm2_uT2);
+    // Forgets the sums; the next sample closes a mean alone.
+    void restart_with_one_sample() {
+        clear();
+        steps_ = kHeadingSteps - 1;
+    }
+    void clear() {
+        field_sum_ = linalg::Vector3l();
+        norm2_sum_ = 0;
+        samples_ = 0;
+        steps_ = 0;
+    }
+
+private:
+    linalg::Vector3l field_sum_;  // field samples in earth axes (sum units)
+    uint32_t norm2_sum_ = 0;      // ... and their squared strengths (sum units)
+    uint8_t samples_ = 0;
+    uint16_t steps_ = 0;          // steps the summed samples stand for
+};
+
+enum class FieldVerdict : uint8_t {
+    kDisturbed,   // not the earth's field: the heading runs on the gyro
+    kNewField,    // a new steady field, now the reference: take its heading at once
+    kEarthField,  // the learned earth field (tracked): correct the heading from it
+};
+
+class MagneticGate {
+public:
+    // Forgets the learned strength and dip: the next field is the reference. take_heading:
+    // its heading at once too (a new compass calibration), else at the usual rate.
+    void forget(bool take_heading) {
+        ref_norm_ = 0.0f;
+        take_heading_ = take_heading;
+    }
+    // A start: a new field's steadiness is counted again (the turn meanwhile is kept).
+    void restart_steady_count() { steady_steps_ = 0; }
+    // A field's strength (uT) and dip (its down component over its strength) as the
+    // reference.
+    void learn(float norm, float down_component);
+    // One mean field: its strength, dip, the steps it stands for and the time they take
+    // (s, capped), and the gyro's rate meanwhile (units per step).
+    FieldVerdict judge(float norm, float down_component, uint16_t interval_steps, float sample_dt_s,
+                       const linalg::Vector3l& rate_units, const DcmSettings& settings, const DcmCoefficients& k);
+
+private:
+    bool matches(float norm, float down_component, float ref_norm, float ref_down, float tolerance_scale,
+                 const DcmSettings& settings) const;
+
+    float ref_norm_ = 0.0f;           // learned field strength, uT (0: forgotten)
+    bool take_heading_ = true;        // forget()'s take_heading
+    float ref_down_ = 0.0f;           // learned sine of the dip (field . down / |field|)
+    float candidate_norm_ = 0.0f;     // the recent disturbed field, for the new-field test
+    float candidate_down_ = 0.0f;
+    uint16_t steady_steps_ = 0;       // how long a different field has stayed the same
+    float steady_turn_rad_ = 0.0f;    // how far the board turned meanwhile
+};
+
+}  // namespace dcm

@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The gravity correction alone (Gravity.h), closed through the strapdown part: a tilt
+// the matrix does not know is corrected (sign and pace), a level board gets no
+// correction, the integrator learns only when not held.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "Gravity.h"
+#include "Strapdown.h"
+#include "dcm_test_support.h"
+
+using namespace dcm_test;
+using linalg::Vector3l;
+
+namespace {
+
+struct Loop {
+    dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::GravityCorrection gravity;
+    dcm::Strapdown strapdown;
+    dcm::GyroBias bias;
+    explicit Loop(const Matrix3f& estimate) {
+        strapdown.reset(linalg::q30_from_matrix(estimate));
+        gravity.reset(linalg::fixed_from_float(-kG * k.accel_units_per_m_s2, 0));
+    }
+    // `seconds` of a board at rest at `truth` (gyro reads 0): the correction turns R.
+    void run(const Matrix3f& truth, float seconds, bool hold_integrator) {
+        const Vector3l accel_counts = linalg::fixed_from_vector(accel_for(truth) * (1.0f / dcm::kFloatAccelScale), 0);
+        const int windows = (int)std::lround(seconds / (k.step_s * dcm::kCorrectionDivider));
+        for (int w = 0; w < windows; ++w) {
+            for (int i = 0; i < dcm::kCorrectionDivider; ++i) {
+                gravity.add(Vector3l(), accel_counts);
+                const Vector3l offset = bias.offset_units(gravity.correction_units());
+                strapdown.add_turn(Vector3l(-offset.x, -offset.y, -offset.z));
+                strapdown.end_step();
+                if (strapdown.pending_steps() == dcm::kIntegrationSteps) strapdown.integrate(k);
+            }
+            Vector3l gyro_mean, accel_mean;
+            bool whole = false;
+            ASSERT_TRUE(gravity.low_pass_window(strapdown.r(), strapdown.pending_steps(),
+                                                bias.offset_units(gravity.correction_units()), bias.sensor_units(), false,
+                                                0.0f, k, gyro_mean, accel_mean, whole));
+            EXPECT_TRUE(whole);
+            gravity.correct_tilt(strapdown.r(), 0.0f, hold_integrator, dcm::kDefaultDcmSettings, k, bias);
+        }
+    }
+    Matrix3f estimate() const { return linalg::matrix_from_q30(strapdown.r()); }
+};
+
+}  // namespace
+
+TEST(DcmGravity, ALevelBoardGetsNoCorrection) {
+    Loop loop(Matrix3f::identity());
+    loop.run(Matrix3f::identity(), 2.0f, false);
+    EXPECT_EQ(loop.gravity.correction_units().x, 0);
+    EXPECT_EQ(loop.gravity.correction_units().y, 0);
+    EXPECT_LT(tilt_error_deg(Matrix3f::identity(), loop.estimate()), 1e-3f);
+}
+
+// A 10 deg tilt the matrix does not know: the low-pass (3 s) takes its time, the
+// correction (kp 1/s) turns R towards it; after 15 s it is within 0.05
+// deg, and the heading is not touched.
+TEST(DcmGravity, AnUnknownTiltIsCorrected) {
+    for (const Matrix3f& truth : {dcm::dcm_from_euler(10.0f * linalg::kRadPerDeg, 0.0f, 0.0f),
+                                  dcm::dcm_from_euler(0.0f, -10.0f * linalg::kRadPerDeg, 0.0f)}) {
+        Loop loop(Matrix3f::identity());
+        loop.run(truth, 1.0f, true);
+        const float after_1s = tilt_error_deg(truth, loop.estimate());
+        EXPECT_LT(after_1s, 9.9f);
+        EXPECT_GT(after_1s, 1.0f);
+        loop.run(truth, 14.0f, true);
+        EXPECT_LT(tilt_error_deg(truth, loop.estimate()), 0.05f);  // float acos resolves ~0.02 deg
+        const dcm::EulerAngles e = dcm::euler_from_dcm(loop.estimate());
+        EXPECT_NEAR(e.yaw_rad, 0.0f, 1e-3f);
+    }
+}
+
+TEST(DcmGravity, TheIntegratorLearnsOnlyWhenNotHeld) {
+    const Matrix3f truth = dcm::dcm_from_euler(5.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    Loop held(Matrix3f::identity());
+    held.run(truth, 2.0f, true);
+    EXPECT_EQ(held.bias.units().x, 0);
+    Loop learning(Matrix3f::identity());
+    learning.run(truth, 2.0f, false);
+    EXPECT_NE(learning.bias.units().x, 0);
+}
+
+TEST(DcmGravity, AnEmptyWindowIsNoWindow) {
+    Loop loop(Matrix3f::identity());
+    Vector3l g, a;
+    bool whole = true;
+    EXPECT_FALSE(loop.gravity.low_pass_window(loop.strapdown.r(), 0, Vector3l(), Vector3l(), false, 0.0f, loop.k, g, a, whole));
+}

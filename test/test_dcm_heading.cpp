@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The heading's parts alone (Heading.h): the earth-frame field mean, and the magnetic
+// disturbance gate's verdicts (the learned field, a disturbance, a new steady field
+// adopted only while the board turns, a forgotten reference).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "Heading.h"
+#include "dcm_test_support.h"
+
+using linalg::Vector3f;
+using linalg::Vector3l;
+
+using dcm_test::float_form_coefficients;
+
+namespace {
+
+// A field in the earth-frame sum's units (uT * 2^17) and a squared strength in the
+// norm sum's (uT^2 * 2^6).
+Vector3l earth_units(const Vector3f& uT) { return linalg::fixed_from_vector(uT * 131072.0f, 0); }
+uint32_t norm2_units(const Vector3f& uT) { return (uint32_t)(uT.length_squared() * 64.0f); }
+
+constexpr float kEarthNorm = 49.24f, kEarthDown = 45.0f / 49.24f;  // 20 uT north, 45 down
+constexpr uint16_t kMeanSteps = dcm::kHeadingSteps;
+constexpr float kMeanDt = 0.005f * kMeanSteps;
+
+struct Gate {
+    dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::MagneticGate gate;
+    Gate() { gate.learn(kEarthNorm, kEarthDown); }
+    dcm::FieldVerdict judge(float norm, float down, float rate_rad_s = 0.0f) {
+        const Vector3l rate_units = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, rate_rad_s * k.units_per_rad_s), 0);
+        return gate.judge(norm, down, kMeanSteps, kMeanDt, rate_units, dcm::kDefaultDcmSettings, k);
+    }
+    // Means of one field until the verdict is not kDisturbed; the seconds it took (or -1).
+    float seconds_to_adopt(float norm, float down, float rate_rad_s, float limit_s = 60.0f) {
+        for (float t = kMeanDt; t <= limit_s; t += kMeanDt)
+            if (judge(norm, down, rate_rad_s) != dcm::FieldVerdict::kDisturbed) return t;
+        return -1.0f;
+    }
+};
+
+}  // namespace
+
+TEST(DcmHeading, TheMeanIsInEarthAxesOverKHeadingSteps) {
+    dcm::EarthFieldMean mean;
+    const Vector3f a(20.0f, 1.0f, 45.0f), b(20.0f, -1.0f, 45.0f), c(21.0f, 0.0f, 44.0f);
+    mean.add(earth_units(a), norm2_units(a), 3);
+    mean.add(earth_units(b), norm2_units(b), 3);
+    EXPECT_FALSE(mean.complete());
+    EXPECT_TRUE(mean.complete_after(1));
+    EXPECT_FALSE(mean.complete_after(0));
+    mean.add(earth_units(c), norm2_units(c), 2);
+    ASSERT_TRUE(mean.complete());
+    EXPECT_EQ(mean.steps(), 8);
+    Vector3f field;
+    float norm2 = 0.0f;
+    mean.take(field, norm2);
+    const Vector3f expected = (a + b + c) * (1.0f / 3.0f);
+    EXPECT_NEAR(field.x, expected.x, 1e-4f);
+    EXPECT_NEAR(field.y, expected.y, 1e-4f);
+    EXPECT_NEAR(field.z, expected.z, 1e-4f);
+    EXPECT_NEAR(norm2, (a.length_squared() + b.length_squared() + c.length_squared()) / 3.0f, 0.05f);
+    EXPECT_EQ(mean.steps(), 0);
+    mean.restart_with_one_sample();
+    mean.add(earth_units(a), norm2_units(a), 1);
+    EXPECT_TRUE(mean.complete());
+}
+
+TEST(DcmHeading, TheLearnedFieldPassesAndADisturbanceDoesNot) {
+    Gate g;
+    EXPECT_EQ(g.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kEarthField);
+    EXPECT_EQ(g.judge(kEarthNorm * 1.05f, kEarthDown + 0.05f), dcm::FieldVerdict::kEarthField);  // within 10 %
+    EXPECT_EQ(g.judge(kEarthNorm * 1.2f, kEarthDown), dcm::FieldVerdict::kDisturbed);            // strength
+    EXPECT_EQ(g.judge(kEarthNorm, kEarthDown - 0.2f), dcm::FieldVerdict::kDisturbed);           // dip
+    EXPECT_EQ(g.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kEarthField);
+}
+
+// A different field that stays the same becomes the reference after mag_recover_s,
+// but only once the board has turned as far as 20 deg/s for that time (VQF's rule): at
+// rest any disturbance is steady too, and at 10 deg/s it takes twice as long.
+TEST(DcmHeading, ANewSteadyFieldIsAdoptedOnlyWhileTurning) {
+    const float recover_s = dcm::kDefaultDcmSettings.mag_recover_s;
+    Gate at_rest;
+    EXPECT_LT(at_rest.seconds_to_adopt(kEarthNorm * 1.3f, kEarthDown, 0.0f), 0.0f);
+    Gate slow;
+    EXPECT_NEAR(slow.seconds_to_adopt(kEarthNorm * 1.3f, kEarthDown, 10.0f * linalg::kRadPerDeg), 2.0f * recover_s, 0.2f);
+    Gate turning;
+    const float t = turning.seconds_to_adopt(kEarthNorm * 1.3f, kEarthDown, 30.0f * linalg::kRadPerDeg);
+    EXPECT_NEAR(t, recover_s, 0.2f);
+    // Now it is the reference.
+    EXPECT_EQ(turning.judge(kEarthNorm * 1.3f, kEarthDown), dcm::FieldVerdict::kEarthField);
+    EXPECT_EQ(turning.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kDisturbed);
+}
+
+TEST(DcmHeading, AForgottenReferenceIsRelearned) {
+    Gate g;
+    g.gate.forget(true);  // a new calibration: its heading at once
+    EXPECT_EQ(g.judge(kEarthNorm * 1.3f, kEarthDown), dcm::FieldVerdict::kNewField);
+    EXPECT_EQ(g.judge(kEarthNorm * 1.3f, kEarthDown), dcm::FieldVerdict::kEarthField);
+    g.gate.forget(false);  // a small offset change: strength and dip only
+    EXPECT_EQ(g.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kEarthField);
+    EXPECT_EQ(g.judge(kEarthNorm * 1.3f, kEarthDown), dcm::FieldVerdict::kDisturbed);
+}
