@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Trajectory.h"
 
+#include <cstdio>
+
 #include <zlib.h>
 
 #include <cmath>
@@ -90,6 +92,16 @@ void Trajectory::drop_before(double t_s) {
     if (keep_from == 0) return;
     samples_.erase(samples_.begin(), samples_.begin() + (long)keep_from);
     cursor_ = 0;
+}
+
+std::string format_trajectory_row(const TrajectorySample& s) {
+    const double sign = s.quat[0] < 0 ? -1.0 : 1.0;  // q and -q are one orientation
+    char row[320];
+    std::snprintf(row, sizeof row, "%.6f,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.9f,%.9f,%.9f,%.9f,%d\n", s.t_s,
+                  s.gyro_rad_s[0], s.gyro_rad_s[1], s.gyro_rad_s[2], s.accel_m_s2[0], s.accel_m_s2[1],
+                  s.accel_m_s2[2], s.mag_uT[0], s.mag_uT[1], s.mag_uT[2], sign * s.quat[0], sign * s.quat[1],
+                  sign * s.quat[2], sign * s.quat[3], s.movement ? 1 : 0);
+    return row;
 }
 
 TrajectorySample Trajectory::at(double t_s) const {

@@ -20,6 +20,12 @@ struct TrajectorySample {
     bool movement;    // counts in error metrics
 };
 
+// The header and one row as the project writes them (scenario, apm25sim --physics-log):
+// t to six decimals, the sensor values to seven significant digits, the quaternion to nine
+// decimals with its scalar part made >= 0.
+constexpr const char* kTrajectoryHeader = "t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz,movement\n";
+std::string format_trajectory_row(const TrajectorySample& s);
+
 class Trajectory {
 public:
     // Loads FILE (.csv or .csv.gz, detected by content). On failure returns false and

@@ -24,16 +24,13 @@
 namespace {
 
 const char* const kUsage =
-    "usage: apm25sim --elf FILE.elf (--trajectory FILE.csv[.gz] | --physics json[:HOST[:PORT]])
-"
-    "                [--seconds S] [--stamp]
-"
-    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE] [--eeprom-cuts T1:T2:STEP]
-"
-    "                [--profile FILE] [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X]
-"
-    "                [--physics-rate HZ] [--physics-timeout S] [--earth-field N,E,D] [--verbose]
-"
+    "usage: apm25sim --elf FILE.elf (--trajectory FILE.csv[.gz] | --physics json[:HOST[:PORT]])\n"
+    "                [--seconds S] [--stamp]\n"
+    "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE]\n"
+    "                [--eeprom-cuts T1:T2:STEP] [--profile FILE]\n"
+    "                [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X]\n"
+    "                [--physics-rate HZ] [--physics-timeout S] [--physics-log FILE]\n"
+    "                [--earth-field N,E,D] [--verbose]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
@@ -114,6 +111,9 @@ const char* const kUsage =
     "                   --seconds. Exit status 4 when the backend stops answering or answers\n"
     "                   something that is not a state\n"
     "  --physics-rate HZ  the frame_rate asked of the backend, 400..10000 (default 1000)\n"
+    "  --physics-log FILE  every state the sensors read, as a trajectory file (the header\n"
+    "                   t,gx,...,qz,movement; the backend's true attitude): replay, score and\n"
+    "                   the peers run on a flight as on any recording\n"
     "  --physics-timeout S  give up on a silent backend after S s (default 30)\n"
     "  --earth-field N,E,D  the earth field for --physics, uT NED (default 20,0,45)\n"
     "  --verbose        print the sensor models' protocol counters on stderr at the end\n"
@@ -157,7 +157,8 @@ bool take_backend_rc(const sim::PhysicsState& state, double t_s, bool from_backe
 
 int main(int argc, char** argv) {
     sim::BoardOptions options;
-    std::string trajectory_path, input_path, profile_path, rc_path, servo_log_path, serial_spec, physics_spec;
+    std::string trajectory_path, input_path, profile_path, rc_path, servo_log_path, serial_spec, physics_spec,
+        physics_log_path;
     double speed = -1.0;
     sim::PhysicsOptions physics;
     double earth_field_uT[3] = {sim::kEarthFieldNed_uT[0], sim::kEarthFieldNed_uT[1], sim::kEarthFieldNed_uT[2]};
@@ -235,6 +236,8 @@ int main(int argc, char** argv) {
                 return 1;
             }
             physics.frame_rate_hz = (int)hz;
+        } else if (arg == "--physics-log") {
+            physics_log_path = value("--physics-log");
         } else if (arg == "--physics-timeout") {
             const char* text = value("--physics-timeout");
             char* end = nullptr;
@@ -322,6 +325,7 @@ int main(int argc, char** argv) {
 
     // --physics: the first state before the board starts (the sensors need one at t = 0).
     sim::PhysicsLink link(physics);
+    FILE* physics_log = nullptr;
     sim::PhysicsState first;
     const bool rc_from_backend = use_physics && rc_path.empty();
     if (use_physics) {
@@ -329,14 +333,24 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
             return 1;
         }
+        link.set_stop_check(sim::stop_requested);
         options.measure_servos = true;
         if (rc_from_backend) options.rc = &rc;
         const uint16_t none[sim::kSitlServoChannels] = {};
         if (!link.exchange(0, none, first)) {
             std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
-            return 4;
+            return link.stopped() ? 0 : 4;
         }
         trajectory.append(sim::physics_sample(first, 0.0, earth_field_uT));
+        if (!physics_log_path.empty()) {
+            physics_log = std::fopen(physics_log_path.c_str(), "w");
+            if (!physics_log) {
+                std::fprintf(stderr, "apm25sim: cannot write the physics log '%s'\n", physics_log_path.c_str());
+                return 1;
+            }
+            std::fputs(sim::kTrajectoryHeader, physics_log);
+            std::fputs(sim::format_trajectory_row(trajectory[0]).c_str(), physics_log);
+        }
         std::string error;
         if (!take_backend_rc(first, 0.0, rc_from_backend, rc, nullptr, error)) {
             std::fprintf(stderr, "apm25sim: the physics backend's answer to frame 0: %s\n", error.c_str());
@@ -370,6 +384,7 @@ int main(int argc, char** argv) {
             sim::PhysicsState state;
             std::string error;
             if (!link.exchange(frame, pwm, state)) {
+                if (link.stopped()) break;  // a clean end, as any SIGINT/SIGTERM
                 error = link.error();
             } else {
                 const double t = state.timestamp_s - first.timestamp_s;
@@ -379,7 +394,9 @@ int main(int argc, char** argv) {
                                   state.timestamp_s, (unsigned)frame, last_t + first.timestamp_s);
                     error = why;
                 } else {
-                    board.append_sample(sim::physics_sample(state, t, earth_field_uT), 1.0);
+                    const sim::TrajectorySample sample = sim::physics_sample(state, t, earth_field_uT);
+                    board.append_sample(sample, 1.0);
+                    if (physics_log) std::fputs(sim::format_trajectory_row(sample).c_str(), physics_log);
                     if (take_backend_rc(state, t, rc_from_backend, rc, &board, error)) {
                         ran = board.run(std::min(t, seconds));
                         last_t = t;
@@ -396,6 +413,10 @@ int main(int argc, char** argv) {
         }
     }
     board.finish_output();
+    if (physics_log && std::fclose(physics_log) != 0) {
+        std::fprintf(stderr, "apm25sim: cannot write the physics log '%s'\n", physics_log_path.c_str());
+        return 1;
+    }
     if (servo_log && std::fclose(servo_log) != 0) {
         std::fprintf(stderr, "apm25sim: cannot write the servo log '%s'\n", servo_log_path.c_str());
         return 1;

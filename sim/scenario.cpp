@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "Rotation.h"
+#include "Trajectory.h"
 
 namespace {
 
@@ -418,7 +419,7 @@ int main(int argc, char** argv) {
     // Random walk: each step adds sigma * sqrt(dt) with sigma in deg/s per sqrt(s).
     const double walk_step_dps = err.gyro_walk_dps_per_sqrt_min / std::sqrt(60.0) * std::sqrt(1.0 / rate_hz);
     double walk_dps[3] = {0, 0, 0};
-    std::printf("t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz,movement\n");
+    std::fputs(sim::kTrajectoryHeader, stdout);
     const long n = (long)std::floor(seconds * rate_hz + 1e-9);
     const double h_s = 1e-5;
     for (long k = 0; k <= n; ++k) {
@@ -460,10 +461,9 @@ int main(int argc, char** argv) {
                 mag[i] = quantised(mag[i], kMagLsb_uT);
             }
         }
-        const Quat qc = q.w < 0 ? Quat{-q.w, -q.x, -q.y, -q.z} : q;  // scalar part >= 0
-        std::printf("%.6f,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.9f,%.9f,%.9f,%.9f,%d\n", t_s, gyro[0],
-                    gyro[1], gyro[2], accel[0], accel[1], accel[2], mag[0], mag[1], mag[2], qc.w, qc.x, qc.y, qc.z,
-                    t_s >= kStartup_s ? 1 : 0);
+        sim::TrajectorySample row{t_s, {gyro[0], gyro[1], gyro[2]}, {accel[0], accel[1], accel[2]},
+                                  {mag[0], mag[1], mag[2]}, {q.w, q.x, q.y, q.z}, t_s >= kStartup_s};
+        std::fputs(sim::format_trajectory_row(row).c_str(), stdout);
     }
     return 0;
 }

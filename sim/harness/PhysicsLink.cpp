@@ -89,6 +89,11 @@ bool PhysicsLink::exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServ
     const double start_s = wall_clock_s();
     double sent_s = -1e9;
     for (;;) {
+        if (stop_ && stop_()) {  // SIGINT/SIGTERM while the backend is silent
+            stopped_ = true;
+            error_ = "stopped while waiting for the physics backend";
+            return false;
+        }
         const double now_s = wall_clock_s();
         if (now_s - sent_s >= options_.resend_s) {
             if (sent_s > -1e9) {

@@ -37,6 +37,9 @@ public:
     // answer came within give_up_s, or the answer is not a state.
     bool exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServoChannels], PhysicsState& state);
     uint32_t resends() const { return resends_; }
+    // Checked while waiting: when it says so, exchange returns false with stopped() true.
+    void set_stop_check(bool (*stop)()) { stop_ = stop; }
+    bool stopped() const { return stopped_; }
 
 private:
     PhysicsOptions options_;
@@ -44,6 +47,8 @@ private:
     sockaddr_in address_{};  // the backend
     std::string error_;
     uint32_t resends_ = 0;
+    bool (*stop_)() = nullptr;
+    bool stopped_ = false;
 };
 
 }  // namespace sim

@@ -59,7 +59,7 @@ std::vector<std::vector<long>> packets(const std::string& log) {
 
 // The firmware on a board the backend holds at roll 20, pitch -10, heading 90 deg (as
 // `attitude`, then as `quaternion`): its lines read that attitude, from the earth field
-// rotated by the backend's attitude. Every frame once, counting from 0, at 1000 Hz, one a
+// rotated by the backend's attitude, and score them against --physics-log's file. Every frame once, counting from 0, at 1000 Hz, one a
 // millisecond of simulated time; the firmware drives no servo: every width 0.
 TEST(HarnessPhysics, TheFirmwareReadsTheBackendsAttitude) {
     E2E_REQUIRE_TOOLS("apm25sim", "firmware.elf");
@@ -68,8 +68,16 @@ TEST(HarnessPhysics, TheFirmwareReadsTheBackendsAttitude) {
         std::vector<std::string> options = {"--attitude", "20,-10,90"};
         if (std::string(form) == "quaternion") options.push_back("--quaternion");
         ASSERT_TRUE(backend.start(options)) << backend.process.text;
-        const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, 5.0);
+        const std::string log = e2e::work_dir() + "/physics_log." + std::to_string(getpid()) + "." + form + ".csv";
+        const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, 5.0, "--physics-log " + log);
         ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+        // The states the sensors read, as a trajectory file: score takes the firmware's lines
+        // against it as against any recording.
+        const e2e::CommandResult score = e2e::score_lines(run.lines, log);
+        unlink(log.c_str());
+        ASSERT_EQ(score.exit_code, 0) << score.out << score.err;
+        EXPECT_LT(e2e::score_field(score.out, "total_rmse_deg"), 0.5) << score.out;
+        EXPECT_GT(e2e::score_field(score.out, "samples"), 150) << score.out;
         const std::vector<e2e::Line> settled = e2e::angle_lines(run.lines, 4.0);
         ASSERT_GE(settled.size(), 20u) << e2e::dump(run);
         for (const e2e::Line& l : settled) {
@@ -129,8 +137,9 @@ TEST(HarnessPhysics, PacketsCarryThePinsWidthsAndRcDrivesThePpm) {
 }
 
 // A backend that stops answering: the frame is sent again every second, said on stderr,
-// and after --physics-timeout the run stops with exit status 4 (not a hang); one that
-// answers with something else than a state stops it at once, saying what is wrong.
+// and after --physics-timeout the run stops with exit status 4 (not a hang), or at once on
+// SIGTERM (exit 0); one that answers with something else than a state stops it at once,
+// saying what is wrong.
 TEST(HarnessPhysics, ASilentOrConfusedBackendStopsTheRunWithAReason) {
     E2E_REQUIRE_TOOLS("apm25sim", "firmware.elf");
     {
@@ -146,6 +155,19 @@ TEST(HarnessPhysics, ASilentOrConfusedBackendStopsTheRunWithAReason) {
         ASSERT_GE(sent.size(), 203u);
         EXPECT_EQ(sent[201][1], 201);
         EXPECT_EQ(sent[202][1], 201) << "a resend keeps the frame count";
+    }
+    {
+        // SIGTERM while waiting for a silent backend: a clean end at once, not after the timeout.
+        Backend backend;
+        ASSERT_TRUE(backend.start({"--silent-after", "50"})) << backend.process.text;
+        e2e::LiveProcess sim;
+        const std::string out = e2e::work_dir() + "/physics_stdout." + std::to_string(getpid()) + ".txt";
+        ASSERT_TRUE(sim.start({e2e::tool("apm25sim"), "--elf", e2e::firmware_elf(), "--physics",
+                               "json:127.0.0.1:" + backend.port, "--physics-timeout", "600"},
+                              2, out));
+        EXPECT_FALSE(sim.wait_line("has not answered frame 51").empty()) << sim.text;
+        EXPECT_EQ(sim.stop(), 0) << sim.text;
+        unlink(out.c_str());
     }
     {
         Backend backend;
