@@ -294,6 +294,9 @@ def check_turn(args):
                   % (t, truth["roll_deg"], roll, -truth["down_m"], truth["airspeed_m_s"]))
     print("turn: worst roll error %.1f deg at %.1f s (true %.1f, estimate %.1f)" % (worst[1], worst[0], worst[2],
                                                                                      worst[3]))
+    ground = next((r["t"] for r in f.truth if -r["down_m"] < 1.0), None)
+    print("turn: %s" % ("the plane reached the ground at %.1f s (a spiral dive: STABILIZE holds the estimated "
+                        "bank)" % ground if ground is not None else "the plane stayed in the air"))
     soft_assert(len(est) > 50 * (seconds - 3.0), "turn: only %d attitude lines" % len(est))
     soft_assert(finite, "turn: a bank that is not finite")
 
