@@ -51,6 +51,9 @@ def parse_args(argv):
     p.add_argument("--gust", type=int, help="turbulence 0 none, 1 light, 2 moderate (default: the flight's, or 0)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--upset", action="append", default=[], metavar="T,SECONDS,NM")
+    p.add_argument("--hold", type=float, default=3.0, metavar="S",
+                   help="the aeroplane held still for S s first, released at trim (default 3: the board "
+                        "powers up and calibrates at rest, as on the ground before a launch)")
     p.add_argument("--seconds", type=float, help="simulated seconds (default: the flight's length, or 30)")
     p.add_argument("--sim", default=os.path.join(ROOT, "build", "apm25sim"))
     p.add_argument("--elf", default=os.path.join(ROOT, "build", "firmware.elf"))
@@ -108,7 +111,7 @@ def run(args):
     port_file = os.path.join(work, "port")
     backend_cmd = [args.python, os.path.join(HERE, "jsbsim_backend.py"), "--port", "0", "--port-file", port_file,
                    "--rc", rc, "--gust", str(gust), "--seed", str(args.seed), "--seconds", "%g" % seconds,
-                   "--idle-timeout", "60"] + extra
+                   "--idle-timeout", "60", "--hold", "%g" % args.hold] + extra
     if args.log:
         backend_cmd += ["--log", args.log]
     if args.trajectory:
