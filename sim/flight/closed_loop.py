@@ -121,6 +121,7 @@ def run(args):
     sim = None
     out = open(args.out, "wb") if args.out else sys.stdout.buffer
     timed_out = False
+    ended_itself = False
     listen_deadline = time.monotonic() + 120.0
     try:
         while not os.path.exists(port_file) or not open(port_file).read().strip():
@@ -162,6 +163,7 @@ def run(args):
             out.write(chunk)
             out.flush()
         status = sim.wait()
+        ended_itself = status == 0 and not timed_out
     except KeyboardInterrupt:
         status = 130
     except BrokenPipeError:
@@ -172,7 +174,7 @@ def run(args):
         # A backend that saw the flight to its end stops by itself (after --linger s of
         # silence); one that did not is interrupted (SIGINT: it closes its files).
         try:
-            backend.wait(30.0 if sim is not None and sim.returncode == 0 else 0.1)
+            backend.wait(30.0 if ended_itself else 0.1)
         except subprocess.TimeoutExpired:
             pass
         backend_status = stop(backend, 5.0, signal.SIGINT)
