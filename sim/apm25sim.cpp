@@ -15,6 +15,7 @@
 
 #include "Board.h"
 #include "FaultSpec.h"
+#include "Mpxv7002dpModel.h"
 #include "PhysicsLink.h"
 #include "RcLink.h"
 #include "Rotation.h"
@@ -34,9 +35,11 @@ const char* const kUsage =
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
-    "(held at its last sample after its end). stdout: exactly the bytes the firmware sends on UART0.\n"
+    "(held at its last sample after its end), or the physics backend's state (--physics). stdout:\n"
+    "exactly the bytes the firmware sends on UART0.\n"
     "\n"
-    "  --seconds S      stop after S simulated seconds (default: the trajectory's length)\n"
+    "  --seconds S      stop after S simulated seconds (default: the trajectory's length; with\n"
+    "                   --serial or --physics, until SIGINT or SIGTERM)\n"
     "  --stamp          prefix each line with the simulated time (s) its newline left the UART\n"
     "  --fault SPEC     inject a fault (repeatable; grammar below)\n"
     "  --input FILE     type FILE's bytes into UART0 RX, one character per 10 bit times at the\n"
@@ -106,8 +109,10 @@ const char* const kUsage =
     "                   frames, so a run is deterministic. rc_1..rc_8 drive the PPM on ICP5 (an\n"
     "                   rc with none of them, or all 0, is a dead receiver; --rc, if given,\n"
     "                   drives it instead). A frame unanswered for 1 s is sent again (same\n"
-    "                   frame_count, said on stderr); position, velocity, airspeed and wind are\n"
-    "                   read but no sensor uses them yet. Runs until SIGINT/SIGTERM unless\n"
+    "                   frame_count, said on stderr); airspeed, when sent, is the pitot's: the\n"
+    "                   APM 2.5's MPXV7002DP on A0 (ADC0), 2.5 V + 1 V/kPa of 1/2 1.225 v^2,\n"
+    "                   held within 0.5..4.5 V; position, velocity and wind are read but no\n"
+    "                   sensor uses them yet. Runs until SIGINT/SIGTERM unless\n"
     "                   --seconds. Exit status 4 when the backend stops answering or answers\n"
     "                   something that is not a state\n"
     "  --physics-rate HZ  the frame_rate asked of the backend, 400..10000 (default 1000)\n"
@@ -149,6 +154,7 @@ bool take_backend_rc(const sim::PhysicsState& state, double t_s, bool from_backe
     for (int c = 0; same && row.signal && c < sim::kRcChannels; ++c) same = last->width_us[c] == row.width_us[c];
     if (same) return true;
     rc.push(row);
+    if (rc.rows().size() > 4096) rc.drop_before(t_s - 1.0);  // a backend whose sticks move every frame
     if (board) board->rc_changed();
     return true;
 }
@@ -370,6 +376,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "apm25sim: %s\n", board.error().c_str());
         return 1;
     }
+    if (use_physics && first.has_airspeed) board.set_a0_mV(sim::Mpxv7002dpModel::output_mV(first.airspeed_m_s));
     bool ran = true;
     int physics_status = 0;
     if (!use_physics) {
@@ -396,6 +403,7 @@ int main(int argc, char** argv) {
                 } else {
                     const sim::TrajectorySample sample = sim::physics_sample(state, t, earth_field_uT);
                     board.append_sample(sample, 1.0);
+                    if (state.has_airspeed) board.set_a0_mV(sim::Mpxv7002dpModel::output_mV(state.airspeed_m_s));
                     if (physics_log) std::fputs(sim::format_trajectory_row(sample).c_str(), physics_log);
                     if (take_backend_rc(state, t, rc_from_backend, rc, &board, error)) {
                         ran = board.run(std::min(t, seconds));

@@ -135,6 +135,24 @@ TEST(PpmEncoder, NoSignalBeforeTheFirstRowAndPushedRowsRestartIt) {
     EXPECT_FALSE(script.push(row));  // no 100 us channel
 }
 
+// A long flight drops old rows; the encoder keeps going from the rows left.
+TEST(PpmEncoder, RowsDroppedBeforeTheFrameDoNotChangeTheSignal) {
+    sim::RcScript script = parsed(
+        "0,1500,1500,1500,1500,1500,1500,1500,1500\n"
+        "0.01,,,,,,,,\n"
+        "0.02,,,,,,,,\n"
+        "0.05,1200,1500,1500,1500,1500,1500,1500,1500\n");
+    sim::PpmEncoder encoder(script);
+    std::vector<sim::PpmEdge> edges = edges_until(encoder, 0.0);  // the first frame's first edge
+    script.drop_before(0.03);
+    ASSERT_EQ(script.rows().size(), 2u);  // 0.02 (in force at 0.03) and 0.05
+    EXPECT_FALSE(script.at(0.03)->signal);
+    sim::PpmEdge e;
+    for (int i = 1; i < 18; ++i) ASSERT_TRUE(encoder.next_edge(e));  // the frame in progress ends whole
+    ASSERT_TRUE(encoder.next_edge(e));
+    EXPECT_DOUBLE_EQ(e.t_s, 0.05);  // dead until the row at 0.05
+}
+
 TEST(PpmEncoder, LongWidthsStretchTheFrameToKeepItsSync) {
     const sim::RcScript script = parsed("0,3000,3000,3000,3000,3000,3000,3000,3000\n");
     sim::PpmEncoder encoder(script);

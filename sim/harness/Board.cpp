@@ -9,6 +9,7 @@
 #include <cstdarg>
 #include <cstring>
 
+#include "avr_adc.h"
 #include "avr_eeprom.h"
 #include "avr_ioport.h"
 #include "avr_spi.h"
@@ -208,6 +209,9 @@ bool Board::init() {
         return false;
     }
     avr_->frequency = kCpuHz;
+    // The APM 2.5's ATmega2560 runs at 5 V, AVCC and the default reference too (simavr's
+    // default: 3.3 V); only the ADC reads these.
+    avr_->vcc = avr_->avcc = avr_->aref = 5000;
     if (!load_eeprom()) return false;
     avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
     avr_->log = LOG_WARNING;
@@ -526,6 +530,11 @@ uint64_t Board::on_link_tick() {
         const std::string event = options_.serial->poll(received);
         if (!event.empty()) std::fprintf(stderr, "apm25sim: t=%.3f s: tcp:%d %s\n", time_s(), options_.serial->port(), event.c_str());
         if (!received.empty()) {
+            if (input_pos_ > 65536) {  // a long session: what has been typed is not kept
+                options_.input.erase(0, input_pos_);
+                input_consumed_ += input_pos_;
+                input_pos_ = 0;
+            }
             options_.input += received;
             if (input_started_) arm_input();
         }
@@ -599,6 +608,11 @@ uint64_t Board::on_ppm_edge() {
 }
 
 void Board::rc_changed() { schedule_ppm_edge(); }
+
+// simavr's ADC converts the millivolts last raised on the channel's IRQ.
+void Board::set_a0_mV(double mV) {
+    avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0), (uint32_t)std::lround(mV));
+}
 
 // Each output's level is the OCnx unit's while TCCRnA's COMnx bits connect it to the pin
 // (as the hardware overrides PORT), else the PORT bit when the pin is an output, else
@@ -782,8 +796,12 @@ void Board::print_counters(FILE* out) const {
                  h.transactions, h.bytes_written, h.bytes_read, h.samples, h.samples_dropped_by_lock,
                  h.nacked_while_absent, h.writes_to_read_only, h.reads_of_invalid_register, bus_violations_,
                  profile_errors_);
-    std::fprintf(out, "# apm25sim: UART0 input %zu of %zu bytes typed, %llu character times held by XOFF\n",
-                 input_pos_, options_.input.size(), (unsigned long long)uart_input_held_chars_);
+    std::fprintf(out, "# apm25sim: UART0 input %llu of %llu bytes typed, %llu character times held by XOFF\n",
+                 (unsigned long long)(input_consumed_ + input_pos_),
+                 (unsigned long long)(input_consumed_ + options_.input.size()), (unsigned long long)uart_input_held_chars_);
+    if (options_.serial)
+        std::fprintf(out, "# apm25sim: tcp:%d: %llu TX bytes dropped (client not reading)\n", options_.serial->port(),
+                     (unsigned long long)options_.serial->dropped());
     if (ppm_)
         std::fprintf(out, "# apm25sim: PPM frames begun %lu; ICP5 fed %s\n", ppm_->frames(),
                      ppm_icp_irq_ ? "through Timer5's capture IRQ (the core leaves the pin unwired)"

@@ -113,6 +113,8 @@ public:
     // Appends a state to the sensor models' samples (--physics), and forgets those older
     // than `keep_s` before it.
     void append_sample(const TrajectorySample& sample, double keep_s);
+    // The voltage on analog input A0 (ADC0), in millivolts: the airspeed sensor (--physics).
+    void set_a0_mV(double mV);
     // After RcScript::push: restarts the PPM line if it had gone quiet.
     void rc_changed();
 
@@ -166,6 +168,7 @@ private:
     bool uart_input_held_ = false;        // simavr's receive FIFO is full (XOFF)
     uint64_t uart_input_held_chars_ = 0;  // character times the input waited for it
     size_t input_pos_ = 0;
+    uint64_t input_consumed_ = 0;         // bytes typed and dropped from `input` (a live client's)
     bool input_timer_armed_ = false;      // uart_input_timer is registered
     Pacer pacer_{0.0};
 

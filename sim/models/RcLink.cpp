@@ -118,6 +118,12 @@ bool RcScript::push(const RcRow& row) {
     return true;
 }
 
+void RcScript::drop_before(double t_s) {
+    size_t keep_from = 0;
+    while (keep_from + 1 < rows_.size() && rows_[keep_from + 1].t_s <= t_s) ++keep_from;
+    rows_.erase(rows_.begin(), rows_.begin() + (long)keep_from);
+}
+
 const RcRow* RcScript::at(double t_s) const {
     // Last row with t <= t_s.
     auto it = std::upper_bound(rows_.begin(), rows_.end(), t_s,
@@ -133,13 +139,10 @@ bool PpmEncoder::start_frame() {
     const RcRow* row = script_.at(start_s);
     if (!row || !row->signal) {
         const std::vector<RcRow>& rows = script_.rows();
-        row = nullptr;
-        for (const RcRow& r : rows) {
-            if (r.t_s > start_s && r.signal) {
-                row = &r;
-                break;
-            }
-        }
+        auto next = std::upper_bound(rows.begin(), rows.end(), start_s,
+                                     [](double t, const RcRow& r) { return t < r.t_s; });
+        while (next != rows.end() && !next->signal) ++next;
+        row = next == rows.end() ? nullptr : &*next;
         if (!row) return false;
         start_s = row->t_s;
     }

@@ -50,6 +50,8 @@ public:
     bool push(const RcRow& row);
 
     const std::vector<RcRow>& rows() const { return rows_; }
+    // Forgets the rows before t_s but the one in force at t_s (a long flight's history).
+    void drop_before(double t_s);
     // The row in force at t (nullptr before the first row).
     const RcRow* at(double t_s) const;
 

@@ -99,12 +99,14 @@ TEST(HarnessPhysics, TheFirmwareReadsTheBackendsAttitude) {
 // The probe (io_probe.elf) writes output k's width 900 + 100 k + 25 j us (j stepping every
 // 10 periods) and captures PPM: the packets carry each width as measured on the pin (the
 // pin is high width + 0.5 us: within 1 us), OUT9-16 at 0; the backend's rc_1..rc_8 reach
-// the capture within 0.5 us, and its empty `rc` (from 1 s) stops the PPM.
+// the capture within 0.5 us, and its empty `rc` (from 1 s) stops the PPM; its `airspeed`
+// reaches A0 as the MPXV7002DP's voltage.
 TEST(HarnessPhysics, PacketsCarryThePinsWidthsAndRcDrivesThePpm) {
     E2E_REQUIRE_TOOLS("apm25sim");
     E2E_REQUIRE_AVR_PROGRAMS(dir);
     Backend backend;
-    ASSERT_TRUE(backend.start({"--rc", "1100,1200,1300,1400,1500,1600,1700,1800", "--rc-dead-from", "1.0"}))
+    ASSERT_TRUE(backend.start({"--rc", "1100,1200,1300,1400,1500,1600,1700,1800", "--rc-dead-from", "1.0",
+                               "--airspeed", "20"}))
         << backend.process.text;
     const e2e::SimRun run = run_physics(dir + "/io_probe.elf", backend, 1.6);
     ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
@@ -133,6 +135,15 @@ TEST(HarnessPhysics, PacketsCarryThePinsWidthsAndRcDrivesThePpm) {
         frames_last = e2e::field(l.text, "e");
     }
     EXPECT_GT(frames_at_1_1, 300) << e2e::dump(run);
+    // airspeed 20 m/s: 245 Pa, the MPXV7002DP at 2.5 V + 0.245 V: 562 counts of 5 V by the
+    // datasheet's Vin x 1024 / Vref, 561 from simavr 1.6 (it scales by 1023).
+    int a0_lines = 0;
+    for (const e2e::Line& l : run.lines) {
+        if (l.text.rfind("ppm ", 0) != 0) continue;
+        EXPECT_NEAR(e2e::field(l.text, "a0"), 2745.0 * 1024.0 / 5000.0, 1.5) << l.text;
+        ++a0_lines;
+    }
+    EXPECT_GT(a0_lines, 25);
     EXPECT_EQ(frames_last, frames_at_1_1) << "captures after the backend's rc went empty";
 }
 

@@ -12,6 +12,7 @@ readme's resend). Prints 'port N' on stdout once listening.
   --attitude R,P,Y      degrees, sent as `attitude` (default 0,0,0)
   --quaternion          send the attitude as `quaternion` instead
   --rc W1,...,W8        send `rc` with these widths (us); --rc-dead-from T: `rc` empty from T s
+  --airspeed V          send `airspeed` V m/s
   --log FILE            one CSV row per packet: frame_count,frame_rate,pwm1..pwm16
   --silent-after N      stop answering after frame N (the link's timeout test)
   --garbage-after N     answer frames after N with text that is not a state
@@ -44,6 +45,7 @@ def main():
     ap.add_argument('--quaternion', action='store_true')
     ap.add_argument('--rc')
     ap.add_argument('--rc-dead-from', type=float)
+    ap.add_argument('--airspeed', type=float)
     ap.add_argument('--log')
     ap.add_argument('--silent-after', type=int)
     ap.add_argument('--garbage-after', type=int)
@@ -83,6 +85,8 @@ def main():
             state['quaternion'] = quaternion(roll, pitch, yaw)
         else:
             state['attitude'] = [roll, pitch, yaw]
+        if args.airspeed is not None:
+            state['airspeed'] = args.airspeed
         if rc:
             dead = args.rc_dead_from is not None and t >= args.rc_dead_from
             state['rc'] = {} if dead else {'rc_%d' % (i + 1): w for i, w in enumerate(rc)}

@@ -14,7 +14,8 @@
 // input capture on the rising edge (ICES5) of ICP5 = PL1; a rising-to-rising interval over
 // 8000 ticks (4 ms) is the frame sync. Every 50 ms it prints
 //   ppm f:<whole 8-channel frames> e:<captures> w1:<ticks> ... w8:<ticks>
-// with the last whole frame's intervals in 0.5 us ticks.
+// with the last whole frame's intervals in 0.5 us ticks, then ` a0:<counts>`, analog input A0
+// (the airspeed sensor's) against the 5 V reference.
 #include <Arduino.h>
 
 static volatile uint16_t overflows[3];  // Timer1, Timer4, Timer3
@@ -126,5 +127,6 @@ void loop() {
         Serial.print(':');
         Serial.print(frame[c]);
     }
-    Serial.println();
+    Serial.print(F(" a0:"));
+    Serial.println(analogRead(A0));
 }
