@@ -9,8 +9,9 @@ namespace rc_input {
 
 namespace {
 
-// A frame is 9 edges in 22.5 ms; the loop polls every 5 ms: 16 leave room for a slow step.
-constexpr uint8_t kRing = 16;  // a power of two
+// Edges come at least 0.8 ms apart and the loop polls between its steps (a step and a
+// console reply part take under 8 ms together): 8 hold what comes meanwhile.
+constexpr uint8_t kRing = 8;  // a power of two
 volatile uint16_t ring[kRing];
 volatile uint8_t head;  // captures stored (wraps)
 uint8_t tail;           // captures taken

@@ -122,11 +122,12 @@ static void say_flight_events() {
 
 // The control step, every 4th loop step (50 Hz) right after the estimator's: the servo
 // pulse only changes once a 20 ms period, so a faster step would compute widths that are
-// never sent. Without samples (the MPU6000 gone) the loop runs it on its own every
+// never sent. It moves onto the output line's steps when the output rate is 50 Hz or
+// less, to take the angles the line worked out (the Euler extraction is the step's
+// largest part). Without samples (the MPU6000 gone) the loop runs it on its own every
 // 20 ms, without an attitude: the receiver, MANUAL and the failsafe go on.
 constexpr uint8_t kControlDivider = 4;
 constexpr uint16_t kControlPeriodUs = 20000;
-constexpr float kControlDt_s = 0.02f;
 static uint8_t control_count = 0;
 static uint32_t last_control_us = 0;
 
@@ -134,21 +135,38 @@ static void take_receiver_frames(uint32_t now_ms) {
     while (rc_input::poll(ppm)) flight_control.on_frame(ppm.frame_us(), now_ms);
 }
 
-static void control_step(uint32_t now_us, uint32_t now_ms, bool have_sample) {
+// angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
+// The rates are the sample's body-frame counts less the calibrated bias, in integers (the
+// pipeline's float rates cost several times as much; the D term needs no more); the
+// bias in those units is worked out again once a second (`cal gyro` changes it).
+constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
+constexpr int32_t kCdsPerCountQ10 =
+    (int32_t)(mpu6000::gyro_rad_s_per_count(mpu6000::kGyroRange) * kCdsPerRad_s * 1024.0f + 0.5f);
+static int16_t bias_cds[2];
+static uint8_t bias_age = 0xFF;
+
+static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
+                         const pipeline::AnglesCentideg* angles) {
     last_control_us = now_us;
     control_count = 0;
     board::mark_begin(board::kSecControl);
-    flight::Attitude att{0, 0, 0.0f, 0.0f, have_sample && imu.ok() && pipe.phase() == pipeline::Phase::Running};
-    if (att.valid) {
-        const pipeline::AnglesCentideg a = pipe.angles_centideg();
-        const linalg::Vector3f rate = pipe.body_rate_rad_s();
+    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    flight_control.update_signal(now_ms);
+    if (att.valid && flight_control.wants_attitude()) {  // MANUAL and no receiver yet need none
+        const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
         att.roll_cd = a.roll_centideg;
         att.pitch_cd = a.pitch_centideg;
-        att.roll_rate_deg_s = rate.x * linalg::kDegPerRad;
-        att.pitch_rate_deg_s = rate.y * linalg::kDegPerRad;
+        if (++bias_age >= 50u) {
+            const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
+            bias_cds[0] = (int16_t)(bias.x * kCdsPerRad_s);
+            bias_cds[1] = (int16_t)(bias.y * kCdsPerRad_s);
+            bias_age = 0;
+        }
+        att.roll_rate_cds = (((int32_t)sample->gyro.x * kCdsPerCountQ10) >> 10) - bias_cds[0];
+        att.pitch_rate_cds = (((int32_t)sample->gyro.y * kCdsPerCountQ10) >> 10) - bias_cds[1];
     }
     uint16_t widths[flight::kChannels];
-    flight_control.step(now_ms, att, kControlDt_s, widths);
+    flight_control.step(now_ms, att, widths);
     servo_outputs::set(widths);
     board::mark_end(board::kSecControl);
     say_flight_events();
@@ -252,14 +270,14 @@ static void send_heartbeat_and_status() {
 }
 
 // One output line (or frame) in the chosen mode, none in quiet mode. Lines are written
-// only when they fit whole: a backlog of replies delays a line, never a sample.
-static void emit_output(uint32_t now_ms) {
+// only when they fit whole: a backlog of replies delays a line, never a sample. True
+// when it worked out the angles in hundredths (c): the control step takes them.
+static bool emit_output(uint32_t now_ms, pipeline::AnglesCentideg& c) {
     const fmt::OutputMode mode = pipe.settings().mode;
-    if (mode == fmt::OutputMode::Quiet) return;
+    if (mode == fmt::OutputMode::Quiet) return false;
     // Plot and csv lines print hundredths, which the integer path gives without a float;
     // MAVLink's ATTITUDE carries floats.
     pipeline::Angles a{};
-    pipeline::AnglesCentideg c{};
     if (mode == fmt::OutputMode::Mavlink) {
         board::mark_begin(board::kSecEuler);
         a = pipe.angles();
@@ -289,6 +307,7 @@ static void emit_output(uint32_t now_ms) {
     board::mark_end(board::kSecFormat);
     if (n > 0) serial_text::write_line_if_room(line, n);
     else if (warn_angle.allow(now_ms, 2000)) say(TXT(TXT_WARN "output not finite: line skipped"));
+    return mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv;
 }
 
 // ---------------------------------------------------------------------------
@@ -323,6 +342,7 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
         case console::CommandId::Defaults:
             pipe.restore_defaults();
+            flight_control.configure();
             console::print_defaults(out);
             break;
         case console::CommandId::Flight:
@@ -337,7 +357,10 @@ static bool answer(const console::Command& c, uint8_t part) {
                 print_widths(TXT("# servo"), widths);
             }
             break;
-        default: console::apply_setting(c, pipe.settings(), out); break;  // rate, decl, mode, set, get
+        default:  // rate, decl, mode, set, get
+            console::apply_setting(c, pipe.settings(), out);
+            if (c.id == console::CommandId::Set) flight_control.configure();
+            break;
     }
     return true;
 }
@@ -406,9 +429,13 @@ static void step(uint32_t now_us) {
         board::mark_end(board::kSecEstimator);
         take_console_input();
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
-        if (pipe.output_due()) emit_output(now_ms);
-        take_receiver_frames(now_ms);
-        if (++control_count >= kControlDivider) control_step(now_us, now_ms, true);
+        pipeline::AnglesCentideg c;
+        const bool output = pipe.output_due();
+        const bool have_angles = output && emit_output(now_ms, c);
+        ++control_count;
+        if (control_count >= kControlDivider ||
+            (output && control_count >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
+            control_step(now_us, now_ms, &sample, have_angles ? &c : nullptr);
     }
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
@@ -438,7 +465,8 @@ void setup() {
     // The outputs from here on, at trim and the throttle at its failsafe value until the
     // receiver's first frame (the loaded settings' end points).
     uint16_t widths[flight::kChannels];
-    flight_control.step(0, flight::Attitude{0, 0, 0.0f, 0.0f, false}, kControlDt_s, widths);
+    flight_control.configure();  // the loaded settings
+    flight_control.step(0, flight::Attitude{0, 0, 0, 0, false}, widths);
     servo_outputs::begin(widths);
     rc_input::begin();
     print_settings_line();
@@ -476,9 +504,9 @@ void loop() {
     user_loop();
 
     const uint32_t now_us = micros();
+    take_receiver_frames(now_ms);
     if (now_us - last_control_us >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
-        take_receiver_frames(now_ms);
-        control_step(now_us, now_ms, false);
+        control_step(now_us, now_ms, nullptr, nullptr);
     }
     if (now_us - window_start_us >= 1000000u) {  // load over the last second
         load_pct = (uint8_t)(work_us / ((now_us - window_start_us) / 100u));

@@ -171,14 +171,26 @@ TEST(FlightEndPoints, ModeSwitchBandsAreArduPlanes) {
 
 TEST(FlightController, PGainIsDegreesOfSurfacePerDegreeOfError) {
     flight::AxisController c;
-    const flight::AxisGains g{0.5f, 0.4f, 0.0f, 0.02f, 3000};
-    // 10 deg of error, no rate: (P - I tau) x 10 deg = 4 deg = 400 cd.
-    EXPECT_EQ(c.step(g, 1000, 0.0f, 0.0f, 0.02f), 400);
+    const flight::AxisTerms t = flight::axis_terms(flight::AxisGains{0.5f, 0.4f, 0.0f, 0.02f, 3000}, 0.02f);
+    // 10 deg of error, no rate: (P - I tau) x 10 deg = 4 deg = 400 cd (to the fixed point's 1 cd).
+    EXPECT_NEAR(c.step(t, 1000, 0, 0), 400, 1);
     // A measured rate toward the demand damps: D x 20 deg/s = 0.4 deg less.
-    EXPECT_EQ(c.step(g, 1000, 0.0f, 20.0f, 0.02f), 360);
+    EXPECT_NEAR(c.step(t, 1000, 0, 2000), 360, 1);
     // Full throw at most.
-    EXPECT_EQ(c.step(g, 18000, 0.0f, 0.0f, 0.02f), 4500);
-    EXPECT_EQ(c.step(g, -18000, 0.0f, 0.0f, 0.02f), -4500);
+    EXPECT_EQ(c.step(t, 18000, 0, 0), 4500);
+    EXPECT_EQ(c.step(t, -18000, 0, 0), -4500);
+    // Gains over their whole ranges, errors and rates at their ends: no overflow, the
+    // sign of the error, within full throw.
+    for (float p : {0.1f, 4.0f})
+        for (float d : {0.0f, 0.2f})
+            for (float tau : {0.4f, 1.0f}) {
+                const flight::AxisTerms big = flight::axis_terms(flight::AxisGains{tau, p, 0.0f, d, 4500}, 0.02f);
+                flight::AxisController e, f;
+                const int16_t up = e.step(big, 36000, 0, -200000), down = f.step(big, -36000, 0, 200000);
+                EXPECT_GT(up, 0);
+                EXPECT_LE(up, 4500);
+                EXPECT_EQ(down, -up);
+            }
 }
 
 TEST(FlightController, StepResponseOfAModelAircraftSettles) {
@@ -186,10 +198,10 @@ TEST(FlightController, StepResponseOfAModelAircraftSettles) {
     // a 0.2 s lag): the default gains bring a 20 deg demand within 1 deg in 3 s, no
     // overshoot beyond 10 %.
     flight::AxisController c;
-    const flight::AxisGains g{0.5f, 0.4f, 0.04f, 0.02f, 3000};
+    const flight::AxisTerms t = flight::axis_terms(flight::AxisGains{0.5f, 0.4f, 0.04f, 0.02f, 3000}, 0.02f);
     float angle_deg = 0.0f, rate_deg_s = 0.0f, peak = 0.0f;
     for (int i = 0; i < 250; ++i) {
-        const int16_t out = c.step(g, (int32_t)lroundf((20.0f - angle_deg) * 100.0f), 0.0f, rate_deg_s, 0.02f);
+        const int16_t out = c.step(t, (int32_t)lroundf((20.0f - angle_deg) * 100.0f), 0, (int32_t)lroundf(rate_deg_s * 100.0f));
         const float target_rate = 15.0f * (float)out / 100.0f;  // 15 deg/s per deg of surface
         rate_deg_s += (target_rate - rate_deg_s) * 0.02f / 0.2f;
         angle_deg += rate_deg_s * 0.02f;
@@ -201,33 +213,39 @@ TEST(FlightController, StepResponseOfAModelAircraftSettles) {
 }
 
 TEST(FlightController, IntegratorLimitedAndFrozenWhenSaturated) {
-    const flight::AxisGains g{0.5f, 0.4f, 0.5f, 0.0f, 1000};  // imax 10 deg
+    const flight::AxisTerms t = flight::axis_terms(flight::AxisGains{0.5f, 0.4f, 0.5f, 0.0f, 1000}, 0.02f);  // imax 10 deg
     flight::AxisController c;
     // A steady 2 deg error, no motion: the integrator grows to its limit and stops there.
-    for (int i = 0; i < 2000; ++i) c.step(g, 200, 0.0f, 0.0f, 0.02f);
+    for (int i = 0; i < 2000; ++i) c.step(t, 200, 0, 0);
     EXPECT_FLOAT_EQ(c.integrator_deg(), 10.0f);
     // Saturated (a huge error): the integrator may not grow the way the output is pinned.
     flight::AxisController s;
-    const flight::AxisGains big{0.5f, 4.0f, 0.2f, 0.0f, 4500};
-    s.step(big, 9000, 0.0f, 0.0f, 0.02f);  // saturates
+    const flight::AxisTerms big = flight::axis_terms(flight::AxisGains{0.5f, 4.0f, 0.2f, 0.0f, 4500}, 0.02f);
+    s.step(big, 9000, 0, 0);  // saturates
     const float before = s.integrator_deg();
-    for (int i = 0; i < 50; ++i) EXPECT_EQ(s.step(big, 9000, 0.0f, 0.0f, 0.02f), 4500);
+    for (int i = 0; i < 50; ++i) EXPECT_EQ(s.step(big, 9000, 0, 0), 4500);
     EXPECT_FLOAT_EQ(s.integrator_deg(), before);
     // ... but it unwinds at once when the error turns.
-    s.step(big, -100, 0.0f, 0.0f, 0.02f);
+    s.step(big, -100, 0, 0);
     EXPECT_LT(s.integrator_deg(), before);
 }
 
 TEST(FlightController, TurnCoordinationPitchesUpInABankEitherWay) {
-    // 30 deg bank at 15.5 m/s: g/V tan sin = 9.81/15.5 x 0.577 x 0.5 rad/s = 10.5 deg/s.
-    const float r = flight::turn_rate_offset_deg_s(3000, 0, 15.5f, 1.0f);
-    EXPECT_NEAR(r, 57.29578f * 9.80665f / 15.5f * std::tan(0.5236f) * std::sin(0.5236f), 0.05f);
-    EXPECT_NEAR(flight::turn_rate_offset_deg_s(-3000, 0, 15.5f, 1.0f), r, 1e-4f);
-    EXPECT_FLOAT_EQ(flight::turn_rate_offset_deg_s(0, 0, 15.5f, 1.0f), 0.0f);
+    // 30 deg bank at 15.5 m/s: g/V tan sin = 9.81/15.5 x 0.577 x 0.5 rad/s = 10.5 deg/s
+    // (the tables at 5.12 deg steps: within 1 %).
+    const int16_t k = flight::turn_gain_cds(15.5f, 1.0f);
+    const int32_t r = flight::turn_rate_offset_cds(3000, 0, k);
+    EXPECT_NEAR((double)r, 5729.578 * 9.80665 / 15.5 * std::tan(0.5236) * std::sin(0.5236), 0.01 * 1046.0);
+    EXPECT_EQ(flight::turn_rate_offset_cds(-3000, 0, k), r);
+    EXPECT_EQ(flight::turn_rate_offset_cds(0, 0, k), 0);
+    // Between the table's points, and with the pitch's cosine.
+    EXPECT_NEAR((double)flight::turn_rate_offset_cds(4250, 3000, k),
+                5729.578 * 9.80665 / 15.5 * std::tan(0.74176) * std::sin(0.74176) * std::cos(0.5236), 0.01 * r + 3.0);
     // Limited at 80 deg, none inverted.
-    EXPECT_NEAR(flight::turn_rate_offset_deg_s(8900, 0, 15.5f, 1.0f), flight::turn_rate_offset_deg_s(8000, 0, 15.5f, 1.0f),
-                1e-3f);
-    EXPECT_FLOAT_EQ(flight::turn_rate_offset_deg_s(17000, 0, 15.5f, 1.0f), 0.0f);
+    EXPECT_EQ(flight::turn_rate_offset_cds(8900, 0, k), flight::turn_rate_offset_cds(8000, 0, k));
+    EXPECT_EQ(flight::turn_rate_offset_cds(17000, 0, k), 0);
+    // The largest gain at the largest bank fits.
+    EXPECT_GT(flight::turn_rate_offset_cds(8000, 0, flight::turn_gain_cds(5.0f, 1.5f)), 0);
 }
 
 // --- Mixers -----------------------------------------------------------------------------
@@ -235,8 +253,8 @@ TEST(FlightController, TurnCoordinationPitchesUpInABankEitherWay) {
 TEST(FlightMixer, PlainElevonAndVtail) {
     settings::Settings s = defaults();
     uint16_t out[8];
-    const int16_t aux[4] = {4500, -4500, 0, 2250};
-    flight::mix(s.flight, flight::Surfaces{900, -900, 500, 450}, aux, out);
+    const uint16_t aux[4] = {2000, 1000, 1500, 1750};
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{900, -900, 500, 450}, aux, out);
     EXPECT_EQ(out[0], 1600);  // aileron: +900 cd of 4500 = +100 us
     EXPECT_EQ(out[1], 1400);  // elevator
     EXPECT_EQ(out[2], 1500);  // throttle 50 %
@@ -248,16 +266,16 @@ TEST(FlightMixer, PlainElevonAndVtail) {
     s.flight.elevon_output = 1;
     // Elevons: left = (elevator - aileron) / 2, right = (elevator + aileron) / 2 (trailing
     // edge up positive): roll right lowers the left trailing edge and raises the right.
-    flight::mix(s.flight, flight::Surfaces{900, 0, 0, 0}, nullptr, out);
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{900, 0, 0, 0}, nullptr, out);
     EXPECT_EQ(out[0], 1450);
     EXPECT_EQ(out[1], 1550);
-    flight::mix(s.flight, flight::Surfaces{0, 900, 0, 0}, nullptr, out);
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{0, 900, 0, 0}, nullptr, out);
     EXPECT_EQ(out[0], 1550);
     EXPECT_EQ(out[1], 1550);
     EXPECT_EQ(out[4], 1500);  // aux at trim without aux commands
     s.flight.elevon_output = 0;
     s.flight.vtail_output = 1;
-    flight::mix(s.flight, flight::Surfaces{900, 900, 0, 900}, nullptr, out);
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{900, 900, 0, 900}, nullptr, out);
     EXPECT_EQ(out[0], 1600);  // the aileron stays on OUT1
     EXPECT_EQ(out[1], 1500);  // left ruddervator: (900 - 900) / 2
     EXPECT_EQ(out[3], 1600);  // right: (900 + 900) / 2
@@ -265,8 +283,12 @@ TEST(FlightMixer, PlainElevonAndVtail) {
     s.flight.vtail_output = 0;
     s.flight.servo_reversed = 0x01;
     s.flight.servo[0] = flight::EndPoints{1100, 1900, 1500};
-    flight::mix(s.flight, flight::Surfaces{4500, 0, 0, 0}, nullptr, out);
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{4500, 0, 0, 0}, aux, out);
     EXPECT_EQ(out[0], 1100);
+    s.flight.servo_reversed = 0x10;  // an aux output reversed about its trim
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{0, 0, 0, 0}, aux, out);
+    EXPECT_EQ(out[4], 1000);
+    EXPECT_EQ(out[5], 1000);
 }
 
 // --- Modes --------------------------------------------------------------------------------
@@ -278,7 +300,7 @@ struct Rig {
     flight::FlightControl fc{s.flight};
     uint16_t rc[8] = {1500, 1500, 1100, 1500, 1500, 1500, 1500, 1000};  // mode switch low: MANUAL
     uint32_t now_ms = 0;
-    flight::Attitude att{0, 0, 0.0f, 0.0f, true};
+    flight::Attitude att{0, 0, 0, 0, true};
     uint16_t out[8] = {};
 
     // Runs `seconds` of 50 Hz steps with frames every 22 ms while `signal`.
@@ -290,7 +312,7 @@ struct Rig {
                 fc.on_frame(rc, now_ms);
                 next_frame += 22;
             }
-            if (now_ms % 20u == 0u) fc.step(now_ms, att, 0.02f, out);
+            if (now_ms % 20u == 0u) fc.step(now_ms, att, out);
             ++now_ms;
         }
     }
@@ -301,7 +323,7 @@ struct Rig {
 TEST(FlightModes, NeutralBeforeTheFirstFrameThenManualPassThrough) {
     Rig r;
     r.s.flight.thr_fs_pct = 0;
-    r.fc.step(0, r.att, 0.02f, r.out);
+    r.fc.step(0, r.att, r.out);
     EXPECT_EQ(r.fc.state(), flight::State::NoSignal);
     const uint16_t neutral[8] = {1500, 1500, 1000, 1500, 1500, 1500, 1500, 1500};
     EXPECT_EQ(0, std::memcmp(r.out, neutral, sizeof neutral));

@@ -1,27 +1,28 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Flight.h"
 
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#endif
+
 namespace flight {
 
 namespace {
 
 // a / b rounded to the nearest, half away from zero (b > 0).
-int32_t div_round(int32_t a, int32_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
-
 int32_t clamp32(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 bool bit(uint8_t mask, uint8_t index) { return ((mask >> index) & 1u) != 0u; }
 
-// sin and cos of |x| <= pi/2 by their Taylor series to x^7 and x^8 (within 2e-4):
-// the turn coordination needs no more, and avr-libc's sinf and cosf cost several times
-// as much.
-void sin_cos(float x, float& s, float& c) {
-    const float x2 = x * x;
-    s = x * (1.0f - x2 * (1.0f / 6.0f - x2 * (1.0f / 120.0f - x2 * (1.0f / 5040.0f))));
-    c = 1.0f - x2 * (0.5f - x2 * (1.0f / 24.0f - x2 * (1.0f / 720.0f - x2 * (1.0f / 40320.0f))));
+// A stick's command (-4500..4500) as a demanded angle, full stick = limit_cd: |stick x
+// limit| (< 2^26) / 4500 as (x >> 7) x (2^24 / 4500) >> 17, within 1 cd and no division.
+int32_t demand_cd(int16_t stick_cd, int16_t limit_cd) {
+    const int32_t x = (int32_t)stick_cd * limit_cd;
+    const uint32_t m = (uint32_t)(x < 0 ? -x : x);
+    const int32_t d = (int32_t)(((m >> 7) * 3728u) >> 17);
+    return x < 0 ? -d : d;
 }
 
-constexpr float kRadPerCentideg = 3.14159265f / 18000.0f;
 constexpr float kDegPerRad = 57.2957795f;
 constexpr float kGravity_m_s2 = 9.80665f;
 constexpr int32_t kMaxCoordinatedBank_cd = 8000;  // AP_PitchController's limit
@@ -30,31 +31,77 @@ constexpr int32_t kMaxCoordinatedBank_cd = 8000;  // AP_PitchController's limit
 
 // --- Normalising and end points -----------------------------------------------------
 
-int16_t width_to_angle(uint16_t width_us, const EndPoints& ep, bool reversed) {
-    const int32_t d = (int32_t)width_us - ep.trim_us;
-    const int32_t span = d >= 0 ? (int32_t)ep.max_us - ep.trim_us : (int32_t)ep.trim_us - ep.min_us;
-    int32_t a = span > 0 ? clamp32(div_round(d * kFullThrow_cd, span), -kFullThrow_cd, kFullThrow_cd) : 0;
-    return (int16_t)(reversed ? -a : a);
+namespace {
+
+// round(num / span), 0 when it would not fit 16 bits (a side too short to scale).
+uint16_t factor(uint32_t num, int32_t span) {
+    if (span <= 0) return 0;
+    const uint32_t f = (num + (uint32_t)span / 2u) / (uint32_t)span;
+    return f > 0xFFFFu ? 0 : (uint16_t)f;
 }
 
-int16_t width_to_throttle(uint16_t width_us, const EndPoints& ep, bool reversed) {
-    const int32_t span = (int32_t)ep.max_us - ep.min_us;
-    if (span <= 0) return 0;
-    const int32_t t = clamp32(div_round(((int32_t)width_us - ep.min_us) * kFullThrottle, span), 0, kFullThrottle);
+// (x * f) >> shift rounded, x >= 0.
+int32_t scaled(uint16_t x, uint16_t f, uint8_t shift) {
+    return (int32_t)(((uint32_t)x * f + (1ul << (shift - 1u))) >> shift);
+}
+
+uint16_t clamp_width(int32_t w, const EndPoints& ep) { return (uint16_t)clamp32(w, ep.min_us, ep.max_us); }
+
+}  // namespace
+
+Scale angle_input_scale(const EndPoints& ep) {
+    return Scale{factor((uint32_t)kFullThrow_cd << 8, (int32_t)ep.max_us - ep.trim_us),
+                 factor((uint32_t)kFullThrow_cd << 8, (int32_t)ep.trim_us - ep.min_us)};
+}
+Scale throttle_input_scale(const EndPoints& ep) {
+    return Scale{factor((uint32_t)kFullThrottle << 8, (int32_t)ep.max_us - ep.min_us), 0};
+}
+Scale angle_output_scale(const EndPoints& ep) {
+    const uint32_t up = (uint32_t)(ep.max_us > ep.trim_us ? ep.max_us - ep.trim_us : 0u) << 16;
+    const uint32_t down = (uint32_t)(ep.trim_us > ep.min_us ? ep.trim_us - ep.min_us : 0u) << 16;
+    return Scale{factor(up, kFullThrow_cd), factor(down, kFullThrow_cd)};
+}
+Scale throttle_output_scale(const EndPoints& ep) {
+    const uint32_t span = (uint32_t)(ep.max_us > ep.min_us ? ep.max_us - ep.min_us : 0u) << 15;
+    return Scale{factor(span, kFullThrottle), 0};
+}
+
+int16_t width_to_angle(uint16_t width_us, const EndPoints& ep, Scale sc, bool reversed) {
+    const int32_t d = (int32_t)width_us - ep.trim_us;
+    // |d| beyond its side's span would only clamp: limited first, so that d x f fits.
+    const int32_t a = d >= 0 ? scaled((uint16_t)clamp32(d, 0, 2200), sc.up, 8)
+                             : -scaled((uint16_t)clamp32(-d, 0, 2200), sc.down, 8);
+    const int32_t c = clamp32(a, -kFullThrow_cd, kFullThrow_cd);
+    return (int16_t)(reversed ? -c : c);
+}
+
+int16_t width_to_throttle(uint16_t width_us, const EndPoints& ep, Scale sc, bool reversed) {
+    const int32_t d = clamp32((int32_t)width_us - ep.min_us, 0, 2200);
+    const int32_t t = clamp32(scaled((uint16_t)d, sc.up, 8), 0, kFullThrottle);
     return (int16_t)(reversed ? kFullThrottle - t : t);
 }
 
-uint16_t angle_to_width(int16_t angle_cd, const EndPoints& ep, bool reversed) {
+uint16_t angle_to_width(int16_t angle_cd, const EndPoints& ep, Scale sc, bool reversed) {
     const int32_t a = clamp32(reversed ? -(int32_t)angle_cd : angle_cd, -kFullThrow_cd, kFullThrow_cd);
-    const int32_t span = a >= 0 ? (int32_t)ep.max_us - ep.trim_us : (int32_t)ep.trim_us - ep.min_us;
-    return (uint16_t)clamp32(ep.trim_us + div_round(a * span, kFullThrow_cd), ep.min_us, ep.max_us);
+    const int32_t d = a >= 0 ? scaled((uint16_t)a, sc.up, 16) : -scaled((uint16_t)-a, sc.down, 16);
+    return clamp_width(ep.trim_us + d, ep);
 }
 
-uint16_t throttle_to_width(int16_t throttle, const EndPoints& ep, bool reversed) {
+uint16_t throttle_to_width(int16_t throttle, const EndPoints& ep, Scale sc, bool reversed) {
     int32_t t = clamp32(throttle, 0, kFullThrottle);
     if (reversed) t = kFullThrottle - t;
-    const int32_t span = (int32_t)ep.max_us - ep.min_us;
-    return (uint16_t)clamp32(ep.min_us + div_round(t * span, kFullThrottle), ep.min_us, ep.max_us);
+    return clamp_width(ep.min_us + scaled((uint16_t)t, sc.up, 15), ep);
+}
+
+Scales scales_of(const FlightSettings& s) {
+    Scales sc;
+    for (uint8_t role = 0; role < 4; ++role) {
+        const uint8_t ch = s.rcmap[role];
+        const EndPoints& ep = s.rc[(ch >= 1u && ch <= kChannels) ? ch - 1u : role];
+        sc.in[role] = role == kThrottle ? throttle_input_scale(ep) : angle_input_scale(ep);
+        sc.out[role] = role == 2 ? throttle_output_scale(s.servo[role]) : angle_output_scale(s.servo[role]);
+    }
+    return sc;
 }
 
 uint8_t switch_position(uint16_t width_us) {
@@ -69,39 +116,88 @@ uint8_t switch_position(uint16_t width_us) {
 
 // --- The attitude controller ----------------------------------------------------------
 
-int16_t AxisController::step(const AxisGains& g, int32_t error_cd, float rate_offset_deg_s, float rate_deg_s,
-                             float dt_s) {
-    const float desired_deg_s = (float)error_cd * 0.01f / g.tconst_s + rate_offset_deg_s;
-    const float rate_error_deg_s = desired_deg_s - rate_deg_s;
-    const float ki_rate = g.i * g.tconst_s;
-    if (ki_rate > 0.0f) {
-        float delta = rate_error_deg_s * ki_rate * dt_s;
-        // A saturated surface: the integrator may only unwind (ArduPilot's anti-windup).
-        if ((saturation_ > 0 && delta > 0.0f) || (saturation_ < 0 && delta < 0.0f)) delta = 0.0f;
-        const float limit_deg = (float)g.imax_cd * 0.01f;
-        integrator_deg_ += delta;
-        if (integrator_deg_ > limit_deg) integrator_deg_ = limit_deg;
-        if (integrator_deg_ < -limit_deg) integrator_deg_ = -limit_deg;
-    } else {
-        integrator_deg_ = 0.0f;
-    }
-    float kp_ff = (g.p - g.i * g.tconst_s) * g.tconst_s - g.d;
-    if (kp_ff < 0.0f) kp_ff = 0.0f;
-    const float out_cd = (g.d * rate_error_deg_s + kp_ff * desired_deg_s + integrator_deg_) * 100.0f;
-    saturation_ = out_cd >= (float)kFullThrow_cd ? 1 : (out_cd <= -(float)kFullThrow_cd ? -1 : 0);
-    if (saturation_ > 0) return kFullThrow_cd;
-    if (saturation_ < 0) return -kFullThrow_cd;
-    return (int16_t)out_cd;
+namespace {
+
+int16_t q(float x, float one) {
+    const float v = x * one + 0.5f;
+    return v >= 32767.0f ? 32767 : (v <= 0.0f ? 0 : (int16_t)v);
 }
 
-float turn_rate_offset_deg_s(int32_t roll_cd, int32_t pitch_cd, float airspeed_m_s, float gain) {
-    if (roll_cd > 9000 || roll_cd < -9000 || airspeed_m_s <= 0.0f) return 0.0f;  // inverted: no coordination
-    const int32_t bank_cd = clamp32(roll_cd, -kMaxCoordinatedBank_cd, kMaxCoordinatedBank_cd);
-    float sb, cb, sp, cp;
-    sin_cos((float)bank_cd * kRadPerCentideg, sb, cb);
-    sin_cos((float)clamp32(pitch_cd, -9000, 9000) * kRadPerCentideg, sp, cp);
-    // tan(bank) sin(bank) = sin^2 / cos; cos(bank) >= cos(80 deg) here.
-    return cp * kDegPerRad * kGravity_m_s2 / airspeed_m_s * (sb * sb / cb) * gain;
+// x * f / 2^shift, rounded to the nearest (half away from zero: a left and a right upset
+// get mirror-image surfaces); |x| kept within `limit` first so that the product fits 32
+// bits.
+int32_t mul_shift(int32_t x, int16_t f, uint8_t shift, int32_t limit) {
+    const int32_t p = clamp32(x, -limit, limit) * f;
+    const int32_t half = shift > 0u ? (int32_t)1 << (shift - 1u) : 0;
+    return p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
+}
+
+}  // namespace
+
+AxisTerms axis_terms(const AxisGains& g, float dt_s) {
+    float kp_ff = (g.p - g.i * g.tconst_s) * g.tconst_s - g.d;
+    if (kp_ff < 0.0f) kp_ff = 0.0f;
+    return AxisTerms{q(1.0f / g.tconst_s, 4096.0f), q(kp_ff, 4096.0f), q(g.d, 16384.0f),
+                     q(g.i * g.tconst_s * dt_s, 65536.0f), g.imax_cd};
+}
+
+int16_t AxisController::step(const AxisTerms& t, int32_t error_cd, int32_t rate_offset_cds, int32_t rate_cds) {
+    // Bounds: errors within a turn, rates within 2000 deg/s: every product below 2^31.
+    const int32_t desired_cds = mul_shift(error_cd, t.inv_tau_q12, 12, 36000) + rate_offset_cds;
+    const int32_t rate_error_cds = clamp32(desired_cds - rate_cds, -400000, 400000);
+    if (t.ki_dt_q16 > 0) {
+        int32_t delta_q16 = mul_shift(rate_error_cds, t.ki_dt_q16, 0, 400000);
+        // A saturated surface: the integrator may only unwind (ArduPilot's anti-windup).
+        if ((saturation_ > 0 && delta_q16 > 0) || (saturation_ < 0 && delta_q16 < 0)) delta_q16 = 0;
+        const int32_t limit_q16 = (int32_t)t.imax_cd << 16;
+        integrator_q16_ = clamp32(integrator_q16_ + delta_q16, -limit_q16, limit_q16);
+    } else {
+        integrator_q16_ = 0;
+    }
+    const int32_t out_cd = mul_shift(desired_cds, t.kp_ff_q12, 12, 120000) +
+                           mul_shift(rate_error_cds, t.kd_q14, 14, 400000) + (integrator_q16_ >> 16);
+    saturation_ = out_cd >= kFullThrow_cd ? 1 : (out_cd <= -kFullThrow_cd ? -1 : 0);
+    return (int16_t)clamp32(out_cd, -kFullThrow_cd, kFullThrow_cd);
+}
+
+namespace {
+
+#ifdef __AVR__
+#define FLIGHT_TABLE PROGMEM
+uint16_t table_word(const uint16_t* p) { return pgm_read_word(p); }
+#else
+#define FLIGHT_TABLE
+uint16_t table_word(const uint16_t* p) { return *p; }
+#endif
+
+// tan(x) sin(x) at 0, 5.12, ... 81.92 deg (steps of 512 cd: the index a shift), Q12;
+// cos(x) at 0, 5.12, ... 92.16 deg, Q15 (0 past 90).
+const uint16_t kTanSinQ12[17] FLIGHT_TABLE = {0, 33, 132, 298, 535, 848, 1243, 1732, 2331, 3064, 3970, 5115, 6609, 8668, 11744, 17002, 28566};
+const uint16_t kCosQ15[19] FLIGHT_TABLE = {32768, 32637, 32246, 31598, 30697, 29551, 28170, 26564, 24745, 22730, 20533, 18172, 15666, 13035, 10300, 7483, 4606, 1692, 0};
+
+// A table at 512 cd steps, linearly between them, at |angle_cd| (within the table).
+uint16_t lookup(const uint16_t* table, int32_t angle_cd) {
+    const uint16_t a = (uint16_t)(angle_cd < 0 ? -angle_cd : angle_cd);
+    const uint8_t i = (uint8_t)(a >> 9);
+    const uint16_t frac = (uint16_t)(a & 511u);
+    const int32_t y0 = table_word(table + i);
+    if (frac == 0u) return (uint16_t)y0;
+    const int32_t y1 = table_word(table + i + 1);
+    return (uint16_t)(y0 + (((y1 - y0) * (int32_t)frac) >> 9));
+}
+
+}  // namespace
+
+int16_t turn_gain_cds(float airspeed_m_s, float roll_ff) {
+    if (airspeed_m_s <= 0.0f) return 0;
+    return q(kGravity_m_s2 / airspeed_m_s * kDegPerRad * 100.0f * roll_ff, 1.0f);
+}
+
+int32_t turn_rate_offset_cds(int32_t roll_cd, int32_t pitch_cd, int16_t gain_cds) {
+    if (roll_cd > 9000 || roll_cd < -9000) return 0;  // inverted: no coordination
+    const uint16_t f = lookup(kTanSinQ12, clamp32(roll_cd, -kMaxCoordinatedBank_cd, kMaxCoordinatedBank_cd));
+    const uint16_t c = lookup(kCosQ15, clamp32(pitch_cd, -9000, 9000));
+    return ((((int32_t)gain_cds * f) >> 12) * (int32_t)(c >> 1)) >> 14;
 }
 
 // --- The mixer --------------------------------------------------------------------------
@@ -120,15 +216,21 @@ void mix_pair(int16_t a, int16_t b, int16_t& left, int16_t& right) {
 
 }  // namespace
 
-void mix(const FlightSettings& s, const Surfaces& in, const int16_t* aux_cd, uint16_t out_us[kChannels]) {
-    int16_t cmd[kChannels] = {in.aileron_cd, in.elevator_cd, 0, in.rudder_cd, 0, 0, 0, 0};
+void mix(const FlightSettings& s, const Scales& sc, const Surfaces& in, const uint16_t* aux_us,
+         uint16_t out_us[kChannels]) {
+    int16_t cmd[4] = {in.aileron_cd, in.elevator_cd, 0, in.rudder_cd};
     if (s.elevon_output != 0u) mix_pair(in.elevator_cd, in.aileron_cd, cmd[0], cmd[1]);
     if (s.vtail_output != 0u) mix_pair(in.elevator_cd, in.rudder_cd, cmd[1], cmd[3]);
-    if (aux_cd != nullptr)
-        for (uint8_t i = 4; i < kChannels; ++i) cmd[i] = aux_cd[i - 4];
-    for (uint8_t i = 0; i < kChannels; ++i) {
+    for (uint8_t i = 0; i < 4; ++i) {
         const bool rev = bit(s.servo_reversed, i);
-        out_us[i] = i == 2 ? throttle_to_width(in.throttle, s.servo[i], rev) : angle_to_width(cmd[i], s.servo[i], rev);
+        out_us[i] = i == 2 ? throttle_to_width(in.throttle, s.servo[i], sc.out[i], rev)
+                           : angle_to_width(cmd[i], s.servo[i], sc.out[i], rev);
+    }
+    for (uint8_t i = 4; i < kChannels; ++i) {
+        const EndPoints& ep = s.servo[i];
+        int32_t w = aux_us != nullptr ? aux_us[i - 4] : ep.trim_us;
+        if (bit(s.servo_reversed, i)) w = 2 * (int32_t)ep.trim_us - w;
+        out_us[i] = clamp_width(w, ep);
     }
 }
 
@@ -142,7 +244,7 @@ State state_of(Mode m) { return m == Mode::Stabilize ? State::Stabilize : State:
 
 void FlightControl::hold_neutral(uint16_t out_us[kChannels]) const {
     const Surfaces neutral{0, 0, (int16_t)(s_.thr_fs_pct * 10u), 0};
-    mix(s_, neutral, nullptr, out_us);
+    mix(s_, scales_, neutral, nullptr, out_us);
 }
 
 void FlightControl::choose(Mode m) {
@@ -196,19 +298,25 @@ void FlightControl::update_signal(uint32_t now_ms) {
     }
 }
 
-Surfaces FlightControl::stabilize(const Attitude& att, int32_t roll_demand_cd, int32_t pitch_demand_cd, float dt_s) {
+Surfaces FlightControl::stabilize(const Attitude& att, int32_t roll_demand_cd, int32_t pitch_demand_cd) {
     int32_t roll_error_cd = roll_demand_cd - att.roll_cd;
     if (roll_error_cd > 18000) roll_error_cd -= 36000;  // the short way round
     if (roll_error_cd < -18000) roll_error_cd += 36000;
-    const float airspeed_m_s = 0.5f * (float)(s_.arspd_min_m_s + s_.arspd_max_m_s);
-    const float offset = turn_rate_offset_deg_s(att.roll_cd, att.pitch_cd, airspeed_m_s, s_.pitch_roll_ff);
+    const int32_t offset = turn_rate_offset_cds(att.roll_cd, att.pitch_cd, turn_gain_cds_);
     Surfaces out{};
-    out.aileron_cd = roll_.step(s_.roll, roll_error_cd, 0.0f, att.roll_rate_deg_s, dt_s);
-    out.elevator_cd = pitch_.step(s_.pitch, pitch_demand_cd - att.pitch_cd, offset, att.pitch_rate_deg_s, dt_s);
+    out.aileron_cd = roll_.step(roll_terms_, roll_error_cd, 0, att.roll_rate_cds);
+    out.elevator_cd = pitch_.step(pitch_terms_, pitch_demand_cd - att.pitch_cd, offset, att.pitch_rate_cds);
     return out;
 }
 
-void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s, uint16_t out_us[kChannels]) {
+void FlightControl::configure() {
+    scales_ = scales_of(s_);
+    roll_terms_ = axis_terms(s_.roll, kControlDt_s);
+    pitch_terms_ = axis_terms(s_.pitch, kControlDt_s);
+    turn_gain_cds_ = turn_gain_cds(0.5f * (float)(s_.arspd_min_m_s + s_.arspd_max_m_s), s_.pitch_roll_ff);
+}
+
+void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[kChannels]) {
     update_signal(now_ms);
     if (state_ == State::NoSignal) {
         hold_neutral(out_us);
@@ -227,28 +335,30 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, float dt_s, uint1
     const int16_t fs_throttle = (int16_t)(s_.thr_fs_pct * 10u);
     if (state_ == State::Failsafe) {
         Surfaces sf{0, 0, fs_throttle, 0};
-        if (att.valid) sf = stabilize(att, 0, s_.fs_pitch_cd, dt_s);
+        if (att.valid) sf = stabilize(att, 0, s_.fs_pitch_cd);
         sf.throttle = fs_throttle;
         sf.rudder_cd = 0;
-        mix(s_, sf, nullptr, out_us);
+        mix(s_, scales_, sf, nullptr, out_us);
         return;
     }
-    int16_t in[kChannels];
-    for (uint8_t i = 0; i < kChannels; ++i) in[i] = width_to_angle(rc_us_[i], s_.rc[i], bit(s_.rc_reversed, i));
-    const uint8_t* map = s_.rcmap;
-    const uint8_t thr = (uint8_t)(map[kThrottle] - 1u);
-    Surfaces sf{in[map[kRoll] - 1u], in[map[kPitch] - 1u],
-                width_to_throttle(rc_us_[thr], s_.rc[thr], bit(s_.rc_reversed, thr)), in[map[kYaw] - 1u]};
+    // The sticks, by role (RCMAP_*).
+    int16_t in[4];
+    for (uint8_t role = 0; role < 4; ++role) {
+        const uint8_t ch = (uint8_t)(s_.rcmap[role] - 1u);
+        const bool rev = bit(s_.rc_reversed, ch);
+        in[role] = role == kThrottle ? width_to_throttle(rc_us_[ch], s_.rc[ch], scales_.in[role], rev)
+                                     : width_to_angle(rc_us_[ch], s_.rc[ch], scales_.in[role], rev);
+    }
+    Surfaces sf{in[kRoll], in[kPitch], in[kThrottle], in[kYaw]};
     if (state_ == State::Stabilize && !fallback) {
-        const int32_t roll_demand = div_round((int32_t)sf.aileron_cd * s_.lim_roll_cd, kFullThrow_cd);
-        const int32_t pitch_demand = sf.elevator_cd >= 0
-                                         ? div_round((int32_t)sf.elevator_cd * s_.lim_pitch_max_cd, kFullThrow_cd)
-                                         : div_round(-(int32_t)sf.elevator_cd * s_.lim_pitch_min_cd, kFullThrow_cd);
-        const Surfaces c = stabilize(att, roll_demand, pitch_demand, dt_s);
+        const int32_t roll_demand = demand_cd(sf.aileron_cd, s_.lim_roll_cd);
+        const int32_t pitch_demand =
+            demand_cd(sf.elevator_cd, sf.elevator_cd >= 0 ? s_.lim_pitch_max_cd : (int16_t)-s_.lim_pitch_min_cd);
+        const Surfaces c = stabilize(att, roll_demand, pitch_demand);
         sf.aileron_cd = c.aileron_cd;
         sf.elevator_cd = c.elevator_cd;
     }
-    mix(s_, sf, in + 4, out_us);
+    mix(s_, scales_, sf, rc_us_ + 4, out_us);
 }
 
 }  // namespace flight
