@@ -838,6 +838,11 @@ def main():
         rows.append(["rest scenario total RMSE", "≤ %.1f°" % TARGET_REST, "–", "N/A"])
     rep.append(md_table(["target", "limit", "now", ""], rows))
     rep.append("")
+    # In flight (issue 22): bench/flights.py.
+    import flights
+    flight_rep, flight_errors = flights.flight_section(build, out_dir, task_replay, peer_names, log)
+    rep += flight_rep
+    errors += flight_errors
     if errors:
         rep += ["## Errors", ""] + ["- " + e for e in errors] + [""]
     if pngs:

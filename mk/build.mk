@@ -18,7 +18,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools sim test bench tune upload size
+.PHONY: all firmware tools sim fly test bench tune upload size
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -126,6 +126,20 @@ sim: firmware tools
 	@echo "# simavr: build/firmware.elf on scenario '$(SCENARIO)' (SCENARIO=name, SECONDS=s, SERIAL=tcp:5760 to change)"
 	@$(BUILD)/apm25sim --elf $(BUILD)/firmware.elf --trajectory $(BUILD)/scenarios/$(SCENARIO).csv \
 	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL))
+
+# make fly [FLIGHT=cruise|gusty|upset|turn|figure8|climb] [GUST=0|1|2] [SECONDS=s] [STAMP=1]
+# [VIEW=1]: the firmware flies the JSBSim Rascal (sim/flight/closed_loop.py: the backend with
+# the flight's stick script, apm25sim --physics json in lock-step), the board's serial
+# output shown as a serial monitor would (STAMP=1: after its simulated time); VIEW=1 (or
+# make view FLIGHT=...) draws it on the live horizon. Both processes end by themselves,
+# or after FLY_TIMEOUT wall seconds.
+FLY_TIMEOUT ?= 1800
+fly: firmware tools venv
+	@echo "# flight '$(or $(FLIGHT),cruise)': build/firmware.elf in simavr flies the JSBSim Rascal 110 (FLIGHT=name, GUST=0-2, SECONDS=s; flights: fly.py --list)"
+	@$(VENV_PY) sim/flight/closed_loop.py --flight $(or $(FLIGHT),cruise) $(if $(GUST),--gust $(GUST)) \
+	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(STAMP),--stamp) --sim $(BUILD)/apm25sim \
+	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) \
+	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
 
 test: firmware tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)

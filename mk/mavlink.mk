@@ -12,6 +12,7 @@
 #                                     (quat, csv, mavlink: the view reads them all)
 #   make view PORT=/dev/ttyACM0       ... by a real board (115200)
 #   make view FILE=stream.txt         ... by a recorded stream (text modes or MAVLink)
+#   make view FLIGHT=turn             ... by the simulated board flying (make fly VIEW=1)
 #   make view VIEW_FLAGS="--frames DIR"   headless: PNG frames into DIR, no window
 #
 # mavgen reads only the XML files beside common.xml (standard.xml, minimal.xml) and copies
@@ -48,6 +49,8 @@ ifeq ($(filter file undefined default,$(origin PORT)),)
 	$(VENV_PY) tools/view.py --port $(PORT) --baud $(BAUD) $(VIEW_FLAGS)
 else ifneq ($(FILE),)
 	$(VENV_PY) tools/view.py --file $(FILE) $(VIEW_FLAGS)
+else ifneq ($(FLIGHT),)
+	@$(MAKE) --no-print-directory -f mk/build.mk fly VIEW=1
 else
 	@$(MAKE) --no-print-directory firmware tools
 	@mkdir -p $(BUILD)/scenarios

@@ -112,10 +112,13 @@ class Trim:
 
 class FlightModel:
     def __init__(self, airspeed_m_s=18.0, altitude_m=100.0, heading_deg=0.0, gust=0, seed=1,
-                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0):
+                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0, hold_s=0.0):
         """upsets: (start_s, duration_s, roll_moment_Nm) tuples, a roll moment applied from
         start_s for duration_s (positive rolls right). vibration_m_s2: the amplitude of the
-        propeller's vibration at the IMU at the trim's propeller speed (see vibration())."""
+        propeller's vibration at the IMU at the trim's propeller speed (see vibration()).
+        hold_s: the aeroplane is held still at its start attitude for so long (on a launch
+        stand: the board powers up and calibrates its gyro at rest, as on the ground), then
+        released into the trimmed flight (a catapult launch at the trim's speed)."""
         if gust not in GUST_LEVELS:
             raise ValueError("gust level %r: 0 (none), 1 (light) or 2 (moderate)" % (gust,))
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
@@ -123,6 +126,7 @@ class FlightModel:
         self.gust_level, self.seed = gust, seed
         self.upsets = [tuple(float(v) for v in u) for u in upsets]
         self.vibration_m_s2 = float(vibration_m_s2)
+        self.hold_s = max(0.0, float(hold_s))
         jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
         self.fdm.set_debug_level(0)
@@ -232,6 +236,12 @@ class FlightModel:
 
     def step(self, dt_s):
         """Advance dt_s of simulated time (in steps of at most MAX_STEP_S)."""
+        if self.held():
+            held = min(dt_s, self.hold_s - self.time_s)
+            self.time_s += held
+            dt_s -= held
+            if dt_s <= 1e-12:
+                return
         n = max(1, int(math.ceil(dt_s / MAX_STEP_S - 1e-9)))
         h = dt_s / n
         f = self.fdm
@@ -252,6 +262,10 @@ class FlightModel:
             self.prop_angle_rad = (self.prop_angle_rad +
                                    f["propulsion/engine/propeller-rpm"] * 2 * math.pi / 60 * h) % (2 * math.pi)
         self.time_s += dt_s
+
+    def held(self):
+        """Still on the launch stand (hold_s)."""
+        return self.time_s < self.hold_s - 1e-12
 
     def vibration(self):
         """The propeller's vibration at the IMU, m/s^2 body axes: a rotating imbalance at the
@@ -278,6 +292,10 @@ class FlightModel:
         # Body rates relative to the earth: integrating them gives the NED attitude exactly.
         gyro = [f["velocities/%s-rad_sec" % a] for a in "pqr"]
         rot = body_to_ned_matrix(roll, pitch, yaw)
+        held = self.held()
+        if held:  # at rest on the stand: no rates, the stand's reaction against gravity
+            gyro = [0.0, 0.0, 0.0]
+            accel = [float(v) for v in rot.T @ np.array([0.0, 0.0, -G0])]
         mag = rot.T @ np.array(EARTH_FIELD_NED_UT)
         lat, lon = f["position/lat-geod-rad"], f["position/long-gc-rad"]
         north = (lat - self.lat0) * EARTH_RADIUS_M
@@ -290,8 +308,8 @@ class FlightModel:
             "quat": q,
             "euler": (roll, pitch, yaw),
             "position": [north, east, -f["position/h-agl-ft"] * FT],
-            "velocity": [f["velocities/v-%s-fps" % a] * FT for a in ("north", "east", "down")],
-            "airspeed": f["velocities/vt-fps"] * FT,
+            "velocity": [0.0, 0.0, 0.0] if held else [f["velocities/v-%s-fps" % a] * FT for a in ("north", "east", "down")],
+            "airspeed": 0.0 if held else f["velocities/vt-fps"] * FT,
             "wind": [f["atmosphere/total-wind-%s-fps" % a] * FT for a in ("north", "east", "down")],
             "alpha": f["aero/alpha-rad"],
             "beta": f["aero/beta-rad"],

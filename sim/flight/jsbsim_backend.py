@@ -47,6 +47,9 @@ def parse_args(argv):
                         "of simulated time; repeatable")
     p.add_argument("--vibration", type=float, default=0.0, metavar="M_S2",
                    help="propeller vibration at the IMU, amplitude at the trim's propeller speed (m/s^2)")
+    p.add_argument("--hold", type=float, default=0.0, metavar="S",
+                   help="hold the aeroplane still at its start attitude for S s (a launch stand: the "
+                        "board starts at rest), then release it into the trimmed flight")
     p.add_argument("--trajectory", help="write the flight as a trajectory (../shared/SIM.md)")
     p.add_argument("--log", help="write the true state, one row a frame")
     p.add_argument("--seconds", type=float, default=0.0,
@@ -71,7 +74,7 @@ class Backend:
                 raise ValueError("--upset %r: want T,SECONDS,NM (three numbers)" % spec)
             upsets.append((start, length, moment))
         self.model = flightmodel.FlightModel(args.airspeed, args.altitude, args.heading, args.gust, args.seed,
-                                             upsets=upsets, vibration_m_s2=args.vibration)
+                                             upsets=upsets, vibration_m_s2=args.vibration, hold_s=args.hold)
         trim = self.model.trim
         widths = trim.widths_us()
         if args.rc == "none":
