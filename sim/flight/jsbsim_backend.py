@@ -132,7 +132,10 @@ class Backend:
             self.frames = 0
             self.open_outputs()
         self.model.set_widths(pwm[:4])
+        crashed_before = self.model.crashed_at is not None
         self.model.step(1.0 / frame_rate)
+        if self.model.crashed_at is not None and not crashed_before:
+            self.say("# crashed at %.3f s: the aeroplane lies still where it hit the ground" % self.model.crashed_at)
         self.frames += 1
         state = self.model.state()
         self.record(state)
