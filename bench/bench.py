@@ -59,6 +59,7 @@ SECTIONS = [
     (9, "gravity", "step part: gravity (low-pass, rest, roll/pitch)", ()),
     (10, "compass", "step part: heading correction", ()),
     (11, "learner", "step part: compass offset learner", ()),
+    (14, "magfit", "one part of the cal mag fit (outside the step)", ()),
 ]
 
 # Targets of issue 10 (the 24 KB flash target of issue 5 is dropped: the 2560 has 256 KB):

@@ -219,3 +219,31 @@ TEST(RecordSlots, SlotOfAnotherRecordLengthIsRefused) {
 }
 
 }  // namespace
+
+// The store writes a slot a byte at a time from the live settings (firmware/SettingsStore):
+// record_byte and header_byte are encode's bytes, the CRCs run to slot_crc's.
+TEST(RecordSlots, ByteAtATimeIsTheEncodedSlot) {
+    for (uint8_t n = 0; n < 3; ++n) {
+        Settings s = numbered(n);
+        s.flight.elevon_output = n == 1 ? 1 : 0;
+        s.flight.roll.p = 0.5f + 0.25f * n;
+        s.flight.servo[7].trim_us = (uint16_t)(1400 + n);
+        const std::vector<uint8_t> record = record_of(s);
+        const uint16_t sequence = (uint16_t)(0xFFFEu + n);
+        std::vector<uint8_t> slot(slots::kSlotSize);
+        slots::encode(record.data(), sequence, slot.data());
+        uint16_t crc = settings::kCrc16Init;
+        for (uint8_t i = 0; i < slots::kHeaderSize; ++i) {
+            EXPECT_EQ(slots::header_byte(sequence, i), slot[i]) << "header byte " << (int)i;
+            crc = settings::crc16_update(crc, slot[i]);
+        }
+        for (uint8_t i = 0; i + 2u < settings::kRecordSize; ++i) {
+            ASSERT_EQ(settings::record_byte(s, i), record[i]) << "record byte " << (int)i;
+            crc = settings::crc16_update(crc, record[i]);
+        }
+        const uint16_t covered = (uint16_t)(slots::kHeaderSize + settings::kRecordSize);
+        crc = settings::crc16_update(settings::crc16_update(crc, slot[covered - 2u]), slot[covered - 1u]);
+        EXPECT_EQ(crc, slots::slot_crc(record.data(), sequence));
+        EXPECT_EQ(crc, (uint16_t)(slot[covered] | slot[covered + 1u] << 8));
+    }
+}

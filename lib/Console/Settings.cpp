@@ -19,13 +19,16 @@ Settings defaults() {
 }
 
 // CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF): check value 0x29B1 for "123456789".
+uint16_t crc16_update(uint16_t crc, uint8_t byte) {
+    crc = (uint16_t)(crc ^ (uint16_t)((uint16_t)byte << 8));
+    for (uint8_t b = 0; b < 8; ++b)
+        crc = (crc & 0x8000u) ? (uint16_t)((uint16_t)(crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
+    return crc;
+}
+
 uint16_t crc16(const uint8_t* data, uint16_t len) {
-    uint16_t crc = 0xFFFFu;
-    for (uint16_t i = 0; i < len; ++i) {
-        crc = (uint16_t)(crc ^ (uint16_t)((uint16_t)data[i] << 8));
-        for (uint8_t b = 0; b < 8; ++b)
-            crc = (crc & 0x8000u) ? (uint16_t)((uint16_t)(crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
-    }
+    uint16_t crc = kCrc16Init;
+    for (uint16_t i = 0; i < len; ++i) crc = crc16_update(crc, data[i]);
     return crc;
 }
 
@@ -35,18 +38,27 @@ static_assert(sizeof(calib::Calibration) == 60, "Calibration is fifteen packed f
 static_assert(kV2PayloadLength == 5 + sizeof(calib::Calibration), "version 2 payload = header bytes + calibration");
 static_assert(kRecordSize <= 255, "the record's size is a byte");
 
+uint8_t record_byte(const Settings& s, uint8_t i) {
+    switch (i) {
+        case 0: return kMagic0;
+        case 1: return kMagic1;
+        case 2: return kSettingsVersion;
+        case 3: return kPayloadLength;
+        case 4: return s.rate_hz;
+        case 5: return (uint8_t)((uint16_t)s.declination_centideg & 0xFFu);
+        case 6: return (uint8_t)((uint16_t)s.declination_centideg >> 8);
+        case 7: return (uint8_t)s.mode;
+        case 8: return (uint8_t)(s.flags & ~kFlagUpgraded);
+        default: break;
+    }
+    if (i < kFlightOffset) return ((const uint8_t*)&s.cal)[i - 9u];
+    return params::flight_byte(s, (uint8_t)(i - kFlightOffset));
+}
+
 void encode(const Settings& s, uint8_t out[kRecordSize]) {
-    out[0] = kMagic0;
-    out[1] = kMagic1;
-    out[2] = kSettingsVersion;
-    out[3] = kPayloadLength;
-    out[4] = s.rate_hz;
-    out[5] = (uint8_t)((uint16_t)s.declination_centideg & 0xFFu);
-    out[6] = (uint8_t)((uint16_t)s.declination_centideg >> 8);
-    out[7] = (uint8_t)s.mode;
-    out[8] = (uint8_t)(s.flags & ~kFlagUpgraded);
+    for (uint8_t i = 0; i < 9; ++i) out[i] = record_byte(s, i);
     memcpy(out + 9, &s.cal, sizeof s.cal);
-    params::encode_flight(s, out + 4 + kV2PayloadLength);
+    params::encode_flight(s, out + kFlightOffset);
     const uint16_t crc = crc16(out, (uint16_t)(4u + kPayloadLength));
     out[4 + kPayloadLength] = (uint8_t)(crc & 0xFFu);
     out[5 + kPayloadLength] = (uint8_t)(crc >> 8);

@@ -74,6 +74,14 @@ enum class LoadResult : uint8_t {
 };
 
 uint16_t crc16(const uint8_t* data, uint16_t len);
+// The same CRC a byte at a time: crc16(d, n) is crc16_update(...(kCrc16Init, d[0])..., d[n-1]).
+constexpr uint16_t kCrc16Init = 0xFFFFu;
+uint16_t crc16_update(uint16_t crc, uint8_t byte);
+// Where the flight settings start in the record.
+constexpr uint8_t kFlightOffset = 4 + kV2PayloadLength;
+// Byte i of encode(s)'s record, for i < 4 + kPayloadLength (all but the record's CRC):
+// a record written a byte at a time needs no copy of it.
+uint8_t record_byte(const Settings& s, uint8_t i);
 
 void encode(const Settings& s, uint8_t out[kRecordSize]);
 // On anything but Ok, `out` is set to defaults(): never garbage.

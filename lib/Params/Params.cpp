@@ -270,6 +270,16 @@ void decode_flight(const uint8_t in[settings::kFlightBytes], Settings& s) {
     });
 }
 
+uint8_t flight_byte(const Settings& s, uint8_t offset) {
+    uint16_t at = 0;
+    uint8_t byte = 0;
+    each_flight_value(s, [&](uint8_t* p, uint8_t n) {
+        if (offset >= at && offset < at + n) byte = p[offset - at];
+        at = (uint16_t)(at + n);
+    });
+    return byte;
+}
+
 uint16_t flight_bytes() {
     uint16_t at = 0;
     const Settings s{};

@@ -27,9 +27,6 @@ constexpr uint32_t kNormalAccelCounts2 =
 // 2000 deg/s full scale make 60 rad/s) is a broken read, not a rotation.
 constexpr uint32_t kMaxCredibleRateCounts2 = (uint32_t)((dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s) *
                                                         (dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s));
-// A part of the `cal mag` fit, for the simulator's profiler: the next id after
-// profile::Part's (lib/LinAlg/Profile.h).
-constexpr uint8_t kMagFitSection = 13;
 // |a - b| of two counts.
 int32_t jump(int16_t a, int16_t b) {
     const int32_t d = (int32_t)a - b;
@@ -464,9 +461,9 @@ void AttitudePipeline::start_mag_calibration() {
 // A part of the fit, or (on the step after its last) the verdict.
 void AttitudePipeline::step_mag_fit() {
     if (mag_cal_.fitting()) {
-        profile::begin(kMagFitSection);
+        profile::begin(profile::kMagFit);
         mag_cal_.fit_part();
-        profile::end(kMagFitSection);
+        profile::end(profile::kMagFit);
         return;
     }
     st_.mag_fit_active = false;
