@@ -169,3 +169,104 @@ TEST(DcmProperties, TheFloatFormAfterOtherScalesReadsItsOwnUnits) {
         EXPECT_NEAR(filter.euler().yaw_rad, 1.0f, 0.01f) << "scale " << gyro_scale;
     }
 }
+
+// Without a specific force (free fall, a ballistic flight) its direction is no gravity:
+// once the low-passed force is below g/2 the tilt is no longer corrected towards it.
+// (Before, for the ~2 s the 3 s low-pass takes to fall below g/2, it moves ~1.5 deg.)
+TEST(DcmProperties, FreeFallStopsTheTiltCorrection) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    for (int i = 0; i < 800; ++i) filter.update(Vector3f(), accel_for(Matrix3f::identity()));  // past start-up
+    // 20 s with a little drag sideways (0.5 m/s^2 along x).
+    for (int i = 0; i < 4000; ++i) filter.update(Vector3f(), Vector3f(0.5f, 0.0f, -0.3f));
+    EXPECT_LT(tilt_error_deg(Matrix3f::identity(), filter.matrix()), 5.0f);
+}
+
+// A sample beyond any accelerometer on any axis, either sign, gives gravity no weight.
+TEST(DcmProperties, AbsurdAccelIsIgnoredOnEveryAxis) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (float sign : {1.0f, -1.0f}) {
+            dcm::Dcm filter;
+            ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+            Vector3f a = accel_for(Matrix3f::identity());
+            (&a.x)[axis] = sign * 300.0f * kG;
+            for (int i = 0; i < 50; ++i) filter.update(Vector3f(), a);
+            EXPECT_TRUE(filter.status() & dcm::kStatusAccelIgnored) << "axis " << axis << " sign " << sign;
+            EXPECT_LT(tilt_error_deg(Matrix3f::identity(), filter.matrix()), 0.01f) << "axis " << axis;
+        }
+    }
+}
+
+// The compass learner's gyro turn saturates at 1.5 rad on either side, whatever the
+// counts (beyond 2^22 they are saturated first: no overflow of the sums).
+TEST(DcmProperties, GyroTurnSaturatesOnBothSidesForAnyCount) {
+    dcm::Dcm filter;
+    filter.set_sample_scales(0.001065f, 0.0024f);
+    const Vector3f t = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(-(1L << 24), (1L << 24), -(1L << 30)), 100));
+    EXPECT_NEAR(t.x, -1.5f, 1e-4f);
+    EXPECT_NEAR(t.y, 1.5f, 1e-4f);
+    EXPECT_NEAR(t.z, -1.5f, 1e-4f);
+}
+
+// heading_due_next() tells the caller which field sample completes the heading's mean
+// (kHeadingSteps steps of samples): with a sample every third step, every third one.
+TEST(DcmProperties, HeadingDueNextMarksEveryMeansLastSample) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    int due = 0, samples = 0;
+    for (int i = 1; i <= 3000; ++i) {
+        const bool due_next = filter.heading_due_next();
+        filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+        if (i % 3 == 0) {
+            filter.correct_heading(earth_field_uT());
+            ++samples;
+            if (due_next) ++due;
+        }
+    }
+    EXPECT_NEAR((float)due, (float)samples / 3.0f, 2.0f);
+}
+
+// A field sample that arrives before the first accel sample is kept (uT) and becomes the
+// start-up heading and the learned field: the next samples match it.
+TEST(DcmProperties, AFieldBeforeTheFirstSampleIsTheReference) {
+    dcm::Dcm filter;
+    const Matrix3f truth = dcm::dcm_from_euler(0.0f, 0.0f, 0.7f);
+    filter.correct_heading(mag_for(truth));
+    filter.update(Vector3f(), accel_for(truth));  // the first sample starts it
+    ASSERT_TRUE(filter.initialised());
+    for (int i = 0; i < 600; ++i) {
+        if (i % 3 == 0) filter.correct_heading(mag_for(truth));
+        filter.update(Vector3f(), accel_for(truth));
+    }
+    EXPECT_FALSE(filter.status() & dcm::kStatusMagIgnored);
+    EXPECT_LT(angle_between_deg(truth, filter.matrix()), 0.5f);
+}
+
+// With a yaw integral gain (ki_yaw, off by default) the compass's heading error teaches
+// the vertical gyro bias, in the right direction.
+TEST(DcmProperties, AYawIntegralLearnsTheVerticalBiasFromTheCompass) {
+    dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
+    settings.ki_yaw_1_s2 = 0.02f;
+    settings.rest_bias_s = 0.0f;  // not from the rest test
+    dcm::Dcm filter(settings);
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const float bias_rad_s = 0.5f * linalg::kRadPerDeg;
+    for (int i = 0; i < 200 * 120; ++i) {
+        if (i % 3 == 0) filter.correct_heading(earth_field_uT());
+        filter.update(Vector3f(0, 0, bias_rad_s), accel_for(Matrix3f::identity()));
+    }
+    EXPECT_NEAR(filter.gyro_bias_rad_s().z * linalg::kDegPerRad, 0.5f, 0.1f);
+}
+
+// A compass sampled at the step rate (more samples in a heading mean than the usual
+// three): the mean is still a mean, the heading converges to the compass's.
+TEST(DcmProperties, ACompassAtTheStepRateStillGivesTheHeading) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const Matrix3f turned = dcm::dcm_from_euler(0.0f, 0.0f, 20.0f * linalg::kRadPerDeg);
+    for (int i = 0; i < 200 * 60; ++i) {
+        filter.correct_heading(mag_for(i < 1000 ? Matrix3f::identity() : turned));
+        filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+    }
+    EXPECT_NEAR(filter.euler().yaw_rad * linalg::kDegPerRad, 20.0f, 0.5f);
+}

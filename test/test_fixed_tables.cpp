@@ -66,3 +66,19 @@ TEST(FixedTables, HeadingFoldsIntoAFullTurn) {
     EXPECT_NEAR(dcm::heading_deg(90.0f * linalg::kRadPerDeg, 0.0f), 90.0f, 1e-3f);
     EXPECT_EQ(dcm::heading_deg(NAN, 0.0f), 0.0f);
 }
+
+// The printed heading in hundredths: north is 0, never 36000; just west of north 35999.
+TEST(FixedTables, HeadingCentidegFoldsAtNorth) {
+    EXPECT_EQ(dcm::heading_centideg(0, 0), 0);
+    EXPECT_EQ(dcm::heading_centideg(0, -1), 35999);
+    EXPECT_EQ(dcm::heading_centideg(0, 1), 1);
+    EXPECT_EQ(dcm::heading_centideg(-linalg::kHalfPiQ24, 0), 27000);
+}
+
+// hypot at the end of its table (the two sides equal: ratio 1, or beyond by rounding).
+TEST(FixedTables, HypotOfEqualSidesIsRootTwoTimesTheSide) {
+    for (uint32_t ratio : {0x80000000u, 0xFFFFFFFFu}) {
+        const uint32_t h = linalg::hypot_from_ratio(1000000000u, ratio);
+        EXPECT_NEAR((double)h, 1000000000.0 * std::sqrt(2.0), 1000000000.0 * 2.5e-5) << ratio;
+    }
+}

@@ -298,6 +298,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--library", action="append", help="only this library (lib/DCM, lib/LinAlg/Fixed, ...)")
+    ap.add_argument("--survivors-of", metavar="REPORT", help="run only the survivors a previous report lists "
+                    "(build/mutate/report.txt: after writing tests for them)")
     args = ap.parse_args()
     os.chdir(ROOT)
     start = time.time()
@@ -346,7 +348,10 @@ def main():
     print("# mutate: test binary of %s (%.1f s a run, timeout %.0f s)" % (
         " ".join(os.path.basename(t) for t in test_objs), base_s, timeout_s))
 
-    mutants = generate(out, files, os.path.join(ROOT, args.build, "venv", "bin", "mutate"))
+    mutate_bin = os.path.join(ROOT, args.build, "venv", "bin", "mutate")
+    if not os.path.exists(mutate_bin):
+        mutate_bin = shutil.which("mutate") or os.path.join(ROOT, "build", "venv", "bin", "mutate")
+    mutants = generate(out, files, mutate_bin)
     equivalent = load_equivalent()
     # Shuffled before the equivalent ones are taken out: listing one leaves the rest of
     # the sample as it was (the next mutant in the order takes its place).
@@ -354,6 +359,11 @@ def main():
     rng.shuffle(mutants)
     pool = collections.OrderedDict((lib, []) for lib in LIBRARIES if lib in files.values())
     n_equivalent = collections.Counter()
+    if args.survivors_of:
+        listed = set(re.findall(r"^(\S+):\d+: (.*)\n    -> (.*)$", open(os.path.join(ROOT, args.survivors_of)).read(), re.M))
+        listed = {(f, "" if o == "(new line)" else o, "" if n == "(line deleted)" else n) for f, o, n in listed}
+        mutants = [m for m in mutants if (m["file"], m["orig"], m["new"]) in listed]
+        args.mutants = "all"
     for m in mutants:
         lib = files[m["file"]]
         if (m["file"], m["orig"], m["new"]) in equivalent:
