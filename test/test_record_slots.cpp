@@ -238,7 +238,11 @@ TEST(RecordSlots, ByteAtATimeIsTheEncodedSlot) {
             crc = settings::crc16_update(crc, slot[i]);
         }
         for (uint8_t i = 0; i + 2u < settings::kRecordSize; ++i) {
-            ASSERT_EQ(settings::record_byte(s, i), record[i]) << "record byte " << (int)i;
+            for (uint8_t n = 1; n <= 17 && i + n + 2u <= settings::kRecordSize; n = (uint8_t)(n + 8)) {
+                uint8_t part[17];
+                settings::record_part(s, i, n, part);
+                ASSERT_EQ(0, std::memcmp(part, record.data() + i, n)) << "record bytes " << (int)i << "+" << (int)n;
+            }
             crc = settings::crc16_update(crc, record[i]);
         }
         const uint16_t covered = (uint16_t)(slots::kHeaderSize + settings::kRecordSize);

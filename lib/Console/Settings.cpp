@@ -51,8 +51,13 @@ uint8_t record_byte(const Settings& s, uint8_t i) {
         case 8: return (uint8_t)(s.flags & ~kFlagUpgraded);
         default: break;
     }
-    if (i < kFlightOffset) return ((const uint8_t*)&s.cal)[i - 9u];
-    return params::flight_byte(s, (uint8_t)(i - kFlightOffset));
+    return ((const uint8_t*)&s.cal)[i - 9u];
+}
+
+void record_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out) {
+    uint8_t i = from;
+    for (; i < kFlightOffset && (uint8_t)(i - from) < n; ++i) out[i - from] = record_byte(s, i);
+    if ((uint8_t)(i - from) < n) params::flight_part(s, (uint8_t)(i - kFlightOffset), (uint8_t)(n - (i - from)), out + (i - from));
 }
 
 void encode(const Settings& s, uint8_t out[kRecordSize]) {
