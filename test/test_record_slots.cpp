@@ -251,3 +251,20 @@ TEST(RecordSlots, ByteAtATimeIsTheEncodedSlot) {
         EXPECT_EQ(crc, (uint16_t)(slot[covered] | slot[covered + 1u] << 8));
     }
 }
+
+// crc16_update's byte-at-once form is CRC-16/CCITT-FALSE: the check value, and the
+// bitwise definition (poly 0x1021, MSB first) for every state and byte.
+TEST(RecordSlots, Crc16IsCcittFalse) {
+    const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    EXPECT_EQ(0x29B1u, settings::crc16(check, sizeof check));
+    for (uint32_t state = 0; state < 0x10000u; ++state) {
+        for (uint16_t byte = 0; byte < 256; ++byte) {
+            uint16_t bitwise = (uint16_t)(state ^ (byte << 8));
+            for (uint8_t b = 0; b < 8; ++b)
+                bitwise = (bitwise & 0x8000u) ? (uint16_t)((uint16_t)(bitwise << 1) ^ 0x1021u) : (uint16_t)(bitwise << 1);
+            if (settings::crc16_update((uint16_t)state, (uint8_t)byte) != bitwise) {
+                FAIL() << "state " << state << " byte " << byte;
+            }
+        }
+    }
+}
