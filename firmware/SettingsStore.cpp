@@ -45,6 +45,7 @@ void SettingsStore::begin() {
     record_crc_ = settings::kCrc16Init;
     slot_crc_ = settings::kCrc16Init;
     index_ = 0;
+    part_from_ = 0xFFu;
     verify_index_ = slots::kSlotSize;
 }
 
@@ -55,7 +56,13 @@ uint8_t SettingsStore::next_byte() {
     if (index_ < slots::kHeaderSize) {
         b = slots::header_byte(next_sequence_, (uint8_t)index_);
     } else if (index_ < kRecordCrcAt) {
-        b = settings::record_byte(*source_, (uint8_t)(index_ - slots::kHeaderSize));
+        const uint8_t i = (uint8_t)(index_ - slots::kHeaderSize);
+        if (part_from_ == 0xFFu || i < part_from_ || i >= part_from_ + kPartSize) {
+            constexpr uint8_t kEnd = settings::kRecordSize - 2u;
+            part_from_ = i;
+            settings::record_part(*source_, i, (uint8_t)(kEnd - i < kPartSize ? kEnd - i : kPartSize), part_);
+        }
+        b = part_[i - part_from_];
         record_crc_ = settings::crc16_update(record_crc_, b);
     } else if (index_ < kRecordEnd) {
         b = index_ == kRecordCrcAt ? (uint8_t)(record_crc_ & 0xFFu) : (uint8_t)(record_crc_ >> 8);
@@ -87,7 +94,7 @@ void SettingsStore::verify_some() {
     // A part at a time: the CRC of the whole slot read back at once would stretch one
     // loop iteration.
     constexpr uint16_t kCovered = slots::kHeaderSize + settings::kRecordSize;
-    constexpr uint8_t kBytesPerCall = 16;
+    constexpr uint8_t kBytesPerCall = 64;
     for (uint8_t n = 0; n < kBytesPerCall && verify_index_ < kCovered; ++n, ++verify_index_)
         verify_crc_ = settings::crc16_update(verify_crc_, eeprom_read_byte((const uint8_t*)(slot_address() + verify_index_)));
     if (verify_index_ < kCovered) return;

@@ -45,6 +45,11 @@ private:
     uint16_t expected_crc_ = 0;          // the slot's CRC of the record at `save`
     uint16_t record_crc_ = 0;            // the running CRCs of the bytes written
     uint16_t slot_crc_ = 0;
+    // The record's bytes from part_from_ on, encoded a part at a time (the parameter
+    // table is walked once a part, not once a byte).
+    static constexpr uint8_t kPartSize = 12;
+    uint8_t part_[kPartSize];
+    uint8_t part_from_ = 0xFFu;
     uint16_t verify_index_ = slots::kSlotSize;  // the next byte read back; kSlotSize: none
     uint16_t verify_crc_ = 0;
     uint16_t next_sequence_ = 1;

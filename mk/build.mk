@@ -65,6 +65,9 @@ FW_HDR   := $(wildcard firmware/*.h) $(foreach d,$(LIB_DIRS),$(wildcard $(d)*.h)
 
 firmware: $(BUILD)/firmware.hex size
 
+# The core's objects follow this file's flags (TWI_BUFFER_LENGTH ...).
+$(CORE_OBJ): mk/build.mk
+
 $(BUILD)/avr/arduino/%.c.o: $(ARDUINO_AVR)/%.c
 	@mkdir -p $(dir $@)
 	$(Q)$(AVR_CC) $(AVR_CFLAGS) $(AVR_INC) -w -c $< -o $@

@@ -19,11 +19,14 @@ Settings defaults() {
 }
 
 // CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF): check value 0x29B1 for "123456789".
+// A byte at once, not a bit: x is the top byte's feedback, and 0x1021 = 2^12 + 2^5 + 1
+// makes the shifted copies of x (x ^= x >> 4 folds in the feedback of x's own high
+// nibble). The same CRC as eight bit steps, several times faster on the AVR (a `save`
+// takes two CRCs of the record in one loop iteration).
 uint16_t crc16_update(uint16_t crc, uint8_t byte) {
-    crc = (uint16_t)(crc ^ (uint16_t)((uint16_t)byte << 8));
-    for (uint8_t b = 0; b < 8; ++b)
-        crc = (crc & 0x8000u) ? (uint16_t)((uint16_t)(crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
-    return crc;
+    uint8_t x = (uint8_t)((crc >> 8) ^ byte);
+    x = (uint8_t)(x ^ (x >> 4));
+    return (uint16_t)((uint16_t)(crc << 8) ^ (uint16_t)((uint16_t)x << 12) ^ (uint16_t)((uint16_t)x << 5) ^ x);
 }
 
 uint16_t crc16(const uint8_t* data, uint16_t len) {
@@ -51,8 +54,13 @@ uint8_t record_byte(const Settings& s, uint8_t i) {
         case 8: return (uint8_t)(s.flags & ~kFlagUpgraded);
         default: break;
     }
-    if (i < kFlightOffset) return ((const uint8_t*)&s.cal)[i - 9u];
-    return params::flight_byte(s, (uint8_t)(i - kFlightOffset));
+    return ((const uint8_t*)&s.cal)[i - 9u];
+}
+
+void record_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out) {
+    uint8_t i = from;
+    for (; i < kFlightOffset && (uint8_t)(i - from) < n; ++i) out[i - from] = record_byte(s, i);
+    if ((uint8_t)(i - from) < n) params::flight_part(s, (uint8_t)(i - kFlightOffset), (uint8_t)(n - (i - from)), out + (i - from));
 }
 
 void encode(const Settings& s, uint8_t out[kRecordSize]) {

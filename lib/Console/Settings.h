@@ -79,9 +79,11 @@ constexpr uint16_t kCrc16Init = 0xFFFFu;
 uint16_t crc16_update(uint16_t crc, uint8_t byte);
 // Where the flight settings start in the record.
 constexpr uint8_t kFlightOffset = 4 + kV2PayloadLength;
-// Byte i of encode(s)'s record, for i < 4 + kPayloadLength (all but the record's CRC):
-// a record written a byte at a time needs no copy of it.
+// Byte i of encode(s)'s record, for i < kFlightOffset (the header and calibration).
 uint8_t record_byte(const Settings& s, uint8_t i);
+// Bytes from..from+n-1 of encode(s)'s record, within 4 + kPayloadLength (all but the
+// record's CRC): a record written a part at a time needs no copy of it.
+void record_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out);
 
 void encode(const Settings& s, uint8_t out[kRecordSize]);
 // On anything but Ok, `out` is set to defaults(): never garbage.

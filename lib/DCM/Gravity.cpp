@@ -140,7 +140,8 @@ void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_
                          : settings.kp_rp_1_s;
     // kp error in units: the error in 16 bits (Q14: steps of 6e-5 rad, 0.003 deg of tilt)
     // times the gain in units per rad/s.
-    const int32_t kp_units = startup_left > 0.0f ? fixed_from_float(kp * k.units_per_rad_s, 0) : k.kp_units;
+    // (Start-up only: the ordinary call.)
+    const int32_t kp_units = startup_left > 0.0f ? linalg::fixed_from_float(kp * k.units_per_rad_s, 0) : k.kp_units;
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
@@ -149,7 +150,8 @@ void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
     // with it ((e_n, e_e, 0) x lp, scaled).
-    const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt_s(settings), linalg::kQ30) : k.tilt_turn_q30;
+    const int32_t turn =
+        startup_left > 0.0f ? linalg::fixed_from_float(kp * correction_dt_s(settings), linalg::kQ30) : k.tilt_turn_q30;
     const int32_t turn_n = mul_q14(q14_of(n), turn), turn_e = mul_q14(q14_of(e), turn);
     const Vector3l old = lp_ef_;
     lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),

@@ -255,11 +255,7 @@ void each_flight_value(const Settings& s, F f) {
 // The AVR and every host this builds on are little-endian: a value's bytes are its
 // record bytes.
 void encode_flight(const Settings& s, uint8_t out[settings::kFlightBytes]) {
-    uint16_t at = 0;
-    each_flight_value(s, [&](uint8_t* p, uint8_t n) {
-        if (at + n <= settings::kFlightBytes) memcpy(out + at, p, n);
-        at = (uint16_t)(at + n);
-    });
+    flight_part(s, 0, settings::kFlightBytes, out);
 }
 
 void decode_flight(const uint8_t in[settings::kFlightBytes], Settings& s) {
@@ -270,14 +266,16 @@ void decode_flight(const uint8_t in[settings::kFlightBytes], Settings& s) {
     });
 }
 
-uint8_t flight_byte(const Settings& s, uint8_t offset) {
+void flight_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out) {
     uint16_t at = 0;
-    uint8_t byte = 0;
-    each_flight_value(s, [&](uint8_t* p, uint8_t n) {
-        if (offset >= at && offset < at + n) byte = p[offset - at];
-        at = (uint16_t)(at + n);
+    const uint16_t to = (uint16_t)(from + n);
+    each_flight_value(s, [&](uint8_t* p, uint8_t len) {
+        for (uint8_t j = 0; j < len; ++j) {
+            const uint16_t k = (uint16_t)(at + j);
+            if (k >= from && k < to) out[k - from] = p[j];
+        }
+        at = (uint16_t)(at + len);
     });
-    return byte;
 }
 
 uint16_t flight_bytes() {

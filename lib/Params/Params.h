@@ -56,8 +56,8 @@ void apply_defaults(settings::Settings& s);
 // row's eight bits as one byte: settings::kFlightBytes bytes. A new row changes the
 // record: it needs a new record version.
 void encode_flight(const settings::Settings& s, uint8_t out[settings::kFlightBytes]);
-// Byte `offset` (< kFlightBytes) of what encode_flight writes.
-uint8_t flight_byte(const settings::Settings& s, uint8_t offset);
+// Bytes from..from+n-1 (within kFlightBytes) of what encode_flight writes.
+void flight_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* out);
 void decode_flight(const uint8_t in[settings::kFlightBytes], settings::Settings& s);
 // What encode_flight writes (a test holds it to settings::kFlightBytes).
 uint16_t flight_bytes();
