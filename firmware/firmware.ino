@@ -180,6 +180,7 @@ static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample
 // 2.5 V is no sensor. Then the mean of each kAirspeedReadings readings is the airspeed.
 enum class AirspeedState : uint8_t { kZero, kSensor, kNone };
 constexpr uint8_t kAirspeedReadings = 8;
+constexpr int16_t kAirspeedIdleThrottle = 100;  // tenths of a percent: 10 % of the stick
 static AirspeedState airspeed_state = AirspeedState::kZero;
 static bool airspeed_started = false;
 static uint16_t airspeed_zero = 0;
@@ -193,7 +194,19 @@ static void airspeed_begin() {
 }
 
 static void airspeed_step() {
-    if (airspeed_state == AirspeedState::kNone || (ADCSRA & _BV(ADSC))) return;
+    if (airspeed_state == AirspeedState::kNone) {
+        // No sensor: the configured cruise speed (TRIM_ARSPD_CM), only while the receiver's
+        // throttle is above idle (on the ground, or gliding, the velocity is not the cruise's).
+        const flight::FlightSettings& fs = pipe.settings().flight;
+        if (fs.trim_arspd_cm == 0u || pipe.steps() % kAirspeedReadings != 0u) return;
+        const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
+        const bool powered = flight_control.state() != flight::State::NoSignal && ch < flight::kChannels &&
+                             flight::width_to_throttle(flight_control.rc_us()[ch], fs.rc[ch],
+                                                       (fs.rc_reversed >> ch) & 1u) > kAirspeedIdleThrottle;
+        pipe.set_airspeed_m_s(powered ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
+        return;
+    }
+    if (ADCSRA & _BV(ADSC)) return;
     const uint16_t counts = ADC;
     ADCSRA |= _BV(ADSC);
     if (!airspeed_started) {  // the first conversion is the ADC's longer first one: not used

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "Airspeed.h"
+#include "Params.h"
 #include "Pipeline.h"
 
 namespace {
@@ -119,6 +120,27 @@ TEST(AirspeedSensor, CountsToAirspeedWithTheMeasuredZero) {
     EXPECT_NEAR(airspeed::airspeed_m_s(8u * counts_at(18.0f), 8, zero), 18.0f, 0.3f);
     EXPECT_NEAR(airspeed::airspeed_m_s(8u * counts_at(40.0f), 8, zero), 40.0f, 0.2f);
     EXPECT_FLOAT_EQ(airspeed::airspeed_m_s(0u, 0, zero), 0.0f);
+}
+
+}  // namespace
+
+namespace {
+
+// The cruise speed of a board without a sensor (TRIM_ARSPD_CM): off by default, in cm/s
+// within ArduPlane's 0..5000, kept by the settings record.
+TEST(AirspeedSensor, TrimAirspeedParameterDefaultsOffAndRoundTrips) {
+    settings::Settings s = settings::defaults();
+    const int16_t p = params::find("TRIM_ARSPD_CM");
+    ASSERT_GE(p, 0);
+    EXPECT_EQ(s.flight.trim_arspd_cm, 0u);
+    EXPECT_FALSE(params::set(s, (uint16_t)p, 5001.0f));
+    EXPECT_FALSE(params::set(s, (uint16_t)p, -1.0f));
+    EXPECT_TRUE(params::set(s, (uint16_t)p, 1800.0f));
+    uint8_t bytes[settings::kFlightBytes];
+    params::encode_flight(s, bytes);
+    settings::Settings back = settings::defaults();
+    params::decode_flight(bytes, back);
+    EXPECT_EQ(back.flight.trim_arspd_cm, 1800u);
 }
 
 }  // namespace
