@@ -22,6 +22,7 @@
 #include <SPI.h>
 #include <Wire.h>
 
+#include "Airspeed.h"
 #include "ArduinoCore.h"
 #include "Board.h"
 #include "Compass.h"
@@ -172,6 +173,62 @@ static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample
     say_flight_events();
 }
 
+// The airspeed sensor on A0 (lib/Pipeline/Airspeed.h), for the estimator's centripetal
+// correction. Never blocking: each step reads the conversion the previous step started
+// (13 ADC clocks at 125 kHz, long done 5 ms later) and starts the next. While the gyro
+// calibrates (the board still) the readings are the sensor's zero; a zero far from
+// 2.5 V is no sensor. Then the mean of each kAirspeedReadings readings is the airspeed.
+enum class AirspeedState : uint8_t { kZero, kSensor, kNone };
+constexpr uint8_t kAirspeedReadings = 8;
+constexpr int16_t kAirspeedIdleThrottle = 100;  // tenths of a percent: 10 % of the stick
+static AirspeedState airspeed_state = AirspeedState::kZero;
+static bool airspeed_started = false;
+static uint16_t airspeed_zero = 0;
+static uint16_t airspeed_n = 0;
+static uint32_t airspeed_sum = 0;
+
+static void airspeed_begin() {
+    ADMUX = _BV(REFS0);  // AVcc reference, channel 0 (MUX5 in ADCSRB clear)
+    ADCSRB &= (uint8_t)~_BV(MUX5);
+    ADCSRA |= _BV(ADEN) | _BV(ADSC);
+}
+
+static void airspeed_step() {
+    if (airspeed_state == AirspeedState::kNone) {
+        // No sensor: the configured cruise speed (TRIM_ARSPD_CM), only while the receiver's
+        // throttle is above idle (on the ground, or gliding, the velocity is not the cruise's).
+        const flight::FlightSettings& fs = pipe.settings().flight;
+        if (fs.trim_arspd_cm == 0u || pipe.steps() % kAirspeedReadings != 0u) return;
+        const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
+        const bool powered = flight_control.state() != flight::State::NoSignal && ch < flight::kChannels &&
+                             flight::width_to_throttle(flight_control.rc_us()[ch], fs.rc[ch],
+                                                       (fs.rc_reversed >> ch) & 1u) > kAirspeedIdleThrottle;
+        pipe.set_airspeed_m_s(powered ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
+        return;
+    }
+    if (ADCSRA & _BV(ADSC)) return;
+    const uint16_t counts = ADC;
+    ADCSRA |= _BV(ADSC);
+    if (!airspeed_started) {  // the first conversion is the ADC's longer first one: not used
+        airspeed_started = true;
+        return;
+    }
+    airspeed_sum += counts;
+    ++airspeed_n;
+    if (airspeed_state == AirspeedState::kZero) {
+        if (pipe.phase() != pipeline::Phase::Running || airspeed_n < kAirspeedReadings) return;
+        airspeed_zero = (uint16_t)(airspeed_sum / airspeed_n);
+        airspeed_state = airspeed::present(airspeed_zero) ? AirspeedState::kSensor : AirspeedState::kNone;
+        if (airspeed_state == AirspeedState::kNone) say(TXT("# airspeed: no sensor on A0"));
+    } else if (airspeed_n >= kAirspeedReadings) {
+        pipe.set_airspeed_m_s(airspeed::airspeed_m_s(airspeed_sum, (uint8_t)airspeed_n, airspeed_zero));
+    } else {
+        return;
+    }
+    airspeed_sum = 0;
+    airspeed_n = 0;
+}
+
 // `status`, a line (a part: console::kPartReply) at a time: false past the last part.
 // Parts 2 and 3 are the pipeline's gyro bias and compass lines, the long ones to format
 // (print_bias formats both, seven numbers from floats, for each).
@@ -196,7 +253,12 @@ static bool print_status(uint8_t part) {
             char buf[14];
             w.str(TXT("# load ")).u32(load_pct).str(TXT("%, overruns ")).u32(imu.missed_samples())
                 .str(TXT(", spikes ")).u32(pipe.spikes()).str(TXT(", uptime "))
-                .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s")).end();
+                .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s, airspeed "));
+            if (airspeed_state == AirspeedState::kSensor)
+                w.str(buf, text::format_centi(buf, (int32_t)(pipe.airspeed_m_s() * 100.0f))).str(TXT(" m/s"));
+            else
+                w.str(airspeed_state == AirspeedState::kNone ? TXT("none") : TXT("zeroing"));
+            w.end();
             return true;
         }
         case kStatusBiasPart: print_bias_line(0); return true;
@@ -427,6 +489,7 @@ static void step(uint32_t now_us) {
         board::mark_begin(board::kSecEstimator);
         pipe.on_imu_sample(sample);
         board::mark_end(board::kSecEstimator);
+        airspeed_step();
         take_console_input();
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
         pipeline::AnglesCentideg c;
@@ -469,6 +532,7 @@ void setup() {
     flight_control.step(0, flight::Attitude{0, 0, 0, 0, false}, widths);
     servo_outputs::begin(widths);
     rc_input::begin();
+    airspeed_begin();
     print_settings_line();
     if (pipe.settings().flags & settings::kFlagUpgraded) {
         pipe.settings().flags = (uint8_t)(pipe.settings().flags & ~settings::kFlagUpgraded);

@@ -34,7 +34,7 @@ constexpr uint8_t kMagic1 = 'T';
 // 3: the flight settings (issue 21).
 constexpr uint8_t kSettingsVersion = 3;
 constexpr uint8_t kV2PayloadLength = 65;  // rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
-constexpr uint8_t kFlightBytes = 164;     // params::encode_flight (checked by params' tests)
+constexpr uint8_t kFlightBytes = 166;     // params::encode_flight (checked by params' tests)
 constexpr uint8_t kPayloadLength = kV2PayloadLength + kFlightBytes;
 constexpr uint8_t kRecordSize = 4 + kPayloadLength + 2;
 constexpr uint16_t kEepromAddress = 0;

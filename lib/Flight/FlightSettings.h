@@ -47,6 +47,8 @@ struct FlightSettings {
     uint8_t thr_fs_pct;         // THR_FS_OUT: throttle output in failsafe, percent
     uint8_t arspd_min_m_s;      // ARSPD_FBW_MIN: the airspeed assumed (no sensor) is the mean of
     uint8_t arspd_max_m_s;      // ARSPD_FBW_MAX:   these two, for the turn coordination
+    uint16_t trim_arspd_cm;     // TRIM_ARSPD_CM: cruise airspeed, cm/s, for the estimator's centripetal
+                                //   correction on a board without an airspeed sensor (0: none)
     uint8_t fltmode_ch;         // FLTMODE_CH: the mode switch's channel, 1..8 (0: none)
     uint8_t fltmode[6];         // FLTMODE1..6: Mode of each switch position (ArduPlane's six bands)
     uint8_t rcmap[4];           // RCMAP_ROLL, _PITCH, _THROTTLE, _YAW: channel numbers 1..8

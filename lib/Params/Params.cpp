@@ -61,6 +61,7 @@ const Row kRows[] PARAM_TABLE = {
     {"THR_FS_OUT", Type::UInt8, 0, 1, 0, AT(flight.thr_fs_pct), 0.0f, 100.0f, 0.0f},
     {"ARSPD_FBW_MIN", Type::UInt8, 0, 1, 0, AT(flight.arspd_min_m_s), 5.0f, 50.0f, 9.0f},
     {"ARSPD_FBW_MAX", Type::UInt8, 0, 1, 0, AT(flight.arspd_max_m_s), 5.0f, 50.0f, 22.0f},
+    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 0.0f},
     {"FLTMODE_CH", Type::UInt8, 0, 1, 0, AT(flight.fltmode_ch), 0.0f, 8.0f, 8.0f},
     {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 2.0f, 0.0f},
     {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 2.0f, 2.0f},

@@ -39,6 +39,37 @@ uint32_t norm2(const linalg::Vector3i& v) {
 }
 }  // namespace
 
+// An int32 into int16's range.
+static int16_t sat16(int32_t v) { return v > 32767 ? 32767 : v < -32767 ? -32767 : (int16_t)v; }
+
+int16_t centripetal_gain_q8(float airspeed_m_s) {
+    if (!(airspeed_m_s >= kCentripetalMinAirspeed_m_s)) return 0;  // NaN too
+    const float v = airspeed_m_s < kCentripetalMaxAirspeed_m_s ? airspeed_m_s : kCentripetalMaxAirspeed_m_s;
+    return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
+}
+
+linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8) {
+    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V.
+    return linalg::Vector3i(a.x, sat16((int32_t)a.y - (linalg::mul_s16(gyro_z, gain_q8) >> 8)),
+                            sat16((int32_t)a.z + (linalg::mul_s16(gyro_y, gain_q8) >> 8)));
+}
+
+// A rate in gyro counts, rounded and clamped (NaN: 0).
+static int16_t gyro_counts_of(float rate_rad_s) {
+    const float c = rate_rad_s / kGyroCount_rad_s;
+    if (!(c > -32767.0f)) return c < 0.0f ? -32767 : 0;
+    return c >= 32767.0f ? 32767 : (int16_t)(c < 0.0f ? c - 0.5f : c + 0.5f);
+}
+
+void AttitudePipeline::set_airspeed_m_s(float airspeed_m_s) {
+    airspeed_m_s_ = airspeed_m_s;
+    centripetal_gain_q8_ = centripetal_gain_q8(airspeed_m_s);
+    // The calibrated bias in counts (the estimator's own residual is left: a fraction of
+    // a deg/s, a few tenths of a m/s^2 at cruise).
+    gyro_bias_y_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.y);
+    gyro_bias_z_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.z);
+}
+
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
     // Events held back go out first, in deferred()'s line, which counts this one too.
     if (ever && (now - last < interval || held != 0)) {
@@ -328,7 +359,16 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         st_.output_due = true;
     }
     const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
-    dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
+    if (centripetal_gain_q8_ != 0) {
+        // Gravity for the DCM: the turn's centripetal acceleration taken off (see
+        // kCentripetalMinAirspeed_m_s); the clip checks above saw the measured sample.
+        const linalg::Vector3i accel = centripetal_corrected(
+            s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_), sat16((int32_t)s.gyro.z - gyro_bias_z_counts_),
+            centripetal_gain_q8_);
+        dcm_.update(s.gyro, accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
+    } else {
+        dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
+    }
     // The board's turn for the compass learner: the gyro alone (the biases come off when
     // a field sample takes it).
     turn_counts_ += s.gyro;

@@ -86,6 +86,24 @@ constexpr float kMagMax_uT = 200.0f;
 // learn the field again, before the shift can get a good field rejected.
 constexpr float kMagReferenceShift_uT = 2.5f;
 
+// The centripetal correction (Premerlani & Bizard, "Direction Cosine Matrix IMU: Theory",
+// eq. 26; ArduPilot's AP_AHRS_DCM with an airspeed): in steady flight the velocity is
+// (V, 0, 0) along the body's x axis and the accelerometer reads f = omega x v - g_body,
+// so gravity is f - omega x v = f - (0, omega_z V, -omega_y V). Below this airspeed the
+// velocity is not along x (on the ground, a launch, a stall): no correction. ArduPlane's
+// ARSPD_FBW_MIN default, about two thirds of a small aeroplane's stall.
+constexpr float kCentripetalMinAirspeed_m_s = 9.0f;
+// Above the MPXV7002DP's full scale (2 kPa: 57 m/s) an airspeed is a fault: clamped.
+constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
+
+// The correction's gain: accel counts per gyro count of omega x v at this airspeed, Q8
+// (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum).
+int16_t centripetal_gain_q8(float airspeed_m_s);
+// f - omega x v in the MPU6000's counts, gyro_counts less the sensor bias; each axis
+// saturates at +-32767.
+linalg::Vector3i centripetal_corrected(const linalg::Vector3i& accel_counts, int16_t gyro_y_counts,
+                                       int16_t gyro_z_counts, int16_t gain_q8);
+
 enum class Phase : uint8_t {
     WaitImu,      // no sample yet
     Calibrating,  // measuring the gyro bias; nothing estimated yet
@@ -133,6 +151,11 @@ public:
     // Whether a magnetometer is delivering. false: yaw is gyro-only, heading not corrected.
     void set_mag_present(bool present);
     bool mag_present() const { return st_.mag_present; }
+
+    // The airspeed along the body's x axis (m/s; 0: none, no correction) for the
+    // centripetal correction of the accelerometer: holds until set again.
+    void set_airspeed_m_s(float airspeed_m_s);
+    float airspeed_m_s() const { return airspeed_m_s_; }
 
     // One MPU6000 sample at the fixed 200 Hz step.
     void on_imu_sample(const mpu6000::Sample& s);
@@ -210,6 +233,10 @@ private:
     linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
+    float airspeed_m_s_ = 0.0f;
+    int16_t centripetal_gain_q8_ = 0;     // 0: no correction
+    int16_t gyro_bias_y_counts_ = 0;      // the calibrated bias the gyro counts carry
+    int16_t gyro_bias_z_counts_ = 0;
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
     // clears it in one loop instead of a store per member (~250 B of AVR flash).
