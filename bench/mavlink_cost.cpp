@@ -10,7 +10,7 @@
 //   section 3  SYS_STATUS            (1 Hz)
 //   section 4  a 30-character "# " line through StatusText (one STATUSTEXT)
 //   section 5  a 70-character "# error:" line (two chunks)
-//   section 7  FrameFilter over one 21-byte HEARTBEAT frame from a GCS
+//   section 7  Parser over one 21-byte HEARTBEAT frame from a GCS (CRC-checked)
 //   section 6  the whole run
 #include <avr/io.h>
 #include <stdint.h>
@@ -42,18 +42,18 @@ int main() {
 #ifndef MAV_COST_EMPTY
     mav::Packer packer;
     mav::StatusText text(packer, mav::FrameSink{nullptr, &sink});
-    mav::FrameFilter filter;
+    mav::Parser filter;
     uint8_t frame[mav::kMaxFrame];
     uint8_t gcs[mav::kMaxFrame];
     mav::Packer gcs_packer;
-    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active);
+    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active, mav::PlaneMode::Manual);
     static const char kShort[] = "# mode mavlink: MAVLink 2 now\n";
     static const char kLong[] = "# error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68), retrying each s\n";
 #endif
     for (uint8_t k = 0; k < 20; ++k) {
 #ifndef MAV_COST_EMPTY
         begin(1);
-        uint8_t n = packer.heartbeat(frame, mav::State::Active);
+        uint8_t n = packer.heartbeat(frame, mav::State::Active, mav::PlaneMode::Stabilize);
         end(1);
         sink(nullptr, frame, n);
         begin(2);
@@ -73,6 +73,7 @@ int main() {
         end(5);
         begin(7);
         for (uint8_t i = 0; i < gcs_len; ++i) g_sink = filter.consume(gcs[i]);
+        filter.release();
         end(7);
 #else
         begin(1);
