@@ -427,6 +427,7 @@ static void run_console_command() {
 // them (~37 bytes each, ~3 ms at 115200 baud).
 
 mav::ParamReplies param_replies;
+static bool save_due = false;  // a PARAM_SET changed a value: save (start_save) when there is time
 constexpr uint16_t kStreamPeriodMs = 200;  // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
 static uint32_t last_stream_ms = 0;
 
@@ -446,9 +447,14 @@ static void take_gcs_heartbeat() {
     if (!mavlink_mode()) mavlink_input.release();
 }
 
-static bool gcs_can_send(uint8_t frame_bytes) {
-    return serial_text::room() >= frame_bytes + output_line_bytes() &&
-           imu.us_since_sample(micros()) <= latest_start_us(false);
+// A piece of the link's work starts only when it fits the queue and ends before the next
+// sample is late (7.5 ms after the last): what each costs at most (apm25sim --profile,
+// sections 14 and 15: README "Performance") with a margin.
+constexpr uint32_t kGcsRequestLatestUs = 3000;  // a request: a name looked up, a command run
+constexpr uint32_t kGcsReplyLatestUs = 4000;    // a PARAM_VALUE, or the RC + servo pair
+constexpr uint32_t kGcsSaveLatestUs = 1500;     // SettingsStore::start_save (the record encoded)
+static bool gcs_can_send(uint8_t frame_bytes, uint32_t latest_us) {
+    return serial_text::room() >= frame_bytes + output_line_bytes() && imu.us_since_sample(micros()) <= latest_us;
 }
 
 static void send_frame(const uint8_t* frame, uint8_t n) {
@@ -506,8 +512,8 @@ static void take_gcs_request(const mav::Received& rx) {
         const int16_t index = mav::apply_param_set(pipe.settings(), set, changed);
         if (index >= 0) param_replies.request_one((uint16_t)index);
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
-        // settings before it whole until the new ones are).
-        if (changed) store.start_save(pipe.settings());
+        // settings before it whole until the new ones are), in a pass of its own.
+        if (changed) save_due = true;
     } else if (mav::decode_command_long(rx, cmd)) {
         const mav::Result r = run_command(cmd);
         uint8_t frame[mav::kMaxFrame];
@@ -519,15 +525,20 @@ static void answer_ground_station(uint32_t now_ms) {
     if (!mavlink_mode()) return;
     uint8_t frame[mav::kMaxFrame];
     // A request: room for its ACK (and the "# " lines a save or calibration says).
-    if (mavlink_input.ready() && gcs_can_send(2u * mav::kMaxFrame)) {
+    if (mavlink_input.ready() && gcs_can_send(2u * mav::kMaxFrame, kGcsRequestLatestUs)) {
         board::mark_begin(board::kSecGcsRequest);
         take_gcs_request(mavlink_input.frame());
         mavlink_input.release();
         board::mark_end(board::kSecGcsRequest);
         return;
     }
+    if (save_due && gcs_can_send(2u * mav::kMaxFrame, kGcsSaveLatestUs)) {
+        save_due = false;
+        store.start_save(pipe.settings());
+        return;
+    }
     uint16_t index;
-    if (param_replies.peek(index) && gcs_can_send(mav::kParamValueFrame)) {
+    if (param_replies.peek(index) && gcs_can_send(mav::kParamValueFrame, kGcsReplyLatestUs)) {
         board::mark_begin(board::kSecGcsReply);
         const uint8_t n = mav::pack_param_value(mavlink, frame, pipe.settings(), index);
         board::mark_end(board::kSecGcsReply);
@@ -535,7 +546,7 @@ static void answer_ground_station(uint32_t now_ms) {
         param_replies.pop();
         return;
     }
-    if (now_ms - last_stream_ms >= kStreamPeriodMs && gcs_can_send(2u * mav::kRcChannelsFrame)) {
+    if (now_ms - last_stream_ms >= kStreamPeriodMs && gcs_can_send(2u * mav::kRcChannelsFrame, kGcsReplyLatestUs)) {
         last_stream_ms = now_ms;
         board::mark_begin(board::kSecGcsReply);
         const bool signal = flight_control.state() != flight::State::NoSignal &&

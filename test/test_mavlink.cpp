@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <stdint.h>
+#include <ctype.h>
 #include <string.h>
 
 #include <algorithm>
@@ -649,6 +650,20 @@ TEST(ParamLink, ReadByIndexOrName) {
     EXPECT_EQ(mav::requested_index(r), params::find("COMPASS_DEC"));
     strcpy(r.name, "NO_SUCH_PARAM");
     EXPECT_EQ(mav::requested_index(r), -1);
+    // params::find's one pass over the rows: every name, in either case, and near misses.
+    for (uint16_t i = 0; i < params::count(); ++i) {
+        params::Info in;
+        ASSERT_TRUE(params::info(i, in));
+        strcpy(r.name, in.name);
+        EXPECT_EQ(mav::requested_index(r), (int16_t)i) << in.name;
+        for (char* c = r.name; *c; ++c) *c = (char)tolower(*c);
+        EXPECT_EQ(mav::requested_index(r), (int16_t)i) << r.name;
+    }
+    for (const char* miss : {"RC0_MIN", "RC9_MIN", "RC#_MIN", "RC1_MI", "RC1_MINX", "SERVO10_MIN", "FLTMODE7",
+                             "FLTMODE0", "FLTMODE", "", "RLL2SRV_PX", "RLL2SRV_"}) {
+        strcpy(r.name, miss);
+        EXPECT_EQ(mav::requested_index(r), -1) << miss;
+    }
 }
 
 TEST(ParamLink, SetAppliesInRangeAndKeepsTheOldValueOtherwise) {

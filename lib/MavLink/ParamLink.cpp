@@ -16,9 +16,10 @@ uint8_t param_type(params::Type t) {
 }
 
 uint8_t pack_param_value(Packer& packer, uint8_t out[kMaxFrame], const settings::Settings& s, uint16_t index) {
+    static const uint16_t count = params::count();  // a walk over the table: once
     params::Info in;
     if (!params::info(index, in)) return 0;
-    return packer.param_value(out, in.name, params::get(s, index), param_type(in.type), params::count(), index);
+    return packer.param_value(out, in.name, params::get(s, index), param_type(in.type), count, index);
 }
 
 int16_t requested_index(const ParamRequest& r) {
