@@ -7,6 +7,8 @@
 
 #include <stdint.h>
 #include <ctype.h>
+#include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <algorithm>
@@ -734,6 +736,78 @@ TEST(ParamLink, RepliesSinglesFirstThenTheWholeListOnce) {
         ++n;
     }
     EXPECT_EQ(n, (unsigned)mav::ParamReplies::kSingles);
+}
+
+// --- The README's parameter table ---------------------------------------------------------
+
+std::vector<std::string> split_cells(const std::string& line) {
+    std::vector<std::string> cells;
+    size_t at = 1;
+    while (at < line.size()) {
+        const size_t bar = line.find('|', at);
+        if (bar == std::string::npos) break;
+        std::string c = line.substr(at, bar - at);
+        while (!c.empty() && c.front() == ' ') c.erase(c.begin());
+        while (!c.empty() && c.back() == ' ') c.pop_back();
+        cells.push_back(c);
+        at = bar + 1;
+    }
+    return cells;
+}
+
+TEST(MavLink, ReadmeParameterTableIsTheCodes) {
+    std::string path(__FILE__);
+    path = path.substr(0, path.rfind('/')) + "/../README.md";
+    FILE* f = fopen(path.c_str(), "r");
+    ASSERT_NE(f, nullptr) << path;
+    std::vector<std::string> lines;
+    char buf[1024];
+    while (fgets(buf, sizeof buf, f)) {
+        std::string l(buf);
+        while (!l.empty() && (l.back() == '\n' || l.back() == '\r')) l.pop_back();
+        lines.push_back(l);
+    }
+    fclose(f);
+    size_t at = 0;
+    while (at < lines.size() && lines[at] != "#### Parameters") ++at;
+    ASSERT_LT(at, lines.size()) << "no '#### Parameters' heading";
+    while (at < lines.size() && lines[at].rfind("| name | unit | range | default |", 0) != 0) ++at;
+    ASSERT_LT(at, lines.size()) << "no table after it";
+    at += 2;
+    std::vector<int> covered(params::count(), 0);
+    unsigned rows = 0;
+    for (; at < lines.size() && lines[at].rfind("| `", 0) == 0; ++at, ++rows) {
+        const std::vector<std::string> c = split_cells(lines[at]);
+        ASSERT_EQ(c.size(), 5u) << lines[at];
+        const size_t tick = c[0].find('`', 1);
+        ASSERT_NE(tick, std::string::npos) << lines[at];
+        const std::string name = c[0].substr(1, tick - 1);
+        int first = 0, last = 0;
+        const size_t n_at = name.find('n');
+        if (n_at != std::string::npos)
+            ASSERT_EQ(sscanf(c[0].c_str() + tick + 1, " (n %d-%d)", &first, &last), 2) << lines[at];
+        float lo = 0, hi = 0, def = 0;
+        ASSERT_EQ(sscanf(c[2].c_str(), "%f to %f", &lo, &hi), 2) << lines[at];
+        ASSERT_EQ(sscanf(c[3].c_str(), "%f", &def), 1) << lines[at];
+        for (int k = first; k <= last; ++k) {
+            std::string expanded = name;
+            if (n_at != std::string::npos) expanded[n_at] = (char)('0' + k);
+            const int16_t i = params::find(expanded.c_str());
+            ASSERT_GE(i, 0) << expanded << ": not a parameter";
+            ++covered[(size_t)i];
+            params::Info in;
+            ASSERT_TRUE(params::info((uint16_t)i, in));
+            const auto close = [](float a, float b) { return fabsf(a - b) <= 1e-4f * fmaxf(1.0f, fabsf(b)); };
+            EXPECT_TRUE(close(lo, in.min) && close(hi, in.max)) << expanded << " range " << c[2];
+            EXPECT_TRUE(close(def, in.def)) << expanded << " default " << c[3];
+        }
+    }
+    EXPECT_GT(rows, 30u);
+    for (uint16_t i = 0; i < params::count(); ++i) {
+        params::Info in;
+        params::info(i, in);
+        EXPECT_EQ(covered[i], 1) << in.name << " in the README's table " << covered[i] << " times";
+    }
 }
 
 }  // namespace
