@@ -540,7 +540,7 @@ static void answer_ground_station(uint32_t now_ms) {
     uint16_t index;
     if (param_replies.peek(index) && gcs_can_send(mav::kParamValueFrame, kGcsReplyLatestUs)) {
         board::mark_begin(board::kSecGcsReply);
-        const uint8_t n = mav::pack_param_value(mavlink, frame, pipe.settings(), index);
+        const uint8_t n = mav::pack_param_value(mavlink, frame, pipe.settings(), index, param_replies.count());
         board::mark_end(board::kSecGcsReply);
         if (n > 0) send_frame(frame, n);
         param_replies.pop();

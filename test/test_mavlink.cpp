@@ -613,7 +613,7 @@ TEST(ParamLink, EveryIndexPacksItsNameValueTypeAndCount) {
     ASSERT_GT(count, 90u);
     std::vector<std::string> names;
     for (uint16_t i = 0; i < count; ++i) {
-        const uint8_t n = mav::pack_param_value(p, buf, s, i);
+        const uint8_t n = mav::pack_param_value(p, buf, s, i, count);
         ASSERT_EQ(n, mav::kParamValueFrame);
         const Frame f = parse(buf, n, kExtraParamValue);
         ASSERT_TRUE(f.crc_ok);
@@ -636,7 +636,7 @@ TEST(ParamLink, EveryIndexPacksItsNameValueTypeAndCount) {
         }
         names.push_back(name);
     }
-    EXPECT_EQ(mav::pack_param_value(p, buf, s, count), 0u) << "past the end";
+    EXPECT_EQ(mav::pack_param_value(p, buf, s, count, count), 0u) << "past the end";
     std::sort(names.begin(), names.end());
     EXPECT_EQ(std::adjacent_find(names.begin(), names.end()), names.end()) << "a name twice";
 }

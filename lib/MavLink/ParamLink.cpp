@@ -15,8 +15,8 @@ uint8_t param_type(params::Type t) {
     }
 }
 
-uint8_t pack_param_value(Packer& packer, uint8_t out[kMaxFrame], const settings::Settings& s, uint16_t index) {
-    static const uint16_t count = params::count();  // a walk over the table: once
+uint8_t pack_param_value(Packer& packer, uint8_t out[kMaxFrame], const settings::Settings& s, uint16_t index,
+                         uint16_t count) {
     params::Info in;
     if (!params::info(index, in)) return 0;
     return packer.param_value(out, in.name, params::get(s, index), param_type(in.type), count, index);
@@ -36,7 +36,13 @@ int16_t apply_param_set(settings::Settings& s, const ParamSet& p, bool& changed)
     return index;
 }
 
+void ParamReplies::request_all() {
+    count_ = (uint8_t)params::count();
+    next_of_list_ = 0;
+}
+
 void ParamReplies::request_one(uint16_t index) {
+    count_ = (uint8_t)params::count();
     if (single_count_ < kSingles) singles_[single_count_++] = (uint8_t)index;
 }
 
@@ -57,7 +63,7 @@ void ParamReplies::pop() {
     }
     if (next_of_list_ == kNone) return;
     ++next_of_list_;
-    if (next_of_list_ >= params::count()) next_of_list_ = kNone;
+    if (next_of_list_ >= count_) next_of_list_ = kNone;
 }
 
 }  // namespace mav

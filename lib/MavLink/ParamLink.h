@@ -25,8 +25,10 @@ namespace mav {
 // MAV_PARAM_TYPE of a table type.
 uint8_t param_type(params::Type t);
 
-// PARAM_VALUE of parameter `index` (0 past the end).
-uint8_t pack_param_value(Packer& packer, uint8_t out[kMaxFrame], const settings::Settings& s, uint16_t index);
+// PARAM_VALUE of parameter `index` (0 past the end); count: params::count() (a walk over
+// the table: ParamReplies keeps it).
+uint8_t pack_param_value(Packer& packer, uint8_t out[kMaxFrame], const settings::Settings& s, uint16_t index,
+                         uint16_t count);
 
 // The index a PARAM_REQUEST_READ asks for, or -1 (past the end, unknown name).
 int16_t requested_index(const ParamRequest& r);
@@ -41,16 +43,18 @@ int16_t apply_param_set(settings::Settings& s, const ParamSet& p, bool& changed)
 class ParamReplies {
 public:
     static constexpr uint8_t kSingles = 4;
-    void request_all() { next_of_list_ = 0; }
+    void request_all();
     void request_one(uint16_t index);
     // The next index to send; false when none is pending.
     bool peek(uint16_t& index) const;
     void pop();  // the peeked one was sent
+    uint16_t count() const { return count_; }  // params::count(), taken at a request
 
 private:
     uint8_t singles_[kSingles] = {};
     uint8_t single_count_ = 0;
     uint8_t next_of_list_ = kNone;
+    uint8_t count_ = 0;
     static constexpr uint8_t kNone = 0xFF;  // params::count() < 255
 };
 
