@@ -345,10 +345,8 @@ TEST(MavLink, StatustextRejectsMoreThanOneChunk) {
 
 // --- Incoming frames -------------------------------------------------------------------
 
-// A frame as a ground station sends it, built here from the wire format (not by lib/MavLink).
-Bytes frame_v2(uint8_t msgid, uint8_t crc_extra, Bytes payload, uint8_t seq = 7, bool trim = true) {
-    while (trim && payload.size() > 1 && payload.back() == 0) payload.pop_back();  // MAVLink 2 trimming
-    Bytes f = {0xFD, (uint8_t)payload.size(), 0, 0, seq, 255, 190, msgid, 0, 0};
+// header + payload + the CRC over both after STX, then CRC_EXTRA.
+Bytes with_crc(Bytes f, const Bytes& payload, uint8_t crc_extra) {
     f.insert(f.end(), payload.begin(), payload.end());
     uint16_t crc = x25(f.data() + 1, f.size() - 1);
     crc = x25(&crc_extra, 1, crc);
@@ -357,14 +355,14 @@ Bytes frame_v2(uint8_t msgid, uint8_t crc_extra, Bytes payload, uint8_t seq = 7,
     return f;
 }
 
+// A frame as a ground station sends it, built here from the wire format (not by lib/MavLink).
+Bytes frame_v2(uint8_t msgid, uint8_t crc_extra, Bytes payload, uint8_t seq = 7, bool trim = true) {
+    while (trim && payload.size() > 1 && payload.back() == 0) payload.pop_back();  // MAVLink 2 trimming
+    return with_crc(Bytes{0xFD, (uint8_t)payload.size(), 0, 0, seq, 255, 190, msgid, 0, 0}, payload, crc_extra);
+}
+
 Bytes frame_v1(uint8_t msgid, uint8_t crc_extra, const Bytes& payload, uint8_t seq = 3) {
-    Bytes f = {0xFE, (uint8_t)payload.size(), seq, 255, 190, msgid};
-    f.insert(f.end(), payload.begin(), payload.end());
-    uint16_t crc = x25(f.data() + 1, f.size() - 1);
-    crc = x25(&crc_extra, 1, crc);
-    f.push_back((uint8_t)(crc & 0xFF));
-    f.push_back((uint8_t)(crc >> 8));
-    return f;
+    return with_crc(Bytes{0xFE, (uint8_t)payload.size(), seq, 255, 190, msgid}, payload, crc_extra);
 }
 
 void put_f32(Bytes& b, float v) {
