@@ -19,7 +19,7 @@ and must switch to MAVLink by itself). Checks:
   - HEARTBEAT custom_mode follows the mode switch (MANUAL 0, STABILIZE 2) and the failsafe
     (FBWA 5, system_status CRITICAL);
   - RC_CHANNELS equal to the --rc script (within 1 us), no channels while it is dead;
-  - SERVO_OUTPUT_RAW equal to a pulse measured on the pin around it (within 1 us);
+  - SERVO_OUTPUT_RAW equal to a pulse measured on the pin around it (within 1.5 us);
   - no sample missed meanwhile (no "loop overrun" STATUSTEXT).
 Then a second run on the same EEPROM file (a power cycle): the two parameters set come back
 as set; PREFLIGHT_STORAGE defaults, then read, bring the defaults and then them back.
@@ -280,7 +280,9 @@ def check_streams(msgs, servo_log):
             w = getattr(m, "servo%d_raw" % o)
             ts, ws = pulses[o]
             lo, hi = bisect.bisect_left(ts, t - 0.03), bisect.bisect_right(ts, t + 0.05)
-            soft_assert(any(abs(x - 0.5 - w) <= 1.0 for x in ws[lo:hi]),
+            # Within 1.5 us: the pin's measurement (+-0.3 us) and a width that changes by
+            # the receiver's 1 us jitter between two control steps (the newer goes out).
+            soft_assert(any(abs(x - w) <= 1.5 for x in ws[lo:hi]),
                         "SERVO_OUTPUT_RAW at %.3f s: OUT%d %d, pulses around it %r" % (t, o, w, ws[lo:hi]))
         if t > 14.5:
             last_manual_out1.append(m.servo1_raw)
