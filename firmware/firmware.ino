@@ -31,6 +31,7 @@
 #include "Format.h"
 #include "Imu.h"
 #include "MavLink.h"
+#include "ParamLink.h"
 #include "Pipeline.h"
 #include "RcInput.h"
 #include "SerialText.h"
@@ -53,7 +54,7 @@ SettingsStore store(out);
 console::LineReader reader;
 flight::PpmDecoder ppm;
 flight::FlightControl flight_control(pipe.settings().flight);
-mav::FrameFilter mavlink_input;  // a ground station's frames, kept from the console
+mav::Parser mavlink_input;  // a ground station's frames (ground station link, below)
 
 // Loop load: the share of each second spent on samples (measured, shown by `status`).
 uint32_t work_us = 0, window_start_us = 0;
@@ -277,7 +278,11 @@ static void write_frame(void*, const uint8_t* frame, uint8_t len) {
 }
 mav::StatusText status_text(mavlink, mav::FrameSink{nullptr, write_frame});
 
-static bool mavlink_mode() { return pipe.settings().mode == fmt::OutputMode::Mavlink; }
+// A ground station's HEARTBEAT in a text mode switches the port to MAVLink until reset:
+// not a setting (`save` keeps the mode typed), and a typed `mode` ends it.
+static bool gcs_link = false;
+static fmt::OutputMode output_mode() { return gcs_link ? fmt::OutputMode::Mavlink : pipe.settings().mode; }
+static bool mavlink_mode() { return output_mode() == fmt::OutputMode::Mavlink; }
 
 static void send_message(const char* data, uint8_t len) {
     if (mavlink_mode()) status_text.write(data, len);
@@ -313,6 +318,16 @@ static void print_bias_line(uint8_t line) {
     only_line = kAllLines;
 }
 
+// The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode): the failsafe's
+// wings-level glide is ArduPlane's FBWA glide (MavLink.h), STABILIZE without an attitude
+// flies as MANUAL.
+static mav::PlaneMode plane_mode() {
+    if (flight_control.state() == flight::State::Failsafe) return mav::PlaneMode::FlyByWireA;
+    if (flight_control.chosen() == flight::Mode::Stabilize && !flight_control.without_attitude())
+        return mav::PlaneMode::Stabilize;
+    return mav::PlaneMode::Manual;
+}
+
 // HEARTBEAT and SYS_STATUS, once a second in `mode mavlink` (MAVLink's 1 Hz convention:
 // a ground station drops a link after ~3 s without a heartbeat).
 static void send_heartbeat_and_status() {
@@ -323,7 +338,8 @@ static void send_heartbeat_and_status() {
                                  ? mav::State::Calibrating
                                  : mav::State::Active;
     uint8_t frame[mav::kMaxFrame];
-    uint8_t n = mavlink.heartbeat(frame, state);
+    uint8_t n = mavlink.heartbeat(frame, flight_control.state() == flight::State::Failsafe ? mav::State::Critical : state,
+                                  plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = mavlink.sys_status(frame, mav::health(true, imu.ok(), true, compass.ok()), (uint16_t)(load_pct * 10u),
@@ -335,7 +351,7 @@ static void send_heartbeat_and_status() {
 // only when they fit whole: a backlog of replies delays a line, never a sample. True
 // when it worked out the angles in hundredths (c): the control step takes them.
 static bool emit_output(uint32_t now_ms, pipeline::AnglesCentideg& c) {
-    const fmt::OutputMode mode = pipe.settings().mode;
+    const fmt::OutputMode mode = output_mode();
     if (mode == fmt::OutputMode::Quiet) return false;
     // Plot and csv lines print hundredths, which the integer path gives without a float;
     // MAVLink's ATTITUDE carries floats.
@@ -419,7 +435,11 @@ static bool answer(const console::Command& c, uint8_t part) {
                 print_widths(TXT("# servo"), widths);
             }
             break;
-        default:  // rate, decl, mode, set, get
+        case console::CommandId::Mode:
+            gcs_link = false;  // the mode typed, not the ground station's
+            console::apply_setting(c, pipe.settings(), out);
+            break;
+        default:  // rate, decl, set, get
             console::apply_setting(c, pipe.settings(), out);
             if (c.id == console::CommandId::Set) flight_control.configure();
             break;
@@ -429,13 +449,20 @@ static bool answer(const console::Command& c, uint8_t part) {
 
 // Received bytes -> parsed commands, while the command queue has room (when it has none,
 // the bytes wait in Serial's ring).
+static void take_gcs_heartbeat();
 static void take_console_input() {
-    while (!commands.full()) {
+    while (!commands.full() && !mavlink_input.ready()) {
         const int b = Serial.read();
         if (b < 0) return;
         // In `mode mavlink`, a ground station's frames are set aside (not garbage to
-        // answer). Only then: 0xFD/0xFE in garbage would hide the next ~260 bytes.
-        if (mavlink_mode() && mavlink_input.consume((uint8_t)b)) continue;
+        // answer). In a text mode every byte is the console's too (0xFD/0xFE in garbage
+        // would hide the next ~260 bytes), and the parser only looks for a ground
+        // station's HEARTBEAT, which switches to MAVLink.
+        const bool was_mavlink = mavlink_mode();
+        if (mavlink_input.consume((uint8_t)b)) {
+            take_gcs_heartbeat();
+            if (was_mavlink || mavlink_mode()) continue;
+        }
         const console::Command c = reader.feed((uint8_t)b);
         if (c.id != console::CommandId::None) commands.push(c);
     }
@@ -473,6 +500,149 @@ static void run_console_command() {
     } else {
         commands.pop();
         reply_part = 0;
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The ground station link (lib/MavLink: Parser, ParamLink): its requests answered, the
+// radio and servo pages' streams. Replies go through the same queue as everything else,
+// each only when it fits whole with an output line after it and leaves time before the
+// next sample (latest_start_us), so no sample is missed and no frame dropped: a
+// PARAM_REQUEST_LIST's ~100 PARAM_VALUEs go out a few per loop step as the UART drains
+// them (~37 bytes each, ~3 ms at 115200 baud).
+
+mav::ParamReplies param_replies;
+static bool save_due = false;  // a PARAM_SET changed a value: save (start_save) when there is time
+constexpr uint16_t kStreamPeriodMs = 200;  // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
+static uint32_t last_stream_ms = 0;
+
+// Called for every frame end: a ground station's HEARTBEAT switches a text mode to
+// MAVLink; in a text mode the other requests are not answered (the ground station asks
+// again once the board speaks MAVLink).
+static void take_gcs_heartbeat() {
+    if (!mavlink_input.ready()) return;
+    if (mavlink_input.frame().msgid == mav::kMsgHeartbeat) {
+        mavlink_input.release();
+        if (!mavlink_mode()) {
+            gcs_link = true;
+            reader = console::LineReader();  // the frame's bytes so far are no command
+        }
+        return;
+    }
+    if (!mavlink_mode()) mavlink_input.release();
+}
+
+// A piece of the link's work starts only when it fits the queue and ends before the next
+// sample is late (7.5 ms after the last): what each costs at most (apm25sim --profile,
+// sections 14 and 15: README "Performance") with a margin.
+constexpr uint32_t kGcsRequestLatestUs = 3000;  // a request: a name looked up, a command run
+constexpr uint32_t kGcsReplyLatestUs = 4000;    // a PARAM_VALUE, or the RC + servo pair
+constexpr uint32_t kGcsSaveLatestUs = 1500;     // SettingsStore::start_save (the record encoded)
+static bool gcs_can_send(uint8_t frame_bytes, uint32_t latest_us) {
+    return serial_text::room() >= frame_bytes + output_line_bytes() && imu.us_since_sample(micros()) <= latest_us;
+}
+
+static void send_frame(const uint8_t* frame, uint8_t n) {
+    serial_text::write(reinterpret_cast<const char*>(frame), n);
+}
+
+// MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
+// (`cal mag`); the others (baro, accel, airspeed ...) the board does not have.
+// MAV_CMD_PREFLIGHT_STORAGE: param1 0 read (the parameters, lib/Params' table, from
+// EEPROM again; rate, mode and calibration stay as they are), 1 write (`save`), 2
+// defaults (`defaults`, not saved). The result comes as "# " lines.
+static mav::Result run_command(const mav::CommandLong& c) {
+    const float* p = c.param;
+    if (c.command == mav::kCmdPreflightCalibration) {
+        const bool gyro = p[0] == 1.0f, mag = p[1] == 1.0f;
+        for (uint8_t i = 2; i < 7; ++i)
+            if (p[i] != 0.0f) return mav::Result::Unsupported;
+        if (!gyro && !mag) return mav::Result::Unsupported;
+        if (pipe.gyro_calibrating() || pipe.mag_calibrating() || pipe.phase() != pipeline::Phase::Running)
+            return mav::Result::TemporarilyRejected;
+        if (gyro) pipe.start_gyro_calibration();
+        if (mag) pipe.start_mag_calibration();
+        return mav::Result::Accepted;
+    }
+    if (c.command == mav::kCmdPreflightStorage) {
+        if (p[0] == 0.0f) {
+            settings::Settings saved;
+            store.load(saved);
+            pipe.settings().flight = saved.flight;
+            pipe.settings().declination_centideg = saved.declination_centideg;
+        } else if (p[0] == 1.0f) {
+            store.start_save(pipe.settings());
+        } else if (p[0] == 2.0f) {
+            pipe.restore_defaults();
+            console::print_defaults(out);
+        } else {
+            return mav::Result::Unsupported;
+        }
+        return mav::Result::Accepted;
+    }
+    return mav::Result::Unsupported;
+}
+
+static void take_gcs_request(const mav::Received& rx) {
+    mav::ParamRequest read;
+    mav::ParamSet set;
+    mav::CommandLong cmd;
+    if (mav::decode_param_request_list(rx)) {
+        param_replies.request_all();
+    } else if (mav::decode_param_request_read(rx, read)) {
+        const int16_t index = mav::requested_index(read);
+        if (index >= 0) param_replies.request_one((uint16_t)index);
+    } else if (mav::decode_param_set(rx, set)) {
+        bool changed = false;
+        const int16_t index = mav::apply_param_set(pipe.settings(), set, changed);
+        if (index >= 0) param_replies.request_one((uint16_t)index);
+        // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
+        // settings before it whole until the new ones are), in a pass of its own.
+        if (changed) save_due = true;
+    } else if (mav::decode_command_long(rx, cmd)) {
+        const mav::Result r = run_command(cmd);
+        uint8_t frame[mav::kMaxFrame];
+        send_frame(frame, mavlink.command_ack(frame, cmd.command, r, rx.sysid, rx.compid));
+    }
+}
+
+static void answer_ground_station(uint32_t now_ms) {
+    if (!mavlink_mode()) return;
+    uint8_t frame[mav::kMaxFrame];
+    // A request: room for its ACK (and the "# " lines a save or calibration says).
+    if (mavlink_input.ready() && gcs_can_send(2u * mav::kMaxFrame, kGcsRequestLatestUs)) {
+        board::mark_begin(board::kSecGcsRequest);
+        take_gcs_request(mavlink_input.frame());
+        mavlink_input.release();
+        board::mark_end(board::kSecGcsRequest);
+        return;
+    }
+    if (save_due && gcs_can_send(2u * mav::kMaxFrame, kGcsSaveLatestUs)) {
+        save_due = false;
+        store.start_save(pipe.settings());
+        return;
+    }
+    uint16_t index;
+    if (param_replies.peek(index) && gcs_can_send(mav::kParamValueFrame, kGcsReplyLatestUs)) {
+        board::mark_begin(board::kSecGcsReply);
+        const uint8_t n = mav::pack_param_value(mavlink, frame, pipe.settings(), index, param_replies.count());
+        board::mark_end(board::kSecGcsReply);
+        if (n > 0) send_frame(frame, n);
+        param_replies.pop();
+        return;
+    }
+    if (now_ms - last_stream_ms >= kStreamPeriodMs && gcs_can_send(2u * mav::kRcChannelsFrame, kGcsReplyLatestUs)) {
+        last_stream_ms = now_ms;
+        board::mark_begin(board::kSecGcsReply);
+        const bool signal = flight_control.state() != flight::State::NoSignal &&
+                            flight_control.failsafe_cause() != flight::FailsafeCause::Lost;
+        uint8_t n = mavlink.rc_channels(frame, now_ms, flight_control.rc_us(), signal ? flight::kChannels : 0u);
+        send_frame(frame, n);
+        uint16_t widths[flight::kChannels];
+        for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
+        n = mavlink.servo_output_raw(frame, micros(), widths);
+        send_frame(frame, n);
+        board::mark_end(board::kSecGcsReply);
     }
 }
 
@@ -561,6 +731,7 @@ void loop() {
     serial_text::pump();
     take_console_input();
     run_console_command();
+    answer_ground_station(millis());
     store.service();
     const uint32_t now_ms = millis();
     if (imu.retry(now_ms)) pipe.restart_estimator();

@@ -84,5 +84,6 @@ mavlink-cost: $(MAVLINK_STAMP) tools
 	@$(BUILD)/apm25sim --elf $(MAVCOST_DIR)/cost.elf --trajectory $(MAVCOST_DIR)/rest.csv --seconds 0.2 \
 	  --profile $(MAVCOST_DIR)/profile.csv > /dev/null
 	@awk -F, 'BEGIN { n[1]="HEARTBEAT"; n[2]="ATTITUDE"; n[3]="SYS_STATUS"; n[4]="STATUSTEXT, 30-char line"; \
-	  n[5]="STATUSTEXT, 70-char line (2 chunks)"; n[7]="FrameFilter, 21-byte frame" } \
+	  n[5]="STATUSTEXT, 70-char line (2 chunks)"; n[7]="Parser, 21-byte HEARTBEAT frame"; \
+	  n[8]="RC_CHANNELS + SERVO_OUTPUT_RAW"; n[9]="Parser, 35-byte PARAM_SET (bad CRC)" } \
 	  ($$1 in n) { printf "# %-38s %6d cycles avg (min %d, max %d)\n", n[$$1], $$3, $$4, $$5 }' $(MAVCOST_DIR)/profile.csv

@@ -181,12 +181,29 @@ bool info(uint16_t index, Info& out) {
     return true;
 }
 
+// One pass over the rows (a numbered row matched by its prefix, one digit, its suffix),
+// not info() for every index: MAVLink's PARAM_SET and PARAM_REQUEST_READ look names up
+// between samples.
 int16_t find(const char* name) {
-    Info in;
-    for (uint16_t k = 0; info(k, in); ++k) {
-        uint8_t i = 0;
-        while (in.name[i] != '\0' && upper(name[i]) == in.name[i]) ++i;
-        if (in.name[i] == '\0' && name[i] == '\0') return (int16_t)k;
+    Row row;
+    uint16_t index = 0;
+    for (uint8_t r = 0; r < kRowCount; ++r) {
+        COPY_ROW(&row, &kRows[r]);
+        uint8_t i = 0, j = 0;  // row.name, name
+        int16_t instance = 0;
+        bool match = true;
+        while (match && row.name[i] != '\0') {
+            if (row.name[i] == '#') {
+                const char c = name[j++];
+                instance = (int16_t)(c - '0' - (char)row.first);
+                match = c >= '0' && c <= '9' && instance >= 0 && instance < row.count;
+            } else {
+                match = upper(name[j++]) == row.name[i];
+            }
+            ++i;
+        }
+        if (match && name[j] == '\0') return (int16_t)(index + instance);
+        index = (uint16_t)(index + row.count);
     }
     return -1;
 }
