@@ -47,13 +47,13 @@ using text::Writer;
 static void write_message(void*, const char* data, uint8_t len);
 const text::Sink message_sink = {nullptr, write_message};
 const text::Sink* const out = &message_sink;
-pipeline::AttitudePipeline pipe(out);
+pipeline::AttitudePipeline pipe(out, pipeline::AttitudePipeline::SettingsLoadedLater{});
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
 console::LineReader reader;
 flight::PpmDecoder ppm;
-flight::FlightControl flight_control(pipe.settings().flight);
+flight::FlightControl flight_control(pipe.settings().flight, flight::FlightControl::ConfiguredLater{});
 mav::Parser mavlink_input;  // a ground station's frames (ground station link, below)
 
 // Loop load: the share of each second spent on samples (measured, shown by `status`).

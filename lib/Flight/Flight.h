@@ -171,6 +171,10 @@ enum class FailsafeCause : uint8_t { None, Lost, Encoder };
 class FlightControl {
 public:
     explicit FlightControl(const FlightSettings& s) : s_(s) { configure(); }
+    // The firmware's static object (no work before init(): AttitudePipeline's
+    // SettingsLoadedLater): setup() calls configure() once the settings are loaded.
+    struct ConfiguredLater {};
+    FlightControl(const FlightSettings& s, ConfiguredLater) : s_(s) {}
 
     // The end points' factors and the gains' terms again: call after any change of the
     // settings.

@@ -90,7 +90,12 @@ uint16_t RateLimiter::deferred(uint32_t now, uint16_t interval) {
 }
 
 AttitudePipeline::AttitudePipeline(const text::Sink* log, const dcm::DcmSettings& dcm_settings)
-    : log_(log), settings_(settings::defaults()), dcm_(dcm_settings), st_() {
+    : AttitudePipeline(log, SettingsLoadedLater{}, dcm_settings) {
+    settings_ = settings::defaults();
+}
+
+AttitudePipeline::AttitudePipeline(const text::Sink* log, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
+    : log_(log), settings_(), dcm_(dcm_settings), st_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f);
 }
 

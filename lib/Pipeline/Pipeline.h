@@ -143,6 +143,12 @@ public:
     // replay tool may try others, `replay --set`).
     explicit AttitudePipeline(const text::Sink* log = nullptr,
                               const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
+    // The firmware's static object: settings zeroed until setup() loads them. A static
+    // constructor runs before Arduino's init() starts millis(), so its work would shift
+    // the firmware's timeline (kMpuStartMs ...) against reset, and replay's with it.
+    struct SettingsLoadedLater {};
+    AttitudePipeline(const text::Sink* log, SettingsLoadedLater,
+                     const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
 
     // Rate, declination, mode and calibration; change them freely (console commands).
     settings::Settings& settings() { return settings_; }

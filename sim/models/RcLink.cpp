@@ -41,6 +41,13 @@ bool width_ok(double w) { return w >= RcScript::kMinWidth_us && w <= RcScript::k
 
 }  // namespace
 
+// The out-of-class definitions C++14 needs for constants passed by reference (std::max).
+constexpr double RcScript::kMinWidth_us;
+constexpr double RcScript::kMaxWidth_us;
+constexpr double PpmEncoder::kFrame_us;
+constexpr double PpmEncoder::kPrePulse_us;
+constexpr double PpmEncoder::kMinSync_us;
+
 bool RcScript::load(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) {
