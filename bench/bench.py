@@ -60,6 +60,8 @@ SECTIONS = [
     (10, "compass", "step part: heading correction", ()),
     (11, "learner", "step part: compass offset learner", ()),
     (14, "magfit", "one part of the cal mag fit (outside the step)", ()),
+    (16, "gcsrequest", "a ground station's MAVLink request handled", ()),
+    (17, "gcsreply", "one PARAM_VALUE, or RC_CHANNELS + SERVO_OUTPUT_RAW, packed", ()),
 ]
 
 # Targets of issue 10 (the 24 KB flash target of issue 5 is dropped: the 2560 has 256 KB):

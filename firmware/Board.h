@@ -40,8 +40,8 @@ enum Section : uint8_t {
     kSecMagRead = 5,
     kSecLoop = 6,       // one loop iteration's work, from data-ready seen to work done
     kSecControl = 13,   // the flight control step (every 4th loop step: 50 Hz, the servo frame)
-    kSecGcsRequest = 14,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
-    kSecGcsReply = 15,    // one PARAM_VALUE, or the RC_CHANNELS + SERVO_OUTPUT_RAW pair, packed
+    kSecGcsRequest = 16,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
+    kSecGcsReply = 17,    // one PARAM_VALUE, or the RC_CHANNELS + SERVO_OUTPUT_RAW pair, packed
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

@@ -462,7 +462,7 @@ TEST(FlightParams, TableIndexNameAndDefaults) {
     EXPECT_EQ(params::find("rc8_reversed"), params::find("RC8_REVERSED"));
     EXPECT_EQ(params::find("RC9_MIN"), -1);
     const settings::Settings s = settings::defaults();
-    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("RLL2SRV_P")), 0.4f);
+    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("RLL2SRV_P")), 1.0f);
     EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("SERVO3_TRIM")), 1500.0f);
     EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("FLTMODE1")), 0.0f);
     EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("FLTMODE6")), 2.0f);
@@ -533,7 +533,7 @@ TEST(FlightParams, RecordVersion3RoundTripsAndVersion2StillLoads) {
     EXPECT_EQ(up.mode, fmt::OutputMode::Csv);
     EXPECT_TRUE(up.cal.mag_offset_uT == old.cal.mag_offset_uT);
     EXPECT_EQ(up.flags, settings::kFlagMagCalibrated | settings::kFlagUpgraded);
-    EXPECT_FLOAT_EQ(up.flight.roll.p, 0.4f) << "flight settings at defaults";
+    EXPECT_FLOAT_EQ(up.flight.roll.p, 1.0f) << "flight settings at defaults";
     // Saved again: version 3, the upgrade flag not stored.
     settings::encode(up, rec);
     ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);

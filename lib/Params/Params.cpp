@@ -38,19 +38,22 @@ constexpr uint8_t kN = flight::kChannels;
 
 // The ranges are ArduPilot's where it documents one (RLL2SRV_TCONST 0.4..1.0, P 0.1..4,
 // I 0..1, D 0..0.2, IMAX 0..4500, PTCH2SRV_RLL 0.7..1.5), widths the PPM decoder's
-// plausible ones. Defaults: ArduPlane 3's (P 0.4, I 0.04, D 0.02, IMAX 3000, TCONST
-// 0.5; LIM_ROLL_CD 4500, LIM_PITCH_MAX/MIN +-2500 as issue 21 asks), end points
-// 1000..2000 around 1500.
+// plausible ones. Defaults: ArduPlane's P (1.0) and D (roll 0.08, pitch 0.04), TCONST 0.5,
+// IMAX 3000; I ArduPlane 3's 0.04, not the 0.3 of its later releases: the integrator
+// trims steady moments, and 0.3 also stores an upset's rate error (a 20 N m roll upset of
+// the simulated Rascal left -15 deg of aileron that banked it 5 deg the other way for
+// 2 s; 0.04: 2.5 deg). LIM_ROLL_CD 4500, LIM_PITCH_MAX/MIN +-2500 as issue 21 asks;
+// end points 1000..2000 around 1500.
 const Row kRows[] PARAM_TABLE = {
     {"RLL2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.roll.tconst_s), 0.4f, 1.0f, 0.5f},
-    {"RLL2SRV_P", Type::Float, 0, 1, 0, AT(flight.roll.p), 0.1f, 4.0f, 0.4f},
+    {"RLL2SRV_P", Type::Float, 0, 1, 0, AT(flight.roll.p), 0.1f, 4.0f, 1.0f},
     {"RLL2SRV_I", Type::Float, 0, 1, 0, AT(flight.roll.i), 0.0f, 1.0f, 0.04f},
-    {"RLL2SRV_D", Type::Float, 0, 1, 0, AT(flight.roll.d), 0.0f, 0.2f, 0.02f},
+    {"RLL2SRV_D", Type::Float, 0, 1, 0, AT(flight.roll.d), 0.0f, 0.2f, 0.08f},
     {"RLL2SRV_IMAX", Type::Int16, 0, 1, 0, AT(flight.roll.imax_cd), 0.0f, 4500.0f, 3000.0f},
     {"PTCH2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.pitch.tconst_s), 0.4f, 1.0f, 0.5f},
-    {"PTCH2SRV_P", Type::Float, 0, 1, 0, AT(flight.pitch.p), 0.1f, 4.0f, 0.4f},
+    {"PTCH2SRV_P", Type::Float, 0, 1, 0, AT(flight.pitch.p), 0.1f, 4.0f, 1.0f},
     {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.04f},
-    {"PTCH2SRV_D", Type::Float, 0, 1, 0, AT(flight.pitch.d), 0.0f, 0.2f, 0.02f},
+    {"PTCH2SRV_D", Type::Float, 0, 1, 0, AT(flight.pitch.d), 0.0f, 0.2f, 0.04f},
     {"PTCH2SRV_IMAX", Type::Int16, 0, 1, 0, AT(flight.pitch.imax_cd), 0.0f, 4500.0f, 3000.0f},
     {"PTCH2SRV_RLL", Type::Float, 0, 1, 0, AT(flight.pitch_roll_ff), 0.7f, 1.5f, 1.0f},
     {"LIM_ROLL_CD", Type::Int16, 0, 1, 0, AT(flight.lim_roll_cd), 0.0f, 9000.0f, 4500.0f},

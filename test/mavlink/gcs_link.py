@@ -83,8 +83,11 @@ class Board:
 
     def __init__(self, tools, work, name, extra):
         self.log = open(os.path.join(work, name + ".stderr"), "w")
+        # The sections' cycles (loop 6, request 16, reply 17), printed at the end: where a
+        # missed sample would come from.
+        self.profile = os.path.join(work, name + ".profile.csv")
         cmd = [os.path.join(tools, "apm25sim"), "--elf", os.path.join(tools, "firmware.elf"),
-               "--serial", "tcp:0", "--speed", "0"] + extra
+               "--serial", "tcp:0", "--speed", "0", "--profile", self.profile] + extra
         self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         line = self.proc.stderr.readline()
         self.log.write(line)
@@ -138,6 +141,14 @@ class Board:
         self.log.write(self.proc.stderr.read())
         self.log.close()
         soft_assert(rc == 0, "apm25sim exited %s" % rc)
+        names = {"1": "estimator step", "6": "loop iteration", "13": "control step", "16": "GCS request",
+                 "17": "GCS reply"}
+        if os.path.exists(self.profile):
+            with open(self.profile) as f:
+                for r in csv.DictReader(f):
+                    if r["section"] in names:
+                        print("%s: %s %s times, cycles avg %s max %s" % (os.path.basename(self.profile),
+                              names[r["section"]], r["count"], r["avg_cycles"], r["max_cycles"]))
 
 
 def command(board, cmd, *params):
