@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Board.h"
 
+#include <avr/sleep.h>
+
 #include <SPI.h>
 #include <Wire.h>
 
@@ -21,6 +23,24 @@ void init_pins() {
     high_output(kPinBaroCs);
     pinMode(kPinMagDrdy, INPUT);
     DDRE &= (uint8_t)~_BV(PE6);  // MPU6000 INT
+}
+
+// Nothing to do in the handler: waking the core is the point; the loop reads the pin.
+static void on_data_ready() {}
+void wake_on_data_ready() { attachInterrupt(6, on_data_ready, RISING); }  // INT6 on the 2560's core
+
+void idle_until_interrupt() {
+    set_sleep_mode(SLEEP_MODE_IDLE);
+    // Checked with interrupts off: an edge after the check sets INTF6, and the interrupt
+    // then wakes the SLEEP that follows SEI (the instruction after SEI always runs first).
+    cli();
+    if (!mpu_int_high()) {
+        sleep_enable();
+        sei();
+        sleep_cpu();
+        sleep_disable();
+    }
+    sei();
 }
 
 void set_leds(bool calibrating, bool running, bool fault) {

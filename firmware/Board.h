@@ -51,6 +51,13 @@ inline bool mpu_int_high() { return (PINE & _BV(PE6)) != 0; }
 inline bool mag_drdy_high() { return (PINC & _BV(PC6)) != 0; }
 inline bool sda_low() { return (PIND & _BV(PD1)) == 0; }
 
+// Idle until an interrupt: the MPU6000's data-ready (INT6, rising edge, enabled by
+// wake_on_data_ready()), timer0's millis() tick (1.024 ms), a UART byte, a receiver edge.
+// Returns at once when the data-ready line is already high. Idle keeps every timer and
+// peripheral running (datasheet 11.1): the servo pulses and the PPM capture go on.
+void wake_on_data_ready();
+void idle_until_interrupt();
+
 // LEDs off, every SPI chip select high (53 before 40, as ArduPilot brought the bus
 // up on APM2) before any SPI traffic, the data-ready lines as inputs.
 void init_pins();

@@ -712,6 +712,7 @@ void setup() {
     board::spi_begin();
     wait_until_ms(pipeline::kMpuStartMs);
     imu.start(millis());
+    board::wake_on_data_ready();  // the loop idles between samples
 
     board::wire_begin();
     if (board::sda_low()) board::i2c_recover();
@@ -752,7 +753,10 @@ void loop() {
         if (const uint16_t n = warn_angle.deferred(millis(), 2000))
             Writer(out).str(TXT(TXT_WARN "output not finite: ")).u32(n).str(TXT(" more lines skipped")).end();
     }
-    if (!imu.sample_ready(now_us)) return;
+    if (!imu.sample_ready(now_us)) {
+        board::idle_until_interrupt();  // until the next sample, a byte, a tick
+        return;
+    }
     step(now_us);
     if (pipe.steps() % 50u == 0u) update_leds();
 }
