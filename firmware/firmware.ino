@@ -513,6 +513,7 @@ static void run_console_command() {
 
 mav::ParamReplies param_replies;
 static bool save_due = false;  // a PARAM_SET changed a value: save (start_save) when there is time
+static bool defaults_said_due = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
 constexpr uint16_t kStreamPeriodMs = 200;  // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
 static uint32_t last_stream_ms = 0;
 
@@ -535,7 +536,7 @@ static void take_gcs_heartbeat() {
 // A piece of the link's work starts only when it fits the queue and ends before the next
 // sample is late (7.5 ms after the last): what each costs at most (apm25sim --profile,
 // sections 14 and 15: README "Performance") with a margin.
-constexpr uint32_t kGcsRequestLatestUs = 3000;  // a request: a name looked up, a command run
+constexpr uint32_t kGcsRequestLatestUs = 2000;  // a request: up to PREFLIGHT_STORAGE defaults' reset
 constexpr uint32_t kGcsReplyLatestUs = 4000;    // a PARAM_VALUE, or the RC + servo pair
 constexpr uint32_t kGcsSaveLatestUs = 1500;     // SettingsStore::start_save (the record encoded)
 static bool gcs_can_send(uint8_t frame_bytes, uint32_t latest_us) {
@@ -548,9 +549,8 @@ static void send_frame(const uint8_t* frame, uint8_t n) {
 
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
 // (`cal mag`); the others (baro, accel, airspeed ...) the board does not have.
-// MAV_CMD_PREFLIGHT_STORAGE: param1 0 read (the parameters, lib/Params' table, from
-// EEPROM again; rate, mode and calibration stay as they are), 1 write (`save`), 2
-// defaults (`defaults`, not saved). The result comes as "# " lines.
+// MAV_CMD_PREFLIGHT_STORAGE: param1 1 write (`save`), 2 defaults (`defaults`, not
+// saved); 0 (read) UNSUPPORTED. The result comes as "# " lines.
 static mav::Result run_command(const mav::CommandLong& c) {
     const float* p = c.param;
     if (c.command == mav::kCmdPreflightCalibration) {
@@ -565,16 +565,13 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdPreflightStorage) {
-        if (p[0] == 0.0f) {
-            settings::Settings saved;
-            store.load(saved);
-            pipe.settings().flight = saved.flight;
-            pipe.settings().declination_centideg = saved.declination_centideg;
-        } else if (p[0] == 1.0f) {
+        // No read (param1 0): both slots read, checked and decoded take longer than a
+        // sample period (README "Ground stations"); a PARAM_SET is saved at once anyway.
+        if (p[0] == 1.0f) {
             store.start_save(pipe.settings());
         } else if (p[0] == 2.0f) {
             pipe.restore_defaults();
-            console::print_defaults(out);
+            defaults_said_due = true;
         } else {
             return mav::Result::Unsupported;
         }
@@ -615,6 +612,11 @@ static void answer_ground_station(uint32_t now_ms) {
         take_gcs_request(mavlink_input.frame());
         mavlink_input.release();
         board::mark_end(board::kSecGcsRequest);
+        return;
+    }
+    if (defaults_said_due && gcs_can_send(2u * mav::kMaxFrame, kGcsRequestLatestUs)) {
+        defaults_said_due = false;
+        console::print_defaults(out);
         return;
     }
     if (save_due && gcs_can_send(2u * mav::kMaxFrame, kGcsSaveLatestUs)) {

@@ -8,7 +8,7 @@ Starts `apm25sim --serial tcp:0 --speed 1` (real time, as SITL) on the tilt tour
 `mavproxy.py --master tcp:127.0.0.1:PORT --no-state --default-modules param,mode`, its
 console driven through stdin as a user types, and checks what it prints:
   - it fetches the whole parameter list ("Received N parameters", N = the board's count);
-  - `param show RLL2SRV_P` prints the default 0.4;
+  - `param show RLL2SRV_P` prints the default 1.0;
   - `param set RLL2SRV_P 0.55` is saved by the board ("AP: saved") and `param show` then
     prints 0.55;
   - the prompt names the mode (MANUAL>, from HEARTBEAT's ArduPlane mode number) and it says
@@ -120,7 +120,7 @@ def main():
         soft_assert(m and int(m.group(1)) > 90, "parameters received: %s" % (m and m.group(1)))
         type_line("param show RLL2SRV_P")
         m = out.wait(r"RLL2SRV_P\s+([-0-9.e]+)", "RLL2SRV_P's value")
-        soft_assert(m and abs(float(m.group(1)) - 0.4) < 1e-6, "RLL2SRV_P %s, default 0.4" % (m and m.group(1)))
+        soft_assert(m and abs(float(m.group(1)) - 1.0) < 1e-6, "RLL2SRV_P %s, default 1.0" % (m and m.group(1)))
         type_line("param set RLL2SRV_P 0.55")
         soft_assert(out.wait(r"AP: saved", "the board's 'saved'"), "param set not saved")
         type_line("param show RLL2SRV_P")
