@@ -16,7 +16,6 @@ time-stamped), once with `mode mavlink` typed at 3 s. Checks, for the MAVLink ru
   - STATUSTEXT for the fault ("HMC5883L", severity error) and its recovery.
 Exit 1 with every failure listed.
 """
-import argparse
 import math
 import os
 import subprocess
@@ -25,6 +24,7 @@ import sys
 from pymavlink.dialects.v20 import common as mavlink2
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from sim_run import scenario_file, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 RATE_HZ = 50
@@ -64,14 +64,8 @@ def angle_diff_rad(a, b):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tools", required=True, help="the build directory (apm25sim, scenario, firmware.elf)")
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    trajectory = os.path.join(args.work, "tilt_tour.csv")
-    with open(trajectory, "wb") as f:
-        subprocess.run([os.path.join(args.tools, "scenario"), "tilt_tour"], stdout=f, check=True)
+    args = tools_and_work()
+    trajectory = scenario_file(args.tools, args.work, "tilt_tour")
 
     reference = csv_angles(run(args.tools, args.work, trajectory, "mode csv"))
     soft_assert(len(reference) > 400, "csv run: %d rows" % len(reference))

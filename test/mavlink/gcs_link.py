@@ -25,7 +25,6 @@ Then a second run on the same EEPROM file (a power cycle): the two parameters se
 as set; PREFLIGHT_STORAGE defaults brings the defaults, read is UNSUPPORTED; no sample missed.
 Exit 1 with every failure listed. Timing assertions are on simulated time only.
 """
-import argparse
 import bisect
 import csv
 import os
@@ -39,6 +38,7 @@ from pymavlink import mavutil
 from pymavlink.dialects.v20 import common as mavlink2
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from sim_run import scenario_file, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 WALL_TIMEOUT_S = 600  # a loaded machine runs simavr many times slower than the board
@@ -339,14 +339,8 @@ def second_session(args, trajectory, eeprom):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tools", required=True, help="the build directory (apm25sim, scenario, firmware.elf)")
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    trajectory = os.path.join(args.work, "tilt_tour.csv")
-    with open(trajectory, "wb") as f:
-        subprocess.run([os.path.join(args.tools, "scenario"), "tilt_tour"], stdout=f, check=True)
+    args = tools_and_work()
+    trajectory = scenario_file(args.tools, args.work, "tilt_tour")
     rc_path = os.path.join(args.work, "rc.csv")
     write_rc(rc_path)
     eeprom = os.path.join(args.work, "eeprom.bin")
