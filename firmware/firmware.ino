@@ -33,6 +33,7 @@
 #include "MavLink.h"
 #include "ParamLink.h"
 #include "Pipeline.h"
+#include "PipelineText.h"
 #include "RcInput.h"
 #include "SerialText.h"
 #include "ServoOutputs.h"
@@ -43,11 +44,13 @@ using text::Flash;
 using text::Writer;
 
 // Every "# " message goes through `out`: to the serial port as text, or, in `mode
-// mavlink`, as STATUSTEXT frames (write_message, below).
+// mavlink`, as STATUSTEXT frames (write_message, below). The pipeline's events are
+// worded there too (lib/Pipeline/PipelineText).
 static void write_message(void*, const char* data, uint8_t len);
 const text::Sink message_sink = {nullptr, write_message};
 const text::Sink* const out = &message_sink;
-pipeline::AttitudePipeline pipe(out, pipeline::AttitudePipeline::SettingsLoadedLater{});
+const pipeline::EventSink pipeline_events = pipeline_text::events_to(&message_sink);
+pipeline::AttitudePipeline pipe(&pipeline_events, pipeline::AttitudePipeline::SettingsLoadedLater{});
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
@@ -231,9 +234,8 @@ static void airspeed_step() {
 }
 
 // `status`, a line (a part: console::kPartReply) at a time: false past the last part.
-// Parts 2 and 3 are the pipeline's gyro bias and compass lines, the long ones to format
-// (print_bias formats both, seven numbers from floats, for each).
-static void print_bias_line(uint8_t line);
+// Parts 2 and 3 are the gyro bias and compass lines, the long ones to format (four
+// numbers from floats each).
 constexpr uint8_t kStatusBiasPart = 2, kStatusCompassPart = 3;
 static bool print_status(uint8_t part) {
     Writer w(out);
@@ -262,8 +264,8 @@ static bool print_status(uint8_t part) {
             w.end();
             return true;
         }
-        case kStatusBiasPart: print_bias_line(0); return true;
-        case kStatusCompassPart: print_bias_line(1); return true;
+        case kStatusBiasPart: pipeline_text::write_bias_status(out, pipe); return true;
+        case kStatusCompassPart: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
         case 5: print_flight_line(TXT("# flight ")); return true;
         default: return false;
@@ -284,38 +286,9 @@ static bool gcs_link = false;
 static fmt::OutputMode output_mode() { return gcs_link ? fmt::OutputMode::Mavlink : pipe.settings().mode; }
 static bool mavlink_mode() { return output_mode() == fmt::OutputMode::Mavlink; }
 
-static void send_message(const char* data, uint8_t len) {
+static void write_message(void*, const char* data, uint8_t len) {
     if (mavlink_mode()) status_text.write(data, len);
     else serial_text::write(data, len);
-}
-
-// `status` sends the pipeline's gyro bias and compass lines, which print_bias writes in
-// one call, as two parts (a part is one line: console::kPartReply): while only_line is
-// set, write_message passes on only that line of what it is given.
-constexpr uint8_t kAllLines = 0xFF;
-static uint8_t only_line = kAllLines;
-static uint8_t lines_seen = 0;
-static void write_message(void*, const char* data, uint8_t len) {
-    if (only_line == kAllLines) {
-        send_message(data, len);
-        return;
-    }
-    while (len > 0) {
-        uint8_t n = 0;
-        while (n < len && data[n] != '\n') ++n;
-        const bool line_end = n < len;
-        if (line_end) ++n;
-        if (lines_seen == only_line) send_message(data, n);
-        if (line_end) ++lines_seen;
-        data += n;
-        len = (uint8_t)(len - n);
-    }
-}
-static void print_bias_line(uint8_t line) {
-    only_line = line;
-    lines_seen = 0;
-    pipe.print_bias(TXT("# gyro bias "), true);
-    only_line = kAllLines;
 }
 
 // The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode): the failsafe's

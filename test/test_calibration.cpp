@@ -609,6 +609,7 @@ TEST(OffsetLearner, SplitSolveGivesTheReferenceEstimates) {
 #include <string>
 
 #include "Pipeline.h"
+#include "PipelineText.h"
 
 namespace {
 
@@ -625,7 +626,8 @@ const Vector3f kFieldNorthDown(20.0f, 0.0f, 40.0f);
 TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     p.set_mag_present(true);
     int first_output = -1;
     for (int i = 0; i < 400; ++i) {
@@ -660,7 +662,8 @@ TEST(Pipeline, RolledAndPitchedBoardFromGravity) {
 TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     int first_output = -1;
     for (int i = 0; i < 400 && first_output < 0; ++i) {
         const float wobble = (i % 20 < 10) ? 0.2f : -0.2f;  // +-11 deg/s
@@ -693,7 +696,8 @@ TEST(Pipeline, OutputRateFollowsTheSetting) {
 TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(kBias, kLevel));
     log.clear();
     p.on_imu_sample(imu(Vector3f(30.0f, -30.0f, 30.0f), kLevel * 6.0f));
@@ -709,7 +713,8 @@ TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
 TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));  // past the start-up ramp
     log.clear();
     // 1 s of accel stuck at full scale on every axis (a broken sensor, 14 g): it must
@@ -770,7 +775,8 @@ TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
 TEST(Pipeline, MagCalibrationCommand) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     p.set_mag_present(true);
     for (int i = 0; i < 250; ++i) p.on_imu_sample(imu(kBias, kLevel));
     p.start_mag_calibration();

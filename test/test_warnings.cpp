@@ -7,6 +7,7 @@
 #include <string>
 
 #include "Pipeline.h"
+#include "PipelineText.h"
 
 namespace {
 
@@ -56,7 +57,8 @@ TEST(RateLimiter, HeldCountSaturates) {
 TEST(RateLimiter, TwoSpikeBurstsOneSecondApartAreBothReported) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     ASSERT_EQ(p.phase(), pipeline::Phase::Running);
     log.clear();
@@ -80,7 +82,8 @@ TEST(RateLimiter, TwoSpikeBurstsOneSecondApartAreBothReported) {
 TEST(RateLimiter, HeldSaturationWarningsAreTold) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     log.clear();
     // Accel clipped on one axis for five samples (a shake: the rise over a few samples is
@@ -101,7 +104,8 @@ TEST(RateLimiter, HeldSaturationWarningsAreTold) {
 TEST(RateLimiter, BoardMovedCountsTheRestartsBetweenLines) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     for (int i = 0; i < 230; ++i) {
         const float wobble = (i % 2 == 0) ? 1.0f : -1.0f;  // restarts again and again
         p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
