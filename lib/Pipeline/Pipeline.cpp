@@ -343,16 +343,16 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         st_.output_due = true;
     }
     const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
+    const linalg::Vector3i* accel = &s.accel;
+    linalg::Vector3i corrected;
     if (centripetal_gain_q8_ != 0) {
         // Gravity for the DCM: the turn's centripetal acceleration taken off (see
         // kCentripetalMinAirspeed_m_s); the clip checks above saw the measured sample.
-        const linalg::Vector3i accel = centripetal_corrected(
-            s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_), sat16((int32_t)s.gyro.z - gyro_bias_z_counts_),
-            centripetal_gain_q8_);
-        dcm_.update(s.gyro, accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
-    } else {
-        dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
+        corrected = centripetal_corrected(s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_),
+                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_);
+        accel = &corrected;
     }
+    dcm_.update(s.gyro, *accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
     // The board's turn for the compass learner: the gyro alone (the biases come off when
     // a field sample takes it).
     turn_counts_ += s.gyro;
