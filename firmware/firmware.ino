@@ -4,7 +4,8 @@
 //
 //   roll:-1.23 pitch:4.56 yaw:271.80
 //
-// This is the sketch: set-up, the 200 Hz loop, the output. The board's pieces are the
+// This is the sketch: set-up, the 200 Hz loop, the output (the pipeline's events and
+// `status` lines in the words of lib/Pipeline/PipelineText). The board's pieces are the
 // other files of this folder (Board: pins and buses; Imu: the MPU6000; Compass: the
 // HMC5883L; SerialText: output that never blocks; SettingsStore: EEPROM); everything
 // that turns samples into angles is the AttitudePipeline (lib/Pipeline), which the
@@ -234,8 +235,8 @@ static void airspeed_step() {
 }
 
 // `status`, a line (a part: console::kPartReply) at a time: false past the last part.
-// Parts 2 and 3 are the gyro bias and compass lines, the long ones to format (four
-// numbers from floats each).
+// Parts 2 and 3 are the gyro bias and compass lines, the long ones to format (numbers
+// from floats: lib/Pipeline/PipelineText).
 constexpr uint8_t kStatusBiasPart = 2, kStatusCompassPart = 3;
 static bool print_status(uint8_t part) {
     Writer w(out);
@@ -366,7 +367,7 @@ static bool emit_output(uint32_t now_ms, pipeline::AnglesCentideg& c) {
 //
 // Nothing typed or pasted is lost: bytes are taken from Serial's 64-byte receive ring
 // and parsed at once, every loop iteration and again inside the step after the
-// estimator (at 115200 baud the ring fills in 5.6 ms; the longest step is ~4.5 ms), and
+// estimator (at 115200 baud the ring fills in 5.6 ms, longer than the longest step), and
 // the parsed commands wait in a queue. A reply goes out a part (a line) at a time, each
 // only when the output queue has room for it and an output line after it: a paste is
 // answered line by line as fast as the UART carries the replies, a reply never blocks
@@ -452,11 +453,10 @@ static_assert(2u * mav::kMaxFrame + mav::kAttitudeFrame <= serial_text::kCapacit
               "serial_text's queue and Serial's ring hold a reply part and an output line");
 
 // A sample is missed when the next read comes more than 1.5 periods (7.5 ms) after the
-// previous one: a part starts only when it ends by 7.3 ms. What a part costs at most
-// (apm25sim --profile): a line 0.7 ms, status's bias or compass line 2.0 ms (seven
-// numbers from floats); in `mode mavlink`, with the STATUSTEXT packing, 2.1 and 3.8 ms.
-// A part that cannot start now waits for a step that leaves it time (a step takes
-// 0.7..5 ms, ~1.9 at least in `mode mavlink`).
+// previous one: a part starts only when it ends by 7.3 ms, by what a part costs at most
+// with a margin (README "Performance", console replies): `status`'s gyro bias and
+// compass lines (numbers from floats) cost the most, and `mode mavlink` adds the
+// STATUSTEXT packing. A part that cannot start now waits for a step that leaves it time.
 static uint32_t latest_start_us(bool float_lines) {
     if (mavlink_mode()) return float_lines ? 3500u : 5200u;
     return float_lines ? 5300u : 6000u;

@@ -193,9 +193,9 @@ void AttitudePipeline::forget_mag_reference(bool take_heading) {
     learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
 }
 
-// Spikes and non-finite values are replaced by the previous sample; saturation is
-// reported (a saturated gyro is used: the true rate is at least the full scale; a
-// saturated accel is withheld from the DCM by on_imu_sample).
+// Spikes are replaced by the previous sample; saturation is reported (a saturated gyro
+// is used: the true rate is at least the full scale; on_imu_sample decides whether a
+// saturated accel is gravity).
 const mpu6000::Sample& AttitudePipeline::guard(const mpu6000::Sample& s) {
     bool spike = false;
     if (st_.have_last) {
@@ -319,8 +319,9 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // RMSE; its clipped samples never have two axes clipped at once). Two or more
     // axes at full scale (at least 11 g) is not a motion but a stuck or broken sensor,
     // and so is one axis clipped for longer than kAccelSaturationFaultSteps: then the
-    // DCM gets NaN and gives gravity no weight that step (Dcm::update). The gyro is
-    // always integrated (saturated, it is a lower bound of the rate).
+    // DCM is told the accel is not valid and gives gravity no weight that step
+    // (Dcm::update). The gyro is integrated (saturated, it is a lower bound of the rate)
+    // unless the rate is beyond any MEMS gyro's.
     st_.accel_saturated_steps = s.accel_saturated ? (uint8_t)(st_.accel_saturated_steps < 255 ? st_.accel_saturated_steps + 1 : 255) : 0;
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);

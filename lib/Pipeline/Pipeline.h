@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // AttitudePipeline: decoded sensor samples in, estimator state and output timing out.
-// The firmware and the host replay tool run exactly this; the firmware adds only the
-// Arduino set-up, the buses, the data-ready pacing, serial I/O, LEDs and EEPROM.
+// The firmware and the host replay tool run exactly this; the firmware adds the Arduino
+// set-up, the buses, the data-ready pacing, serial I/O (the events' words:
+// PipelineText.h), LEDs, EEPROM, the airspeed sensor and the flight control.
 //
 // Use (one call per MPU6000 data-ready, 200 Hz):
 //
@@ -17,18 +18,21 @@
 // board moves); then the DCM starts from the mean gravity and the latest field (TRIAD).
 // If the board is never still for kStartupDeadlineSteps the estimator starts anyway
 // with the saved bias (or zero) and the measurement goes on in the background.
-// Each step: calibration applied (calib::apply_*), spikes and non-finite samples
-// replaced by the previous sample, Dcm::update at the fixed 5 ms step (a saturated
-// accelerometer sample goes in as NaN: no gravity weight that step), then
-// Dcm::correct_heading if a field sample came in since the previous step.
+// Each step, on the sample in the MPU6000's counts: a spike replaced by the previous
+// sample (guard), the accelerometer's centripetal term taken off when an airspeed is
+// set, Dcm::update at the fixed 5 ms step (the DCM subtracts the calibrated bias; an
+// accelerometer stuck at full scale gets no gravity weight that step, a rate beyond any
+// gyro's is not integrated), then Dcm::correct_heading with the latest field sample
+// (waiting out up to kMaxMagWaitSteps of the DCM's heavy steps), and on a step with room
+// the deferred compass work (the `cal mag` sums and fit, the offset learner).
 //
 // Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
 // the offset learned in motion) before the DCM sees it; while running, the learner
 // (calib::OffsetLearner) estimates the hard iron from the field's change against the
-// gyro's rotation, and puts it in use once it is significant. A new calibration, or a learned offset that has moved by
-// kMagReferenceShift_uT since the estimator learned the earth field, makes the
-// estimator forget that field (Dcm::reset_mag_reference): its strength and dip are
-// those of the calibrated field from then on.
+// gyro's rotation, and puts it in use once it is significant. A new calibration, or a
+// learned offset that has moved by kMagReferenceShift_uT since the estimator learned the
+// earth field, makes the estimator forget that field (Dcm::reset_mag_reference): its
+// strength and dip are those of the calibrated field from then on.
 //
 // Events (to the EventSink, as plain numbers: the sketch words them, PipelineText.h):
 // the gyro calibration's progress and result, spikes and saturation of the MPU6000,
