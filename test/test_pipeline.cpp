@@ -532,24 +532,23 @@ TEST(PipelineText, EachEventIsOneLine) {
             EXPECT_EQ(s.find('\n'), s.size() - 1) << s;
         }
     }
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kSpike, 0, 3, 7, 0.0f}),
-              "# warn: MPU6000 spike: 3 more samples replaced (7 so far)\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kSpike, 0, 0, 1, 0.0f}),
-              "# warn: MPU6000 spike: previous sample used instead (1 so far)\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kGyroSaturated, 0, 0, 0, 0.0f}),
-              "# warn: MPU6000 gyro saturated (beyond 2000 deg/s)\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kAccelSaturated, 0, 4, 0, 0.0f}),
-              "# warn: MPU6000 accel saturated: 4 more samples\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kGyroCalMoved, 0, 0, 0, 0.0f}),
-              "# calibrating gyro: board moved, retrying\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kGyroCalMoved, 0, 12, 0, 0.0f}),
-              "# calibrating gyro: board moved 12 more times, retrying\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kMagCalProgress, 0, 15, 929, 0.0f}),
-              "# cal mag: 15 s left, keep turning (929 samples)\n");
-    EXPECT_EQ(words_of(p, pipeline::Event{EventKind::kMagCalDone, (uint8_t)calib::MagCalibrator::Quality::PoorFit, 90,
-                                          2000, 3.5f}),
-              "# error: cal mag failed: residual 3.50 uT, over " + centi(calib::kMagMaxResidual_uT) +
-                  " (field changed while turning?); calibration unchanged\n");
+    // The counted forms: the first at once, then "N more".
+    const struct {
+        pipeline::Event event;
+        std::string line;
+    } kLines[] = {
+        {{EventKind::kSpike, 0, 3, 7, 0.0f}, "# warn: MPU6000 spike: 3 more samples replaced (7 so far)\n"},
+        {{EventKind::kSpike, 0, 0, 1, 0.0f}, "# warn: MPU6000 spike: previous sample used instead (1 so far)\n"},
+        {{EventKind::kGyroSaturated, 0, 0, 0, 0.0f}, "# warn: MPU6000 gyro saturated (beyond 2000 deg/s)\n"},
+        {{EventKind::kAccelSaturated, 0, 4, 0, 0.0f}, "# warn: MPU6000 accel saturated: 4 more samples\n"},
+        {{EventKind::kGyroCalMoved, 0, 0, 0, 0.0f}, "# calibrating gyro: board moved, retrying\n"},
+        {{EventKind::kGyroCalMoved, 0, 12, 0, 0.0f}, "# calibrating gyro: board moved 12 more times, retrying\n"},
+        {{EventKind::kMagCalProgress, 0, 15, 929, 0.0f}, "# cal mag: 15 s left, keep turning (929 samples)\n"},
+        {{EventKind::kMagCalDone, (uint8_t)calib::MagCalibrator::Quality::PoorFit, 90, 2000, 3.5f},
+         "# error: cal mag failed: residual 3.50 uT, over " + centi(calib::kMagMaxResidual_uT) +
+             " (field changed while turning?); calibration unchanged\n"},
+    };
+    for (const auto& l : kLines) EXPECT_EQ(words_of(p, l.event), l.line);
 }
 
 TEST(PipelineText, StatusLinesWordTheBiasAndTheCompass) {
