@@ -4,7 +4,8 @@
 //
 //   roll:-1.23 pitch:4.56 yaw:271.80
 //
-// This is the sketch: set-up, the 200 Hz loop, the output. The board's pieces are the
+// This is the sketch: set-up, the 200 Hz loop, the output (the pipeline's events and
+// `status` lines in the words of lib/Pipeline/PipelineText). The board's pieces are the
 // other files of this folder (Board: pins and buses; Imu: the MPU6000; Compass: the
 // HMC5883L; SerialText: output that never blocks; SettingsStore: EEPROM); everything
 // that turns samples into angles is the AttitudePipeline (lib/Pipeline), which the
@@ -33,6 +34,7 @@
 #include "MavLink.h"
 #include "ParamLink.h"
 #include "Pipeline.h"
+#include "PipelineText.h"
 #include "RcInput.h"
 #include "SerialText.h"
 #include "ServoOutputs.h"
@@ -43,11 +45,13 @@ using text::Flash;
 using text::Writer;
 
 // Every "# " message goes through `out`: to the serial port as text, or, in `mode
-// mavlink`, as STATUSTEXT frames (write_message, below).
+// mavlink`, as STATUSTEXT frames (write_message, below). The pipeline's events are
+// worded there too (lib/Pipeline/PipelineText).
 static void write_message(void*, const char* data, uint8_t len);
 const text::Sink message_sink = {nullptr, write_message};
 const text::Sink* const out = &message_sink;
-pipeline::AttitudePipeline pipe(out, pipeline::AttitudePipeline::SettingsLoadedLater{});
+const pipeline::EventSink pipeline_events = pipeline_text::events_to(&message_sink);
+pipeline::AttitudePipeline pipe(&pipeline_events, pipeline::AttitudePipeline::SettingsLoadedLater{});
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
@@ -231,9 +235,8 @@ static void airspeed_step() {
 }
 
 // `status`, a line (a part: console::kPartReply) at a time: false past the last part.
-// Parts 2 and 3 are the pipeline's gyro bias and compass lines, the long ones to format
-// (print_bias formats both, seven numbers from floats, for each).
-static void print_bias_line(uint8_t line);
+// Parts 2 and 3 are the gyro bias and compass lines, the long ones to format (numbers
+// from floats: lib/Pipeline/PipelineText).
 constexpr uint8_t kStatusBiasPart = 2, kStatusCompassPart = 3;
 static bool print_status(uint8_t part) {
     Writer w(out);
@@ -262,8 +265,8 @@ static bool print_status(uint8_t part) {
             w.end();
             return true;
         }
-        case kStatusBiasPart: print_bias_line(0); return true;
-        case kStatusCompassPart: print_bias_line(1); return true;
+        case kStatusBiasPart: pipeline_text::write_bias_status(out, pipe); return true;
+        case kStatusCompassPart: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
         case 5: print_flight_line(TXT("# flight ")); return true;
         default: return false;
@@ -284,38 +287,9 @@ static bool gcs_link = false;
 static fmt::OutputMode output_mode() { return gcs_link ? fmt::OutputMode::Mavlink : pipe.settings().mode; }
 static bool mavlink_mode() { return output_mode() == fmt::OutputMode::Mavlink; }
 
-static void send_message(const char* data, uint8_t len) {
+static void write_message(void*, const char* data, uint8_t len) {
     if (mavlink_mode()) status_text.write(data, len);
     else serial_text::write(data, len);
-}
-
-// `status` sends the pipeline's gyro bias and compass lines, which print_bias writes in
-// one call, as two parts (a part is one line: console::kPartReply): while only_line is
-// set, write_message passes on only that line of what it is given.
-constexpr uint8_t kAllLines = 0xFF;
-static uint8_t only_line = kAllLines;
-static uint8_t lines_seen = 0;
-static void write_message(void*, const char* data, uint8_t len) {
-    if (only_line == kAllLines) {
-        send_message(data, len);
-        return;
-    }
-    while (len > 0) {
-        uint8_t n = 0;
-        while (n < len && data[n] != '\n') ++n;
-        const bool line_end = n < len;
-        if (line_end) ++n;
-        if (lines_seen == only_line) send_message(data, n);
-        if (line_end) ++lines_seen;
-        data += n;
-        len = (uint8_t)(len - n);
-    }
-}
-static void print_bias_line(uint8_t line) {
-    only_line = line;
-    lines_seen = 0;
-    pipe.print_bias(TXT("# gyro bias "), true);
-    only_line = kAllLines;
 }
 
 // The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode): the failsafe's
@@ -393,7 +367,7 @@ static bool emit_output(uint32_t now_ms, pipeline::AnglesCentideg& c) {
 //
 // Nothing typed or pasted is lost: bytes are taken from Serial's 64-byte receive ring
 // and parsed at once, every loop iteration and again inside the step after the
-// estimator (at 115200 baud the ring fills in 5.6 ms; the longest step is ~4.5 ms), and
+// estimator (at 115200 baud the ring fills in 5.6 ms, longer than the longest step), and
 // the parsed commands wait in a queue. A reply goes out a part (a line) at a time, each
 // only when the output queue has room for it and an output line after it: a paste is
 // answered line by line as fast as the UART carries the replies, a reply never blocks
@@ -479,11 +453,10 @@ static_assert(2u * mav::kMaxFrame + mav::kAttitudeFrame <= serial_text::kCapacit
               "serial_text's queue and Serial's ring hold a reply part and an output line");
 
 // A sample is missed when the next read comes more than 1.5 periods (7.5 ms) after the
-// previous one: a part starts only when it ends by 7.3 ms. What a part costs at most
-// (apm25sim --profile): a line 0.7 ms, status's bias or compass line 2.0 ms (seven
-// numbers from floats); in `mode mavlink`, with the STATUSTEXT packing, 2.1 and 3.8 ms.
-// A part that cannot start now waits for a step that leaves it time (a step takes
-// 0.7..5 ms, ~1.9 at least in `mode mavlink`).
+// previous one: a part starts only when it ends by 7.3 ms, by what a part costs at most
+// with a margin (README "Performance", console replies): `status`'s gyro bias and
+// compass lines (numbers from floats) cost the most, and `mode mavlink` adds the
+// STATUSTEXT packing. A part that cannot start now waits for a step that leaves it time.
 static uint32_t latest_start_us(bool float_lines) {
     if (mavlink_mode()) return float_lines ? 3500u : 5200u;
     return float_lines ? 5300u : 6000u;

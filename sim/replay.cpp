@@ -27,6 +27,7 @@
 #include "Mpu6000.h"
 #include "Mpu6000Model.h"
 #include "Pipeline.h"
+#include "PipelineText.h"
 #include "Text.h"
 #include "Trajectory.h"
 
@@ -254,7 +255,8 @@ int main(int argc, char** argv) {
     // Set-up, in the firmware's order and on its timeline (firmware/firmware.ino setup()).
     mpu6000::Mpu6000 mpu(spi);
     hmc5883::Hmc5883 mag(i2c);
-    pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr, dcm_settings);
+    const pipeline::EventSink log_events = pipeline_text::events_to(&log_sink);
+    pipeline::AttitudePipeline pipe(log ? &log_events : nullptr, dcm_settings);
     board.advance(pipeline::kMpuStartMs * 1e-3);
     const mpu6000::InitResult mpu_init = mpu.begin();
     if (mpu_init.status != mpu6000::InitStatus::Ok) {
