@@ -268,7 +268,7 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
 // and the roll/pitch error (correct_tilt).
-void Dcm::correct_gravity() {
+FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
     schedule_.gravity_done();
     const bool starting = steps_ < k_.startup_steps;

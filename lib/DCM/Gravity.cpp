@@ -108,7 +108,7 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     return true;
 }
 
-void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
+FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
                                      const DcmSettings& settings, const DcmCoefficients& k, GyroBias& bias) {
     using linalg::hot::fixed_from_float;
     using linalg::mul_q30;

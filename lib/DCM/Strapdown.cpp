@@ -32,7 +32,7 @@ void Strapdown::end_step() {
 // kRenormaliseEvery updates, and row c is rebuilt as a x b at each (rows a and b are
 // what the update turns). The paper's first-order R (I + [theta x]) is not a rotation:
 // it stretches each row by a^2/2 an update, which renormalising at every update hid.
-void Strapdown::integrate(const DcmCoefficients& k) {
+FIXED_OWN_FRAME void Strapdown::integrate(const DcmCoefficients& k) {
     profile::begin(profile::kIntegration);
     using linalg::hot::mul_q14;
     using linalg::hot::mul_q30;

@@ -34,15 +34,21 @@
 
 // FIXED_INLINE: forced inline on the AVR (out of line, -mcall-prologues gives each call
 // the register-saving routines). FIXED_COLD: never inline (one copy of cold code that
-// would otherwise be copied into each caller).
+// would otherwise be copied into each caller, or cold code whose locals would grow a hot
+// caller's frame). FIXED_OWN_FRAME: never inline either, for a large part of a hot step
+// called from one place: inlined, its locals join the caller's, and a frame beyond the 63
+// bytes ldd/std reach from Y makes every access beyond them five instructions (subi,
+// sbci, the access, subi, sbci) in the caller's whole body.
 #ifdef __AVR__
 #define FIXED_INLINE __attribute__((always_inline)) inline
 #define FIXED_COLD __attribute__((noinline))
+#define FIXED_OWN_FRAME __attribute__((noinline))
 #include <avr/pgmspace.h>
 #define FIXED_PROGMEM PROGMEM
 #else
 #define FIXED_INLINE inline
 #define FIXED_COLD
+#define FIXED_OWN_FRAME
 #define FIXED_PROGMEM
 #endif
 
