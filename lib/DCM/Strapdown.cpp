@@ -35,7 +35,7 @@ void Strapdown::end_step() {
 FIXED_OWN_FRAME void Strapdown::integrate(const DcmCoefficients& k) {
     profile::begin(profile::kIntegration);
     using linalg::hot::mul_q14;
-    using linalg::hot::mul_q30;
+    using linalg::mul_q30;
     using linalg::q14_of;
     // In Q30 integers (R's entries and the turn, radians): mul_q30 (13 MULs) where the
     // update's orthonormality depends on the product; mul_q14 (two 16x16 products) in the
