@@ -105,7 +105,7 @@ bool Strapdown::renormalise() {
 
 // One row of R turned: r + r D (D = exp([theta x]) - I, rows as Matrix3q30), in Q30.
 void Strapdown::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
-    using linalg::hot::mul_q30;
+    using linalg::mul_q30;
     r = Vector3l(r.x + mul_q30(r.x, d.a.x) + mul_q30(r.y, d.b.x) + mul_q30(r.z, d.c.x),
                  r.y + mul_q30(r.x, d.a.y) + mul_q30(r.y, d.b.y) + mul_q30(r.z, d.c.y),
                  r.z + mul_q30(r.x, d.a.z) + mul_q30(r.y, d.b.z) + mul_q30(r.z, d.c.z));
