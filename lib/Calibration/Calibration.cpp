@@ -617,8 +617,8 @@ void OffsetLearner::end_solve() {
     solve_part_ = 0;
 }
 
-// First part (8-10.5 k cycles on the AVR, 14-15 k in float: short enough for a step
-// that also corrects gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
+// First part (in fixed point, not float: short enough for a step that also corrects
+// gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
 // H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn, in fixed point: P in Q30
 // from q's products (mul_q30, ~1e-9 each), the fields less the estimate in Q16 uT (steps
 // of 1.5e-5 uT; fields within 2^15 uT). Leaves r . r in turn_.f[0] (q is not needed
@@ -657,7 +657,7 @@ FIXED_COLD bool OffsetLearner::solve_residual() {
     return true;
 }
 
-// Second part (~14 k): the information, the step, the gate. A = I / prior^2 + L (L
+// Second part (the long one): the information, the step, the gate. A = I / prior^2 + L (L
 // faded, this pair's H^T H / sigma^2 added) and its inverse C (symmetric: cofactors
 // over the determinant), the posterior covariance, uT^2. H^T H = 2 I - P - P^T =
 // 4 (|u|^2 I - u u^T) for the unit q = (w, u). info_ holds L already faded (the third
@@ -713,7 +713,7 @@ FIXED_COLD bool OffsetLearner::solve_step() {
     return true;
 }
 
-// Third part (~5 k): the estimate moves by the step, and the offset in use follows it
+// Third part: the estimate moves by the step, and the offset in use follows it
 // once it is significant; the information taken in fades for the next pair.
 FIXED_COLD bool OffsetLearner::solve_estimate(Vector3f& in_use_uT) {
     const Vector3f step = field_ref_;
