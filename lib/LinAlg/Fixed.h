@@ -18,12 +18,16 @@
 //   - FIXED_INLINE helpers are a few instructions (mul_s16, mul_u16, q14_of ...): forced
 //     inline everywhere, cheaper than a call.
 //   - mul_q30, mul_q14, mul_q14_unit and fixed_from_float are ordinary calls
-//     (linalg::mul_q30 ...; mul_q30's called form keeps to the call-clobbered
-//     registers, Fixed.cpp); the hot list takes their forced-inline copies from
-//     namespace linalg::hot, one `using linalg::hot::...` at the top of the function:
-//     the DCM's integration (Strapdown), the gravity window's products and the field
-//     sample's latency turn (each runs at 50 to 200 Hz). Cold code (start-up, the
-//     float paths, renormalisation, a new field's heading, the learner's solve) calls.
+//     (linalg::mul_q30 ...); the hot list takes the forced-inline copies of mul_q14,
+//     mul_q14_unit and fixed_from_float from namespace linalg::hot, one
+//     `using linalg::hot::...` at the top of the function: the integration's coning term
+//     (Strapdown), the gravity window's products, the rest means and the field sample's
+//     latency turn (each runs at 50 to 200 Hz). Cold code (start-up, the float paths,
+//     renormalisation, a new field's heading, the learner's solve) calls.
+//   - mul_q30 is called even on the hot list: its called form keeps to the
+//     call-clobbered registers (Fixed.cpp), while a function with many inline copies
+//     (the integration) ran out of registers and spilled to a deep frame, slower and
+//     larger than the calls. hot::mul_q30 is the host's form and the reference.
 //   - The Euler output (atan2_q24 ...) runs once a line, all inline (its own target).
 #pragma once
 
