@@ -23,7 +23,9 @@ int32_t inverse_q30(uint8_t n) {
 }
 
 // A sum's mean: v / n, by two bit shifts in the usual case (n = 4), else by 1/n in Q30.
-Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
+// Forced inline: called, its vector argument had to be stored in correct_gravity's deep
+// frame and the result read back from it.
+FIXED_INLINE Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
     if (n == 4) return Vector3l(v.x >> 2, v.y >> 2, v.z >> 2);
     return Vector3l(linalg::mul_q30(inverse_q30, v.x), linalg::mul_q30(inverse_q30, v.y), linalg::mul_q30(inverse_q30, v.z));
 }
