@@ -3,6 +3,7 @@
 
 #include <string.h>
 
+#include "Fixed.h"
 #include "Params.h"
 
 namespace settings {
@@ -79,7 +80,9 @@ bool is_valid(const Settings& s) {
            calib::is_plausible(s.cal) && params::all_valid(s);
 }
 
-LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
+// Out of line (FIXED_COLD): inlined into slots::load, its locals made load's frame too
+// deep for ldd/std.
+FIXED_COLD LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     out = defaults();
     bool blank = true;
     for (uint8_t i = 0; i < kRecordSize; ++i) blank = blank && (in[i] == 0xFFu || in[i] == 0x00u);
@@ -91,16 +94,19 @@ LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     const uint8_t len = in[3];
     const uint16_t crc = (uint16_t)(in[4 + len] | (uint16_t)((uint16_t)in[5 + len] << 8));
     if (crc != crc16(in, (uint16_t)(4u + len))) return LoadResult::BadCrc;
-    Settings s = out;
-    s.rate_hz = in[4];
-    s.declination_centideg = (int16_t)(uint16_t)(in[5] | (uint16_t)((uint16_t)in[6] << 8));
-    s.mode = (fmt::OutputMode)in[7];
-    s.flags = in[8];
-    memcpy(&s.cal, in + 9, sizeof s.cal);
-    if (v2) s.flags = (uint8_t)(s.flags | kFlagUpgraded);
-    else params::decode_flight(in + 4 + kV2PayloadLength, s);
-    if ((in[8] & kFlagUpgraded) != 0u || !is_valid(s)) return LoadResult::BadValue;
-    out = s;
+    // Into `out` itself (a copy would be a Settings more of stack), defaults again when
+    // a value is out of range.
+    out.rate_hz = in[4];
+    out.declination_centideg = (int16_t)(uint16_t)(in[5] | (uint16_t)((uint16_t)in[6] << 8));
+    out.mode = (fmt::OutputMode)in[7];
+    out.flags = in[8];
+    memcpy(&out.cal, in + 9, sizeof out.cal);
+    if (v2) out.flags = (uint8_t)(out.flags | kFlagUpgraded);
+    else params::decode_flight(in + 4 + kV2PayloadLength, out);
+    if ((in[8] & kFlagUpgraded) != 0u || !is_valid(out)) {
+        out = defaults();
+        return LoadResult::BadValue;
+    }
     return LoadResult::Ok;
 }
 
