@@ -60,8 +60,8 @@ static void spi_select(void*, bool on, uint32_t clock_hz) {
             SPI.beginTransaction(SPISettings(mpu6000::kReadClockHz, MSBFIRST, SPI_MODE0));
         else
             SPI.beginTransaction(SPISettings(mpu6000::kConfigClockHz, MSBFIRST, SPI_MODE0));
-        // Chip select on its port (one instruction, where digitalWrite costs ~60 cycles
-        // and this runs twice per sample); pin 40 (barometer) is never touched.
+        // Chip select on its port (one instruction, where digitalWrite looks the pin up
+        // in tables, and this runs twice per sample); pin 40 (barometer) is never touched.
         PORTB &= (uint8_t)~_BV(PB0);
     } else {
         PORTB |= _BV(PB0);
