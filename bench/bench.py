@@ -51,6 +51,7 @@ SECTIONS = [
     (4, "mpu", "MPU6000 burst read", ("mpu",)),
     (5, "hmc", "HMC5883L read", ("hmc", "compass", "mag")),
     (6, "loop", "one loop iteration's work", ("loop",)),
+    (13, "control", "flight control step (50 Hz: every 4th loop step)", ("control", "flight")),
     # The parts of the estimator step (lib/LinAlg/Profile.h), inside section 1.
     (12, "checks", "step part: sample checks, calibration", ()),
     (7, "integration", "step part: gyro integration", ()),
@@ -58,6 +59,9 @@ SECTIONS = [
     (9, "gravity", "step part: gravity (low-pass, rest, roll/pitch)", ()),
     (10, "compass", "step part: heading correction", ()),
     (11, "learner", "step part: compass offset learner", ()),
+    (14, "magfit", "one part of the cal mag fit (outside the step)", ()),
+    (16, "gcsrequest", "a ground station's MAVLink request handled", ()),
+    (17, "gcsreply", "one PARAM_VALUE, or RC_CHANNELS + SERVO_OUTPUT_RAW, packed", ()),
 ]
 
 # Targets of issue 10 (the 24 KB flash target of issue 5 is dropped: the 2560 has 256 KB):
@@ -221,6 +225,12 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
     if os.path.exists(prof):
         os.remove(prof)
     cmd = [sim, "--elf", elf, "--trajectory", traj, "--seconds", str(seconds), "--profile", prof]
+    # Control on: a receiver from 0.5 s with the mode switch high (STABILIZE), so that the
+    # flight control step (section 13) runs its controllers, not the idle neutral outputs.
+    rc = os.path.join(out_dir, "scenarios", "stabilize_rc.csv")
+    with open(rc, "w") as f:
+        f.write("t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8\n0.5,1500,1500,1500,1500,1500,1500,1500,2000\n")
+    cmd += ["--rc", rc]
     log("cycles: %s (simavr, %g simulated s)" % (" ".join(os.path.relpath(c, REPO) if os.sep in c else c
                                                             for c in cmd), seconds))
     t0 = time.time()
@@ -831,6 +841,11 @@ def main():
         rows.append(["rest scenario total RMSE", "≤ %.1f°" % TARGET_REST, "–", "N/A"])
     rep.append(md_table(["target", "limit", "now", ""], rows))
     rep.append("")
+    # In flight (issue 22): bench/flights.py.
+    import flights
+    flight_rep, flight_errors = flights.flight_section(build, out_dir, task_replay, peer_names, log)
+    rep += flight_rep
+    errors += flight_errors
     if errors:
         rep += ["## Errors", ""] + ["- " + e for e in errors] + [""]
     if pngs:

@@ -10,7 +10,9 @@
 //   section 3  SYS_STATUS            (1 Hz)
 //   section 4  a 30-character "# " line through StatusText (one STATUSTEXT)
 //   section 5  a 70-character "# error:" line (two chunks)
-//   section 7  FrameFilter over one 21-byte HEARTBEAT frame from a GCS
+//   section 7  Parser over one 21-byte HEARTBEAT frame from a GCS (CRC-checked)
+//   section 8  RC_CHANNELS and SERVO_OUTPUT_RAW (the 5 Hz pair)
+//   section 9  Parser over one 35-byte PARAM_SET frame from a GCS (CRC-checked), decoded
 //   section 6  the whole run
 #include <avr/io.h>
 #include <stdint.h>
@@ -42,18 +44,25 @@ int main() {
 #ifndef MAV_COST_EMPTY
     mav::Packer packer;
     mav::StatusText text(packer, mav::FrameSink{nullptr, &sink});
-    mav::FrameFilter filter;
+    mav::Parser filter;
     uint8_t frame[mav::kMaxFrame];
     uint8_t gcs[mav::kMaxFrame];
     mav::Packer gcs_packer;
-    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active);
+    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active, mav::PlaneMode::Manual);
+    // A PARAM_SET as QGroundControl sends it (MAVLink 2, system 255, component 190).
+    static const uint8_t kParamSet[] = {0xFD, 0x17, 0x00, 0x00, 0x07, 0xFF, 0xBE, 0x17, 0x00, 0x00, 0x00, 0x00,
+                                        0xA0, 0x3F, 0x01, 0x01, 'R',  'L',  'L',  '2',  'S',  'R',  'V',  '_',
+                                        'P',  0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x09, 0x00, 0x00};
+    uint8_t param_set[sizeof kParamSet];
+    for (uint8_t i = 0; i < sizeof kParamSet; ++i) param_set[i] = kParamSet[i];
+    const uint16_t widths[8] = {1500, 1500, 1100, 1500, 1520, 1480, 1500, 1900};
     static const char kShort[] = "# mode mavlink: MAVLink 2 now\n";
     static const char kLong[] = "# error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68), retrying each s\n";
 #endif
     for (uint8_t k = 0; k < 20; ++k) {
 #ifndef MAV_COST_EMPTY
         begin(1);
-        uint8_t n = packer.heartbeat(frame, mav::State::Active);
+        uint8_t n = packer.heartbeat(frame, mav::State::Active, mav::PlaneMode::Stabilize);
         end(1);
         sink(nullptr, frame, n);
         begin(2);
@@ -73,7 +82,20 @@ int main() {
         end(5);
         begin(7);
         for (uint8_t i = 0; i < gcs_len; ++i) g_sink = filter.consume(gcs[i]);
+        filter.release();
         end(7);
+        begin(8);
+        n = packer.rc_channels(frame, 1000u * k, widths, 8u);
+        sink(nullptr, frame, n);
+        n = packer.servo_output_raw(frame, 1000000u * k, widths);
+        end(8);
+        sink(nullptr, frame, n);
+        begin(9);
+        mav::ParamSet ps;
+        for (uint8_t i = 0; i < sizeof param_set; ++i) filter.consume(param_set[i]);
+        g_sink = filter.ready() && mav::decode_param_set(filter.frame(), ps);
+        filter.release();
+        end(9);
 #else
         begin(1);
         g_sink = (uint8_t)(g_sink + (uint8_t)g_angle);

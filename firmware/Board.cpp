@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Board.h"
 
+#include <avr/sleep.h>
+
 #include <SPI.h>
 #include <Wire.h>
 
@@ -23,6 +25,24 @@ void init_pins() {
     DDRE &= (uint8_t)~_BV(PE6);  // MPU6000 INT
 }
 
+// Nothing to do in the handler: waking the core is the point; the loop reads the pin.
+static void on_data_ready() {}
+void wake_on_data_ready() { attachInterrupt(6, on_data_ready, RISING); }  // INT6 on the 2560's core
+
+void idle_until_interrupt() {
+    set_sleep_mode(SLEEP_MODE_IDLE);
+    // Checked with interrupts off: an edge after the check sets INTF6, and the interrupt
+    // then wakes the SLEEP that follows SEI (the instruction after SEI always runs first).
+    cli();
+    if (!mpu_int_high()) {
+        sleep_enable();
+        sei();
+        sleep_cpu();
+        sleep_disable();
+    }
+    sei();
+}
+
 void set_leds(bool calibrating, bool running, bool fault) {
     digitalWrite(kPinLedA, calibrating ? LOW : HIGH);  // active low
     digitalWrite(kPinLedB, running ? LOW : HIGH);
@@ -40,8 +60,8 @@ static void spi_select(void*, bool on, uint32_t clock_hz) {
             SPI.beginTransaction(SPISettings(mpu6000::kReadClockHz, MSBFIRST, SPI_MODE0));
         else
             SPI.beginTransaction(SPISettings(mpu6000::kConfigClockHz, MSBFIRST, SPI_MODE0));
-        // Chip select on its port (one instruction, where digitalWrite costs ~60 cycles
-        // and this runs twice per sample); pin 40 (barometer) is never touched.
+        // Chip select on its port (one instruction, where digitalWrite looks the pin up
+        // in tables, and this runs twice per sample); pin 40 (barometer) is never touched.
         PORTB &= (uint8_t)~_BV(PB0);
     } else {
         PORTB |= _BV(PB0);

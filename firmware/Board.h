@@ -39,6 +39,9 @@ enum Section : uint8_t {
     kSecMpuRead = 4,
     kSecMagRead = 5,
     kSecLoop = 6,       // one loop iteration's work, from data-ready seen to work done
+    kSecControl = 13,   // the flight control step (every 4th loop step: 50 Hz, the servo frame)
+    kSecGcsRequest = 16,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
+    kSecGcsReply = 17,    // one PARAM_VALUE, or the RC_CHANNELS + SERVO_OUTPUT_RAW pair, packed
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }
@@ -47,6 +50,13 @@ inline void mark_end(uint8_t id) { GPIOR1 = id; }
 inline bool mpu_int_high() { return (PINE & _BV(PE6)) != 0; }
 inline bool mag_drdy_high() { return (PINC & _BV(PC6)) != 0; }
 inline bool sda_low() { return (PIND & _BV(PD1)) == 0; }
+
+// Idle until an interrupt: the MPU6000's data-ready (INT6, rising edge, enabled by
+// wake_on_data_ready()), timer0's millis() tick (1.024 ms), a UART byte, a receiver edge.
+// Returns at once when the data-ready line is already high. Idle keeps every timer and
+// peripheral running (datasheet 11.1): the servo pulses and the PPM capture go on.
+void wake_on_data_ready();
+void idle_until_interrupt();
 
 // LEDs off, every SPI chip select high (53 before 40, as ArduPilot brought the bus
 // up on APM2) before any SPI traffic, the data-ready lines as inputs.

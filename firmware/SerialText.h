@@ -3,8 +3,8 @@
 //
 // The Arduino core's Serial has a 64-byte transmit ring (what the Arduino IDE builds
 // with): a `help` reply (~330 bytes) would block Serial.write for ~30 ms, six samples.
-// So every text goes into this queue first (~15 cycles a byte), and pump(), called by
-// loop() between samples (thousands of times a second), hands Serial only what fits
+// So every text goes into this queue first (a byte copied into a ring), and pump(),
+// called by every loop() iteration (each interrupt wakes one), hands Serial only what fits
 // in Serial.availableForWrite(): a write never waits for the UART, and the sample path
 // pays only for the queueing.
 //

@@ -8,9 +8,11 @@
 
 // Once, at the end of setup(): start your own devices (Serial1 for a GPS, servos, ...).
 void user_setup();
-// Every loop() iteration (thousands of times a second while the loop waits for data).
+// Every loop() iteration: after each interrupt (a sample, a serial byte, a receiver
+// edge), and at least every 1.024 ms (timer0's tick) while the loop idles between samples.
 void user_loop();
 // After every estimator step (200 Hz), while the attitude is being estimated:
 // pipe.estimator() is the DCM (its rotation matrix), pipe.angles() the Euler angles
-// (~17 k cycles: call it at the rate you need, not every step).
+// (an Euler extraction and float conversions: call it at the rate you need, not every
+// step).
 void user_attitude_step(const pipeline::AttitudePipeline& pipe);

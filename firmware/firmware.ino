@@ -4,7 +4,8 @@
 //
 //   roll:-1.23 pitch:4.56 yaw:271.80
 //
-// This is the sketch: set-up, the 200 Hz loop, the output. The board's pieces are the
+// This is the sketch: set-up, the 200 Hz loop, the output (the pipeline's events and
+// `status` lines in the words of lib/Pipeline/PipelineText). The board's pieces are the
 // other files of this folder (Board: pins and buses; Imu: the MPU6000; Compass: the
 // HMC5883L; SerialText: output that never blocks; SettingsStore: EEPROM); everything
 // that turns samples into angles is the AttitudePipeline (lib/Pipeline), which the
@@ -15,18 +16,28 @@
 // read when its DRDY pin says so. Every line that is not angle data begins with "# ".
 // Other output modes (`mode csv|quat|raw|mavlink|quiet`): README.md; in `mode mavlink`
 // the board speaks MAVLink 2 to a ground station and its "# " lines go as STATUSTEXT.
+//
+// It also flies (README "Flying"): the receiver's PPM (RcInput) and the attitude go
+// through lib/Flight's modes, controllers and mixer to the eight servo outputs
+// (ServoOutputs), 50 times a second.
 #include <SPI.h>
 #include <Wire.h>
 
+#include "Airspeed.h"
 #include "ArduinoCore.h"
 #include "Board.h"
 #include "Compass.h"
 #include "Console.h"
+#include "Flight.h"
 #include "Format.h"
 #include "Imu.h"
 #include "MavLink.h"
+#include "ParamLink.h"
 #include "Pipeline.h"
+#include "PipelineText.h"
+#include "RcInput.h"
 #include "SerialText.h"
+#include "ServoOutputs.h"
 #include "SettingsStore.h"
 #include "UserCode.h"
 
@@ -34,16 +45,20 @@ using text::Flash;
 using text::Writer;
 
 // Every "# " message goes through `out`: to the serial port as text, or, in `mode
-// mavlink`, as STATUSTEXT frames (write_message, below).
+// mavlink`, as STATUSTEXT frames (write_message, below). The pipeline's events are
+// worded there too (lib/Pipeline/PipelineText).
 static void write_message(void*, const char* data, uint8_t len);
 const text::Sink message_sink = {nullptr, write_message};
 const text::Sink* const out = &message_sink;
-pipeline::AttitudePipeline pipe(out);
+const pipeline::EventSink pipeline_events = pipeline_text::events_to(&message_sink);
+pipeline::AttitudePipeline pipe(&pipeline_events, pipeline::AttitudePipeline::SettingsLoadedLater{});
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
 console::LineReader reader;
-mav::FrameFilter mavlink_input;  // a ground station's frames, kept from the console
+flight::PpmDecoder ppm;
+flight::FlightControl flight_control(pipe.settings().flight, flight::FlightControl::ConfiguredLater{});
+mav::Parser mavlink_input;  // a ground station's frames (ground station link, below)
 
 // Loop load: the share of each second spent on samples (measured, shown by `status`).
 uint32_t work_us = 0, window_start_us = 0;
@@ -66,10 +81,162 @@ static void print_settings_line() {
 
 static Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
 
+// ---------------------------------------------------------------------------
+// Flying (lib/Flight): the state, the receiver, the outputs.
+
+static Flash flight_mode_name(flight::Mode m) { return m == flight::Mode::Stabilize ? TXT("STABILIZE") : TXT("MANUAL"); }
+
+// "<prefix>MODE, receiver ok|no signal yet|FAILSAFE (lost|encoder failsafe)"
+static void print_flight_line(Flash prefix) {
+    Writer w(out);
+    w.str(prefix);
+    const flight::State st = flight_control.state();
+    if (st == flight::State::Failsafe) {
+        w.str(TXT("FAILSAFE ("))
+            .str(flight_control.failsafe_cause() == flight::FailsafeCause::Lost ? TXT("receiver lost")
+                                                                                 : TXT("receiver's encoder failsafe"))
+            .str(TXT("), then "));
+    }
+    w.str(flight_mode_name(flight_control.chosen()));
+    if (flight_control.without_attitude()) w.str(TXT(" (no attitude: MANUAL)"));
+    if (st == flight::State::NoSignal) w.str(TXT(", no receiver signal yet: outputs at trim"));
+    w.end();
+}
+
+// "# rc 1500 ..." or "# servo 1500 ...": eight widths, us.
+static void print_widths(Flash prefix, const uint16_t* widths) {
+    Writer w(out);
+    w.str(prefix);
+    for (uint8_t i = 0; i < flight::kChannels; ++i) w.chr(' ').u32(widths[i]);
+    w.end();
+}
+
+// The flight control's events, said as "# " lines (STATUSTEXT in `mode mavlink`).
+static void say_flight_events() {
+    const uint8_t e = flight_control.take_events();
+    if (e == 0) return;
+    if (e & flight::kEvFailsafeLost)
+        say(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT"));
+    if (e & flight::kEvFailsafeEncoder)
+        say(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding"));
+    if (e & flight::kEvFailsafeEnd) print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
+    if (e & flight::kEvSensorFallback)
+        say(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): MANUAL until it returns"));
+    if (e & flight::kEvAttitudeBack) say(TXT("# attitude back: flight STABILIZE"));
+    if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
+}
+
+// The control step, every 4th loop step (50 Hz) right after the estimator's: the servo
+// pulse only changes once a 20 ms period, so a faster step would compute widths that are
+// never sent. It moves onto the output line's steps when the output rate is 50 Hz or
+// less, to take the angles the line worked out (the Euler extraction is the step's
+// largest part). Without samples (the MPU6000 gone) the loop runs it on its own every
+// 20 ms, without an attitude: the receiver, MANUAL and the failsafe go on.
+constexpr uint8_t kControlDivider = 4;
+constexpr uint16_t kControlPeriodUs = 20000;
+static uint8_t control_count = 0;
+static uint32_t last_control_us = 0;
+
+static void take_receiver_frames(uint32_t now_ms) {
+    while (rc_input::poll(ppm)) flight_control.on_frame(ppm.frame_us(), now_ms);
+}
+
+// angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
+// The rates are the sample's body-frame counts less the calibrated bias, in integers (the
+// pipeline's float rates cost several times as much; the D term needs no more); the
+// bias in those units is worked out again once a second (`cal gyro` changes it).
+constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
+constexpr int32_t kCdsPerCountQ10 =
+    (int32_t)(mpu6000::gyro_rad_s_per_count(mpu6000::kGyroRange) * kCdsPerRad_s * 1024.0f + 0.5f);
+static int16_t bias_cds[2];
+static uint8_t bias_age = 0xFF;
+
+static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
+                         const pipeline::AnglesCentideg* angles) {
+    last_control_us = now_us;
+    control_count = 0;
+    board::mark_begin(board::kSecControl);
+    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    flight_control.update_signal(now_ms);
+    if (att.valid && flight_control.wants_attitude()) {  // MANUAL and no receiver yet need none
+        const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
+        att.roll_cd = a.roll_centideg;
+        att.pitch_cd = a.pitch_centideg;
+        if (++bias_age >= 50u) {
+            const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
+            bias_cds[0] = (int16_t)(bias.x * kCdsPerRad_s);
+            bias_cds[1] = (int16_t)(bias.y * kCdsPerRad_s);
+            bias_age = 0;
+        }
+        att.roll_rate_cds = (((int32_t)sample->gyro.x * kCdsPerCountQ10) >> 10) - bias_cds[0];
+        att.pitch_rate_cds = (((int32_t)sample->gyro.y * kCdsPerCountQ10) >> 10) - bias_cds[1];
+    }
+    uint16_t widths[flight::kChannels];
+    flight_control.step(now_ms, att, widths);
+    servo_outputs::set(widths);
+    board::mark_end(board::kSecControl);
+    say_flight_events();
+}
+
+// The airspeed sensor on A0 (lib/Pipeline/Airspeed.h), for the estimator's centripetal
+// correction. Never blocking: each step reads the conversion the previous step started
+// (13 ADC clocks at 125 kHz, long done 5 ms later) and starts the next. While the gyro
+// calibrates (the board still) the readings are the sensor's zero; a zero far from
+// 2.5 V is no sensor. Then the mean of each kAirspeedReadings readings is the airspeed.
+enum class AirspeedState : uint8_t { kZero, kSensor, kNone };
+constexpr uint8_t kAirspeedReadings = 8;
+constexpr int16_t kAirspeedIdleThrottle = 100;  // tenths of a percent: 10 % of the stick
+static AirspeedState airspeed_state = AirspeedState::kZero;
+static bool airspeed_started = false;
+static uint16_t airspeed_zero = 0;
+static uint16_t airspeed_n = 0;
+static uint32_t airspeed_sum = 0;
+
+static void airspeed_begin() {
+    ADMUX = _BV(REFS0);  // AVcc reference, channel 0 (MUX5 in ADCSRB clear)
+    ADCSRB &= (uint8_t)~_BV(MUX5);
+    ADCSRA |= _BV(ADEN) | _BV(ADSC);
+}
+
+static void airspeed_step() {
+    if (airspeed_state == AirspeedState::kNone) {
+        // No sensor: the configured cruise speed (TRIM_ARSPD_CM), only while the receiver's
+        // throttle is above idle (on the ground, or gliding, the velocity is not the cruise's).
+        const flight::FlightSettings& fs = pipe.settings().flight;
+        if (fs.trim_arspd_cm == 0u || pipe.steps() % kAirspeedReadings != 0u) return;
+        const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
+        const bool powered = flight_control.state() != flight::State::NoSignal && ch < flight::kChannels &&
+                             flight::width_to_throttle(flight_control.rc_us()[ch], fs.rc[ch],
+                                                       (fs.rc_reversed >> ch) & 1u) > kAirspeedIdleThrottle;
+        pipe.set_airspeed_m_s(powered ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
+        return;
+    }
+    if (ADCSRA & _BV(ADSC)) return;
+    const uint16_t counts = ADC;
+    ADCSRA |= _BV(ADSC);
+    if (!airspeed_started) {  // the first conversion is the ADC's longer first one: not used
+        airspeed_started = true;
+        return;
+    }
+    airspeed_sum += counts;
+    ++airspeed_n;
+    if (airspeed_state == AirspeedState::kZero) {
+        if (pipe.phase() != pipeline::Phase::Running || airspeed_n < kAirspeedReadings) return;
+        airspeed_zero = (uint16_t)(airspeed_sum / airspeed_n);
+        airspeed_state = airspeed::present(airspeed_zero) ? AirspeedState::kSensor : AirspeedState::kNone;
+        if (airspeed_state == AirspeedState::kNone) say(TXT("# airspeed: no sensor on A0"));
+    } else if (airspeed_n >= kAirspeedReadings) {
+        pipe.set_airspeed_m_s(airspeed::airspeed_m_s(airspeed_sum, (uint8_t)airspeed_n, airspeed_zero));
+    } else {
+        return;
+    }
+    airspeed_sum = 0;
+    airspeed_n = 0;
+}
+
 // `status`, a line (a part: console::kPartReply) at a time: false past the last part.
-// Parts 2 and 3 are the pipeline's gyro bias and compass lines, the long ones to format
-// (print_bias formats both, seven numbers from floats, for each).
-static void print_bias_line(uint8_t line);
+// Parts 2 and 3 are the gyro bias and compass lines, the long ones to format (numbers
+// from floats: lib/Pipeline/PipelineText).
 constexpr uint8_t kStatusBiasPart = 2, kStatusCompassPart = 3;
 static bool print_status(uint8_t part) {
     Writer w(out);
@@ -90,12 +257,18 @@ static bool print_status(uint8_t part) {
             char buf[14];
             w.str(TXT("# load ")).u32(load_pct).str(TXT("%, overruns ")).u32(imu.missed_samples())
                 .str(TXT(", spikes ")).u32(pipe.spikes()).str(TXT(", uptime "))
-                .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s")).end();
+                .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s, airspeed "));
+            if (airspeed_state == AirspeedState::kSensor)
+                w.str(buf, text::format_centi(buf, (int32_t)(pipe.airspeed_m_s() * 100.0f))).str(TXT(" m/s"));
+            else
+                w.str(airspeed_state == AirspeedState::kNone ? TXT("none") : TXT("zeroing"));
+            w.end();
             return true;
         }
-        case kStatusBiasPart: print_bias_line(0); return true;
-        case kStatusCompassPart: print_bias_line(1); return true;
+        case kStatusBiasPart: pipeline_text::write_bias_status(out, pipe); return true;
+        case kStatusCompassPart: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
+        case 5: print_flight_line(TXT("# flight ")); return true;
         default: return false;
     }
 }
@@ -108,40 +281,25 @@ static void write_frame(void*, const uint8_t* frame, uint8_t len) {
 }
 mav::StatusText status_text(mavlink, mav::FrameSink{nullptr, write_frame});
 
-static bool mavlink_mode() { return pipe.settings().mode == fmt::OutputMode::Mavlink; }
+// A ground station's HEARTBEAT in a text mode switches the port to MAVLink until reset:
+// not a setting (`save` keeps the mode typed), and a typed `mode` ends it.
+static bool gcs_link = false;
+static fmt::OutputMode output_mode() { return gcs_link ? fmt::OutputMode::Mavlink : pipe.settings().mode; }
+static bool mavlink_mode() { return output_mode() == fmt::OutputMode::Mavlink; }
 
-static void send_message(const char* data, uint8_t len) {
+static void write_message(void*, const char* data, uint8_t len) {
     if (mavlink_mode()) status_text.write(data, len);
     else serial_text::write(data, len);
 }
 
-// `status` sends the pipeline's gyro bias and compass lines, which print_bias writes in
-// one call, as two parts (a part is one line: console::kPartReply): while only_line is
-// set, write_message passes on only that line of what it is given.
-constexpr uint8_t kAllLines = 0xFF;
-static uint8_t only_line = kAllLines;
-static uint8_t lines_seen = 0;
-static void write_message(void*, const char* data, uint8_t len) {
-    if (only_line == kAllLines) {
-        send_message(data, len);
-        return;
-    }
-    while (len > 0) {
-        uint8_t n = 0;
-        while (n < len && data[n] != '\n') ++n;
-        const bool line_end = n < len;
-        if (line_end) ++n;
-        if (lines_seen == only_line) send_message(data, n);
-        if (line_end) ++lines_seen;
-        data += n;
-        len = (uint8_t)(len - n);
-    }
-}
-static void print_bias_line(uint8_t line) {
-    only_line = line;
-    lines_seen = 0;
-    pipe.print_bias(TXT("# gyro bias "), true);
-    only_line = kAllLines;
+// The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode): the failsafe's
+// wings-level glide is ArduPlane's FBWA glide (MavLink.h), STABILIZE without an attitude
+// flies as MANUAL.
+static mav::PlaneMode plane_mode() {
+    if (flight_control.state() == flight::State::Failsafe) return mav::PlaneMode::FlyByWireA;
+    if (flight_control.chosen() == flight::Mode::Stabilize && !flight_control.without_attitude())
+        return mav::PlaneMode::Stabilize;
+    return mav::PlaneMode::Manual;
 }
 
 // HEARTBEAT and SYS_STATUS, once a second in `mode mavlink` (MAVLink's 1 Hz convention:
@@ -154,7 +312,8 @@ static void send_heartbeat_and_status() {
                                  ? mav::State::Calibrating
                                  : mav::State::Active;
     uint8_t frame[mav::kMaxFrame];
-    uint8_t n = mavlink.heartbeat(frame, state);
+    uint8_t n = mavlink.heartbeat(frame, flight_control.state() == flight::State::Failsafe ? mav::State::Critical : state,
+                                  plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = mavlink.sys_status(frame, mav::health(true, imu.ok(), true, compass.ok()), (uint16_t)(load_pct * 10u),
@@ -163,14 +322,14 @@ static void send_heartbeat_and_status() {
 }
 
 // One output line (or frame) in the chosen mode, none in quiet mode. Lines are written
-// only when they fit whole: a backlog of replies delays a line, never a sample.
-static void emit_output(uint32_t now_ms) {
-    const fmt::OutputMode mode = pipe.settings().mode;
-    if (mode == fmt::OutputMode::Quiet) return;
+// only when they fit whole: a backlog of replies delays a line, never a sample. True
+// when it worked out the angles in hundredths (c): the control step takes them.
+static bool emit_output(uint32_t now_ms, pipeline::AnglesCentideg& c) {
+    const fmt::OutputMode mode = output_mode();
+    if (mode == fmt::OutputMode::Quiet) return false;
     // Plot and csv lines print hundredths, which the integer path gives without a float;
     // MAVLink's ATTITUDE carries floats.
     pipeline::Angles a{};
-    pipeline::AnglesCentideg c{};
     if (mode == fmt::OutputMode::Mavlink) {
         board::mark_begin(board::kSecEuler);
         a = pipe.angles();
@@ -200,6 +359,7 @@ static void emit_output(uint32_t now_ms) {
     board::mark_end(board::kSecFormat);
     if (n > 0) serial_text::write_line_if_room(line, n);
     else if (warn_angle.allow(now_ms, 2000)) say(TXT(TXT_WARN "output not finite: line skipped"));
+    return mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv;
 }
 
 // ---------------------------------------------------------------------------
@@ -207,7 +367,7 @@ static void emit_output(uint32_t now_ms) {
 //
 // Nothing typed or pasted is lost: bytes are taken from Serial's 64-byte receive ring
 // and parsed at once, every loop iteration and again inside the step after the
-// estimator (at 115200 baud the ring fills in 5.6 ms; the longest step is ~4.5 ms), and
+// estimator (at 115200 baud the ring fills in 5.6 ms, longer than the longest step), and
 // the parsed commands wait in a queue. A reply goes out a part (a line) at a time, each
 // only when the output queue has room for it and an output line after it: a paste is
 // answered line by line as fast as the UART carries the replies, a reply never blocks
@@ -222,6 +382,9 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Error: return console::print_error(c, part, out);
         case console::CommandId::Help: return console::print_help(part, out);
         case console::CommandId::Status: return print_status(part);
+        case console::CommandId::Show:
+            if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            break;
         default: break;
     }
     if (part > 0) return false;
@@ -231,22 +394,49 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
         case console::CommandId::Defaults:
             pipe.restore_defaults();
+            flight_control.configure();
             console::print_defaults(out);
             break;
-        default: console::apply_setting(c, pipe.settings(), out); break;  // rate, decl, mode
+        case console::CommandId::Flight:
+            flight_control.choose(c.arg != 0 ? flight::Mode::Stabilize : flight::Mode::Manual);
+            print_flight_line(TXT("# flight "));
+            break;
+        case console::CommandId::Show:
+            if (c.arg == console::kShowRc) print_widths(TXT("# rc"), flight_control.rc_us());
+            else {
+                uint16_t widths[flight::kChannels];
+                for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
+                print_widths(TXT("# servo"), widths);
+            }
+            break;
+        case console::CommandId::Mode:
+            gcs_link = false;  // the mode typed, not the ground station's
+            console::apply_setting(c, pipe.settings(), out);
+            break;
+        default:  // rate, decl, set, get
+            console::apply_setting(c, pipe.settings(), out);
+            if (c.id == console::CommandId::Set) flight_control.configure();
+            break;
     }
     return true;
 }
 
 // Received bytes -> parsed commands, while the command queue has room (when it has none,
 // the bytes wait in Serial's ring).
+static void take_gcs_heartbeat();
 static void take_console_input() {
-    while (!commands.full()) {
+    while (!commands.full() && !mavlink_input.ready()) {
         const int b = Serial.read();
         if (b < 0) return;
         // In `mode mavlink`, a ground station's frames are set aside (not garbage to
-        // answer). Only then: 0xFD/0xFE in garbage would hide the next ~260 bytes.
-        if (mavlink_mode() && mavlink_input.consume((uint8_t)b)) continue;
+        // answer). In a text mode every byte is the console's too (0xFD/0xFE in garbage
+        // would hide the next ~260 bytes), and the parser only looks for a ground
+        // station's HEARTBEAT, which switches to MAVLink.
+        const bool was_mavlink = mavlink_mode();
+        if (mavlink_input.consume((uint8_t)b)) {
+            take_gcs_heartbeat();
+            if (was_mavlink || mavlink_mode()) continue;
+        }
         const console::Command c = reader.feed((uint8_t)b);
         if (c.id != console::CommandId::None) commands.push(c);
     }
@@ -263,11 +453,10 @@ static_assert(2u * mav::kMaxFrame + mav::kAttitudeFrame <= serial_text::kCapacit
               "serial_text's queue and Serial's ring hold a reply part and an output line");
 
 // A sample is missed when the next read comes more than 1.5 periods (7.5 ms) after the
-// previous one: a part starts only when it ends by 7.3 ms. What a part costs at most
-// (apm25sim --profile): a line 0.7 ms, status's bias or compass line 2.0 ms (seven
-// numbers from floats); in `mode mavlink`, with the STATUSTEXT packing, 2.1 and 3.8 ms.
-// A part that cannot start now waits for a step that leaves it time (a step takes
-// 0.7..5 ms, ~1.9 at least in `mode mavlink`).
+// previous one: a part starts only when it ends by 7.3 ms, by what a part costs at most
+// with a margin (README "Performance", console replies): `status`'s gyro bias and
+// compass lines (numbers from floats) cost the most, and `mode mavlink` adds the
+// STATUSTEXT packing. A part that cannot start now waits for a step that leaves it time.
 static uint32_t latest_start_us(bool float_lines) {
     if (mavlink_mode()) return float_lines ? 3500u : 5200u;
     return float_lines ? 5300u : 6000u;
@@ -288,6 +477,151 @@ static void run_console_command() {
 }
 
 // ---------------------------------------------------------------------------
+// The ground station link (lib/MavLink: Parser, ParamLink): its requests answered, the
+// radio and servo pages' streams. Replies go through the same queue as everything else,
+// each only when it fits whole with an output line after it and leaves time before the
+// next sample (latest_start_us), so no sample is missed and no frame dropped: a
+// PARAM_REQUEST_LIST's ~100 PARAM_VALUEs go out a few per loop step as the UART drains
+// them (~37 bytes each, ~3 ms at 115200 baud).
+
+mav::ParamReplies param_replies;
+static bool save_due = false;  // a PARAM_SET changed a value: save (start_save) when there is time
+static bool defaults_said_due = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
+constexpr uint16_t kStreamPeriodMs = 200;  // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
+static uint32_t last_stream_ms = 0;
+
+// Called for every frame end: a ground station's HEARTBEAT switches a text mode to
+// MAVLink; in a text mode the other requests are not answered (the ground station asks
+// again once the board speaks MAVLink).
+static void take_gcs_heartbeat() {
+    if (!mavlink_input.ready()) return;
+    if (mavlink_input.frame().msgid == mav::kMsgHeartbeat) {
+        mavlink_input.release();
+        if (!mavlink_mode()) {
+            gcs_link = true;
+            reader = console::LineReader();  // the frame's bytes so far are no command
+        }
+        return;
+    }
+    if (!mavlink_mode()) mavlink_input.release();
+}
+
+// A piece of the link's work starts only when it fits the queue and ends before the next
+// sample is late (7.5 ms after the last): what each costs at most (apm25sim --profile,
+// sections 14 and 15: README "Performance") with a margin.
+constexpr uint32_t kGcsRequestLatestUs = 2000;  // a request: up to PREFLIGHT_STORAGE defaults' reset
+constexpr uint32_t kGcsReplyLatestUs = 4000;    // a PARAM_VALUE, or the RC + servo pair
+constexpr uint32_t kGcsSaveLatestUs = 1500;     // SettingsStore::start_save (the record encoded)
+static bool gcs_can_send(uint8_t frame_bytes, uint32_t latest_us) {
+    return serial_text::room() >= frame_bytes + output_line_bytes() && imu.us_since_sample(micros()) <= latest_us;
+}
+
+static void send_frame(const uint8_t* frame, uint8_t n) {
+    serial_text::write(reinterpret_cast<const char*>(frame), n);
+}
+
+// MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
+// (`cal mag`); the others (baro, accel, airspeed ...) the board does not have.
+// MAV_CMD_PREFLIGHT_STORAGE: param1 1 write (`save`), 2 defaults (`defaults`, not
+// saved); 0 (read) UNSUPPORTED. The result comes as "# " lines.
+static mav::Result run_command(const mav::CommandLong& c) {
+    const float* p = c.param;
+    if (c.command == mav::kCmdPreflightCalibration) {
+        const bool gyro = p[0] == 1.0f, mag = p[1] == 1.0f;
+        for (uint8_t i = 2; i < 7; ++i)
+            if (p[i] != 0.0f) return mav::Result::Unsupported;
+        if (!gyro && !mag) return mav::Result::Unsupported;
+        if (pipe.gyro_calibrating() || pipe.mag_calibrating() || pipe.phase() != pipeline::Phase::Running)
+            return mav::Result::TemporarilyRejected;
+        if (gyro) pipe.start_gyro_calibration();
+        if (mag) pipe.start_mag_calibration();
+        return mav::Result::Accepted;
+    }
+    if (c.command == mav::kCmdPreflightStorage) {
+        // No read (param1 0): both slots read, checked and decoded take longer than a
+        // sample period (README "Ground stations"); a PARAM_SET is saved at once anyway.
+        if (p[0] == 1.0f) {
+            store.start_save(pipe.settings());
+        } else if (p[0] == 2.0f) {
+            pipe.restore_defaults();
+            defaults_said_due = true;
+        } else {
+            return mav::Result::Unsupported;
+        }
+        return mav::Result::Accepted;
+    }
+    return mav::Result::Unsupported;
+}
+
+static void take_gcs_request(const mav::Received& rx) {
+    mav::ParamRequest read;
+    mav::ParamSet set;
+    mav::CommandLong cmd;
+    if (mav::decode_param_request_list(rx)) {
+        param_replies.request_all();
+    } else if (mav::decode_param_request_read(rx, read)) {
+        const int16_t index = mav::requested_index(read);
+        if (index >= 0) param_replies.request_one((uint16_t)index);
+    } else if (mav::decode_param_set(rx, set)) {
+        bool changed = false;
+        const int16_t index = mav::apply_param_set(pipe.settings(), set, changed);
+        if (index >= 0) param_replies.request_one((uint16_t)index);
+        // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
+        // settings before it whole until the new ones are), in a pass of its own.
+        if (changed) save_due = true;
+    } else if (mav::decode_command_long(rx, cmd)) {
+        const mav::Result r = run_command(cmd);
+        uint8_t frame[mav::kMaxFrame];
+        send_frame(frame, mavlink.command_ack(frame, cmd.command, r, rx.sysid, rx.compid));
+    }
+}
+
+static void answer_ground_station(uint32_t now_ms) {
+    if (!mavlink_mode()) return;
+    uint8_t frame[mav::kMaxFrame];
+    // A request: room for its ACK (and the "# " lines a save or calibration says).
+    if (mavlink_input.ready() && gcs_can_send(2u * mav::kMaxFrame, kGcsRequestLatestUs)) {
+        board::mark_begin(board::kSecGcsRequest);
+        take_gcs_request(mavlink_input.frame());
+        mavlink_input.release();
+        board::mark_end(board::kSecGcsRequest);
+        return;
+    }
+    if (defaults_said_due && gcs_can_send(2u * mav::kMaxFrame, kGcsRequestLatestUs)) {
+        defaults_said_due = false;
+        console::print_defaults(out);
+        return;
+    }
+    if (save_due && gcs_can_send(2u * mav::kMaxFrame, kGcsSaveLatestUs)) {
+        save_due = false;
+        store.start_save(pipe.settings());
+        return;
+    }
+    uint16_t index;
+    if (param_replies.peek(index) && gcs_can_send(mav::kParamValueFrame, kGcsReplyLatestUs)) {
+        board::mark_begin(board::kSecGcsReply);
+        const uint8_t n = mav::pack_param_value(mavlink, frame, pipe.settings(), index, param_replies.count());
+        board::mark_end(board::kSecGcsReply);
+        if (n > 0) send_frame(frame, n);
+        param_replies.pop();
+        return;
+    }
+    if (now_ms - last_stream_ms >= kStreamPeriodMs && gcs_can_send(2u * mav::kRcChannelsFrame, kGcsReplyLatestUs)) {
+        last_stream_ms = now_ms;
+        board::mark_begin(board::kSecGcsReply);
+        const bool signal = flight_control.state() != flight::State::NoSignal &&
+                            flight_control.failsafe_cause() != flight::FailsafeCause::Lost;
+        uint8_t n = mavlink.rc_channels(frame, now_ms, flight_control.rc_us(), signal ? flight::kChannels : 0u);
+        send_frame(frame, n);
+        uint16_t widths[flight::kChannels];
+        for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
+        n = mavlink.servo_output_raw(frame, micros(), widths);
+        send_frame(frame, n);
+        board::mark_end(board::kSecGcsReply);
+    }
+}
+
+// ---------------------------------------------------------------------------
 // The 200 Hz step, once the MPU6000 has a sample.
 
 static void step(uint32_t now_us) {
@@ -300,9 +634,16 @@ static void step(uint32_t now_us) {
         board::mark_begin(board::kSecEstimator);
         pipe.on_imu_sample(sample);
         board::mark_end(board::kSecEstimator);
+        airspeed_step();
         take_console_input();
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
-        if (pipe.output_due()) emit_output(now_ms);
+        pipeline::AnglesCentideg c;
+        const bool output = pipe.output_due();
+        const bool have_angles = output && emit_output(now_ms, c);
+        ++control_count;
+        if (control_count >= kControlDivider ||
+            (output && control_count >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
+            control_step(now_us, now_ms, &sample, have_angles ? &c : nullptr);
     }
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
@@ -329,11 +670,24 @@ void setup() {
     say(TXT("# apm25-attitude 0.2.0: APM 2.5, 200 Hz loop\n"
             "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     store.load(pipe.settings());
+    // The outputs from here on, at trim and the throttle at its failsafe value until the
+    // receiver's first frame (the loaded settings' end points).
+    uint16_t widths[flight::kChannels];
+    flight_control.configure();  // the loaded settings
+    flight_control.step(0, flight::Attitude{0, 0, 0, 0, false}, widths);
+    servo_outputs::begin(widths);
+    rc_input::begin();
+    airspeed_begin();
     print_settings_line();
+    if (pipe.settings().flags & settings::kFlagUpgraded) {
+        pipe.settings().flags = (uint8_t)(pipe.settings().flags & ~settings::kFlagUpgraded);
+        say(TXT("# settings: a version 2 record: flight settings at their defaults (save to keep)"));
+    }
 
     board::spi_begin();
     wait_until_ms(pipeline::kMpuStartMs);
     imu.start(millis());
+    board::wake_on_data_ready();  // the loop idles between samples
 
     board::wire_begin();
     if (board::sda_low()) board::i2c_recover();
@@ -345,6 +699,7 @@ void setup() {
     user_setup();
     wait_until_ms(pipeline::kLoopStartMs);
     window_start_us = micros();
+    last_control_us = window_start_us;
     update_leds();
 }
 
@@ -352,6 +707,7 @@ void loop() {
     serial_text::pump();
     take_console_input();
     run_console_command();
+    answer_ground_station(millis());
     store.service();
     const uint32_t now_ms = millis();
     if (imu.retry(now_ms)) pipe.restart_estimator();
@@ -359,6 +715,10 @@ void loop() {
     user_loop();
 
     const uint32_t now_us = micros();
+    take_receiver_frames(now_ms);
+    if (now_us - last_control_us >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
+        control_step(now_us, now_ms, nullptr, nullptr);
+    }
     if (now_us - window_start_us >= 1000000u) {  // load over the last second
         load_pct = (uint8_t)(work_us / ((now_us - window_start_us) / 100u));
         work_us = 0;
@@ -368,7 +728,10 @@ void loop() {
         if (const uint16_t n = warn_angle.deferred(millis(), 2000))
             Writer(out).str(TXT(TXT_WARN "output not finite: ")).u32(n).str(TXT(" more lines skipped")).end();
     }
-    if (!imu.sample_ready(now_us)) return;
+    if (!imu.sample_ready(now_us)) {
+        board::idle_until_interrupt();  // until the next sample, a byte, a tick
+        return;
+    }
     step(now_us);
     if (pipe.steps() % 50u == 0u) update_leds();
 }

@@ -12,6 +12,7 @@
 #                                     (quat, csv, mavlink: the view reads them all)
 #   make view PORT=/dev/ttyACM0       ... by a real board (115200)
 #   make view FILE=stream.txt         ... by a recorded stream (text modes or MAVLink)
+#   make view FLIGHT=turn             ... by the simulated board flying (make fly VIEW=1)
 #   make view VIEW_FLAGS="--frames DIR"   headless: PNG frames into DIR, no window
 #
 # mavgen reads only the XML files beside common.xml (standard.xml, minimal.xml) and copies
@@ -48,6 +49,8 @@ ifeq ($(filter file undefined default,$(origin PORT)),)
 	$(VENV_PY) tools/view.py --port $(PORT) --baud $(BAUD) $(VIEW_FLAGS)
 else ifneq ($(FILE),)
 	$(VENV_PY) tools/view.py --file $(FILE) $(VIEW_FLAGS)
+else ifneq ($(FLIGHT),)
+	@$(MAKE) --no-print-directory -f mk/build.mk fly VIEW=1
 else
 	@$(MAKE) --no-print-directory firmware tools
 	@mkdir -p $(BUILD)/scenarios
@@ -81,5 +84,6 @@ mavlink-cost: $(MAVLINK_STAMP) tools
 	@$(BUILD)/apm25sim --elf $(MAVCOST_DIR)/cost.elf --trajectory $(MAVCOST_DIR)/rest.csv --seconds 0.2 \
 	  --profile $(MAVCOST_DIR)/profile.csv > /dev/null
 	@awk -F, 'BEGIN { n[1]="HEARTBEAT"; n[2]="ATTITUDE"; n[3]="SYS_STATUS"; n[4]="STATUSTEXT, 30-char line"; \
-	  n[5]="STATUSTEXT, 70-char line (2 chunks)"; n[7]="FrameFilter, 21-byte frame" } \
+	  n[5]="STATUSTEXT, 70-char line (2 chunks)"; n[7]="Parser, 21-byte HEARTBEAT frame"; \
+	  n[8]="RC_CHANNELS + SERVO_OUTPUT_RAW"; n[9]="Parser, 35-byte PARAM_SET (bad CRC)" } \
 	  ($$1 in n) { printf "# %-38s %6d cycles avg (min %d, max %d)\n", n[$$1], $$3, $$4, $$5 }' $(MAVCOST_DIR)/profile.csv

@@ -2,6 +2,7 @@
 // build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
 //
 //   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]
+//                [--airspeed M_S | --airspeed-log LOG.csv]
 //
 // The same pipeline as the board, minus the AVR: the simulator's register models
 // (sim/models) answer the very drivers the firmware runs (lib/MPU6000, lib/HMC5883)
@@ -15,14 +16,18 @@
 // (calibration, warnings) to stderr.
 #include <cstdio>
 #include <cstdlib>
+#include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "Hmc5883.h"
 #include "Hmc5883Model.h"
 #include "Mpu6000.h"
 #include "Mpu6000Model.h"
 #include "Pipeline.h"
+#include "PipelineText.h"
 #include "Text.h"
 #include "Trajectory.h"
 
@@ -38,7 +43,12 @@ void usage(FILE* out) {
             "  --log        the pipeline's messages (calibration, warnings) on stderr\n"
             "  --set NAME=VALUE  one of the estimator's settings instead of the firmware's\n"
             "               (lib/DCM/Dcm.h, DcmSettings; angles in degrees): for tuning and\n"
-            "               cross-validation (bench/tune.py). --set list prints them.\n");
+            "               cross-validation (bench/tune.py). --set list prints them.\n"
+            "  --airspeed M_S  the airspeed the pipeline is given (the centripetal\n"
+            "               correction; a configured cruise speed): default none\n"
+            "  --airspeed-log LOG.csv  the airspeed over time from a flight's state log\n"
+            "               (sim/flight: columns t and airspeed_m_s), given every\n"
+            "               8 steps as the firmware reads its sensor\n");
 }
 
 // The estimator's settings by name, for --set (DcmSettings in lib/DCM/Dcm.h).
@@ -137,10 +147,54 @@ void print_centideg(int32_t c, char end) {
 
 }  // namespace
 
+// The state log's airspeed (sim/flight/flightio.py LOG_HEADER: t and airspeed_m_s
+// columns), as (t, airspeed) pairs; false with a message when unreadable.
+bool load_airspeed_log(const std::string& path, std::vector<std::pair<double, double>>& out) {
+    FILE* f = fopen(path.c_str(), "r");
+    if (!f) {
+        fprintf(stderr, "replay: cannot open %s\n", path.c_str());
+        return false;
+    }
+    char line[1024];
+    int t_col = -1, v_col = -1;
+    if (fgets(line, sizeof line, f)) {
+        int col = 0;
+        for (char* tok = strtok(line, ",\r\n"); tok; tok = strtok(nullptr, ",\r\n"), ++col) {
+            if (strcmp(tok, "t") == 0) t_col = col;
+            if (strcmp(tok, "airspeed_m_s") == 0) v_col = col;
+        }
+    }
+    if (t_col < 0 || v_col < 0) {
+        fprintf(stderr, "replay: %s has no t and airspeed_m_s columns\n", path.c_str());
+        fclose(f);
+        return false;
+    }
+    int line_no = 1;
+    while (fgets(line, sizeof line, f)) {
+        ++line_no;
+        double t = NAN, v = NAN;
+        int col = 0;
+        for (char* tok = strtok(line, ",\r\n"); tok; tok = strtok(nullptr, ",\r\n"), ++col) {
+            if (col == t_col) t = strtod(tok, nullptr);
+            if (col == v_col) v = strtod(tok, nullptr);
+        }
+        if (!std::isfinite(t) || !std::isfinite(v)) {
+            fprintf(stderr, "replay: %s line %d: no finite t and airspeed_m_s\n", path.c_str(), line_no);
+            fclose(f);
+            return false;
+        }
+        out.emplace_back(t, v);
+    }
+    fclose(f);
+    return true;
+}
+
 int main(int argc, char** argv) {
     std::string path;
     double seconds = -1.0;
     bool log = false;
+    double airspeed_m_s = 0.0;
+    std::vector<std::pair<double, double>> airspeed_log;
     dcm::DcmSettings dcm_settings = dcm::kDefaultDcmSettings;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -153,6 +207,15 @@ int main(int argc, char** argv) {
                 fprintf(stderr, "replay: --seconds needs a positive number, not '%s'\n", argv[i]);
                 return 1;
             }
+        } else if (a == "--airspeed" && i + 1 < argc) {
+            char* end = nullptr;
+            airspeed_m_s = strtod(argv[++i], &end);
+            if (!end || *end || !(airspeed_m_s >= 0.0 && airspeed_m_s < 1000.0)) {
+                fprintf(stderr, "replay: --airspeed needs a speed in m/s, not '%s'\n", argv[i]);
+                return 1;
+            }
+        } else if (a == "--airspeed-log" && i + 1 < argc) {
+            if (!load_airspeed_log(argv[++i], airspeed_log)) return 1;
         } else if (a == "--log") {
             log = true;
         } else if (a == "--set" && i + 1 < argc) {
@@ -192,7 +255,8 @@ int main(int argc, char** argv) {
     // Set-up, in the firmware's order and on its timeline (firmware/firmware.ino setup()).
     mpu6000::Mpu6000 mpu(spi);
     hmc5883::Hmc5883 mag(i2c);
-    pipeline::AttitudePipeline pipe(log ? &log_sink : nullptr, dcm_settings);
+    const pipeline::EventSink log_events = pipeline_text::events_to(&log_sink);
+    pipeline::AttitudePipeline pipe(log ? &log_events : nullptr, dcm_settings);
     board.advance(pipeline::kMpuStartMs * 1e-3);
     const mpu6000::InitResult mpu_init = mpu.begin();
     if (mpu_init.status != mpu6000::InitStatus::Ok) {
@@ -207,6 +271,7 @@ int main(int argc, char** argv) {
     board.advance(pipeline::kLoopStartMs * 1e-3);
     printf("t,roll,pitch,yaw\n");
     uint32_t last_mag_read_step = 0;
+    size_t airspeed_cursor = 0;
     while (board.t_s < end_s) {
         // Wait for the data-ready line, as the loop does.
         while (!mpu_model.int_pin_high() && board.t_s < end_s) board.advance(mpu_model.next_event_s());
@@ -220,6 +285,15 @@ int main(int argc, char** argv) {
             linalg::Vector3f field_uT;
             if (mag.read(field_uT) == hmc5883::ReadStatus::Ok) pipe.on_mag_sample(field_uT);
             last_mag_read_step = pipe.steps();
+        }
+        if (pipe.steps() % 8u == 0u) {
+            if (!airspeed_log.empty()) {
+                while (airspeed_cursor + 1 < airspeed_log.size() && airspeed_log[airspeed_cursor + 1].first <= board.t_s)
+                    ++airspeed_cursor;
+                pipe.set_airspeed_m_s((float)airspeed_log[airspeed_cursor].second);
+            } else if (airspeed_m_s > 0.0) {
+                pipe.set_airspeed_m_s((float)airspeed_m_s);
+            }
         }
         pipe.on_imu_sample(sample);
         if (pipe.output_due()) {

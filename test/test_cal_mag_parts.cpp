@@ -9,6 +9,7 @@
 
 #include "Calibration.h"
 #include "Pipeline.h"
+#include "PipelineText.h"
 
 namespace {
 
@@ -64,7 +65,8 @@ TEST(CalMagParts, PartsGiveTheFitAtOnce) {
 TEST(CalMagParts, PipelineFitsAPartAStepAndThenGivesTheVerdict) {
     std::string log;
     const text::Sink sink{&log, sink_write};
-    pipeline::AttitudePipeline p(&sink);
+    const pipeline::EventSink events = pipeline_text::events_to(&sink);
+    pipeline::AttitudePipeline p(&events);
     p.set_mag_present(true);
     int step = 0;
     auto one_step = [&] {

@@ -243,8 +243,9 @@ TEST(Console, HelpListsEveryCommandOnHashLines) {
 TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
     console::CommandQueue q;
     EXPECT_TRUE(q.empty());
-    // Rates take 2 bytes: full (a decl might not fit) with 2 bytes left.
-    constexpr uint8_t kRates = (console::CommandQueue::kBytes - 2) / 2;
+    // Rates take 2 bytes: full (a set, the longest item, might not fit) with 4 bytes left.
+    constexpr uint8_t kRates = (console::CommandQueue::kBytes - 4) / 2;
+    static_assert(console::CommandQueue::kMaxItem == 6, "a set: id, index, int32");
     for (uint8_t i = 0; i < kRates; ++i) {
         EXPECT_FALSE(q.full());
         console::Command c = console::parse_line("rate 10");
@@ -253,7 +254,7 @@ TEST(CommandQueue, KeepsOrderAndRefusesWhenFull) {
     }
     EXPECT_TRUE(q.full());
     EXPECT_EQ(q.size(), kRates);
-    EXPECT_FALSE(q.push(console::parse_line("decl 5")));  // 3 bytes: 2 are left
+    EXPECT_FALSE(q.push(console::parse_line("set RLL2SRV_P 1")));  // 6 bytes: 4 are left
     // Oldest first, and the ring wraps: pop two, push a rate and a decl, then all in order.
     EXPECT_EQ(q.pop().value, 10);
     EXPECT_EQ(q.pop().value, 11);
@@ -279,7 +280,7 @@ TEST(CommandQueue, EveryKindComesBackAsParsed) {
     for (int round = 0; round < 20; ++round) {
         for (const char* line : lines) {
             const console::Command c = line[0] == '\x01' ? console::Command{CommandId::Error, console::Error::Garbage,
-                                                                                0, fmt::OutputMode::Plot}
+                                                                                0, fmt::OutputMode::Plot, 0}
                                                             : parse(line);
             ASSERT_TRUE(q.push(c)) << line;
             const console::Command back = q.pop();
@@ -291,9 +292,10 @@ TEST(CommandQueue, EveryKindComesBackAsParsed) {
         }
     }
     // The capacity in commands: one byte each for those without a number.
-    for (uint8_t i = 0; i < console::CommandQueue::kBytes - 2; ++i) ASSERT_TRUE(q.push(parse("help")));
+    constexpr uint8_t kHelps = console::CommandQueue::kBytes - console::CommandQueue::kMaxItem + 1;
+    for (uint8_t i = 0; i < kHelps; ++i) ASSERT_TRUE(q.push(parse("help")));
     EXPECT_TRUE(q.full());
-    EXPECT_EQ(q.size(), console::CommandQueue::kBytes - 2);
+    EXPECT_EQ(q.size(), kHelps);
 }
 
 TEST(CommandQueue, ErrorsBeyondTheirSlotsAreCountedAndCommandsStillFit) {

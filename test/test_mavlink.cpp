@@ -6,12 +6,19 @@
 #include <gtest/gtest.h>
 
 #include <stdint.h>
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
 #include <string.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
 #include "MavLink.h"
+#include "ParamLink.h"
+#include "Params.h"
+#include "Settings.h"
 
 namespace {
 
@@ -29,6 +36,9 @@ uint16_t x25(const uint8_t* p, size_t n, uint16_t crc = 0xFFFFu) {
 
 // The CRC_EXTRA seeds of common.xml (the MAVLink message set's published values).
 constexpr uint8_t kExtraHeartbeat = 50, kExtraAttitude = 39, kExtraSysStatus = 124, kExtraStatustext = 83;
+constexpr uint8_t kExtraParamValue = 220, kExtraParamSet = 168, kExtraParamRequestRead = 214,
+                  kExtraParamRequestList = 159, kExtraCommandLong = 152, kExtraCommandAck = 143,
+                  kExtraRcChannels = 118, kExtraServoOutputRaw = 222;
 
 struct Frame {
     uint8_t len, seq, sysid, compid;
@@ -67,10 +77,10 @@ float f32(const Bytes& p, size_t off) {
     return f;
 }
 
-TEST(MavLink, HeartbeatIsAGenericAutopilotOfComponentOne) {
+TEST(MavLink, HeartbeatIsAnArduPlaneOfComponentOneWithItsModeNumber) {
     mav::Packer p;
     uint8_t buf[mav::kMaxFrame];
-    const uint8_t n = p.heartbeat(buf, mav::State::Active);
+    const uint8_t n = p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Manual);
     ASSERT_EQ(n, mav::kHeartbeatFrame);
     ASSERT_EQ(n, 21u);
     const Frame f = parse(buf, n, kExtraHeartbeat);
@@ -80,19 +90,27 @@ TEST(MavLink, HeartbeatIsAGenericAutopilotOfComponentOne) {
     EXPECT_EQ(f.compid, 1u);  // MAV_COMP_ID_AUTOPILOT1
     EXPECT_EQ(f.seq, 0u);
     // Wire order: custom_mode (u32), type, autopilot, base_mode, system_status, mavlink_version.
-    EXPECT_EQ(u32(f.payload, 0), 0u);
-    EXPECT_EQ(u8(f.payload, 4), 0u);  // MAV_TYPE_GENERIC
-    EXPECT_EQ(u8(f.payload, 5), 0u);  // MAV_AUTOPILOT_GENERIC (not INVALID = 8)
-    EXPECT_EQ(u8(f.payload, 6), 0u);  // base_mode: never armed
+    EXPECT_EQ(u32(f.payload, 0), 0u);  // ArduPlane MANUAL
+    EXPECT_EQ(u8(f.payload, 4), 1u);   // MAV_TYPE_FIXED_WING
+    EXPECT_EQ(u8(f.payload, 5), 3u);   // MAV_AUTOPILOT_ARDUPILOTMEGA
+    // CUSTOM_MODE_ENABLED 1 | MANUAL_INPUT_ENABLED 64 | SAFETY_ARMED 128
+    EXPECT_EQ(u8(f.payload, 6), 1u + 64u + 128u);
     EXPECT_EQ(u8(f.payload, 7), 4u);  // MAV_STATE_ACTIVE
     EXPECT_EQ(u8(f.payload, 8), 3u);  // mavlink_version
+
+    const Frame s = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Stabilize), kExtraHeartbeat);
+    EXPECT_EQ(u32(s.payload, 0), 2u);                   // ArduPlane STABILIZE
+    EXPECT_EQ(u8(s.payload, 6), 1u + 16u + 64u + 128u);  // ... STABILIZE_ENABLED 16
+    const Frame fs = parse(buf, p.heartbeat(buf, mav::State::Critical, mav::PlaneMode::FlyByWireA), kExtraHeartbeat);
+    EXPECT_EQ(u32(fs.payload, 0), 5u);  // ArduPlane FLY_BY_WIRE_A: the failsafe glide
+    EXPECT_EQ(u8(fs.payload, 7), 5u);   // MAV_STATE_CRITICAL
 }
 
 TEST(MavLink, SequenceCountsAcrossMessagesAndWraps) {
     mav::Packer p;
     uint8_t buf[mav::kMaxFrame];
     for (int i = 0; i < 300; ++i) {
-        const uint8_t n = (i % 2 == 0) ? p.heartbeat(buf, mav::State::Boot)
+        const uint8_t n = (i % 2 == 0) ? p.heartbeat(buf, mav::State::Boot, mav::PlaneMode::Manual)
                                        : p.attitude(buf, 0u, 1.0f, 2.0f, 3.0f, linalg::Vector3f(0.1f, 0.2f, 0.3f));
         ASSERT_GT(n, 0u);
         EXPECT_EQ(buf[4], (uint8_t)(i & 0xFF));
@@ -276,10 +294,10 @@ TEST(MavLink, StatusTextDropsLinesThatAreNotHashLines) {
     EXPECT_EQ(p.next_sequence(), 1u);
 }
 
-TEST(MavLink, FrameFilterKeepsMavlinkAwayFromTheConsole) {
+TEST(MavLink, ParserKeepsMavlinkAwayFromTheConsole) {
     mav::Packer p;
     uint8_t hb[mav::kMaxFrame], st[mav::kMaxFrame];
-    const uint8_t n_hb = p.heartbeat(hb, mav::State::Active);
+    const uint8_t n_hb = p.heartbeat(hb, mav::State::Active, mav::PlaneMode::Manual);
     const uint8_t n_st = p.statustext(st, mav::Severity::Info, "status\nhelp\r", 12, 0u, 0u);
     Bytes in;
     const std::string typed = "status\n";
@@ -296,12 +314,21 @@ TEST(MavLink, FrameFilterKeepsMavlinkAwayFromTheConsole) {
     in.insert(in.end(), signed_frame.begin(), signed_frame.end());
     in.push_back('x');
 
-    mav::FrameFilter ff;
+    mav::Parser ff;
     std::string text;
-    for (uint8_t b : in)
+    unsigned heartbeats = 0;
+    for (uint8_t b : in) {
         if (!ff.consume(b)) text += (char)b;
+        if (ff.ready()) {
+            heartbeats += ff.frame().msgid == mav::kMsgHeartbeat;
+            ff.release();
+        }
+    }
     EXPECT_EQ(text, "status\nstatus\nx");
     EXPECT_EQ(ff.frames(), 4u);
+    EXPECT_EQ(heartbeats, 1u);
+    // The v1 and the signed frame are PARAM_REQUEST_LIST with a made-up CRC.
+    EXPECT_EQ(ff.bad_crc(), 2u);
 }
 
 TEST(MavLink, StatustextRejectsMoreThanOneChunk) {
@@ -314,6 +341,471 @@ TEST(MavLink, StatustextRejectsMoreThanOneChunk) {
                                    50, 0u, 0u);
     EXPECT_EQ(n, mav::kMaxFrame - 3u) << "50 characters, id and chunk_seq zero (trimmed)";
     EXPECT_EQ(decode_text(Bytes(buf, buf + n)).text.size(), 50u);
+}
+
+// --- Incoming frames -------------------------------------------------------------------
+
+// header + payload + the CRC over both after STX, then CRC_EXTRA.
+Bytes with_crc(Bytes f, const Bytes& payload, uint8_t crc_extra) {
+    f.insert(f.end(), payload.begin(), payload.end());
+    uint16_t crc = x25(f.data() + 1, f.size() - 1);
+    crc = x25(&crc_extra, 1, crc);
+    f.push_back((uint8_t)(crc & 0xFF));
+    f.push_back((uint8_t)(crc >> 8));
+    return f;
+}
+
+// A frame as a ground station sends it, built here from the wire format (not by lib/MavLink).
+Bytes frame_v2(uint8_t msgid, uint8_t crc_extra, Bytes payload, uint8_t seq = 7, bool trim = true) {
+    while (trim && payload.size() > 1 && payload.back() == 0) payload.pop_back();  // MAVLink 2 trimming
+    return with_crc(Bytes{0xFD, (uint8_t)payload.size(), 0, 0, seq, 255, 190, msgid, 0, 0}, payload, crc_extra);
+}
+
+Bytes frame_v1(uint8_t msgid, uint8_t crc_extra, const Bytes& payload, uint8_t seq = 3) {
+    return with_crc(Bytes{0xFE, (uint8_t)payload.size(), seq, 255, 190, msgid}, payload, crc_extra);
+}
+
+void put_f32(Bytes& b, float v) {
+    uint8_t raw[4];
+    memcpy(raw, &v, 4);
+    b.insert(b.end(), raw, raw + 4);
+}
+void put_id(Bytes& b, const std::string& id) {
+    for (size_t i = 0; i < 16; ++i) b.push_back(i < id.size() ? (uint8_t)id[i] : 0u);
+}
+
+// PARAM_SET payload: param_value (f32), target_system, target_component, param_id[16], param_type.
+Bytes param_set_payload(const std::string& id, float value, uint8_t target_system = 1) {
+    Bytes b;
+    put_f32(b, value);
+    b.push_back(target_system);
+    b.push_back(1);
+    put_id(b, id);
+    b.push_back(9);
+    return b;
+}
+
+// COMMAND_LONG payload: param1..7 (f32), command (u16), target_system, target_component, confirmation.
+Bytes command_long_payload(uint16_t command, const float (&param)[7]) {
+    Bytes b;
+    for (float v : param) put_f32(b, v);
+    b.push_back((uint8_t)(command & 0xFF));
+    b.push_back((uint8_t)(command >> 8));
+    b.push_back(1);
+    b.push_back(0);
+    b.push_back(0);
+    return b;
+}
+
+// Feeds bytes; returns the frames that came out ready (copied), releasing each.
+std::vector<mav::Received> feed(mav::Parser& parser, const Bytes& in, std::string* text = nullptr) {
+    std::vector<mav::Received> got;
+    for (uint8_t b : in) {
+        const bool framed = parser.consume(b);
+        if (!framed && text != nullptr) *text += (char)b;
+        if (parser.ready()) {
+            got.push_back(parser.frame());
+            parser.release();
+        }
+    }
+    return got;
+}
+
+TEST(MavLinkParser, ParamSetInMavlink2TrimmedAndInMavlink1) {
+    for (int v1 = 0; v1 < 2; ++v1) {
+        mav::Parser parser;
+        const Bytes payload = param_set_payload("RLL2SRV_P", 1.5f);
+        const Bytes f = v1 ? frame_v1(23, kExtraParamSet, payload) : frame_v2(23, kExtraParamSet, payload);
+        const auto got = feed(parser, f);
+        ASSERT_EQ(got.size(), 1u) << (v1 ? "v1" : "v2");
+        EXPECT_EQ(got[0].msgid, mav::kMsgParamSet);
+        EXPECT_EQ(got[0].sysid, 255u);
+        EXPECT_EQ(got[0].compid, 190u);
+        mav::ParamSet ps;
+        ASSERT_TRUE(mav::decode_param_set(got[0], ps));
+        EXPECT_STREQ(ps.name, "RLL2SRV_P");
+        EXPECT_EQ(ps.value, 1.5f);
+        EXPECT_EQ(parser.bad_crc(), 0u);
+    }
+}
+
+TEST(MavLinkParser, TrimmedPayloadIsZeroFilled) {
+    // PARAM_REQUEST_READ by index 5: param_index (i16), targets, param_id all zero: the
+    // MAVLink 2 frame carries 4 bytes of 20.
+    Bytes payload = {5, 0, 1, 1};
+    payload.resize(20, 0);
+    const Bytes f = frame_v2(20, kExtraParamRequestRead, payload);
+    ASSERT_EQ(f[1], 4u);
+    mav::Parser parser;
+    const auto got = feed(parser, f);
+    ASSERT_EQ(got.size(), 1u);
+    mav::ParamRequest r;
+    ASSERT_TRUE(mav::decode_param_request_read(got[0], r));
+    EXPECT_EQ(r.index, 5);
+    EXPECT_STREQ(r.name, "");
+}
+
+TEST(MavLinkParser, SixteenCharacterNameHasNoTerminatorOnTheWire) {
+    Bytes payload = {0xFF, 0xFF, 0, 0};  // index -1: by name; target 0/0: everyone
+    put_id(payload, "SERVO8_REVERSED1");  // 16 characters (not a parameter: the field is full)
+    mav::Parser parser;
+    const auto got = feed(parser, frame_v2(20, kExtraParamRequestRead, payload));
+    ASSERT_EQ(got.size(), 1u);
+    mav::ParamRequest r;
+    ASSERT_TRUE(mav::decode_param_request_read(got[0], r));
+    EXPECT_EQ(r.index, -1);
+    EXPECT_STREQ(r.name, "SERVO8_REVERSED1");
+    EXPECT_EQ(mav::requested_index(r), -1);
+}
+
+TEST(MavLinkParser, BadCrcIsCountedNotTakenAndTheNextFrameIs) {
+    mav::Parser parser;
+    Bytes bad = frame_v2(23, kExtraParamSet, param_set_payload("RLL2SRV_P", 2.0f));
+    bad[12] ^= 0x01;  // one payload bit
+    Bytes wrong_extra = frame_v2(23, kExtraParamSet + 1, param_set_payload("RLL2SRV_P", 2.0f));
+    Bytes in = bad;
+    in.insert(in.end(), wrong_extra.begin(), wrong_extra.end());
+    const Bytes good = frame_v2(21, kExtraParamRequestList, Bytes{1, 1});
+    in.insert(in.end(), good.begin(), good.end());
+    const auto got = feed(parser, in);
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_EQ(got[0].msgid, mav::kMsgParamRequestList);
+    EXPECT_TRUE(mav::decode_param_request_list(got[0]));
+    EXPECT_EQ(parser.bad_crc(), 2u);
+    EXPECT_EQ(parser.frames(), 3u);
+}
+
+TEST(MavLinkParser, TruncatedFrameLosesItselfAndAtMostTheNextOne) {
+    mav::Parser parser;
+    const Bytes whole = frame_v2(23, kExtraParamSet, param_set_payload("RLL2SRV_P", 2.0f));
+    Bytes in(whole.begin(), whole.begin() + 15);  // cut short (a link dropout)
+    const Bytes list = frame_v2(21, kExtraParamRequestList, Bytes{1, 1});
+    for (int i = 0; i < 4; ++i) in.insert(in.end(), list.begin(), list.end());
+    const auto got = feed(parser, in);
+    // The cut frame claims 21 more bytes: the first request (14 bytes) and 7 of the
+    // second are taken as its rest and fail its CRC; the parser then finds the next STX.
+    EXPECT_EQ(parser.bad_crc(), 1u);
+    EXPECT_GE(got.size(), 2u);
+    for (const auto& r : got) EXPECT_EQ(r.msgid, mav::kMsgParamRequestList);
+}
+
+TEST(MavLinkParser, GarbageNeverMakesAFrameAndTheParserRecovers) {
+    std::vector<uint8_t> noise;
+    uint32_t x = 12345u;
+    for (int i = 0; i < 200000; ++i) {
+        x = x * 1103515245u + 12345u;
+        noise.push_back((uint8_t)(x >> 16));
+    }
+    // Runs of STX with lengths that fit our messages, to reach the CRC check often.
+    for (int i = 0; i < 2000; ++i) {
+        noise.push_back(0xFD);
+        noise.push_back((uint8_t)(i % 34));
+    }
+    mav::Parser parser;
+    const auto got = feed(parser, noise);
+    EXPECT_EQ(got.size(), 0u) << "a frame out of noise";
+    EXPECT_GT(parser.frames(), 500u);
+    // The longest frame is 280 bytes: after that many non-STX bytes, the next frame is whole.
+    Bytes in(280, 'x');
+    const Bytes good = frame_v2(0, kExtraHeartbeat, Bytes{0, 0, 0, 0, 6, 8, 0, 0, 3});
+    in.insert(in.end(), good.begin(), good.end());
+    const auto after = feed(parser, in);
+    ASSERT_EQ(after.size(), 1u);
+    EXPECT_EQ(after[0].msgid, mav::kMsgHeartbeat);
+}
+
+TEST(MavLinkParser, RequestsForAnotherSystemOrComponentAreNotOurs) {
+    mav::Parser parser;
+    auto got = feed(parser, frame_v2(23, kExtraParamSet, param_set_payload("RLL2SRV_P", 2.0f, 2)));
+    ASSERT_EQ(got.size(), 1u);
+    mav::ParamSet ps;
+    EXPECT_FALSE(mav::decode_param_set(got[0], ps));
+    EXPECT_FALSE(mav::decode_param_request_list(got[0])) << "not that message";
+    got = feed(parser, frame_v2(21, kExtraParamRequestList, Bytes{1, 2}));
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_FALSE(mav::decode_param_request_list(got[0]));
+    got = feed(parser, frame_v2(21, kExtraParamRequestList, Bytes{0, 0}));
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_TRUE(mav::decode_param_request_list(got[0])) << "0/0: broadcast";
+}
+
+TEST(MavLinkParser, LongerPayloadThanTheMessagesIsNotTaken) {
+    Bytes payload = param_set_payload("RLL2SRV_P", 2.0f);
+    payload.push_back(1);  // 24 bytes: no PARAM_SET is that long (an extension we do not know)
+    mav::Parser parser;
+    EXPECT_EQ(feed(parser, frame_v2(23, kExtraParamSet, payload)).size(), 0u);
+    EXPECT_EQ(parser.frames(), 1u);
+}
+
+TEST(MavLinkParser, CommandLongDecodes) {
+    const float param[7] = {1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    mav::Parser parser;
+    const auto got = feed(parser, frame_v2(76, kExtraCommandLong, command_long_payload(241, param)));
+    ASSERT_EQ(got.size(), 1u);
+    mav::CommandLong c;
+    ASSERT_TRUE(mav::decode_command_long(got[0], c));
+    EXPECT_EQ(c.command, mav::kCmdPreflightCalibration);
+    EXPECT_EQ(c.param[0], 1.0f);
+    EXPECT_EQ(c.param[6], 0.0f);
+}
+
+// --- Outgoing replies and streams ------------------------------------------------------
+
+TEST(MavLink, ParamValueCommandAckRcChannelsServoOutputRawOnTheWire) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    uint8_t n = p.param_value(buf, "SERVO8_REVERSED", 1.0f, mav::kParamTypeInt8, 97u, 96u);
+    ASSERT_EQ(n, mav::kParamValueFrame);
+    Frame f = parse(buf, n, kExtraParamValue);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 22u);
+    // Wire order: param_value (f32), param_count, param_index (u16), param_id[16], param_type.
+    EXPECT_EQ(f32(f.payload, 0), 1.0f);
+    EXPECT_EQ(u16(f.payload, 4), 97u);
+    EXPECT_EQ(u16(f.payload, 6), 96u);
+    EXPECT_EQ(std::string((const char*)f.payload.data() + 8, 15), "SERVO8_REVERSED");
+    EXPECT_EQ(u8(f.payload, 8 + 15), 0u);
+    EXPECT_EQ(u8(f.payload, 24), 2u);
+
+    n = p.command_ack(buf, 245, mav::Result::Unsupported, 255u, 190u);
+    f = parse(buf, n, kExtraCommandAck);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 77u);
+    // command (u16), result, progress, result_param2 (i32), target_system, target_component.
+    EXPECT_EQ(u16(f.payload, 0), 245u);
+    EXPECT_EQ(u8(f.payload, 2), 3u);
+    EXPECT_EQ(u8(f.payload, 8), 255u);
+    EXPECT_EQ(u8(f.payload, 9), 190u);
+
+    const uint16_t w[8] = {1001, 1102, 1203, 1304, 1405, 1506, 1607, 1708};
+    n = p.rc_channels(buf, 123456u, w, 8u);
+    ASSERT_EQ(n, mav::kRcChannelsFrame);
+    f = parse(buf, n, kExtraRcChannels);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 65u);
+    // time_boot_ms, chan1..18_raw (u16), chancount, rssi.
+    EXPECT_EQ(u32(f.payload, 0), 123456u);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(u16(f.payload, 4 + 2 * (size_t)i), w[i]);
+    for (int i = 8; i < 18; ++i) EXPECT_EQ(u16(f.payload, 4 + 2 * (size_t)i), 0xFFFFu) << "unused channel";
+    EXPECT_EQ(u8(f.payload, 40), 8u);
+    EXPECT_EQ(u8(f.payload, 41), 255u);
+
+    n = p.servo_output_raw(buf, 4000000u, w);
+    f = parse(buf, n, kExtraServoOutputRaw);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 36u);
+    EXPECT_EQ(n, mav::kFrameOverhead + 20u) << "port 0 and servo9..16 (extensions) zero: trimmed";
+    // time_usec (u32), servo1..8_raw (u16), port.
+    EXPECT_EQ(u32(f.payload, 0), 4000000u);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(u16(f.payload, 4 + 2 * (size_t)i), w[i]);
+    EXPECT_EQ(u8(f.payload, 20), 0u);
+}
+
+// --- The parameter protocol over lib/Params ---------------------------------------------
+
+TEST(ParamLink, EveryIndexPacksItsNameValueTypeAndCount) {
+    settings::Settings s = settings::defaults();
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const uint16_t count = params::count();
+    ASSERT_GT(count, 90u);
+    std::vector<std::string> names;
+    for (uint16_t i = 0; i < count; ++i) {
+        const uint8_t n = mav::pack_param_value(p, buf, s, i, count);
+        ASSERT_EQ(n, mav::kParamValueFrame);
+        const Frame f = parse(buf, n, kExtraParamValue);
+        ASSERT_TRUE(f.crc_ok);
+        params::Info in;
+        ASSERT_TRUE(params::info(i, in));
+        EXPECT_EQ(u16(f.payload, 4), count);
+        EXPECT_EQ(u16(f.payload, 6), i);
+        const std::string name((const char*)f.payload.data() + 8, strnlen((const char*)f.payload.data() + 8, 16));
+        EXPECT_EQ(name, in.name);
+        EXPECT_EQ(f32(f.payload, 0), params::get(s, i)) << name;
+        EXPECT_EQ(f32(f.payload, 0), in.def) << name << ": defaults";
+        const uint8_t type = u8(f.payload, 24);
+        if (params::is_integer(in.type)) {
+            EXPECT_TRUE(type == 2u || type == 4u) << name;
+            // The value fits the type ArduPilot's GCS code reads it as.
+            EXPECT_LE(in.max, type == 2u ? 127.0f : 32767.0f) << name;
+            EXPECT_GE(in.min, type == 2u ? -128.0f : -32768.0f) << name;
+        } else {
+            EXPECT_EQ(type, 9u) << name;
+        }
+        names.push_back(name);
+    }
+    EXPECT_EQ(mav::pack_param_value(p, buf, s, count, count), 0u) << "past the end";
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(std::adjacent_find(names.begin(), names.end()), names.end()) << "a name twice";
+}
+
+TEST(ParamLink, ReadByIndexOrName) {
+    mav::ParamRequest r{};
+    r.index = 3;
+    EXPECT_EQ(mav::requested_index(r), 3);
+    r.index = (int16_t)params::count();
+    EXPECT_EQ(mav::requested_index(r), -1);
+    r.index = -1;
+    strcpy(r.name, "COMPASS_DEC");
+    EXPECT_EQ(mav::requested_index(r), params::find("COMPASS_DEC"));
+    strcpy(r.name, "NO_SUCH_PARAM");
+    EXPECT_EQ(mav::requested_index(r), -1);
+    // params::find's one pass over the rows: every name, in either case, and near misses.
+    for (uint16_t i = 0; i < params::count(); ++i) {
+        params::Info in;
+        ASSERT_TRUE(params::info(i, in));
+        strcpy(r.name, in.name);
+        EXPECT_EQ(mav::requested_index(r), (int16_t)i) << in.name;
+        for (char* c = r.name; *c; ++c) *c = (char)tolower(*c);
+        EXPECT_EQ(mav::requested_index(r), (int16_t)i) << r.name;
+    }
+    for (const char* miss : {"RC0_MIN", "RC9_MIN", "RC#_MIN", "RC1_MI", "RC1_MINX", "SERVO10_MIN", "FLTMODE7",
+                             "FLTMODE0", "FLTMODE", "", "RLL2SRV_PX", "RLL2SRV_"}) {
+        strcpy(r.name, miss);
+        EXPECT_EQ(mav::requested_index(r), -1) << miss;
+    }
+}
+
+TEST(ParamLink, SetAppliesInRangeAndKeepsTheOldValueOtherwise) {
+    settings::Settings s = settings::defaults();
+    mav::ParamSet ps{};
+    strcpy(ps.name, "RLL2SRV_P");
+    ps.value = 1.25f;
+    bool changed = false;
+    const int16_t i = mav::apply_param_set(s, ps, changed);
+    ASSERT_EQ(i, params::find("RLL2SRV_P"));
+    EXPECT_TRUE(changed);
+    EXPECT_EQ(s.flight.roll.p, 1.25f);
+    ps.value = 9.0f;  // above its 4.0
+    EXPECT_EQ(mav::apply_param_set(s, ps, changed), i);
+    EXPECT_FALSE(changed);
+    EXPECT_EQ(params::get(s, (uint16_t)i), 1.25f) << "the reply carries the value in force";
+    ps.value = 1.25f;
+    mav::apply_param_set(s, ps, changed);
+    EXPECT_FALSE(changed) << "the same value: nothing to save";
+    strcpy(ps.name, "SERVO1_TRIM");
+    ps.value = 2100.0f;  // above SERVO1_MAX 2000: end points out of order
+    mav::apply_param_set(s, ps, changed);
+    EXPECT_FALSE(changed);
+    EXPECT_EQ(s.flight.servo[0].trim_us, 1500u);
+    strcpy(ps.name, "THR_FS_OUT");
+    ps.value = 12.5f;  // not whole
+    mav::apply_param_set(s, ps, changed);
+    EXPECT_FALSE(changed);
+    strcpy(ps.name, "rll2srv_i");  // ground stations send upper case; the table takes either
+    ps.value = 0.5f;
+    EXPECT_EQ(mav::apply_param_set(s, ps, changed), params::find("RLL2SRV_I"));
+    EXPECT_TRUE(changed);
+    strcpy(ps.name, "NOPE");
+    EXPECT_EQ(mav::apply_param_set(s, ps, changed), -1);
+}
+
+TEST(ParamLink, RepliesSinglesFirstThenTheWholeListOnce) {
+    mav::ParamReplies r;
+    uint16_t index = 0;
+    EXPECT_FALSE(r.peek(index));
+    r.request_all();
+    r.request_one(40);
+    std::vector<uint16_t> sent;
+    for (int k = 0; k < 5; ++k) {
+        ASSERT_TRUE(r.peek(index));
+        sent.push_back(index);
+        r.pop();
+    }
+    r.request_one(7);  // a READ in the middle of the list
+    while (r.peek(index)) {
+        sent.push_back(index);
+        r.pop();
+        ASSERT_LT(sent.size(), 400u);
+    }
+    ASSERT_EQ(sent.size(), params::count() + 2u);
+    EXPECT_EQ(sent[0], 40u);
+    EXPECT_EQ(sent[1], 0u);
+    EXPECT_EQ(sent[5], 7u);
+    std::vector<uint16_t> list(sent.begin() + 1, sent.begin() + 5);
+    list.insert(list.end(), sent.begin() + 6, sent.end());
+    for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(list[i], i);
+    // More singles than it holds: the extra ones are dropped, none repeated.
+    for (uint16_t i = 0; i < 10; ++i) r.request_one(i);
+    unsigned n = 0;
+    while (r.peek(index)) {
+        EXPECT_EQ(index, n);
+        r.pop();
+        ++n;
+    }
+    EXPECT_EQ(n, (unsigned)mav::ParamReplies::kSingles);
+}
+
+// --- The README's parameter table ---------------------------------------------------------
+
+std::vector<std::string> split_cells(const std::string& line) {
+    std::vector<std::string> cells;
+    size_t at = 1;
+    while (at < line.size()) {
+        const size_t bar = line.find('|', at);
+        if (bar == std::string::npos) break;
+        std::string c = line.substr(at, bar - at);
+        while (!c.empty() && c.front() == ' ') c.erase(c.begin());
+        while (!c.empty() && c.back() == ' ') c.pop_back();
+        cells.push_back(c);
+        at = bar + 1;
+    }
+    return cells;
+}
+
+TEST(MavLink, ReadmeParameterTableIsTheCodes) {
+    std::string path(__FILE__);
+    path = path.substr(0, path.rfind('/')) + "/../README.md";
+    FILE* f = fopen(path.c_str(), "r");
+    ASSERT_NE(f, nullptr) << path;
+    std::vector<std::string> lines;
+    char buf[1024];
+    while (fgets(buf, sizeof buf, f)) {
+        std::string l(buf);
+        while (!l.empty() && (l.back() == '\n' || l.back() == '\r')) l.pop_back();
+        lines.push_back(l);
+    }
+    fclose(f);
+    size_t at = 0;
+    while (at < lines.size() && lines[at] != "#### Parameters") ++at;
+    ASSERT_LT(at, lines.size()) << "no '#### Parameters' heading";
+    while (at < lines.size() && lines[at].rfind("| name | unit | range | default |", 0) != 0) ++at;
+    ASSERT_LT(at, lines.size()) << "no table after it";
+    at += 2;
+    std::vector<int> covered(params::count(), 0);
+    unsigned rows = 0;
+    for (; at < lines.size() && lines[at].rfind("| `", 0) == 0; ++at, ++rows) {
+        const std::vector<std::string> c = split_cells(lines[at]);
+        ASSERT_EQ(c.size(), 5u) << lines[at];
+        const size_t tick = c[0].find('`', 1);
+        ASSERT_NE(tick, std::string::npos) << lines[at];
+        const std::string name = c[0].substr(1, tick - 1);
+        int first = 0, last = 0;
+        const size_t n_at = name.find('n');
+        if (n_at != std::string::npos)
+            ASSERT_EQ(sscanf(c[0].c_str() + tick + 1, " (n %d-%d)", &first, &last), 2) << lines[at];
+        float lo = 0, hi = 0, def = 0;
+        ASSERT_EQ(sscanf(c[2].c_str(), "%f to %f", &lo, &hi), 2) << lines[at];
+        ASSERT_EQ(sscanf(c[3].c_str(), "%f", &def), 1) << lines[at];
+        for (int k = first; k <= last; ++k) {
+            std::string expanded = name;
+            if (n_at != std::string::npos) expanded[n_at] = (char)('0' + k);
+            const int16_t i = params::find(expanded.c_str());
+            ASSERT_GE(i, 0) << expanded << ": not a parameter";
+            ++covered[(size_t)i];
+            params::Info in;
+            ASSERT_TRUE(params::info((uint16_t)i, in));
+            const auto close = [](float a, float b) { return fabsf(a - b) <= 1e-4f * fmaxf(1.0f, fabsf(b)); };
+            EXPECT_TRUE(close(lo, in.min) && close(hi, in.max)) << expanded << " range " << c[2];
+            EXPECT_TRUE(close(def, in.def)) << expanded << " default " << c[3];
+        }
+    }
+    EXPECT_GT(rows, 30u);
+    for (uint16_t i = 0; i < params::count(); ++i) {
+        params::Info in;
+        params::info(i, in);
+        EXPECT_EQ(covered[i], 1) << in.name << " in the README's table " << covered[i] << " times";
+    }
 }
 
 }  // namespace

@@ -219,3 +219,52 @@ TEST(RecordSlots, SlotOfAnotherRecordLengthIsRefused) {
 }
 
 }  // namespace
+
+// The store writes a slot a byte at a time from the live settings (firmware/SettingsStore):
+// record_byte and header_byte are encode's bytes, the CRCs run to slot_crc's.
+TEST(RecordSlots, ByteAtATimeIsTheEncodedSlot) {
+    for (uint8_t n = 0; n < 3; ++n) {
+        Settings s = numbered(n);
+        s.flight.elevon_output = n == 1 ? 1 : 0;
+        s.flight.roll.p = 0.5f + 0.25f * n;
+        s.flight.servo[7].trim_us = (uint16_t)(1400 + n);
+        const std::vector<uint8_t> record = record_of(s);
+        const uint16_t sequence = (uint16_t)(0xFFFEu + n);
+        std::vector<uint8_t> slot(slots::kSlotSize);
+        slots::encode(record.data(), sequence, slot.data());
+        uint16_t crc = settings::kCrc16Init;
+        for (uint8_t i = 0; i < slots::kHeaderSize; ++i) {
+            EXPECT_EQ(slots::header_byte(sequence, i), slot[i]) << "header byte " << (int)i;
+            crc = settings::crc16_update(crc, slot[i]);
+        }
+        for (uint8_t i = 0; i + 2u < settings::kRecordSize; ++i) {
+            for (uint8_t n = 1; n <= 17 && i + n + 2u <= settings::kRecordSize; n = (uint8_t)(n + 8)) {
+                uint8_t part[17];
+                settings::record_part(s, i, n, part);
+                ASSERT_EQ(0, std::memcmp(part, record.data() + i, n)) << "record bytes " << (int)i << "+" << (int)n;
+            }
+            crc = settings::crc16_update(crc, record[i]);
+        }
+        const uint16_t covered = (uint16_t)(slots::kHeaderSize + settings::kRecordSize);
+        crc = settings::crc16_update(settings::crc16_update(crc, slot[covered - 2u]), slot[covered - 1u]);
+        EXPECT_EQ(crc, slots::slot_crc(record.data(), sequence));
+        EXPECT_EQ(crc, (uint16_t)(slot[covered] | slot[covered + 1u] << 8));
+    }
+}
+
+// crc16_update's byte-at-once form is CRC-16/CCITT-FALSE: the check value, and the
+// bitwise definition (poly 0x1021, MSB first) for every state and byte.
+TEST(RecordSlots, Crc16IsCcittFalse) {
+    const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    EXPECT_EQ(0x29B1u, settings::crc16(check, sizeof check));
+    for (uint32_t state = 0; state < 0x10000u; ++state) {
+        for (uint16_t byte = 0; byte < 256; ++byte) {
+            uint16_t bitwise = (uint16_t)(state ^ (byte << 8));
+            for (uint8_t b = 0; b < 8; ++b)
+                bitwise = (bitwise & 0x8000u) ? (uint16_t)((uint16_t)(bitwise << 1) ^ 0x1021u) : (uint16_t)(bitwise << 1);
+            if (settings::crc16_update((uint16_t)state, (uint8_t)byte) != bitwise) {
+                FAIL() << "state " << state << " byte " << byte;
+            }
+        }
+    }
+}

@@ -194,8 +194,10 @@ TEST(Settings, OutOfRangeValueWithGoodCrcGivesDefaults) {
 
 TEST(Settings, EveryOutputModeIsStoredAndNothingBeyondTheLast) {
     // quat, raw and mavlink are new values of the mode byte: they need no new field in
-    // the record (version 2's 65 bytes: the compass calibration's terms).
-    EXPECT_EQ(settings::kPayloadLength, 65u);
+    // the record (version 2's 65 bytes: the compass calibration's terms; version 3 adds
+    // the flight settings after them).
+    EXPECT_EQ(settings::kV2PayloadLength, 65u);
+    EXPECT_EQ(settings::kPayloadLength, 65u + settings::kFlightBytes);
     for (uint8_t m = 0; m <= (uint8_t)fmt::kLastOutputMode; ++m) {
         Settings in = sample();
         in.mode = (fmt::OutputMode)m;

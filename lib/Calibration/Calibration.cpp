@@ -323,7 +323,7 @@ bool MagCalibrator::fit_sphere() {
 // count - b^T t = count - |L^-1 b|^2.
 static const uint8_t kEllipsoidRegressors[MagCalibrator::kUnknowns] CALIB_PROGMEM = {
     2 * kX, 2 * kY, 2 * kZ, kY + kZ, kX + kZ, kX + kY, kX, kY, kZ};
-void MagCalibrator::normal_equations() {
+FIXED_COLD void MagCalibrator::normal_equations() {
     Work::Normal n;  // built apart: the sums are read while it is written
     float largest = 0.0f;
     for (uint8_t p = 0; p < kUnknowns; ++p) {
@@ -339,7 +339,7 @@ void MagCalibrator::normal_equations() {
 
 // Columns first_column .. first_column + kCholeskyColumns - 1 of L (Cholesky-Banachiewicz
 // by columns: each needs the ones before it). False when a pivot is not above tiny.
-bool MagCalibrator::cholesky_part(uint8_t first_column) {
+FIXED_COLD bool MagCalibrator::cholesky_part(uint8_t first_column) {
     float* l = work_.normal.l;
     for (uint8_t j = first_column; j < first_column + kCholeskyColumns && j < kUnknowns; ++j) {
         float d = l[row_start(j) + j];
@@ -358,7 +358,7 @@ bool MagCalibrator::cholesky_part(uint8_t first_column) {
 }
 
 // b <- L^-1 b, and |L^-1 b|^2.
-void MagCalibrator::forward_substitution() {
+FIXED_COLD void MagCalibrator::forward_substitution() {
     const float* l = work_.normal.l;
     float* b = work_.normal.b;
     fit_yy_ = 0.0f;
@@ -371,7 +371,7 @@ void MagCalibrator::forward_substitution() {
 }
 
 // b <- L^-T b: the solution t.
-void MagCalibrator::back_substitution() {
+FIXED_COLD void MagCalibrator::back_substitution() {
     const float* l = work_.normal.l;
     float* b = work_.normal.b;
     for (uint8_t i = kUnknowns; i-- > 0;) {
@@ -414,7 +414,7 @@ bool MagCalibrator::quadric() {
 // Y -> Y T, Z -> T Z, T = (3I - Z Y) / 2; quadratic convergence while |I - A| < 1). The
 // first step, from Z = I, written out: T = (3I - A) / 2 and Z = T (an identity matrix
 // object would be a 36-byte constant in the AVR's SRAM).
-void MagCalibrator::root_start() {
+FIXED_COLD void MagCalibrator::root_start() {
     Work::Root& r = work_.root;
     const Matrix3f a = matrix_of(r.a);
     const Matrix3f z = newton_schulz_t(a);
@@ -438,7 +438,7 @@ static bool within_box(const Vector3f& v, float limit) {
     return within(v.x, -limit, limit) && within(v.y, -limit, limit) && within(v.z, -limit, limit);
 }
 
-MagCalibrator::Quality MagCalibrator::final_checks() {
+FIXED_COLD MagCalibrator::Quality MagCalibrator::final_checks() {
     const Work::Root& r = work_.root;
     // The root has not converged: A too far from I, soft iron beyond any limit.
     const Matrix3f y = matrix_of(r.y);
@@ -617,15 +617,15 @@ void OffsetLearner::end_solve() {
     solve_part_ = 0;
 }
 
-// First part (8-10.5 k cycles on the AVR, 14-15 k in float: short enough for a step
-// that also corrects gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
+// First part (in fixed point, not float: short enough for a step that also corrects
+// gravity): the innovation r = P f2 - f1 - (P - I) x = P (f2 - x) - (f1 - x) =
 // H (e - x) and H^T r = P^T r - r, P = R(q) the pair's turn, in fixed point: P in Q30
 // from q's products (mul_q30, ~1e-9 each), the fields less the estimate in Q16 uT (steps
 // of 1.5e-5 uT; fields within 2^15 uT). Leaves r . r in turn_.f[0] (q is not needed
 // again), H^T r in field_ref_ (f1 is not either), and the rotation's axis for the second
 // part: m = 2 u / sigma in turn_.f[1..3] (the pair's information H^T H / sigma^2 =
 // |m|^2 I - m m^T) and 1 / |m|^2 in inv_axis2_.
-bool OffsetLearner::solve_residual() {
+FIXED_COLD bool OffsetLearner::solve_residual() {
     using linalg::mul_q30;
     using linalg::Vector3l;
     const int32_t w = turn_.q30[0], x = turn_.q30[1], y = turn_.q30[2], z = turn_.q30[3];
@@ -657,13 +657,13 @@ bool OffsetLearner::solve_residual() {
     return true;
 }
 
-// Second part (~14 k): the information, the step, the gate. A = I / prior^2 + L (L
+// Second part (the long one): the information, the step, the gate. A = I / prior^2 + L (L
 // faded, this pair's H^T H / sigma^2 added) and its inverse C (symmetric: cofactors
 // over the determinant), the posterior covariance, uT^2. H^T H = 2 I - P - P^T =
 // 4 (|u|^2 I - u u^T) for the unit q = (w, u). info_ holds L already faded (the third
 // part fades what it takes in). Leaves the step in field_ref_, 1 / det A in turn_.f[0]
 // and C's diagonal cofactors in turn_.f[1..3]; false when the pair is dropped.
-bool OffsetLearner::solve_step() {
+FIXED_COLD bool OffsetLearner::solve_step() {
     const Vector3f m(turn_.f[1], turn_.f[2], turn_.f[3]);
     const Vector3f across = field_ref_;
     const float rr = turn_.f[0];
@@ -713,9 +713,9 @@ bool OffsetLearner::solve_step() {
     return true;
 }
 
-// Third part (~5 k): the estimate moves by the step, and the offset in use follows it
+// Third part: the estimate moves by the step, and the offset in use follows it
 // once it is significant; the information taken in fades for the next pair.
-bool OffsetLearner::solve_estimate(Vector3f& in_use_uT) {
+FIXED_COLD bool OffsetLearner::solve_estimate(Vector3f& in_use_uT) {
     const Vector3f step = field_ref_;
     const float inv_det = turn_.f[0];
     const float var[3] = {turn_.f[1] * inv_det, turn_.f[2] * inv_det, turn_.f[3] * inv_det};

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Sensor calibration, applied in one place (apply_gyro / apply_mag), and the two
-// procedures that measure it: gyro bias at rest and magnetometer hard iron + per-axis
-// scale from the extremes of a rotation.
+// Sensor calibration, applied in one place (apply_gyro / apply_mag), and the procedures
+// that measure it: gyro bias at rest, the magnetometer's hard and soft iron from a
+// least-squares ellipsoid fit on the samples of a rotation (`cal mag`), and its hard
+// iron learned in motion (OffsetLearner).
 //
 // Body frame (x forward, y right, z down), gyro in rad/s, accel in m/s^2 (specific
 // force), field in uT. Pure C++: no clock, no bus, no Arduino include; the caller
@@ -59,8 +60,8 @@ public:
 
     void restart();
     // Feeds one sample in the MPU6000's counts and their scales (rad/s and m/s^2 per
-    // count); returns what happened. In integers (~0.5 k cycles a sample on the AVR where
-    // floats took 6.5 k: it runs at every step while it measures, in the background too).
+    // count); returns what happened. In integers, not floats: it runs at every step while
+    // it measures, in the background too (its cost: `make bench`).
     Result add(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& accel_counts, float gyro_rad_s_per_count,
                float accel_m_s2_per_count);
     // The same in SI units (tests, tools), held in fine counts (kFloatGyroScale,
@@ -151,8 +152,8 @@ public:
     // result() into cal. The figures below are valid after any fit that got as far as
     // the ellipsoid (Ok, NotEarthField, SoftIronTooLarge, PoorFit).
     Quality finish(Calibration& cal);
-    // The same fit in kFitParts (25) parts for a caller with a few thousand cycles a step to
-    // spare (the whole is several 5 ms steps' worth on the AVR): begin_fit() once the
+    // The same fit in kFitParts (25) parts for a caller with part of a step to spare (the
+    // whole is longer than a 5 ms step on the AVR): begin_fit() once the
     // samples are in, then fit_part() while fitting(); then quality() and, on Ok,
     // result(). The fit works in the sums' memory: no add() until restart().
     void begin_fit();
@@ -304,11 +305,11 @@ constexpr float kLearnMaxOffset_uT = 50.0f;
 constexpr float kLearnPriorUncalibrated_uT = 30.0f;
 constexpr float kLearnPriorCalibrated_uT = 1.0f;
 
-// Cost on the AVR: a pair's update is ~34 k cycles of float arithmetic, more than a
-// 5 ms step can carry beside the estimator's own work; so a sample only composes the
-// turn (a quaternion product in Q30, ~5 k) and stores a pair that completes, and the pair is
-// worked out by solve_part() in kSolveParts parts (~8-10 k in fixed point, ~14 k, ~5 k), on
-// the caller's next steps with room for them (the Pipeline: the long one on a step without
+// Cost on the AVR (figures: `make bench`, the README): a pair's update in float is more
+// than a 5 ms step can carry beside the estimator's own work; so a sample only composes
+// the turn (a quaternion product in Q30) and stores a pair that completes, and the pair is
+// worked out by solve_part() in kSolveParts parts (the residual in fixed point, the 3x3
+// solve in float, the estimate), on the caller's next steps with room for them (the Pipeline: the long one on a step without
 // the DCM's heavy parts, none with a heading correction or a line), before the next
 // sample: the same arithmetic as one update.
 class OffsetLearner {
@@ -332,8 +333,8 @@ public:
              linalg::Vector3f& in_use_uT);
     // A completed pair waits for solve_part().
     bool solving() const { return solve_part_ != 0; }
-    // The next solve_part() is the second, the long one (~14 k cycles on the AVR: the 3x3
-    // solve in float); the others, like a sample (add), take at most ~10 k.
+    // The next solve_part() is the second, the long one (the 3x3 solve in float); the
+    // others are shorter.
     bool long_part_next() const { return solve_part_ == 2; }
     // The next part of the pending pair's update (nothing when none): the estimate, and
     // `in_use_uT` as add() describes; returns true when that changed.

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Console.h"
 
+#include "Params.h"
+
+#include <string.h>
+
 namespace console {
 
 using text::Writer;
@@ -41,34 +45,55 @@ int8_t find_word(const char* word, text::Flash names) {
     return -1;
 }
 
-Command make(CommandId id) { return Command{id, Error::None, 0, fmt::OutputMode::Plot}; }
-Command fail(Error e) { return Command{CommandId::Error, e, 0, fmt::OutputMode::Plot}; }
+Command make(CommandId id) { return Command{id, Error::None, 0, fmt::OutputMode::Plot, 0}; }
+Command fail(Error e) { return Command{CommandId::Error, e, 0, fmt::OutputMode::Plot, 0}; }
+
+// A value with four decimals as the float a parameter takes (a division: 1500.0000
+// comes back exactly 1500).
+float param_value(int32_t scaled) { return (float)scaled / (float)kParamScale; }
+
+// "VALUE": an integer type's whole number, a float's four decimals.
+void write_value(Writer& w, params::Type t, float v) {
+    int32_t x;
+    if (params::is_integer(t)) {
+        w.i32((int32_t)v);
+    } else if (text::to_fixed(v, 4, x)) {
+        char buf[16];
+        w.str(buf, text::format_fixed(buf, x, 4));
+    } else {
+        w.chr('?');
+    }
+}
 
 }  // namespace
 
-bool parse_centi(const char* s, int32_t& out) {
+bool parse_centi(const char* s, int32_t& out) { return parse_fixed(s, 2, 7, out); }
+
+bool parse_fixed(const char* s, uint8_t decimals, uint8_t max_int_digits, int32_t& out) {
     bool neg = false;
     if (*s == '+' || *s == '-') neg = (*s++ == '-');
     int32_t whole = 0;
     uint8_t int_digits = 0, frac_digits = 0;
-    int32_t frac = 0;      // hundredths
+    int32_t frac = 0;      // in units of the last kept decimal
     bool round_up = false;
     while (*s >= '0' && *s <= '9') {
-        if (++int_digits > 7) return false;
+        if (++int_digits > max_int_digits) return false;
         whole = whole * 10 + (*s++ - '0');
     }
     if (*s == '.') {
         ++s;
         while (*s >= '0' && *s <= '9') {
-            if (frac_digits < 2) frac = frac * 10 + (*s - '0');
-            else if (frac_digits == 2) round_up = (*s >= '5');
+            if (frac_digits < decimals) frac = frac * 10 + (*s - '0');
+            else if (frac_digits == decimals) round_up = (*s >= '5');
             if (frac_digits < 255) ++frac_digits;
             ++s;
         }
     }
     if (*s != '\0' || (int_digits == 0 && frac_digits == 0)) return false;
-    if (frac_digits == 1) frac *= 10;
-    int32_t v = whole * 100 + frac + (round_up ? 1 : 0);
+    int32_t unit = 1;
+    for (uint8_t k = 0; k < decimals; ++k) unit *= 10;
+    for (uint8_t k = frac_digits; k < decimals; ++k) frac *= 10;
+    int32_t v = whole * unit + frac + (round_up ? 1 : 0);
     out = neg ? -v : v;
     return true;
 }
@@ -83,21 +108,61 @@ Command parse_line(const char* line) {
 
     // The command names in flash, those without an argument first; each name's command
     // is its byte in kIds (a TXT string too: an array would be copied to the AVR's SRAM).
-    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x03\x04\x05\x07");
+    // (rc, servo and params are Show with kShowRc .. kShowParams.)
+    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x0C\x0C\x0C\x03\x04\x05\x07\x0B\x0E\x0D");
     static_assert((uint8_t)CommandId::Help == 2 && (uint8_t)CommandId::Status == 6 &&
                       (uint8_t)CommandId::Save == 9 && (uint8_t)CommandId::Defaults == 10 &&
                       (uint8_t)CommandId::Rate == 3 && (uint8_t)CommandId::Decl == 4 &&
-                      (uint8_t)CommandId::Mode == 5 && (uint8_t)CommandId::CalGyro == 7,
+                      (uint8_t)CommandId::Mode == 5 && (uint8_t)CommandId::CalGyro == 7 &&
+                      (uint8_t)CommandId::Flight == 11 && (uint8_t)CommandId::Show == 12 &&
+                      (uint8_t)CommandId::Set == 13 && (uint8_t)CommandId::Get == 14,
                   "kIds holds these values");
-    constexpr int8_t kFirstWithArgument = 5;
-    const int8_t k = find_word(cmd, TXT("help\0?\0status\0save\0defaults\0rate\0decl\0mode\0cal\0"));
+    constexpr int8_t kFirstShow = 5, kFirstWithArgument = 8;
+    const int8_t k = find_word(
+        cmd, TXT("help\0?\0status\0save\0defaults\0rc\0servo\0params\0rate\0decl\0mode\0cal\0flight\0get\0set\0"));
     if (k < 0) return fail(Error::Unknown);
     const CommandId id = (CommandId)text::flash_byte(kIds.p + k);
-    if (k < kFirstWithArgument) return n == 1 ? make(id) : fail(Error::ExtraArgument);
+    if (k < kFirstWithArgument) {
+        if (n != 1) return fail(Error::ExtraArgument);
+        Command r = make(id);
+        if (id == CommandId::Show) r.arg = (uint8_t)(k - kFirstShow);
+        return r;
+    }
     if (n < 2) return fail(Error::MissingArgument);
+    if (id == CommandId::Set) {
+        if (n < 3) return fail(Error::MissingArgument);
+        const int16_t index = params::find(w[1]);
+        if (index < 0) return fail(Error::UnknownParam);
+        params::Info in;
+        params::info((uint16_t)index, in);
+        int32_t v;
+        if (!parse_fixed(w[2], 4, 5, v)) return fail(Error::BadNumber);
+        const float f = param_value(v);
+        Command r = make(id);
+        r.arg = (uint8_t)index;
+        if (!(f >= in.min && f <= in.max) || (params::is_integer(in.type) && v % kParamScale != 0)) {
+            r = fail(Error::ParamRange);
+            r.arg = (uint8_t)index;
+            return r;
+        }
+        r.value = v;
+        return r;
+    }
     if (n > 2) return fail(Error::ExtraArgument);
     const char* arg = w[1];
     Command r = make(id);
+    if (id == CommandId::Get) {
+        const int16_t index = params::find(arg);
+        if (index < 0) return fail(Error::UnknownParam);
+        r.arg = (uint8_t)index;
+        return r;
+    }
+    if (id == CommandId::Flight) {
+        const int8_t m = find_word(arg, TXT("manual\0stabilize\0"));
+        if (m < 0) return fail(Error::BadFlightMode);
+        r.arg = (uint8_t)m;
+        return r;
+    }
     if (id == CommandId::Rate || id == CommandId::Decl) {
         int32_t c;
         if (!parse_centi(arg, c)) return fail(Error::BadNumber);
@@ -191,6 +256,18 @@ bool print_error(const Command& c, uint8_t part, const text::Sink* out) {
         case Error::DeclRange: w.str(TXT("decl must be -180..180 degrees")); break;
         case Error::BadMode: w.str(TXT("mode must be plot, csv, quat, raw, mavlink or quiet")); break;
         case Error::BadCalTarget: w.str(TXT("cal gyro or cal mag")); break;
+        case Error::UnknownParam: w.str(TXT("unknown parameter (type params)")); break;
+        case Error::BadFlightMode: w.str(TXT("flight manual or flight stabilize")); break;
+        case Error::ParamRange: {
+            params::Info in;
+            if (!params::info(c.arg, in)) break;
+            w.str(in.name, (uint8_t)strlen(in.name)).str(TXT(" must be "));
+            write_value(w, in.type, in.min);
+            w.str(TXT(".."));
+            write_value(w, in.type, in.max);
+            if (params::is_integer(in.type)) w.str(TXT(", whole"));
+            break;
+        }
         case Error::None: w.str(TXT("internal")); break;
     }
     w.str(TXT("; nothing changed")).end();
@@ -209,7 +286,10 @@ bool print_help(uint8_t part, const text::Sink* out) {
                         "# status: health, load, bias, temperature, uptime\0"
                         "# cal gyro: gyro bias (keep still 1 s)\0"
                         "# cal mag: compass (turn every way for 30 s)\0"
-                        "# save | defaults: store settings / back to defaults\0").p;
+                        "# save | defaults: store settings / back to defaults\0"
+                        "# flight manual|stabilize: flight mode\0"
+                        "# rc | servo: receiver / output widths, us\0"
+                        "# params | get NAME | set NAME VALUE: flight settings\0").p;
     for (uint8_t k = 0; k < part && text::flash_byte(p) != 0u; ++k)
         while (text::flash_byte(p++) != 0u) {}
     if (text::flash_byte(p) == 0u) return false;
@@ -225,9 +305,32 @@ void print_defaults(const text::Sink* out) {
     Writer(out).str(TXT("# defaults: rate 50 Hz, decl 0.00, mode plot, no compass cal (save to keep)")).end();
 }
 
+bool print_param(uint16_t index, const settings::Settings& s, const text::Sink* out) {
+    params::Info in;
+    if (!params::info(index, in)) return false;
+    Writer w(out);
+    w.str(TXT("# ")).str(in.name, (uint8_t)strlen(in.name)).chr(' ');
+    write_value(w, in.type, params::get(s, index));
+    w.end();
+    return true;
+}
+
 bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* out) {
     Writer w(out);
     switch (c.id) {
+        case CommandId::Get:
+            print_param(c.arg, s, out);
+            return true;
+        case CommandId::Set:
+            if (params::set(s, c.arg, param_value(c.value))) {
+                print_param(c.arg, s, out);
+            } else {
+                params::Info in;
+                params::info(c.arg, in);
+                w.str(TXT(TXT_ERROR)).str(in.name, (uint8_t)strlen(in.name))
+                    .str(TXT(": end points must stay MIN <= TRIM <= MAX; nothing changed")).end();
+            }
+            return true;
         case CommandId::Rate:
             s.rate_hz = (uint8_t)c.value;
             w.str(TXT("# rate ")).i32(c.value).str(TXT(" Hz")).end();
@@ -252,15 +355,17 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
     }
 }
 
-static_assert((uint8_t)CommandId::Defaults < 15 && (uint8_t)Error::BadCalTarget < 16 &&
+static_assert((uint8_t)CommandId::Get < 15 && (uint8_t)Error::BadFlightMode < 16 &&
                   (uint8_t)fmt::kLastOutputMode < 16,
               "CommandQueue packs the id and the error or mode into 4 bits each, id 15 spare");
 static_assert((CommandQueue::kBytes & (CommandQueue::kBytes - 1u)) == 0, "kBytes must be a power of two");
 
 uint8_t CommandQueue::item_bytes(uint8_t first) {
     const uint8_t id = first & 0x0Fu;
-    if (id == (uint8_t)CommandId::Rate) return 2;
+    if (id == (uint8_t)CommandId::Rate || id == (uint8_t)CommandId::Get) return 2;
+    if (id == (uint8_t)CommandId::Error && (first >> 4) == (uint8_t)Error::ParamRange) return 2;
     if (id == (uint8_t)CommandId::Decl || id == kMergedError) return 3;
+    if (id == (uint8_t)CommandId::Set) return kMaxItem;
     return 1;
 }
 
@@ -277,6 +382,11 @@ Command CommandQueue::decode(uint8_t at) const {
     if (id == (uint8_t)CommandId::Mode) c.mode = (fmt::OutputMode)high;
     if (id == (uint8_t)CommandId::Rate) c.value = byte((uint8_t)(at + 1u));
     if (id == (uint8_t)CommandId::Decl) c.value = (int16_t)word((uint8_t)(at + 1u));
+    if (id == (uint8_t)CommandId::Flight || id == (uint8_t)CommandId::Show) c.arg = high;
+    if (item_bytes(first) >= 2u && id != (uint8_t)CommandId::Rate && id != (uint8_t)CommandId::Decl)
+        c.arg = byte((uint8_t)(at + 1u));  // get, set, a range error: the index
+    if (id == (uint8_t)CommandId::Set)
+        c.value = (int32_t)((uint32_t)word((uint8_t)(at + 2u)) | ((uint32_t)word((uint8_t)(at + 4u)) << 16));
     return c;
 }
 
@@ -290,14 +400,17 @@ bool CommandQueue::push(const Command& c) {
             return true;
         }
         // A plain error is the last item: its count goes in the two bytes after it.
-        if ((first & 0x0Fu) == (uint8_t)CommandId::Error && (uint8_t)(kBytes - used_) >= 2u) {
+        if ((first & 0x0Fu) == (uint8_t)CommandId::Error && item_bytes(first) == 1u &&
+            (uint8_t)(kBytes - used_) >= 2u) {
             items_[newest_ & kMask] = (uint8_t)(kMergedError | (first & 0xF0u));
             put_word((uint8_t)(newest_ + 1u), 1u);
             used_ = (uint8_t)(used_ + 2u);
             return true;
         }
     }
-    const uint8_t high = c.id == CommandId::Mode ? (uint8_t)c.mode : (uint8_t)c.error;
+    const uint8_t high = c.id == CommandId::Mode ? (uint8_t)c.mode
+                         : (c.id == CommandId::Flight || c.id == CommandId::Show) ? c.arg
+                                                                                  : (uint8_t)c.error;
     const uint8_t first = (uint8_t)((uint8_t)c.id | (uint8_t)(high << 4));
     const uint8_t n = item_bytes(first);
     if ((uint8_t)(kBytes - used_) < n) return false;
@@ -305,6 +418,11 @@ bool CommandQueue::push(const Command& c) {
     items_[at & kMask] = first;
     if (c.id == CommandId::Rate) items_[(uint8_t)(at + 1u) & kMask] = (uint8_t)c.value;
     if (c.id == CommandId::Decl) put_word((uint8_t)(at + 1u), (uint16_t)(int16_t)c.value);
+    if (n >= 2u && c.id != CommandId::Rate && c.id != CommandId::Decl) items_[(uint8_t)(at + 1u) & kMask] = c.arg;
+    if (c.id == CommandId::Set) {
+        put_word((uint8_t)(at + 2u), (uint16_t)((uint32_t)c.value & 0xFFFFu));
+        put_word((uint8_t)(at + 4u), (uint16_t)((uint32_t)c.value >> 16));
+    }
     newest_ = (uint8_t)(at & kMask);
     used_ = (uint8_t)(used_ + n);
     ++count_;

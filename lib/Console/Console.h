@@ -12,6 +12,12 @@
 //   cal mag              hard iron + scale: turn the board every way for 30 s
 //   save                 write settings and calibration to EEPROM
 //   defaults             back to the defaults (not saved until `save`)
+//   flight manual|stabilize  the flight mode (the mode switch's next move overrides it)
+//   rc                   the receiver's eight channel widths, us (radio set-up)
+//   servo                the eight output widths, us
+//   params               every parameter (lib/Params) and its value, one a line
+//   get NAME             one parameter
+//   set NAME VALUE       set one (range-checked; `save` keeps it)
 //
 // Anything else (unknown words, bad or out-of-range numbers, extra arguments, a line
 // over kLineCapacity characters, control or non-ASCII bytes) is answered with
@@ -45,7 +51,15 @@ enum class CommandId : uint8_t {
     CalMag,
     Save,
     Defaults,
+    Flight,    // arg = 0 manual, 1 stabilize
+    Show,      // arg = Show*
+    Set,       // arg = parameter index, value = the value x kParamScale
+    Get,       // arg = parameter index
 };
+
+enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2 };
+// `set` values are parsed with four decimals (parse_fixed) and carried as integers.
+constexpr int32_t kParamScale = 10000;
 
 enum class Error : uint8_t {
     None,
@@ -59,6 +73,9 @@ enum class Error : uint8_t {
     DeclRange,        // outside -180..180
     BadMode,          // not plot|csv|quat|raw|mavlink|quiet
     BadCalTarget,     // cal without gyro|mag
+    UnknownParam,     // get/set of a name the table does not have
+    ParamRange,       // set: outside the parameter's range, or not whole for an integer (arg: the index)
+    BadFlightMode,    // flight without manual|stabilize
 };
 
 struct Command {
@@ -66,6 +83,7 @@ struct Command {
     Error error;
     int32_t value;  // Rate: Hz, Decl: hundredths of a degree; Error: further bad lines merged in (CommandQueue)
     fmt::OutputMode mode;
+    uint8_t arg;    // Flight, Show, Set, Get, Error ParamRange: see CommandId
 };
 
 // Parses one complete line (NUL-terminated, without the line ending).
@@ -75,6 +93,8 @@ Command parse_line(const char* line);
 // from zero on the third decimal. False for anything else (empty, letters, "1e3",
 // "nan", two points, more than 7 integer digits).
 bool parse_centi(const char* s, int32_t& out);
+// The same with `decimals` (0..4) decimals kept and at most int_digits integer digits.
+bool parse_fixed(const char* s, uint8_t decimals, uint8_t int_digits, int32_t& out);
 
 // Collects bytes into lines and parses them.
 class LineReader {
@@ -106,10 +126,14 @@ bool print_help(uint8_t part, const text::Sink* out);
 void print_error(const Command& c, const text::Sink* out);
 void print_help(const text::Sink* out);
 
-// Executes Rate, Decl, Mode and Defaults on `s` and writes the reply; returns false
-// (and touches nothing) for every other command. Defaults keeps nothing: calibration
-// too returns to zero bias and unit scale.
+// Executes Rate, Decl, Mode, Defaults, Set and Get on `s` and writes the reply; returns
+// false (and touches nothing) for every other command. Defaults keeps nothing:
+// calibration too returns to zero bias and unit scale.
 bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* out);
+
+// "# NAME VALUE" (floats with four decimals); false past the last parameter: `params`
+// writes one a part.
+bool print_param(uint16_t index, const settings::Settings& s, const text::Sink* out);
 
 // The reply to `defaults`.
 void print_defaults(const text::Sink* out);
@@ -146,6 +170,7 @@ public:
 
     // True when a command of some kind might not fit: stop reading input.
     bool full() const { return (uint8_t)(kBytes - used_) < kMaxItem; }
+    static constexpr uint8_t kMaxItem = 6;  // a set: id, index, value (int32)
     bool empty() const { return count_ == 0; }
     uint8_t size() const { return count_; }  // commands
     // False (nothing stored) when c does not fit; an error beyond kErrorBytes is merged (true).
@@ -157,10 +182,10 @@ public:
 
 private:
     // First byte: the id in the low 4 bits (kMergedError: an error with a 16-bit count of
-    // merged ones after it), the error or the mode in the high 4; then rate (1 byte) or
-    // decl (int16, little-endian), values parse_line keeps within those ranges.
+    // merged ones after it), the error, the mode or the arg (Flight, Show) in the high 4;
+    // then rate (1 byte), decl (int16, little-endian), get (the index) or set (the index,
+    // the value as int32), values parse_line keeps within those ranges.
     static constexpr uint8_t kMergedError = 0x0F;
-    static constexpr uint8_t kMaxItem = 3;
     static constexpr uint8_t kMask = kBytes - 1u;
     static uint8_t item_bytes(uint8_t first);
     uint8_t byte(uint8_t at) const { return items_[at & kMask]; }

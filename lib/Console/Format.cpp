@@ -9,8 +9,9 @@ namespace fmt {
 namespace {
 
 // Hundredths of an angle, rounded half away from zero, in integers: the angle read in
-// Q15 from its bits (|deg| < 360.005: < 2^24), times 100 (< 2^31), rounded (~250 cycles
-// on the 2560 where a float multiply, add and conversion took ~400; the Q15 truncation,
+// Q15 from its bits (|deg| < 360.005: < 2^24), times 100 (< 2^31), rounded (integer
+// shifts and one 32-bit multiply where a float multiply, add and conversion were library
+// calls on the 2560; the Q15 truncation,
 // < 3.1e-5 deg, moves a value only within 0.003 % of a half count). False for NaN,
 // infinities and anything beyond a full turn (|c| > 36000), which is not an attitude
 // angle.

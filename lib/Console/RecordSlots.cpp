@@ -66,12 +66,21 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     return out;
 }
 
+uint8_t header_byte(uint16_t sequence, uint8_t i) {
+    return i == 0 ? (uint8_t)(sequence & 0xFFu) : i == 1 ? (uint8_t)(sequence >> 8) : settings::kRecordSize;
+}
+
+uint16_t slot_crc(const uint8_t record[settings::kRecordSize], uint16_t sequence) {
+    uint16_t crc = settings::kCrc16Init;
+    for (uint8_t i = 0; i < kHeaderSize; ++i) crc = settings::crc16_update(crc, header_byte(sequence, i));
+    for (uint8_t i = 0; i < settings::kRecordSize; ++i) crc = settings::crc16_update(crc, record[i]);
+    return crc;
+}
+
 void encode(const uint8_t record[settings::kRecordSize], uint16_t sequence, uint8_t out[kSlotSize]) {
-    out[0] = (uint8_t)(sequence & 0xFFu);
-    out[1] = (uint8_t)(sequence >> 8);
-    out[2] = settings::kRecordSize;
+    for (uint8_t i = 0; i < kHeaderSize; ++i) out[i] = header_byte(sequence, i);
     memcpy(out + kHeaderSize, record, settings::kRecordSize);
-    const uint16_t crc = settings::crc16(out, (uint16_t)(kHeaderSize + settings::kRecordSize));
+    const uint16_t crc = slot_crc(record, sequence);
     out[kHeaderSize + settings::kRecordSize] = (uint8_t)(crc & 0xFFu);
     out[kHeaderSize + settings::kRecordSize + 1u] = (uint8_t)(crc >> 8);
 }

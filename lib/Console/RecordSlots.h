@@ -76,6 +76,11 @@ struct Loaded {
 // Uses ~kMaxSlotSize bytes of stack.
 Loaded load(ReadBlock read, settings::Settings& s);
 
+// Header byte i (< kHeaderSize) of a slot of this firmware with `sequence`.
+uint8_t header_byte(uint16_t sequence, uint8_t i);
+// The CRC that ends a slot holding `record` with `sequence` (encode's last two bytes).
+uint16_t slot_crc(const uint8_t record[settings::kRecordSize], uint16_t sequence);
+
 // A slot holding `record` (this firmware's kRecordSize) with `sequence`: kSlotSize bytes.
 void encode(const uint8_t record[settings::kRecordSize], uint16_t sequence, uint8_t out[kSlotSize]);
 

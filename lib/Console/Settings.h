@@ -1,21 +1,29 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The persistent settings: output rate, declination, output mode and the sensor
-// calibration, stored in EEPROM as one record:
+// The persistent settings: output rate, declination, output mode, the sensor
+// calibration and the flight settings, stored in EEPROM as one record:
 //
 //   offset 0  'A' 'T'           magic
 //          2  version           kSettingsVersion; any other value: defaults
 //          3  payload length    kPayloadLength
-//          4  payload           little-endian fields, floats as IEEE-754 bytes
+//          4  payload           little-endian fields, floats as IEEE-754 bytes:
+//             4  rate, 5 decl (int16), 7 mode, 8 flags, 9 calibration (15 floats)
+//             69 the flight settings (version 3): params::encode_flight, the parameter
+//                table's rows in order (a Bit row's eight bits one byte), kFlightBytes
 //          4+len  CRC-16/CCITT-FALSE of bytes 0 .. 3+len, little-endian
 //
 // encode/decode are explicit byte by byte, so the layout is the same on the AVR and
 // the host (no struct padding or endianness in the record). No EEPROM access here:
 // the firmware copies kRecordSize bytes to and from EEPROM.
+//
+// A version 2 record (a 65-byte payload, no flight settings) still loads: its rate,
+// declination, mode and calibration are kept, the flight settings are the defaults and
+// kFlagUpgraded says so (the firmware tells the user, `save` writes version 3).
 #pragma once
 
 #include <stdint.h>
 
 #include "Calibration.h"
+#include "FlightSettings.h"
 #include "Format.h"
 
 namespace settings {
@@ -23,9 +31,11 @@ namespace settings {
 constexpr uint8_t kMagic0 = 'A';
 constexpr uint8_t kMagic1 = 'T';
 // 2: the compass calibration gained the soft-iron cross terms and the learned offset.
-constexpr uint8_t kSettingsVersion = 2;
-// rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
-constexpr uint8_t kPayloadLength = 65;
+// 3: the flight settings (issue 21).
+constexpr uint8_t kSettingsVersion = 3;
+constexpr uint8_t kV2PayloadLength = 65;  // rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
+constexpr uint8_t kFlightBytes = 166;     // params::encode_flight (checked by params' tests)
+constexpr uint8_t kPayloadLength = kV2PayloadLength + kFlightBytes;
 constexpr uint8_t kRecordSize = 4 + kPayloadLength + 2;
 constexpr uint16_t kEepromAddress = 0;
 
@@ -38,6 +48,7 @@ constexpr int16_t kDeclMaxCentideg = 18000;
 enum Flags : uint8_t {
     kFlagGyroCalibrated = 0x01,  // cal.gyro_bias was measured (used when start-up calibration fails)
     kFlagMagCalibrated = 0x02,   // cal.mag_offset/scale/cross came from `cal mag`
+    kFlagUpgraded = 0x04,        // loaded from a version 2 record: flight settings at defaults (never stored)
 };
 
 struct Settings {
@@ -46,6 +57,7 @@ struct Settings {
     fmt::OutputMode mode;
     uint8_t flags;                 // Flags
     calib::Calibration cal;
+    flight::FlightSettings flight;  // lib/Params has their names, ranges and defaults
 
     float declination_deg() const { return (float)declination_centideg * 0.01f; }
 };
@@ -62,6 +74,16 @@ enum class LoadResult : uint8_t {
 };
 
 uint16_t crc16(const uint8_t* data, uint16_t len);
+// The same CRC a byte at a time: crc16(d, n) is crc16_update(...(kCrc16Init, d[0])..., d[n-1]).
+constexpr uint16_t kCrc16Init = 0xFFFFu;
+uint16_t crc16_update(uint16_t crc, uint8_t byte);
+// Where the flight settings start in the record.
+constexpr uint8_t kFlightOffset = 4 + kV2PayloadLength;
+// Byte i of encode(s)'s record, for i < kFlightOffset (the header and calibration).
+uint8_t record_byte(const Settings& s, uint8_t i);
+// Bytes from..from+n-1 of encode(s)'s record, within 4 + kPayloadLength (all but the
+// record's CRC): a record written a part at a time needs no copy of it.
+void record_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out);
 
 void encode(const Settings& s, uint8_t out[kRecordSize]);
 // On anything but Ok, `out` is set to defaults(): never garbage.

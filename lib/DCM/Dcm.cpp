@@ -268,7 +268,7 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
 // and the roll/pitch error (correct_tilt).
-void Dcm::correct_gravity() {
+FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
     schedule_.gravity_done();
     const bool starting = steps_ < k_.startup_steps;
@@ -376,7 +376,12 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
                              row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
                              row_times(strapdown_.r().c, field_now) >> kEarthFieldShift),
                     sample_norm2, since_last);
-    if (!field_mean_.complete()) return;
+    if (field_mean_.complete()) correct_heading_from_mean();
+}
+
+// The heading's correction from a complete mean (kHeadingSteps samples, 25 Hz): out of
+// line (FIXED_OWN_FRAME), so that its float locals stay out of the 75 Hz part's frame.
+FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     uint16_t interval_steps = field_mean_.steps();
     Vector3f field_ef;
     float norm2;

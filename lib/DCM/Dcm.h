@@ -188,6 +188,7 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
+    void correct_heading_from_mean();
     void update_offset();
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
     // 32x32 routine).

@@ -23,7 +23,9 @@ int32_t inverse_q30(uint8_t n) {
 }
 
 // A sum's mean: v / n, by two bit shifts in the usual case (n = 4), else by 1/n in Q30.
-Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
+// Forced inline: called, its vector argument had to be stored in correct_gravity's deep
+// frame and the result read back from it.
+FIXED_INLINE Vector3l per(const Vector3l& v, uint8_t n, int32_t inverse_q30) {
     if (n == 4) return Vector3l(v.x >> 2, v.y >> 2, v.z >> 2);
     return Vector3l(linalg::mul_q30(inverse_q30, v.x), linalg::mul_q30(inverse_q30, v.y), linalg::mul_q30(inverse_q30, v.z));
 }
@@ -78,11 +80,13 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
     // In integers: counts * 2^8, the turn per step in 16 bits (Q14 radians: the term
     // is a few percent of the sum, its rounding 6e-5 rad of it).
+    // (A subtraction per pending step, a step or two: opaque keeps avr-gcc from making
+    // the loop three calls of its 32x32 multiply.)
     Vector3l weighted = accel_sum_of_sums_;
     for (uint8_t i = pending_steps; i > 0; --i) {
-        weighted.x -= accel_sum_.x;
-        weighted.y -= accel_sum_.y;
-        weighted.z -= accel_sum_.z;
+        weighted.x = linalg::opaque(weighted.x - accel_sum_.x);
+        weighted.y = linalg::opaque(weighted.y - accel_sum_.y);
+        weighted.z = linalg::opaque(weighted.z - accel_sum_.z);
     }
     weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
     const Vector3l turn = k.theta_q26_coarse(gyro_raw_mean - offset_units);
@@ -108,7 +112,7 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     return true;
 }
 
-void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
+FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
                                      const DcmSettings& settings, const DcmCoefficients& k, GyroBias& bias) {
     using linalg::hot::fixed_from_float;
     using linalg::mul_q30;
@@ -140,7 +144,8 @@ void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_
                          : settings.kp_rp_1_s;
     // kp error in units: the error in 16 bits (Q14: steps of 6e-5 rad, 0.003 deg of tilt)
     // times the gain in units per rad/s.
-    const int32_t kp_units = startup_left > 0.0f ? fixed_from_float(kp * k.units_per_rad_s, 0) : k.kp_units;
+    // (Start-up only: the ordinary call.)
+    const int32_t kp_units = startup_left > 0.0f ? linalg::fixed_from_float(kp * k.units_per_rad_s, 0) : k.kp_units;
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
@@ -149,7 +154,8 @@ void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns
     // with it ((e_n, e_e, 0) x lp, scaled).
-    const int32_t turn = startup_left > 0.0f ? fixed_from_float(kp * correction_dt_s(settings), linalg::kQ30) : k.tilt_turn_q30;
+    const int32_t turn =
+        startup_left > 0.0f ? linalg::fixed_from_float(kp * correction_dt_s(settings), linalg::kQ30) : k.tilt_turn_q30;
     const int32_t turn_n = mul_q14(q14_of(n), turn), turn_e = mul_q14(q14_of(e), turn);
     const Vector3l old = lp_ef_;
     lp_ef_ += Vector3l(mul_q30(turn_e, old.z), -mul_q30(turn_n, old.z),

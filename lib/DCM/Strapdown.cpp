@@ -32,10 +32,10 @@ void Strapdown::end_step() {
 // kRenormaliseEvery updates, and row c is rebuilt as a x b at each (rows a and b are
 // what the update turns). The paper's first-order R (I + [theta x]) is not a rotation:
 // it stretches each row by a^2/2 an update, which renormalising at every update hid.
-void Strapdown::integrate(const DcmCoefficients& k) {
+FIXED_OWN_FRAME void Strapdown::integrate(const DcmCoefficients& k) {
     profile::begin(profile::kIntegration);
     using linalg::hot::mul_q14;
-    using linalg::hot::mul_q30;
+    using linalg::mul_q30;
     using linalg::q14_of;
     // In Q30 integers (R's entries and the turn, radians): mul_q30 (13 MULs) where the
     // update's orthonormality depends on the product; mul_q14 (two 16x16 products) in the
@@ -105,7 +105,7 @@ bool Strapdown::renormalise() {
 
 // One row of R turned: r + r D (D = exp([theta x]) - I, rows as Matrix3q30), in Q30.
 void Strapdown::turn_row(Vector3l& r, const linalg::Matrix3q30& d) {
-    using linalg::hot::mul_q30;
+    using linalg::mul_q30;
     r = Vector3l(r.x + mul_q30(r.x, d.a.x) + mul_q30(r.y, d.b.x) + mul_q30(r.z, d.c.x),
                  r.y + mul_q30(r.x, d.a.y) + mul_q30(r.y, d.b.y) + mul_q30(r.z, d.c.y),
                  r.z + mul_q30(r.x, d.a.z) + mul_q30(r.y, d.b.z) + mul_q30(r.z, d.c.z));

@@ -18,12 +18,16 @@
 //   - FIXED_INLINE helpers are a few instructions (mul_s16, mul_u16, q14_of ...): forced
 //     inline everywhere, cheaper than a call.
 //   - mul_q30, mul_q14, mul_q14_unit and fixed_from_float are ordinary calls
-//     (linalg::mul_q30 ...; mul_q30's called form keeps to the call-clobbered
-//     registers, Fixed.cpp); the hot list takes their forced-inline copies from
-//     namespace linalg::hot, one `using linalg::hot::...` at the top of the function:
-//     the DCM's integration (Strapdown), the gravity window's products and the field
-//     sample's latency turn (each runs at 50 to 200 Hz). Cold code (start-up, the
-//     float paths, renormalisation, a new field's heading, the learner's solve) calls.
+//     (linalg::mul_q30 ...); the hot list takes the forced-inline copies of mul_q14,
+//     mul_q14_unit and fixed_from_float from namespace linalg::hot, one
+//     `using linalg::hot::...` at the top of the function: the integration's coning term
+//     (Strapdown), the gravity window's products, the rest means and the field sample's
+//     latency turn (each runs at 50 to 200 Hz). Cold code (start-up, the float paths,
+//     renormalisation, a new field's heading, the learner's solve) calls.
+//   - mul_q30 is called even on the hot list: its called form keeps to the
+//     call-clobbered registers (Fixed.cpp), while a function with many inline copies
+//     (the integration) ran out of registers and spilled to a deep frame, slower and
+//     larger than the calls. hot::mul_q30 is the host's form and the reference.
 //   - The Euler output (atan2_q24 ...) runs once a line, all inline (its own target).
 #pragma once
 
@@ -34,15 +38,21 @@
 
 // FIXED_INLINE: forced inline on the AVR (out of line, -mcall-prologues gives each call
 // the register-saving routines). FIXED_COLD: never inline (one copy of cold code that
-// would otherwise be copied into each caller).
+// would otherwise be copied into each caller, or cold code whose locals would grow a hot
+// caller's frame). FIXED_OWN_FRAME: never inline either, for a large part of a hot step
+// called from one place: inlined, its locals join the caller's, and a frame beyond the 63
+// bytes ldd/std reach from Y makes every access beyond them five instructions (subi,
+// sbci, the access, subi, sbci) in the caller's whole body.
 #ifdef __AVR__
 #define FIXED_INLINE __attribute__((always_inline)) inline
 #define FIXED_COLD __attribute__((noinline))
+#define FIXED_OWN_FRAME __attribute__((noinline))
 #include <avr/pgmspace.h>
 #define FIXED_PROGMEM PROGMEM
 #else
 #define FIXED_INLINE inline
 #define FIXED_COLD
+#define FIXED_OWN_FRAME
 #define FIXED_PROGMEM
 #endif
 

@@ -17,6 +17,8 @@ enum Part : uint8_t {
     kCompass = 10,        // heading correction from a field sample (Dcm::correct_heading)
     kLearner = 11,        // the compass offset learner's pair update (Pipeline)
     kChecks = 12,         // the pipeline's sample checks and calibration before the DCM
+    // 13 is the firmware's flight control step (firmware/Board.h).
+    kMagFit = 14,         // one part of the `cal mag` fit (Pipeline), outside the estimator step
 };
 
 #if defined(__AVR__)

@@ -80,8 +80,8 @@ enum class BurstStatus : uint8_t {
 };
 
 // One sample in the sensor's own counts, body frame: the estimator sums counts at
-// 200 Hz and turns only the sums into SI units (a float conversion and multiply per
-// axis would cost ~300 cycles a sample on the 2560). The accessors give SI units.
+// 200 Hz and turns only the sums into SI units (not six float conversions and
+// multiplies a sample, library calls on the 2560). The accessors give SI units.
 struct Sample {
     linalg::Vector3i gyro;           // counts of gyro_rad_s_per_count
     linalg::Vector3i accel;          // specific force (level at rest: z < 0), counts of accel_m_s2_per_count
@@ -98,8 +98,8 @@ struct Sample {
 
 constexpr float kStandardGravity_m_s2 = 9.80665f;
 
-// The same sensitivities as scale factors, constant expressions (a float division
-// costs ~500 cycles on the 2560 and the decode runs 200 times a second; a switch here
+// The same sensitivities as scale factors, constant expressions (a float division is
+// the 2560's slowest library call and the decode runs 200 times a second; a switch here
 // became a 68-byte table in RAM).
 constexpr float gyro_rad_s_per_count(GyroRange range) {
     return range == GyroRange::Dps250    ? linalg::kRadPerDeg / 131.0f

@@ -45,6 +45,28 @@ static_assert(kGyro3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_GYRO && kAccel3d == 
                   kMag3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_MAG,
               "SensorBits are MAV_SYS_STATUS_SENSOR's");
 static_assert(kComponentId == (uint8_t)MAV_COMP_ID_AUTOPILOT1, "QGroundControl makes vehicles of AUTOPILOT1 only");
+static_assert(kParamTypeInt8 == MAV_PARAM_TYPE_INT8 && kParamTypeInt16 == MAV_PARAM_TYPE_INT16 &&
+                  kParamTypeReal32 == MAV_PARAM_TYPE_REAL32,
+              "MAV_PARAM_TYPE values");
+static_assert(kParamIdLen == MAVLINK_MSG_PARAM_VALUE_FIELD_PARAM_ID_LEN, "param_id length");
+static_assert(kParamValueFrame == kFrameOverhead + MAVLINK_MSG_ID_PARAM_VALUE_LEN, "PARAM_VALUE size");
+static_assert(kRcChannelsFrame == kFrameOverhead + MAVLINK_MSG_ID_RC_CHANNELS_LEN, "RC_CHANNELS size");
+static_assert(kMaxFrame >= kRcChannelsFrame && kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_SERVO_OUTPUT_RAW_LEN &&
+                  kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_COMMAND_ACK_LEN,
+              "the replies and streams fit kMaxFrame");
+static_assert(kRxPayloadMax == MAVLINK_MSG_ID_COMMAND_LONG_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_PARAM_SET_LEN &&
+                  kRxPayloadMax >= MAVLINK_MSG_ID_PARAM_REQUEST_READ_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_HEARTBEAT_LEN,
+              "the received payloads fit");
+static_assert(kMsgHeartbeat == MAVLINK_MSG_ID_HEARTBEAT && kMsgParamRequestRead == MAVLINK_MSG_ID_PARAM_REQUEST_READ &&
+                  kMsgParamRequestList == MAVLINK_MSG_ID_PARAM_REQUEST_LIST && kMsgParamSet == MAVLINK_MSG_ID_PARAM_SET &&
+                  kMsgCommandLong == MAVLINK_MSG_ID_COMMAND_LONG,
+              "MsgId values are the message ids");
+static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE,
+              "MAV_CMD values");
+static_assert((uint8_t)Result::Accepted == MAV_RESULT_ACCEPTED && (uint8_t)Result::TemporarilyRejected ==
+                  MAV_RESULT_TEMPORARILY_REJECTED && (uint8_t)Result::Denied == MAV_RESULT_DENIED &&
+                  (uint8_t)Result::Unsupported == MAV_RESULT_UNSUPPORTED && (uint8_t)Result::Failed == MAV_RESULT_FAILED,
+              "Result values are MAV_RESULT's");
 
 namespace {
 
@@ -82,10 +104,12 @@ Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok) {
     return h;
 }
 
-uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state) {
+uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode) {
     Frame f(seq_);
-    mavlink_msg_heartbeat_pack_status(kSystemId, kComponentId, &f.status, &f.msg, MAV_TYPE_GENERIC,
-                                      MAV_AUTOPILOT_GENERIC, 0u, 0u, (uint8_t)state);
+    uint8_t base = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | MAV_MODE_FLAG_MANUAL_INPUT_ENABLED | MAV_MODE_FLAG_SAFETY_ARMED;
+    if (mode != PlaneMode::Manual) base |= MAV_MODE_FLAG_STABILIZE_ENABLED;
+    mavlink_msg_heartbeat_pack_status(kSystemId, kComponentId, &f.status, &f.msg, MAV_TYPE_FIXED_WING,
+                                      MAV_AUTOPILOT_ARDUPILOTMEGA, base, (uint32_t)mode, (uint8_t)state);
     return f.finish(out, seq_);
 }
 
@@ -117,6 +141,42 @@ uint8_t Packer::statustext(uint8_t out[kMaxFrame], Severity severity, const char
     Frame f(seq_);
     mavlink_msg_statustext_pack_status(kSystemId, kComponentId, &f.status, &f.msg, (uint8_t)severity, field, id,
                                        chunk_seq);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::param_value(uint8_t out[kMaxFrame], const char* name, float value, uint8_t type, uint16_t count,
+                            uint16_t index) {
+    char id[kParamIdLen];  // the generated code copies all 16: NUL after a shorter name
+    uint8_t i = 0;
+    for (; i < kParamIdLen && name[i] != '\0'; ++i) id[i] = name[i];
+    for (; i < kParamIdLen; ++i) id[i] = '\0';
+    Frame f(seq_);
+    mavlink_msg_param_value_pack_status(kSystemId, kComponentId, &f.status, &f.msg, id, value, type, count, index);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::command_ack(uint8_t out[kMaxFrame], uint16_t command, Result result, uint8_t target_system,
+                            uint8_t target_component) {
+    Frame f(seq_);
+    mavlink_msg_command_ack_pack_status(kSystemId, kComponentId, &f.status, &f.msg, command, (uint8_t)result, 0u, 0,
+                                        target_system, target_component);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::rc_channels(uint8_t out[kMaxFrame], uint32_t time_boot_ms, const uint16_t w[8], uint8_t count) {
+    Frame f(seq_);
+    const uint16_t none = UINT16_MAX;
+    mavlink_msg_rc_channels_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_boot_ms, count, w[0], w[1],
+                                        w[2], w[3], w[4], w[5], w[6], w[7], none, none, none, none, none, none, none,
+                                        none, none, none, UINT8_MAX);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::servo_output_raw(uint8_t out[kMaxFrame], uint32_t time_boot_us, const uint16_t w[8]) {
+    Frame f(seq_);
+    mavlink_msg_servo_output_raw_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_boot_us, 0u, w[0],
+                                             w[1], w[2], w[3], w[4], w[5], w[6], w[7], 0u, 0u, 0u, 0u, 0u, 0u, 0u,
+                                             0u);
     return f.finish(out, seq_);
 }
 
@@ -190,27 +250,144 @@ void StatusText::flush_chunk() {
 
 // ---------------------------------------------------------------------------------------
 
-bool FrameFilter::consume(uint8_t byte) {
+namespace {
+
+// The CRC_EXTRA of a message the board answers, and its payload length; 0 for the others.
+uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
+    switch (msgid) {
+        case MAVLINK_MSG_ID_HEARTBEAT: max_len = MAVLINK_MSG_ID_HEARTBEAT_LEN; return MAVLINK_MSG_ID_HEARTBEAT_CRC;
+        case MAVLINK_MSG_ID_PARAM_REQUEST_READ:
+            max_len = MAVLINK_MSG_ID_PARAM_REQUEST_READ_LEN;
+            return MAVLINK_MSG_ID_PARAM_REQUEST_READ_CRC;
+        case MAVLINK_MSG_ID_PARAM_REQUEST_LIST:
+            max_len = MAVLINK_MSG_ID_PARAM_REQUEST_LIST_LEN;
+            return MAVLINK_MSG_ID_PARAM_REQUEST_LIST_CRC;
+        case MAVLINK_MSG_ID_PARAM_SET: max_len = MAVLINK_MSG_ID_PARAM_SET_LEN; return MAVLINK_MSG_ID_PARAM_SET_CRC;
+        case MAVLINK_MSG_ID_COMMAND_LONG:
+            max_len = MAVLINK_MSG_ID_COMMAND_LONG_LEN;
+            return MAVLINK_MSG_ID_COMMAND_LONG_CRC;
+        default: return 0;
+    }
+}
+
+}  // namespace
+
+void Parser::start(uint8_t stx) {
+    v2_ = stx == MAVLINK_STX;
+    pos_ = 1;
+    crc_init(&crc_);
+    crc_extra_ = 0;
+    memset(&rx_, 0, sizeof rx_);
+}
+
+// Frame layout after STX (v2): len, incompat, compat, seq, sysid, compid, msgid (3
+// bytes), payload, CRC (2), [signature 13]; (v1): len, seq, sysid, compid, msgid,
+// payload, CRC (2). The CRC covers len .. the payload's end, then CRC_EXTRA.
+bool Parser::consume(uint8_t byte) {
     if (pos_ == 0) {
         if (byte != MAVLINK_STX && byte != MAVLINK_STX_MAVLINK1) return false;
-        v2_ = byte == MAVLINK_STX;
-        pos_ = 1;
+        start(byte);
         return true;
     }
+    const uint8_t header = v2_ ? 10u : 6u;  // STX .. msgid
     if (pos_ == 1) {
-        // After STX and length: the rest of the header (v2: 8, v1: 4), payload, CRC.
-        remaining_ = (uint16_t)((v2_ ? 8u : 4u) + byte + 2u);
-        pos_ = 2;
-        return true;
+        len_ = byte;
+        remaining_ = (uint16_t)(header - 1u + byte + 2u);  // this byte to the CRC's last
+    } else if (pos_ < header) {
+        const uint8_t sysid_at = v2_ ? 5u : 3u;
+        const uint8_t at = (uint8_t)(pos_ - sysid_at);  // 0 sysid, 1 compid, 2.. msgid
+        if (v2_ && pos_ == 2 && (byte & MAVLINK_IFLAG_SIGNED) != 0u)
+            remaining_ = (uint16_t)(remaining_ + MAVLINK_SIGNATURE_BLOCK_LEN);
+        if (pos_ >= sysid_at) {
+            if (at == 0) rx_.sysid = byte;
+            else if (at == 1) rx_.compid = byte;
+            else if (at == 2) {
+                rx_.msgid = byte;
+                uint8_t max_len = 0;
+                crc_extra_ = crc_extra_of(byte, max_len);
+                if (len_ > max_len) crc_extra_ = 0;
+            } else if (byte != 0u) {
+                crc_extra_ = 0;  // msgid above 255: not one of ours
+            }
+        }
+    } else if (pos_ < header + len_) {
+        const uint16_t i = (uint16_t)(pos_ - header);
+        if (i < kRxPayloadMax) rx_.payload[i] = byte;
+    } else if (pos_ == header + len_) {
+        crc_lo_ = byte;
+    } else if (pos_ == header + len_ + 1u) {
+        crc_ok_ = crc_lo_ == (uint8_t)(crc_ & 0xFFu) && byte == (uint8_t)(crc_ >> 8);
     }
-    if (pos_ == 2) {
-        if (v2_ && (byte & MAVLINK_IFLAG_SIGNED) != 0u) remaining_ = (uint16_t)(remaining_ + MAVLINK_SIGNATURE_BLOCK_LEN);
-        pos_ = 3;
-    }
-    if (--remaining_ == 0u) {
-        pos_ = 0;
-        ++frames_;
-    }
+    if (pos_ < header + len_) crc_accumulate(byte, &crc_);
+    if (pos_ + 1u == header + len_ && crc_extra_ != 0u) crc_accumulate(crc_extra_, &crc_);
+    ++pos_;
+    if (--remaining_ == 0u) finish();
+    return true;
+}
+
+void Parser::finish() {
+    pos_ = 0;
+    ++frames_;
+    if (crc_extra_ == 0u) return;  // not a message the board answers
+    if (crc_ok_) ready_ = true;
+    else ++bad_crc_;
+}
+
+bool for_us(uint8_t target_system, uint8_t target_component) {
+    return (target_system == 0u || target_system == kSystemId) &&
+           (target_component == 0u || target_component == kComponentId);
+}
+
+namespace {
+void copy_id(char out[kParamIdLen + 1], const char* id) {
+    memcpy(out, id, kParamIdLen);
+    out[kParamIdLen] = '\0';
+}
+}  // namespace
+
+// The generated structs are the payload's wire layout (packed, little-endian, as the
+// AVR and the hosts this builds on are): a copy of the zero-filled payload decodes it,
+// as the generated mavlink_msg_*_decode does.
+bool decode_param_request_read(const Received& rx, ParamRequest& out) {
+    if (rx.msgid != kMsgParamRequestRead) return false;
+    mavlink_param_request_read_t m;
+    memcpy(&m, rx.payload, sizeof m);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    out.index = m.param_index;
+    copy_id(out.name, m.param_id);
+    return true;
+}
+
+bool decode_param_request_list(const Received& rx) {
+    if (rx.msgid != kMsgParamRequestList) return false;
+    mavlink_param_request_list_t m;
+    memcpy(&m, rx.payload, sizeof m);
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_param_set(const Received& rx, ParamSet& out) {
+    if (rx.msgid != kMsgParamSet) return false;
+    mavlink_param_set_t m;
+    memcpy(&m, rx.payload, sizeof m);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    copy_id(out.name, m.param_id);
+    out.value = m.param_value;
+    return true;
+}
+
+bool decode_command_long(const Received& rx, CommandLong& out) {
+    if (rx.msgid != kMsgCommandLong) return false;
+    mavlink_command_long_t m;
+    memcpy(&m, rx.payload, sizeof m);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    out.command = m.command;
+    out.param[0] = m.param1;
+    out.param[1] = m.param2;
+    out.param[2] = m.param3;
+    out.param[3] = m.param4;
+    out.param[4] = m.param5;
+    out.param[5] = m.param6;
+    out.param[6] = m.param7;
     return true;
 }
 

@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// MAVLink 2 for ground stations (Mission Planner, QGroundControl): the four messages an
-// attitude-only board sends, packed into the caller's byte buffer, and the separation
-// of incoming MAVLink frames from console text on the same UART.
+// MAVLink 2 for ground stations (Mission Planner, QGroundControl, MAVProxy): the messages
+// the board sends, packed into the caller's byte buffer, and the ground station's frames,
+// parsed (CRC-checked, MAVLink 2 and 1) from the bytes it shares the UART with.
 //
-//   HEARTBEAT    1 Hz      21 bytes   type MAV_TYPE_GENERIC, autopilot MAV_AUTOPILOT_GENERIC
-//   ATTITUDE     per line  40 bytes   roll, pitch, yaw (rad, yaw with declination), body rates
-//   SYS_STATUS   1 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
-//   STATUSTEXT   per "# "  15..66     every "# " console line, severity from its first word
+//   HEARTBEAT        1 Hz      21 bytes   FIXED_WING, ARDUPILOTMEGA, ArduPlane's mode number
+//   ATTITUDE         per line  40 bytes   roll, pitch, yaw (rad, yaw with declination), body rates
+//   SYS_STATUS       1 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
+//   STATUSTEXT       per "# "  15..66     every "# " console line, severity from its first word
+//   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us
+//   SERVO_OUTPUT_RAW 5 Hz      33 bytes   the eight outputs' widths, us
+//   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
+//   COMMAND_ACK      replies   ~15 bytes
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -15,11 +19,13 @@
 //
 // Why these HEARTBEAT values: QGroundControl creates a vehicle for a heartbeat from
 // component MAV_COMP_ID_AUTOPILOT1 (1) unless its type is GCS, ONBOARD_CONTROLLER, GIMBAL
-// or ADSB (MultiVehicleManager), and MAVLink tools (pymavlink's mavutil, MAVProxy) take
-// autopilot MAV_AUTOPILOT_INVALID to mean "not a flight controller"; so: system 1,
-// component 1, MAV_TYPE_GENERIC (the board flies nothing; claiming FIXED_WING would make
-// a GCS show plane set-up pages) and MAV_AUTOPILOT_GENERIC (not ArduPilot or PX4: a GCS
-// must not try those stacks' parameters and modes). base_mode 0 (never armed).
+// or ADSB (MultiVehicleManager). The board flies a plane with ArduPlane's modes and
+// parameter names (issue 21), so it says what ArduPlane says: MAV_TYPE_FIXED_WING,
+// MAV_AUTOPILOT_ARDUPILOTMEGA and custom_mode = ArduPlane's mode number, which Mission
+// Planner, QGroundControl and MAVProxy name (MANUAL, STABILIZE, FBWA). base_mode: custom
+// mode enabled, manual input enabled, stabilize enabled outside MANUAL, and armed: the
+// board has no arming, its outputs are live from power-up (ArduPlane with ARMING_REQUIRE
+// 0 says armed too).
 //
 // Plain C++: no Arduino include, the same code on the AVR and the host tests.
 #pragma once
@@ -42,6 +48,18 @@ constexpr uint8_t kMaxFrame = kFrameOverhead + 54;
 constexpr uint8_t kHeartbeatFrame = kFrameOverhead + 9;  // never trimmed: mavlink_version = 3 last
 constexpr uint8_t kAttitudeFrame = kFrameOverhead + 28;  // trimmed only if yawspeed is exactly 0
 
+constexpr uint8_t kParamIdLen = 16;  // PARAM_* param_id, characters
+constexpr uint8_t kParamValueFrame = kFrameOverhead + 25;
+constexpr uint8_t kRcChannelsFrame = kFrameOverhead + 42;
+
+// PARAM_VALUE param_type (MAV_PARAM_TYPE): the ones ArduPilot uses.
+constexpr uint8_t kParamTypeInt8 = 2;
+constexpr uint8_t kParamTypeInt16 = 4;
+constexpr uint8_t kParamTypeReal32 = 9;
+
+// COMMAND_ACK result (MAV_RESULT).
+enum class Result : uint8_t { Accepted = 0, TemporarilyRejected = 1, Denied = 2, Unsupported = 3, Failed = 4 };
+
 // HEARTBEAT system_status (MAV_STATE).
 enum class State : uint8_t {
     Boot = 1,         // before the first attitude
@@ -49,6 +67,11 @@ enum class State : uint8_t {
     Active = 4,       // estimating
     Critical = 5,     // a sensor is missing or has failed
 };
+
+// ArduPlane's mode numbers (HEARTBEAT custom_mode). The failsafe (wings level, gliding,
+// throttle at THR_FS_OUT) is ArduPlane's FS_SHORT_ACTN 2, "FBWA at zero throttle": the
+// board reports FBWA then, as ArduPlane does, with system_status CRITICAL.
+enum class PlaneMode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
 
 // STATUSTEXT severity (MAV_SEVERITY).
 enum class Severity : uint8_t { Error = 3, Warning = 4, Notice = 5, Info = 6 };
@@ -69,7 +92,7 @@ Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok);
 // Each call writes one frame into `out` and returns its length (0 only on bad input).
 class Packer {
 public:
-    uint8_t heartbeat(uint8_t out[kMaxFrame], State state);
+    uint8_t heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode);
     // The pipeline's angles in degrees (heading 0..360, declination applied) are sent
     // in radians, heading wrapped to -pi..pi as ATTITUDE's yaw; rates in rad/s, body axes.
     uint8_t attitude(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float roll_deg, float pitch_deg,
@@ -81,6 +104,18 @@ public:
     // in one chunk; otherwise chunks of one message share id and count chunk_seq from 0.
     uint8_t statustext(uint8_t out[kMaxFrame], Severity severity, const char* text, uint8_t len,
                        uint16_t id, uint8_t chunk_seq);
+    // PARAM_VALUE: name up to kParamIdLen characters (NUL-terminated when shorter),
+    // type a MAV_PARAM_TYPE, the value as a float (ArduPilot's convention for every type).
+    uint8_t param_value(uint8_t out[kMaxFrame], const char* name, float value, uint8_t type, uint16_t count,
+                        uint16_t index);
+    // COMMAND_ACK to the ground station that sent the command.
+    uint8_t command_ack(uint8_t out[kMaxFrame], uint16_t command, Result result, uint8_t target_system,
+                        uint8_t target_component);
+    // RC_CHANNELS: `count` channels (0: no receiver signal), the eight widths in us
+    // (channels 9-18 unused: UINT16_MAX), RSSI unknown.
+    uint8_t rc_channels(uint8_t out[kMaxFrame], uint32_t time_boot_ms, const uint16_t width_us[8], uint8_t count);
+    // SERVO_OUTPUT_RAW: the eight outputs' widths in us, port 0.
+    uint8_t servo_output_raw(uint8_t out[kMaxFrame], uint32_t time_boot_us, const uint16_t width_us[8]);
     uint8_t next_sequence() const { return seq_; }
 
 private:
@@ -127,21 +162,85 @@ private:
     Line state_ = Line::Start;
 };
 
+// The messages the board answers (msgid).
+enum MsgId : uint8_t {
+    kMsgHeartbeat = 0,
+    kMsgParamRequestRead = 20,
+    kMsgParamRequestList = 21,
+    kMsgParamSet = 23,
+    kMsgCommandLong = 76,
+};
+constexpr uint8_t kRxPayloadMax = 33;  // COMMAND_LONG's, the longest of them
+
+// A frame from the ground station, CRC-checked: its payload zero-filled to the message's
+// full length (MAVLink 2 trims trailing zeros).
+struct Received {
+    uint8_t msgid;  // MsgId
+    uint8_t sysid, compid;
+    uint8_t payload[kRxPayloadMax];
+};
+
 // Splits received bytes into MAVLink frames (from a GCS: its HEARTBEAT, PARAM_REQUEST_LIST
-// ...) and console text. A MAVLink frame starts with 0xFD (v2) or 0xFE (v1), bytes that
-// never occur in console text (printable ASCII); its length byte gives the frame size,
-// so a frame never reaches the console's line reader (where it would be "non-text bytes").
-class FrameFilter {
+// ...) and console text, and checks each frame of a message the board answers (CRC with
+// the message's CRC_EXTRA, payload not longer than the message's). A frame starts with
+// 0xFD (v2) or 0xFE (v1), bytes that never occur in console text (printable ASCII); its
+// length byte gives the frame size, so a frame never reaches the console's line reader
+// (where it would be "non-text bytes"). Signed frames are taken without checking the
+// signature (the board does not sign).
+class Parser {
 public:
-    // True when `byte` belongs to a MAVLink frame (do not give it to the console).
+    // True when `byte` belongs to a MAVLink frame (in `mode mavlink`, not console input).
     bool consume(uint8_t byte);
-    uint16_t frames() const { return frames_; }  // complete frames seen (not CRC-checked)
+    // A good frame of a message the board answers has ended: frame() holds it until
+    // release(). Until then consume() must not be called (the caller stops reading).
+    bool ready() const { return ready_; }
+    const Received& frame() const { return rx_; }
+    void release() { ready_ = false; }
+    uint16_t frames() const { return frames_; }     // complete frames seen
+    uint16_t bad_crc() const { return bad_crc_; }   // ... of a message the board answers, CRC wrong
 
 private:
+    void start(uint8_t stx);
+    void finish();
+
+    Received rx_ = {};
+    uint16_t crc_ = 0;
     uint16_t remaining_ = 0;  // bytes of the current frame still to come
-    uint8_t pos_ = 0;         // bytes of the current frame seen
+    uint16_t pos_ = 0;        // bytes of the current frame seen
+    uint8_t len_ = 0;         // payload length (as sent)
+    uint8_t crc_extra_ = 0;   // 0: a message the board does not answer (or too long): not kept
+    uint8_t crc_lo_ = 0;
     bool v2_ = false;
+    bool ready_ = false;
+    bool crc_ok_ = false;
     uint16_t frames_ = 0;
+    uint16_t bad_crc_ = 0;
 };
+
+// True when a request names this board (target system 0 = all, or kSystemId; target
+// component 0 = all, or kComponentId).
+bool for_us(uint8_t target_system, uint8_t target_component);
+
+// The requests' fields (false: not for this board, or not that message).
+struct ParamRequest {
+    int16_t index;                // -1: by name
+    char name[kParamIdLen + 1];   // NUL-terminated
+};
+bool decode_param_request_read(const Received& rx, ParamRequest& out);
+bool decode_param_request_list(const Received& rx);
+struct ParamSet {
+    char name[kParamIdLen + 1];
+    float value;
+};
+bool decode_param_set(const Received& rx, ParamSet& out);
+struct CommandLong {
+    uint16_t command;  // MAV_CMD
+    float param[7];
+};
+bool decode_command_long(const Received& rx, CommandLong& out);
+
+// The commands the board carries out (MAV_CMD).
+constexpr uint16_t kCmdPreflightCalibration = 241;
+constexpr uint16_t kCmdPreflightStorage = 245;
 
 }  // namespace mav

@@ -10,7 +10,6 @@
 namespace pipeline {
 
 using linalg::Vector3f;
-using text::Writer;
 
 namespace {
 constexpr float kG = mpu6000::kStandardGravity_m_s2;
@@ -27,9 +26,6 @@ constexpr uint32_t kNormalAccelCounts2 =
 // 2000 deg/s full scale make 60 rad/s) is a broken read, not a rotation.
 constexpr uint32_t kMaxCredibleRateCounts2 = (uint32_t)((dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s) *
                                                         (dcm::kMaxCredibleRate_rad_s / kGyroCount_rad_s));
-// A part of the `cal mag` fit, for the simulator's profiler: the next id after
-// profile::Part's (lib/LinAlg/Profile.h).
-constexpr uint8_t kMagFitSection = 13;
 // |a - b| of two counts.
 int32_t jump(int16_t a, int16_t b) {
     const int32_t d = (int32_t)a - b;
@@ -41,6 +37,37 @@ uint32_t norm2(const linalg::Vector3i& v) {
            (uint32_t)linalg::mul_s16(v.z, v.z);
 }
 }  // namespace
+
+// An int32 into int16's range.
+static int16_t sat16(int32_t v) { return v > 32767 ? 32767 : v < -32767 ? -32767 : (int16_t)v; }
+
+int16_t centripetal_gain_q8(float airspeed_m_s) {
+    if (!(airspeed_m_s >= kCentripetalMinAirspeed_m_s)) return 0;  // NaN too
+    const float v = airspeed_m_s < kCentripetalMaxAirspeed_m_s ? airspeed_m_s : kCentripetalMaxAirspeed_m_s;
+    return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
+}
+
+linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8) {
+    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V.
+    return linalg::Vector3i(a.x, sat16((int32_t)a.y - (linalg::mul_s16(gyro_z, gain_q8) >> 8)),
+                            sat16((int32_t)a.z + (linalg::mul_s16(gyro_y, gain_q8) >> 8)));
+}
+
+// A rate in gyro counts, rounded and clamped (NaN: 0).
+static int16_t gyro_counts_of(float rate_rad_s) {
+    const float c = rate_rad_s / kGyroCount_rad_s;
+    if (!(c > -32767.0f)) return c < 0.0f ? -32767 : 0;
+    return c >= 32767.0f ? 32767 : (int16_t)(c < 0.0f ? c - 0.5f : c + 0.5f);
+}
+
+void AttitudePipeline::set_airspeed_m_s(float airspeed_m_s) {
+    airspeed_m_s_ = airspeed_m_s;
+    centripetal_gain_q8_ = centripetal_gain_q8(airspeed_m_s);
+    // The calibrated bias in counts (the estimator's own residual is left: a fraction of
+    // a deg/s, a few tenths of a m/s^2 at cruise).
+    gyro_bias_y_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.y);
+    gyro_bias_z_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.z);
+}
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
     // Events held back go out first, in deferred()'s line, which counts this one too.
@@ -61,10 +88,21 @@ uint16_t RateLimiter::deferred(uint32_t now, uint16_t interval) {
     return n;
 }
 
-AttitudePipeline::AttitudePipeline(const text::Sink* log, const dcm::DcmSettings& dcm_settings)
-    : log_(log), settings_(settings::defaults()), dcm_(dcm_settings), st_() {
+AttitudePipeline::AttitudePipeline(const EventSink* events, const dcm::DcmSettings& dcm_settings)
+    : AttitudePipeline(events, SettingsLoadedLater{}, dcm_settings) {
+    settings_ = settings::defaults();
+}
+
+AttitudePipeline::AttitudePipeline(const EventSink* events, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
+    : events_(events), settings_(), dcm_(dcm_settings), st_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f);
 }
+
+void AttitudePipeline::tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const {
+    if (events_ != nullptr) events_->tell(events_->ctx, *this, Event{kind, code, count, total, value});
+}
+void AttitudePipeline::tell(EventKind kind, uint16_t count) const { tell(kind, count, 0, 0.0f, 0); }
+void AttitudePipeline::tell(EventKind kind) const { tell(kind, 0); }
 
 void AttitudePipeline::set_mag_present(bool present) {
     st_.mag_present = present;
@@ -73,16 +111,13 @@ void AttitudePipeline::set_mag_present(bool present) {
 
 void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     if (!field_uT.is_finite()) return;
-    // The fit's sums (~10 k cycles) wait for a step free of heavy work, as the learner does.
+    // The fit's sums wait for a step free of heavy work, as the learner does.
     cal_field_uT_ = field_uT;
     if (st_.mag_cal_active) st_.cal_pending = true;
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     const float n = f.length();
     if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
-        if (st_.warn_mag.allow(st_.steps, kWarnIntervalSteps)) {
-            Writer(log_).str(TXT(TXT_WARN TXT_HMC " field ")).fixed2(n)
-                .str(TXT(" uT is not the Earth's (10..200): sample dropped")).end();
-        }
+        if (warn_of(EventKind::kMagNotEarth).allow(st_.steps, kWarnIntervalSteps)) tell(EventKind::kMagNotEarth, 0, 0, n, 0);
         return;
     }
     // The learner takes the sample on a later step with neither an output line, a heading
@@ -139,7 +174,7 @@ void AttitudePipeline::learn_mag_offset(bool one_piece) {
     const bool solved_part = learner_.solving();
     if (solved_part) learner_.solve_part(learned);
     // The sample waits for the solve (the learner composes no turn meanwhile); it follows
-    // the solve's last part on its step (that part is the estimate's update, ~5 k).
+    // the solve's last part on its step (that part is the estimate's update, a short one).
     if (!(one_piece && solved_part) && !learner_.solving() && st_.learn_pending) {
         st_.learn_pending = false;
         // The turn less every bias estimate (the one now stands for the interval's).
@@ -158,9 +193,9 @@ void AttitudePipeline::forget_mag_reference(bool take_heading) {
     learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
 }
 
-// Spikes and non-finite values are replaced by the previous sample; saturation is
-// reported (a saturated gyro is used: the true rate is at least the full scale; a
-// saturated accel is withheld from the DCM by on_imu_sample).
+// Spikes are replaced by the previous sample; saturation is reported (a saturated gyro
+// is used: the true rate is at least the full scale; on_imu_sample decides whether a
+// saturated accel is gravity).
 const mpu6000::Sample& AttitudePipeline::guard(const mpu6000::Sample& s) {
     bool spike = false;
     if (st_.have_last) {
@@ -171,10 +206,7 @@ const mpu6000::Sample& AttitudePipeline::guard(const mpu6000::Sample& s) {
     if (spike && st_.spike_run < kMaxSpikeRun) {
         ++st_.spike_run;
         ++st_.spikes;
-        if (st_.warn_spike.allow(st_.steps, kWarnIntervalSteps)) {
-            Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: previous sample used instead ("))
-                .u32(st_.spikes).str(TXT(" so far)")).end();
-        }
+        if (warn_of(EventKind::kSpike).allow(st_.steps, kWarnIntervalSteps)) tell(EventKind::kSpike, 0, st_.spikes, 0.0f, 0);
         last_.temperature_raw = s.temperature_raw;  // the previous sample, with this one's temperature
         st_.turn_doubtful = true;  // the gyro stood in for, not measured: no learner pair across it
         return last_;
@@ -182,34 +214,17 @@ const mpu6000::Sample& AttitudePipeline::guard(const mpu6000::Sample& s) {
     // A run longer than kMaxSpikeRun is real (saturation, a crash) and used.
     st_.spike_run = 0;
     if (s.gyro_saturated) st_.turn_doubtful = true;  // the rate is only a lower bound
-    if (s.gyro_saturated && st_.warn_gyro_sat.allow(st_.steps, kWarnIntervalSteps))
-        Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated (beyond 2000 deg/s)")).end();
-    if (s.accel_saturated && st_.warn_accel_sat.allow(st_.steps, kWarnIntervalSteps))
-        Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated (beyond 8 g)")).end();
+    if (s.gyro_saturated && warn_of(EventKind::kGyroSaturated).allow(st_.steps, kWarnIntervalSteps)) tell(EventKind::kGyroSaturated);
+    if (s.accel_saturated && warn_of(EventKind::kAccelSaturated).allow(st_.steps, kWarnIntervalSteps)) tell(EventKind::kAccelSaturated);
     last_ = s;
     st_.have_last = true;
     return last_;
 }
 
-void AttitudePipeline::print_bias(text::Flash prefix, bool status) const {
-    Writer w(log_);
-    w.str(prefix).vec(status ? gyro_bias_rad_s() : settings_.cal.gyro_bias_rad_s, linalg::kDegPerRad)
-        .str(TXT(" deg/s"));
-    if (!status) {
-        w.end();
-        return;
-    }
-    w.str(TXT(", temperature ")).fixed2(last_.temperature_c()).str(TXT(" C")).end();
-    w.str(TXT("# compass: cal "))
-        .str((settings_.flags & settings::kFlagMagCalibrated) ? TXT("yes") : TXT("none"))
-        .str(TXT(", learned offset ")).vec(settings_.cal.mag_learned_uT).str(TXT(" uT ("))
-        .u32(learner_.updates()).str(TXT(" updates)")).end();
-}
-
-// The DCM started from gravity and the latest field (TRIAD, ~20 k cycles). A DCM that has
-// run is reset first (~10 k: a fresh object copied in) and given its scales; at the first
-// start it is as the constructor made it with the scales set when the calibration began
-// (nothing else touches it while calibrating): only the sensor bias is set (~2 k).
+// The DCM started from gravity and the latest field (TRIAD). A DCM that has run is reset
+// first (a fresh object copied in) and given its scales; at the first start it is as the
+// constructor made it with the scales set when the calibration began (nothing else
+// touches it while calibrating): only the sensor bias is set.
 void AttitudePipeline::start_estimator(const Vector3f& gravity) {
     if (st_.phase == Phase::Running) {
         dcm_ = dcm::Dcm(dcm_.settings());
@@ -237,8 +252,8 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagGyroCalibrated);
-        // The message (~11 k cycles) goes out on the next step: with the start's work this
-        // one would overrun its 5 ms.
+        // The event goes out on the next step: with the start's work and the line's words
+        // this one would overrun its 5 ms.
         st_.start_message = StartMessage::kBias;
         if (st_.phase == Phase::Calibrating) {
             start_estimator(gyro_cal_.mean_accel_m_s2());
@@ -249,20 +264,20 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         return;
     }
     if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz)) {
-        Writer(log_).str(TXT("# calibrating gyro: board moved, retrying")).end();
+        tell(EventKind::kGyroCalMoved);
     } else if (const uint16_t n = st_.warn_moved.deferred(st_.steps, kRateHz)) {
-        Writer(log_).str(TXT("# calibrating gyro: board moved ")).u32(n).str(TXT(" more times, retrying")).end();
+        tell(EventKind::kGyroCalMoved, n);
     }
     if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
         // Never still long enough: run with what we have, keep measuring in the background
-        // (the warning on the next step, as the bias message).
+        // (the event on the next step, as the bias's).
         st_.start_message = StartMessage::kNotStill;
         start_estimator(raw.accel_m_s2());
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
         st_.gyro_cal_active = false;
-        Writer(log_).str(TXT(TXT_ERROR "cal gyro: board never still for 1 s; bias unchanged")).end();
+        tell(EventKind::kGyroCalTimeout);
     }
 }
 
@@ -276,19 +291,16 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     ++st_.steps;
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);
-    if (st_.start_message == StartMessage::kBias) print_bias(TXT("# gyro bias: "), false);
-    if (st_.start_message == StartMessage::kNotStill) {
-        Writer(log_).str(TXT(TXT_WARN "board not still: starting with "))
-            .str((settings_.flags & settings::kFlagGyroCalibrated) ? TXT("the saved") : TXT("zero"))
-            .str(TXT(" gyro bias, measuring on")).end();
-    }
+    if (st_.start_message == StartMessage::kBias) tell(EventKind::kGyroBias);
+    if (st_.start_message == StartMessage::kNotStill)
+        tell(EventKind::kNotStill, 0, 0, 0.0f, (settings_.flags & settings::kFlagGyroCalibrated) ? 1 : 0);
     st_.start_message = StartMessage::kNone;
     const mpu6000::Sample& s = guard(raw);  // last_, the sample the step uses
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
-        // The DCM's scales now (~4 k cycles): the step that ends the calibration starts it.
+        // The DCM's scales now: the step that ends the calibration starts the DCM.
         dcm_.set_sample_scales(s.gyro_rad_s_per_count, s.accel_m_s2_per_count);
-        Writer(log_).str(TXT("# calibrating gyro: keep the board still")).end();
+        tell(EventKind::kGyroCalStart);
         start_gyro_calibration();
     }
     if (st_.gyro_cal_active) step_calibration(s);
@@ -298,7 +310,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
     if (st_.reinit_pending) {
         st_.reinit_pending = false;
-        start_estimator(s.accel_m_s2());  // a restart after an outage (rare): ~50 k cycles
+        start_estimator(s.accel_m_s2());  // a restart after an outage (rare): a long step
     }
 
     // A clipped accelerometer sample still points roughly the right way: in a violent
@@ -307,18 +319,19 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // RMSE; its clipped samples never have two axes clipped at once). Two or more
     // axes at full scale (at least 11 g) is not a motion but a stuck or broken sensor,
     // and so is one axis clipped for longer than kAccelSaturationFaultSteps: then the
-    // DCM gets NaN and gives gravity no weight that step (Dcm::update). The gyro is
-    // always integrated (saturated, it is a lower bound of the rate).
+    // DCM is told the accel is not valid and gives gravity no weight that step
+    // (Dcm::update). The gyro is integrated (saturated, it is a lower bound of the rate)
+    // unless the rate is beyond any MEMS gyro's.
     st_.accel_saturated_steps = s.accel_saturated ? (uint8_t)(st_.accel_saturated_steps < 255 ? st_.accel_saturated_steps + 1 : 255) : 0;
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
     profile::end(profile::kChecks);
-    // A field sample (10-20 k cycles: into earth axes, and the heading's correction
-    // every kHeadingSteps) waits out a step on which the DCM integrates or corrects
-    // gravity (~18-30 k), up to kMaxMagWaitSteps: its age is counted in the latency
-    // compensation. A line (Euler angles and formatting, ~10 k) is not made on a step
-    // with a field sample: it moves to the next step, 5 ms later (samples come at
-    // least two steps apart). The DCM brings its matrix up to date for the line.
+    // A field sample (into earth axes, and the heading's correction every kHeadingSteps)
+    // waits out a step on which the DCM integrates or corrects gravity, up to
+    // kMaxMagWaitSteps: its age is counted in the latency compensation. A line (Euler
+    // angles and formatting) is not made on a step with a field sample: it moves to the
+    // next step, 5 ms later (samples come at least two steps apart). The DCM brings its
+    // matrix up to date for the line. (The parts' costs: README "Performance".)
     bool heading_corrected = st_.mag_pending && st_.mag_present;
     if (heading_corrected && st_.mag_wait_steps < kMaxMagWaitSteps && dcm_.heavy_due()) {
         heading_corrected = false;
@@ -331,7 +344,16 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         st_.output_due = true;
     }
     const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
-    dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
+    const linalg::Vector3i* accel = &s.accel;
+    linalg::Vector3i corrected;
+    if (centripetal_gain_q8_ != 0) {
+        // Gravity for the DCM: the turn's centripetal acceleration taken off (see
+        // kCentripetalMinAirspeed_m_s); the clip checks above saw the measured sample.
+        corrected = centripetal_corrected(s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_),
+                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_);
+        accel = &corrected;
+    }
+    dcm_.update(s.gyro, *accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
     // The board's turn for the compass learner: the gyro alone (the biases come off when
     // a field sample takes it).
     turn_counts_ += s.gyro;
@@ -346,10 +368,8 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     if (st_.mag_cal_active) {
         ++st_.mag_cal_steps;
         if (st_.mag_cal_steps % (5u * kRateHz) == 0u && st_.mag_cal_steps < calib::kMagCalSeconds * kRateHz) {
-            Writer(log_).str(TXT("# cal mag: "))
-                .u32(calib::kMagCalSeconds - st_.mag_cal_steps / kRateHz)
-                .str(TXT(" s left, keep turning ("))
-                .u32(mag_cal_.count()).str(TXT(" samples)")).end();
+            tell(EventKind::kMagCalProgress, (uint16_t)(calib::kMagCalSeconds - st_.mag_cal_steps / kRateHz),
+                 mag_cal_.count(), 0.0f, 0);
         }
         if (st_.mag_cal_steps >= calib::kMagCalSeconds * kRateHz) {
             // The fit (several steps' worth) goes a part a step, on steps with room.
@@ -360,13 +380,12 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         }
     }
 
-    // The deferred compass work (the cal mag sums ~10 k cycles on the AVR; the learner:
-    // a sample ~6 k, or one part of a completed pair's solve, <= ~15 k) goes on a step
-    // with neither an output line nor the heading's correction from its mean or its first
-    // heading (Dcm::heading_due_next; a field sample's own ~3 k leaves room). On a step
-    // with the DCM's integration or gravity correction (Dcm::heavy_step, ~8.5 k and
-    // ~12-15 k) only one short piece of it fits, under 30 k: a sample or a part of the
-    // solve but its long second one. A pair's solve takes three such steps, and the
+    // The deferred compass work (the cal mag sums; the learner: a sample, or one part of
+    // a completed pair's solve) goes on a step with neither an output line nor the
+    // heading's correction from its mean or its first heading (Dcm::heading_due_next; a
+    // field sample's own short work leaves room). On a step with the DCM's integration
+    // or gravity correction (Dcm::heavy_step) only one short piece of it fits within the
+    // step's budget: a sample or a part of the solve but its long second one. A pair's solve takes three such steps, and the
     // samples that come meanwhile wait (the turn goes on summing). Each step kept from
     // the learner delays the offset it finds, and in a fast turn with a compass never
     // calibrated the first one ends the heading's freeze on a field the disturbance test
@@ -391,24 +410,14 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
 }
 
 // The warnings the rate limits held back, each kind once its quiet time is over (one
-// line a step at most: a line is a few thousand cycles).
+// a step at most: each is a line to word).
 void AttitudePipeline::report_deferred() {
-    uint16_t n = st_.warn_spike.deferred(st_.steps, kWarnIntervalSteps);
-    if (n != 0) {
-        Writer(log_).str(TXT(TXT_WARN TXT_MPU " spike: ")).u32(n).str(TXT(" more samples replaced ("))
-            .u32(st_.spikes).str(TXT(" so far)")).end();
+    for (uint8_t i = 0; i < kWarnKinds; ++i) {
+        const uint16_t n = st_.warn[i].deferred(st_.steps, kWarnIntervalSteps);
+        if (n == 0) continue;
+        tell((EventKind)((uint8_t)EventKind::kSpike + i), n, i == 0 ? st_.spikes : 0, 0.0f, 0);
         return;
     }
-    if ((n = st_.warn_gyro_sat.deferred(st_.steps, kWarnIntervalSteps)) != 0) {
-        Writer(log_).str(TXT(TXT_WARN TXT_MPU " gyro saturated: ")).u32(n).str(TXT(" more samples")).end();
-        return;
-    }
-    if ((n = st_.warn_accel_sat.deferred(st_.steps, kWarnIntervalSteps)) != 0) {
-        Writer(log_).str(TXT(TXT_WARN TXT_MPU " accel saturated: ")).u32(n).str(TXT(" more samples")).end();
-        return;
-    }
-    if ((n = st_.warn_mag.deferred(st_.steps, kWarnIntervalSteps)) != 0)
-        Writer(log_).str(TXT(TXT_WARN TXT_HMC " field not the Earth's: ")).u32(n).str(TXT(" more samples dropped")).end();
 }
 
 Angles AttitudePipeline::angles() const {
@@ -437,8 +446,7 @@ void AttitudePipeline::start_gyro_calibration() {
     gyro_cal_.restart();
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
-    if (st_.phase == Phase::Running)
-        Writer(log_).str(TXT("# cal gyro: keep the board still for 1 s")).end();
+    if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);
 }
 
 void AttitudePipeline::restart_estimator() {
@@ -449,7 +457,7 @@ void AttitudePipeline::restart_estimator() {
 
 void AttitudePipeline::start_mag_calibration() {
     if (!st_.mag_present) {
-        Writer(log_).str(TXT(TXT_ERROR "cal mag: " TXT_HMC " absent")).end();
+        tell(EventKind::kMagCalNoCompass);
         return;
     }
     // The centre in use (the fit's offset plus the learned one, which W ~ I barely
@@ -458,15 +466,15 @@ void AttitudePipeline::start_mag_calibration() {
     st_.mag_cal_steps = 0;
     st_.mag_cal_active = true;
     st_.mag_fit_active = false;  // a fit under way is dropped
-    Writer(log_).str(TXT("# cal mag: turn the board every way for 30 s")).end();
+    tell(EventKind::kMagCalStart);
 }
 
 // A part of the fit, or (on the step after its last) the verdict.
 void AttitudePipeline::step_mag_fit() {
     if (mag_cal_.fitting()) {
-        profile::begin(kMagFitSection);
+        profile::begin(profile::kMagFit);
         mag_cal_.fit_part();
-        profile::end(kMagFitSection);
+        profile::end(profile::kMagFit);
         return;
     }
     st_.mag_fit_active = false;
@@ -475,7 +483,6 @@ void AttitudePipeline::step_mag_fit() {
 
 void AttitudePipeline::finish_mag_calibration() {
     const calib::MagCalibrator::Quality q = mag_cal_.quality();
-    Writer w(log_);
     if (q == calib::MagCalibrator::Quality::Ok) {
         calib::Calibration& c = settings_.cal;
         mag_cal_.result(c);
@@ -483,42 +490,22 @@ void AttitudePipeline::finish_mag_calibration() {
         // calibrated the old way: the DCM takes the heading from the new one.
         mag_cal_uT_ = calib::apply_mag(c, cal_field_uT_);
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
-        w.str(TXT("# cal mag: offset ")).vec(c.mag_offset_uT).str(TXT(" uT, scale ")).vec(c.mag_scale)
-            .str(TXT(", cross ")).vec(c.mag_cross).str(TXT(", residual ")).fixed2(mag_cal_.residual_uT())
-            .str(TXT(" uT, coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("% (save to keep)")).end();
-        // Applied from the next sample: the estimator learns the calibrated field afresh.
-        learner_.restart(calib::kLearnPriorCalibrated_uT, Vector3f());
-        if (st_.phase == Phase::Running) {
-            forget_mag_reference(true);
-            // The estimator's bias residual was learned partly from heading corrections
-            // against the old calibration (a simulated tumble with 8 uT of hard iron, `cal
-            // mag` at its end: kept, the heading at rest swung from -0.9 to +0.9 deg over
-            // the next 15 s; dropped, it settles from -0.9 to 0.0): it goes with it, and
-            // is learned again.
-            dcm_.set_gyro_bias_rad_s(Vector3f());
-        }
-        return;
     }
-    w.str(TXT(TXT_ERROR "cal mag failed: "));
-    switch (q) {
-        case calib::MagCalibrator::Quality::TooFewSamples:
-            w.str(TXT("too few samples (")).u32(mag_cal_.count()).chr(')');
-            break;
-        case calib::MagCalibrator::Quality::ThinCoverage:
-            w.str(TXT("not turned every way (coverage ")).u32(mag_cal_.coverage_pct()).str(TXT("%, need "))
-                .u32(calib::kMagMinCoveragePct).str(TXT("%)"));
-            break;
-        case calib::MagCalibrator::Quality::FitFailed: w.str(TXT("no ellipsoid fits the samples")); break;
-        case calib::MagCalibrator::Quality::NotEarthField:
-            w.str(TXT("field ")).fixed2(mag_cal_.radius_uT()).str(TXT(" uT is not the Earth's (magnet near?)"));
-            break;
-        case calib::MagCalibrator::Quality::SoftIronTooLarge: w.str(TXT("soft iron beyond 20% (magnet near?)")); break;
-        default:
-            w.str(TXT("residual ")).fixed2(mag_cal_.residual_uT()).str(TXT(" uT, over "))
-                .fixed2(calib::kMagMaxResidual_uT).str(TXT(" (field changed while turning?)"));
-            break;
+    tell(EventKind::kMagCalDone, mag_cal_.coverage_pct(), mag_cal_.count(),
+         q == calib::MagCalibrator::Quality::NotEarthField ? mag_cal_.radius_uT() : mag_cal_.residual_uT(),
+         (uint8_t)q);
+    if (q != calib::MagCalibrator::Quality::Ok) return;
+    // Applied from the next sample: the estimator learns the calibrated field afresh.
+    learner_.restart(calib::kLearnPriorCalibrated_uT, Vector3f());
+    if (st_.phase == Phase::Running) {
+        forget_mag_reference(true);
+        // The estimator's bias residual was learned partly from heading corrections
+        // against the old calibration (a simulated tumble with 8 uT of hard iron, `cal
+        // mag` at its end: kept, the heading at rest swung from -0.9 to +0.9 deg over
+        // the next 15 s; dropped, it settles from -0.9 to 0.0): it goes with it, and
+        // is learned again.
+        dcm_.set_gyro_bias_rad_s(Vector3f());
     }
-    w.str(TXT("; calibration unchanged")).end();
 }
 
 void AttitudePipeline::restore_defaults() {

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // AttitudePipeline: decoded sensor samples in, estimator state and output timing out.
-// The firmware and the host replay tool run exactly this; the firmware adds only the
-// Arduino set-up, the buses, the data-ready pacing, serial I/O, LEDs and EEPROM.
+// The firmware and the host replay tool run exactly this; the firmware adds the Arduino
+// set-up, the buses, the data-ready pacing, serial I/O (the events' words:
+// PipelineText.h), LEDs, EEPROM, the airspeed sensor and the flight control.
 //
 // Use (one call per MPU6000 data-ready, 200 Hz):
 //
-//   pipeline::AttitudePipeline pipe(sink_or_nullptr);   // null sink: silent
+//   pipeline::AttitudePipeline pipe(events_or_nullptr); // null: silent
 //   pipe.settings() = settings_from_eeprom_or_defaults;  // rate, declination, calibration
 //   pipe.set_mag_present(true);                          // false: yaw is gyro-only
 //   loop:
@@ -17,24 +18,27 @@
 // board moves); then the DCM starts from the mean gravity and the latest field (TRIAD).
 // If the board is never still for kStartupDeadlineSteps the estimator starts anyway
 // with the saved bias (or zero) and the measurement goes on in the background.
-// Each step: calibration applied (calib::apply_*), spikes and non-finite samples
-// replaced by the previous sample, Dcm::update at the fixed 5 ms step (a saturated
-// accelerometer sample goes in as NaN: no gravity weight that step), then
-// Dcm::correct_heading if a field sample came in since the previous step.
+// Each step, on the sample in the MPU6000's counts: a spike replaced by the previous
+// sample (guard), the accelerometer's centripetal term taken off when an airspeed is
+// set, Dcm::update at the fixed 5 ms step (the DCM subtracts the calibrated bias; an
+// accelerometer stuck at full scale gets no gravity weight that step, a rate beyond any
+// gyro's is not integrated), then Dcm::correct_heading with the latest field sample
+// (waiting out up to kMaxMagWaitSteps of the DCM's heavy steps), and on a step with room
+// the deferred compass work (the `cal mag` sums and fit, the offset learner).
 //
 // Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
 // the offset learned in motion) before the DCM sees it; while running, the learner
 // (calib::OffsetLearner) estimates the hard iron from the field's change against the
-// gyro's rotation, and puts it in use once it is significant. A new calibration, or a learned offset that has moved by
-// kMagReferenceShift_uT since the estimator learned the earth field, makes the
-// estimator forget that field (Dcm::reset_mag_reference): its strength and dip are
-// those of the calibrated field from then on.
+// gyro's rotation, and puts it in use once it is significant. A new calibration, or a
+// learned offset that has moved by kMagReferenceShift_uT since the estimator learned the
+// earth field, makes the estimator forget that field (Dcm::reset_mag_reference): its
+// strength and dip are those of the calibrated field from then on.
 //
-// Messages (to the sink, each a "# " line): gyro calibration progress and result,
-// "# warn: MPU6000 ..." for spikes and saturation, "# warn: HMC5883L ..." for absurd
-// fields (at most one per kWarnIntervalSteps per kind; what came meanwhile is told once
-// that time is over: "# warn: MPU6000 spike: 10 more samples replaced (12 so far)"),
-// the `cal mag` progress and verdict.
+// Events (to the EventSink, as plain numbers: the sketch words them, PipelineText.h):
+// the gyro calibration's progress and result, spikes and saturation of the MPU6000,
+// absurd fields from the HMC5883L (at most one per kWarnIntervalSteps per kind; what
+// came meanwhile is told once that time is over, with its count), the `cal mag`
+// progress and verdict.
 #pragma once
 
 #include <stdint.h>
@@ -44,7 +48,6 @@
 #include "LinAlg.h"
 #include "Mpu6000Registers.h"
 #include "Settings.h"
-#include "Text.h"
 
 namespace pipeline {
 
@@ -60,9 +63,9 @@ constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the b
 // Counted in steps, not milliseconds, so the reads fall on the same steps in the
 // firmware and in the host replay tool.
 constexpr uint8_t kMagReadMinSteps = 2;
-// The offset learner takes a field sample at most every this many steps (25 Hz): a
-// sample costs it ~6 k cycles (its turn composed), and pairs close at 20 deg of turn
-// (kLearnMinCos) whatever the rate; the gyro's turn between two samples is summed as a
+// The offset learner takes a field sample at most every this many steps (25 Hz): each
+// sample costs it a turn composed (README "Performance"), and pairs close at 20 deg of
+// turn (kLearnMinCos) whatever the rate; the gyro's turn between two samples is summed as a
 // rotation vector, whose error over 40 ms (at most 0.2 rad at 300 deg/s) is below 0.003 rad.
 constexpr uint8_t kLearnMinSteps = 8;
 // A field sample waits at most this many steps for a step free of the DCM's heavy parts
@@ -86,14 +89,32 @@ constexpr float kMagMax_uT = 200.0f;
 // learn the field again, before the shift can get a good field rejected.
 constexpr float kMagReferenceShift_uT = 2.5f;
 
+// The centripetal correction (Premerlani & Bizard, "Direction Cosine Matrix IMU: Theory",
+// eq. 26; ArduPilot's AP_AHRS_DCM with an airspeed): in steady flight the velocity is
+// (V, 0, 0) along the body's x axis and the accelerometer reads f = omega x v - g_body,
+// so gravity is f - omega x v = f - (0, omega_z V, -omega_y V). Below this airspeed the
+// velocity is not along x (on the ground, a launch, a stall): no correction. ArduPlane's
+// ARSPD_FBW_MIN default, about two thirds of a small aeroplane's stall.
+constexpr float kCentripetalMinAirspeed_m_s = 9.0f;
+// Above the MPXV7002DP's full scale (2 kPa: 57 m/s) an airspeed is a fault: clamped.
+constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
+
+// The correction's gain: accel counts per gyro count of omega x v at this airspeed, Q8
+// (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum).
+int16_t centripetal_gain_q8(float airspeed_m_s);
+// f - omega x v in the MPU6000's counts, gyro_counts less the sensor bias; each axis
+// saturates at +-32767.
+linalg::Vector3i centripetal_corrected(const linalg::Vector3i& accel_counts, int16_t gyro_y_counts,
+                                       int16_t gyro_z_counts, int16_t gain_q8);
+
 enum class Phase : uint8_t {
     WaitImu,      // no sample yet
     Calibrating,  // measuring the gyro bias; nothing estimated yet
     Running,      // estimating
 };
 
-// A message of the start, printed on the step after the one that starts the estimator
-// (with the start's work that step would overrun its 5 ms).
+// An event of the start, told on the step after the one that starts the estimator
+// (with the start's work and the line's words that step would overrun its 5 ms).
 enum class StartMessage : uint8_t { kNone, kBias, kNotStill };
 
 struct Angles {
@@ -119,12 +140,57 @@ struct RateLimiter {
     bool ever;      // allow() has said yes before
 };
 
+// What the pipeline tells, as numbers; the words are the sketch's (PipelineText.h).
+enum class EventKind : uint8_t {
+    kGyroCalStart,     // the start-up gyro calibration begins
+    kGyroCalAgain,     // `cal gyro` begins
+    kGyroCalMoved,     // the board moved: the calibration restarts; count more since the last line
+    kGyroCalTimeout,   // `cal gyro` gave up (never still for 1 s): the bias unchanged
+    kGyroBias,         // the calibration's result: settings().cal.gyro_bias_rad_s
+    kNotStill,         // never still: started anyway; code 1 with the saved bias, 0 with zero
+    kSpike,            // MPU6000 samples replaced by the previous one; total so far
+    kGyroSaturated,    // MPU6000 gyro at its full scale (used: a lower bound)
+    kAccelSaturated,   // MPU6000 accel at its full scale
+    kMagNotEarth,      // an HMC5883L field outside kMagMin_uT..kMagMax_uT dropped; value uT
+                       // (kSpike .. kMagNotEarth: the rate-limited warnings, in this order)
+    kMagCalStart,      // `cal mag` begins
+    kMagCalNoCompass,  // `cal mag` refused: no magnetometer
+    kMagCalProgress,   // `cal mag` collecting: count seconds left, total samples
+    kMagCalDone,       // the verdict: code a calib::MagCalibrator::Quality (Ok: in settings().cal)
+};
+
+// One event. count, for the rate-limited kinds (kGyroCalMoved, kSpike, kGyroSaturated,
+// kAccelSaturated, kMagNotEarth): 0 for the first, at once; else how many the limit held
+// back since the last line. kMagCalDone: count the coverage (%), total the samples,
+// value the residual (uT; the fitted field's radius for NotEarthField).
+struct Event {
+    EventKind kind;
+    uint8_t code;
+    uint16_t count;
+    uint32_t total;
+    float value;
+};
+
+class AttitudePipeline;
+// Where the events go: a function and its context (no virtual call: avr-gcc keeps
+// vtables in SRAM). The function may read the pipeline's state (settings, bias).
+struct EventSink {
+    void* ctx;
+    void (*tell)(void* ctx, const AttitudePipeline& pipe, const Event& e);
+};
+
 class AttitudePipeline {
 public:
     // dcm_settings: the estimator's gains (the firmware's are the defaults; the host
     // replay tool may try others, `replay --set`).
-    explicit AttitudePipeline(const text::Sink* log = nullptr,
+    explicit AttitudePipeline(const EventSink* events = nullptr,
                               const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
+    // The firmware's static object: settings zeroed until setup() loads them. A static
+    // constructor runs before Arduino's init() starts millis(), so its work would shift
+    // the firmware's timeline (kMpuStartMs ...) against reset, and replay's with it.
+    struct SettingsLoadedLater {};
+    AttitudePipeline(const EventSink* events, SettingsLoadedLater,
+                     const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
 
     // Rate, declination, mode and calibration; change them freely (console commands).
     settings::Settings& settings() { return settings_; }
@@ -134,6 +200,11 @@ public:
     void set_mag_present(bool present);
     bool mag_present() const { return st_.mag_present; }
 
+    // The airspeed along the body's x axis (m/s; 0: none, no correction) for the
+    // centripetal correction of the accelerometer: holds until set again.
+    void set_airspeed_m_s(float airspeed_m_s);
+    float airspeed_m_s() const { return airspeed_m_s_; }
+
     // One MPU6000 sample at the fixed 200 Hz step.
     void on_imu_sample(const mpu6000::Sample& s);
     // One magnetometer sample (body frame, uT, self-test scale applied, before the
@@ -141,11 +212,10 @@ public:
     void on_mag_sample(const linalg::Vector3f& field_uT);
     // True once per output period after on_imu_sample (only while Running).
     bool output_due() const { return st_.output_due; }
-    // Current angles (Euler extraction in integers, then floats: ~6 k cycles on the AVR
-    // with today's float lead; call when due).
+    // Current angles (Euler extraction in integers, then floats; call when due).
     Angles angles() const;
-    // The same in printed hundredths, with no float after the matrix entries (~3.3 k
-    // cycles on the AVR besides the lead's): what the plot and csv lines print.
+    // The same in printed hundredths, with no float after the matrix entries (cheaper
+    // than angles(): section 2, README "Performance"): what the plot and csv lines print.
     AnglesCentideg angles_centideg() const;
     // The same attitude as a unit quaternion, body to the true-north earth frame
     // (declination applied like the heading's): `mode quat`.
@@ -181,10 +251,8 @@ public:
     linalg::Vector3f gyro_bias_rad_s() const;
     float temperature_c() const { return last_.temperature_c(); }
     uint32_t spikes() const { return st_.spikes; }
-    // "<prefix>x y z deg/s": the calibrated bias, or (status) the calibrated bias plus the
-    // estimator's, followed by ", temperature T C" and a second line, the compass's:
-    // "# compass: cal yes|none, learned offset x y z uT (n updates)".
-    void print_bias(text::Flash prefix, bool status) const;
+    // The `cal mag` collection and fit: its sample count, coverage and residual.
+    const calib::MagCalibrator& mag_calibrator() const { return mag_cal_; }
     const calib::OffsetLearner& offset_learner() const { return learner_; }
 
 private:
@@ -194,11 +262,18 @@ private:
     void step_mag_fit();
     void finish_mag_calibration();
     void report_deferred();
+    // An event to the sink; the short forms keep each call site small (flash).
+    void tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const;
+    __attribute__((noinline)) void tell(EventKind kind, uint16_t count) const;
+    __attribute__((noinline)) void tell(EventKind kind) const;
+    // The rate-limited warnings: the kinds kSpike .. kMagNotEarth, each with its limiter.
+    static constexpr uint8_t kWarnKinds = 4;
+    RateLimiter& warn_of(EventKind kind) { return st_.warn[(uint8_t)kind - (uint8_t)EventKind::kSpike]; }
     void take_learner_sample(const linalg::Vector3f& field_uT);
     void learn_mag_offset(bool one_piece);
     void forget_mag_reference(bool take_heading);
 
-    const text::Sink* log_;
+    const EventSink* events_;
     settings::Settings settings_;
     dcm::Dcm dcm_;
     calib::GyroCalibrator gyro_cal_;
@@ -210,11 +285,16 @@ private:
     linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
+    float airspeed_m_s_ = 0.0f;
+    int16_t centripetal_gain_q8_ = 0;     // 0: no correction
+    int16_t gyro_bias_y_counts_ = 0;      // the calibrated bias the gyro counts carry
+    int16_t gyro_bias_z_counts_ = 0;
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
-    // clears it in one loop instead of a store per member (~250 B of AVR flash).
+    // clears it in one loop instead of a store per member (less flash).
     struct State {
-        RateLimiter warn_spike, warn_gyro_sat, warn_accel_sat, warn_mag, warn_moved;
+        RateLimiter warn[kWarnKinds];  // kSpike .. kMagNotEarth (warn_of)
+        RateLimiter warn_moved;
         uint32_t steps;
         uint32_t spikes;
         uint16_t gyro_cal_steps;
@@ -235,7 +315,7 @@ private:
         bool mag_fit_active;            // its fit, a part a step
         bool output_due;
         bool reinit_pending;
-        StartMessage start_message;     // printed on the step after the calibration's end
+        StartMessage start_message;     // told on the step after the calibration's end
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn

@@ -24,6 +24,8 @@ EARTH_FIELD_NED_UT = (20.0, 0.0, 45.0)
 SURFACE_THROW_US = 500.0
 # Physics is never stepped coarser than this, whatever the servo packets' frame rate.
 MAX_STEP_S = 1.0 / 400.0
+# The C.G. this close to the ground is a crash (the gear sits 0.37 m below it).
+CRASH_HEIGHT_M = 0.25
 
 # Dryden turbulence at low altitude (MIL-F-8785C as tabulated by Beard & McLain, Small
 # Unmanned Aircraft, Table 4.1): intensities sigma_u = sigma_v, sigma_w in m/s, scale
@@ -112,10 +114,13 @@ class Trim:
 
 class FlightModel:
     def __init__(self, airspeed_m_s=18.0, altitude_m=100.0, heading_deg=0.0, gust=0, seed=1,
-                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0):
+                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0, hold_s=0.0):
         """upsets: (start_s, duration_s, roll_moment_Nm) tuples, a roll moment applied from
         start_s for duration_s (positive rolls right). vibration_m_s2: the amplitude of the
-        propeller's vibration at the IMU at the trim's propeller speed (see vibration())."""
+        propeller's vibration at the IMU at the trim's propeller speed (see vibration()).
+        hold_s: the aeroplane is held still at its start attitude for so long (on a launch
+        stand: the board powers up and calibrates its gyro at rest, as on the ground), then
+        released into the trimmed flight (a catapult launch at the trim's speed)."""
         if gust not in GUST_LEVELS:
             raise ValueError("gust level %r: 0 (none), 1 (light) or 2 (moderate)" % (gust,))
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
@@ -123,6 +128,8 @@ class FlightModel:
         self.gust_level, self.seed = gust, seed
         self.upsets = [tuple(float(v) for v in u) for u in upsets]
         self.vibration_m_s2 = float(vibration_m_s2)
+        self.hold_s = max(0.0, float(hold_s))
+        self.crashed_at = None  # time of the crash (the ground), None while flying
         jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
         self.fdm.set_debug_level(0)
@@ -210,6 +217,9 @@ class FlightModel:
         t = self.trim
         self._residual((t.throttle, t.elevator, t.aileron, t.rudder, t.alpha_rad, t.beta_rad))
         self.time_s = 0.0
+        self.crashed_at = None
+        self.crash_euler = None
+        self.crash_position = None
         self.surfaces = [t.aileron, t.elevator, t.throttle, t.rudder]
         self.dryden = Dryden(self.gust_level, self.seed)
         self.gust_body = np.zeros(3)
@@ -232,6 +242,15 @@ class FlightModel:
 
     def step(self, dt_s):
         """Advance dt_s of simulated time (in steps of at most MAX_STEP_S)."""
+        if self.crashed_at is not None:
+            self.time_s += dt_s
+            return
+        if self.held():
+            held = min(dt_s, self.hold_s - self.time_s)
+            self.time_s += held
+            dt_s -= held
+            if dt_s <= 1e-12:
+                return
         n = max(1, int(math.ceil(dt_s / MAX_STEP_S - 1e-9)))
         h = dt_s / n
         f = self.fdm
@@ -251,7 +270,36 @@ class FlightModel:
             f.run()
             self.prop_angle_rad = (self.prop_angle_rad +
                                    f["propulsion/engine/propeller-rpm"] * 2 * math.pi / 60 * h) % (2 * math.pi)
+            if self._hit_ground():
+                self.crashed_at = self.time_s + (i + 1) * h
+                break
         self.time_s += dt_s
+
+    def _hit_ground(self):
+        """The C.G. within CRASH_HEIGHT_M of the ground (the gear crushed: not a landing this
+        model's simple gear can take) or a state that is no longer finite: the aeroplane has
+        crashed. It then lies still where it hit (the model's ground contact is not made for
+        crashes: left to run, JSBSim's state grows without bound)."""
+        f = self.fdm
+        values = [f["position/h-agl-ft"], f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"],
+                  f["velocities/vt-fps"]]
+        if all(math.isfinite(v) for v in values) and values[0] * FT > CRASH_HEIGHT_M:
+            self.last_good = (values[1:4], self._position())
+            return False
+        euler, position = getattr(self, "last_good", ((0.0, 0.0, self.heading0), [0.0, 0.0, -self.altitude0]))
+        self.crash_euler = tuple(euler)
+        self.crash_position = [position[0], position[1], 0.0]
+        return True
+
+    def _position(self):
+        f = self.fdm
+        lat, lon = f["position/lat-geod-rad"], f["position/long-gc-rad"]
+        return [(lat - self.lat0) * EARTH_RADIUS_M, (lon - self.lon0) * EARTH_RADIUS_M * math.cos(self.lat0),
+                -f["position/h-agl-ft"] * FT]
+
+    def held(self):
+        """Still on the launch stand (hold_s)."""
+        return self.time_s < self.hold_s - 1e-12
 
     def vibration(self):
         """The propeller's vibration at the IMU, m/s^2 body axes: a rotating imbalance at the
@@ -270,7 +318,11 @@ class FlightModel:
     def state(self):
         """The true state and the ideal sensor values, SI, as a dict."""
         f = self.fdm
-        roll, pitch, yaw = f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"]
+        crashed = self.crashed_at is not None
+        if crashed:
+            roll, pitch, yaw = self.crash_euler
+        else:
+            roll, pitch, yaw = f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"]
         q = quat_from_euler(roll, pitch, yaw)
         mass_slug = f["inertia/mass-slugs"]
         # Specific force: every force but gravity (aerodynamics, thrust, ground) over the mass.
@@ -278,10 +330,12 @@ class FlightModel:
         # Body rates relative to the earth: integrating them gives the NED attitude exactly.
         gyro = [f["velocities/%s-rad_sec" % a] for a in "pqr"]
         rot = body_to_ned_matrix(roll, pitch, yaw)
+        held = self.held() or crashed
+        if held:  # at rest on the stand: no rates, the stand's reaction against gravity
+            gyro = [0.0, 0.0, 0.0]
+            accel = [float(v) for v in rot.T @ np.array([0.0, 0.0, -G0])]
         mag = rot.T @ np.array(EARTH_FIELD_NED_UT)
-        lat, lon = f["position/lat-geod-rad"], f["position/long-gc-rad"]
-        north = (lat - self.lat0) * EARTH_RADIUS_M
-        east = (lon - self.lon0) * EARTH_RADIUS_M * math.cos(self.lat0)
+        position = self.crash_position if crashed else self._position()
         return {
             "t": self.time_s,
             "gyro": gyro,
@@ -289,12 +343,13 @@ class FlightModel:
             "mag": [float(m) for m in mag],
             "quat": q,
             "euler": (roll, pitch, yaw),
-            "position": [north, east, -f["position/h-agl-ft"] * FT],
-            "velocity": [f["velocities/v-%s-fps" % a] * FT for a in ("north", "east", "down")],
-            "airspeed": f["velocities/vt-fps"] * FT,
-            "wind": [f["atmosphere/total-wind-%s-fps" % a] * FT for a in ("north", "east", "down")],
-            "alpha": f["aero/alpha-rad"],
-            "beta": f["aero/beta-rad"],
+            "position": list(position),
+            "velocity": [0.0, 0.0, 0.0] if held else [f["velocities/v-%s-fps" % a] * FT for a in ("north", "east", "down")],
+            "airspeed": 0.0 if held else f["velocities/vt-fps"] * FT,
+            "wind": [0.0, 0.0, 0.0] if crashed else
+                    [f["atmosphere/total-wind-%s-fps" % a] * FT for a in ("north", "east", "down")],
+            "alpha": 0.0 if crashed else f["aero/alpha-rad"],
+            "beta": 0.0 if crashed else f["aero/beta-rad"],
             "surfaces": list(self.surfaces),
-            "rpm": f["propulsion/engine/propeller-rpm"],
+            "rpm": 0.0 if crashed else f["propulsion/engine/propeller-rpm"],
         }

@@ -141,6 +141,8 @@ def start_backend(args, rc_path, seconds, gust, work, extra):
     cmd += list(extra) + [a for u in args.upset for a in ("--upset", u)]
     if args.vibration:
         cmd += ["--vibration", repr(args.vibration)]
+    if args.hold:
+        cmd += ["--hold", repr(args.hold)]
     proc = subprocess.Popen(cmd)
     deadline = time.monotonic() + 60.0
     while not (os.path.exists(port_file) and open(port_file).read().endswith("\n")):
@@ -191,6 +193,7 @@ def main():
     p.add_argument("--mode", choices=("stabilize", "manual"), default="stabilize")
     p.add_argument("--vibration", type=float, default=0.0, metavar="M_S2", help="passed to the backend")
     p.add_argument("--upset", action="append", default=[], metavar="T,SECONDS,NM", help="passed to the backend")
+    p.add_argument("--hold", type=float, default=0.0, metavar="S", help="passed to the backend (a launch stand)")
     p.add_argument("--out", help="trajectory file (.csv or .csv.gz)")
     p.add_argument("--log", help="true-state log")
     p.add_argument("--list", action="store_true")

@@ -47,6 +47,9 @@ def parse_args(argv):
                         "of simulated time; repeatable")
     p.add_argument("--vibration", type=float, default=0.0, metavar="M_S2",
                    help="propeller vibration at the IMU, amplitude at the trim's propeller speed (m/s^2)")
+    p.add_argument("--hold", type=float, default=0.0, metavar="S",
+                   help="hold the aeroplane still at its start attitude for S s (a launch stand: the "
+                        "board starts at rest), then release it into the trimmed flight")
     p.add_argument("--trajectory", help="write the flight as a trajectory (../shared/SIM.md)")
     p.add_argument("--log", help="write the true state, one row a frame")
     p.add_argument("--seconds", type=float, default=0.0,
@@ -71,7 +74,7 @@ class Backend:
                 raise ValueError("--upset %r: want T,SECONDS,NM (three numbers)" % spec)
             upsets.append((start, length, moment))
         self.model = flightmodel.FlightModel(args.airspeed, args.altitude, args.heading, args.gust, args.seed,
-                                             upsets=upsets, vibration_m_s2=args.vibration)
+                                             upsets=upsets, vibration_m_s2=args.vibration, hold_s=args.hold)
         trim = self.model.trim
         widths = trim.widths_us()
         if args.rc == "none":
@@ -129,7 +132,10 @@ class Backend:
             self.frames = 0
             self.open_outputs()
         self.model.set_widths(pwm[:4])
+        crashed_before = self.model.crashed_at is not None
         self.model.step(1.0 / frame_rate)
+        if self.model.crashed_at is not None and not crashed_before:
+            self.say("# crashed at %.3f s: the aeroplane lies still where it hit the ground" % self.model.crashed_at)
         self.frames += 1
         state = self.model.state()
         self.record(state)

@@ -33,10 +33,17 @@ def main():
     p.add_argument("--estimate")
     p.add_argument("--title", default="")
     p.add_argument("--out", required=True)
+    p.add_argument("--until", type=float, help="draw up to this time (s), e.g. the ground")
     args = p.parse_args()
     try:
         t, north, east, down, roll = columns(args.log, ("t", "north_m", "east_m", "down_m", "roll_deg"))
         estimate = columns(args.estimate, ("t", "roll")) if args.estimate else None
+        if args.until is not None:
+            n = sum(1 for v in t if v <= args.until)
+            t, north, east, down, roll = (c[:n] for c in (t, north, east, down, roll))
+            if estimate:
+                m = sum(1 for v in estimate[0] if v <= args.until)
+                estimate = [c[:m] for c in estimate]
     except (OSError, ValueError) as e:
         print("plot_flight: %s" % e, file=sys.stderr)
         return 1

@@ -737,7 +737,7 @@ bool Board::write_eeprom(const std::string& path) const {
 // --- profiling ----------------------------------------------------------------
 
 void Board::on_gpior_write(bool end, uint8_t value) {
-    if (value == 0 || value > 15) return;
+    if (value == 0 || value > kMaxSectionId) return;
     SectionProfile& s = sections_[value];
     const uint64_t now = avr_->cycle;
     if (!end) {
@@ -767,7 +767,7 @@ bool Board::write_profile(const std::string& path) const {
     FILE* f = std::fopen(path.c_str(), "w");
     if (!f) return false;
     std::fprintf(f, "section,count,avg_cycles,min_cycles,max_cycles,total_cycles\n");
-    for (int id = 1; id <= 15; ++id) {
+    for (int id = 1; id <= kMaxSectionId; ++id) {
         const SectionProfile& s = sections_[id];
         if (s.count == 0) continue;
         std::fprintf(f, "%d,%llu,%llu,%llu,%llu,%llu\n", id, (unsigned long long)s.count,

@@ -59,7 +59,9 @@ struct BoardOptions {
 void request_stop();
 bool stop_requested();
 
-// Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id.
+// Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id
+// (1..kMaxSectionId; other values are ignored).
+constexpr int kMaxSectionId = 31;
 struct SectionProfile {
     uint64_t count = 0, total = 0, min = UINT64_MAX, max = 0;
     uint64_t started_at = 0;
@@ -184,7 +186,7 @@ private:
     ServoPulseLog servo_pulses_;
     std::vector<ServoPulse> servo_ready_;
 
-    SectionProfile sections_[16];
+    SectionProfile sections_[kMaxSectionId + 1];
     uint64_t run_first_start_ = 0, run_last_end_ = 0;
     bool run_started_ = false;
     uint32_t profile_errors_ = 0;

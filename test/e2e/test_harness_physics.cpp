@@ -60,7 +60,7 @@ std::vector<std::vector<long>> packets(const std::string& log) {
 // The firmware on a board the backend holds at roll 20, pitch -10, heading 90 deg (as
 // `attitude`, then as `quaternion`): its lines read that attitude, from the earth field
 // rotated by the backend's attitude, and score them against --physics-log's file. Every frame once, counting from 0, at 1000 Hz, one a
-// millisecond of simulated time; the firmware drives no servo: every width 0.
+// millisecond of simulated time; with no receiver the outputs hold their safe values.
 TEST(HarnessPhysics, TheFirmwareReadsTheBackendsAttitude) {
     E2E_REQUIRE_TOOLS("apm25sim", "firmware.elf");
     for (const char* form : {"attitude", "quaternion"}) {
@@ -91,7 +91,16 @@ TEST(HarnessPhysics, TheFirmwareReadsTheBackendsAttitude) {
             ASSERT_EQ(sent[i].size(), 18u);
             EXPECT_EQ(sent[i][0], 1000) << i;
             EXPECT_EQ(sent[i][1], (long)i);
-            for (int c = 0; c < 16; ++c) EXPECT_EQ(sent[i][2 + c], 0) << i;
+            // Without a receiver the firmware holds its safe outputs (issue 21): OUT3, the
+            // throttle, at its failsafe 1000 us, the others at their 1500 us trim, from their
+            // first pulse on (0 before it: nothing measured yet); OUT9-16 are not wired.
+            for (int c = 0; c < 8; ++c) {
+                const long neutral_us = c == 2 ? 1000 : 1500;
+                const long width_us = sent[i][2 + c];
+                if (i >= 100) EXPECT_EQ(width_us, neutral_us) << i << " OUT" << c + 1;
+                else EXPECT_TRUE(width_us == 0 || width_us == neutral_us) << i << " OUT" << c + 1 << " " << width_us;
+            }
+            for (int c = 8; c < 16; ++c) EXPECT_EQ(sent[i][2 + c], 0) << i;
         }
     }
 }

@@ -28,7 +28,7 @@ def main():
     soft_assert(mav.total_receive_errors == 0, "receive errors: %d" % mav.total_receive_errors)
     types = [m.get_type() for m in msgs]
     want = ["HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT",
-            "HEARTBEAT"]
+            "HEARTBEAT", "PARAM_VALUE", "COMMAND_ACK", "RC_CHANNELS", "SERVO_OUTPUT_RAW"]
     soft_assert(types == want, "message order %r, expected %r" % (types, want))
     if types != want:
         return
@@ -38,11 +38,36 @@ def main():
         soft_assert(m.get_srcSystem() == 1 and m.get_srcComponent() == 1, "source %d/%d" % (m.get_srcSystem(),
                                                                                      m.get_srcComponent()))
     hb = msgs[0]
-    soft_assert(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC,
+    soft_assert(hb.type == mavlink2.MAV_TYPE_FIXED_WING and hb.autopilot == mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA,
           "heartbeat type/autopilot %d/%d" % (hb.type, hb.autopilot))
-    soft_assert(hb.system_status == mavlink2.MAV_STATE_ACTIVE and hb.base_mode == 0 and hb.mavlink_version == 3,
-          "heartbeat state %d base_mode %d version %d" % (hb.system_status, hb.base_mode, hb.mavlink_version))
-    soft_assert(msgs[7].system_status == mavlink2.MAV_STATE_CRITICAL, "second heartbeat: critical")
+    flags = (mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | mavlink2.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED |
+             mavlink2.MAV_MODE_FLAG_SAFETY_ARMED)
+    stabilize = flags | mavlink2.MAV_MODE_FLAG_STABILIZE_ENABLED
+    soft_assert(hb.system_status == mavlink2.MAV_STATE_ACTIVE and hb.base_mode == stabilize and hb.custom_mode == 2
+                and hb.mavlink_version == 3, "heartbeat state %d base_mode %d custom_mode %d version %d"
+                % (hb.system_status, hb.base_mode, hb.custom_mode, hb.mavlink_version))
+    soft_assert(msgs[7].system_status == mavlink2.MAV_STATE_CRITICAL and msgs[7].custom_mode == 5
+                and msgs[7].base_mode == stabilize,
+                "second heartbeat: critical, FBWA (the failsafe glide)")
+    # pymavlink's own mode names for an ArduPlane (what MAVProxy shows).
+    from pymavlink import mavutil
+    soft_assert(mavutil.mode_string_v10(hb) == "STABILIZE" and mavutil.mode_string_v10(msgs[7]) == "FBWA",
+                "mode names %r %r" % (mavutil.mode_string_v10(hb), mavutil.mode_string_v10(msgs[7])))
+
+    pv, ack, rc, servo = msgs[8:12]
+    soft_assert(pv.param_id == "RLL2SRV_P" and abs(pv.param_value - 1.0) < 1e-6
+                and pv.param_type == mavlink2.MAV_PARAM_TYPE_REAL32 and pv.param_count == 97 and pv.param_index == 1,
+                "PARAM_VALUE %r" % pv)
+    soft_assert(ack.command == mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION and ack.result == mavlink2.MAV_RESULT_ACCEPTED
+                and ack.target_system == 255 and ack.target_component == 190, "COMMAND_ACK %r" % ack)
+    soft_assert(rc.time_boot_ms == 4000 and rc.chancount == 8 and
+                [getattr(rc, "chan%d_raw" % i) for i in range(1, 10)] == [1100, 1200, 1300, 1400, 1500, 1600, 1700,
+                                                                         1800, 65535] and rc.rssi == 255,
+                "RC_CHANNELS %r" % rc)
+    soft_assert(servo.time_usec == 4000000 and servo.port == 0 and
+                [getattr(servo, "servo%d_raw" % i) for i in range(1, 9)] == [1000, 1100, 1200, 1300, 1400, 1500, 1600,
+                                                                            2000],
+                "SERVO_OUTPUT_RAW %r" % servo)
 
     att = msgs[1]
     soft_assert(att.time_boot_ms == 123456, "time_boot_ms %d" % att.time_boot_ms)

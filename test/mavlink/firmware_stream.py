@@ -8,14 +8,14 @@ Runs build/firmware.elf in build/apm25sim twice on the same 12 s of the tilt tou
 HMC5883L unplugged from 6 to 7 s: once with `mode csv` typed at 3 s (the reference angles,
 time-stamped), once with `mode mavlink` typed at 3 s. Checks, for the MAVLink run:
   - everything after the reply to `mode mavlink` decodes: no bad CRC, no stray byte;
-  - HEARTBEAT about once a second (every ~50 ATTITUDE), generic type and autopilot;
+  - HEARTBEAT about once a second (every ~50 ATTITUDE), a fixed wing ArduPilot in MANUAL (no receiver);
+  - RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz (no receiver: no channels, outputs at trim);
   - ATTITUDE at the output rate (50 Hz: time_boot_ms 20 +- 6 ms apart, 20 on average, none missing), its
     roll, pitch and yaw equal to the csv run's at the same time_boot_ms within 0.01 rad;
   - SYS_STATUS each second, the compass' health bit cleared while it is unplugged;
   - STATUSTEXT for the fault ("HMC5883L", severity error) and its recovery.
 Exit 1 with every failure listed.
 """
-import argparse
 import math
 import os
 import subprocess
@@ -24,6 +24,7 @@ import sys
 from pymavlink.dialects.v20 import common as mavlink2
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from sim_run import scenario_file, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 RATE_HZ = 50
@@ -63,14 +64,8 @@ def angle_diff_rad(a, b):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tools", required=True, help="the build directory (apm25sim, scenario, firmware.elf)")
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    trajectory = os.path.join(args.work, "tilt_tour.csv")
-    with open(trajectory, "wb") as f:
-        subprocess.run([os.path.join(args.tools, "scenario"), "tilt_tour"], stdout=f, check=True)
+    args = tools_and_work()
+    trajectory = scenario_file(args.tools, args.work, "tilt_tour")
 
     reference = csv_angles(run(args.tools, args.work, trajectory, "mode csv"))
     soft_assert(len(reference) > 400, "csv run: %d rows" % len(reference))
@@ -88,7 +83,8 @@ def main():
     soft_assert(not bad and mav.total_receive_errors == 0,
           "%d bad frames, %d receive errors: %r" % (len(bad), mav.total_receive_errors, bad[:3]))
     types = [m.get_type() for m in msgs]
-    soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT"}, "unexpected: %r" % set(types))
+    soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "RC_CHANNELS", "SERVO_OUTPUT_RAW"},
+                "unexpected: %r" % set(types))
     soft_assert(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
           "first frame: the reply to the command, got %r" % (msgs[:1],))
     seqs = [m.get_seq() for m in msgs]
@@ -125,8 +121,18 @@ def main():
         soft_assert(45 <= n <= 55, "%d ATTITUDE between two HEARTBEAT (one a second expected)" % n)
     for i in hb_at:
         hb = msgs[i]
-        soft_assert(hb.type == mavlink2.MAV_TYPE_GENERIC and hb.autopilot == mavlink2.MAV_AUTOPILOT_GENERIC
-              and hb.mavlink_version == 3, "HEARTBEAT %r" % hb)
+        soft_assert(hb.type == mavlink2.MAV_TYPE_FIXED_WING and hb.autopilot == mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA
+                    and hb.custom_mode == 0 and hb.mavlink_version == 3, "HEARTBEAT %r" % hb)
+
+    # The radio and servo pages' streams, 5 Hz: no receiver, so no channels, outputs at trim
+    # and the throttle (OUT3) at its failsafe value, SERVO3_MIN.
+    rc = [m for m in msgs if m.get_type() == "RC_CHANNELS"]
+    servo = [m for m in msgs if m.get_type() == "SERVO_OUTPUT_RAW"]
+    soft_assert(abs(len(rc) - 5 * span_s) <= 5 and len(servo) == len(rc),
+                "%d RC_CHANNELS, %d SERVO_OUTPUT_RAW in %d s (5 Hz expected)" % (len(rc), len(servo), span_s))
+    soft_assert(all(m.chancount == 0 for m in rc), "RC_CHANNELS with channels and no receiver")
+    soft_assert(all([m.servo1_raw, m.servo2_raw, m.servo3_raw, m.servo4_raw] == [1500, 1500, 1000, 1500] for m in servo),
+                "SERVO_OUTPUT_RAW not at trim: %r" % servo[:1])
 
     # SYS_STATUS: the compass bit follows the fault.
     status = [m for m in msgs if m.get_type() == "SYS_STATUS"]

@@ -1,0 +1,147 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""`make bench`'s flights (issue 22): the estimator in flight beside the peers.
+
+The flights come from sim/flight/fly.py --all (the JSBSim Rascal flown by fly.py's
+STABILIZE stand-in, written as trajectory files: ideal sensor values and the true
+quaternion at 400 Hz). Ours runs through build/replay (the firmware's drivers and DCM on
+the simulated chips), the peers through bench/peers.py, all scored with the same metric.
+The worst roll error over the 60 s turn is printed: the turn's centripetal acceleration is
+what fools an accelerometer-corrected filter. When the closed-loop turn test has run
+(ctest flight.closed_loop.turn: the ELF in simavr flying the model itself), its worst roll
+error is reported too.
+
+    flight_section(build, out_dir, run_replay, peer_names, log) -> markdown lines
+"""
+import os
+import subprocess
+import sys
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FLY = os.path.join(REPO, "sim", "flight", "fly.py")
+FLIGHT_SOURCES = os.path.join(REPO, "sim", "flight")
+FLIGHTS = ("cruise", "turn", "figure8", "gusty", "upset", "climb")
+TURN_FROM_S, TURN_TO_S = 5.0, 65.0  # fly.py's turn: the stick held for 30 deg from 5 to 65 s
+
+
+def newest_source_mtime():
+    newest = 0.0
+    for root, _, files in os.walk(FLIGHT_SOURCES):
+        for f in files:
+            if f.endswith((".py", ".xml", ".csv")):
+                newest = max(newest, os.path.getmtime(os.path.join(root, f)))
+    return newest
+
+
+def make_flights(flight_dir, log):
+    """fly.py --all into flight_dir unless its files are newer than sim/flight's sources."""
+    paths = {n: os.path.join(flight_dir, n + ".csv.gz") for n in FLIGHTS}
+    fresh = all(os.path.exists(p) for p in paths.values()) and \
+        min(os.path.getmtime(p) for p in paths.values()) > newest_source_mtime()
+    if not fresh:
+        log("flights: sim/flight/fly.py --all %s" % os.path.relpath(flight_dir, REPO))
+        r = subprocess.run([sys.executable, FLY, "--all", flight_dir], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.PIPE, text=True, timeout=3600)
+        if r.returncode != 0:
+            return None, "fly.py --all failed (exit %d): %s" % (r.returncode, r.stderr.strip()[-300:])
+    return {n: p for n, p in paths.items() if os.path.exists(p)}, None
+
+
+def worst_roll_error_replay(traj, est_path):
+    """(worst |roll error| deg, its time s, true roll, estimated roll) over the turn, from
+    replay's t,roll,pitch,yaw against the trajectory's truth at the nearest sample."""
+    import numpy as np
+    import peers
+    tr = peers.load_trajectory(traj)
+    true_roll, _, _ = peers.euler_from_quat(tr["quat"])
+    est = np.loadtxt(est_path, delimiter=",", skiprows=1, ndmin=2)
+    worst = (0.0, float("nan"), float("nan"), float("nan"))
+    for t, roll in zip(est[:, 0], est[:, 1]):
+        if not TURN_FROM_S <= t <= TURN_TO_S:
+            continue
+        i = min(int(np.searchsorted(tr["t"], t)), len(tr["t"]) - 1)
+        err = (roll - true_roll[i] + 180.0) % 360.0 - 180.0
+        if abs(err) > abs(worst[0]):
+            worst = (float(err), float(t), float(true_roll[i]), float(roll))
+    return worst
+
+
+def worst_roll_error_peer(tr, q):
+    import numpy as np
+    import peers
+    true_roll, _, _ = peers.euler_from_quat(tr["quat"])
+    roll, _, _ = peers.euler_from_quat(q)
+    m = (tr["t"] >= TURN_FROM_S) & (tr["t"] <= TURN_TO_S) & np.isfinite(roll)
+    err = (roll[m] - true_roll[m] + 180.0) % 360.0 - 180.0
+    return float(err[np.argmax(np.abs(err))]) if len(err) else float("nan")
+
+
+def closed_loop_turn(build):
+    """The closed-loop turn test's log (true and estimated bank), if it ran: its worst error."""
+    path = os.path.join(build, "host", "closed_loop_turn", "turn_bank.csv")
+    if not os.path.exists(path):
+        return None
+    worst = None
+    with open(path) as f:
+        next(f)
+        for line in f:
+            t, true_bank, est_bank, err, height = (float(v) for v in line.split(","))
+            if t >= TURN_FROM_S and height > 1.0 and (worst is None or abs(err) > abs(worst[1])):
+                worst = (t, err, true_bank, est_bank)
+    return path, worst
+
+
+def flight_section(build, out_dir, run_replay, peer_names, log):
+    import peers
+    flight_dir = os.path.join(out_dir, "flights")
+    os.makedirs(flight_dir, exist_ok=True)
+    paths, error = make_flights(flight_dir, log)
+    rep = ["## In flight: the JSBSim Rascal 110 (issue 22)", ""]
+    if error:
+        log("flights: " + error)
+        return rep + ["Not measured: %s." % error, ""], [error]
+    replay, score = os.path.join(build, "replay"), os.path.join(build, "score")
+    rows, turn_worst, errors = [], {}, []
+    for name in FLIGHTS:
+        traj = paths.get(name)
+        if not traj:
+            continue
+        est = os.path.join(flight_dir, name + "_estimate.csv")
+        _, _, ours, err, _ = run_replay(("flight " + name, traj, est, replay, score))
+        if err:
+            errors.append("flight %s: %s" % (name, err))
+        cells = [name, "%.2f / %.2f / %.2f" % (ours["total"], ours["incl"], ours["heading"]) if ours else "–"]
+        if name == "turn" and ours:
+            turn_worst["ours (replay)"] = worst_roll_error_replay(traj, est)[0]
+        tr = peers.load_trajectory(traj)
+        for peer in peer_names:
+            try:
+                q = peers.PEERS[peer](tr)
+            except Exception as e:  # a peer that breaks is reported, the bench goes on
+                cells.append("error")
+                errors.append("flight %s, %s: %s: %s" % (name, peer, type(e).__name__, e))
+                continue
+            s = peers.score(tr["quat"], q, tr["movement"])
+            cells.append("%.2f / %.2f / %.2f" % (s["total"], s["incl"], s["heading"]))
+            if name == "turn":
+                turn_worst[peer] = worst_roll_error_peer(tr, q)
+        rows.append(cells)
+        log("flight %s: %s" % (name, " | ".join(cells[1:])))
+    header = ["flight", "ours"] + list(peer_names)
+    rep += ["Flights of sim/flight/fly.py (the model flown by its STABILIZE stand-in; ideal sensors at "
+            "400 Hz): total / inclination / heading RMSE in degrees. Ours through `build/replay`.", "",
+            "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    rep += ["| " + " | ".join(r) + " |" for r in rows]
+    rep.append("")
+    if turn_worst:
+        text = ", ".join("%s %.1f" % (k, v) for k, v in turn_worst.items())
+        rep += ["Worst roll error during the 60 s, 30 deg turn (estimate - truth, deg): %s." % text, ""]
+        log("the turn's worst roll error (deg): " + text)
+    loop = closed_loop_turn(build)
+    if loop and loop[1]:
+        t, err, true_bank, est_bank = loop[1]
+        text = ("the board flying the turn itself (ctest flight.closed_loop.turn, %s): worst roll error %.1f deg "
+                "at %.1f s (true %.1f, estimate %.1f), while above the ground"
+                % (os.path.relpath(loop[0], REPO), err, t, true_bank, est_bank))
+        rep += ["In the closed loop, " + text + ".", ""]
+        log(text)
+    return rep, errors

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The settings as one table of named, typed parameters: what the console's `set`,
+// `get` and `params` use and what MAVLink's PARAM_* protocol iterates by index. Names
+// are ArduPilot's where it has one (RLL2SRV_P, SERVO3_MIN, COMPASS_DEC ...), units too
+// (COMPASS_DEC in radians, LIM_ROLL_CD in centi-degrees).
+//
+// The table (Params.cpp, in flash) has one row per parameter or per group of numbered
+// ones ("RC#_MIN": RC1_MIN .. RC8_MIN); an index runs over the expanded parameters,
+// 0 .. count()-1, in table order. Each row says where the value lives in
+// settings::Settings (offset, stride), its type, range and default: the flight
+// settings' defaults come from here and nowhere else (apply_defaults).
+#pragma once
+
+#include <stdint.h>
+
+#include "Settings.h"
+
+namespace params {
+
+// How a value is stored (MAVLink's MAV_PARAM_TYPE follows: Float and DeclRad are REAL32,
+// the others their integer types).
+enum class Type : uint8_t {
+    Float,    // float
+    Int16,    // int16_t
+    UInt16,   // uint16_t
+    UInt8,    // uint8_t
+    Bit,      // bit n of a uint8_t (n = the instance), 0 or 1
+    DeclRad,  // the declination: int16_t centi-degrees, shown in radians (ArduPilot's COMPASS_DEC)
+};
+
+constexpr uint8_t kNameMax = 16;  // MAVLink's param_id length
+
+struct Info {
+    char name[kNameMax + 1];  // NUL-terminated, upper case
+    Type type;
+    float min, max, def;
+};
+
+// How many parameters there are (< 255: an index fits a byte).
+uint16_t count();
+// The parameter at index; false past the end.
+bool info(uint16_t index, Info& out);
+// The index of a name (case-insensitive), or -1.
+int16_t find(const char* name);
+bool is_integer(Type t);
+// The value as a float (MAVLink's PARAM_VALUE carries every type so).
+float get(const settings::Settings& s, uint16_t index);
+// Sets a value: false (nothing changed) when index is past the end, the value is NaN,
+// out of range, not whole for an integer type, or leaves an end point pair out of order
+// (RCn/SERVOn: MIN <= TRIM <= MAX).
+bool set(settings::Settings& s, uint16_t index, float value);
+// Every parameter to its default.
+void apply_defaults(settings::Settings& s);
+// The flight settings in the EEPROM record (settings::encode): the rows that live in
+// Settings::flight, in table order, each value little-endian in its type's size, a Bit
+// row's eight bits as one byte: settings::kFlightBytes bytes. A new row changes the
+// record: it needs a new record version.
+void encode_flight(const settings::Settings& s, uint8_t out[settings::kFlightBytes]);
+// Bytes from..from+n-1 (within kFlightBytes) of what encode_flight writes.
+void flight_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* out);
+void decode_flight(const uint8_t in[settings::kFlightBytes], settings::Settings& s);
+// What encode_flight writes (a test holds it to settings::kFlightBytes).
+uint16_t flight_bytes();
+// Every parameter within its range and the end points in order (settings::is_valid).
+bool all_valid(const settings::Settings& s);
+
+}  // namespace params

@@ -1,0 +1,199 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The board flies the JSBSim aeroplane: the JSBSim backend and `apm25sim --physics json`
+with the firmware's ELF, in lock-step, the board's serial output on stdout.
+
+    closed_loop.py --flight turn [--gust 0|1|2] [--seed N] [--seconds S]
+    closed_loop.py --rc STICKS.csv [--upset T,SECONDS,NM ...] [--seconds S]
+        [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
+        [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
+
+--flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
+length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
+(the backend sends it in its replies' rc; apm25sim turns it into the receiver's PPM).
+The backend listens on a free UDP port, apm25sim flies it; --log is the backend's true
+state, --servo-log apm25sim's measured pulses. Both processes always end: when apm25sim
+ends the backend is stopped, when the backend dies apm25sim is stopped, and after
+--timeout s of wall time (default 900) both are. Exit status: apm25sim's, or 4 when the
+backend failed, 5 on the timeout.
+"""
+import argparse
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+
+import fly  # noqa: E402
+
+PILOTS = os.path.join(HERE, "pilots")
+# The cruise throttle of the default trim, only to build the named flights' list (their
+# stick scripts come from sim/flight/pilots/, written by fly.py --write-pilots).
+NOMINAL_THROTTLE_US = 1106
+
+
+def named_flights():
+    return fly.flights(NOMINAL_THROTTLE_US)
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--flight", help="a named flight (fly.py --list)")
+    src.add_argument("--rc", help="a stick script, CSV t,ch1..ch8 (us)")
+    p.add_argument("--gust", type=int, help="turbulence 0 none, 1 light, 2 moderate (default: the flight's, or 0)")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--upset", action="append", default=[], metavar="T,SECONDS,NM")
+    p.add_argument("--hold", type=float, default=3.0, metavar="S",
+                   help="the aeroplane held still for S s first, released at trim (default 3: the board "
+                        "powers up and calibrates at rest, as on the ground before a launch)")
+    p.add_argument("--seconds", type=float, help="simulated seconds (default: the flight's length, or 30)")
+    p.add_argument("--sim", default=os.path.join(ROOT, "build", "apm25sim"))
+    p.add_argument("--elf", default=os.path.join(ROOT, "build", "firmware.elf"))
+    p.add_argument("--python", default=sys.executable, help="the Python that runs the backend")
+    p.add_argument("--stamp", action="store_true", help="apm25sim --stamp: each line after its simulated time")
+    p.add_argument("--input", help="apm25sim --input: console commands typed into the board")
+    p.add_argument("--servo-log", help="apm25sim --servo-log: every output pulse")
+    p.add_argument("--log", help="the backend's true state, one row a frame")
+    p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
+    p.add_argument("--out", help="the serial output into this file instead of stdout")
+    p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
+    p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
+    return p.parse_args(argv)
+
+
+def resolve(args):
+    """(rc path, seconds, gust, extra backend arguments) of the flight asked for."""
+    if args.flight:
+        table = named_flights()
+        if args.flight not in table:
+            raise ValueError("no flight '%s'; the flights: %s" % (args.flight, ", ".join(sorted(table))))
+        _, seconds, gust, _, extra = table[args.flight]
+        rc = os.path.join(PILOTS, args.flight + ".csv")
+    else:
+        rc, seconds, gust, extra = args.rc, 30.0, 0, []
+    if not os.path.isfile(rc):
+        raise ValueError("no stick script %s" % rc)
+    for spec in args.upset:
+        extra = list(extra) + ["--upset", spec]
+    return (rc, args.seconds if args.seconds else seconds, gust if args.gust is None else args.gust, list(extra))
+
+
+def stop(proc, grace_s=5.0, sig=signal.SIGTERM):
+    """sig, then SIGKILL after grace_s; returns the exit status."""
+    if proc.poll() is None:
+        proc.send_signal(sig)
+        try:
+            proc.wait(grace_s)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+    return proc.wait()
+
+
+def run(args):
+    for path, what in ((args.sim, "apm25sim"), (args.elf, "the firmware")):
+        if not os.path.isfile(path):
+            print("closed_loop: %s missing: %s (make all)" % (what, path), file=sys.stderr)
+            return 2
+    try:
+        rc, seconds, gust, extra = resolve(args)
+    except ValueError as e:
+        print("closed_loop: %s" % e, file=sys.stderr)
+        return 2
+    work = tempfile.mkdtemp(prefix="closed_loop_")
+    port_file = os.path.join(work, "port")
+    backend_cmd = [args.python, os.path.join(HERE, "jsbsim_backend.py"), "--port", "0", "--port-file", port_file,
+                   "--rc", rc, "--gust", str(gust), "--seed", str(args.seed), "--seconds", "%g" % seconds,
+                   "--idle-timeout", "60", "--hold", "%g" % args.hold] + extra
+    if args.log:
+        backend_cmd += ["--log", args.log]
+    if args.trajectory:
+        backend_cmd += ["--trajectory", args.trajectory]
+    deadline = time.monotonic() + args.timeout
+    backend = subprocess.Popen(backend_cmd)
+    sim = None
+    out = open(args.out, "wb") if args.out else sys.stdout.buffer
+    timed_out = False
+    ended_itself = False
+    listen_deadline = time.monotonic() + 120.0
+    try:
+        while not os.path.exists(port_file) or not open(port_file).read().strip():
+            if backend.poll() is not None:
+                print("closed_loop: the backend ended before it listened (status %d)" % backend.returncode,
+                      file=sys.stderr)
+                return 4
+            if time.monotonic() > listen_deadline:
+                print("closed_loop: the backend did not listen within 120 s", file=sys.stderr)
+                return 4
+            time.sleep(0.05)
+        port = int(open(port_file).read())
+        sim_cmd = [args.sim, "--elf", args.elf, "--physics", "json:127.0.0.1:%d" % port, "--seconds", "%g" % seconds,
+                   "--physics-rate", str(args.physics_rate), "--physics-timeout", "60"]
+        if args.stamp:
+            sim_cmd.append("--stamp")
+        if args.input:
+            sim_cmd += ["--input", args.input]
+        if args.servo_log:
+            sim_cmd += ["--servo-log", args.servo_log]
+        sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)
+
+        def watchdog():
+            # The backend dying or the wall clock running out stops the simulator (whose
+            # stdout the main thread is reading).
+            nonlocal timed_out
+            while sim.poll() is None:
+                if backend.poll() is not None or time.monotonic() > deadline:
+                    timed_out = time.monotonic() > deadline
+                    stop(sim)
+                    return
+                time.sleep(0.1)
+
+        threading.Thread(target=watchdog, daemon=True).start()
+        while True:
+            chunk = sim.stdout.read1(4096)
+            if not chunk:
+                break
+            out.write(chunk)
+            out.flush()
+        status = sim.wait()
+        ended_itself = status == 0 and not timed_out
+    except KeyboardInterrupt:
+        status = 130
+    except BrokenPipeError:
+        status = 0  # the reader (a pager, the view) went away
+    finally:
+        if sim is not None:
+            stop(sim)
+        # A backend that saw the flight to its end stops by itself (after --linger s of
+        # silence); one that did not is interrupted (SIGINT: it closes its files).
+        try:
+            backend.wait(30.0 if ended_itself else 0.1)
+        except subprocess.TimeoutExpired:
+            pass
+        backend_status = stop(backend, 5.0, signal.SIGINT)
+        if args.out:
+            out.close()
+        shutil.rmtree(work, ignore_errors=True)
+    if timed_out:
+        print("closed_loop: stopped after %.0f s of wall time (--timeout)" % args.timeout, file=sys.stderr)
+        return 5
+    if status == 0 and backend_status != 0:
+        return 4
+    return status
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
+    return run(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

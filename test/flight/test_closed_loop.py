@@ -1,0 +1,368 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Closed-loop flights (issue 22): the firmware's ELF in apm25sim flies the JSBSim Rascal
+through `apm25sim --physics json` (sim/flight/closed_loop.py), with the firmware's DEFAULT
+settings. Truth from the backend's true-state log, the board from its serial output
+(`--stamp`) and its servo pulses (`--servo-log`). One group per run:
+
+    build/venv/bin/python test/flight/test_closed_loop.py GROUP --work DIR [--tools build]
+
+GROUP is one of:
+  manual_circuit  MANUAL (mode switch low): OUT1-OUT4 follow the scripted sticks within
+                  1.3 us; the plane flies the circuit the same sticks fly when applied
+                  straight to the model (fly.py --mode manual): a 170 deg turn and back to
+                  level, the path within 25 m and the heading within 15 deg of it
+  manual_upset    MANUAL, hands off: a 20 N m roll moment for 0.5 s (the upset flight: 48 deg
+                  of bank) leaves the plane still banked past 15 deg 10 s later
+  stabilize       STABILIZE (mode switch high), light gusts (--gust): the same upset is recovered to
+                  within 10 deg of level in <= 3 s of its start; then for 20 s the wings stay
+                  within 5 deg of level and the pitch within 5 deg; the height lost from the
+                  upset to the end is < 15 m
+  rc_loss         STABILIZE in a 20 deg bank, the receiver dies: the board says failsafe within
+                  1.5 s, the throttle goes to THR_FS_OUT (OUT3 1000 us), 3 s into the failsafe
+                  the board's wings are level (its estimate within 5 deg) and the true bank is at
+                  most half of what it was (printed: an accelerometer-corrected estimate reads
+                  a coordinated turn as level, the acceleration issue); the receiver back:
+                  STABILIZE again
+  turn            the stick held for a 30 deg bank for 60 s: the true and the estimated bank,
+                  logged (DIR/turn_bank.csv) and printed every 5 s, with the worst roll error;
+                  asserted only that they are logged and finite (the estimate's drift in a
+                  turn is the acceleration issue's baseline)
+  determinism     the same flight twice: the same bytes on the serial line and the servo log
+Exit 1 with the reasons on any failure. The figures are printed on stdout.
+"""
+import argparse
+import csv
+import math
+import os
+import subprocess
+import sys
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+sys.path.insert(0, os.path.join(ROOT, "test", "support"))
+from soft_assert import finish, soft_assert  # noqa: E402
+
+CLOSED_LOOP = os.path.join(ROOT, "sim", "flight", "closed_loop.py")
+FLY = os.path.join(ROOT, "sim", "flight", "fly.py")
+THROTTLE_US = 1106  # the cruise throttle at 18 m/s (the backend's trim)
+MANUAL, STABILIZE = 1000, 2000  # channel 8, the mode switch: low MANUAL, high STABILIZE
+# The aeroplane is held still for HOLD_S first (closed_loop.py --hold: the board powers up
+# and calibrates at rest, as on the ground), then released into trimmed flight.
+HOLD_S = 3.0
+UPSET = "6,0.5,20"  # sim/flight's upset flight: 48 deg of bank when nothing resists
+# The servo log stamps edges within 0.3 us; the receiver's 0.5 us ticks round to 1 us.
+FOLLOW_US = 1.3
+GUST_NAMES = {0: "no", 1: "light", 2: "moderate"}
+
+
+def row(t, roll=1500, pitch=1500, throttle=THROTTLE_US, yaw=1500, mode=STABILIZE):
+    return (t, (roll, pitch, throttle, yaw, 1500, 1500, 1500, mode))
+
+
+def write_rc(path, rows):
+    with open(path, "w") as f:
+        f.write("t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8\n")
+        for t, widths in rows:
+            f.write("%.3f,%s\n" % (t, ",".join("" if widths is None else str(w) for w in (widths or [None] * 8))))
+    return path
+
+
+def stick_for_bank(bank_deg):
+    return round(1500 + 500 * bank_deg / 45.0)  # LIM_ROLL_CD 4500: full stick is 45 deg
+
+
+class Flight:
+    """One closed-loop flight's files, read back."""
+
+    def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1):
+        self.name, self.seconds = name, seconds
+        base = os.path.join(work, name)
+        self.rc = write_rc(base + "_rc.csv", rows)
+        self.serial_path, self.log_path, self.servo_path = base + "_serial.txt", base + "_log.csv", base + "_servo.csv"
+        tools = tools or os.path.join(ROOT, "build")
+        cmd = [sys.executable, CLOSED_LOOP, "--rc", self.rc, "--seconds", "%g" % seconds, "--gust", str(gust),
+               "--seed", str(seed), "--stamp", "--out", self.serial_path, "--log", self.log_path,
+               "--servo-log", self.servo_path, "--sim", os.path.join(tools, "apm25sim"),
+               "--elf", os.path.join(tools, "firmware.elf"), "--timeout", "2300", "--hold", "%g" % HOLD_S]
+        for u in upsets:
+            cmd += ["--upset", u]
+        self.status = subprocess.call(cmd)
+        soft_assert(self.status == 0, "%s: closed_loop.py ended with status %d" % (name, self.status))
+        self.truth = read_log(self.log_path)
+        self.lines = read_serial(self.serial_path)
+        self.pulses = read_servo(self.servo_path)
+
+    def truth_between(self, t0, t1):
+        return [r for r in self.truth if t0 <= r["t"] < t1]
+
+    def truth_at(self, t):
+        best = None
+        for r in self.truth:
+            if r["t"] <= t + 1e-9:
+                best = r
+            else:
+                break
+        return best
+
+    def said(self, prefix, after=0.0):
+        """(time, text) of the first `# ` line from `after` that starts with prefix."""
+        for t, text in self.lines:
+            if t >= after and text.startswith(prefix):
+                return t, text
+        return None
+
+    def estimates(self):
+        """(t, roll, pitch, yaw) of the board's attitude lines."""
+        out = []
+        for t, text in self.lines:
+            if text.startswith("roll:"):
+                v = dict(f.split(":", 1) for f in text.split())
+                try:
+                    out.append((t, float(v["roll"]), float(v["pitch"]), float(v["yaw"])))
+                except (KeyError, ValueError):
+                    out.append((t, float("nan"), float("nan"), float("nan")))
+        return out
+
+
+def read_log(path):
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+
+
+def read_serial(path):
+    lines = []
+    if not os.path.exists(path):
+        return lines
+    with open(path, "rb") as f:
+        data = f.read()
+    for raw in data.split(b"\n")[:-1]:  # a last unterminated line is not whole
+        text = raw.decode("ascii", "replace").rstrip("\r")
+        stamp, _, rest = text.partition(" ")
+        try:
+            lines.append((float(stamp), rest))
+        except ValueError:
+            pass
+    return lines
+
+
+def read_servo(path):
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        next(f, None)
+        return [(float(t), int(o), float(w)) for t, o, w in (line.strip().split(",") for line in f if line.strip())]
+
+
+def angle_diff(a, b):
+    return (a - b + 180.0) % 360.0 - 180.0
+
+
+# ---------------------------------------------------------------------------------------
+
+
+def check_manual_circuit(args):
+    h = HOLD_S
+    rows = [row(0.0, mode=MANUAL), row(h + 1.0, 1700, throttle=1150, mode=MANUAL),
+            row(h + 1.8, 1495, 1570, 1150, mode=MANUAL), row(h + 10.5, 1300, mode=MANUAL),
+            row(h + 11.5, mode=MANUAL)]
+    seconds = h + 17.0
+    f = Flight(args.work, "manual_circuit", rows, seconds, tools=args.tools)
+    # The outputs follow the sticks: every pulse from 0.1 s after a stick row (a PPM frame
+    # and an output period) to the next row, from the receiver's first frame taken (before
+    # it, the outputs are at their trims and the throttle at its failsafe value, 1000 us;
+    # MANUAL is the board's mode at power-up, so it says nothing when the switch agrees).
+    first = next((t for t, out, w in f.pulses if out == 3 and abs(w - THROTTLE_US) <= FOLLOW_US), None)
+    soft_assert(first is not None and first < 1.0, "MANUAL: the throttle took its stick at %s s" % first)
+    start = (first if first is not None else 1.0) + 0.1
+    worst = 0.0
+    for i, (t0, widths) in enumerate(rows):
+        t0 = max(t0, start)
+        t1 = rows[i + 1][0] if i + 1 < len(rows) else seconds
+        n = 0
+        for t, out, w in f.pulses:
+            if out <= 4 and t0 + 0.1 <= t < t1:
+                worst = max(worst, abs(w - widths[out - 1]))
+                n += 1
+        soft_assert(n >= 4 * int((t1 - t0 - 0.1) / 0.02) - 4, "MANUAL: %d pulses on OUT1-4 in %.1f-%.1f s" % (n, t0, t1))
+    soft_assert(worst <= FOLLOW_US, "MANUAL: an output %.2f us from its stick (at most %.1f)" % (worst, FOLLOW_US))
+    # The same sticks straight into the model (no board): the circuit the sticks fly.
+    ref_log = os.path.join(args.work, "manual_circuit_reference_log.csv")
+    subprocess.call([sys.executable, FLY, "--rc", f.rc, "--mode", "manual", "--seconds", "%g" % seconds,
+                     "--hold", "%g" % HOLD_S,
+                     "--out", os.path.join(args.work, "manual_circuit_reference.csv.gz"), "--log", ref_log],
+                    stderr=subprocess.DEVNULL)
+    ref = read_log(ref_log)
+    soft_assert(len(f.truth) > 100 and len(ref) > 100, "manual_circuit: no log to compare")
+    if len(f.truth) > 100 and len(ref) > 100:
+        a, b = f.truth[-1], ref[-1]
+        turned = (a["yaw_deg"] - f.truth[0]["yaw_deg"]) % 360.0
+        miss = math.hypot(a["north_m"] - b["north_m"], a["east_m"] - b["east_m"])
+        heading_miss = angle_diff(a["yaw_deg"], b["yaw_deg"])
+        height = [-r["down_m"] for r in f.truth]
+        print("manual_circuit: outputs within %.2f us of the sticks; turned %.0f deg, ends %.0f m from the "
+              "sticks' own circuit (heading %+.1f deg), bank %.1f deg, height %.0f-%.0f m"
+              % (worst, turned, miss, heading_miss, a["roll_deg"], min(height), max(height)))
+        soft_assert(150.0 <= turned <= 200.0, "manual_circuit: turned %.0f deg, not about 170" % turned)
+        soft_assert(abs(a["roll_deg"]) < 15.0, "manual_circuit: ends banked %.1f deg" % a["roll_deg"])
+        # The board passes the sticks on a PPM frame (22.5 ms) and a servo period (20 ms)
+        # late, and the reference's rudder sits at the model's trim, 1501 us: after a 170 deg
+        # turn the two paths part by some metres.
+        soft_assert(miss < 25.0, "manual_circuit: %.1f m from the circuit the sticks fly" % miss)
+        soft_assert(abs(heading_miss) < 15.0, "manual_circuit: heading %.1f deg off the sticks' circuit" % heading_miss)
+        soft_assert(min(height) > 80.0, "manual_circuit: down to %.0f m" % min(height))
+
+
+def upset_start():
+    return float(UPSET.split(",")[0])
+
+
+def check_manual_upset(args):
+    t_up = upset_start()
+    f = Flight(args.work, "manual_upset", [row(0.0, mode=MANUAL)], t_up + 10.5, upsets=[UPSET], tools=args.tools)
+    peak = max((abs(r["roll_deg"]) for r in f.truth_between(t_up, t_up + 10.5)), default=float("nan"))
+    later = f.truth_at(t_up + 10.0)
+    bank = abs(later["roll_deg"]) if later else float("nan")
+    print("manual_upset: bank peaks at %.1f deg, %.1f deg 10 s after the upset began" % (peak, bank))
+    soft_assert(peak > 40.0, "manual_upset: the upset banked only %.1f deg" % peak)
+    soft_assert(bank > 15.0, "manual_upset: %.1f deg 10 s later: MANUAL levelled by itself" % bank)
+
+
+def check_stabilize(args):
+    t_up, hold_s = upset_start(), 20.0
+    end = t_up + 3.0 + hold_s
+    f = Flight(args.work, "stabilize", [row(0.0)], end, gust=args.gust, upsets=[UPSET], tools=args.tools)
+    after = f.truth_between(t_up, end)
+    soft_assert(len(after) > 1000, "stabilize: no true state after the upset")
+    if len(after) <= 1000:
+        return
+    peak = max(abs(r["roll_deg"]) for r in after)
+    last_out = max((r["t"] for r in after if abs(r["roll_deg"]) >= 10.0), default=t_up)
+    recovery_s = last_out - t_up
+    hold = f.truth_between(t_up + 3.0, end)
+    roll_hold = max(abs(r["roll_deg"]) for r in hold)
+    pitch_hold = max(abs(r["pitch_deg"]) for r in hold)
+    h0 = -f.truth_at(t_up)["down_m"]
+    lost = h0 - min(-r["down_m"] for r in after)
+    est = [e for e in f.estimates() if e[0] >= t_up]
+    print("stabilize: bank peaks at %.1f deg; within 10 deg for good %.2f s after the upset began; "
+          "then %.0f s in %s gusts: |bank| <= %.1f deg, |pitch| <= %.1f deg; height lost %.1f m"
+          % (peak, recovery_s, hold_s, GUST_NAMES[args.gust], roll_hold, pitch_hold, lost))
+    soft_assert(f.said("# flight STABILIZE") is not None, "stabilize: the board never said STABILIZE")
+    soft_assert(est and all(math.isfinite(e[1]) for e in est), "stabilize: no finite estimate after the upset")
+    soft_assert(recovery_s <= 3.0, "stabilize: %.2f s to stay within 10 deg (at most 3)" % recovery_s)
+    soft_assert(roll_hold <= 5.0, "stabilize: bank reached %.1f deg in the hold (at most 5)" % roll_hold)
+    soft_assert(pitch_hold <= 5.0, "stabilize: pitch reached %.1f deg in the hold (at most 5)" % pitch_hold)
+    soft_assert(lost < 15.0, "stabilize: lost %.1f m of height (less than 15)" % lost)
+
+
+def check_rc_loss(args):
+    t_bank, t_lost, t_back, end = HOLD_S + 2.0, HOLD_S + 6.0, HOLD_S + 10.0, HOLD_S + 13.0
+    rows = [row(0.0), row(t_bank, stick_for_bank(20)), (t_lost, None), row(t_back)]
+    f = Flight(args.work, "rc_loss", rows, end, tools=args.tools)
+    said = f.said("# failsafe: receiver lost", t_lost)
+    soft_assert(said is not None, "rc_loss: no '# failsafe: receiver lost' line")
+    bank_at_loss = f.truth_at(t_lost)["roll_deg"] if f.truth_at(t_lost) else float("nan")
+    fs_out = [t for t, out, w in f.pulses if out == 3 and t >= t_lost and abs(w - 1000.0) <= FOLLOW_US]
+    soft_assert(fs_out, "rc_loss: OUT3 never went to 1000 us (THR_FS_OUT 0)")
+    if said is None or not fs_out:
+        return
+    t_fs = said[0]
+    level = f.truth_between(t_fs + 3.0, t_back)
+    worst_bank = max(abs(r["roll_deg"]) for r in level)
+    est_level = [e for e in f.estimates() if t_fs + 3.0 <= e[0] < t_back]
+    worst_est = max((abs(e[1]) for e in est_level), default=float("nan"))
+    back = f.said("# failsafe cleared", t_back)
+    print("rc_loss: bank %.1f deg when the receiver died; failsafe said %.2f s later, OUT3 at 1000 us %.2f s "
+          "later; from 3 s into the failsafe to the receiver's return: estimated |bank| <= %.1f deg, true "
+          "|bank| <= %.1f deg; %s"
+          % (bank_at_loss, t_fs - t_lost, fs_out[0] - t_lost, worst_est, worst_bank,
+             "back %.2f s after the receiver: %s" % (back[0] - t_back, back[1]) if back else "never back"))
+    soft_assert(bank_at_loss > 12.0, "rc_loss: only %.1f deg of bank when the receiver died" % bank_at_loss)
+    soft_assert(t_fs - t_lost <= 1.5, "rc_loss: failsafe said %.2f s after the loss (at most 1.5)" % (t_fs - t_lost))
+    soft_assert(fs_out[0] - t_lost <= 1.5, "rc_loss: throttle cut %.2f s after the loss" % (fs_out[0] - t_lost))
+    # Wings level as the board sees them (what the failsafe controls); the true bank at least
+    # halved. A coordinated turn reads as level to an accelerometer-corrected estimate (the
+    # acceleration issue): the true residual bank is printed as its baseline.
+    soft_assert(worst_est <= 5.0, "rc_loss: estimated bank %.1f deg in the failsafe (at most 5)" % worst_est)
+    soft_assert(worst_bank <= abs(bank_at_loss) / 2.0, "rc_loss: true bank %.1f deg in the failsafe, not rolled "
+                "toward level from %.1f" % (worst_bank, bank_at_loss))
+    soft_assert(back is not None and "STABILIZE" in back[1], "rc_loss: STABILIZE not back after the receiver")
+    soft_assert(back is None or back[0] - t_back <= 1.0, "rc_loss: the mode came back late")
+    thr = [w for t, out, w in f.pulses if out == 3 and t >= t_back + 0.2]
+    soft_assert(thr and all(abs(w - THROTTLE_US) <= FOLLOW_US for w in thr), "rc_loss: throttle not back on the stick")
+
+
+def check_turn(args):
+    t_turn = HOLD_S + 2.0
+    seconds = t_turn + 60.0
+    rows = [row(0.0), row(t_turn, stick_for_bank(30), throttle=THROTTLE_US + 40)]
+    f = Flight(args.work, "turn", rows, seconds, tools=args.tools)
+    est = f.estimates()
+    # The backend lays a crashed aeroplane still on the ground (sim/flight/flightmodel.py):
+    # the errors count while it flies.
+    ground = next((r["t"] for r in f.truth if r["t"] > HOLD_S and -r["down_m"] < 1.0), None)
+    out_path = os.path.join(args.work, "turn_bank.csv")
+    worst = (0.0, 0.0, 0.0, 0.0)
+    finite = bool(est)
+    printed = set()
+    print("turn: true and estimated bank, every 5 s (all in %s):" % out_path)
+    with open(out_path, "w") as out:
+        out.write("t,true_bank_deg,estimated_bank_deg,error_deg,height_m\n")
+        for t, roll, _, _ in est:
+            truth = f.truth_at(t)
+            if truth is None:
+                continue
+            err = angle_diff(roll, truth["roll_deg"])
+            finite = finite and math.isfinite(roll) and math.isfinite(truth["roll_deg"])
+            out.write("%.3f,%.2f,%.2f,%.2f,%.1f\n" % (t, truth["roll_deg"], roll, err, -truth["down_m"]))
+            flying = ground is None or t < ground
+            if t >= t_turn and flying and abs(err) > abs(worst[1]):
+                worst = (t, err, truth["roll_deg"], roll)
+            slot = int(t // 5.0)
+            if slot not in printed:
+                printed.add(slot)
+                print("  t %5.1f s  true %6.1f deg  estimate %6.1f deg  height %6.1f m  airspeed %5.1f m/s"
+                      % (t, truth["roll_deg"], roll, -truth["down_m"], truth["airspeed_m_s"]))
+    print("turn: worst roll error in flight %.1f deg at %.1f s (true %.1f, estimate %.1f)"
+          % (worst[1], worst[0], worst[2], worst[3]))
+    print("turn: %s" % ("the aeroplane hit the ground at %.1f s, %.1f s into the turn (a spiral dive: STABILIZE "
+                        "holds the ESTIMATED bank)" % (ground, ground - t_turn) if ground is not None
+                        else "the aeroplane stayed in the air"))
+    soft_assert(len(est) > 45 * (seconds - 3.0), "turn: only %d attitude lines" % len(est))
+    soft_assert(finite, "turn: a bank that is not finite")
+
+
+def check_determinism(args):
+    rows = [row(0.0), row(HOLD_S + 0.5, 1700), row(HOLD_S + 1.5)]
+    a = Flight(args.work, "determinism_a", rows, HOLD_S + 2.5, gust=1, tools=args.tools)
+    b = Flight(args.work, "determinism_b", rows, HOLD_S + 2.5, gust=1, tools=args.tools)
+    serial = [open(x.serial_path, "rb").read() for x in (a, b)]
+    servo = [open(x.servo_path, "rb").read() for x in (a, b)]
+    print("determinism: %d and %d bytes on the serial line, %d and %d bytes of servo log"
+          % (len(serial[0]), len(serial[1]), len(servo[0]), len(servo[1])))
+    soft_assert(len(serial[0]) > 2000, "determinism: only %d bytes on the serial line" % len(serial[0]))
+    soft_assert(serial[0] == serial[1], "determinism: the same flight gave different serial bytes")
+    soft_assert(servo[0] == servo[1], "determinism: the same flight gave different servo pulses")
+
+
+GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+          "rc_loss": check_rc_loss, "turn": check_turn, "determinism": check_determinism}
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("group", choices=sorted(GROUPS))
+    p.add_argument("--work", required=True)
+    p.add_argument("--tools", help="directory of apm25sim and firmware.elf (default build/)")
+    p.add_argument("--gust", type=int, default=1, choices=(0, 1, 2),
+                   help="stabilize: the turbulence of the hold (default 1, light)")
+    args = p.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    GROUPS[args.group](args)
+    return finish("closed loop " + args.group, "closed loop %s: all checks passed" % args.group)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
