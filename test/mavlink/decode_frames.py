@@ -55,7 +55,7 @@ def main():
                 "mode names %r %r" % (mavutil.mode_string_v10(hb), mavutil.mode_string_v10(msgs[7])))
 
     pv, ack, rc, servo = msgs[8:12]
-    soft_assert(pv.param_id == "RLL2SRV_P" and abs(pv.param_value - 1.0) < 1e-6
+    soft_assert(pv.param_id == "RLL2SRV_P" and abs(pv.param_value - 0.4) < 1e-6
                 and pv.param_type == mavlink2.MAV_PARAM_TYPE_REAL32 and pv.param_count == 97 and pv.param_index == 1,
                 "PARAM_VALUE %r" % pv)
     soft_assert(ack.command == mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION and ack.result == mavlink2.MAV_RESULT_ACCEPTED
