@@ -11,6 +11,7 @@
 
 #include "avr_adc.h"
 #include "avr_eeprom.h"
+#include "avr_extint.h"
 #include "avr_ioport.h"
 #include "avr_spi.h"
 #include "avr_timer.h"
@@ -215,6 +216,13 @@ bool Board::init() {
     if (!load_eeprom()) return false;
     avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
     avr_->log = LOG_WARNING;
+
+    // External interrupts INT0-7: a low level raises its interrupt once, not again at every
+    // cycle while it stays low. simavr's "strict" level triggering polls each pin every
+    // cycle while it is low, enabled or not, in level mode (ISC 00, the reset value): the
+    // servo outputs on INT4/INT5 (OUT7/OUT6, low 90 % of the time) cost a third of the
+    // simulation's time. The firmware uses no level-triggered interrupt.
+    for (uint8_t extint = 0; extint < 8; ++extint) avr_extint_set_strict_lvl_trig(avr_, extint, 0);
 
     // UART0: no stdio echo, no sleep on RX poll (SIM.md).
     uint32_t uart_flags = 0;
