@@ -4,7 +4,9 @@
 
     build/venv/bin/python test/mavlink/gcs_link.py --tools build --work DIR
 
-Runs build/firmware.elf in `apm25sim --serial tcp:0 --speed 0` on the tilt tour with a
+Runs build/firmware.elf in `apm25sim --serial tcp:0 --speed 1` (real time, as a board and
+ArduPilot's SITL run: the ground station's once-a-second HEARTBEAT is the board's second)
+on the tilt tour with a
 scripted receiver (--rc: MANUAL, sticks moved, STABILIZE, a dead receiver, STABILIZE,
 MANUAL) and the outputs measured on the pins (--servo-log), and talks to it as a ground
 station does: HEARTBEAT once a second from system 255 (the board starts in its text mode
@@ -87,7 +89,7 @@ class Board:
         # missed sample would come from.
         self.profile = os.path.join(work, name + ".profile.csv")
         cmd = [os.path.join(tools, "apm25sim"), "--elf", os.path.join(tools, "firmware.elf"),
-               "--serial", "tcp:0", "--speed", "0", "--profile", self.profile] + extra
+               "--serial", "tcp:0", "--speed", "1", "--profile", self.profile] + extra
         self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         line = self.proc.stderr.readline()
         self.log.write(line)
