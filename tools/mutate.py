@@ -46,8 +46,14 @@ def run(cmd, **kw):
     return subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, **kw)
 
 
+# The generated MAVLink headers (make mavlink: BUILD/mavlink), for lib/MavLink; None when
+# they are not there (lib/MavLink and the tests that need it are then left out).
+MAVLINK_DIR = None
+
+
 def include_flags():
-    return ["-I" + d.rstrip("/") for d in sorted(glob.glob("lib/*/"))] + ["-Itest"]
+    mavlink = ["-I" + MAVLINK_DIR] if MAVLINK_DIR else []
+    return ["-I" + d.rstrip("/") for d in sorted(glob.glob("lib/*/"))] + ["-Itest"] + mavlink
 
 
 # GoogleTest's header precompiled for the tests (a third of a test file's compile time):
@@ -99,7 +105,8 @@ def base_build(out, files, jobs):
     obj_dir = os.path.join(out, "obj")
     os.makedirs(obj_dir, exist_ok=True)
     lib_srcs = sorted(glob.glob("lib/*/*.cpp"))
-    lib_srcs = [s for s in lib_srcs if not s.startswith("lib/MavLink/")]  # generated headers
+    if not MAVLINK_DIR:
+        lib_srcs = [s for s in lib_srcs if not s.startswith("lib/MavLink/")]
     test_srcs = sorted(glob.glob("test/test_*.cpp"))
     jobs_list = [(s, False) for s in lib_srcs] + [(s, True) for s in test_srcs]
 
@@ -121,7 +128,8 @@ def base_build(out, files, jobs):
             deps[src] = d
             if src in lib_srcs:
                 lib_objs.append(src)
-            elif any(f in d for f in files) and not any(x.startswith("sim/") for x in d):
+            elif any(f in d for f in files) and not any(x.startswith("sim/") for x in d) and \
+                    (MAVLINK_DIR or not any(x.startswith("lib/MavLink/") for x in d)):
                 test_objs.append(src)
     return lib_objs, test_objs, deps
 
@@ -302,6 +310,9 @@ def main():
                     "(build/mutate/report.txt: after writing tests for them)")
     args = ap.parse_args()
     os.chdir(ROOT)
+    global MAVLINK_DIR
+    generated = os.path.abspath(os.path.join(args.build, "mavlink"))
+    MAVLINK_DIR = generated if os.path.exists(os.path.join(generated, "common", "mavlink.h")) else None
     start = time.time()
     out = os.path.join(args.build, "mutate")
     os.makedirs(out, exist_ok=True)
