@@ -93,6 +93,27 @@ TEST(DcmRest, AFieldThatMovesEndsTheRest) {
     EXPECT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
 }
 
+// Every axis counts, alone or together: a 1.5 uT move along x, y or z ends a rest, and so
+// does one of 0.81 uT along two axes at once (1.15 uT in all, no axis beyond 1 uT); 0.5 uT
+// along two (0.71 uT) does not. (A mutant that checked only x and y lived before this.)
+TEST(DcmRest, AFieldMoveOnAnyAxisOrAcrossTwoEndsTheRest) {
+    const Vector3i field(20 * 32, 0, 45 * 32);  // uT Q5
+    struct Move {
+        int16_t dx, dy, dz;
+        bool ends;
+    };
+    const Move moves[] = {{48, 0, 0, true}, {0, 48, 0, true}, {0, 0, 48, true},
+                          {26, 0, -26, true}, {0, 26, 26, true}, {16, 0, 16, false}};
+    for (const Move& m : moves) {
+        RestFixture f;
+        f.rest.watch_field(field);
+        ASSERT_GT(f.updates_to_rest(Vector3l(), true), 0);
+        f.rest.watch_field(Vector3i((int16_t)(field.x + m.dx), (int16_t)(field.y + m.dy), (int16_t)(field.z + m.dz)));
+        EXPECT_EQ(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k), !m.ends)
+            << m.dx << " " << m.dy << " " << m.dz << " (uT x 32)";
+    }
+}
+
 TEST(DcmGyroBias, FollowsTheRestMeanWithRestBiasSeconds) {
     const dcm::DcmCoefficients k = float_form_coefficients();
     dcm::GyroBias bias;

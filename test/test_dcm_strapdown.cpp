@@ -96,6 +96,22 @@ TEST(DcmStrapdown, ConstantRateForOneSecondTurnsOneRadian) {
     EXPECT_NEAR(e.roll_rad, 0.0f, 1e-5f);
 }
 
+// A turn sum beyond any gyro's range over an integration (a corrupt one) is saturated at
+// kMaxTurnAxisQ26, the same on both sides: never a turn of the other sign.
+TEST(DcmStrapdown, ATurnBeyondAnyGyroIsSaturatedOnBothSides) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    ASSERT_NE(k.theta_factor_q30, 0) << "the integer path";
+    const int32_t limit = k.theta_units_limit;
+    const int32_t far = limit > 1000000000L ? 2000000000L : limit * 2;
+    const Vector3l beyond = k.theta_q26(Vector3l(far, -far, 0));
+    const Vector3l at = k.theta_q26(Vector3l(limit, -limit, 0));
+    EXPECT_EQ(beyond.x, at.x);
+    EXPECT_EQ(beyond.y, at.y);
+    EXPECT_NEAR((double)beyond.x, (double)dcm::kMaxTurnAxisQ26, dcm::kMaxTurnAxisQ26 * 1e-6);
+    EXPECT_NEAR((double)beyond.y, -(double)dcm::kMaxTurnAxisQ26, dcm::kMaxTurnAxisQ26 * 1e-6);
+    EXPECT_EQ(beyond.z, 0);
+}
+
 TEST(DcmStrapdown, TheFirstHalfIsKeptApartAtHalfTheSteps) {
     dcm::Strapdown s;
     s.reset(linalg::q30_from_matrix(Matrix3f::identity()));
