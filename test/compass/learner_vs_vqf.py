@@ -11,7 +11,6 @@ firmware runs in apm25sim (its offset learner on, no command typed); VQF 2.1.2 (
 runs on the raw samples of the same file through bench/peers.py, as `make bench` runs it.
 Both are scored with the dataset's heading error over the rest from 36 s to the end.
 """
-import argparse
 import os
 import subprocess
 import sys
@@ -22,6 +21,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import peers  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from sim_run import tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 REST_FROM_S = 36.0
@@ -29,11 +29,7 @@ SECONDS = 50.0
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tools", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
+    args = tools_and_work()
     csv = os.path.join(args.work, "tumble_hard_soft_iron.csv")
     with open(csv, "wb") as f:
         subprocess.run([os.path.join(args.tools, "scenario"), "tumble", "--hard-iron", "8,-5,3",

@@ -18,7 +18,6 @@ console driven through stdin as a user types, and checks what it prints:
     3 degrees.
 Exit 1 with every failure listed.
 """
-import argparse
 import math
 import os
 import queue
@@ -29,6 +28,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from sim_run import tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 WALL_TIMEOUT_S = 600
@@ -86,11 +86,7 @@ def write_banked(path):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tools", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
+    args = tools_and_work()
     trajectory = os.path.join(args.work, "banked.csv")
     write_banked(trajectory)
     sim_log = open(os.path.join(args.work, "apm25sim.stderr"), "w")
