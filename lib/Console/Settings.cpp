@@ -65,9 +65,7 @@ void record_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out) {
 }
 
 void encode(const Settings& s, uint8_t out[kRecordSize]) {
-    for (uint8_t i = 0; i < 9; ++i) out[i] = record_byte(s, i);
-    memcpy(out + 9, &s.cal, sizeof s.cal);
-    params::encode_flight(s, out + kFlightOffset);
+    record_part(s, 0, (uint8_t)(4u + kPayloadLength), out);  // the bytes a save writes in parts
     const uint16_t crc = crc16(out, (uint16_t)(4u + kPayloadLength));
     out[4 + kPayloadLength] = (uint8_t)(crc & 0xFFu);
     out[5 + kPayloadLength] = (uint8_t)(crc >> 8);
