@@ -202,3 +202,35 @@ TEST(DcmSchedule, ALineIntegratesTwoOrMoreWaitingSteps) {
     EXPECT_EQ(schedule.next(0, true, false), dcm::HeavyPart::kRenormalisation);
     EXPECT_EQ(schedule.next(0, true, true), dcm::HeavyPart::kNone);
 }
+
+// A reset starts the integration afresh: the steps summed before it are gone.
+TEST(DcmStrapdown, AResetForgetsThePendingSteps) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::Strapdown s;
+    s.reset(linalg::q30_from_matrix(Matrix3f::identity()));
+    for (int step = 0; step < dcm::kIntegrationSteps - 1; ++step) {
+        s.add_turn(units_of(k, Vector3f(0.01f, 0.0f, 0.0f)));
+        s.end_step();
+    }
+    ASSERT_EQ(s.pending_steps(), dcm::kIntegrationSteps - 1);
+    s.reset(linalg::q30_from_matrix(Matrix3f::identity()));
+    EXPECT_EQ(s.pending_steps(), 0);
+    EXPECT_TRUE(same(s.pending_units(), Vector3l()));
+}
+
+// A row twice a unit long or more (its entries each within Q30's +-1.4) is no rotation
+// to rescale: reported, like a row too short.
+TEST(DcmStrapdown, RenormalisationReportsARowTwiceTooLong) {
+    dcm::Strapdown s;
+    const float h = std::sqrt(0.5f);
+    // a . b = 0: the orthogonalisation leaves the rows as they are. |a|^2 = 4.92 and
+    // 4.19: beyond what unsigned Q30 holds (they would read 0.92 and 0.19).
+    s.reset(linalg::q30_from_matrix(Matrix3f(Vector3f(1.4f, 1.4f, 1.0f), Vector3f(h, -h, 0.0f), Vector3f(0.0f, 0.0f, 1.0f))));
+    EXPECT_FALSE(s.renormalise());
+    s.reset(linalg::q30_from_matrix(Matrix3f(Vector3f(1.3f, 1.3f, 0.9f), Vector3f(h, -h, 0.0f), Vector3f(0.0f, 0.0f, 1.0f))));
+    EXPECT_FALSE(s.renormalise());
+    // ... while 3.6 is rescaled to a unit row.
+    s.reset(linalg::q30_from_matrix(Matrix3f(Vector3f(1.2f, 1.2f, 0.9f), Vector3f(h, -h, 0.0f), Vector3f(0.0f, 0.0f, 1.0f))));
+    EXPECT_TRUE(s.renormalise());
+    EXPECT_LT(orthonormality_error(linalg::matrix_from_q30(s.r())), 1e-4f);
+}

@@ -137,8 +137,12 @@ bool Strapdown::rescale(const Vector3l& row, Vector3l& out) {
     const int32_t* entry[3] = {&row.x, &row.y, &row.z};
     for (uint8_t i = 0; i < 3; ++i)
         if (*entry[i] >= kMaxEntry || *entry[i] <= -kMaxEntry) return false;
-    const uint32_t length2 = (uint32_t)linalg::mul_q30(row.x, row.x) + (uint32_t)linalg::mul_q30(row.y, row.y) +
-                             (uint32_t)linalg::mul_q30(row.z, row.z);  // < 6 in unsigned Q30: no overflow
+    // |r|^2 in unsigned Q30, which holds up to 4: a row twice a unit long or more wraps
+    // (a sum below one of its terms) and is hopeless.
+    const uint32_t xx = (uint32_t)linalg::mul_q30(row.x, row.x), yy = (uint32_t)linalg::mul_q30(row.y, row.y),
+                   zz = (uint32_t)linalg::mul_q30(row.z, row.z);
+    const uint32_t xy = xx + yy, length2 = xy + zz;
+    if (xy < xx || length2 < zz) return false;
     if (length2 > (uint32_t)(kOne - kWindow) && length2 < (uint32_t)(kOne + kWindow)) {
         const int32_t factor = kOne + kOne / 2 - (int32_t)(length2 / 2);
         out = Vector3l(linalg::mul_q30(factor, row.x), linalg::mul_q30(factor, row.y), linalg::mul_q30(factor, row.z));
@@ -147,7 +151,7 @@ bool Strapdown::rescale(const Vector3l& row, Vector3l& out) {
     // Far from unit length (a rebuilt matrix, a heading taken at once): the exact factor,
     // in float, unless the matrix is hopeless.
     const float length2_f = linalg::float_from_fixed((int32_t)(length2 / 2), 29);
-    if (!(length2_f > 0.25f && length2_f < 4.0f)) return false;
+    if (!(length2_f > 0.25f)) return false;
     out = linalg::fixed_from_vector(linalg::vector_from_q30(row) * (1.0f / sqrtf(length2_f)), linalg::kQ30);
     return true;
 }
