@@ -92,3 +92,28 @@ TEST(DcmGravity, AnEmptyWindowIsNoWindow) {
     bool whole = true;
     EXPECT_FALSE(loop.gravity.low_pass_window(loop.strapdown.r(), 0, Vector3l(), Vector3l(), false, 0.0f, loop.k, g, a, whole));
 }
+
+// A reset puts the low-pass exactly at gravity (earth down) with no correction.
+TEST(DcmGravity, AResetStartsAtGravityWithNoCorrection) {
+    dcm::GravityCorrection gravity;
+    gravity.reset(-123456);
+    EXPECT_EQ(gravity.low_pass_ef().x, 0);
+    EXPECT_EQ(gravity.low_pass_ef().y, 0);
+    EXPECT_EQ(gravity.low_pass_ef().z, -123456);
+    EXPECT_EQ(gravity.correction_units().x, 0);
+    EXPECT_EQ(gravity.correction_units().y, 0);
+    EXPECT_EQ(gravity.correction_units().z, 0);
+}
+
+// New sample scales (a new calibration): the low-pass, in accel units, follows the
+// accelerometer's ratio either way, and stays as it is when only the gyro's changes.
+TEST(DcmGravity, TheLowPassFollowsANewAccelScale) {
+    dcm::GravityCorrection gravity;
+    gravity.reset(-400000);
+    gravity.rescale(1.0f, 0.5f);
+    EXPECT_EQ(gravity.low_pass_ef().z, -200000);
+    gravity.rescale(1.0f, 2.0f);
+    EXPECT_EQ(gravity.low_pass_ef().z, -400000);
+    gravity.rescale(2.0f, 1.0f);
+    EXPECT_EQ(gravity.low_pass_ef().z, -400000);
+}

@@ -63,9 +63,14 @@ TEST(DcmHeading, TheMeanIsInEarthAxesOverKHeadingSteps) {
     EXPECT_NEAR(field.z, expected.z, 1e-4f);
     EXPECT_NEAR(norm2, (a.length_squared() + b.length_squared() + c.length_squared()) / 3.0f, 0.05f);
     EXPECT_EQ(mean.steps(), 0);
+    // After a restart the next sample closes a mean alone, and stands for the steps a
+    // whole mean would (the correction's size and the gate's time follow them); before
+    // it there is nothing to take.
     mean.restart_with_one_sample();
+    EXPECT_FALSE(mean.complete());
     mean.add(earth_units(a), norm2_units(a), 1);
     EXPECT_TRUE(mean.complete());
+    EXPECT_EQ(mean.steps(), dcm::kHeadingSteps);
 }
 
 TEST(DcmHeading, TheLearnedFieldPassesAndADisturbanceDoesNot) {

@@ -158,3 +158,22 @@ TEST(DcmGyroBias, IntegratesTheTiltErrorAgainstIt) {
     EXPECT_NEAR(bias.estimate_rad_s(k).x, expected, 0.02f * std::fabs(expected));
     EXPECT_NEAR(bias.estimate_rad_s(k).z, -expected, 0.02f * std::fabs(expected));
 }
+
+// New sample scales during a rest (a new calibration): the means follow the ratios, so
+// the same motion read at the new scales is still rest; with means left at the old
+// scales the rest would end.
+TEST(DcmRest, ANewScaleKeepsTheRest) {
+    for (int axis = 0; axis < 2; ++axis) {
+        RestFixture f;
+        f.gyro_mean = units(f.k, Vector3f(4.0f, -3.0f, 3.0f) * kDegPerS);  // a bias read at rest
+        for (int i = 0; i < 400; ++i) f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k);
+        ASSERT_TRUE(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k));
+        const float gyro_ratio = axis == 0 ? 2.0f : 1.0f, accel_ratio = axis == 0 ? 1.0f : 2.0f;
+        const Vector3l mean_before = f.rest.gyro_mean();
+        f.rest.rescale(gyro_ratio, accel_ratio);
+        EXPECT_NEAR(f.rest.gyro_mean().x, mean_before.x * gyro_ratio, 1) << (axis == 0 ? "gyro" : "accel");
+        const Vector3l gyro = linalg::fixed_from_vector(f.gyro_mean.scaled(gyro_ratio), 0);
+        const Vector3l accel = linalg::fixed_from_vector(f.accel_mean.scaled(accel_ratio), 0);
+        EXPECT_TRUE(f.rest.update(gyro, accel, Vector3l(), true, true, f.k)) << (axis == 0 ? "gyro" : "accel");
+    }
+}
