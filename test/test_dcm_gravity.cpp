@@ -62,6 +62,7 @@ TEST(DcmGravity, ALevelBoardGetsNoCorrection) {
 // correction (kp 1/s) turns R towards it; after 15 s it is within 0.05
 // deg, and the heading is not touched.
 TEST(DcmGravity, AnUnknownTiltIsCorrected) {
+    float first_after_1s = -1.0f;
     for (const Matrix3f& truth : {dcm::dcm_from_euler(10.0f * linalg::kRadPerDeg, 0.0f, 0.0f),
                                   dcm::dcm_from_euler(0.0f, -10.0f * linalg::kRadPerDeg, 0.0f)}) {
         Loop loop(Matrix3f::identity());
@@ -69,6 +70,9 @@ TEST(DcmGravity, AnUnknownTiltIsCorrected) {
         const float after_1s = tilt_error_deg(truth, loop.estimate());
         EXPECT_LT(after_1s, 9.9f);
         EXPECT_GT(after_1s, 1.0f);
+        // Roll (a tilt about north) and pitch (about east) at the same pace.
+        if (first_after_1s < 0.0f) first_after_1s = after_1s;
+        EXPECT_NEAR(after_1s, first_after_1s, 0.02f * first_after_1s);
         loop.run(truth, 14.0f, true);
         EXPECT_LT(tilt_error_deg(truth, loop.estimate()), 0.05f);  // float acos resolves ~0.02 deg
         const dcm::EulerAngles e = dcm::euler_from_dcm(loop.estimate());

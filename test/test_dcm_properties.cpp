@@ -392,3 +392,19 @@ TEST(DcmProperties, TheLearnedFieldFollowsASlowChangeInSeconds) {
         EXPECT_EQ((run.filter.status() & dcm::kStatusMagIgnored) != 0, wait_s < 2.0f) << "after " << wait_s << " s";
     }
 }
+
+// Without a field, yaw starts at 0: north is body x on the horizontal, or body y when x
+// is vertical (nose straight up or down): a rotation either way, no heading yet.
+TEST(DcmProperties, WithoutAFieldAVerticalNoseStillGivesARotation) {
+    // The specific force exactly along body x (nose up: -g on x; nose down: +g), and a tilt.
+    for (const Vector3f& accel : {Vector3f(-kG, 0.0f, 0.0f), Vector3f(kG, 0.0f, 0.0f), Vector3f(-0.5f * kG, 0.0f, -0.866f * kG)}) {
+        dcm::Dcm filter;
+        ASSERT_TRUE(filter.init(accel, Vector3f()));
+        EXPECT_TRUE(filter.status() & dcm::kStatusNoHeading);
+        const Matrix3f r = filter.matrix();
+        EXPECT_LT(orthonormality_error(r), 1e-4f) << accel.x;
+        // Its third row is earth down in body axes: along the specific force's opposite.
+        const Vector3f down = (-accel).normalized();
+        EXPECT_NEAR(r.c.dot(down), 1.0f, 1e-4f) << accel.x;
+    }
+}

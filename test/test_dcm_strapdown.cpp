@@ -234,3 +234,17 @@ TEST(DcmStrapdown, RenormalisationReportsARowTwiceTooLong) {
     EXPECT_TRUE(s.renormalise());
     EXPECT_LT(orthonormality_error(linalg::matrix_from_q30(s.r())), 1e-4f);
 }
+
+// Rows 2.5 % too long or short are outside the first-order factor's window (its
+// residual 3/8 (r.r - 1)^2 would be 2e-4): they take the exact factor and come out of
+// one pass at unit length.
+TEST(DcmStrapdown, RenormalisationRescalesRowsFarFromUnitExactly) {
+    for (float scale : {1.025f, 0.975f}) {
+        dcm::Strapdown s;
+        s.reset(linalg::q30_from_matrix(Matrix3f::identity() * scale));
+        ASSERT_TRUE(s.renormalise());
+        const Matrix3f r = linalg::matrix_from_q30(s.r());
+        EXPECT_NEAR(r.a.length_squared(), 1.0f, 1e-5f) << scale;
+        EXPECT_NEAR(r.b.length_squared(), 1.0f, 1e-5f) << scale;
+    }
+}
