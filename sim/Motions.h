@@ -337,7 +337,7 @@ inline Plan car(Random& r) {
     p.heading_deg.base = r.between(0, 360);
     p.pitch_deg_per_m_s2 = r.between(0.3, 0.5);
     p.roll_deg_per_m_s2 = r.between(0.4, 0.7);
-    const double length_s = r.between(120, 170);
+    const double length_s = r.between(110, 150);
     double t = kStill_s, v = 0.0;
     auto change_speed = [&](double dv, double peak_m_s2) {
         const double dur_s = std::fmax(2.0, 2.0 * std::fabs(dv) / peak_m_s2);
