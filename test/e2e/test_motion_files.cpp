@@ -101,7 +101,8 @@ TEST_P(MotionFile, PhysicallyConsistent) {
     EXPECT_LT(worst_angle, 0.3) << "the gyro does not integrate to the truth";
     EXPECT_LT(still_a, 0.2) << "moving in the first 2 s";
     EXPECT_GT(peak_a, 2.0) << "the board hardly accelerates";
-    const double end_speed = std::sqrt(velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2]);
+    const double end_speed =
+        std::sqrt(velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2]);
     EXPECT_LT(end_speed, 0.1) << "the specific force does not integrate to a board that ends at rest";
     EXPECT_GE(tr.duration_s(), 60.0);
     EXPECT_LE(tr.duration_s(), 180.0);
