@@ -112,7 +112,7 @@ def ensure_venv(build):
     if r.returncode != 0:
         sys.exit("bench: `make venv` failed (python3-venv and PyPI are needed)")
     py = os.path.join(venv, "bin", "python")
-    os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:])
+    os.execv(py, [py, os.path.abspath(sys.argv[0])] + sys.argv[1:])  # the script run: bench, tune or motions
 
 
 # ---------------------------------------------------------------------------
@@ -346,7 +346,67 @@ def cached_peer_series(cache_dir, key, name):
         return z["t"].astype(float), z["q"].astype(float)
 
 
-def list_scenarios(build):
+def score_files(files, est_dir, cache_dir, replay, score_tool, peer_names, jobs):
+    """Ours (build/replay, scored by build/score) and the peers (from the cache, or run and
+    cached) on each (label, path, kind) of files, in a pool of jobs processes.
+    Returns ({filter: {label: score}}, {label: peer cache key}, [error lines])."""
+    import multiprocessing
+    results = {OURS: {}}
+    for n in peer_names:
+        results[n] = {}
+    keys = {}
+    tasks = []
+    for label, path, _ in files:
+        if replay and score_tool:
+            tasks.append((task_replay, (label, path, os.path.join(est_dir, label + ".csv"), replay, score_tool),
+                          "replay %s" % label))
+        if peer_names:
+            keys[label] = peer_cache_key(file_hash(path))
+            missing = []
+            for n in peer_names:
+                s = load_cached_peer(cache_dir, keys[label], n)
+                if s is None:
+                    missing.append(n)
+                else:
+                    results[n][label] = s
+            if missing:
+                tasks.append((task_peers, (label, path, missing, cache_dir, keys[label]),
+                              "peers on %s (%s)" % (label, ", ".join(missing))))
+    cached = sum(len(v) for k, v in results.items() if k != OURS)
+    if cached:
+        log("%d peer results from the cache" % cached)
+    errors = []
+    if tasks:
+        log("running %d tasks on %d processes" % (len(tasks), jobs))
+        # Slow tasks (peers in Python) first so that both processes stay busy.
+        tasks.sort(key=lambda t: t[0] is not task_peers)
+        with multiprocessing.Pool(jobs) as pool:
+            pending = [(desc, pool.apply_async(fn, (a,))) for fn, a, desc in tasks]
+            done = 0
+            for desc, res in pending:
+                kind, label, value, err, dt = res.get()
+                done += 1
+                if err:
+                    errors.append("%s: %s" % (desc, err))
+                    log("[%d/%d] %s: ERROR %s" % (done, len(tasks), desc, err))
+                    continue
+                if kind == "replay":
+                    results[OURS][label] = value
+                    log("[%d/%d] %s: total %.2f incl %.2f heading %.2f deg (%.1f s)" % (
+                        done, len(tasks), desc, value["total"], value["incl"], value["heading"], dt))
+                else:
+                    for n, s in value.items():
+                        if "error" in s:
+                            errors.append("%s on %s: %s" % (n, label, s["error"]))
+                        else:
+                            results[n][label] = s
+                    log("[%d/%d] %s (%.1f s)" % (done, len(tasks), desc, dt))
+    return results, keys, errors
+
+
+def list_scenarios(build, seeded=False):
+    """The scenario tool's names: the keyframed ones, or (seeded) the motions whose
+    description begins with `seeded:` (bench/motions.py scores those on fresh seeds)."""
     scen = tool(build, "scenario")
     if not scen:
         log("no scenario tool: scenarios skipped (make tools)")
@@ -359,7 +419,8 @@ def list_scenarios(build):
     for line in r.stdout.splitlines():
         line = line.strip()
         if line and not line.startswith("#"):
-            names.append(line.split()[0].rstrip(":"))
+            if (line.split(None, 3)[3:] or [""])[0].startswith("seeded:") == seeded:
+                names.append(line.split()[0].rstrip(":"))
     return names
 
 
@@ -486,7 +547,6 @@ def main():
         ensure_venv(build)
 
     sys.path.insert(0, BENCH_DIR)
-    import multiprocessing
     import numpy as np
     import peers
     import plots
@@ -538,56 +598,7 @@ def main():
 
     files = [(trial_name(p), p, "broad") for p in recordings] + [(n, p, "scenario") for n, p in scen_paths.items()]
     peer_names = [] if args.no_peers else list(peers.PEERS)
-    results = {OURS: {}}
-    for n in peer_names:
-        results[n] = {}
-    keys = {}
-    tasks = []
-    for label, path, kind in files:
-        if replay and score_tool:
-            tasks.append((task_replay, (label, path, os.path.join(est_dir, label + ".csv"), replay, score_tool),
-                          "replay %s" % label))
-        if peer_names:
-            keys[label] = peer_cache_key(file_hash(path))
-            missing = []
-            for n in peer_names:
-                s = load_cached_peer(cache_dir, keys[label], n)
-                if s is None:
-                    missing.append(n)
-                else:
-                    results[n][label] = s
-            if missing:
-                tasks.append((task_peers, (label, path, missing, cache_dir, keys[label]),
-                              "peers on %s (%s)" % (label, ", ".join(missing))))
-    cached = sum(len(v) for k, v in results.items() if k != OURS)
-    if cached:
-        log("%d peer results from the cache" % cached)
-    errors = []
-    if tasks:
-        log("running %d tasks on %d processes" % (len(tasks), args.jobs))
-        # Slow tasks (peers in Python) first so that both processes stay busy.
-        tasks.sort(key=lambda t: t[0] is not task_peers)
-        with multiprocessing.Pool(args.jobs) as pool:
-            pending = [(desc, pool.apply_async(fn, (a,))) for fn, a, desc in tasks]
-            done = 0
-            for desc, res in pending:
-                kind, label, value, err, dt = res.get()
-                done += 1
-                if err:
-                    errors.append("%s: %s" % (desc, err))
-                    log("[%d/%d] %s: ERROR %s" % (done, len(tasks), desc, err))
-                    continue
-                if kind == "replay":
-                    results[OURS][label] = value
-                    log("[%d/%d] %s: total %.2f incl %.2f heading %.2f deg (%.1f s)" % (
-                        done, len(tasks), desc, value["total"], value["incl"], value["heading"], dt))
-                else:
-                    for n, s in value.items():
-                        if "error" in s:
-                            errors.append("%s on %s: %s" % (n, label, s["error"]))
-                        else:
-                            results[n][label] = s
-                    log("[%d/%d] %s (%.1f s)" % (done, len(tasks), desc, dt))
+    results, keys, errors = score_files(files, est_dir, cache_dir, replay, score_tool, peer_names, args.jobs)
 
     trials = [trial_name(p) for p in recordings]
     scen_names = list(scen_paths)
@@ -848,6 +859,11 @@ def main():
     flight_rep, flight_errors = flights.flight_section(build, out_dir, task_replay, peer_names, log)
     rep += flight_rep
     errors += flight_errors
+    # Seeded motions on fresh seeds (issue 24): bench/motions.py.
+    import motions
+    motion_rep, motion_errors = motions.motion_section(build, out_dir, peer_names, args.jobs, log)
+    rep += motion_rep
+    errors += motion_errors
     if errors:
         rep += ["## Errors", ""] + ["- " + e for e in errors] + [""]
     if pngs:

@@ -4,6 +4,10 @@
 //   build/scenario NAME [--seconds S] [--rate HZ] [sensor-error options]   CSV on stdout
 //   build/scenario --list                             names, descriptions and the options
 //
+// The seeded motions (translate_slow, translate_fast, walk, pendulum, car, tapping; see
+// Motions.h) also move the board: specific force = R^T ((0, 0, -g) + a) with a the
+// analytic second derivative of the motion; their random parts come from --seed.
+//
 // Physically consistent: each scenario is an analytic attitude q(t) (body -> earth, NED,
 // built as Rz(yaw) Ry(pitch) Rx(roll) from smooth keyframed angles, any angle range);
 // the body rate is omega = 2 vec(q* dq/dt) (central difference, h = 10 us), specific
@@ -26,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "Motions.h"
 #include "Rotation.h"
 #include "Trajectory.h"
 
@@ -63,6 +68,7 @@ struct Scenario {
     const char* description;
     std::vector<Key> keys;
     Extras extras;
+    sim::motion::Kind motion = sim::motion::kNone;  // a seeded motion (Motions.h) instead of keys
 };
 
 std::vector<Scenario> scenarios() {
@@ -147,6 +153,30 @@ std::vector<Scenario> scenarios() {
                    {}};
         list.push_back(s);
     }
+    // Seeded motions (Motions.h): the random parts come from --seed; keys hold only the
+    // default motion's length.
+    const struct {
+        const char* name;
+        const char* description;
+        sim::motion::Kind kind;
+    } motions[] = {
+        {"translate_slow", "seeded: moved by hand along x, y, z and diagonals, 0.3-1 m strokes at 0.3-0.8 Hz",
+         sim::motion::kTranslateSlow},
+        {"translate_fast", "seeded: the same at 0.8-1.5 Hz, up to 20 m/s^2", sim::motion::kTranslateFast},
+        {"walk", "seeded: carried in hand while walking, 2 Hz steps, arm sway, 90 deg turns, pauses",
+         sim::motion::kWalk},
+        {"pendulum", "seeded: swinging 10-30 deg on a 1-2 m string, decaying, twisting in yaw",
+         sim::motion::kPendulum},
+        {"car", "seeded: flat road, 2-4 m/s^2 starts and stops, corners at 5-15 m/s, suspension",
+         sim::motion::kCar},
+        {"tapping", "seeded: held in a shaking hand, tapped (20-50 m/s^2, 10 ms) every 1-3 s",
+         sim::motion::kTapping},
+    };
+    for (const auto& m : motions) {
+        const double end_s = sim::motion::make_plan(m.kind, 0).end_s;
+        Scenario s{m.name, m.description, {{0, 0, 0, 0}, {end_s, 0, 0, 0}}, {}, m.kind};
+        list.push_back(s);
+    }
     return list;
 }
 
@@ -179,20 +209,7 @@ Quat attitude(const Scenario& s, double t_s) {
     return sim::from_euler(roll * kDeg, pitch * kDeg, yaw * kDeg);
 }
 
-// Deterministic Gaussian noise: xorshift64* and Box-Muller (same numbers on every libc).
-struct Noise {
-    uint64_t state = 0x9E3779B97F4A7C15ull;
-    double uniform() {
-        state ^= state >> 12;
-        state ^= state << 25;
-        state ^= state >> 27;
-        return ((state * 2685821657736338717ull) >> 11) * (1.0 / 9007199254740992.0);
-    }
-    double gauss() {
-        const double u1 = uniform() + 1e-300, u2 = uniform();
-        return std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * kPi * u2);
-    }
-};
+using Noise = sim::Random;  // the fixed sequences of the default files
 
 // Imperfections of the measured columns (body frame), applied after the physics:
 //   gyro  = omega + bias + drift * t + walk(t) + noise
@@ -264,7 +281,8 @@ const char* const kOptionsHelp =
     "  --noise default         the fixed amounts (0.03 deg/s, 0.025 m/s^2, 0.2 uT rms)\n"
     "  --quantise              round to one count of each chip at the firmware's ranges\n"
     "                          (1/16.4 deg/s, 8 g / 32768, 1/1090 G)\n"
-    "  --seed N                another noise sequence (default: the fixed one)\n"
+    "  --seed N                another noise sequence (default: the fixed one); for the\n"
+    "                          seeded motions also another motion (0: the default one)\n"
     "  --preset uncalibrated   a realistic uncalibrated board: gyro bias (1.5,-1,0.8) deg/s\n"
     "                          drifting (0.1,-0.08,0.06) deg/s/min, accel offset\n"
     "                          (0.1,-0.08,0.2) m/s^2 and scale (1.02,0.985,1.01), hard iron\n"
@@ -404,7 +422,12 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "scenario: --rate must be positive\n");
         return 1;
     }
-    if (seconds < 0.0) seconds = scenario->keys.back().t_s;
+    const sim::motion::Plan plan = sim::motion::make_plan(scenario->motion, err.seed);
+    const bool moving = scenario->motion != sim::motion::kNone;
+    if (seconds < 0.0) seconds = moving ? plan.end_s : scenario->keys.back().t_s;
+    auto attitude_at = [&](double t_s) {
+        return moving ? sim::motion::attitude(plan, t_s) : attitude(*scenario, t_s);
+    };
 
     const Extras& x = scenario->extras;
     Noise noise;
@@ -424,9 +447,9 @@ int main(int argc, char** argv) {
     const double h_s = 1e-5;
     for (long k = 0; k <= n; ++k) {
         const double t_s = (double)k / rate_hz;
-        const Quat q = attitude(*scenario, t_s);
+        const Quat q = attitude_at(t_s);
         // omega_body = 2 vec(q* dq/dt)
-        const Quat qp = attitude(*scenario, t_s + h_s), qm = attitude(*scenario, t_s - h_s);
+        const Quat qp = attitude_at(t_s + h_s), qm = attitude_at(t_s - h_s);
         const Quat dq{(qp.w - qm.w) / (2 * h_s), (qp.x - qm.x) / (2 * h_s), (qp.y - qm.y) / (2 * h_s),
                       (qp.z - qm.z) / (2 * h_s)};
         const Quat omega = q.conj() * dq;
@@ -434,7 +457,14 @@ int main(int argc, char** argv) {
 
         const double down_g[3] = {0.0, 0.0, -kGravity_m_s2};  // specific force at rest, earth frame
         double accel[3];
-        earth_to_body(q, down_g, accel);
+        if (moving) {  // specific force = R^T ((0, 0, -g) + a), a the motion's linear acceleration
+            double force_ned[3];
+            sim::motion::accel_ned(plan, t_s, force_ned);
+            force_ned[2] -= kGravity_m_s2;
+            earth_to_body(q, force_ned, accel);
+        } else {
+            earth_to_body(q, down_g, accel);
+        }
         double field_ned[3] = {kEarthField_uT[0], kEarthField_uT[1], kEarthField_uT[2]};
         if (t_s >= x.disturb_from_s && t_s < x.disturb_to_s)
             for (int i = 0; i < 3; ++i) field_ned[i] += x.disturb_uT[i];
