@@ -200,15 +200,16 @@ static void airspeed_begin() {
 
 static void airspeed_step() {
     if (airspeed_state == AirspeedState::kNone) {
-        // No sensor: the configured cruise speed (TRIM_ARSPD_CM), only while the receiver's
-        // throttle is above idle (on the ground, or gliding, the velocity is not the cruise's).
+        // No sensor: the configured cruise speed (TRIM_ARSPD_CM, grown in a banked turn as
+        // the lift needs), only while the receiver's throttle is above idle (on the ground,
+        // or gliding, the velocity is not the cruise's).
         const flight::FlightSettings& fs = pipe.settings().flight;
         if (fs.trim_arspd_cm == 0u || pipe.steps() % kAirspeedReadings != 0u) return;
         const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
         const bool powered = flight_control.state() != flight::State::NoSignal && ch < flight::kChannels &&
                              flight::width_to_throttle(flight_control.rc_us()[ch], fs.rc[ch],
                                                        (fs.rc_reversed >> ch) & 1u) > kAirspeedIdleThrottle;
-        pipe.set_airspeed_m_s(powered ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
+        pipe.set_cruise_airspeed_m_s(powered ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
         return;
     }
     if (ADCSRA & _BV(ADSC)) return;

@@ -44,8 +44,9 @@ void usage(FILE* out) {
             "  --set NAME=VALUE  one of the estimator's settings instead of the firmware's\n"
             "               (lib/DCM/Dcm.h, DcmSettings; angles in degrees): for tuning and\n"
             "               cross-validation (bench/tune.py). --set list prints them.\n"
-            "  --airspeed M_S  the airspeed the pipeline is given (the centripetal\n"
-            "               correction; a configured cruise speed): default none\n"
+            "  --airspeed M_S  a configured cruise speed (the firmware's TRIM_ARSPD_CM,\n"
+            "               for the centripetal correction), grown in a banked turn as\n"
+            "               the firmware does: default none\n"
             "  --airspeed-log LOG.csv  the airspeed over time from a flight's state log\n"
             "               (sim/flight: columns t and airspeed_m_s), given every\n"
             "               8 steps as the firmware reads its sensor\n");
@@ -292,7 +293,7 @@ int main(int argc, char** argv) {
                     ++airspeed_cursor;
                 pipe.set_airspeed_m_s((float)airspeed_log[airspeed_cursor].second);
             } else if (airspeed_m_s > 0.0) {
-                pipe.set_airspeed_m_s((float)airspeed_m_s);
+                pipe.set_cruise_airspeed_m_s((float)airspeed_m_s);  // as the firmware does with TRIM_ARSPD_CM
             }
         }
         pipe.on_imu_sample(sample);

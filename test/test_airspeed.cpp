@@ -144,3 +144,18 @@ TEST(AirspeedSensor, TrimAirspeedParameterDefaultsOffAndRoundTrips) {
 }
 
 }  // namespace
+
+namespace {
+
+// A configured cruise speed in a banked turn: level it is the trim; at 30 deg of bank
+// the lift needs sqrt(1 / cos 30) of it (7.5 % more); beyond 60 deg it stays at sqrt(2);
+// an upside-down estimate (down_z < 0) is held there too.
+TEST(AirspeedSensor, ACruiseSpeedGrowsWithTheTurnsLoadFactor) {
+    EXPECT_FLOAT_EQ(airspeed::cruise_in_turn_m_s(18.0f, 1.0f), 18.0f);
+    EXPECT_FLOAT_EQ(airspeed::cruise_in_turn_m_s(18.0f, 1.0001f), 18.0f);
+    EXPECT_NEAR(airspeed::cruise_in_turn_m_s(18.0f, std::cos(30.0f * linalg::kRadPerDeg)), 18.0f * 1.0746f, 0.01f);
+    EXPECT_NEAR(airspeed::cruise_in_turn_m_s(18.0f, 0.2f), 18.0f * std::sqrt(2.0f), 1e-4f);
+    EXPECT_NEAR(airspeed::cruise_in_turn_m_s(18.0f, -1.0f), 18.0f * std::sqrt(2.0f), 1e-4f);
+}
+
+}  // namespace

@@ -32,4 +32,17 @@ inline float airspeed_m_s(uint32_t sum_counts, uint8_t n, uint16_t zero_counts) 
     return dp_Pa > 0.0f ? sqrtf(2.0f * dp_Pa / kAirDensity_kg_m3) : 0.0f;
 }
 
+// A configured cruise speed (TRIM_ARSPD_CM: no sensor) in a banked turn. The trim holds
+// the wing near its trimmed angle of attack, so its lift coefficient stays: the lift
+// n W = 1/2 rho V^2 S C_L of a load factor n takes V = V_trim sqrt(n), and n = 1/cos(bank)
+// in a level coordinated turn. cos(bank) is the estimate's (earth down's body z
+// component, cos(roll) cos(pitch)), held at 0.5 or more (n <= 2: a bank within 60 deg).
+// Without it the speed read is short by sqrt(n) in the turn, the centripetal term short
+// by as much, and STABILIZE's bank (held on the estimate) creeps past the one asked for.
+constexpr float kMinCosBank = 0.5f;
+inline float cruise_in_turn_m_s(float trim_m_s, float down_z) {
+    const float cos_bank = down_z > 1.0f ? 1.0f : (down_z > kMinCosBank ? down_z : kMinCosBank);
+    return trim_m_s / sqrtf(cos_bank);
+}
+
 }  // namespace airspeed

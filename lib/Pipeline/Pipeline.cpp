@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Pipeline.h"
 
+#include "Airspeed.h"
 #include "Profile.h"
 #include "Fixed.h"
 #include "Mpu6000.h"
@@ -67,6 +68,10 @@ void AttitudePipeline::set_airspeed_m_s(float airspeed_m_s) {
     // a deg/s, a few tenths of a m/s^2 at cruise).
     gyro_bias_y_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.y);
     gyro_bias_z_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.z);
+}
+
+void AttitudePipeline::set_cruise_airspeed_m_s(float trim_m_s) {
+    set_airspeed_m_s(trim_m_s > 0.0f ? airspeed::cruise_in_turn_m_s(trim_m_s, dcm_.matrix().c.z) : 0.0f);
 }
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {

@@ -203,6 +203,9 @@ public:
     // The airspeed along the body's x axis (m/s; 0: none, no correction) for the
     // centripetal correction of the accelerometer: holds until set again.
     void set_airspeed_m_s(float airspeed_m_s);
+    // A configured cruise speed instead (no sensor; 0: none), grown in a banked turn as
+    // the lift needs (airspeed::cruise_in_turn_m_s): set it again as the bank changes.
+    void set_cruise_airspeed_m_s(float trim_m_s);
     float airspeed_m_s() const { return airspeed_m_s_; }
 
     // One MPU6000 sample at the fixed 200 Hz step.
