@@ -6,9 +6,11 @@ STABILIZE stand-in, written as trajectory files: ideal sensor values and the tru
 quaternion at 400 Hz). Ours runs through build/replay (the firmware's drivers and DCM on
 the simulated chips), the peers through bench/peers.py, all scored with the same metric.
 The worst roll error over the 60 s turn is printed: the turn's centripetal acceleration is
-what fools an accelerometer-corrected filter. When the closed-loop turn test has run
-(ctest flight.closed_loop.turn: the ELF in simavr flying the model itself), its worst roll
-error is reported too.
+what fools an accelerometer-corrected filter; ours also with `replay --airspeed` at the
+trim speed (a configured cruise speed, TRIM_ARSPD_CM, given to the centripetal correction).
+When the closed-loop turn tests have run (ctest flight.closed_loop.turn: the ELF in simavr
+flying the model itself with the airspeed sensor; flight.closed_loop.turn_cruise: without
+it, TRIM_ARSPD_CM set), their worst roll errors are reported too.
 
     flight_section(build, out_dir, run_replay, peer_names, log) -> markdown lines
 """
@@ -21,6 +23,10 @@ FLY = os.path.join(REPO, "sim", "flight", "fly.py")
 FLIGHT_SOURCES = os.path.join(REPO, "sim", "flight")
 FLIGHTS = ("cruise", "turn", "figure8", "gusty", "upset", "climb")
 TURN_FROM_S, TURN_TO_S = 5.0, 65.0  # fly.py's turn: the stick held for 30 deg from 5 to 65 s
+TRIM_AIRSPEED_M_S = 18.0  # fly.py's trim speed: the configured cruise speed of a board without a pitot
+# The closed-loop turns (test/flight/test_closed_loop.py): ctest group, what the board knows.
+CLOSED_LOOP_TURNS = (("turn", "with the airspeed sensor"),
+                     ("turn_cruise", "without it, TRIM_ARSPD_CM %d" % round(TRIM_AIRSPEED_M_S * 100)))
 
 
 def newest_source_mtime():
@@ -75,9 +81,20 @@ def worst_roll_error_peer(tr, q):
     return float(err[np.argmax(np.abs(err))]) if len(err) else float("nan")
 
 
-def closed_loop_turn(build):
-    """The closed-loop turn test's log (true and estimated bank), if it ran: its worst error."""
-    path = os.path.join(build, "host", "closed_loop_turn", "turn_bank.csv")
+def replay_turn_with_airspeed(replay, traj, est_path, airspeed_m_s):
+    """replay --airspeed on the turn: (its worst roll error as worst_roll_error_replay, None)
+    or (None, the error)."""
+    with open(est_path, "w") as f:
+        r = subprocess.run([replay, "--trajectory", traj, "--airspeed", "%g" % airspeed_m_s], stdout=f,
+                           stderr=subprocess.PIPE, text=True, timeout=1800)
+    if r.returncode != 0:
+        return None, "replay --airspeed failed (exit %d): %s" % (r.returncode, r.stderr.strip()[-300:])
+    return worst_roll_error_replay(traj, est_path), None
+
+
+def closed_loop_turn(build, name="turn"):
+    """A closed-loop turn test's log (true and estimated bank), if it ran: its worst error."""
+    path = os.path.join(build, "host", "closed_loop_" + name, name + "_bank.csv")
     if not os.path.exists(path):
         return None
     worst = None
@@ -112,6 +129,12 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         cells = [name, "%.2f / %.2f / %.2f" % (ours["total"], ours["incl"], ours["heading"]) if ours else "–"]
         if name == "turn" and ours:
             turn_worst["ours (replay)"] = worst_roll_error_replay(traj, est)[0]
+            worst, err = replay_turn_with_airspeed(replay, traj, os.path.join(flight_dir, "turn_estimate_airspeed.csv"),
+                                                   TRIM_AIRSPEED_M_S)
+            if err:
+                errors.append("flight turn: " + err)
+            else:
+                turn_worst["ours (replay --airspeed %g)" % TRIM_AIRSPEED_M_S] = worst[0]
         tr = peers.load_trajectory(traj)
         for peer in peer_names:
             try:
@@ -136,12 +159,16 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         text = ", ".join("%s %.1f" % (k, v) for k, v in turn_worst.items())
         rep += ["Worst roll error during the 60 s, 30 deg turn (estimate - truth, deg): %s." % text, ""]
         log("the turn's worst roll error (deg): " + text)
-    loop = closed_loop_turn(build)
-    if loop and loop[1]:
-        t, err, true_bank, est_bank = loop[1]
-        text = ("the board flying the turn itself (ctest flight.closed_loop.turn, %s): worst roll error %.1f deg "
-                "at %.1f s (true %.1f, estimate %.1f), while above the ground"
-                % (os.path.relpath(loop[0], REPO), err, t, true_bank, est_bank))
+    loop_texts = []
+    for name, what in CLOSED_LOOP_TURNS:
+        loop = closed_loop_turn(build, name)
+        if loop and loop[1]:
+            t, err, true_bank, est_bank = loop[1]
+            loop_texts.append("%s (ctest flight.closed_loop.%s, %s): worst roll error %.1f deg at %.1f s (true %.1f, "
+                              "estimate %.1f)" % (what, name, os.path.relpath(loop[0], REPO), err, t, true_bank,
+                                                  est_bank))
+    if loop_texts:
+        text = "the board flying the turn itself, while above the ground: " + "; ".join(loop_texts)
         rep += ["In the closed loop, " + text + ".", ""]
         log(text)
     return rep, errors

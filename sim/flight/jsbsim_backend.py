@@ -7,7 +7,7 @@ autopilot speaks the protocol (build/apm25sim --physics json, ArduPilot SITL wit
     build/venv/bin/python sim/flight/jsbsim_backend.py [--port 9002] [--rc FILE|none]
         [--gust 0|1|2] [--seed N] [--trajectory FILE.csv[.gz]] [--log FILE.csv[.gz]]
         [--seconds S] [--airspeed 18] [--altitude 100] [--heading 0] [--upset T,SECONDS,NM ...]
-        [--vibration M_S2]
+        [--vibration M_S2] [--no-airspeed]
 
 Lock-step: one physics frame (1 / frame_rate of the packet, in JSBSim steps of at most
 2.5 ms) per servo packet received, no wall clock, so a flight is the same every time.
@@ -15,7 +15,9 @@ The aeroplane starts trimmed for level flight at the given airspeed and height (
 wings level); outputs without pulses (width 0) hold the trim. The pilot's sticks from
 --rc are sent as the reply's rc channels, and no signal as an empty rc object (default:
 hands off, sticks centred, throttle at the trim, ch5-ch8 1500; `--rc none` sends no rc
-field).
+field). --no-airspeed leaves the replies' optional airspeed out: an aeroplane without a
+pitot (apm25sim then leaves the MPXV7002DP's input A0 at 0 V, which the board reads as no
+sensor).
 The files hold --seconds of simulated time; after it the backend still answers (an
 autopilot may run a frame longer) and exits once no packet came for --linger s (default 1);
 --idle-timeout s without a packet before that stops it too.
@@ -50,6 +52,8 @@ def parse_args(argv):
     p.add_argument("--hold", type=float, default=0.0, metavar="S",
                    help="hold the aeroplane still at its start attitude for S s (a launch stand: the "
                         "board starts at rest), then release it into the trimmed flight")
+    p.add_argument("--no-airspeed", action="store_true",
+                   help="send no airspeed in the replies (no pitot on the aeroplane; the log keeps the truth)")
     p.add_argument("--trajectory", help="write the flight as a trajectory (../shared/SIM.md)")
     p.add_argument("--log", help="write the true state, one row a frame")
     p.add_argument("--seconds", type=float, default=0.0,
@@ -139,7 +143,7 @@ class Backend:
         self.frames += 1
         state = self.model.state()
         self.record(state)
-        self.last_reply = jsonlink.make_reply(state, self.rc_at(state["t"]))
+        self.last_reply = jsonlink.make_reply(state, self.rc_at(state["t"]), airspeed=not self.args.no_airspeed)
         return self.last_reply
 
     def done(self):

@@ -56,11 +56,12 @@ def pack_servo_packet(frame_rate, frame_count, pwm):
 NO_RC = "no rc field"
 
 
-def make_reply(state, rc=NO_RC):
+def make_reply(state, rc=NO_RC, airspeed=True):
     """The JSON frame for a state dict of flightmodel.FlightModel.state(). rc: the channel
     widths (us); None for a receiver without signal, sent as an rc object with no channels
     (the readme has no word for a lost receiver; apm25sim --physics reads an empty rc as a
-    dead one, ArduPilot's SITL keeps its last channels); NO_RC for no rc field at all."""
+    dead one, ArduPilot's SITL keeps its last channels); NO_RC for no rc field at all.
+    airspeed False: no airspeed field (the field is optional: an aeroplane without a pitot)."""
     body = {
         "timestamp": state["t"],
         "imu": {"gyro": list(state["gyro"]), "accel_body": list(state["accel"])},
@@ -71,6 +72,8 @@ def make_reply(state, rc=NO_RC):
         "airspeed": state["airspeed"],
         "velocity_wind": list(state["wind"]),
     }
+    if not airspeed:
+        del body["airspeed"]
     if rc is None:
         body["rc"] = {}
     elif rc is not NO_RC:

@@ -24,10 +24,14 @@ GROUP is one of:
                   most half of what it was (printed: an accelerometer-corrected estimate reads
                   a coordinated turn as level, the acceleration issue); the receiver back:
                   STABILIZE again
-  turn            the stick held for a 30 deg bank for 60 s: the true and the estimated bank,
-                  logged (DIR/turn_bank.csv) and printed every 5 s, with the worst roll error;
-                  asserted only that they are logged and finite (the estimate's drift in a
-                  turn is the acceleration issue's baseline)
+  turn            the stick held for a 30 deg bank for 60 s, the pitot (MPXV7002DP on A0) fed
+                  the backend's airspeed: the true and the estimated bank, logged
+                  (DIR/turn_bank.csv) and printed every 5 s; the worst roll error while the
+                  aeroplane flies is under 2 deg (issue 24) and every bank finite
+  turn_cruise     the same turn without a pitot (the backend sends no airspeed: A0 at 0 V),
+                  TRIM_ARSPD_CM set to the trim speed (18 m/s) on the console before it: the
+                  board says it has no airspeed sensor and takes the set; the worst roll error
+                  (DIR/turn_cruise_bank.csv) under 5 deg (issue 24) and every bank finite
   determinism     the same flight twice: the same bytes on the serial line and the servo log
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
@@ -53,6 +57,11 @@ UPSET = "6,0.5,20"  # sim/flight's upset flight: 48 deg of bank when nothing res
 # The servo log stamps edges within 0.3 us; the receiver's 0.5 us ticks round to 1 us.
 FOLLOW_US = 1.3
 GUST_NAMES = {0: "no", 1: "light", 2: "moderate"}
+# Issue 24's roll error targets in a 60 s, 30 deg turn: with the airspeed sensor, and with
+# the configured cruise speed only (TRIM_ARSPD_CM, the backend's trim speed: the turn's
+# power setting flies faster, the honest mismatch of a configured speed).
+TURN_SENSOR_MAX_DEG, TURN_CRUISE_MAX_DEG = 2.0, 5.0
+TRIM_ARSPD_CM = 1800
 
 
 def row(t, roll=1500, pitch=1500, throttle=THROTTLE_US, yaw=1500, mode=STABILIZE):
@@ -74,7 +83,10 @@ def stick_for_bank(bank_deg):
 class Flight:
     """One closed-loop flight's files, read back."""
 
-    def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1):
+    def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
+                 console=()):
+        """airspeed False: the backend sends none (no pitot); console: lines typed into the
+        board (apm25sim --input: from its first angle line)."""
         self.name, self.seconds = name, seconds
         base = os.path.join(work, name)
         self.rc = write_rc(base + "_rc.csv", rows)
@@ -86,6 +98,12 @@ class Flight:
                "--elf", os.path.join(tools, "firmware.elf"), "--timeout", "2300", "--hold", "%g" % HOLD_S]
         for u in upsets:
             cmd += ["--upset", u]
+        if not airspeed:
+            cmd.append("--no-airspeed")
+        if console:
+            with open(base + "_console.txt", "w") as f:
+                f.write("".join(line + "\n" for line in console))
+            cmd += ["--input", base + "_console.txt"]
         self.status = subprocess.call(cmd)
         soft_assert(self.status == 0, "%s: closed_loop.py ended with status %d" % (name, self.status))
         self.truth = read_log(self.log_path)
@@ -294,20 +312,22 @@ def check_rc_loss(args):
     soft_assert(thr and all(abs(w - THROTTLE_US) <= FOLLOW_US for w in thr), "rc_loss: throttle not back on the stick")
 
 
-def check_turn(args):
+def fly_turn(args, name, **flight_options):
+    """The 60 s, 30 deg turn: (the Flight, the worst roll error in flight (t, error, true,
+    estimate), all banks finite), the banks logged to DIR/NAME_bank.csv and printed."""
     t_turn = HOLD_S + 2.0
     seconds = t_turn + 60.0
     rows = [row(0.0), row(t_turn, stick_for_bank(30), throttle=THROTTLE_US + 40)]
-    f = Flight(args.work, "turn", rows, seconds, tools=args.tools)
+    f = Flight(args.work, name, rows, seconds, tools=args.tools, **flight_options)
     est = f.estimates()
     # The backend lays a crashed aeroplane still on the ground (sim/flight/flightmodel.py):
     # the errors count while it flies.
     ground = next((r["t"] for r in f.truth if r["t"] > HOLD_S and -r["down_m"] < 1.0), None)
-    out_path = os.path.join(args.work, "turn_bank.csv")
+    out_path = os.path.join(args.work, name + "_bank.csv")
     worst = (0.0, 0.0, 0.0, 0.0)
     finite = bool(est)
     printed = set()
-    print("turn: true and estimated bank, every 5 s (all in %s):" % out_path)
+    print("%s: true and estimated bank, every 5 s (all in %s):" % (name, out_path))
     with open(out_path, "w") as out:
         out.write("t,true_bank_deg,estimated_bank_deg,error_deg,height_m\n")
         for t, roll, _, _ in est:
@@ -325,13 +345,33 @@ def check_turn(args):
                 printed.add(slot)
                 print("  t %5.1f s  true %6.1f deg  estimate %6.1f deg  height %6.1f m  airspeed %5.1f m/s"
                       % (t, truth["roll_deg"], roll, -truth["down_m"], truth["airspeed_m_s"]))
-    print("turn: worst roll error in flight %.1f deg at %.1f s (true %.1f, estimate %.1f)"
-          % (worst[1], worst[0], worst[2], worst[3]))
-    print("turn: %s" % ("the aeroplane hit the ground at %.1f s, %.1f s into the turn (a spiral dive: STABILIZE "
-                        "holds the ESTIMATED bank)" % (ground, ground - t_turn) if ground is not None
-                        else "the aeroplane stayed in the air"))
-    soft_assert(len(est) > 45 * (seconds - 3.0), "turn: only %d attitude lines" % len(est))
-    soft_assert(finite, "turn: a bank that is not finite")
+    print("%s: worst roll error in flight %.1f deg at %.1f s (true %.1f, estimate %.1f)"
+          % (name, worst[1], worst[0], worst[2], worst[3]))
+    print("%s: %s" % (name, "the aeroplane hit the ground at %.1f s, %.1f s into the turn (a spiral dive: "
+                      "STABILIZE holds the ESTIMATED bank)" % (ground, ground - t_turn) if ground is not None
+                      else "the aeroplane stayed in the air"))
+    soft_assert(len(est) > 45 * (seconds - 3.0), "%s: only %d attitude lines" % (name, len(est)))
+    soft_assert(finite, "%s: a bank that is not finite" % name)
+    return f, worst, finite
+
+
+def check_turn(args):
+    f, worst, finite = fly_turn(args, "turn")
+    soft_assert(f.said("# airspeed: no sensor") is None, "turn: the board found no airspeed sensor on A0")
+    soft_assert(finite and abs(worst[1]) < TURN_SENSOR_MAX_DEG, "turn: worst roll error %.1f deg with the airspeed "
+                "sensor (under %g)" % (worst[1], TURN_SENSOR_MAX_DEG))
+
+
+def check_turn_cruise(args):
+    f, worst, finite = fly_turn(args, "turn_cruise", airspeed=False, console=["set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    said = f.said("# TRIM_ARSPD_CM")
+    print("turn_cruise: the board said %r and %r" % (f.said("# airspeed:"), said))
+    soft_assert(f.said("# airspeed: no sensor") is not None, "turn_cruise: the board did not say it has no "
+                "airspeed sensor (the backend sent no airspeed)")
+    soft_assert(said is not None and said[1] == "# TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM and said[0] < HOLD_S + 2.0,
+                "turn_cruise: TRIM_ARSPD_CM not set before the turn: %r" % (said,))
+    soft_assert(finite and abs(worst[1]) < TURN_CRUISE_MAX_DEG, "turn_cruise: worst roll error %.1f deg with the "
+                "configured cruise speed only (under %g)" % (worst[1], TURN_CRUISE_MAX_DEG))
 
 
 def check_determinism(args):
@@ -348,7 +388,8 @@ def check_determinism(args):
 
 
 GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
-          "rc_loss": check_rc_loss, "turn": check_turn, "determinism": check_determinism}
+          "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
+          "determinism": check_determinism}
 
 
 def main():

@@ -135,6 +135,12 @@ def check_protocol(work):
     silent = jsbsim_backend.Backend(jsbsim_backend.parse_args(["--quiet", "--rc", "none"]))
     soft_assert("rc" not in json.loads(silent.handle(packet(400, 0, trim_pwm))), "--rc none still sent an rc field")
     silent.close_outputs()
+    # No pitot: the replies carry no airspeed (the field is optional), the rest unchanged.
+    bare = jsbsim_backend.Backend(jsbsim_backend.parse_args(["--quiet", "--rc", script_path, "--no-airspeed"]))
+    bare_obj = jsonlink.parse_reply(bare.handle(packet(400, 0, trim_pwm)))
+    soft_assert("airspeed" not in bare_obj, "--no-airspeed still sent an airspeed")
+    soft_assert(bare_obj["position"] == json.loads(first)["position"], "--no-airspeed changed the flight")
+    bare.close_outputs()
 
     # One real round trip over UDP: the reply goes back to the sender's address and port.
     port_file = os.path.join(work, "port")
