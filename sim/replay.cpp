@@ -2,7 +2,7 @@
 // build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
 //
 //   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]
-//                [--airspeed M_S | --airspeed-log LOG.csv]
+//                [--airspeed M_S | --airspeed-log LOG.csv] [--trace FILE.csv]
 //
 // The same pipeline as the board, minus the AVR: the simulator's register models
 // (sim/models) answer the very drivers the firmware runs (lib/MPU6000, lib/HMC5883)
@@ -13,7 +13,9 @@
 //
 // stdout: CSV `t,roll,pitch,yaw` (s, degrees; yaw = heading 0..360 with the default
 // declination) at the firmware's output rate. --log sends the pipeline's "# " lines
-// (calibration, warnings) to stderr.
+// (calibration, warnings) to stderr. --trace writes, per estimator step (200 Hz), the
+// error against the trajectory's truth and what each correction did (lib/DCM/Trace.h):
+// stdout is the same with or without it.
 #include <cstdio>
 #include <cstdlib>
 #include <cmath>
@@ -28,6 +30,7 @@
 #include "Mpu6000Model.h"
 #include "Pipeline.h"
 #include "PipelineText.h"
+#include "ScoreMetric.h"
 #include "Text.h"
 #include "Trajectory.h"
 
@@ -49,7 +52,17 @@ void usage(FILE* out) {
             "               the firmware does: default none\n"
             "  --airspeed-log LOG.csv  the airspeed over time from a flight's state log\n"
             "               (sim/flight: columns t and airspeed_m_s), given every\n"
-            "               8 steps as the firmware reads its sensor\n");
+            "               8 steps as the firmware reads its sensor\n"
+            "  --trace FILE.csv  per estimator step (200 Hz, from the estimator's start):\n"
+            "               the error against the trajectory's truth (signed, deg; the tilt\n"
+            "               error split about magnetic north and east; the heading error a\n"
+            "               compass would see from that tilt, tilt_n tan(dip)), which\n"
+            "               corrections ran and why (gravity: ran/not_due/no_direction and\n"
+            "               held; heading: used/disturbed/new_field/too_vertical/not_due and\n"
+            "               the error it measured), the field against the learned reference,\n"
+            "               rest, and the gyro bias estimate (deg/s) with its changes summed\n"
+            "               by source (gravity integrator, compass integrator, rest).\n"
+            "               stdout is unchanged.\n");
 }
 
 // The estimator's settings by name, for --set (DcmSettings in lib/DCM/Dcm.h).
@@ -146,6 +159,127 @@ void print_centideg(int32_t c, char end) {
     printf("%.*s%c", (int)n, buf, end);
 }
 
+const char* gravity_word(dcm::GravityEvent e) {
+    switch (e) {
+        case dcm::GravityEvent::kRan: return "ran";
+        case dcm::GravityEvent::kNoDirection: return "no_direction";
+        default: return "not_due";
+    }
+}
+
+const char* heading_word(dcm::HeadingEvent e) {
+    switch (e) {
+        case dcm::HeadingEvent::kTooVertical: return "too_vertical";
+        case dcm::HeadingEvent::kDisturbed: return "disturbed";
+        case dcm::HeadingEvent::kNewField: return "new_field";
+        case dcm::HeadingEvent::kUsed: return "used";
+        default: return "not_due";
+    }
+}
+
+double wrap_deg(double d) {
+    while (d > 180.0) d -= 360.0;
+    while (d <= -180.0) d += 360.0;
+    return d;
+}
+
+// Roll, pitch, yaw (deg) of a body -> earth quaternion (Z-Y-X, as the firmware prints).
+void euler_deg(const score::Quat& q, double out[3]) {
+    out[0] = score::rad2deg(std::atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y)));
+    const double s = 2.0 * (q.w * q.y - q.z * q.x);
+    out[1] = score::rad2deg(std::asin(s > 1.0 ? 1.0 : (s < -1.0 ? -1.0 : s)));
+    out[2] = score::rad2deg(std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z)));
+}
+
+// v turned by the unit quaternion q (body -> earth).
+void rotate(const score::Quat& q, const double v[3], double out[3]) {
+    const score::Quat p{0.0, v[0], v[1], v[2]};
+    const score::Quat r = score::quat_mul(score::quat_mul(q, p), score::quat_conj(q));
+    out[0] = r.x;
+    out[1] = r.y;
+    out[2] = r.z;
+}
+
+// --trace: one row per estimator step.
+class TraceWriter {
+public:
+    explicit TraceWriter(FILE* out) : out_(out) {
+        if (!out_) return;
+        fprintf(out_,
+                "t,roll_err_deg,pitch_err_deg,heading_err_deg,incl_err_deg,tilt_n_deg,tilt_e_deg,"
+                "true_dip_deg,tilt_n_tan_dip_deg,gravity,integrator_held,gravity_kp_1_s,est_tilt_n_deg,"
+                "est_tilt_e_deg,rest,heading,mag_err_deg,field_norm_uT,field_dip_deg,ref_norm_uT,ref_dip_deg,"
+                "bias_x_deg_s,bias_y_deg_s,bias_z_deg_s,grav_bias_x_deg_s,grav_bias_y_deg_s,grav_bias_z_deg_s,"
+                "mag_bias_x_deg_s,mag_bias_y_deg_s,mag_bias_z_deg_s,rest_bias_x_deg_s,rest_bias_y_deg_s,"
+                "rest_bias_z_deg_s,status\n");
+    }
+
+    // The step just run: the estimate (as printed) against the truth at t.
+    void row(double t_s, const sim::TrajectorySample& truth, const pipeline::AttitudePipeline& pipe,
+             const dcm::DcmTrace& tr) {
+        const pipeline::Angles a = pipe.angles();
+        const score::Quat q_est = score::quat_from_euler_deg(a.roll_deg, a.pitch_deg, a.heading_deg);
+        const score::Quat q_true{truth.quat[0], truth.quat[1], truth.quat[2], truth.quat[3]};
+        double err[9];
+        for (double& e : err) e = NAN;
+        if (score::quat_finite(q_true)) {
+            const score::Quat qt = score::quat_normalized(q_true);
+            // The magnetic north and dip in the truth's earth frame: the field turned into
+            // it, averaged (10 s) so that the sensor's noise does not turn the axes.
+            double field_earth[3];
+            rotate(qt, truth.mag_uT, field_earth);
+            const double alpha = have_field_ ? 0.005 / 10.0 : 1.0;
+            for (int i = 0; i < 3; ++i) field_ef_[i] += alpha * (field_earth[i] - field_ef_[i]);
+            have_field_ = true;
+            const double horizontal = std::hypot(field_ef_[0], field_ef_[1]);
+            const double dip_rad = std::atan2(field_ef_[2], horizontal);
+            const double cn = horizontal > 0.0 ? field_ef_[0] / horizontal : 1.0;
+            const double sn = horizontal > 0.0 ? field_ef_[1] / horizontal : 0.0;
+            double e_true[3], e_est[3];
+            euler_deg(qt, e_true);
+            euler_deg(q_est, e_est);
+            // The error in the earth frame, e = q_est q_true^-1, as its rotation vector.
+            score::Quat e = score::quat_normalized(score::quat_mul(q_est, score::quat_conj(qt)));
+            if (e.w < 0.0) e = score::Quat{-e.w, -e.x, -e.y, -e.z};
+            const double vn = std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z);
+            const double angle = 2.0 * std::atan2(vn, e.w);
+            const double k = vn > 1e-12 ? angle / vn : 2.0;
+            const double rx = k * e.x, ry = k * e.y;
+            const score::ErrorAngles split = score::error_angles(qt, q_est);
+            err[0] = wrap_deg(e_est[0] - e_true[0]);
+            err[1] = wrap_deg(e_est[1] - e_true[1]);
+            err[2] = score::rad2deg(2.0 * std::atan2(e.z, e.w));  // signed: estimate - truth
+            err[3] = score::rad2deg(split.inclination_rad);
+            err[4] = score::rad2deg(cn * rx + sn * ry);   // about magnetic north
+            err[5] = score::rad2deg(-sn * rx + cn * ry);  // about magnetic east
+            err[6] = score::rad2deg(dip_rad);
+            // The compass measures heading - tilt_n tan(dip) (a field (H, 0, Z) seen in an
+            // earth frame tilted by tilt_n about north has an east part -tilt_n Z): driving
+            // that to zero puts the heading at tilt_n tan(dip).
+            err[7] = err[4] * std::tan(dip_rad);
+        }
+        const dcm::Dcm& d = pipe.estimator();
+        const linalg::Vector3f b = d.gyro_bias_rad_s();
+        fprintf(out_, "%.4f", t_s);
+        for (int i = 0; i < 8; ++i) fprintf(out_, ",%.4f", err[i]);
+        const double deg = 1.0 / (double)linalg::kRadPerDeg;
+        fprintf(out_, ",%s,%d,%.4f,%.4f,%.4f,%d,%s,%.4f,%.3f,%.3f,%.3f,%.3f", gravity_word(tr.gravity),
+                tr.integrator_held ? 1 : 0, (double)tr.gravity_kp_1_s, tr.tilt_error_n_rad * deg,
+                tr.tilt_error_e_rad * deg, (d.status() & dcm::kStatusAtRest) ? 1 : 0, heading_word(tr.heading),
+                (double)tr.heading_error_deg, (double)tr.field_norm_uT, (double)tr.field_dip_deg,
+                (double)tr.ref_norm_uT, (double)tr.ref_dip_deg);
+        const linalg::Vector3f* vs[4] = {&b, &tr.bias_from_gravity_rad_s, &tr.bias_from_heading_rad_s,
+                                         &tr.bias_from_rest_rad_s};
+        for (const linalg::Vector3f* v : vs) fprintf(out_, ",%.5f,%.5f,%.5f", v->x * deg, v->y * deg, v->z * deg);
+        fprintf(out_, ",0x%02x\n", (unsigned)d.status());
+    }
+
+private:
+    FILE* out_;
+    double field_ef_[3] = {0.0, 0.0, 0.0};
+    bool have_field_ = false;
+};
+
 }  // namespace
 
 // The state log's airspeed (sim/flight/flightio.py LOG_HEADER: t and airspeed_m_s
@@ -196,6 +330,7 @@ int main(int argc, char** argv) {
     bool log = false;
     double airspeed_m_s = 0.0;
     std::vector<std::pair<double, double>> airspeed_log;
+    std::string trace_path;
     dcm::DcmSettings dcm_settings = dcm::kDefaultDcmSettings;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -217,6 +352,8 @@ int main(int argc, char** argv) {
             }
         } else if (a == "--airspeed-log" && i + 1 < argc) {
             if (!load_airspeed_log(argv[++i], airspeed_log)) return 1;
+        } else if (a == "--trace" && i + 1 < argc) {
+            trace_path = argv[++i];
         } else if (a == "--log") {
             log = true;
         } else if (a == "--set" && i + 1 < argc) {
@@ -245,6 +382,14 @@ int main(int argc, char** argv) {
         return 2;
     }
     const double end_s = seconds > 0.0 ? seconds : trajectory.duration_s();
+    FILE* trace_file = nullptr;
+    if (!trace_path.empty()) {
+        trace_file = fopen(trace_path.c_str(), "w");
+        if (!trace_file) {
+            fprintf(stderr, "replay: cannot write %s\n", trace_path.c_str());
+            return 1;
+        }
+    }
 
     sim::Mpu6000Model mpu_model(trajectory);
     sim::Hmc5883Model mag_model(trajectory);
@@ -258,6 +403,9 @@ int main(int argc, char** argv) {
     hmc5883::Hmc5883 mag(i2c);
     const pipeline::EventSink log_events = pipeline_text::events_to(&log_sink);
     pipeline::AttitudePipeline pipe(log ? &log_events : nullptr, dcm_settings);
+    dcm::DcmTrace trace;
+    if (trace_file) pipe.set_trace(&trace);
+    TraceWriter trace_writer(trace_file);
     board.advance(pipeline::kMpuStartMs * 1e-3);
     const mpu6000::InitResult mpu_init = mpu.begin();
     if (mpu_init.status != mpu6000::InitStatus::Ok) {
@@ -277,6 +425,7 @@ int main(int argc, char** argv) {
         // Wait for the data-ready line, as the loop does.
         while (!mpu_model.int_pin_high() && board.t_s < end_s) board.advance(mpu_model.next_event_s());
         if (board.t_s >= end_s) break;
+        trace.reset_step();
         mpu6000::Sample sample;
         if (mpu.read(sample) != mpu6000::BurstStatus::Ok) {
             fprintf(stderr, "replay: MPU6000 burst read failed at t=%.3f s\n", board.t_s);
@@ -297,6 +446,7 @@ int main(int argc, char** argv) {
             }
         }
         pipe.on_imu_sample(sample);
+        if (trace_file && pipe.estimator().initialised()) trace_writer.row(board.t_s, trajectory.at(board.t_s), pipe, trace);
         if (pipe.output_due()) {
             // The hundredths the firmware prints, from the same integers.
             const pipeline::AnglesCentideg a = pipe.angles_centideg();
@@ -305,6 +455,10 @@ int main(int argc, char** argv) {
             print_centideg(a.pitch_centideg, ',');
             print_centideg(a.heading_centideg, '\n');
         }
+    }
+    if (trace_file && fclose(trace_file) != 0) {
+        fprintf(stderr, "replay: cannot write %s\n", trace_path.c_str());
+        return 1;
     }
     return 0;
 }

@@ -44,6 +44,7 @@
 #include "Rest.h"
 #include "Schedule.h"
 #include "Strapdown.h"
+#include "Trace.h"
 #include "Fixed.h"
 #include "LinAlg.h"
 
@@ -152,6 +153,11 @@ public:
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
     void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
     const DcmSettings& settings() const { return *settings_; }
+#ifndef __AVR__
+    // What the corrections do, step by step, into *trace (null: none): host tools only
+    // (Trace.h); the firmware has no trace and the estimate does not depend on one.
+    void set_trace(DcmTrace* trace) { trace_ = trace; }
+#endif
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const {
         return euler_in_rad(euler_q24_from_q30(strapdown_.r().a.x, strapdown_.r().a.y, strapdown_.r().b.x, strapdown_.r().b.y, strapdown_.r().c.x, strapdown_.r().c.y, strapdown_.r().c.z));
@@ -230,6 +236,11 @@ private:
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
+#ifndef __AVR__
+    DcmTrace* trace_ = nullptr;          // set_trace (host only)
+    // The bias estimate now, for the trace's split of its changes by source.
+    linalg::Vector3f traced_bias_rad_s() const { return bias_.estimate_rad_s(k_); }
+#endif
 };
 
 }  // namespace dcm

@@ -250,6 +250,10 @@ public:
     uint32_t steps() const { return st_.steps; }
     uint32_t time_ms() const { return st_.steps * 5u; }
     const dcm::Dcm& estimator() const { return dcm_; }
+#ifndef __AVR__
+    // The estimator's corrections step by step into *trace (host tools: replay --trace).
+    void set_trace(dcm::DcmTrace* trace) { dcm_.set_trace(trace); }
+#endif
     // Calibrated bias plus what the estimator has learned since, rad/s.
     linalg::Vector3f gyro_bias_rad_s() const;
     float temperature_c() const { return last_.temperature_c(); }
