@@ -28,6 +28,84 @@ TEST(Replay, LevelRestWithinHalfADegree) {
     EXPECT_GT(rows, 2500u);
 }
 
+// --trace writes a row per estimator step with the errors and what each correction did,
+// and leaves stdout byte for byte as it was (the trace is only written, never read back).
+TEST(Replay, TraceWritesItsColumnsAndLeavesStdoutAlone) {
+    E2E_REQUIRE_TOOLS("replay", "scenario");
+    const std::string csv = e2e::scenario_csv("tilt_tour", 20);
+    const std::string trace = e2e::work_dir() + "/trace." + std::to_string(getpid()) + ".csv";
+    const e2e::CommandResult plain = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
+    const e2e::CommandResult traced =
+        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --trace " + trace);
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    ASSERT_EQ(traced.exit_code, 0) << traced.err;
+    EXPECT_GT(plain.out.size(), 1000u);
+    EXPECT_TRUE(plain.out == traced.out) << "stdout differs with --trace";
+
+    std::istringstream in(e2e::read_text(trace));
+    std::string row;
+    ASSERT_TRUE(std::getline(in, row));
+    std::vector<std::string> names;
+    for (std::istringstream h(row); std::getline(h, row, ',');) names.push_back(row);
+    const auto column = [&](const std::string& name) {
+        for (size_t i = 0; i < names.size(); ++i)
+            if (names[i] == name) return (int)i;
+        ADD_FAILURE() << "no column " << name;
+        return -1;
+    };
+    const int t_col = column("t"), heading_err = column("heading_err_deg"), incl = column("incl_err_deg"),
+              tilt_n = column("tilt_n_deg"), coupled = column("tilt_n_tan_dip_deg"), gravity = column("gravity"),
+              heading = column("heading"), ref_norm = column("ref_norm_uT"), bias_z = column("bias_z_deg_s"),
+              grav_bias_z = column("grav_bias_z_deg_s");
+    column("mag_err_deg");
+    column("rest");
+    column("integrator_held");
+    ASSERT_FALSE(::testing::Test::HasFailure());
+    size_t rows = 0, gravity_ran = 0, heading_used = 0, finite_after_start = 0;
+    double last_t = -1.0;
+    std::map<std::string, size_t> heading_words;
+    for (std::string line; std::getline(in, line);) {
+        std::vector<std::string> f;
+        for (std::istringstream l(line); std::getline(l, row, ',');) f.push_back(row);
+        ASSERT_EQ(f.size(), names.size()) << line;
+        const double t = std::stod(f[t_col]);
+        if (last_t >= 0.0) ASSERT_NEAR(t - last_t, 0.005, 1e-3) << "one row per 5 ms step: " << line;
+        last_t = t;
+        ++rows;
+        gravity_ran += f[gravity] == "ran";
+        heading_used += f[heading] == "used";
+        ++heading_words[f[heading]];
+        ASSERT_TRUE(f[gravity] == "ran" || f[gravity] == "not_due" || f[gravity] == "no_direction") << line;
+        if (t < 5.0) continue;
+        // Past the start-up: a clean scenario's errors are small and finite, the
+        // compass-coupled heading is tan(dip) times the tilt about north.
+        const double h = std::stod(f[heading_err]), i = std::stod(f[incl]), n = std::stod(f[tilt_n]),
+                     c = std::stod(f[coupled]);
+        ASSERT_TRUE(std::isfinite(h) && std::isfinite(i) && std::isfinite(n) && std::isfinite(c)) << line;
+        EXPECT_LT(std::fabs(h), 5.0) << line;
+        EXPECT_LT(i, 3.0) << line;
+        EXPECT_LE(std::fabs(n), i + 0.01) << "the tilt about north is part of the inclination error: " << line;
+        EXPECT_GT(std::stod(f[ref_norm]), 1.0) << "a learned field: " << line;
+        EXPECT_TRUE(std::isfinite(std::stod(f[bias_z])) && std::isfinite(std::stod(f[grav_bias_z]))) << line;
+        ++finite_after_start;
+    }
+    EXPECT_GT(rows, 3500u);  // 20 s at 200 Hz, less the start-up
+    EXPECT_GT(finite_after_start, 2500u);
+    // The gravity correction is worked out on one step in kCorrectionDivider (4).
+    EXPECT_NEAR((double)gravity_ran / (double)rows, 0.25, 0.03);
+    // The field means close at 25 Hz (one step in 8), and a clean field is used.
+    EXPECT_NEAR((double)heading_used / (double)rows, 0.125, 0.03);
+    for (const auto& w : heading_words)
+        EXPECT_TRUE(w.first == "used" || w.first == "not_due" || w.first == "disturbed" || w.first == "new_field" ||
+                    w.first == "too_vertical") << w.first;
+    std::remove(trace.c_str());
+
+    const e2e::CommandResult bad =
+        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --trace /nonexistent/dir/trace.csv");
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+}
+
 // replay on a scenario, its output scored: the score's output (total_rmse_deg, ...).
 e2e::CommandResult replay_scored(const char* scenario, double seconds) {
     const std::string csv = e2e::scenario_csv(scenario, seconds);
