@@ -61,7 +61,10 @@ void usage(FILE* out) {
             "               held; heading: used/disturbed/new_field/too_vertical/not_due and\n"
             "               the error it measured), the field against the learned reference,\n"
             "               rest, and the gyro bias estimate (deg/s) with its changes summed\n"
-            "               by source (gravity integrator, compass integrator, rest).\n"
+            "               by source (gravity integrator, compass integrator, rest), the\n"
+            "               status bits and the matrix R as a quaternion (body to NED; the\n"
+            "               errors are those of the printed angles, R carried forward) and\n"
+            "               the accelerometer's sample as the step used it (m/s^2).\n"
             "               stdout is unchanged.\n");
 }
 
@@ -211,7 +214,7 @@ public:
                 "est_tilt_e_deg,rest,heading,mag_err_deg,field_norm_uT,field_dip_deg,ref_norm_uT,ref_dip_deg,"
                 "bias_x_deg_s,bias_y_deg_s,bias_z_deg_s,grav_bias_x_deg_s,grav_bias_y_deg_s,grav_bias_z_deg_s,"
                 "mag_bias_x_deg_s,mag_bias_y_deg_s,mag_bias_z_deg_s,rest_bias_x_deg_s,rest_bias_y_deg_s,"
-                "rest_bias_z_deg_s,status\n");
+                "rest_bias_z_deg_s,status,r_qw,r_qx,r_qy,r_qz,ax_m_s2,ay_m_s2,az_m_s2\n");
     }
 
     // The step just run: the estimate (as printed) against the truth at t.
@@ -271,7 +274,10 @@ public:
         const linalg::Vector3f* vs[4] = {&b, &tr.bias_from_gravity_rad_s, &tr.bias_from_heading_rad_s,
                                          &tr.bias_from_rest_rad_s};
         for (const linalg::Vector3f* v : vs) fprintf(out_, ",%.5f,%.5f,%.5f", v->x * deg, v->y * deg, v->z * deg);
-        fprintf(out_, ",0x%02x\n", (unsigned)d.status());
+        const linalg::Quaternion r = pipe.quaternion();
+        const linalg::Vector3f accel = pipe.accel_m_s2();
+        fprintf(out_, ",0x%02x,%.7f,%.7f,%.7f,%.7f,%.4f,%.4f,%.4f\n", (unsigned)d.status(), (double)r.w, (double)r.x,
+                (double)r.y, (double)r.z, (double)accel.x, (double)accel.y, (double)accel.z);
     }
 
 private:
