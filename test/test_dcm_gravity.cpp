@@ -121,3 +121,25 @@ TEST(DcmGravity, TheLowPassFollowsANewAccelScale) {
     gravity.rescale(2.0f, 1.0f);
     EXPECT_EQ(gravity.low_pass_ef().z, -400000);
 }
+
+// The window's means for every length a window can have (1 to 5 samples: a correction
+// late by a step takes five): the sums over n, whatever n, to a unit (counts * 2^8).
+TEST(DcmGravity, TheWindowsMeansAreTheSumsOverTheirLength) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    const Vector3l gyro_counts(10, -20, 30), accel_counts(100, -200, -4096);
+    for (uint8_t n = 1; n <= 5; ++n) {
+        dcm::GravityCorrection gravity;
+        gravity.reset(-4096 * 256);
+        for (uint8_t i = 0; i < n; ++i) gravity.add(gyro_counts, accel_counts);
+        Vector3l gyro_mean, accel_mean;
+        bool whole = false;
+        ASSERT_TRUE(gravity.low_pass_window(linalg::q30_from_matrix(Matrix3f::identity()), 0, Vector3l(), Vector3l(),
+                                            false, 0.0f, k, gyro_mean, accel_mean, whole));
+        EXPECT_NEAR(gyro_mean.x, 10 * 256, 1) << (int)n;
+        EXPECT_NEAR(gyro_mean.y, -20 * 256, 1) << (int)n;
+        EXPECT_NEAR(gyro_mean.z, 30 * 256, 1) << (int)n;
+        EXPECT_NEAR(accel_mean.x, 100 * 256, 1) << (int)n;
+        EXPECT_NEAR(accel_mean.z, -4096 * 256, 1) << (int)n;
+        EXPECT_EQ(whole, n >= dcm::kCorrectionDivider) << (int)n;
+    }
+}

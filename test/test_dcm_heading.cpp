@@ -108,3 +108,21 @@ TEST(DcmHeading, AForgottenReferenceIsRelearned) {
     EXPECT_EQ(g.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kEarthField);
     EXPECT_EQ(g.judge(kEarthNorm * 1.3f, kEarthDown), dcm::FieldVerdict::kDisturbed);
 }
+
+// The steadiness count starts afresh at a field that is not steady, and a new field is
+// taken after exactly mag_recover_s of it (here means of one step each, while turning).
+TEST(DcmHeading, ANewFieldIsAdoptedAfterExactlyItsRecoverSteps) {
+    Gate g;
+    const Vector3l turning = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, 1.0f * g.k.units_per_rad_s), 0);
+    auto judge = [&](float norm) {
+        return g.gate.judge(norm, kEarthDown, 1, 0.005f, turning, dcm::kDefaultDcmSettings, g.k);
+    };
+    // A disturbance held long enough for the candidate to follow it (53 ms), not to be taken.
+    for (int i = 0; i < 200; ++i) ASSERT_EQ(judge(kEarthNorm * 1.3f), dcm::FieldVerdict::kDisturbed);
+    // One mean of another field breaks the steadiness (the candidate moves only a little).
+    ASSERT_EQ(judge(kEarthNorm * 1.6f), dcm::FieldVerdict::kDisturbed);
+    // The disturbance again: steady from the first mean, taken at the recover_steps'th.
+    int means = 1;
+    while (judge(kEarthNorm * 1.3f) == dcm::FieldVerdict::kDisturbed && means < 100000) ++means;
+    EXPECT_EQ(means, (int)g.k.mag_recover_steps);
+}

@@ -408,3 +408,33 @@ TEST(DcmProperties, WithoutAFieldAVerticalNoseStillGivesARotation) {
         EXPECT_NEAR(r.c.dot(down), 1.0f, 1e-4f) << accel.x;
     }
 }
+
+// A field that differs from the learned one is kept out for mag_recover_s (VQF's 20 s)
+// even while the board turns: a magnet brought beside a turning board does not become
+// north within seconds; a fixed new environment (it turns with the earth's field) is
+// adopted after that time.
+TEST(DcmProperties, ANewFieldWaitsItsRecoverTimeWhileTurning) {
+    dcm::Dcm filter;
+    EXPECT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const float dt = filter.settings().step_s, rate_rad_s = 30.0f * linalg::kRadPerDeg;
+    const Vector3f other_field = earth_field_uT() + Vector3f(15.0f, 10.0f, 0.0f);  // fixed in the room
+    double yaw_rad = 0.0;
+    float first_used_s = -1.0f;
+    bool kept_out = false;  // a mean of the new field was judged (and kept out)
+    for (int i = 0; i < (int)(40.0f / dt); ++i) {
+        const Matrix3f now = dcm::dcm_from_euler(0.0f, 0.0f, (float)yaw_rad);
+        const bool disturbed = i * dt >= 5.0f;
+        if (i % 3 == 0) {
+            filter.correct_heading(now.mul_transpose(disturbed ? other_field : earth_field_uT()));
+            const bool ignored = (filter.status() & dcm::kStatusMagIgnored) != 0;
+            if (disturbed && ignored) kept_out = true;
+            if (kept_out && first_used_s < 0.0f && !ignored) first_used_s = i * dt - 5.0f;
+        }
+        yaw_rad += rate_rad_s * dt;
+        filter.update(Vector3f(0.0f, 0.0f, rate_rad_s), accel_for(dcm::dcm_from_euler(0.0f, 0.0f, (float)yaw_rad)));
+    }
+    RecordProperty("adopted_after_s", std::to_string(first_used_s));
+    EXPECT_GT(first_used_s, 0.9f * filter.settings().mag_recover_s);
+    EXPECT_GE(filter.settings().mag_recover_s, 10.0f);  // long enough to outlast a magnet carried past
+    EXPECT_LT(first_used_s, filter.settings().mag_recover_s + 2.0f);
+}

@@ -248,3 +248,30 @@ TEST(DcmStrapdown, RenormalisationRescalesRowsFarFromUnitExactly) {
         EXPECT_NEAR(r.b.length_squared(), 1.0f, 1e-5f) << scale;
     }
 }
+
+// The gravity correction runs on the step its window completes (it "falls due with this
+// step"), not a step later: three steps counted, the fourth is the correction's.
+TEST(DcmSchedule, TheCorrectionRunsOnTheStepItsWindowCompletes) {
+    dcm::HeavySchedule schedule;
+    for (int i = 0; i < dcm::kCorrectionDivider - 2; ++i) {
+        schedule.count_step();
+        EXPECT_EQ(schedule.next(0, false, false), dcm::HeavyPart::kNone) << i;
+    }
+    schedule.count_step();
+    EXPECT_EQ(schedule.next(0, false, false), dcm::HeavyPart::kGravity);
+}
+
+// x c / 2^15 by two 16x16 products, rounded toward zero, for any 31-bit x and 16-bit c
+// whose product fits 31 bits (the latency turn's and the gravity window's factor):
+// against 64-bit arithmetic.
+TEST(DcmCoefficients, ScaleQ15IsTheProductToAUnit) {
+    const int32_t xs[] = {0, 1, -1, 0x1FFFF, -0x1FFFF, 0x7FFFFFFF - 1, -0x7FFFFFFF, 123456789, -98765, 65535, 65536};
+    const uint16_t cs[] = {0, 1, 2621, 32768, 45698, 65535};
+    for (int32_t x : xs) {
+        for (uint16_t c : cs) {
+            const int64_t exact = (int64_t)x * c / 32768;  // toward zero
+            if (exact > 0x7FFFFFFF || exact < -0x7FFFFFFF) continue;
+            EXPECT_NEAR((double)dcm::scale_q15(x, c), (double)exact, 1.0) << x << " x " << c;
+        }
+    }
+}

@@ -13,8 +13,9 @@ replacement (never by line number: the files change), each with its reason; they
 left out of the sample and the score.
 
 Not mutated: lines the host does not compile (#ifdef __AVR__ blocks), preprocessor
-lines, comment lines, and mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
-not compile). A mutant that does not compile is not counted either.
+lines, comment lines, mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
+not compile) and mutants that only move blanks (the same tokens). A mutant that does not
+compile is not counted either.
 """
 import argparse
 import collections
@@ -203,6 +204,19 @@ def renames_identifier(orig, mutant):
     return bool(inside and (ident.search(orig[max(0, p - 1):len(orig) - s + 1]) or before == "_"))
 
 
+# C++ tokens, roughly: names and numbers, the operators of two or three characters, then
+# any other character.
+TOKEN = re.compile(r"[A-Za-z0-9_.]+|<<=|>>=|->|\+\+|--|<<|>>|<=|>=|==|!=|&&|\|\||[-+*/%&|^]=|::|\S")
+
+
+def same_tokens(before, after):
+    """A change of blanks only (universalmutator's spacing of an unchanged call): the
+    same tokens, no mutant. Lines with a quote are kept (blanks count in a literal)."""
+    if '"' in before or "'" in before:
+        return False
+    return TOKEN.findall(before) == TOKEN.findall(after)
+
+
 def generate(out, files, mutate_bin):
     """Every mutant of every selected file: a list of dicts."""
     mutants = []
@@ -229,6 +243,8 @@ def generate(out, files, mutate_bin):
             if line not in keep and (before or line - 1 not in keep):
                 continue
             if before and after and renames_identifier(before, after):
+                continue
+            if same_tokens(before, after):
                 continue
             mutants.append({"file": path, "mutant": m, "line": line, "orig": before.strip(),
                             "new": after.strip()})
