@@ -273,12 +273,14 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
 
 def task_replay(args):
     """Our estimator through build/replay on one trajectory, scored by build/score. An
-    optional sixth item lists replay's --set assignments (bench/tune.py)."""
+    optional sixth item lists replay's --set assignments (bench/tune.py), a seventh more
+    of replay's arguments (bench/flights.py: --airspeed)."""
     label, traj, est_path, replay, score = args[:5]
     sets = args[5] if len(args) > 5 else ()
     cmd = [replay, "--trajectory", traj]
     for assignment in sets:
         cmd += ["--set", assignment]
+    cmd += list(args[6]) if len(args) > 6 else []
     t0 = time.time()
     with open(est_path, "w") as f:
         r = subprocess.run(cmd, stdout=f, stderr=subprocess.PIPE, text=True, timeout=1800)

@@ -81,17 +81,6 @@ def worst_roll_error_peer(tr, q):
     return float(err[np.argmax(np.abs(err))]) if len(err) else float("nan")
 
 
-def replay_turn_with_airspeed(replay, traj, est_path, airspeed_m_s):
-    """replay --airspeed on the turn: (its worst roll error as worst_roll_error_replay, None)
-    or (None, the error)."""
-    with open(est_path, "w") as f:
-        r = subprocess.run([replay, "--trajectory", traj, "--airspeed", "%g" % airspeed_m_s], stdout=f,
-                           stderr=subprocess.PIPE, text=True, timeout=1800)
-    if r.returncode != 0:
-        return None, "replay --airspeed failed (exit %d): %s" % (r.returncode, r.stderr.strip()[-300:])
-    return worst_roll_error_replay(traj, est_path), None
-
-
 def closed_loop_turn(build, name="turn"):
     """A closed-loop turn test's log (true and estimated bank), if it ran: its worst error."""
     path = os.path.join(build, "host", "closed_loop_" + name, name + "_bank.csv")
@@ -126,15 +115,18 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         _, _, ours, err, _ = run_replay(("flight " + name, traj, est, replay, score))
         if err:
             errors.append("flight %s: %s" % (name, err))
-        cells = [name, "%.2f / %.2f / %.2f" % (ours["total"], ours["incl"], ours["heading"]) if ours else "–"]
+        # The same with the cruise speed a board without a pitot is given (TRIM_ARSPD_CM).
+        est_cruise = os.path.join(flight_dir, name + "_estimate_cruise.csv")
+        _, _, cruise, err, _ = run_replay(("flight %s, cruise speed" % name, traj, est_cruise, replay, score, (),
+                                           ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)))
+        if err:
+            errors.append("flight %s, cruise speed: %s" % (name, err))
+        cells = [name] + ["%.2f / %.2f / %.2f" % (o["total"], o["incl"], o["heading"]) if o else "–"
+                          for o in (ours, cruise)]
         if name == "turn" and ours:
             turn_worst["ours (replay)"] = worst_roll_error_replay(traj, est)[0]
-            worst, err = replay_turn_with_airspeed(replay, traj, os.path.join(flight_dir, "turn_estimate_airspeed.csv"),
-                                                   TRIM_AIRSPEED_M_S)
-            if err:
-                errors.append("flight turn: " + err)
-            else:
-                turn_worst["ours (replay --airspeed %g)" % TRIM_AIRSPEED_M_S] = worst[0]
+            if cruise:
+                turn_worst["ours (replay --airspeed %g)" % TRIM_AIRSPEED_M_S] = worst_roll_error_replay(traj, est_cruise)[0]
         tr = peers.load_trajectory(traj)
         for peer in peer_names:
             try:
@@ -149,9 +141,11 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
                 turn_worst[peer] = worst_roll_error_peer(tr, q)
         rows.append(cells)
         log("flight %s: %s" % (name, " | ".join(cells[1:])))
-    header = ["flight", "ours"] + list(peer_names)
+    header = ["flight", "ours", "ours, cruise %g m/s" % TRIM_AIRSPEED_M_S] + list(peer_names)
     rep += ["Flights of sim/flight/fly.py (the model flown by its STABILIZE stand-in; ideal sensors at "
-            "400 Hz): total / inclination / heading RMSE in degrees. Ours through `build/replay`.", "",
+            "400 Hz): total / inclination / heading RMSE in degrees. Ours through `build/replay`: without "
+            "an airspeed, and with the configured cruise speed (`--airspeed %g`, TRIM_ARSPD_CM: what a board "
+            "without a pitot flies with); the peers have no airspeed input." % TRIM_AIRSPEED_M_S, "",
             "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     rep += ["| " + " | ".join(r) + " |" for r in rows]
     rep.append("")
