@@ -96,3 +96,29 @@ TEST(FixedFallbacks, ALongLeadCarriesTheOutputForward) {
     const float lead_deg = wrap_deg((filter.euler_now().yaw_rad - filter.euler().yaw_rad) * linalg::kDegPerRad);
     EXPECT_NEAR(lead_deg, 100.0f * (settings.output_lead_s + settings.step_s), 0.02f);
 }
+
+// On the coarse gyro the gravity window's turn term (each sample turned back to its own
+// time: theta_q26_coarse's fallback to the float turn) still keeps the tilt true in a
+// steady roll; without it the low-passed down lags the truth by the rate times a few ms.
+TEST(FixedFallbacks, ACoarseGyroKeepsTheTiltInASteadyRoll) {
+    dcm::Dcm filter;
+    filter.set_sample_scales(kCoarseGyro_rad_s, kAccel_m_s2);
+    const double dt = filter.settings().step_s;
+    const linalg::Vector3i gyro(100, 0, 0);  // 1 rad/s in roll
+    const double w[3] = {100.0 * kCoarseGyro_rad_s, 0.0, 0.0};
+    const auto truth = [&](double t) {
+        const double theta[3] = {w[0] * t, w[1] * t, w[2] * t};
+        return dcm_truth::Rot::exp(theta);
+    };
+    ASSERT_TRUE(filter.init(accel_for(truth(0.0).to_float()), Vector3f()));
+    float worst = 0.0f;
+    for (int i = 1; i <= 4000; ++i) {
+        filter.update(gyro, counts_of(accel_for(truth((i - 1) * dt).to_float()), kAccel_m_s2), true, true);
+        if (i > 2000 && i % dcm::Dcm::kIntegrationSteps == 0) {
+            const float e = tilt_error_deg(truth(i * dt).to_float(), filter.matrix());
+            worst = e > worst ? e : worst;
+        }
+    }
+    RecordProperty("worst_deg", std::to_string(worst));
+    EXPECT_LT(worst, 0.1f);  // today 0.028 deg; without the turn term 0.43
+}
