@@ -12,7 +12,8 @@ test/mutants_equivalent.txt, keyed by the file, the mutated line's text and its
 replacement (never by line number: the files change), each with its reason; they are
 left out of the sample and the score.
 
-Not mutated: lines the host does not compile (#ifdef __AVR__ blocks), preprocessor
+Not mutated: lines the host does not compile (#ifdef __AVR__ blocks; the trace's
+#if DCM_TRACE blocks, host-only instrumentation for replay, built with DCM_TRACE=0), preprocessor
 lines, comment lines, mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
 not compile) and mutants that only move blanks (the same tokens). A mutant that does not
 compile is not counted either.
@@ -39,8 +40,9 @@ LIBRARIES = collections.OrderedDict([
     ("lib/Calibration", ["lib/Calibration/*.cpp", "lib/Calibration/*.h"]),
 ])
 EQUIVALENT_FILE = "test/mutants_equivalent.txt"
-LIB_FLAGS = ["-O1"]
-TEST_FLAGS = ["-O0"]
+# The trace (lib/DCM/Trace.h) is host-only instrumentation for replay: left out.
+LIB_FLAGS = ["-O1", "-DDCM_TRACE=0"]
+TEST_FLAGS = ["-O0", "-DDCM_TRACE=0"]
 
 
 def run(cmd, **kw):
@@ -144,8 +146,9 @@ def link(out_bin, objs):
 # Mutants: universalmutator's, less what the host never compiles.
 
 def host_lines(path):
-    """Line numbers (1-based) the host compiles: outside #ifdef __AVR__ ... #else/#endif,
-    and not preprocessor lines."""
+    """Line numbers (1-based) the host compiles: outside #ifdef __AVR__ ... #else/#endif
+    and the trace's #if DCM_TRACE blocks (left out of the build: -DDCM_TRACE=0), and not
+    preprocessor lines."""
     keep = set()
     stack = []  # for each open #if: True when its current branch is AVR-only
     for n, line in enumerate(open(path), 1):
@@ -154,7 +157,8 @@ def host_lines(path):
             word = s[1:].strip().split(" ")[0] if len(s) > 1 else ""
             if word in ("if", "ifdef", "ifndef"):
                 stack.append(word == "ifdef" and "__AVR__" in s or (word == "if" and "defined(__AVR__)" in s
-                                                                     and "!" not in s))
+                                                                     and "!" not in s) or
+                             s.replace(" ", "") == "#ifDCM_TRACE")
             elif word in ("else", "elif") and stack:
                 stack[-1] = False
             elif word == "endif" and stack:

@@ -263,11 +263,11 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
     if (!rest_.update(gyro_mean, accel_mean, mean_off_bias, whole_window, compass_watching, k_)) return;
     status_ |= kStatusAtRest;
-#ifndef __AVR__
+#if DCM_TRACE
     const Vector3f before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif
     bias_.follow_rest_mean(rest_.gyro_mean(), k_);
-#ifndef __AVR__
+#if DCM_TRACE
     if (trace_) trace_->bias_from_rest_rad_s += traced_bias_rad_s() - before;
 #endif
 }
@@ -293,7 +293,7 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     if (gravity_.low_pass_window(strapdown_.r(), strapdown_.pending_steps(), offset_units_, bias_.sensor_units(), starting,
                                  startup_left, k_, gyro_mean, accel_mean, whole_window))
         detect_rest(gyro_mean, accel_mean, mean_off_bias, whole_window);
-#ifndef __AVR__
+#if DCM_TRACE
     Vector3f bias_before;
     if (trace_) {
         // The low-pass's direction against earth down, as correct_tilt sees it, in float.
@@ -309,7 +309,7 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     }
 #endif
     gravity_.correct_tilt(strapdown_.r(), startup_left, hold_integrator, *settings_, k_, bias_);
-#ifndef __AVR__
+#if DCM_TRACE
     if (trace_) trace_->bias_from_gravity_rad_s += traced_bias_rad_s() - bias_before;
 #endif
     update_offset();
@@ -412,7 +412,7 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     field_mean_.take(field_ef, norm2);
     status_ |= kStatusMagIgnored;
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
-#ifndef __AVR__
+#if DCM_TRACE
     if (trace_) {
         trace_->heading = HeadingEvent::kTooVertical;
         trace_->heading_error_deg = atan2f(field_ef.y, field_ef.x) * (1.0f / linalg::kRadPerDeg);
@@ -436,7 +436,7 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     // board never looks the same twice, so it never gets in.
     const FieldVerdict verdict =
         gate_.judge(norm, down_component, interval_steps, sample_dt, last_rate_units(), *settings_, k_);
-#ifndef __AVR__
+#if DCM_TRACE
     if (trace_) {
         trace_->heading = verdict == FieldVerdict::kDisturbed ? HeadingEvent::kDisturbed
                           : verdict == FieldVerdict::kNewField ? HeadingEvent::kNewField
@@ -480,14 +480,14 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
                                  linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
     if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
-#ifndef __AVR__
+#if DCM_TRACE
         const Vector3f bias_before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif
         const Vector3f error = linalg::vector_from_q30(strapdown_.r().c) * -heading_error;
         bias_.subtract_fine(linalg::fixed_from_vector(
             error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0), k_);
         update_offset();
-#ifndef __AVR__
+#if DCM_TRACE
         if (trace_) trace_->bias_from_heading_rad_s += traced_bias_rad_s() - bias_before;
 #endif
     }

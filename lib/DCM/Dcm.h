@@ -153,7 +153,7 @@ public:
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
     void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
     const DcmSettings& settings() const { return *settings_; }
-#ifndef __AVR__
+#if DCM_TRACE
     // What the corrections do, step by step, into *trace (null: none): host tools only
     // (Trace.h); the firmware has no trace and the estimate does not depend on one.
     void set_trace(DcmTrace* trace) { trace_ = trace; }
@@ -236,7 +236,7 @@ private:
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
-#ifndef __AVR__
+#if DCM_TRACE
     DcmTrace* trace_ = nullptr;          // set_trace (host only)
     // The bias estimate now, for the trace's split of its changes by source.
     linalg::Vector3f traced_bias_rad_s() const { return bias_.estimate_rad_s(k_); }

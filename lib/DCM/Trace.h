@@ -1,10 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What the estimator's corrections did on a step, for the host's `replay --trace`
-// (issue 24: which corrections ran and why, while the board moves). Host only: on the
-// AVR (__AVR__) Dcm has no trace pointer and none of this is compiled, so the firmware's
-// code and RAM are the same with or without it. Dcm only writes here, never reads back:
-// the estimate is the same whether a trace is attached or not.
+// (issue 24: which corrections ran and why, while the board moves). Host only: the
+// trace's code is in `#if DCM_TRACE` blocks, 1 on the host and 0 on the AVR, so the
+// firmware's code and RAM are the same with or without it (and `make mutate` builds
+// without it: instrumentation, not the estimator). Dcm only writes here, never reads
+// back: the estimate is the same whether a trace is attached or not.
 #pragma once
+
+#ifndef DCM_TRACE
+#ifdef __AVR__
+#define DCM_TRACE 0
+#else
+#define DCM_TRACE 1
+#endif
+#endif
 
 #include <stdint.h>
 

@@ -250,7 +250,7 @@ public:
     uint32_t steps() const { return st_.steps; }
     uint32_t time_ms() const { return st_.steps * 5u; }
     const dcm::Dcm& estimator() const { return dcm_; }
-#ifndef __AVR__
+#if DCM_TRACE
     // The estimator's corrections step by step into *trace (host tools: replay --trace).
     void set_trace(dcm::DcmTrace* trace) { dcm_.set_trace(trace); }
 #endif
