@@ -208,6 +208,27 @@ TEST(DcmProperties, GyroTurnSaturatesOnBothSidesForAnyCount) {
     EXPECT_NEAR(t.z, -1.5f, 1e-4f);
 }
 
+// The gyro's turn over a long interval (the compass learner's, across a compass outage):
+// a still board's counts are its calibrated bias at every step, whatever the steps, so
+// the turn is none; and a slow turn over 2 000 steps is its rate times their time.
+TEST(DcmProperties, GyroTurnOverALongIntervalTakesTheBiasOffEveryStep) {
+    dcm::Dcm filter;
+    const float scale = 0.001065f;
+    filter.set_sample_scales(scale, 0.0024f);
+    filter.set_sensor_bias_rad_s(Vector3f(20.0f, -12.0f, 7.0f) * scale);  // counts of bias
+    const float dt = filter.settings().step_s;
+    for (long steps : {100L, 1000L, 2000L, 20000L}) {
+        const Vector3f still = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(20 * steps, -12 * steps, 7 * steps), (uint16_t)steps));
+        EXPECT_NEAR(still.x, 0.0f, 1e-5f) << steps;
+        EXPECT_NEAR(still.y, 0.0f, 1e-5f) << steps;
+        EXPECT_NEAR(still.z, 0.0f, 1e-5f) << steps;
+    }
+    // Two counts above the bias on z for 2 000 steps: 2 x 0.001065 rad/s x 10 s.
+    const Vector3f turn = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(40000, -24000, 9 * 2000), 2000));
+    EXPECT_NEAR(turn.z, 2.0f * scale * 2000.0f * dt, 1e-4f);
+    EXPECT_NEAR(turn.x, 0.0f, 1e-5f);
+}
+
 // heading_due_next() tells the caller which field sample completes the heading's mean
 // (kHeadingSteps steps of samples): with a sample every third step, every third one.
 TEST(DcmProperties, HeadingDueNextMarksEveryMeansLastSample) {

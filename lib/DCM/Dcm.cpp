@@ -127,17 +127,25 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
 
 
 Vector3l Dcm::gyro_turn_q30(const Vector3l& counts, uint16_t steps) const {
-    // In the turn sums' units. Beyond 2^22 counts (128 steps at full scale) and 1 024
-    // steps the turn is far beyond the saturation anyway; within, no product overflows.
+    // In the turn sums' units, less the bias at every step. Within 1 024 steps in
+    // integers: beyond 2^22 counts (128 steps at full scale) the turn is far beyond the
+    // saturation, and within, no product overflows. A longer interval (the first sample
+    // after a compass outage) in float: the bias times 65 535 steps would overflow, and
+    // a still board's counts are then its bias times steps, which the clamp would cut.
     constexpr int32_t kMaxCounts = 1L << 22;
-    const int32_t n = steps < 1024u ? (int32_t)steps : 1024L;
     const Vector3l bias = bias_.sensor_units() + bias_.units();
     const int32_t* c = &counts.x;
     const int32_t* b = &bias.x;
     int32_t units[3];
     for (uint8_t i = 0; i < 3; ++i) {
+        if (steps > 1024u) {
+            const float limit = (float)(1L << 30);  // beyond any saturation below
+            const float u = (float)c[i] * (float)kTurnScale - (float)b[i] * (float)steps;
+            units[i] = (int32_t)linalg::constrain(u, -limit, limit);
+            continue;
+        }
         const int32_t sum = c[i] > kMaxCounts ? kMaxCounts : (c[i] < -kMaxCounts ? -kMaxCounts : c[i]);
-        units[i] = in_turn_units(sum) - b[i] * n;
+        units[i] = in_turn_units(sum) - b[i] * (int32_t)steps;
     }
     // Saturated at twice an integration's limit (1.5 rad: still within Q30's 2).
     if (k_.theta_factor_q30 == 0) {  // scales beyond the integer factor
