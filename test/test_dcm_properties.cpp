@@ -484,3 +484,36 @@ TEST(DcmProperties, ASamplesAgeCountsUpToTwoSteps) {
     EXPECT_EQ(two.euler().yaw_rad, five.euler().yaw_rad);
     EXPECT_EQ(two.euler().roll_rad, five.euler().roll_rad);
 }
+
+// A field sample of zero (a compass that reads nothing) is no direction: ignored, and
+// the heading goes on from the samples before and after.
+TEST(DcmProperties, AFieldOfZeroIsIgnored) {
+    CompassRun run(earth_field_uT());
+    run.run(6.0f, earth_field_uT());
+    for (int i = 0; i < 40; ++i) {
+        run.filter.correct_heading(Vector3f());
+        EXPECT_TRUE(run.filter.status() & dcm::kStatusMagIgnored) << i;
+        run.filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+    }
+    run.run(1.0f, field_turned(20.0f));
+    EXPECT_FALSE(run.filter.status() & dcm::kStatusMagIgnored);
+    EXPECT_NEAR(run.yaw_deg(), 0.0f, 2.0f);   // corrected at kp_yaw from the samples after
+    EXPECT_GT(run.yaw_deg(), 0.3f);
+}
+
+// The renormalisation keeps R a rotation in a long fast tumble: every eighth integration
+// (kRenormaliseEvery) leaves it orthonormal to better than a part in a million.
+TEST(DcmProperties, RStaysOrthonormalInALongTumble) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), Vector3f()));
+    float worst = 0.0f;
+    for (int i = 0; i < 8000; ++i) {  // 40 s
+        const float t = (float)i * filter.settings().step_s;
+        const Vector3f rate(6.0f * std::sin(0.7f * t), 5.0f * std::cos(1.1f * t), 7.0f * std::sin(0.3f * t + 1.0f));
+        filter.update(rate, Vector3f(0.0f, 0.0f, -kG));  // the accelerometer holds no meaning here
+        const float e = orthonormality_error(filter.matrix());
+        worst = e > worst ? e : worst;
+    }
+    RecordProperty("worst", std::to_string(worst * 1e6f) + "e-6");
+    EXPECT_LT(worst, 1e-6f);  // every 255 integrations instead: 2e-6
+}

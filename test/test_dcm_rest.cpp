@@ -177,3 +177,17 @@ TEST(DcmRest, ANewScaleKeepsTheRest) {
         EXPECT_TRUE(f.rest.update(gyro, accel, Vector3l(), true, true, f.k)) << (axis == 0 ? "gyro" : "accel");
     }
 }
+
+// The rest means follow every axis at the same low-pass factor: a step in the
+// accelerometer's y alone moves the y mean as x's step moves x.
+TEST(DcmRest, TheAccelMeanFollowsEachAxisAlike) {
+    for (int axis = 0; axis < 3; ++axis) {
+        RestFixture f;
+        Vector3l accel = f.accel_mean;
+        (axis == 0 ? accel.x : axis == 1 ? accel.y : accel.z) += 40000;  // 0.15 g: ends the rest
+        for (int i = 0; i < 400; ++i) f.rest.update(f.gyro_mean, accel, Vector3l(), true, true, f.k);
+        // After 400 corrections (8 s, the means' time constant is 0.5 s) the mean is there,
+        // so the same sample again is still.
+        EXPECT_TRUE(f.rest.update(f.gyro_mean, accel, Vector3l(), true, true, f.k)) << axis;
+    }
+}

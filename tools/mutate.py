@@ -15,8 +15,9 @@ left out of the sample and the score.
 Not mutated: lines the host does not compile (#ifdef __AVR__ blocks; the trace's
 #if DCM_TRACE blocks, host-only instrumentation for replay, built with DCM_TRACE=0), preprocessor
 lines, comment lines, mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
-not compile) and mutants that only move blanks (the same tokens). A mutant that does not
-compile is not counted either.
+not compile), mutants that only move blanks or swap the arguments of a commutative
+product (mul_q30, mul_s16, mul_u16: the same tokens), and lib/DCM/Trace.h (the trace's
+record). A mutant that does not compile is not counted either.
 """
 import argparse
 import collections
@@ -35,7 +36,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # The libraries and their files (globs: the files may be split and renamed).
 LIBRARIES = collections.OrderedDict([
-    ("lib/DCM", ["lib/DCM/*.cpp", "lib/DCM/*.h"]),
+    # (Trace.h: the replay trace's record, host-only instrumentation, left out.)
+    ("lib/DCM", ["lib/DCM/*.cpp", "lib/DCM/[!T]*.h", "lib/DCM/T[!r]*.h"]),
     ("lib/LinAlg/Fixed", ["lib/LinAlg/Fixed.*"]),
     ("lib/Calibration", ["lib/Calibration/*.cpp", "lib/Calibration/*.h"]),
 ])
@@ -213,12 +215,22 @@ def renames_identifier(orig, mutant):
 TOKEN = re.compile(r"[A-Za-z0-9_.]+|<<=|>>=|->|\+\+|--|<<|>>|<=|>=|==|!=|&&|\|\||[-+*/%&|^]=|::|\S")
 
 
+# Products whose two arguments commute (same types): a mutant that only swaps them is the
+# same product.
+COMMUTATIVE_CALL = re.compile(r"\b(mul_q30|mul_s16|mul_u16)\s*\(\s*([^(),]+?)\s*,\s*([^(),]+?)\s*\)")
+
+
 def same_tokens(before, after):
-    """A change of blanks only (universalmutator's spacing of an unchanged call): the
-    same tokens, no mutant. Lines with a quote are kept (blanks count in a literal)."""
+    """A change of blanks only (universalmutator's spacing of an unchanged call), or the
+    two arguments of a commutative product swapped: the same tokens, no mutant. Lines
+    with a quote are kept (blanks count in a literal)."""
     if '"' in before or "'" in before:
         return False
-    return TOKEN.findall(before) == TOKEN.findall(after)
+
+    def canonical(line):
+        return TOKEN.findall(COMMUTATIVE_CALL.sub(lambda m: "%s(%s)" % (m.group(1), ",".join(sorted(m.group(2, 3)))),
+                                                  line))
+    return canonical(before) == canonical(after)
 
 
 def generate(out, files, mutate_bin):
