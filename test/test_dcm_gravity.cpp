@@ -143,3 +143,16 @@ TEST(DcmGravity, TheWindowsMeansAreTheSumsOverTheirLength) {
         EXPECT_EQ(whole, n >= dcm::kCorrectionDivider) << (int)n;
     }
 }
+
+// A new gyro scale rescales the correction held between corrections (units per step)
+// either way, as the accelerometer's rescales the low-pass.
+TEST(DcmGravity, TheHeldCorrectionFollowsANewGyroScale) {
+    for (float ratio : {2.0f, 0.5f}) {
+        Loop loop(Matrix3f::identity());
+        loop.run(dcm::dcm_from_euler(10.0f * linalg::kRadPerDeg, 0.0f, 0.0f), 0.5f, true);
+        const Vector3l before = loop.gravity.correction_units();
+        ASSERT_NE(before.x, 0);
+        loop.gravity.rescale(ratio, 1.0f);
+        EXPECT_NEAR(loop.gravity.correction_units().x, before.x * ratio, 1.0) << ratio;
+    }
+}

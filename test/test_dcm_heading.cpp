@@ -126,3 +126,13 @@ TEST(DcmHeading, ANewFieldIsAdoptedAfterExactlyItsRecoverSteps) {
     while (judge(kEarthNorm * 1.3f) == dcm::FieldVerdict::kDisturbed && means < 100000) ++means;
     EXPECT_EQ(means, (int)g.k.mag_recover_steps);
 }
+
+// The turn that proves a new field fixed in the earth frame counts only while that field
+// stays the same: turning earlier, among fields that kept changing, does not count, so a
+// steady field at rest afterwards is never adopted.
+TEST(DcmHeading, OnlyTheTurnDuringTheSteadyFieldCounts) {
+    Gate g;
+    for (int i = 0; i < 2000; ++i)  // 80 s turning at 30 deg/s among changing fields
+        g.judge(kEarthNorm * (i % 2 ? 1.3f : 1.6f), kEarthDown, 30.0f * linalg::kRadPerDeg);
+    EXPECT_LT(g.seconds_to_adopt(kEarthNorm * 1.3f, kEarthDown, 0.0f, 60.0f), 0.0f);
+}

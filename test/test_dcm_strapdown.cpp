@@ -140,6 +140,9 @@ TEST(DcmStrapdown, RenormalisationReportsAHopelessMatrix) {
     dcm::Strapdown s;
     s.reset(linalg::q30_from_matrix(Matrix3f(Vector3f(1.6f, 0.0f, 0.0f), Vector3f(0.0f, 1.0f, 0.0f), Vector3f(0.0f, 0.0f, 1.0f))));
     EXPECT_FALSE(s.renormalise());
+    // An entry beyond +-1.4 on any axis of a row (its square beyond Q30's 2).
+    s.reset(linalg::q30_from_matrix(Matrix3f(Vector3f(0.0f, 0.0f, 1.5f), Vector3f(0.0f, 1.0f, 0.0f), Vector3f(1.0f, 0.0f, 0.0f))));
+    EXPECT_FALSE(s.renormalise());
     s.reset(linalg::q30_from_matrix(Matrix3f::zero()));
     EXPECT_FALSE(s.renormalise());
 }
