@@ -90,6 +90,18 @@ TEST(DcmGravity, TheIntegratorLearnsOnlyWhenNotHeld) {
     EXPECT_NE(learning.bias.units().x, 0);
 }
 
+// The integrator learns on the axis of the tilt error: a roll error (about body x, the
+// board facing north) moves the x bias, a pitch error the y bias, each far more than the
+// other axis.
+TEST(DcmGravity, TheIntegratorLearnsOnTheErrorsAxis) {
+    Loop roll(Matrix3f::identity());
+    roll.run(dcm::dcm_from_euler(5.0f * linalg::kRadPerDeg, 0.0f, 0.0f), 2.0f, false);
+    EXPECT_GT(std::abs(roll.bias.units().x), 10 * std::abs(roll.bias.units().y) + 10);
+    Loop pitch(Matrix3f::identity());
+    pitch.run(dcm::dcm_from_euler(0.0f, 5.0f * linalg::kRadPerDeg, 0.0f), 2.0f, false);
+    EXPECT_GT(std::abs(pitch.bias.units().y), 10 * std::abs(pitch.bias.units().x) + 10);
+}
+
 TEST(DcmGravity, AnEmptyWindowIsNoWindow) {
     Loop loop(Matrix3f::identity());
     Vector3l g, a;

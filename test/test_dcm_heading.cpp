@@ -128,11 +128,14 @@ TEST(DcmHeading, ANewFieldIsAdoptedAfterExactlyItsRecoverSteps) {
 }
 
 // The turn that proves a new field fixed in the earth frame counts only while that field
-// stays the same: turning earlier, among fields that kept changing, does not count, so a
-// steady field at rest afterwards is never adopted.
+// stays the same: a field steady for 10 s while the board turned (too short to be
+// adopted), a different one for a moment, then the first again at rest is never
+// adopted: the turn before the break does not count.
 TEST(DcmHeading, OnlyTheTurnDuringTheSteadyFieldCounts) {
     Gate g;
-    for (int i = 0; i < 2000; ++i)  // 80 s turning at 30 deg/s among changing fields
-        g.judge(kEarthNorm * (i % 2 ? 1.3f : 1.6f), kEarthDown, 30.0f * linalg::kRadPerDeg);
+    const float rate = 45.0f * linalg::kRadPerDeg;  // 10 s of it: more than mag_new_min_turn
+    ASSERT_GT(rate * 10.0f, g.k.mag_new_min_turn_rad);
+    for (float t = 0.0f; t < 10.0f; t += kMeanDt) ASSERT_EQ(g.judge(kEarthNorm * 1.3f, kEarthDown, rate), dcm::FieldVerdict::kDisturbed);
+    g.judge(kEarthNorm * 1.6f, kEarthDown, rate);
     EXPECT_LT(g.seconds_to_adopt(kEarthNorm * 1.3f, kEarthDown, 0.0f, 60.0f), 0.0f);
 }

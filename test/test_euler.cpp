@@ -83,3 +83,12 @@ TEST(Heading, WrapsIntoZeroTo360WithDeclination) {
     const float big = dcm::heading_deg(1e30f, 0.0f);
     EXPECT_TRUE(big >= 0.0f && big < 360.0f);
 }
+
+// A yaw a hair below 0 makes h = 360 - 1e-9, which a float rounds to 360 exactly: still
+// inside [0, 360), as 0.
+TEST(EulerHeading, AYawAHairBelowZeroIsNorthNot360) {
+    const float h = dcm::heading_deg(-1e-9f, 0.0f);
+    EXPECT_GE(h, 0.0f);
+    EXPECT_LT(h, 360.0f);
+    EXPECT_EQ(h, 0.0f);
+}
