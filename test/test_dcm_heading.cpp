@@ -139,3 +139,18 @@ TEST(DcmHeading, OnlyTheTurnDuringTheSteadyFieldCounts) {
     g.judge(kEarthNorm * 1.6f, kEarthDown, rate);
     EXPECT_LT(g.seconds_to_adopt(kEarthNorm * 1.3f, kEarthDown, 0.0f, 60.0f), 0.0f);
 }
+
+// A start (init) counts a new field's steadiness again from zero: after the restart the
+// field that was already steady is taken after exactly mag_recover_steps more means.
+TEST(DcmHeading, ARestartCountsTheSteadinessFromZero) {
+    Gate g;
+    const Vector3l turning = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, 1.0f * g.k.units_per_rad_s), 0);
+    auto judge = [&](float norm) {
+        return g.gate.judge(norm, kEarthDown, 1, 0.005f, turning, dcm::kDefaultDcmSettings, g.k);
+    };
+    for (int i = 0; i < 200; ++i) ASSERT_EQ(judge(kEarthNorm * 1.3f), dcm::FieldVerdict::kDisturbed);
+    g.gate.restart_steady_count();
+    int means = 1;
+    while (judge(kEarthNorm * 1.3f) == dcm::FieldVerdict::kDisturbed && means < 100000) ++means;
+    EXPECT_EQ(means, (int)g.k.mag_recover_steps);
+}

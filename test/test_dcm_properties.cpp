@@ -517,3 +517,17 @@ TEST(DcmProperties, RStaysOrthonormalInALongTumble) {
     RecordProperty("worst", std::to_string(worst * 1e6f) + "e-6");
     EXPECT_LT(worst, 1e-6f);  // every 255 integrations instead: 2e-6
 }
+
+// The start-up (faster gains, no bias learned) lasts startup_s from the first estimate,
+// to the step: a board at rest reports the bias held for exactly startup_s / step_s steps.
+TEST(DcmProperties, TheStartUpLastsStartupSecondsToTheStep) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const int expected = (int)(filter.settings().startup_s / filter.settings().step_s);
+    int held = 0;
+    for (int i = 0; i < expected + 400; ++i) {
+        filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+        if (filter.status() & dcm::kStatusBiasHeld) ++held;
+    }
+    EXPECT_EQ(held, expected);
+}
