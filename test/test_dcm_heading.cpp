@@ -39,6 +39,18 @@ struct Gate {
             if (judge(norm, down, rate_rad_s) != dcm::FieldVerdict::kDisturbed) return t;
         return -1.0f;
     }
+    // One mean of a single step (5 ms) while the board turns at 1 rad/s: the finest
+    // count the gate keeps.
+    dcm::FieldVerdict judge_one_step(float norm) {
+        const Vector3l turning = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, 1.0f * k.units_per_rad_s), 0);
+        return gate.judge(norm, kEarthDown, 1, 0.005f, turning, dcm::kDefaultDcmSettings, k);
+    }
+    // One-step means of one field until the verdict is not kDisturbed: how many it took.
+    int one_step_means_to_adopt(float norm) {
+        int means = 1;
+        while (judge_one_step(norm) == dcm::FieldVerdict::kDisturbed && means < 100000) ++means;
+        return means;
+    }
 };
 
 }  // namespace
@@ -113,18 +125,12 @@ TEST(DcmHeading, AForgottenReferenceIsRelearned) {
 // taken after exactly mag_recover_s of it (here means of one step each, while turning).
 TEST(DcmHeading, ANewFieldIsAdoptedAfterExactlyItsRecoverSteps) {
     Gate g;
-    const Vector3l turning = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, 1.0f * g.k.units_per_rad_s), 0);
-    auto judge = [&](float norm) {
-        return g.gate.judge(norm, kEarthDown, 1, 0.005f, turning, dcm::kDefaultDcmSettings, g.k);
-    };
     // A disturbance held long enough for the candidate to follow it (53 ms), not to be taken.
-    for (int i = 0; i < 200; ++i) ASSERT_EQ(judge(kEarthNorm * 1.3f), dcm::FieldVerdict::kDisturbed);
+    for (int i = 0; i < 200; ++i) ASSERT_EQ(g.judge_one_step(kEarthNorm * 1.3f), dcm::FieldVerdict::kDisturbed);
     // One mean of another field breaks the steadiness (the candidate moves only a little).
-    ASSERT_EQ(judge(kEarthNorm * 1.6f), dcm::FieldVerdict::kDisturbed);
+    ASSERT_EQ(g.judge_one_step(kEarthNorm * 1.6f), dcm::FieldVerdict::kDisturbed);
     // The disturbance again: steady from the first mean, taken at the recover_steps'th.
-    int means = 1;
-    while (judge(kEarthNorm * 1.3f) == dcm::FieldVerdict::kDisturbed && means < 100000) ++means;
-    EXPECT_EQ(means, (int)g.k.mag_recover_steps);
+    EXPECT_EQ(g.one_step_means_to_adopt(kEarthNorm * 1.3f), (int)g.k.mag_recover_steps);
 }
 
 // The turn that proves a new field fixed in the earth frame counts only while that field
@@ -144,13 +150,7 @@ TEST(DcmHeading, OnlyTheTurnDuringTheSteadyFieldCounts) {
 // field that was already steady is taken after exactly mag_recover_steps more means.
 TEST(DcmHeading, ARestartCountsTheSteadinessFromZero) {
     Gate g;
-    const Vector3l turning = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, 1.0f * g.k.units_per_rad_s), 0);
-    auto judge = [&](float norm) {
-        return g.gate.judge(norm, kEarthDown, 1, 0.005f, turning, dcm::kDefaultDcmSettings, g.k);
-    };
-    for (int i = 0; i < 200; ++i) ASSERT_EQ(judge(kEarthNorm * 1.3f), dcm::FieldVerdict::kDisturbed);
+    for (int i = 0; i < 200; ++i) ASSERT_EQ(g.judge_one_step(kEarthNorm * 1.3f), dcm::FieldVerdict::kDisturbed);
     g.gate.restart_steady_count();
-    int means = 1;
-    while (judge(kEarthNorm * 1.3f) == dcm::FieldVerdict::kDisturbed && means < 100000) ++means;
-    EXPECT_EQ(means, (int)g.k.mag_recover_steps);
+    EXPECT_EQ(g.one_step_means_to_adopt(kEarthNorm * 1.3f), (int)g.k.mag_recover_steps);
 }
