@@ -10,14 +10,15 @@
 #include "Calibration.h"
 #include "Pipeline.h"
 #include "PipelineText.h"
+#include "pipeline_test_support.h"
 
 namespace {
 
 using linalg::Vector3f;
 
-void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
-mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) { return mpu6000::sample_from_si(gyro, accel, 25.0f); }
-const Vector3f kLevel(0.0f, 0.0f, -9.80665f);
+using pipeline_test::imu;
+using pipeline_test::kLevel;
+using pipeline_test::LoggedPipeline;
 const Vector3f kHardIron(8.0f, -5.0f, 3.0f);
 const int kFitParts = calib::MagCalibrator::kFitParts;  // a value (EXPECT_* take references)
 
@@ -63,10 +64,9 @@ TEST(CalMagParts, PartsGiveTheFitAtOnce) {
 }
 
 TEST(CalMagParts, PipelineFitsAPartAStepAndThenGivesTheVerdict) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     p.set_mag_present(true);
     int step = 0;
     auto one_step = [&] {

@@ -12,18 +12,17 @@
 
 #include "Pipeline.h"
 #include "PipelineText.h"
+#include "pipeline_test_support.h"
 
 using linalg::Vector3f;
 
 namespace {
 
-const Vector3f kLevel(0.0f, 0.0f, -9.80665f);
+using pipeline_test::imu;
+using pipeline_test::kLevel;
+using pipeline_test::LoggedPipeline;
+
 const Vector3f kBias(0.02f, -0.01f, 0.005f);
-
-void sink_write(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
-
-// The sample the MPU6000 gives for these values (counts of its 2000 deg/s and 8 g ranges).
-mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) { return mpu6000::sample_from_si(gyro, accel, 25.0f); }
 
 // North-facing level board: field north and down (dip ~60 deg).
 const Vector3f kFieldNorthDown(20.0f, 0.0f, 40.0f);
@@ -40,10 +39,9 @@ int count_of(const std::string& text, const std::string& what) {
 // Start-up, checks and commands (moved from test_calibration.cpp).
 
 TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     p.set_mag_present(true);
     int first_output = -1;
     for (int i = 0; i < 400; ++i) {
@@ -76,10 +74,9 @@ TEST(Pipeline, RolledAndPitchedBoardFromGravity) {
 }
 
 TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     int first_output = -1;
     for (int i = 0; i < 400 && first_output < 0; ++i) {
         const float wobble = (i % 20 < 10) ? 0.2f : -0.2f;  // +-11 deg/s
@@ -110,10 +107,9 @@ TEST(Pipeline, OutputRateFollowsTheSetting) {
 }
 
 TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(kBias, kLevel));
     log.clear();
     p.on_imu_sample(imu(Vector3f(30.0f, -30.0f, 30.0f), kLevel * 6.0f));
@@ -127,10 +123,9 @@ TEST(Pipeline, SpikeIsReplacedAndWarnedOnce) {
 }
 
 TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));  // past the start-up ramp
     log.clear();
     // 1 s of accel stuck at full scale on every axis (a broken sensor, 14 g): it must
@@ -189,10 +184,9 @@ TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
 }
 
 TEST(Pipeline, MagCalibrationCommand) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     p.set_mag_present(true);
     for (int i = 0; i < 250; ++i) p.on_imu_sample(imu(kBias, kLevel));
     p.start_mag_calibration();
@@ -279,10 +273,9 @@ TEST(RateLimiter, HeldCountSaturates) {
 // Two bursts of ten spikes 1 s apart: the first spike at once, the other nineteen in one
 // line when the 2 s are over; every spike is in a line.
 TEST(RateLimiter, TwoSpikeBurstsOneSecondApartAreBothReported) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     ASSERT_EQ(p.phase(), pipeline::Phase::Running);
     log.clear();
@@ -304,10 +297,9 @@ TEST(RateLimiter, TwoSpikeBurstsOneSecondApartAreBothReported) {
 }
 
 TEST(RateLimiter, HeldSaturationWarningsAreTold) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     log.clear();
     // Accel clipped on one axis for five samples (a shake: the rise over a few samples is
@@ -326,10 +318,9 @@ TEST(RateLimiter, HeldSaturationWarningsAreTold) {
 // The start-up calibration's "board moved" (once a second at most): the restarts in
 // between are counted on the next line.
 TEST(RateLimiter, BoardMovedCountsTheRestartsBetweenLines) {
-    std::string log;
-    const text::Sink sink{&log, sink_write};
-    const pipeline::EventSink events = pipeline_text::events_to(&sink);
-    pipeline::AttitudePipeline p(&events);
+    LoggedPipeline logged;
+    pipeline::AttitudePipeline& p = logged.p;
+    std::string& log = logged.log;
     for (int i = 0; i < 230; ++i) {
         const float wobble = (i % 2 == 0) ? 1.0f : -1.0f;  // restarts again and again
         p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
@@ -373,7 +364,7 @@ std::string centi(float v) {
 
 std::string words_of(const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
     std::string s;
-    const text::Sink sink{&s, sink_write};
+    const text::Sink sink{&s, pipeline_test::append_to_string};
     pipeline_text::write_event(const_cast<text::Sink*>(&sink), pipe, e);
     return s;
 }
@@ -555,7 +546,7 @@ TEST(PipelineText, StatusLinesWordTheBiasAndTheCompass) {
     pipeline::AttitudePipeline p;
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(kBias, kLevel));
     std::string s;
-    const text::Sink sink{&s, sink_write};
+    const text::Sink sink{&s, pipeline_test::append_to_string};
     pipeline_text::write_bias_status(&sink, p);
     EXPECT_EQ(s, "# gyro bias 1.16 -0.55 0.30 deg/s, temperature 25.00 C\n");  // kBias in whole counts
     s.clear();
