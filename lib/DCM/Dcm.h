@@ -148,6 +148,9 @@ public:
     uint16_t recoveries() const { return recoveries_; }
     // R in float (tests, tools, the quaternion output): the estimator keeps it in Q30.
     linalg::Matrix3f matrix() const { return linalg::matrix_from_q30(strapdown_.r()); }
+    // R's last entry, earth down's body z component: cos(roll) cos(pitch), the cosine of
+    // the tilt (one entry, where matrix() converts nine).
+    float cos_tilt() const { return linalg::float_from_fixed(strapdown_.r().c.z, linalg::kQ30); }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.

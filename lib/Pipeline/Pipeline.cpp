@@ -71,7 +71,7 @@ void AttitudePipeline::set_airspeed_m_s(float airspeed_m_s) {
 }
 
 void AttitudePipeline::set_cruise_airspeed_m_s(float trim_m_s) {
-    set_airspeed_m_s(trim_m_s > 0.0f ? airspeed::cruise_in_turn_m_s(trim_m_s, dcm_.matrix().c.z) : 0.0f);
+    set_airspeed_m_s(trim_m_s > 0.0f ? airspeed::cruise_in_turn_m_s(trim_m_s, dcm_.cos_tilt()) : 0.0f);
 }
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
