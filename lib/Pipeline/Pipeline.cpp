@@ -253,6 +253,8 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     const calib::GyroCalibrator::Result r =
         gyro_cal_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count);
     ++st_.gyro_cal_steps;
+    if (st_.phase == Phase::Calibrating)
+        start_gravity_.add(calib::apply_gyro(settings_.cal, raw.gyro_rad_s()), raw.accel_m_s2(), 1.0f / kRateHz);
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
@@ -274,10 +276,11 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         tell(EventKind::kGyroCalMoved, n);
     }
     if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
-        // Never still long enough: run with what we have, keep measuring in the background
-        // (the event on the next step, as the bias's).
+        // Never still long enough: run with what we have, gravity the window's mean carried
+        // by the gyro (StartGravity.h), keep measuring in the background (the event on the
+        // next step, as the bias's).
         st_.start_message = StartMessage::kNotStill;
-        start_estimator(raw.accel_m_s2());
+        start_estimator(start_gravity_.mean_m_s2());
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
@@ -449,6 +452,7 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
 
 void AttitudePipeline::start_gyro_calibration() {
     gyro_cal_.restart();
+    start_gravity_.restart();
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
     if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);

@@ -48,6 +48,7 @@
 #include "LinAlg.h"
 #include "Mpu6000Registers.h"
 #include "Settings.h"
+#include "StartGravity.h"
 
 namespace pipeline {
 
@@ -284,6 +285,7 @@ private:
     settings::Settings settings_;
     dcm::Dcm dcm_;
     calib::GyroCalibrator gyro_cal_;
+    StartGravity start_gravity_;  // the start's gravity if never still (StartGravity.h)
     calib::MagCalibrator mag_cal_;
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
