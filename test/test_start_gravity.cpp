@@ -84,6 +84,16 @@ TEST(StartGravity, PipelineStartsFromTheMeanWhenNeverStill) {
     }
     ASSERT_FALSE(std::isnan(first_roll_deg));
     EXPECT_LT(fabsf(first_roll_deg), 1.0f);
+    EXPECT_FALSE(p.estimator().gyro_bias_measured());  // the bias still to find: ki_rp
+}
+
+// A still start measures the bias: the estimator's gravity integrator starts slow
+// (ki_rp_measured_1_s2, DcmSettings.h).
+TEST(StartGravity, AStillStartMeasuresTheBias) {
+    pipeline::AttitudePipeline p;
+    for (int i = 0; i < 400 && p.phase() != pipeline::Phase::Running; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
+    ASSERT_EQ(p.phase(), pipeline::Phase::Running);
+    EXPECT_TRUE(p.estimator().gyro_bias_measured());
 }
 
 }  // namespace

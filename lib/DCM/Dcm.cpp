@@ -275,6 +275,7 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     const Vector3f before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif
     bias_.follow_rest_mean(rest_.gyro_mean(), k_);
+    bias_.set_measured();
 #if DCM_TRACE
     if (trace_) trace_->bias_from_rest_rad_s += traced_bias_rad_s() - before;
 #endif

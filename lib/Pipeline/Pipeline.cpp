@@ -268,6 +268,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
             dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
         }
+        dcm_.set_gyro_bias_measured();
         return;
     }
     if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz)) {
