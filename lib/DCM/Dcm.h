@@ -155,6 +155,8 @@ public:
     // R's last entry, earth down's body z component: cos(roll) cos(pitch), the cosine of
     // the tilt (one entry, where matrix() converts nine).
     float cos_tilt() const { return linalg::float_from_fixed(strapdown_.r().c.z, linalg::kQ30); }
+    // R's earth down, body y component (sin(roll) cos(pitch)), Q30.
+    int32_t down_y_q30() const { return strapdown_.r().c.y; }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.

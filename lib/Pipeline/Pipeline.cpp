@@ -48,9 +48,22 @@ int16_t centripetal_gain_q8(float airspeed_m_s) {
     return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
 }
 
-linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8) {
+LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30) {
+    // a_y = f_y + g down_y in counts: down_y Q14 times g's counts, Q14.
+    constexpr int16_t kGravityCounts = (int16_t)(kG / kAccelCount_m_s2 + 0.5f);
+    constexpr int16_t kMarginCounts = (int16_t)(kG / kAccelCount_m_s2 * 0.0348995f + 0.5f);  // sin(2 deg)
+    static_assert(kTurnBankMargin_deg == 2.0f, "kMarginCounts is g sin(kTurnBankMargin_deg)");
+    const int32_t a_y = (int32_t)accel_y_counts + (linalg::mul_s16((int16_t)(down_y_q30 >> 16), kGravityCounts) >> 14);
+    return LateralBounds{(a_y < 0 ? a_y : 0) - kMarginCounts, (a_y > 0 ? a_y : 0) + kMarginCounts};
+}
+
+linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8,
+                                       LateralBounds lateral) {
     // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V.
-    return linalg::Vector3i(a.x, sat16((int32_t)a.y - (linalg::mul_s16(gyro_z, gain_q8) >> 8)),
+    int32_t lateral_counts = linalg::mul_s16(gyro_z, gain_q8) >> 8;
+    if (lateral_counts < lateral.lo) lateral_counts = lateral.lo;
+    if (lateral_counts > lateral.hi) lateral_counts = lateral.hi;
+    return linalg::Vector3i(a.x, sat16((int32_t)a.y - lateral_counts),
                             sat16((int32_t)a.z + (linalg::mul_s16(gyro_y, gain_q8) >> 8)));
 }
 
@@ -359,7 +372,8 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         // Gravity for the DCM: the turn's centripetal acceleration taken off (see
         // kCentripetalMinAirspeed_m_s); the clip checks above saw the measured sample.
         corrected = centripetal_corrected(s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_),
-                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_);
+                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_,
+                                          turn_lateral_bounds(s.accel.y, dcm_.down_y_q30()));
         accel = &corrected;
     }
     dcm_.update(s.gyro, *accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
