@@ -266,8 +266,12 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     const calib::GyroCalibrator::Result r =
         gyro_cal_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count);
     ++st_.gyro_cal_steps;
-    if (st_.phase == Phase::Calibrating)
-        start_gravity_.add(calib::apply_gyro(settings_.cal, raw.gyro_rad_s()), raw.accel_m_s2(), 1.0f / kRateHz);
+    // The window's samples for a start that is never still (not the step that starts:
+    // it has the start's work, and a still start takes the calibration's mean).
+    if (st_.phase == Phase::Calibrating && r != calib::GyroCalibrator::Result::Done &&
+        st_.gyro_cal_steps < kStartupDeadlineSteps)
+        start_gravity_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count,
+                           settings_.cal.gyro_bias_rad_s, 1.0f / kRateHz);
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
