@@ -104,8 +104,8 @@ constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
 // (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum).
 int16_t centripetal_gain_q8(float airspeed_m_s);
 // omega_z V is the lateral acceleration only while the relative wind turns with the
-// flight path. Turbulence yaws the aeroplane into a relative wind that changes (16 deg/s
-// rms in the gusty flight, 33 deg of false bank at 18 m/s) while the path hardly turns.
+// flight path. Turbulence yaws the aeroplane into a relative wind that changes while the
+// path hardly turns (README, "Flying in simulation").
 // The accelerometer and the estimate say what the lateral acceleration is: a_y = f_y +
 // g down_y (down_y = sin(roll) cos(pitch), earth down's body y component, the gyro
 // carries it through a turn's entry; a coordinated turn has f_y = 0, a flat skid g down_y
