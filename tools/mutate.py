@@ -9,7 +9,8 @@ kill score is printed per library, then each survivor (file, line, original, mut
 
 Mutants that cannot change behaviour (equivalent ones) are listed in
 test/mutants_equivalent.txt, keyed by the file, the mutated line's text and its
-replacement (never by line number: the files change), each with its reason; they are
+replacement (never by line number: the files change; an inserted line's "original" is
+"(new line after) " and the line before it), each with its reason; they are
 left out of the sample and the score.
 
 Not mutated: lines the host does not compile (#ifdef __AVR__ blocks; the trace's
@@ -233,6 +234,10 @@ def same_tokens(before, after):
     return canonical(before) == canonical(after)
 
 
+# An inserted line's "original" (report and equivalent-mutant file): the line before it.
+NEW_LINE_AFTER = "(new line after) "
+
+
 def generate(out, files, mutate_bin):
     """Every mutant of every selected file: a list of dicts."""
     mutants = []
@@ -252,7 +257,8 @@ def generate(out, files, mutate_bin):
         stem, ext = os.path.splitext(base)
         for m in sorted(glob.glob(os.path.join(mdir, stem + ".mutant.*" + ext)),
                         key=lambda f: int(f.rsplit(".", 2)[-2])):
-            c = changed_line(orig, open(m).read().split("\n"))
+            mutant_lines = open(m).read().split("\n")
+            c = changed_line(orig, mutant_lines)
             if c is None:
                 continue
             line, before, after = c
@@ -262,8 +268,11 @@ def generate(out, files, mutate_bin):
                 continue
             if same_tokens(before, after):
                 continue
-            mutants.append({"file": path, "mutant": m, "line": line, "orig": before.strip(),
-                            "new": after.strip()})
+            # An inserted line (continue; break;) is keyed by the line it follows: the same
+            # insertion elsewhere in the file is another mutant.
+            inserted = len(mutant_lines) == len(orig) + 1
+            key = NEW_LINE_AFTER + orig[line - 2].strip() if inserted and line >= 2 else before.strip()
+            mutants.append({"file": path, "mutant": m, "line": line, "orig": key, "new": after.strip()})
     return mutants
 
 
