@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The estimator's exact promises, each checked to the unit against its definition (a
+// double or a 64-bit reference, or the formula the code states): limits, clamps,
+// roundings and which series runs where. Each is what a mutant of `make mutate`
+// (issue 25) changed while every other test passed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <initializer_list>
+
+#include "Gravity.h"
+#include "Strapdown.h"
+#include "dcm_test_support.h"
+
+using namespace dcm_test;
+using linalg::Vector3l;
+
+namespace {
+
+// c0 - a2 (c1 - a2 (c2 - ...)) in Q30 (Horner, innermost first): the series of
+// sin(a)/a or (1 - cos a)/a^2 in a^2 to as many terms as there are coefficients.
+int32_t alternating_series_q30(int32_t a2_q30, std::initializer_list<int32_t> coefficients_q30) {
+    int32_t sum = 0;
+    bool innermost = true;
+    for (auto c = coefficients_q30.end(); c != coefficients_q30.begin();) {
+        --c;
+        sum = innermost ? *c : *c - linalg::mul_q30(a2_q30, sum);
+        innermost = false;
+    }
+    return sum;
+}
+
+}  // namespace
+
+// A gyro count so fine that kMaxTurnAxisQ26 is more than 2e9 units: the turn's unit
+// limit is held at 2e9 (a float beyond int32_t would not convert), and any turn sum
+// beyond it is taken as 2e9 units.
+TEST(DcmExact, TheTurnsUnitLimitIsHeldAt2e9) {
+    const dcm::DcmSettings& settings = dcm::kDefaultDcmSettings;
+    // Q26 radians per unit for a limit of 2.1e9 units (within int32_t, beyond 2e9).
+    const double q26_per_unit = (double)dcm::kMaxTurnAxisQ26 / 2.1e9;
+    const float gyro_rad_s_per_count = (float)(q26_per_unit / 67108864.0 * dcm::kTurnScale / settings.step_s);
+    dcm::DcmCoefficients k;
+    k.from_settings(settings);
+    k.set_scales(settings, gyro_rad_s_per_count, dcm::kFloatAccelScale);
+    ASSERT_NE(k.theta_factor_q30, 0) << "the integer path";
+    const double limit_units = (double)dcm::kMaxTurnAxisQ26 / ((double)k.turn_rad_per_unit() * 67108864.0);
+    ASSERT_GT(limit_units, 2.05e9);
+    ASSERT_LT(limit_units, 2.14e9);
+    EXPECT_EQ(k.theta_units_limit, 2000000000L);
+    EXPECT_EQ(k.theta_axis_q26(2100000000L), linalg::mul_q30(k.theta_factor_q30, 2000000000L));
+    EXPECT_EQ(k.theta_axis_q26(-2100000000L), linalg::mul_q30(k.theta_factor_q30, -2000000000L));
+}
+
+// The integration's factors sin(a)/a and (1 - cos a)/a^2 come from their series to a^2
+// below a^2 = 2^-10 (a = 1/32 rad) and to a^6 / a^4 from there on, to the bit. A turn
+// about x from R = I shows both: row b becomes (0, 1 - a^2 (1 - cos a)/a^2, -a sin(a)/a).
+TEST(DcmExact, TheShortSeriesRunsBelowASquaredOf2ToTheMinus10) {
+    using linalg::q30_ratio;
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    ASSERT_NE(k.theta_factor_q30, 0) << "the integer path";
+    const int32_t threshold_a2 = q30_ratio(1, 1024);
+    const int32_t middle_units = (int32_t)std::lround(1.0 / 32.0 / (double)k.turn_rad_per_unit());
+    int told_apart_below = 0, told_apart_above = 0;
+    for (int32_t units = middle_units - middle_units / 32; units < middle_units + middle_units / 32; units += 997) {
+        dcm::Strapdown s;
+        s.reset(linalg::q30_from_matrix(Matrix3f::identity()));
+        ASSERT_EQ(s.r().b.y, linalg::kOneQ30);
+        s.add_turn(Vector3l(units, 0, 0));
+        for (int step = 0; step < dcm::kIntegrationSteps; ++step) s.end_step();
+        s.integrate(k);
+        const int32_t a_q30 = k.theta_q30(Vector3l(units, 0, 0)).x;
+        const int32_t a2 = linalg::dot_q30(Vector3l(a_q30, 0, 0), Vector3l(a_q30, 0, 0));
+        const bool small = a2 < threshold_a2;
+        const int32_t sin_short = alternating_series_q30(a2, {linalg::kOneQ30, q30_ratio(1, 6)});
+        const int32_t sin_long = alternating_series_q30(a2, {linalg::kOneQ30, q30_ratio(1, 6), q30_ratio(1, 120),
+                                                            q30_ratio(1, 5040)});
+        const int32_t versine_short = alternating_series_q30(a2, {q30_ratio(1, 2), q30_ratio(1, 24)});
+        const int32_t versine_long = alternating_series_q30(a2, {q30_ratio(1, 2), q30_ratio(1, 24), q30_ratio(1, 720)});
+        const int32_t b_y_short = linalg::kOneQ30 - linalg::mul_q30(a2, versine_short);
+        const int32_t b_y_long = linalg::kOneQ30 - linalg::mul_q30(a2, versine_long);
+        const int32_t b_z_short = -linalg::mul_q30(sin_short, a_q30), b_z_long = -linalg::mul_q30(sin_long, a_q30);
+        EXPECT_EQ(s.r().b.x, 0) << units;
+        EXPECT_EQ(s.r().b.y, small ? b_y_short : b_y_long) << units;
+        EXPECT_EQ(s.r().b.z, small ? b_z_short : b_z_long) << units;
+        if (b_y_short != b_y_long || b_z_short != b_z_long) ++(small ? told_apart_below : told_apart_above);
+    }
+    // Turns on both sides where the two series differ in R's bits: the test tells them.
+    EXPECT_GT(told_apart_below, 0);
+    EXPECT_GT(told_apart_above, 0);
+}
+
+// The output's carry of a turn within 2^-10 rad an axis (|theta| < 65534 Q26) is to
+// Q25: from R = I, the angle it gives is the exact atan within 3/4 of a Q24 unit (a
+// quarter for the turn's rounding, a half for the angle's), up to the limit on each
+// side (the coarse Q17 form there would be a unit off).
+TEST(DcmExact, AFineTurnIsCarriedToQ25UpToItsLimit) {
+    const linalg::Matrix3q30 r = linalg::q30_from_matrix(Matrix3f::identity());
+    for (int32_t t = 65000; t <= 65533; ++t) {
+        for (int32_t sign : {1, -1}) {
+            const int32_t theta_q26 = sign * t;
+            const double exact_q24 = std::atan(theta_q26 / 67108864.0) * 16777216.0;
+            EXPECT_LT(std::fabs(dcm::euler_carried_q24(r, theta_q26, 0, 0).roll_q24 - exact_q24), 0.76) << theta_q26;
+            EXPECT_LT(std::fabs(dcm::euler_carried_q24(r, 0, theta_q26, 0).pitch_q24 - exact_q24), 0.76) << theta_q26;
+            EXPECT_LT(std::fabs(dcm::euler_carried_q24(r, 0, 0, theta_q26).yaw_q24 - exact_q24), 0.76) << theta_q26;
+        }
+    }
+}
