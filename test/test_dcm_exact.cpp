@@ -106,3 +106,52 @@ TEST(DcmExact, AFineTurnIsCarriedToQ25UpToItsLimit) {
         }
     }
 }
+
+namespace {
+
+// One gravity window of `n` samples (counts) through low_pass_window, the low-pass set to
+// take the window's mean as it is (alpha = 1): the means it gives, its low-pass after.
+struct OneWindow {
+    dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::GravityCorrection gravity;
+    Vector3l gyro_mean, accel_mean;
+    bool whole = false;
+    OneWindow() {
+        k.accel_alpha_q30 = linalg::kOneQ30;
+        gravity.reset(-4096 * 256);
+    }
+    void run(const linalg::Matrix3q30& r, const Vector3l& gyro_counts, const Vector3l& accel_counts, uint8_t n,
+             const Vector3l& sensor_bias_units = Vector3l(), bool starting = false, float startup_left = 0.0f) {
+        for (uint8_t i = 0; i < n; ++i) gravity.add(gyro_counts, accel_counts);
+        ASSERT_TRUE(gravity.low_pass_window(r, 0, Vector3l(), sensor_bias_units, starting, startup_left, k, gyro_mean,
+                                            accel_mean, whole));
+    }
+};
+
+}  // namespace
+
+// The window's means over its usual four samples are exact: the gyro's less the
+// calibrated bias, and the earth-frame force's, whose sum is the matrix's 16-bit entries
+// times the sums (mul_q14: a multiple of 4, as the accel units' sums are of 256).
+TEST(DcmExact, AFourSampleWindowsMeansAreExact) {
+    using linalg::q14_of;
+    using linalg::hot::mul_q14;
+    const linalg::Matrix3q30 r = linalg::q30_from_matrix(dcm::dcm_from_euler(0.3f, -0.2f, 0.1f));
+    const Vector3l accel_counts(3, -5, -4093), sensor_bias_units(5 * 256, -3 * 256, 7 * 256);
+    OneWindow w;
+    w.run(r, Vector3l(), accel_counts, 4, sensor_bias_units);
+    EXPECT_TRUE(w.whole);
+    EXPECT_EQ(w.gyro_mean.x, -sensor_bias_units.x);
+    EXPECT_EQ(w.gyro_mean.y, -sensor_bias_units.y);
+    EXPECT_EQ(w.gyro_mean.z, -sensor_bias_units.z);
+    // No turn: the body-axis sum is the samples', in accel units.
+    const Vector3l sum(accel_counts.x * 4 * 256, accel_counts.y * 4 * 256, accel_counts.z * 4 * 256);
+    const linalg::Vector3l* rows[3] = {&r.a, &r.b, &r.c};
+    const int32_t lp[3] = {w.gravity.low_pass_ef().x, w.gravity.low_pass_ef().y, w.gravity.low_pass_ef().z};
+    for (int i = 0; i < 3; ++i) {
+        const linalg::Vector3l& row = *rows[i];
+        const int32_t sum_ef = mul_q14(q14_of(row.x), sum.x) + mul_q14(q14_of(row.y), sum.y) + mul_q14(q14_of(row.z), sum.z);
+        EXPECT_EQ(sum_ef % 4, 0) << i;
+        EXPECT_EQ(lp[i], sum_ef / 4) << i;
+    }
+}
