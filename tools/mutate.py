@@ -238,6 +238,15 @@ def same_tokens(before, after):
 NEW_LINE_AFTER = "(new line after) "
 
 
+# An equivalent mutant's `context:` is looked for among this many lines before it.
+CONTEXT_LINES = 3
+
+
+def is_equivalent(m, equivalent):
+    contexts = equivalent.get((m["file"], m["orig"], m["new"]), [])
+    return any(c is None or c in m["before"] for c in contexts)
+
+
 def generate(out, files, mutate_bin):
     """Every mutant of every selected file: a list of dicts."""
     mutants = []
@@ -272,13 +281,18 @@ def generate(out, files, mutate_bin):
             # insertion elsewhere in the file is another mutant.
             inserted = len(mutant_lines) == len(orig) + 1
             key = NEW_LINE_AFTER + orig[line - 2].strip() if inserted and line >= 2 else before.strip()
-            mutants.append({"file": path, "mutant": m, "line": line, "orig": key, "new": after.strip()})
+            before_lines = [t.strip() for t in orig[max(0, line - 1 - CONTEXT_LINES):line - 1]]
+            mutants.append({"file": path, "mutant": m, "line": line, "orig": key, "new": after.strip(),
+                            "before": before_lines})
     return mutants
 
 
 def load_equivalent():
-    """{(file, original, mutant): reason} from test/mutants_equivalent.txt: blocks of
-    `file:`, `original:`, `mutant:`, `reason:` lines, a blank line between blocks."""
+    """{(file, original, mutant): [context or None, ...]} from test/mutants_equivalent.txt:
+    blocks of `file:`, `original:`, `mutant:`, `reason:` lines (and an optional
+    `context:`, a line among the CONTEXT_LINES before the mutated one, for a line whose
+    text recurs in the file where only one of its mutants is equivalent), a blank line
+    between blocks."""
     out = {}
     if not os.path.exists(EQUIVALENT_FILE):
         return out
@@ -289,7 +303,7 @@ def load_equivalent():
         if not line.strip():
             if block:
                 key = (block.get("file", ""), block.get("original", ""), block.get("mutant", ""))
-                out[key] = block.get("reason", "")
+                out.setdefault(key, []).append(block.get("context"))
                 if not block.get("reason"):
                     sys.exit("mutate: %s: no reason for %s" % (EQUIVALENT_FILE, key))
             block = {}
@@ -418,7 +432,7 @@ def main():
         args.mutants = "all"
     for m in mutants:
         lib = files[m["file"]]
-        if (m["file"], m["orig"], m["new"]) in equivalent:
+        if is_equivalent(m, equivalent):
             n_equivalent[lib] += 1
             continue
         pool[lib].append(m)
