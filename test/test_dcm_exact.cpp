@@ -155,3 +155,78 @@ TEST(DcmExact, AFourSampleWindowsMeansAreExact) {
         EXPECT_EQ(lp[i], sum_ef / 4) << i;
     }
 }
+
+// A window's mean over 1 to 5 samples is its sum times 1/n in Q30 rounded to nearest
+// (q30_ratio), to the unit: the sums here tell that factor from the float's 1/n (one
+// unit apart); a longer window (never in the estimator's schedule, possible in the
+// class) is its sum over n too.
+TEST(DcmExact, AWindowsMeanIsItsSumTimesTheRoundedInverse) {
+    struct Case {
+        uint8_t n;
+        int32_t gyro_counts;
+    };
+    for (const Case& c : {Case{3, 256}, Case{5, 820}, Case{1, 820}, Case{2, 821}}) {
+        OneWindow w;
+        w.run(linalg::q30_from_matrix(Matrix3f::identity()), Vector3l(c.gyro_counts, -c.gyro_counts, 0), Vector3l(0, 0, -4096),
+              c.n);
+        const int32_t sum_units = c.gyro_counts * c.n * 256;
+        const int32_t expected = linalg::mul_q30(linalg::q30_ratio(1, c.n), sum_units);
+        EXPECT_EQ(w.gyro_mean.x, expected) << (int)c.n;
+        EXPECT_EQ(w.gyro_mean.y, -expected) << (int)c.n;
+        if (c.n == 3 || c.n == 5)
+            EXPECT_NE(expected, linalg::mul_q30(linalg::fixed_from_float(1.0f / c.n, linalg::kQ30), sum_units)) << (int)c.n;
+    }
+    for (uint8_t n = 6; n <= 9; ++n) {
+        OneWindow w;
+        w.run(linalg::q30_from_matrix(Matrix3f::identity()), Vector3l(10, -20, 30), Vector3l(100, -200, -4096), n);
+        EXPECT_NEAR(w.gyro_mean.x, 10 * 256, 1) << (int)n;
+        EXPECT_NEAR(w.gyro_mean.z, 30 * 256, 1) << (int)n;
+        EXPECT_NEAR(w.accel_mean.y, -200 * 256, 1) << (int)n;
+        EXPECT_TRUE(w.whole) << (int)n;
+    }
+}
+
+// The low-pass's factor ramps over the start-up from the start's (startup_accel_alpha)
+// to the steady one (accel_alpha): startup_left of the way back from the steady one.
+TEST(DcmExact, TheLowPassFactorRampsOverTheStartUp) {
+    for (float startup_left : {1.0f, 0.5f, 0.25f}) {
+        OneWindow w;
+        w.k = float_form_coefficients();
+        const float steady = linalg::float_from_fixed(w.k.accel_alpha_q30, linalg::kQ30);
+        const float expected = w.k.startup_accel_alpha + (steady - w.k.startup_accel_alpha) * (1.0f - startup_left);
+        ASSERT_GT(w.k.startup_accel_alpha, 2.0f * steady);
+        // Level, 1 000 counts along x: the low-pass (at gravity, x = 0) moves by alpha of it.
+        w.run(linalg::q30_from_matrix(Matrix3f::identity()), Vector3l(), Vector3l(1000, 0, -4096), 4, Vector3l(), true,
+              startup_left);
+        EXPECT_NEAR(w.gravity.low_pass_ef().x / (1000.0f * 256.0f), expected, 1e-5f) << startup_left;
+    }
+}
+
+// Each sample of the window meets the matrix of its own step: turned back by the rate
+// times the steps from it to the matrix's time (R = I, nothing pending: n - j + 1 for
+// sample j), sum_j a_j - (w dt x a_j)(n - j + 1). Against that sum in double, the
+// window's earth-frame mean is within the turn's 16-bit rounding (2^-15 rad a step) on
+// every axis, for a turn about all three.
+TEST(DcmExact, TheWindowsSamplesAreTurnedToTheMatrixsTime) {
+    OneWindow w;
+    const double w_rad_s[3] = {1.5, -2.0, 2.5};
+    const double dt = w.k.step_s;
+    const Vector3l gyro_counts((int32_t)std::lround(w_rad_s[0] / dcm::kFloatGyroScale),
+                               (int32_t)std::lround(w_rad_s[1] / dcm::kFloatGyroScale),
+                               (int32_t)std::lround(w_rad_s[2] / dcm::kFloatGyroScale));
+    const Vector3l accel_counts(2000, -1500, -3000);
+    const uint8_t n = 4;
+    w.run(linalg::q30_from_matrix(Matrix3f::identity()), gyro_counts, accel_counts, n);
+    const double a[3] = {accel_counts.x * 256.0, accel_counts.y * 256.0, accel_counts.z * 256.0};
+    const double phi[3] = {gyro_counts.x * dcm::kFloatGyroScale * dt, gyro_counts.y * dcm::kFloatGyroScale * dt,
+                           gyro_counts.z * dcm::kFloatGyroScale * dt};
+    const double phi_x_a[3] = {phi[1] * a[2] - phi[2] * a[1], phi[2] * a[0] - phi[0] * a[2], phi[0] * a[1] - phi[1] * a[0]};
+    const double steps_summed = n * (n + 1) / 2.0;  // sum_j (n - j + 1)
+    const double bound = 0.5 / 16384.0 * steps_summed * std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) / n + 8.0;
+    const int32_t lp[3] = {w.gravity.low_pass_ef().x, w.gravity.low_pass_ef().y, w.gravity.low_pass_ef().z};
+    for (int i = 0; i < 3; ++i) {
+        const double expected = a[i] - steps_summed / n * phi_x_a[i];
+        EXPECT_NEAR(lp[i], expected, bound) << i;
+        EXPECT_GT(std::fabs(expected - a[i]), 10.0 * bound) << i << ": the turn term is seen";
+    }
+}
