@@ -230,3 +230,34 @@ TEST(DcmExact, TheWindowsSamplesAreTurnedToTheMatrixsTime) {
         EXPECT_GT(std::fabs(expected - a[i]), 10.0 * bound) << i << ": the turn term is seen";
     }
 }
+
+// Beyond 90 deg of heading error the correction is the one of 90 deg (the sine held at
+// +-1, monotonic): two estimators alike but for a field 91 deg off (whose earth-frame
+// north component is only -0.35 uT) and one 170 deg off turn R identically, bit for bit.
+TEST(DcmExact, AHeadingErrorBeyond90DegIsCorrectedAsAt90) {
+    dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
+    settings.kp_startup_1_s = settings.kp_yaw_1_s;  // the steady gain from the start: 0.2 deg a mean
+    const Matrix3f level = Matrix3f::identity();
+    dcm::Dcm a(settings), b(settings), unturned(settings);
+    for (dcm::Dcm* f : {&a, &b, &unturned}) ASSERT_TRUE(f->init(accel_for(level), mag_for(level)));
+    const Vector3f field_91 = dcm::dcm_from_euler(0, 0, 91.0f * linalg::kRadPerDeg).mul_transpose(earth_field_uT());
+    const Vector3f field_170 = dcm::dcm_from_euler(0, 0, 170.0f * linalg::kRadPerDeg).mul_transpose(earth_field_uT());
+    const float dt = settings.step_s;
+    float next_mag_s = 0.0f;
+    for (int i = 0; i < 40; ++i) {  // 0.2 s: five means, the error stays beyond 90 deg
+        if (i * dt >= next_mag_s) {
+            a.correct_heading(field_91);
+            b.correct_heading(field_170);
+            unturned.correct_heading(mag_for(level));
+            next_mag_s += 1.0f / 75.0f;
+        }
+        for (dcm::Dcm* f : {&a, &b, &unturned}) f->update(Vector3f(), accel_for(level));
+    }
+    const Matrix3f ra = a.matrix(), rb = b.matrix();
+    const float da[9] = {ra.a.x, ra.a.y, ra.a.z, ra.b.x, ra.b.y, ra.b.z, ra.c.x, ra.c.y, ra.c.z};
+    const float db[9] = {rb.a.x, rb.a.y, rb.a.z, rb.b.x, rb.b.y, rb.b.z, rb.c.x, rb.c.y, rb.c.z};
+    for (int i = 0; i < 9; ++i) EXPECT_EQ(da[i], db[i]) << i;
+    // The heading did turn (towards the field) meanwhile.
+    EXPECT_GT(std::fabs(a.euler().yaw_rad - unturned.euler().yaw_rad), 0.5f * linalg::kRadPerDeg);
+    EXPECT_FALSE(a.status() & dcm::kStatusMagIgnored);
+}
