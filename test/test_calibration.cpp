@@ -603,3 +603,34 @@ TEST(OffsetLearner, SplitSolveGivesTheReferenceEstimates) {
     EXPECT_NEAR(compare_with_reference(Vector3f(8.0f, -5.0f, 3.0f), 0.2f, 60.0f, true).in_use.x, 8.0f, 0.3f);
     EXPECT_TRUE(compare_with_reference(Vector3f(120.0f, 0.0f, 0.0f), 0.2f, 60.0f, true).in_use == Vector3f());
 }
+
+// The coverage is the share of the 26 direction cells seen kMagCellMinSamples times, in
+// percent rounded to nearest: one cell is 4 % (3.85), three 12 (11.5), all 100.
+TEST(Calibration, MagCoverageIsTheShareOfCellsRounded) {
+    MagCalibrator m;
+    m.restart(Vector3f());
+    int seen = 0;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                if (x == 0 && y == 0 && z == 0) continue;
+                const Vector3f direction = Vector3f((float)x, (float)y, (float)z);
+                for (int i = 0; i < calib::kMagCellMinSamples; ++i) m.add(direction * (50.0f / direction.length()));
+                ++seen;
+                EXPECT_EQ(m.coverage_pct(), (int)std::lround(seen * 100.0 / 26.0)) << seen << " cells";
+            }
+    EXPECT_EQ(seen, 26);
+}
+
+// A fit takes kMagCalMinSamples samples: one fewer is too few, that many enough.
+TEST(Calibration, MagFitTakesFromExactlyItsMinimumSamples) {
+    for (int n : {calib::kMagCalMinSamples - 1, (int)calib::kMagCalMinSamples}) {
+        MagCalibrator m;
+        m.restart(Vector3f());
+        feed_random(m, n, Vector3f(8.0f, -5.0f, 3.0f), Matrix3f::identity(), 49.2f, 0.2f);
+        calib::Calibration c = calib::default_calibration();
+        EXPECT_EQ(m.finish(c), n < calib::kMagCalMinSamples ? MagCalibrator::Quality::TooFewSamples
+                                                            : MagCalibrator::Quality::Ok)
+            << n;
+    }
+}
