@@ -634,3 +634,22 @@ TEST(Calibration, MagFitTakesFromExactlyItsMinimumSamples) {
             << n;
     }
 }
+
+// Soft iron whose cross terms alone are beyond kMagMaxCross (0.3 between x and y: the
+// diagonal stays within kMagMinDiag..kMagMaxDiag) is refused too.
+TEST(Calibration, MagCrossTermsAloneBeyondTheLimitAreRefused) {
+    MagCalibrator m;
+    m.restart(Vector3f());
+    const Matrix3f s(Vector3f(1.0f, 0.3f, 0.0f), Vector3f(0.3f, 1.0f, 0.0f), Vector3f(0.0f, 0.0f, 1.0f));
+    feed_random(m, 2250, Vector3f(), s, 40.0f, 0.2f, 16);
+    calib::Calibration c = calib::default_calibration();
+    EXPECT_EQ(m.finish(c), MagCalibrator::Quality::SoftIronTooLarge);
+    // What decided: the cross terms, not the diagonal.
+    c = calib::default_calibration();
+    m.result(c);
+    EXPECT_GT(std::fabs(c.mag_cross.x), calib::kMagMaxCross);
+    for (float diag : {c.mag_scale.x, c.mag_scale.y, c.mag_scale.z}) {
+        EXPECT_GT(diag, calib::kMagMinDiag);
+        EXPECT_LT(diag, calib::kMagMaxDiag);
+    }
+}
