@@ -653,3 +653,20 @@ TEST(Calibration, MagCrossTermsAloneBeyondTheLimitAreRefused) {
         EXPECT_LT(diag, calib::kMagMaxDiag);
     }
 }
+
+// The coverage cells' centre is the sphere fit of the samples so far, refitted at every
+// kCoverageRefitSamples'th sample: after a second sphere's samples follow the first's,
+// it stays at the first's centre until the next multiple, then moves towards the second.
+TEST(Calibration, MagCoverageCentreIsRefittedEachRefitSamples) {
+    const int n = calib::kCoverageRefitSamples;
+    const Vector3f first(8.0f, -5.0f, 3.0f), second(28.0f, -5.0f, 3.0f);
+    MagCalibrator m;
+    m.restart(Vector3f());
+    feed_random(m, n, first, Matrix3f::identity(), 49.2f, 0.0f, 21);
+    EXPECT_NEAR(m.sphere_offset_uT().x, first.x, 0.01f);
+    feed_random(m, n - 1, second, Matrix3f::identity(), 49.2f, 0.0f, 22);
+    EXPECT_NEAR(m.sphere_offset_uT().x, first.x, 0.01f);
+    feed_random(m, 1, second, Matrix3f::identity(), 49.2f, 0.0f, 23);
+    EXPECT_GT(m.sphere_offset_uT().x, first.x + 5.0f);
+    EXPECT_LT(m.sphere_offset_uT().x, second.x - 5.0f);
+}
