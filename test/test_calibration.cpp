@@ -670,3 +670,25 @@ TEST(Calibration, MagCoverageCentreIsRefittedEachRefitSamples) {
     EXPECT_GT(m.sphere_offset_uT().x, first.x + 5.0f);
     EXPECT_LT(m.sphere_offset_uT().x, second.x - 5.0f);
 }
+
+// A gyro or accel axis may spread by exactly its limit in counts (the limit over the
+// scale, truncated) and the window is still; one count more and the board moved.
+TEST(Calibration, GyroSpreadUpToItsLimitExactlyIsStill) {
+    const float gyro_scale = 0.001f, accel_scale = 0.005f;  // rad/s and m/s^2 per count
+    const int16_t gyro_limit = (int16_t)(calib::kGyroSpreadMax_rad_s / gyro_scale);
+    const int16_t accel_limit = (int16_t)(calib::kAccelSpreadMax_m_s2 / accel_scale);
+    const int16_t g_counts = (int16_t)std::lround(9.80665f / accel_scale);
+    for (int axis = 0; axis < 6; ++axis) {
+        for (int16_t beyond : {0, 1}) {
+            const int16_t step = (int16_t)((axis < 3 ? gyro_limit : accel_limit) + beyond);
+            GyroCalibrator cal;
+            GyroCalibrator::Result r = GyroCalibrator::Result::Collecting;
+            for (int i = 0; i < calib::kGyroWindow && r == GyroCalibrator::Result::Collecting; ++i) {
+                int16_t v[6] = {0, 0, 0, 0, 0, g_counts};
+                if (i & 1) v[axis] = (int16_t)(v[axis] + step);
+                r = cal.add(linalg::Vector3i(v[0], v[1], v[2]), linalg::Vector3i(v[3], v[4], v[5]), gyro_scale, accel_scale);
+            }
+            EXPECT_EQ(r, beyond ? GyroCalibrator::Result::Moved : GyroCalibrator::Result::Done) << axis << " " << beyond;
+        }
+    }
+}
