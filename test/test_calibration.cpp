@@ -603,3 +603,92 @@ TEST(OffsetLearner, SplitSolveGivesTheReferenceEstimates) {
     EXPECT_NEAR(compare_with_reference(Vector3f(8.0f, -5.0f, 3.0f), 0.2f, 60.0f, true).in_use.x, 8.0f, 0.3f);
     EXPECT_TRUE(compare_with_reference(Vector3f(120.0f, 0.0f, 0.0f), 0.2f, 60.0f, true).in_use == Vector3f());
 }
+
+// The coverage is the share of the 26 direction cells seen kMagCellMinSamples times, in
+// percent rounded to nearest: one cell is 4 % (3.85), three 12 (11.5), all 100.
+TEST(Calibration, MagCoverageIsTheShareOfCellsRounded) {
+    MagCalibrator m;
+    m.restart(Vector3f());
+    int seen = 0;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                if (x == 0 && y == 0 && z == 0) continue;
+                const Vector3f direction = Vector3f((float)x, (float)y, (float)z);
+                for (int i = 0; i < calib::kMagCellMinSamples; ++i) m.add(direction * (50.0f / direction.length()));
+                ++seen;
+                EXPECT_EQ(m.coverage_pct(), (int)std::lround(seen * 100.0 / 26.0)) << seen << " cells";
+            }
+    EXPECT_EQ(seen, 26);
+}
+
+// A fit takes kMagCalMinSamples samples: one fewer is too few, that many enough.
+TEST(Calibration, MagFitTakesFromExactlyItsMinimumSamples) {
+    for (int n : {calib::kMagCalMinSamples - 1, (int)calib::kMagCalMinSamples}) {
+        MagCalibrator m;
+        m.restart(Vector3f());
+        feed_random(m, n, Vector3f(8.0f, -5.0f, 3.0f), Matrix3f::identity(), 49.2f, 0.2f);
+        calib::Calibration c = calib::default_calibration();
+        EXPECT_EQ(m.finish(c), n < calib::kMagCalMinSamples ? MagCalibrator::Quality::TooFewSamples
+                                                            : MagCalibrator::Quality::Ok)
+            << n;
+    }
+}
+
+// Soft iron whose cross terms alone are beyond kMagMaxCross (0.3 between x and y: the
+// diagonal stays within kMagMinDiag..kMagMaxDiag) is refused too.
+TEST(Calibration, MagCrossTermsAloneBeyondTheLimitAreRefused) {
+    MagCalibrator m;
+    m.restart(Vector3f());
+    const Matrix3f s(Vector3f(1.0f, 0.3f, 0.0f), Vector3f(0.3f, 1.0f, 0.0f), Vector3f(0.0f, 0.0f, 1.0f));
+    feed_random(m, 2250, Vector3f(), s, 40.0f, 0.2f, 16);
+    calib::Calibration c = calib::default_calibration();
+    EXPECT_EQ(m.finish(c), MagCalibrator::Quality::SoftIronTooLarge);
+    // What decided: the cross terms, not the diagonal.
+    c = calib::default_calibration();
+    m.result(c);
+    EXPECT_GT(std::fabs(c.mag_cross.x), calib::kMagMaxCross);
+    for (float diag : {c.mag_scale.x, c.mag_scale.y, c.mag_scale.z}) {
+        EXPECT_GT(diag, calib::kMagMinDiag);
+        EXPECT_LT(diag, calib::kMagMaxDiag);
+    }
+}
+
+// The coverage cells' centre is the sphere fit of the samples so far, refitted at every
+// kCoverageRefitSamples'th sample: after a second sphere's samples follow the first's,
+// it stays at the first's centre until the next multiple, then moves towards the second.
+TEST(Calibration, MagCoverageCentreIsRefittedEachRefitSamples) {
+    const int n = calib::kCoverageRefitSamples;
+    const Vector3f first(8.0f, -5.0f, 3.0f), second(28.0f, -5.0f, 3.0f);
+    MagCalibrator m;
+    m.restart(Vector3f());
+    feed_random(m, n, first, Matrix3f::identity(), 49.2f, 0.0f, 21);
+    EXPECT_NEAR(m.sphere_offset_uT().x, first.x, 0.01f);
+    feed_random(m, n - 1, second, Matrix3f::identity(), 49.2f, 0.0f, 22);
+    EXPECT_NEAR(m.sphere_offset_uT().x, first.x, 0.01f);
+    feed_random(m, 1, second, Matrix3f::identity(), 49.2f, 0.0f, 23);
+    EXPECT_GT(m.sphere_offset_uT().x, first.x + 5.0f);
+    EXPECT_LT(m.sphere_offset_uT().x, second.x - 5.0f);
+}
+
+// A gyro or accel axis may spread by exactly its limit in counts (the limit over the
+// scale, truncated) and the window is still; one count more and the board moved.
+TEST(Calibration, GyroSpreadUpToItsLimitExactlyIsStill) {
+    const float gyro_scale = 0.001f, accel_scale = 0.005f;  // rad/s and m/s^2 per count
+    const int16_t gyro_limit = (int16_t)(calib::kGyroSpreadMax_rad_s / gyro_scale);
+    const int16_t accel_limit = (int16_t)(calib::kAccelSpreadMax_m_s2 / accel_scale);
+    const int16_t g_counts = (int16_t)std::lround(9.80665f / accel_scale);
+    for (int axis = 0; axis < 6; ++axis) {
+        for (int16_t beyond : {0, 1}) {
+            const int16_t step = (int16_t)((axis < 3 ? gyro_limit : accel_limit) + beyond);
+            GyroCalibrator cal;
+            GyroCalibrator::Result r = GyroCalibrator::Result::Collecting;
+            for (int i = 0; i < calib::kGyroWindow && r == GyroCalibrator::Result::Collecting; ++i) {
+                int16_t v[6] = {0, 0, 0, 0, 0, g_counts};
+                if (i & 1) v[axis] = (int16_t)(v[axis] + step);
+                r = cal.add(linalg::Vector3i(v[0], v[1], v[2]), linalg::Vector3i(v[3], v[4], v[5]), gyro_scale, accel_scale);
+            }
+            EXPECT_EQ(r, beyond ? GyroCalibrator::Result::Moved : GyroCalibrator::Result::Done) << axis << " " << beyond;
+        }
+    }
+}

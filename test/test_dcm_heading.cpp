@@ -154,3 +154,15 @@ TEST(DcmHeading, ARestartCountsTheSteadinessFromZero) {
     g.gate.restart_steady_count();
     EXPECT_EQ(g.one_step_means_to_adopt(kEarthNorm * 1.3f), (int)g.k.mag_recover_steps);
 }
+
+// The learned field tracks slow changes of the local field (temperature, location) with
+// 1.32 s: each mean of the earth field moves the strength and the dip by dt / 1.32 s of
+// their difference.
+TEST(DcmHeading, TheLearnedFieldFollowsWithItsTimeConstant) {
+    Gate g;
+    const float alpha = kMeanDt / 1.32f;
+    const float norm = kEarthNorm * 1.05f, down = kEarthDown + 0.05f;
+    ASSERT_EQ(g.judge(norm, down), dcm::FieldVerdict::kEarthField);
+    EXPECT_NEAR(g.gate.ref_norm(), kEarthNorm + alpha * (norm - kEarthNorm), 1e-5f);
+    EXPECT_NEAR(g.gate.ref_down(), kEarthDown + alpha * (down - kEarthDown), 1e-6f);
+}

@@ -207,3 +207,26 @@ TEST(DcmRest, TheAccelMeanFollowsEachAxisAlike) {
         EXPECT_TRUE(f.rest.update(f.gyro_mean, accel, Vector3l(), true, true, f.k)) << axis;
     }
 }
+
+// A window that is not whole (or not still) ends a rest, and the count starts again
+// from zero: rest again after exactly rest_min_corrections + 1 still windows.
+TEST(DcmRest, AShortWindowRestartsTheCountFromZero) {
+    RestFixture f;
+    ASSERT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
+    EXPECT_FALSE(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), false, true, f.k));
+    EXPECT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
+}
+
+// The rest mean's difference from the bias is saturated alike on both sides: a mean
+// far below the estimate moves it down exactly as far as one far above moves it up
+// (never a wrapped difference that moves it the wrong way).
+TEST(DcmGyroBias, AFarRestMeanMovesTheBiasAlikeOnBothSides) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    for (int32_t far_units : {1L << 23, 3L << 23, 1L << 26}) {
+        dcm::GyroBias up, down;
+        up.follow_rest_mean(Vector3l(far_units, 0, 0), k);
+        down.follow_rest_mean(Vector3l(-far_units, 0, 0), k);
+        EXPECT_GT(up.units().x, 0) << far_units;
+        EXPECT_EQ(down.units().x, -up.units().x) << far_units;
+    }
+}

@@ -92,3 +92,13 @@ TEST(EulerHeading, AYawAHairBelowZeroIsNorthNot360) {
     EXPECT_LT(h, 360.0f);
     EXPECT_EQ(h, 0.0f);
 }
+
+// Euler.h promises 0 outside the documented ranges (yaw -pi..pi, declination
+// -180..180), but the folds wrap an h within (-720, 720): a 190 deg declination at a
+// 3 rad yaw (h = 361.9) gives 1.9, and -190 at -3 rad gives 358.1. The doc or the code
+// is to change (the lead's call: lib/ is not this branch's); disabled until then. Found
+// by make mutate: without the `h >= 360` fold no test inside the ranges tells.
+TEST(EulerHeading, DISABLED_BeyondTheDocumentedRangesIsZero) {
+    EXPECT_EQ(dcm::heading_deg(3.0f, 190.0f), 0.0f);
+    EXPECT_EQ(dcm::heading_deg(-3.0f, -190.0f), 0.0f);
+}

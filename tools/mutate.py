@@ -9,7 +9,8 @@ kill score is printed per library, then each survivor (file, line, original, mut
 
 Mutants that cannot change behaviour (equivalent ones) are listed in
 test/mutants_equivalent.txt, keyed by the file, the mutated line's text and its
-replacement (never by line number: the files change), each with its reason; they are
+replacement (never by line number: the files change; an inserted line's "original" is
+"(new line after) " and the line before it), each with its reason; they are
 left out of the sample and the score.
 
 Not mutated: lines the host does not compile (#ifdef __AVR__ blocks; the trace's
@@ -233,6 +234,19 @@ def same_tokens(before, after):
     return canonical(before) == canonical(after)
 
 
+# An inserted line's "original" (report and equivalent-mutant file): the line before it.
+NEW_LINE_AFTER = "(new line after) "
+
+
+# An equivalent mutant's `context:` is looked for among this many lines before it.
+CONTEXT_LINES = 3
+
+
+def is_equivalent(m, equivalent):
+    contexts = equivalent.get((m["file"], m["orig"], m["new"]), [])
+    return any(c is None or c in m["before"] for c in contexts)
+
+
 def generate(out, files, mutate_bin):
     """Every mutant of every selected file: a list of dicts."""
     mutants = []
@@ -252,7 +266,8 @@ def generate(out, files, mutate_bin):
         stem, ext = os.path.splitext(base)
         for m in sorted(glob.glob(os.path.join(mdir, stem + ".mutant.*" + ext)),
                         key=lambda f: int(f.rsplit(".", 2)[-2])):
-            c = changed_line(orig, open(m).read().split("\n"))
+            mutant_lines = open(m).read().split("\n")
+            c = changed_line(orig, mutant_lines)
             if c is None:
                 continue
             line, before, after = c
@@ -262,14 +277,22 @@ def generate(out, files, mutate_bin):
                 continue
             if same_tokens(before, after):
                 continue
-            mutants.append({"file": path, "mutant": m, "line": line, "orig": before.strip(),
-                            "new": after.strip()})
+            # An inserted line (continue; break;) is keyed by the line it follows: the same
+            # insertion elsewhere in the file is another mutant.
+            inserted = len(mutant_lines) == len(orig) + 1
+            key = NEW_LINE_AFTER + orig[line - 2].strip() if inserted and line >= 2 else before.strip()
+            before_lines = [t.strip() for t in orig[max(0, line - 1 - CONTEXT_LINES):line - 1]]
+            mutants.append({"file": path, "mutant": m, "line": line, "orig": key, "new": after.strip(),
+                            "before": before_lines})
     return mutants
 
 
 def load_equivalent():
-    """{(file, original, mutant): reason} from test/mutants_equivalent.txt: blocks of
-    `file:`, `original:`, `mutant:`, `reason:` lines, a blank line between blocks."""
+    """{(file, original, mutant): [context or None, ...]} from test/mutants_equivalent.txt:
+    blocks of `file:`, `original:`, `mutant:`, `reason:` lines (and an optional
+    `context:`, a line among the CONTEXT_LINES before the mutated one, for a line whose
+    text recurs in the file where only one of its mutants is equivalent), a blank line
+    between blocks."""
     out = {}
     if not os.path.exists(EQUIVALENT_FILE):
         return out
@@ -280,7 +303,7 @@ def load_equivalent():
         if not line.strip():
             if block:
                 key = (block.get("file", ""), block.get("original", ""), block.get("mutant", ""))
-                out[key] = block.get("reason", "")
+                out.setdefault(key, []).append(block.get("context"))
                 if not block.get("reason"):
                     sys.exit("mutate: %s: no reason for %s" % (EQUIVALENT_FILE, key))
             block = {}
@@ -409,7 +432,7 @@ def main():
         args.mutants = "all"
     for m in mutants:
         lib = files[m["file"]]
-        if (m["file"], m["orig"], m["new"]) in equivalent:
+        if is_equivalent(m, equivalent):
             n_equivalent[lib] += 1
             continue
         pool[lib].append(m)
