@@ -54,13 +54,15 @@ AVR_DEFS  := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -DARDUINO=10819 -DARDUINO_AVR_MEGA256
 AVR_INC   := -I$(CORE_DIR) -I$(ARDUINO_AVR)/variants/mega -I$(WIRE_DIR) -I$(WIRE_DIR)/utility \
              -I$(SPI_DIR) -I$(EEPROM_DIR) $(addprefix -I,$(LIB_DIRS)) -Ifirmware
 # -mcall-prologues -mrelax: 1.5 KB less flash for +0.4 % loop cycles (measured with --profile)
-AVR_OPT   := -Os -flto -ffunction-sections -fdata-sections -mcall-prologues -mrelax
+# -mstrict-X: the X register only where the AVR can address through it (it has no
+# displacement): smaller, and the estimator step no slower (README "Performance").
+AVR_OPT   := -Os -flto -ffunction-sections -fdata-sections -mcall-prologues -mrelax -mstrict-X
 AVR_CFLAGS   := $(AVR_DEFS) $(AVR_OPT) -std=gnu11
 AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 -fno-exceptions -fno-threadsafe-statics \
                 -fno-rtti -DDECIMAL_DIG=__DECIMAL_DIG__
 # The project's own files: every warning is an error.
 PROJECT_WARN := -Wall -Wextra -Werror -Wdouble-promotion
-AVR_LDFLAGS  := -mmcu=$(MCU) -Os -flto -fuse-linker-plugin -Wl,--gc-sections -mcall-prologues -mrelax
+AVR_LDFLAGS  := -mmcu=$(MCU) -Os -flto -fuse-linker-plugin -Wl,--gc-sections -mcall-prologues -mrelax -mstrict-X
 
 CORE_SRC := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcard $(CORE_DIR)/*.S) \
             $(WIRE_DIR)/Wire.cpp $(WIRE_DIR)/utility/twi.c $(SPI_DIR)/SPI.cpp
