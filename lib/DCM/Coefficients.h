@@ -148,7 +148,7 @@ FIXED_INLINE int32_t DcmCoefficients::theta_axis_q26(int32_t units) const {
     return linalg::hot::mul_q30(theta_factor_q30, units);
 }
 
-FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26(const linalg::Vector3l& units) const {
+FIXED_COLD inline linalg::Vector3l DcmCoefficients::theta_q26(const linalg::Vector3l& units) const {
     if (theta_factor_q30 == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
     return linalg::Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
 }
