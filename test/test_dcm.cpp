@@ -403,3 +403,45 @@ TEST(Dcm, OutputLeadsByTheSensorDelay) {
     EXPECT_NEAR(lead_deg, 100.0f * filter.settings().output_lead_s, 0.01f);
     EXPECT_GT(filter.settings().output_lead_s, 0.0f);
 }
+
+// The output leads on every axis, in the integer path too (the board's scales): rolling,
+// pitching or yawing at 100 deg/s, the printed angle is output_lead_s ahead.
+TEST(Dcm, OutputLeadsOnEveryAxisAtTheBoardsScales) {
+    const float rate_rad_s = 100.0f * linalg::kRadPerDeg;
+    for (int axis = 0; axis < 3; ++axis) {
+        dcm::Dcm filter;
+        filter.set_sample_scales(1.0f / 16.4f * linalg::kRadPerDeg, 8.0f * 9.80665f / 32768.0f);
+        ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), Vector3f()));
+        const Vector3f rate(axis == 0 ? rate_rad_s : 0.0f, axis == 1 ? rate_rad_s : 0.0f, axis == 2 ? rate_rad_s : 0.0f);
+        const float counts_per_rad_s = 16.4f / linalg::kRadPerDeg, counts_per_m_s2 = 32768.0f / (8.0f * 9.80665f);
+        const linalg::Vector3i gyro((int16_t)std::lround(rate.x * counts_per_rad_s), (int16_t)std::lround(rate.y * counts_per_rad_s),
+                                    (int16_t)std::lround(rate.z * counts_per_rad_s));
+        const linalg::Vector3i level(0, 0, (int16_t)std::lround(-9.80665f * counts_per_m_s2));
+        for (int i = 0; i < 20; ++i) filter.update(gyro, level, true, true, false);  // 0.1 s: 10 deg at most
+        const dcm::EulerAngles now = filter.euler_now(), raw = filter.euler();
+        const float lead_deg[3] = {(now.roll_rad - raw.roll_rad) * linalg::kDegPerRad,
+                                   (now.pitch_rad - raw.pitch_rad) * linalg::kDegPerRad,
+                                   wrap_deg((now.yaw_rad - raw.yaw_rad) * linalg::kDegPerRad)};
+        // The 20th step has just integrated: nothing pending, the lead alone (0.3 deg), to
+        // 10 % (the angles are read off R carried to first order, at 10 deg of tilt).
+        EXPECT_NEAR(lead_deg[axis], 100.0f * filter.settings().output_lead_s,
+                    10.0f * filter.settings().output_lead_s) << axis;
+    }
+}
+
+// Samples the accelerometer cannot have given end a rest: the rest must last rest_min_s
+// again before the bias is taken from it. One broken sample shortens its gravity window
+// (which restarts the count); a run of them leaves whole windows empty, where only the
+// step's own interrupt restarts it.
+TEST(Dcm, BrokenAccelSamplesEndTheRest) {
+    for (const int broken : {1, 3 * dcm::Dcm::kCorrectionDivider}) {
+        RestRun run(Matrix3f::identity());
+        run.run(5.0f, Vector3f());
+        ASSERT_TRUE(run.filter.status() & dcm::kStatusAtRest);
+        for (int i = 0; i < broken; ++i) run.filter.update(Vector3f(), Vector3f(NAN, 0.0f, -9.8f));
+        run.run(0.5f, Vector3f());
+        EXPECT_FALSE(run.filter.status() & dcm::kStatusAtRest) << broken;
+        run.run(2.0f, Vector3f());
+        EXPECT_TRUE(run.filter.status() & dcm::kStatusAtRest) << broken;
+    }
+}

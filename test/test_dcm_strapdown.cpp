@@ -280,3 +280,27 @@ TEST(DcmCoefficients, ScaleQ15IsTheProductToAUnit) {
         }
     }
 }
+
+// Within 0.2 % of unit length (|r|^2 within 1 -+ 0.002) a row takes the first-order
+// factor (3 - r.r)/2 in Q30, to the bit; just outside, the exact one.
+TEST(DcmStrapdown, RescaleTakesTheFirstOrderFactorInsideItsWindow) {
+    const int32_t one = linalg::kOneQ30;
+    for (const double length2 : {0.9985, 0.9995, 1.0, 1.0005, 1.0019}) {
+        const int32_t x = (int32_t)std::lround(std::sqrt(length2 * 0.5) * one);
+        const linalg::Vector3l row(x, -x, 0);
+        const uint32_t l2 = (uint32_t)linalg::mul_q30(x, x) * 2u;
+        const int32_t factor = one + one / 2 - (int32_t)(l2 / 2);
+        linalg::Vector3l out;
+        ASSERT_TRUE(dcm::Strapdown::rescale(row, out)) << length2;
+        EXPECT_EQ(out.x, linalg::mul_q30(factor, x)) << length2;
+        EXPECT_EQ(out.y, linalg::mul_q30(factor, -x)) << length2;
+        EXPECT_EQ(out.z, 0);
+    }
+    // Outside the window: unit length from the exact factor (the first order would leave
+    // 3/8 (r.r - 1)^2 = 1.5e-5 here).
+    const int32_t x = (int32_t)std::lround(std::sqrt(1.01 * 0.5) * one);
+    linalg::Vector3l out;
+    ASSERT_TRUE(dcm::Strapdown::rescale(linalg::Vector3l(x, x, 0), out));
+    const double l = std::sqrt(2.0 * (double)out.x * out.x) / one;
+    EXPECT_NEAR(l, 1.0, 2e-7);
+}

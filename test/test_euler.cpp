@@ -2,6 +2,8 @@
 // Euler extraction: aerospace Z-Y-X, finite and exact through pitch +-90 deg.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "dcm_test_support.h"
 
 using namespace dcm_test;
@@ -104,4 +106,17 @@ TEST(EulerHeading, BeyondTheDocumentedRangesFoldsWithin720ElseZero) {
     EXPECT_NEAR(dcm::heading_deg(-3.0f, -190.0f), 720.0f - yaw_deg - 190.0f, 1e-3f);
     EXPECT_EQ(dcm::heading_deg(0.0f, 800.0f), 0.0f);
     EXPECT_EQ(dcm::heading_deg(0.0f, -800.0f), 0.0f);
+}
+
+// A yaw of exactly 180 deg is +pi on both sides of the gimbal lock: away from it from
+// R21 = 0, R11 < 0; at it (pitch +90, roll folded into yaw) from R12 = 0, R22 < 0.
+TEST(EulerQ24, YawOf180DegIsPlusPiAtTheGimbalLockAsAwayFromIt) {
+    const int32_t one = 1073741824, pi_q24 = (int32_t)std::lround(3.14159265358979 * 16777216.0);
+    // Level, facing south: R11 = -1, R21 = 0, R31 = 0, R12 = 0, R22 = -1, R32 = 0, R33 = 1.
+    const dcm::EulerQ24 level = dcm::euler_q24_from_q30(-one, 0, 0, -one, 0, 0, one);
+    EXPECT_NEAR(level.yaw_q24, pi_q24, 2);
+    // Nose straight up, facing south: R11 = R21 = 0, R31 = -1, R12 = 0, R22 = -1, R32 = R33 = 0.
+    const dcm::EulerQ24 up = dcm::euler_q24_from_q30(0, 0, 0, -one, -one, 0, 0);
+    EXPECT_NEAR(up.yaw_q24, pi_q24, 2);
+    EXPECT_EQ(up.roll_q24, 0);
 }
