@@ -725,3 +725,15 @@ TEST(OffsetLearner, ASampleWithANonFiniteTurnIsNotUsed) {
     EXPECT_TRUE(interrupted.learned == plain.learned);
     EXPECT_EQ(interrupted.updates, plain.updates);
 }
+
+// A sphere near the largest radius the Earth's field may have (90 uT: the quadric's
+// terms in the fit's scale are below 1) fits as well as a small one.
+TEST(Calibration, MagLargeSphereFits) {
+    MagCalibrator m;
+    m.restart(Vector3f());
+    feed_random(m, 2250, Vector3f(8.0f, -5.0f, 3.0f), Matrix3f::identity(), 90.0f, 0.2f, 31);
+    calib::Calibration c = calib::default_calibration();
+    ASSERT_EQ(m.finish(c), MagCalibrator::Quality::Ok);
+    EXPECT_NEAR(m.radius_uT(), 90.0f, 0.2f);
+    EXPECT_NEAR(c.mag_offset_uT.x, 8.0f, 0.1f);
+}
