@@ -261,3 +261,33 @@ TEST(DcmExact, AHeadingErrorBeyond90DegIsCorrectedAsAt90) {
     EXPECT_GT(std::fabs(a.euler().yaw_rad - unturned.euler().yaw_rad), 0.5f * linalg::kRadPerDeg);
     EXPECT_FALSE(a.status() & dcm::kStatusMagIgnored);
 }
+
+// A field sample is brought forward by the latency turn, rounded to Q16 radians to
+// nearest (as every rounding on its way is): mirrored in y (a turn about z of -w for +w,
+// the field's y negated), the heading taken at once from one strong sample is mirrored
+// to the bit. A turn rounded down would be a unit larger one way than the other.
+TEST(DcmExact, TheFieldsLatencyTurnIsRoundedAlikeBothWays) {
+    const Vector3f field_uT(900.0f, 150.0f, 400.0f);  // strong: a unit of the turn moves y by ~0.4 of a Q5 count
+    int mirrored = 0;
+    for (int32_t counts = 128 * 30; counts <= 128 * 90; counts += 128 * 3) {  // 0.23 to 0.7 rad/s
+        Matrix3f r[2];
+        for (int side = 0; side < 2; ++side) {
+            const float sign = side == 0 ? 1.0f : -1.0f;
+            dcm::Dcm f;
+            ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+            f.update(Vector3f(), accel_for(Matrix3f::identity()));
+            // The second step's rate waits (not yet integrated: R stays I) and is the last.
+            f.update(Vector3f(0.0f, 0.0f, sign * (float)counts * dcm::kFloatGyroScale), accel_for(Matrix3f::identity()));
+            f.reset_mag_reference(true);
+            f.correct_heading(Vector3f(field_uT.x, sign * field_uT.y, field_uT.z));
+            r[side] = f.matrix();
+        }
+        EXPECT_EQ(r[0].a.x, r[1].a.x) << counts;
+        EXPECT_EQ(r[0].a.y, -r[1].a.y) << counts;
+        EXPECT_EQ(r[0].b.x, -r[1].b.x) << counts;
+        EXPECT_EQ(r[0].b.y, r[1].b.y) << counts;
+        EXPECT_GT(std::fabs(r[0].a.y), 0.1f) << counts << ": the heading taken from the sample";
+        mirrored += r[0].a.y == -r[1].a.y;
+    }
+    EXPECT_EQ(mirrored, 21);
+}
