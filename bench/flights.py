@@ -111,22 +111,27 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         traj = paths.get(name)
         if not traj:
             continue
-        est = os.path.join(flight_dir, name + "_estimate.csv")
-        _, _, ours, err, _ = run_replay(("flight " + name, traj, est, replay, score))
-        if err:
-            errors.append("flight %s: %s" % (name, err))
-        # The same with the cruise speed a board without a pitot is given (TRIM_ARSPD_CM).
-        est_cruise = os.path.join(flight_dir, name + "_estimate_cruise.csv")
-        _, _, cruise, err, _ = run_replay(("flight %s, cruise speed" % name, traj, est_cruise, replay, score, (),
-                                           ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)))
-        if err:
-            errors.append("flight %s, cruise speed: %s" % (name, err))
-        cells = [name] + ["%.2f / %.2f / %.2f" % (o["total"], o["incl"], o["heading"]) if o else "–"
-                          for o in (ours, cruise)]
-        if name == "turn" and ours:
-            turn_worst["ours (replay)"] = worst_roll_error_replay(traj, est)[0]
-            if cruise:
-                turn_worst["ours (replay --airspeed %g)" % TRIM_AIRSPEED_M_S] = worst_roll_error_replay(traj, est_cruise)[0]
+        # Ours as the board would know its speed: not at all (replay's default, what a
+        # hand-held board does), a configured cruise speed (TRIM_ARSPD_CM, no pitot) and the
+        # airspeed sensor (the flight's logged airspeed, read every 8 steps as the firmware
+        # reads the MPXV7002DP on A0).
+        variants = (("", "", ()),
+                    ("_cruise", ", cruise speed", ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)),
+                    ("_sensor", ", airspeed sensor", ("--airspeed-log", os.path.join(flight_dir, name + "_log.csv"))))
+        cells = [name]
+        for suffix, what, extra in variants:
+            if suffix == "_sensor" and not os.path.exists(extra[1]):
+                cells.append("–")
+                continue
+            est = os.path.join(flight_dir, name + "_estimate%s.csv" % suffix)
+            _, _, ours, err, _ = run_replay(("flight %s%s" % (name, what), traj, est, replay, score, (), extra))
+            if err:
+                errors.append("flight %s%s: %s" % (name, what, err))
+            cells.append("%.2f / %.2f / %.2f" % (ours["total"], ours["incl"], ours["heading"]) if ours else "–")
+            if name == "turn" and ours:
+                key = "ours (replay%s)" % ("" if not extra else " " + " ".join(
+                    [extra[0], os.path.basename(extra[1])]))
+                turn_worst[key] = worst_roll_error_replay(traj, est)[0]
         tr = peers.load_trajectory(traj)
         for peer in peer_names:
             try:
@@ -141,11 +146,12 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
                 turn_worst[peer] = worst_roll_error_peer(tr, q)
         rows.append(cells)
         log("flight %s: %s" % (name, " | ".join(cells[1:])))
-    header = ["flight", "ours", "ours, cruise %g m/s" % TRIM_AIRSPEED_M_S] + list(peer_names)
+    header = ["flight", "ours", "ours, cruise %g m/s" % TRIM_AIRSPEED_M_S, "ours, airspeed sensor"] + list(peer_names)
     rep += ["Flights of sim/flight/fly.py (the model flown by its STABILIZE stand-in; ideal sensors at "
             "400 Hz): total / inclination / heading RMSE in degrees. Ours through `build/replay`: without "
             "an airspeed, and with the configured cruise speed (`--airspeed %g`, TRIM_ARSPD_CM: what a board "
-            "without a pitot flies with); the peers have no airspeed input." % TRIM_AIRSPEED_M_S, "",
+            "without a pitot flies with), and with the airspeed sensor (`--airspeed-log`: the flight's airspeed as "
+            "the firmware reads its sensor); the peers have no airspeed input." % TRIM_AIRSPEED_M_S, "",
             "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     rep += ["| " + " | ".join(r) + " |" for r in rows]
     rep.append("")

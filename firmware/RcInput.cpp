@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "Features.h"
+#if APM25_FLIGHT  // the attitude-only build has no receiver and no outputs
+
 #include "RcInput.h"
 
 #include <avr/interrupt.h>
@@ -55,3 +58,5 @@ ISR(TIMER5_CAPT_vect) {
     rc_input::ring[h & (rc_input::kRing - 1u)] = ICR5;
     rc_input::head = (uint8_t)(h + 1u);
 }
+
+#endif  // APM25_FLIGHT

@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "Features.h"
+#if APM25_FLIGHT  // the attitude-only build has no receiver and no outputs
+
 #include "ServoOutputs.h"
 
 #include <avr/interrupt.h>
@@ -102,3 +105,5 @@ ISR(TIMER3_OVF_vect) {
     OCR3B = servo_outputs::next_ocr[6];
     OCR3A = servo_outputs::next_ocr[7];
 }
+
+#endif  // APM25_FLIGHT

@@ -17,9 +17,9 @@
 // Other output modes (`mode csv|quat|raw|mavlink|quiet`): README.md; in `mode mavlink`
 // the board speaks MAVLink 2 to a ground station and its "# " lines go as STATUSTEXT.
 //
-// It also flies (README "Flying"): the receiver's PPM (RcInput) and the attitude go
-// through lib/Flight's modes, controllers and mixer to the eight servo outputs
-// (ServoOutputs), 50 times a second.
+// It also flies (README "Flying"): FlightIo takes the receiver's PPM and the attitude
+// through lib/Flight's modes, controllers and mixer to the eight servo outputs, 50 times
+// a second. Features.h leaves them out: the attitude-only build (README "Builds").
 #include <SPI.h>
 #include <Wire.h>
 
@@ -28,16 +28,14 @@
 #include "Board.h"
 #include "Compass.h"
 #include "Console.h"
-#include "Flight.h"
+#include "FlightIo.h"
 #include "Format.h"
 #include "Imu.h"
 #include "MavLink.h"
 #include "ParamLink.h"
 #include "Pipeline.h"
 #include "PipelineText.h"
-#include "RcInput.h"
 #include "SerialText.h"
-#include "ServoOutputs.h"
 #include "SettingsStore.h"
 #include "UserCode.h"
 
@@ -56,8 +54,7 @@ Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
 console::LineReader reader;
-flight::PpmDecoder ppm;
-flight::FlightControl flight_control(pipe.settings().flight, flight::FlightControl::ConfiguredLater{});
+FlightIo flight_io(out);
 mav::Parser mavlink_input;  // a ground station's frames (ground station link, below)
 
 // Loop load: the share of each second spent on samples (measured, shown by `status`).
@@ -81,103 +78,6 @@ static void print_settings_line() {
 
 static Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
 
-// ---------------------------------------------------------------------------
-// Flying (lib/Flight): the state, the receiver, the outputs.
-
-static Flash flight_mode_name(flight::Mode m) { return m == flight::Mode::Stabilize ? TXT("STABILIZE") : TXT("MANUAL"); }
-
-// "<prefix>MODE, receiver ok|no signal yet|FAILSAFE (lost|encoder failsafe)"
-static void print_flight_line(Flash prefix) {
-    Writer w(out);
-    w.str(prefix);
-    const flight::State st = flight_control.state();
-    if (st == flight::State::Failsafe) {
-        w.str(TXT("FAILSAFE ("))
-            .str(flight_control.failsafe_cause() == flight::FailsafeCause::Lost ? TXT("receiver lost")
-                                                                                 : TXT("receiver's encoder failsafe"))
-            .str(TXT("), then "));
-    }
-    w.str(flight_mode_name(flight_control.chosen()));
-    if (flight_control.without_attitude()) w.str(TXT(" (no attitude: MANUAL)"));
-    if (st == flight::State::NoSignal) w.str(TXT(", no receiver signal yet: outputs at trim"));
-    w.end();
-}
-
-// "# rc 1500 ..." or "# servo 1500 ...": eight widths, us.
-static void print_widths(Flash prefix, const uint16_t* widths) {
-    Writer w(out);
-    w.str(prefix);
-    for (uint8_t i = 0; i < flight::kChannels; ++i) w.chr(' ').u32(widths[i]);
-    w.end();
-}
-
-// The flight control's events, said as "# " lines (STATUSTEXT in `mode mavlink`).
-static void say_flight_events() {
-    const uint8_t e = flight_control.take_events();
-    if (e == 0) return;
-    if (e & flight::kEvFailsafeLost)
-        say(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT"));
-    if (e & flight::kEvFailsafeEncoder)
-        say(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding"));
-    if (e & flight::kEvFailsafeEnd) print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
-    if (e & flight::kEvSensorFallback)
-        say(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): MANUAL until it returns"));
-    if (e & flight::kEvAttitudeBack) say(TXT("# attitude back: flight STABILIZE"));
-    if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
-}
-
-// The control step, every 4th loop step (50 Hz) right after the estimator's: the servo
-// pulse only changes once a 20 ms period, so a faster step would compute widths that are
-// never sent. It moves onto the output line's steps when the output rate is 50 Hz or
-// less, to take the angles the line worked out (the Euler extraction is the step's
-// largest part). Without samples (the MPU6000 gone) the loop runs it on its own every
-// 20 ms, without an attitude: the receiver, MANUAL and the failsafe go on.
-constexpr uint8_t kControlDivider = 4;
-constexpr uint16_t kControlPeriodUs = 20000;
-static uint8_t control_count = 0;
-static uint32_t last_control_us = 0;
-
-static void take_receiver_frames(uint32_t now_ms) {
-    while (rc_input::poll(ppm)) flight_control.on_frame(ppm.frame_us(), now_ms);
-}
-
-// angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
-// The rates are the sample's body-frame counts less the calibrated bias, in integers (the
-// pipeline's float rates cost several times as much; the D term needs no more); the
-// bias in those units is worked out again once a second (`cal gyro` changes it).
-constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
-constexpr int32_t kCdsPerCountQ10 =
-    (int32_t)(mpu6000::gyro_rad_s_per_count(mpu6000::kGyroRange) * kCdsPerRad_s * 1024.0f + 0.5f);
-static int16_t bias_cds[2];
-static uint8_t bias_age = 0xFF;
-
-static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
-                         const pipeline::AnglesCentideg* angles) {
-    last_control_us = now_us;
-    control_count = 0;
-    board::mark_begin(board::kSecControl);
-    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
-    flight_control.update_signal(now_ms);
-    if (att.valid && flight_control.wants_attitude()) {  // MANUAL and no receiver yet need none
-        const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
-        att.roll_cd = a.roll_centideg;
-        att.pitch_cd = a.pitch_centideg;
-        if (++bias_age >= 50u) {
-            const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
-            bias_cds[0] = (int16_t)(bias.x * kCdsPerRad_s);
-            bias_cds[1] = (int16_t)(bias.y * kCdsPerRad_s);
-            bias_age = 0;
-        }
-        att.roll_rate_cds = (((int32_t)sample->gyro.x * kCdsPerCountQ10) >> 10) - bias_cds[0];
-        att.pitch_rate_cds = (((int32_t)sample->gyro.y * kCdsPerCountQ10) >> 10) - bias_cds[1];
-    }
-    uint16_t widths[flight::kChannels];
-    flight_control.step(now_ms, att, widths);
-    servo_outputs::set(widths);
-    board::mark_end(board::kSecControl);
-    say_flight_events();
-}
-
 // The airspeed sensor on A0 (lib/Pipeline/Airspeed.h), for the estimator's centripetal
 // correction. Never blocking: each step reads the conversion the previous step started
 // (13 ADC clocks at 125 kHz, long done 5 ms later) and starts the next. While the gyro
@@ -185,7 +85,6 @@ static void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample
 // 2.5 V is no sensor. Then the mean of each kAirspeedReadings readings is the airspeed.
 enum class AirspeedState : uint8_t { kZero, kSensor, kNone };
 constexpr uint8_t kAirspeedReadings = 8;
-constexpr int16_t kAirspeedIdleThrottle = 100;  // tenths of a percent: 10 % of the stick
 static AirspeedState airspeed_state = AirspeedState::kZero;
 static bool airspeed_started = false;
 static uint16_t airspeed_zero = 0;
@@ -201,15 +100,10 @@ static void airspeed_begin() {
 static void airspeed_step() {
     if (airspeed_state == AirspeedState::kNone) {
         // No sensor: the configured cruise speed (TRIM_ARSPD_CM, grown in a banked turn as
-        // the lift needs), only while the receiver's throttle is above idle (on the ground,
-        // or gliding, the velocity is not the cruise's).
+        // the lift needs), only while the receiver's throttle is above idle (FlightIo).
         const flight::FlightSettings& fs = pipe.settings().flight;
         if (fs.trim_arspd_cm == 0u || pipe.steps() % kAirspeedReadings != 0u) return;
-        const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
-        const bool powered = flight_control.state() != flight::State::NoSignal && ch < flight::kChannels &&
-                             flight::width_to_throttle(flight_control.rc_us()[ch], fs.rc[ch],
-                                                       (fs.rc_reversed >> ch) & 1u) > kAirspeedIdleThrottle;
-        pipe.set_cruise_airspeed_m_s(powered ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
+        pipe.set_cruise_airspeed_m_s(flight_io.powered() ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
         return;
     }
     if (ADCSRA & _BV(ADSC)) return;
@@ -269,7 +163,7 @@ static bool print_status(uint8_t part) {
         case kStatusBiasPart: pipeline_text::write_bias_status(out, pipe); return true;
         case kStatusCompassPart: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
-        case 5: print_flight_line(TXT("# flight ")); return true;
+        case 5: return flight_io.print_status_line();
         default: return false;
     }
 }
@@ -293,16 +187,6 @@ static void write_message(void*, const char* data, uint8_t len) {
     else serial_text::write(data, len);
 }
 
-// The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode): the failsafe's
-// wings-level glide is ArduPlane's FBWA glide (MavLink.h), STABILIZE without an attitude
-// flies as MANUAL.
-static mav::PlaneMode plane_mode() {
-    if (flight_control.state() == flight::State::Failsafe) return mav::PlaneMode::FlyByWireA;
-    if (flight_control.chosen() == flight::Mode::Stabilize && !flight_control.without_attitude())
-        return mav::PlaneMode::Stabilize;
-    return mav::PlaneMode::Manual;
-}
-
 // HEARTBEAT and SYS_STATUS, once a second in `mode mavlink` (MAVLink's 1 Hz convention:
 // a ground station drops a link after ~3 s without a heartbeat).
 static void send_heartbeat_and_status() {
@@ -313,8 +197,7 @@ static void send_heartbeat_and_status() {
                                  ? mav::State::Calibrating
                                  : mav::State::Active;
     uint8_t frame[mav::kMaxFrame];
-    uint8_t n = mavlink.heartbeat(frame, flight_control.state() == flight::State::Failsafe ? mav::State::Critical : state,
-                                  plane_mode());
+    uint8_t n = mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state, flight_io.plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = mavlink.sys_status(frame, mav::health(true, imu.ok(), true, compass.ok()), (uint16_t)(load_pct * 10u),
@@ -395,28 +278,18 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
         case console::CommandId::Defaults:
             pipe.restore_defaults();
-            flight_control.configure();
+            flight_io.configure();
             console::print_defaults(out);
             break;
         case console::CommandId::Flight:
-            flight_control.choose(c.arg != 0 ? flight::Mode::Stabilize : flight::Mode::Manual);
-            print_flight_line(TXT("# flight "));
-            break;
-        case console::CommandId::Show:
-            if (c.arg == console::kShowRc) print_widths(TXT("# rc"), flight_control.rc_us());
-            else {
-                uint16_t widths[flight::kChannels];
-                for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
-                print_widths(TXT("# servo"), widths);
-            }
-            break;
+        case console::CommandId::Show: flight_io.answer(c); break;  // flight manual|stabilize, rc, servo
         case console::CommandId::Mode:
             gcs_link = false;  // the mode typed, not the ground station's
             console::apply_setting(c, pipe.settings(), out);
             break;
         default:  // rate, decl, set, get
             console::apply_setting(c, pipe.settings(), out);
-            if (c.id == console::CommandId::Set) flight_control.configure();
+            if (c.id == console::CommandId::Set) flight_io.configure();
             break;
     }
     return true;
@@ -607,17 +480,12 @@ static void answer_ground_station(uint32_t now_ms) {
         param_replies.pop();
         return;
     }
-    if (now_ms - last_stream_ms >= kStreamPeriodMs && gcs_can_send(2u * mav::kRcChannelsFrame, kGcsReplyLatestUs)) {
+    if (FlightIo::kEnabled && now_ms - last_stream_ms >= kStreamPeriodMs &&
+        gcs_can_send(2u * mav::kRcChannelsFrame, kGcsReplyLatestUs)) {
         last_stream_ms = now_ms;
         board::mark_begin(board::kSecGcsReply);
-        const bool signal = flight_control.state() != flight::State::NoSignal &&
-                            flight_control.failsafe_cause() != flight::FailsafeCause::Lost;
-        uint8_t n = mavlink.rc_channels(frame, now_ms, flight_control.rc_us(), signal ? flight::kChannels : 0u);
-        send_frame(frame, n);
-        uint16_t widths[flight::kChannels];
-        for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
-        n = mavlink.servo_output_raw(frame, micros(), widths);
-        send_frame(frame, n);
+        send_frame(frame, flight_io.rc_channels(mavlink, frame, now_ms));
+        send_frame(frame, flight_io.servo_output_raw(mavlink, frame, micros()));
         board::mark_end(board::kSecGcsReply);
     }
 }
@@ -641,10 +509,7 @@ static void step(uint32_t now_us) {
         pipeline::AnglesCentideg c;
         const bool output = pipe.output_due();
         const bool have_angles = output && emit_output(now_ms, c);
-        ++control_count;
-        if (control_count >= kControlDivider ||
-            (output && control_count >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
-            control_step(now_us, now_ms, &sample, have_angles ? &c : nullptr);
+        flight_io.after_estimator_step(now_us, now_ms, sample, output, have_angles ? &c : nullptr);
     }
     board::mark_end(board::kSecLoop);
     work_us += micros() - now_us;
@@ -671,13 +536,7 @@ void setup() {
     say(TXT("# apm25-attitude 0.2.0: APM 2.5, 200 Hz loop\n"
             "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     store.load(pipe.settings());
-    // The outputs from here on, at trim and the throttle at its failsafe value until the
-    // receiver's first frame (the loaded settings' end points).
-    uint16_t widths[flight::kChannels];
-    flight_control.configure();  // the loaded settings
-    flight_control.step(0, flight::Attitude{0, 0, 0, 0, false}, widths);
-    servo_outputs::begin(widths);
-    rc_input::begin();
+    flight_io.begin();  // the outputs from here on (the loaded settings' end points), the receiver
     airspeed_begin();
     print_settings_line();
     if (pipe.settings().flags & settings::kFlagUpgraded) {
@@ -700,7 +559,7 @@ void setup() {
     user_setup();
     wait_until_ms(pipeline::kLoopStartMs);
     window_start_us = micros();
-    last_control_us = window_start_us;
+    flight_io.loop_starts(window_start_us);
     update_leds();
 }
 
@@ -716,10 +575,7 @@ void loop() {
     user_loop();
 
     const uint32_t now_us = micros();
-    take_receiver_frames(now_ms);
-    if (now_us - last_control_us >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
-        control_step(now_us, now_ms, nullptr, nullptr);
-    }
+    flight_io.poll(now_us, now_ms);
     if (now_us - window_start_us >= 1000000u) {  // load over the last second
         load_pct = (uint8_t)(work_us / ((now_us - window_start_us) / 100u));
         work_us = 0;

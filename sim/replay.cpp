@@ -77,6 +77,7 @@ struct SettingName {
 const SettingName kSettingNames[] = {
     {"kp_rp_1_s", &dcm::DcmSettings::kp_rp_1_s, 1.0f},
     {"ki_rp_1_s2", &dcm::DcmSettings::ki_rp_1_s2, 1.0f},
+    {"ki_rp_measured_1_s2", &dcm::DcmSettings::ki_rp_measured_1_s2, 1.0f},
     {"kp_yaw_1_s", &dcm::DcmSettings::kp_yaw_1_s, 1.0f},
     {"ki_yaw_1_s2", &dcm::DcmSettings::ki_yaw_1_s2, 1.0f},
     {"kp_startup_1_s", &dcm::DcmSettings::kp_startup_1_s, 1.0f},

@@ -4,6 +4,7 @@
 // airspeed, clamped at the extremes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "Airspeed.h"
@@ -36,8 +37,11 @@ TEST(Centripetal, CoordinatedTurnCorrectedToGravityAtTheBank) {
         for (float v : {12.0f, 18.0f, 30.0f}) {
             const Turn t = coordinated_turn(bank, v);
             const mpu6000::Sample s = imu(t.gyro_rad_s, t.accel_m_s2);
+            // The estimate at the true bank: the bank provides the whole turn.
+            const int32_t down_y_q30 = (int32_t)std::lround(std::sin(bank * kDeg) * 1073741824.0);
             const Vector3i c = pipeline::centripetal_corrected(s.accel, s.gyro.y, s.gyro.z,
-                                                               pipeline::centripetal_gain_q8(v));
+                                                               pipeline::centripetal_gain_q8(v),
+                                                               pipeline::turn_lateral_bounds(s.accel.y, down_y_q30));
             const Vector3f f = linalg::scaled(c, s.accel_m_s2_per_count);
             // Gravity at the bank: -g (0, sin phi, cos phi).
             EXPECT_NEAR(f.x, 0.0f, 0.01f);
@@ -46,6 +50,53 @@ TEST(Centripetal, CoordinatedTurnCorrectedToGravityAtTheBank) {
             EXPECT_NEAR(std::atan2(-f.y, -f.z) / kDeg, bank, 0.2f);
         }
     }
+}
+
+int32_t down_y_q30_at(float bank_deg) { return (int32_t)std::lround(std::sin(bank_deg * kDeg) * 1073741824.0); }
+
+// Wings level, yawing at 20 deg/s (turbulence turning the aeroplane into the relative
+// wind): no bank provides that turn, so at most kTurnBankMargin_deg of it is taken off
+// (unbounded it would be 6.3 m/s^2, 33 deg of false bank).
+TEST(Centripetal, AYawRateWithoutTheBankIsHeldToTheMargin) {
+    const float v = 18.0f;
+    for (float sign : {1.0f, -1.0f}) {
+        const mpu6000::Sample s = imu(Vector3f(0.0f, 0.0f, sign * 20.0f * kDeg), Vector3f(0.0f, 0.0f, -kG));
+        const Vector3i c = pipeline::centripetal_corrected(s.accel, s.gyro.y, s.gyro.z, pipeline::centripetal_gain_q8(v),
+                                                           pipeline::turn_lateral_bounds(s.accel.y, 0));
+        const Vector3f f = linalg::scaled(c, s.accel_m_s2_per_count);
+        const float false_bank_deg = std::atan2(-f.y, -f.z) / kDeg;
+        EXPECT_NEAR(false_bank_deg, sign * pipeline::kTurnBankMargin_deg, 0.05f) << sign;
+    }
+}
+
+// An estimate 10 deg short of a 30 deg coordinated turn's bank: the corrected gravity says
+// the estimate's bank plus the margin, so the estimate is pulled on toward the truth.
+TEST(Centripetal, AnEstimateShortOfTheBankIsPulledOnByTheMargin) {
+    const float v = 18.0f;
+    const Turn t = coordinated_turn(30.0f, v);
+    const mpu6000::Sample s = imu(t.gyro_rad_s, t.accel_m_s2);
+    const Vector3i c = pipeline::centripetal_corrected(s.accel, s.gyro.y, s.gyro.z, pipeline::centripetal_gain_q8(v),
+                                                       pipeline::turn_lateral_bounds(s.accel.y, down_y_q30_at(20.0f)));
+    const Vector3f f = linalg::scaled(c, s.accel_m_s2_per_count);
+    // The lateral term is g sin(20 deg) + g sin(margin); the normal one is whole.
+    EXPECT_NEAR(f.y, -kG * (std::sin(20.0f * kDeg) + std::sin(pipeline::kTurnBankMargin_deg * kDeg)), 0.02f);
+    EXPECT_GT(std::atan2(-f.y, -f.z) / kDeg, 20.0f);
+    // A bank on the other side from the turn gives no room but the margin.
+    const pipeline::LateralBounds other = pipeline::turn_lateral_bounds(0, down_y_q30_at(-20.0f));
+    const pipeline::LateralBounds level = pipeline::turn_lateral_bounds(0, 0);
+    EXPECT_EQ(other.hi, level.hi);
+    EXPECT_LT(other.lo, level.lo);
+}
+
+// A flat skidding turn (wings level, the rudder's sideforce turning the path): the
+// accelerometer reads the whole omega_z V sideways, so all of it is taken off: level.
+TEST(Centripetal, AFlatSkidTurnIsTakenOffWhole) {
+    const float v = 18.0f, rate_rad_s = 10.0f * kDeg;
+    const mpu6000::Sample s = imu(Vector3f(0.0f, 0.0f, rate_rad_s), Vector3f(0.0f, rate_rad_s * v, -kG));
+    const Vector3i c = pipeline::centripetal_corrected(s.accel, s.gyro.y, s.gyro.z, pipeline::centripetal_gain_q8(v),
+                                                       pipeline::turn_lateral_bounds(s.accel.y, 0));
+    const Vector3f f = linalg::scaled(c, s.accel_m_s2_per_count);
+    EXPECT_NEAR(std::atan2(-f.y, -f.z) / kDeg, 0.0f, 0.1f);
 }
 
 TEST(Centripetal, OffBelowTheMinimumAirspeedAndWithoutOne) {
@@ -91,6 +142,25 @@ float bank_after_turn(float airspeed_given_m_s) {
     pipe.set_airspeed_m_s(airspeed_given_m_s);
     for (int i = 0; i < 200 * 60; ++i) pipe.on_imu_sample(imu(t.gyro_rad_s, t.accel_m_s2));
     return pipe.angles().roll_deg;
+}
+
+// Wings level in turbulence: the gusts yaw the aeroplane +-15 deg/s (0.2 Hz) while the
+// path and the accelerometer stay level. Each half cycle's 2.5 s of yaw moves the
+// estimate at most the margin beyond where it is at a time: it stays within a few
+// degrees (the whole omega_z V, unbounded, rolls it 18 deg).
+TEST(Centripetal, PipelineKeepsTheWingsLevelWhenGustsYawTheAeroplane) {
+    pipeline::AttitudePipeline pipe;
+    const Vector3f level(0.0f, 0.0f, -kG);
+    for (int i = 0; i < 400; ++i) pipe.on_imu_sample(imu(Vector3f(), level));
+    ASSERT_EQ(pipe.phase(), pipeline::Phase::Running);
+    pipe.set_airspeed_m_s(18.0f);
+    float worst_roll_deg = 0.0f;
+    for (int i = 0; i < 200 * 30; ++i) {
+        const float yaw_rate_rad_s = 15.0f * kDeg * std::sin(2.0f * 3.14159265f * 0.2f * i / 200.0f);
+        pipe.on_imu_sample(imu(Vector3f(0.0f, 0.0f, yaw_rate_rad_s), level));
+        worst_roll_deg = std::max(worst_roll_deg, std::fabs(pipe.angles().roll_deg));
+    }
+    EXPECT_LT(worst_roll_deg, 2.0f * pipeline::kTurnBankMargin_deg);
 }
 
 TEST(Centripetal, PipelineHoldsTheBankOfATurnWithTheAirspeed) {

@@ -124,7 +124,7 @@ TEST(Dcm, WithoutDriftCorrectionTheBiasRunsAway) {
     // The thesis's failure, reproduced to show the test above can fail: the same
     // bias with every gain at zero drifts by bias x time.
     dcm::DcmSettings no_correction = dcm::kDefaultDcmSettings;
-    no_correction.kp_rp_1_s = no_correction.ki_rp_1_s2 = 0.0f;
+    no_correction.kp_rp_1_s = no_correction.ki_rp_1_s2 = no_correction.ki_rp_measured_1_s2 = 0.0f;
     no_correction.kp_yaw_1_s = no_correction.ki_yaw_1_s2 = no_correction.kp_startup_1_s = 0.0f;
     no_correction.rest_bias_s = 0.0f;  // nor the bias measured at rest
     dcm::Dcm filter(no_correction);
@@ -283,6 +283,7 @@ TEST(Dcm, ASlowSteadyTurnIsNotTakenForABiasTheCompassSeesIt) {
         filter.update(Vector3f(0, 0, rate_rad_s), accel_for(level));
         EXPECT_FALSE(filter.status() & dcm::kStatusAtRest) << "step " << i;
     }
+    EXPECT_FALSE(filter.gyro_bias_measured());  // never at rest: the bias is not known
     EXPECT_LT(std::fabs(filter.gyro_bias_rad_s().z * linalg::kDegPerRad), 0.05f);
     // At rest with a 3 deg/s vertical bias (beyond the bound): the still field says rest.
     RestRun run(level);
@@ -360,6 +361,7 @@ TEST(Dcm, LearnsTheGyroBiasOfEveryAxisAtRestButNotFromTheCompass) {
     RestRun run(truth);
     run.run(20.0f, bias);
     EXPECT_TRUE(run.filter.status() & dcm::kStatusAtRest);
+    EXPECT_TRUE(run.filter.gyro_bias_measured());  // gravity's integrator slows from here
     EXPECT_NEAR(run.filter.gyro_bias_rad_s().z * linalg::kDegPerRad, 0.5f, 0.01f);
     EXPECT_LT(std::fabs(run.yaw_error_deg()), 0.1f);
     // Without the rest measurement the compass holds the heading at bias / kp (5 deg)

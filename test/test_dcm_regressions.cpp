@@ -20,7 +20,7 @@ namespace {
 // No drift correction at all: what is left is the integration alone.
 dcm::DcmSettings integration_only() {
     dcm::DcmSettings s = dcm::kDefaultDcmSettings;
-    s.kp_rp_1_s = s.ki_rp_1_s2 = s.kp_yaw_1_s = s.ki_yaw_1_s2 = s.kp_startup_1_s = 0.0f;
+    s.kp_rp_1_s = s.ki_rp_1_s2 = s.ki_rp_measured_1_s2 = s.kp_yaw_1_s = s.ki_yaw_1_s2 = s.kp_startup_1_s = 0.0f;
     s.rest_bias_s = 0.0f;
     return s;
 }

@@ -159,6 +159,22 @@ TEST(DcmGyroBias, IntegratesTheTiltErrorAgainstIt) {
     EXPECT_NEAR(bias.estimate_rad_s(k).z, -expected, 0.02f * std::fabs(expected));
 }
 
+// Once the bias was measured still, the same error teaches ki_rp_measured_1_s2 instead
+// (DcmSettings.h: a third as much false bias from a sustained acceleration).
+TEST(DcmGyroBias, AMeasuredBiasIntegratesWithTheMeasuredGain) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::GyroBias bias;
+    EXPECT_FALSE(bias.measured());
+    bias.set_measured();
+    EXPECT_TRUE(bias.measured());
+    const int16_t error_q14 = 164;  // 0.01 rad
+    for (int i = 0; i < 50; ++i) bias.integrate_tilt_error(error_q14, -error_q14, 0, k);  // 1 s
+    const float expected = -dcm::kDefaultDcmSettings.ki_rp_measured_1_s2 * 0.01f * 1.0f;
+    EXPECT_NEAR(bias.estimate_rad_s(k).x, expected, 0.02f * std::fabs(expected));
+    EXPECT_NEAR(bias.estimate_rad_s(k).y, -expected, 0.02f * std::fabs(expected));
+    EXPECT_LT(dcm::kDefaultDcmSettings.ki_rp_measured_1_s2, dcm::kDefaultDcmSettings.ki_rp_1_s2);
+}
+
 // New sample scales during a rest (a new calibration): the means follow the ratios, so
 // the same motion read at the new scales is still rest; with means left at the old
 // scales the rest would end.

@@ -93,12 +93,15 @@ TEST(EulerHeading, AYawAHairBelowZeroIsNorthNot360) {
     EXPECT_EQ(h, 0.0f);
 }
 
-// Euler.h promises 0 outside the documented ranges (yaw -pi..pi, declination
-// -180..180), but the folds wrap an h within (-720, 720): a 190 deg declination at a
-// 3 rad yaw (h = 361.9) gives 1.9, and -190 at -3 rad gives 358.1. The doc or the code
-// is to change (the lead's call: lib/ is not this branch's); disabled until then. Found
-// by make mutate: without the `h >= 360` fold no test inside the ranges tells.
-TEST(EulerHeading, DISABLED_BeyondTheDocumentedRangesIsZero) {
-    EXPECT_EQ(dcm::heading_deg(3.0f, 190.0f), 0.0f);
-    EXPECT_EQ(dcm::heading_deg(-3.0f, -190.0f), 0.0f);
+// Beyond the documented ranges (yaw -pi..pi, declination -180..180) a sum within
+// (-720, 720) still folds into 0..360 (Euler.h): a 190 deg declination at a 3 rad yaw
+// (h = 361.9) gives 1.9, -190 at -3 rad gives 358.1; further out, 0. Found by make
+// mutate (without the `h >= 360` fold no test inside the ranges told), which also found
+// Euler.h promising 0 there: the comment now says what the code does.
+TEST(EulerHeading, BeyondTheDocumentedRangesFoldsWithin720ElseZero) {
+    const float yaw_deg = 3.0f * linalg::kDegPerRad;
+    EXPECT_NEAR(dcm::heading_deg(3.0f, 190.0f), yaw_deg + 190.0f - 360.0f, 1e-3f);
+    EXPECT_NEAR(dcm::heading_deg(-3.0f, -190.0f), 720.0f - yaw_deg - 190.0f, 1e-3f);
+    EXPECT_EQ(dcm::heading_deg(0.0f, 800.0f), 0.0f);
+    EXPECT_EQ(dcm::heading_deg(0.0f, -800.0f), 0.0f);
 }

@@ -34,7 +34,7 @@ TEST(FixedFallbacks, ACoarseGyroTurnsTheMatrixAsTheIntegerPathDoes) {
     const Vector3f axes[] = {Vector3f(0, 0, 1), Vector3f(1, 0, 0), Vector3f(0, -0.6f, 0.8f)};
     for (const Vector3f& axis : axes) {
         dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
-        settings.kp_rp_1_s = settings.kp_startup_1_s = settings.ki_rp_1_s2 = 0.0f;  // the integration alone
+        settings.kp_rp_1_s = settings.kp_startup_1_s = settings.ki_rp_1_s2 = settings.ki_rp_measured_1_s2 = 0.0f;  // the integration alone
         dcm::Dcm filter(settings);
         filter.set_sample_scales(kCoarseGyro_rad_s, kAccel_m_s2);
         const Matrix3f level = Matrix3f::identity();

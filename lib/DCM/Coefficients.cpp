@@ -47,6 +47,8 @@ FIXED_COLD void DcmCoefficients::from_settings(const DcmSettings& settings) {
     rest_accel_dev = limit_of(settings.rest_accel_deviation_m_s2 * ((float)kTurnScale / kFloatAccelScale));
     bias_limit_fine = (int32_t)(settings.bias_limit_rad_s * kFloatUnitsPerRad_s * (float)kTurnScale);
     ki_fine = (int32_t)(settings.ki_rp_1_s2 * correction_dt_s(settings) * kFloatUnitsPerRad_s * (float)kTurnScale);
+    ki_measured_fine =
+        (int32_t)(settings.ki_rp_measured_1_s2 * correction_dt_s(settings) * kFloatUnitsPerRad_s * (float)kTurnScale);
 }
 
 void DcmCoefficients::set_scales(const DcmSettings& settings, float gyro_scale, float accel_scale) {
@@ -82,6 +84,8 @@ void DcmCoefficients::derive_from_scales(const DcmSettings& settings) {
     rest_accel_dev = limit_of(settings.rest_accel_deviation_m_s2 * accel_units_per_m_s2);
     bias_limit_fine = fixed_from_float(settings.bias_limit_rad_s * units_per_rad_s * (float)kTurnScale, 0);
     ki_fine = fixed_from_float(settings.ki_rp_1_s2 * correction_dt_s(settings) * units_per_rad_s * (float)kTurnScale, 0);
+    ki_measured_fine =
+        fixed_from_float(settings.ki_rp_measured_1_s2 * correction_dt_s(settings) * units_per_rad_s * (float)kTurnScale, 0);
     kp_units = fixed_from_float(settings.kp_rp_1_s * units_per_rad_s, 0);
     // |lp| = g/2 in correct_tilt's |lp|^2 / 2^30 (lp in accel units).
     const float half_g_units = 0.5f * kGravity_m_s2 * accel_units_per_m_s2;

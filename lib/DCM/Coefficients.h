@@ -100,6 +100,7 @@ struct DcmCoefficients {
     Limit rest_accel_dev = {};                // rest_accel_deviation_m_s2, accel units
     int32_t bias_limit_fine = 0;             // bias_limit_rad_s, fine units
     int32_t ki_fine = 0;                     // ki_rp * the correction interval, fine units per rad/s
+    int32_t ki_measured_fine = 0;            // ki_rp_measured likewise
     int32_t kp_units = 0;                // kp_rp, units per rad/s
     uint32_t min_lp2 = 0;                // (g/2)^2 as correct_tilt's |lp|^2 / 2^30 (lp in accel units)
     uint16_t lead_steps_q15 = 0;         // output_lead_s / step_s, Q15
@@ -147,7 +148,7 @@ FIXED_INLINE int32_t DcmCoefficients::theta_axis_q26(int32_t units) const {
     return linalg::hot::mul_q30(theta_factor_q30, units);
 }
 
-FIXED_INLINE linalg::Vector3l DcmCoefficients::theta_q26(const linalg::Vector3l& units) const {
+FIXED_COLD inline linalg::Vector3l DcmCoefficients::theta_q26(const linalg::Vector3l& units) const {
     if (theta_factor_q30 == 0) return theta_q26_in_float(units);  // scales beyond the integer factor
     return linalg::Vector3l(theta_axis_q26(units.x), theta_axis_q26(units.y), theta_axis_q26(units.z));
 }

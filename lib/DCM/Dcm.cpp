@@ -275,6 +275,7 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     const Vector3f before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif
     bias_.follow_rest_mean(rest_.gyro_mean(), k_);
+    bias_.set_measured();
 #if DCM_TRACE
     if (trace_) trace_->bias_from_rest_rad_s += traced_bias_rad_s() - before;
 #endif
@@ -327,14 +328,14 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
 
 Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
 
-Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit()); }
+FIXED_COLD Vector3f Dcm::pending_turn_rad() const { return pending_turn_units().scaled(k_.turn_rad_per_unit()); }
 
 FIXED_INLINE Vector3l Dcm::last_rate_units() const {
     return Vector3l(in_turn_units(last_gyro_.x) - offset_units_.x, in_turn_units(last_gyro_.y) - offset_units_.y,
                     in_turn_units(last_gyro_.z) - offset_units_.z);
 }
 
-Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(k_.gyro_rad_s_per_count * (1.0f / (float)kTurnScale)); }
+FIXED_COLD Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scaled(k_.gyro_rad_s_per_count * (1.0f / (float)kTurnScale)); }
 
 
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {

@@ -98,6 +98,10 @@ public:
     // The calibrated bias the gyro counts carry (rad/s; the start-up calibration): the
     // step subtracts it with the estimator's own bias estimate.
     void set_sensor_bias_rad_s(const linalg::Vector3f& bias);
+    // The bias was just measured on a still board (the start-up calibration): the gravity
+    // integrator slows to ki_rp_measured (a rest does the same by itself).
+    void set_gyro_bias_measured() { bias_.set_measured(); }
+    bool gyro_bias_measured() const { return bias_.measured(); }
 
     // A new magnetometer sample (call when one arrives, e.g. 75 Hz): turned into earth
     // axes and averaged; every kHeadingSteps the mean's tilt-compensated heading error,
@@ -151,6 +155,8 @@ public:
     // R's last entry, earth down's body z component: cos(roll) cos(pitch), the cosine of
     // the tilt (one entry, where matrix() converts nine).
     float cos_tilt() const { return linalg::float_from_fixed(strapdown_.r().c.z, linalg::kQ30); }
+    // R's earth down, body y component (sin(roll) cos(pitch)), Q30.
+    int32_t down_y_q30() const { return strapdown_.r().c.y; }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.

@@ -14,6 +14,7 @@ struct DcmSettings {
     float step_s;                    // fixed update step, s (200 Hz: 0.005)
     float kp_rp_1_s;                 // roll/pitch proportional gain, 1/s
     float ki_rp_1_s2;                // roll/pitch integral gain (gyro-bias estimate), 1/s^2
+    float ki_rp_measured_1_s2;       // ... once the bias was measured on a still board, 1/s^2
     float kp_yaw_1_s;                // yaw proportional gain, 1/s
     float ki_yaw_1_s2;               // yaw integral gain, 1/s^2
     float kp_startup_1_s;            // roll/pitch/yaw P gain at start, ramping down to the steady ones, 1/s
@@ -42,7 +43,14 @@ struct DcmSettings {
 // residual hard iron, a nearby magnet) are degrees and turn with the heading, so an
 // integrator on them learns a false bias that makes the heading drift whenever the
 // compass is disturbed (mag_disturbance with an uncalibrated compass: 9.6 -> 5.9 deg;
-// VQF makes the same choice). Rest: a hand-held board's tremor stays below 2 deg/s and
+// VQF makes the same choice). The accelerometer cannot tell a sustained acceleration
+// (a car's corner, a climb's speed change, a hand's stroke) from tilt, and the
+// integrator learns what the tilt error holds for its time constant kp_rp / ki_rp: 10 s
+// while the bias is unknown (a board that never kept still: up to degrees per second to
+// find), 33 s once it was measured still (the start-up calibration, a rest), when what
+// is left to follow is the MPU6000's drift as it warms (0.2 deg/s a minute follows with
+// a lag of 0.1 deg/s, 0.1 deg of tilt) and a 10 s acceleration teaches a third as much
+// false bias. Rest: a hand-held board's tremor stays below 2 deg/s and
 // 0.5 m/s^2 (VQF's thresholds); 1.5 s of it is rest.
 // The two latencies: the MPU6000's 42 Hz DLPF delays the gyro by 4.8 ms (Register
 // Map 4.3), of which the step's end-point integration takes back 2.5 ms: the output
@@ -54,6 +62,7 @@ constexpr DcmSettings kDefaultDcmSettings = {
     0.005f,                         // step_s: 200 Hz
     1.0f,                           // kp_rp_1_s
     0.1f,                           // ki_rp_1_s2
+    0.03f,                          // ki_rp_measured_1_s2
     0.1f,                           // kp_yaw_1_s
     0.0f,                           // ki_yaw_1_s2: no bias from the compass (see above)
     5.0f,                           // kp_startup_1_s

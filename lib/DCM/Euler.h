@@ -78,7 +78,8 @@ linalg::Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
 
 // Heading in degrees, 0 <= h < 360, from a yaw angle in radians (-pi..pi) and a
 // declination (east positive) in degrees (-180..180): the firmware's output
-// convention. Outside those ranges, or for NaN, it gives 0 (never NaN).
+// convention. Beyond those ranges a sum within +-720 deg is still folded into 0..360;
+// further out, or for NaN, it gives 0 (never NaN).
 float heading_deg(float yaw_rad, float declination_deg);
 
 // The same in hundredths of a degree, 0 <= h < 36000, from yaw in Q24 radians (-pi..pi)

@@ -43,9 +43,10 @@ void GyroBias::follow_rest_mean(const Vector3l& rest_mean_units, const DcmCoeffi
 // bias -= ki error: the error in 16 bits (Q14 radians) times ki in fine units per rad/s.
 void GyroBias::integrate_tilt_error(int16_t ex_q14, int16_t ey_q14, int16_t ez_q14, const DcmCoefficients& k) {
     using linalg::hot::mul_q14;
-    fine_.x -= mul_q14(ex_q14, k.ki_fine);
-    fine_.y -= mul_q14(ey_q14, k.ki_fine);
-    fine_.z -= mul_q14(ez_q14, k.ki_fine);
+    const int32_t ki_fine = measured_ ? k.ki_measured_fine : k.ki_fine;
+    fine_.x -= mul_q14(ex_q14, ki_fine);
+    fine_.y -= mul_q14(ey_q14, ki_fine);
+    fine_.z -= mul_q14(ez_q14, ki_fine);
     clamp(k);
 }
 

@@ -37,6 +37,10 @@ public:
 
     // At rest: estimate += alpha (rest mean - estimate), alpha = rest_bias_alpha_q30.
     void follow_rest_mean(const linalg::Vector3l& rest_mean_units, const DcmCoefficients& k);
+    // The bias was measured on a still board (the start-up calibration, a rest): from now
+    // the gravity integrator uses ki_rp_measured (DcmSettings.h).
+    void set_measured() { measured_ = true; }
+    bool measured() const { return measured_; }
     // The gravity correction's integral: estimate -= ki error (the error in Q14 radians).
     void integrate_tilt_error(int16_t ex_q14, int16_t ey_q14, int16_t ez_q14, const DcmCoefficients& k);
     // A change in fine units (the compass integrator, ki_yaw), then bounded.
@@ -50,6 +54,7 @@ private:
 
     linalg::Vector3l fine_;          // the estimate, fine units
     linalg::Vector3l sensor_units_;  // the calibrated bias (set_sensor_rad_s), units
+    bool measured_ = false;          // set_measured() since the start
 };
 
 }  // namespace dcm

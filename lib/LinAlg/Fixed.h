@@ -384,7 +384,7 @@ FIXED_INLINE uint32_t interpolate_down(const uint16_t* table, uint16_t i, uint16
 // the ratio num/den in Q31 (2^31 = 1) when ratio_q31 is not null. Error below
 // 1.2e-5 rad (0.0007 deg) over the whole range, test_fixed.cpp: tables of 1/d and
 // t - atan(t) with linear interpolation, no division.
-FIXED_INLINE int32_t atan_of_ratio_q24(uint32_t num, uint32_t den, uint32_t* ratio_q31) {
+inline int32_t atan_of_ratio_q24(uint32_t num, uint32_t den, uint32_t* ratio_q31) {
     if (den == 0) {
         if (ratio_q31) *ratio_q31 = 0;
         return 0;

@@ -48,9 +48,22 @@ int16_t centripetal_gain_q8(float airspeed_m_s) {
     return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
 }
 
-linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8) {
+LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30) {
+    // a_y = f_y + g down_y in counts: down_y Q14 times g's counts, Q14.
+    constexpr int16_t kGravityCounts = (int16_t)(kG / kAccelCount_m_s2 + 0.5f);
+    constexpr int16_t kMarginCounts = (int16_t)(kG / kAccelCount_m_s2 * 0.0348995f + 0.5f);  // sin(2 deg)
+    static_assert(kTurnBankMargin_deg == 2.0f, "kMarginCounts is g sin(kTurnBankMargin_deg)");
+    const int32_t a_y = (int32_t)accel_y_counts + (linalg::mul_s16((int16_t)(down_y_q30 >> 16), kGravityCounts) >> 14);
+    return LateralBounds{(a_y < 0 ? a_y : 0) - kMarginCounts, (a_y > 0 ? a_y : 0) + kMarginCounts};
+}
+
+linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8,
+                                       LateralBounds lateral) {
     // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V.
-    return linalg::Vector3i(a.x, sat16((int32_t)a.y - (linalg::mul_s16(gyro_z, gain_q8) >> 8)),
+    int32_t lateral_counts = linalg::mul_s16(gyro_z, gain_q8) >> 8;
+    if (lateral_counts < lateral.lo) lateral_counts = lateral.lo;
+    if (lateral_counts > lateral.hi) lateral_counts = lateral.hi;
+    return linalg::Vector3i(a.x, sat16((int32_t)a.y - lateral_counts),
                             sat16((int32_t)a.z + (linalg::mul_s16(gyro_y, gain_q8) >> 8)));
 }
 
@@ -253,6 +266,12 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     const calib::GyroCalibrator::Result r =
         gyro_cal_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count);
     ++st_.gyro_cal_steps;
+    // The window's samples for a start that is never still (not the step that starts:
+    // it has the start's work, and a still start takes the calibration's mean).
+    if (st_.phase == Phase::Calibrating && r != calib::GyroCalibrator::Result::Done &&
+        st_.gyro_cal_steps < kStartupDeadlineSteps)
+        start_gravity_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count,
+                           settings_.cal.gyro_bias_rad_s, 1.0f / kRateHz);
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
@@ -266,6 +285,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
             dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
         }
+        dcm_.set_gyro_bias_measured();
         return;
     }
     if (r == calib::GyroCalibrator::Result::Moved && st_.warn_moved.allow(st_.steps, kRateHz)) {
@@ -274,10 +294,11 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         tell(EventKind::kGyroCalMoved, n);
     }
     if (st_.phase == Phase::Calibrating && st_.gyro_cal_steps >= kStartupDeadlineSteps) {
-        // Never still long enough: run with what we have, keep measuring in the background
-        // (the event on the next step, as the bias's).
+        // Never still long enough: run with what we have, gravity the window's mean carried
+        // by the gyro (StartGravity.h), keep measuring in the background (the event on the
+        // next step, as the bias's).
         st_.start_message = StartMessage::kNotStill;
-        start_estimator(raw.accel_m_s2());
+        start_estimator(start_gravity_.mean_m_s2());
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
@@ -355,7 +376,8 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         // Gravity for the DCM: the turn's centripetal acceleration taken off (see
         // kCentripetalMinAirspeed_m_s); the clip checks above saw the measured sample.
         corrected = centripetal_corrected(s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_),
-                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_);
+                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_,
+                                          turn_lateral_bounds(s.accel.y, dcm_.down_y_q30()));
         accel = &corrected;
     }
     dcm_.update(s.gyro, *accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
@@ -449,6 +471,7 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
 
 void AttitudePipeline::start_gyro_calibration() {
     gyro_cal_.restart();
+    start_gravity_.restart();
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
     if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);

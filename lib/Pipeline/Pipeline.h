@@ -48,6 +48,7 @@
 #include "LinAlg.h"
 #include "Mpu6000Registers.h"
 #include "Settings.h"
+#include "StartGravity.h"
 
 namespace pipeline {
 
@@ -102,10 +103,28 @@ constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
 // The correction's gain: accel counts per gyro count of omega x v at this airspeed, Q8
 // (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum).
 int16_t centripetal_gain_q8(float airspeed_m_s);
-// f - omega x v in the MPU6000's counts, gyro_counts less the sensor bias; each axis
-// saturates at +-32767.
+// omega_z V is the lateral acceleration only while the relative wind turns with the
+// flight path. Turbulence yaws the aeroplane into a relative wind that changes while the
+// path hardly turns (README, "Flying in simulation").
+// The accelerometer and the estimate say what the lateral acceleration is: a_y = f_y +
+// g down_y (down_y = sin(roll) cos(pitch), earth down's body y component, the gyro
+// carries it through a turn's entry; a coordinated turn has f_y = 0, a flat skid g down_y
+// = 0). So omega_z V is held between 0 and that a_y, widened by kTurnBankMargin_deg of
+// bank: the estimate is moved toward what omega_z V says at most that far beyond what it
+// holds, a turn that lasts gets all of it (each step the bound moves on with the
+// estimate), a gust's yaw of a second or two hardly any. 2 deg: the bank error a turn's
+// entry leaves in the estimate (the gyro's +-3 % scale tolerance, MPU-6000 datasheet
+// 6.1, over a 45 deg roll, and the half degree the tilt holds before it).
+constexpr float kTurnBankMargin_deg = 2.0f;
+struct LateralBounds {
+    int32_t lo, hi;  // accel counts
+};
+LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30);
+// f - omega x v in the MPU6000's counts, gyro_counts less the sensor bias, the lateral
+// term omega_z V within bounds; each axis saturates at +-32767.
 linalg::Vector3i centripetal_corrected(const linalg::Vector3i& accel_counts, int16_t gyro_y_counts,
-                                       int16_t gyro_z_counts, int16_t gain_q8);
+                                       int16_t gyro_z_counts, int16_t gain_q8,
+                                       LateralBounds lateral = LateralBounds{-2147483647L, 2147483647L});
 
 enum class Phase : uint8_t {
     WaitImu,      // no sample yet
@@ -284,6 +303,7 @@ private:
     settings::Settings settings_;
     dcm::Dcm dcm_;
     calib::GyroCalibrator gyro_cal_;
+    StartGravity start_gravity_;  // the start's gravity if never still (StartGravity.h)
     calib::MagCalibrator mag_cal_;
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field

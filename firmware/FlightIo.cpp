@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "FlightIo.h"
+
+#include "Board.h"
+
+#if APM25_FLIGHT
+
+#include "RcInput.h"
+#include "ServoOutputs.h"
+
+using text::Flash;
+using text::Writer;
+
+// The control step, every 4th loop step (50 Hz) right after the estimator's: the servo
+// pulse only changes once a 20 ms period, so a faster step would compute widths that are
+// never sent. It moves onto the output line's steps when the output rate is 50 Hz or
+// less, to take the angles the line worked out (the Euler extraction is the step's
+// largest part). Without samples (the MPU6000 gone) the loop runs it on its own every
+// 20 ms, without an attitude: the receiver, MANUAL and the failsafe go on.
+constexpr uint8_t kControlDivider = 4;
+constexpr uint16_t kControlPeriodUs = 20000;
+
+// The rates are the sample's body-frame counts less the calibrated bias, in integers (the
+// pipeline's float rates cost several times as much; the D term needs no more); the
+// bias in those units is worked out again once a second (`cal gyro` changes it).
+constexpr float kCdsPerRad_s = 100.0f * linalg::kDegPerRad;
+constexpr int32_t kCdsPerCountQ10 =
+    (int32_t)(mpu6000::gyro_rad_s_per_count(mpu6000::kGyroRange) * kCdsPerRad_s * 1024.0f + 0.5f);
+
+// The cruise speed counts while the throttle is above 10 % of the stick (tenths of a
+// percent): on the ground, or gliding, the velocity is not the cruise's.
+constexpr int16_t kIdleThrottle = 100;
+
+extern pipeline::AttitudePipeline pipe;  // the sketch's (FlightIo.h)
+extern Imu imu;
+
+FlightIo::FlightIo(const text::Sink* out)
+    : out_(out), control_(pipe.settings().flight, flight::FlightControl::ConfiguredLater{}) {}
+
+void FlightIo::begin() {
+    uint16_t widths[flight::kChannels];
+    control_.configure();  // the loaded settings
+    control_.step(0, flight::Attitude{0, 0, 0, 0, false}, widths);
+    servo_outputs::begin(widths);
+    rc_input::begin();
+}
+
+void FlightIo::loop_starts(uint32_t now_us) { last_control_us_ = now_us; }
+
+void FlightIo::configure() { control_.configure(); }
+
+void FlightIo::poll(uint32_t now_us, uint32_t now_ms) {
+    while (rc_input::poll(ppm_)) control_.on_frame(ppm_.frame_us(), now_ms);
+    if (now_us - last_control_us_ >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
+        control_step(now_us, now_ms, nullptr, nullptr);
+    }
+}
+
+void FlightIo::after_estimator_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample, bool output,
+                                    const pipeline::AnglesCentideg* angles) {
+    ++control_count_;
+    if (control_count_ >= kControlDivider ||
+        (output && control_count_ >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
+        control_step(now_us, now_ms, &sample, angles);
+}
+
+// angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
+void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
+                            const pipeline::AnglesCentideg* angles) {
+    last_control_us_ = now_us;
+    control_count_ = 0;
+    board::mark_begin(board::kSecControl);
+    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    control_.update_signal(now_ms);
+    if (att.valid && control_.wants_attitude()) {  // MANUAL and no receiver yet need none
+        const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
+        att.roll_cd = a.roll_centideg;
+        att.pitch_cd = a.pitch_centideg;
+        if (++bias_age_ >= 50u) {
+            const linalg::Vector3f& bias = pipe.settings().cal.gyro_bias_rad_s;
+            bias_cds_[0] = (int16_t)(bias.x * kCdsPerRad_s);
+            bias_cds_[1] = (int16_t)(bias.y * kCdsPerRad_s);
+            bias_age_ = 0;
+        }
+        att.roll_rate_cds = (((int32_t)sample->gyro.x * kCdsPerCountQ10) >> 10) - bias_cds_[0];
+        att.pitch_rate_cds = (((int32_t)sample->gyro.y * kCdsPerCountQ10) >> 10) - bias_cds_[1];
+    }
+    uint16_t widths[flight::kChannels];
+    control_.step(now_ms, att, widths);
+    servo_outputs::set(widths);
+    board::mark_end(board::kSecControl);
+    say_events();
+}
+
+bool FlightIo::powered() const {
+    const flight::FlightSettings& fs = pipe.settings().flight;
+    const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
+    return control_.state() != flight::State::NoSignal && ch < flight::kChannels &&
+           flight::width_to_throttle(control_.rc_us()[ch], fs.rc[ch], (fs.rc_reversed >> ch) & 1u) > kIdleThrottle;
+}
+
+// The failsafe's wings-level glide is ArduPlane's FBWA glide (MavLink.h), STABILIZE
+// without an attitude flies as MANUAL.
+mav::PlaneMode FlightIo::plane_mode() const {
+    if (control_.state() == flight::State::Failsafe) return mav::PlaneMode::FlyByWireA;
+    if (control_.chosen() == flight::Mode::Stabilize && !control_.without_attitude()) return mav::PlaneMode::Stabilize;
+    return mav::PlaneMode::Manual;
+}
+
+bool FlightIo::failsafe() const { return control_.state() == flight::State::Failsafe; }
+
+static Flash flight_mode_name(flight::Mode m) { return m == flight::Mode::Stabilize ? TXT("STABILIZE") : TXT("MANUAL"); }
+
+// "<prefix>MODE, receiver ok|no signal yet|FAILSAFE (lost|encoder failsafe)"
+void FlightIo::print_flight_line(Flash prefix) {
+    Writer w(out_);
+    w.str(prefix);
+    const flight::State st = control_.state();
+    if (st == flight::State::Failsafe) {
+        w.str(TXT("FAILSAFE ("))
+            .str(control_.failsafe_cause() == flight::FailsafeCause::Lost ? TXT("receiver lost")
+                                                                           : TXT("receiver's encoder failsafe"))
+            .str(TXT("), then "));
+    }
+    w.str(flight_mode_name(control_.chosen()));
+    if (control_.without_attitude()) w.str(TXT(" (no attitude: MANUAL)"));
+    if (st == flight::State::NoSignal) w.str(TXT(", no receiver signal yet: outputs at trim"));
+    w.end();
+}
+
+// "# rc 1500 ..." or "# servo 1500 ...": eight widths, us.
+void FlightIo::print_widths(Flash prefix, const uint16_t* widths) {
+    Writer w(out_);
+    w.str(prefix);
+    for (uint8_t i = 0; i < flight::kChannels; ++i) w.chr(' ').u32(widths[i]);
+    w.end();
+}
+
+// The flight control's events, said as "# " lines (STATUSTEXT in `mode mavlink`).
+void FlightIo::say_events() {
+    const uint8_t e = control_.take_events();
+    if (e == 0) return;
+    if (e & flight::kEvFailsafeLost)
+        Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT")).end();
+    if (e & flight::kEvFailsafeEncoder)
+        Writer(out_).str(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding")).end();
+    if (e & flight::kEvFailsafeEnd) print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
+    if (e & flight::kEvSensorFallback)
+        Writer(out_).str(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): MANUAL until it returns")).end();
+    if (e & flight::kEvAttitudeBack) Writer(out_).str(TXT("# attitude back: flight STABILIZE")).end();
+    if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
+}
+
+bool FlightIo::print_status_line() {
+    print_flight_line(TXT("# flight "));
+    return true;
+}
+
+void FlightIo::answer(const console::Command& c) {
+    if (c.id == console::CommandId::Flight) {
+        control_.choose(c.arg != 0 ? flight::Mode::Stabilize : flight::Mode::Manual);
+        print_flight_line(TXT("# flight "));
+    } else if (c.arg == console::kShowRc) {
+        print_widths(TXT("# rc"), control_.rc_us());
+    } else {
+        uint16_t widths[flight::kChannels];
+        for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
+        print_widths(TXT("# servo"), widths);
+    }
+}
+
+uint8_t FlightIo::rc_channels(mav::Packer& mavlink, uint8_t* frame, uint32_t now_ms) const {
+    const bool signal =
+        control_.state() != flight::State::NoSignal && control_.failsafe_cause() != flight::FailsafeCause::Lost;
+    return mavlink.rc_channels(frame, now_ms, control_.rc_us(), signal ? flight::kChannels : 0u);
+}
+
+uint8_t FlightIo::servo_output_raw(mav::Packer& mavlink, uint8_t* frame, uint32_t now_us) const {
+    uint16_t widths[flight::kChannels];
+    for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
+    return mavlink.servo_output_raw(frame, now_us, widths);
+}
+
+#else  // the attitude-only build: nothing to fly
+
+FlightIo::FlightIo(const text::Sink* out) : out_(out) {}
+void FlightIo::begin() {}
+void FlightIo::loop_starts(uint32_t) {}
+void FlightIo::configure() {}
+void FlightIo::poll(uint32_t, uint32_t) {}
+void FlightIo::after_estimator_step(uint32_t, uint32_t, const mpu6000::Sample&, bool, const pipeline::AnglesCentideg*) {}
+bool FlightIo::powered() const { return false; }
+mav::PlaneMode FlightIo::plane_mode() const { return mav::PlaneMode::Manual; }
+bool FlightIo::failsafe() const { return false; }
+bool FlightIo::print_status_line() { return false; }
+void FlightIo::answer(const console::Command&) {
+    text::Writer(out_).str(TXT("# error: this build has no flight features (README \"Builds\"); nothing changed")).end();
+}
+uint8_t FlightIo::rc_channels(mav::Packer&, uint8_t*, uint32_t) const { return 0; }
+uint8_t FlightIo::servo_output_raw(mav::Packer&, uint8_t*, uint32_t) const { return 0; }
+
+#endif

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The flight features as the sketch sees them (README "Flying"): the receiver (RcInput)
+// and the attitude go through lib/Flight's modes, controllers and mixer to the eight
+// servo outputs (ServoOutputs), 50 times a second, and this says so on the console and
+// the ground station link. In the attitude-only build (Features.h: APM25_FLIGHT 0) the
+// same calls do nothing, the `flight`, `rc` and `servo` commands answer an error, and
+// none of those parts is in the firmware.
+//
+// It flies the sketch's own pipeline and IMU (firmware.ino's `pipe` and `imu`), named
+// rather than held as references: the compiler then knows where they are and keeps the
+// attitude's code specialised for them, as in the sketch.
+#pragma once
+
+#include <stdint.h>
+
+#include "Console.h"
+#include "Features.h"
+#include "Imu.h"
+#include "MavLink.h"
+#include "Mpu6000.h"
+#include "Pipeline.h"
+#include "Text.h"
+#if APM25_FLIGHT
+#include "Flight.h"
+#include "Ppm.h"
+#endif
+
+class FlightIo {
+public:
+    static constexpr bool kEnabled = APM25_FLIGHT != 0;
+
+    explicit FlightIo(const text::Sink* out);
+
+    // In setup(), once the settings are loaded: the outputs at trim and the throttle at
+    // its failsafe value until the receiver's first frame, then the receiver.
+    void begin();
+    // Just before the first loop(): the control step's clock starts.
+    void loop_starts(uint32_t now_us);
+    // The flight settings changed (`set`, `defaults`).
+    void configure();
+    // Every loop(): the receiver's frames; without samples (the MPU6000 gone) the
+    // control step on its own every 20 ms, without an attitude.
+    void poll(uint32_t now_us, uint32_t now_ms);
+    // After each estimator step: the control step when it is due. output: an output line
+    // was due on this step; angles: the angles it worked out, or nullptr.
+    void after_estimator_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample, bool output,
+                              const pipeline::AnglesCentideg* angles);
+
+    // The receiver's throttle above idle: the aeroplane flies at its cruise speed.
+    bool powered() const;
+    // The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode), and whether it
+    // is the failsafe (HEARTBEAT's state CRITICAL).
+    mav::PlaneMode plane_mode() const;
+    bool failsafe() const;
+
+    // `status`'s flight line: false (no line) without the flight features.
+    bool print_status_line();
+    // `flight manual|stabilize`, `rc`, `servo`.
+    void answer(const console::Command& c);
+    // The ground station's RC_CHANNELS and SERVO_OUTPUT_RAW frames (kEnabled only).
+    uint8_t rc_channels(mav::Packer& mavlink, uint8_t* frame, uint32_t now_ms) const;
+    uint8_t servo_output_raw(mav::Packer& mavlink, uint8_t* frame, uint32_t now_us) const;
+
+private:
+    const text::Sink* out_;
+#if APM25_FLIGHT
+    void print_flight_line(text::Flash prefix);
+    void print_widths(text::Flash prefix, const uint16_t* widths);
+    void say_events();
+    void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
+                      const pipeline::AnglesCentideg* angles);
+
+    flight::PpmDecoder ppm_;
+    flight::FlightControl control_;
+    uint8_t control_count_ = 0;
+    uint32_t last_control_us_ = 0;
+    // The gyro bias in the control's rate units, worked out again once a second.
+    int16_t bias_cds_[2] = {0, 0};
+    uint8_t bias_age_ = 0xFF;
+#endif
+};
