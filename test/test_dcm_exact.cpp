@@ -291,3 +291,65 @@ TEST(DcmExact, TheFieldsLatencyTurnIsRoundedAlikeBothWays) {
     }
     EXPECT_EQ(mirrored, 21);
 }
+
+// The output's Q15 factors and the compass latency in Q12 are their values rounded:
+// the lead in steps (up to 1.99 of them: 1.5 here), Q26 radians per unit, and the
+// latency held at 5.9 steps (10 asked); the coarse turn is the 16-bit factor's product.
+TEST(DcmExact, TheOutputAndLatencyFactorsAreTheirRoundedValues) {
+    dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
+    settings.output_lead_s = 1.5f * settings.step_s;
+    settings.mag_latency_s = 10.0f * settings.step_s;
+    dcm::DcmCoefficients k;
+    k.from_settings(settings);
+    k.derive_from_scales(settings);
+    EXPECT_EQ(k.lead_steps_q15, 49152);  // 1.5 * 2^15
+    EXPECT_NEAR(k.theta_q26_per_unit_q15, (double)k.turn_rad_per_unit() * 67108864.0 * 32768.0, 0.51);
+    EXPECT_NEAR(k.mag_latency_steps_q12, 5.9 * 4096.0, 0.51);
+    const Vector3l units(123456, -654321, 7777777);
+    const Vector3l coarse = k.theta_q26_coarse(units);
+    EXPECT_EQ(coarse.x, dcm::scale_q15(units.x, k.theta_q26_per_unit_q15));
+    EXPECT_EQ(coarse.y, dcm::scale_q15(units.y, k.theta_q26_per_unit_q15));
+    EXPECT_EQ(coarse.z, dcm::scale_q15(units.z, k.theta_q26_per_unit_q15));
+    EXPECT_NE(coarse.z, k.theta_q26(units).z) << "the 16-bit factor's product, not the Q30 one's";
+}
+
+// No tilt correction from a low-pass shorter than g/2: at |lp|^2 = min_lp2 exactly (the
+// sum of the mul_q30 squares it is compared as) none; with the limit a unit lower, one.
+TEST(DcmExact, NoTiltCorrectionFromALowPassAtTheLimit) {
+    OneWindow w;
+    const linalg::Matrix3q30 level = linalg::q30_from_matrix(Matrix3f::identity());
+    w.run(level, Vector3l(), Vector3l(1000, 0, -4000), 4);
+    const Vector3l lp = w.gravity.low_pass_ef();
+    const uint32_t lp2 = (uint32_t)linalg::mul_q30(lp.x, lp.x) + (uint32_t)linalg::mul_q30(lp.y, lp.y) +
+                         (uint32_t)linalg::mul_q30(lp.z, lp.z);
+    for (uint32_t below : {0u, 1u}) {
+        dcm::GravityCorrection gravity = w.gravity;
+        dcm::DcmCoefficients k = w.k;
+        k.min_lp2 = lp2 - below;
+        dcm::GyroBias bias;
+        gravity.correct_tilt(level, 0.0f, true, dcm::kDefaultDcmSettings, k, bias);
+        if (below)
+            EXPECT_NE(gravity.correction_units().y, 0);
+        else
+            EXPECT_TRUE(gravity.correction_units().x == 0 && gravity.correction_units().y == 0 &&
+                        gravity.correction_units().z == 0);
+    }
+}
+
+// The output leads by output_lead_s on every axis: turning at a steady 100 deg/s in roll
+// or in pitch, euler_now() is ahead of euler() by the rate times the lead.
+TEST(DcmExact, TheOutputLeadsOnRollAndPitch) {
+    for (int axis = 0; axis < 2; ++axis) {
+        dcm::Dcm filter;
+        ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), Vector3f()));
+        const float rate_rad_s = 100.0f * linalg::kRadPerDeg;
+        const Vector3f rate = axis == 0 ? Vector3f(rate_rad_s, 0, 0) : Vector3f(0, rate_rad_s, 0);
+        for (int i = 0; i < 40; ++i) {  // 0.2 s: 20 deg, the accelerometer turning with it
+            const float angle = rate_rad_s * filter.settings().step_s * (float)i;
+            filter.update(rate, accel_for(axis == 0 ? dcm::dcm_from_euler(angle, 0, 0) : dcm::dcm_from_euler(0, angle, 0)));
+        }
+        const dcm::EulerAngles now = filter.euler_now(), then = filter.euler();
+        const float lead_rad = axis == 0 ? now.roll_rad - then.roll_rad : now.pitch_rad - then.pitch_rad;
+        EXPECT_NEAR(lead_rad / linalg::kRadPerDeg, 100.0f * filter.settings().output_lead_s, 0.01f) << axis;
+    }
+}
