@@ -353,3 +353,21 @@ TEST(DcmExact, TheOutputLeadsOnRollAndPitch) {
         EXPECT_NEAR(lead_rad / linalg::kRadPerDeg, 100.0f * filter.settings().output_lead_s, 0.01f) << axis;
     }
 }
+
+// Near unit length (|r|^2 within 1 +- 0.002) a row is rescaled by the first-order factor
+// (3 - r.r) / 2, to the bit (r.r as the sum of the mul_q30 squares); a row a little
+// longer or shorter than that window by the exact factor instead.
+TEST(DcmExact, ARowNearUnitLengthIsRescaledToFirstOrder) {
+    for (double length2 : {1.0015, 0.9985, 1.0005}) {
+        const double scale = std::sqrt(length2 / 3.0);
+        const Vector3l row = linalg::fixed_from_vector(Vector3f((float)scale, (float)-scale, (float)scale), linalg::kQ30);
+        const uint32_t r2 = (uint32_t)linalg::mul_q30(row.x, row.x) + (uint32_t)linalg::mul_q30(row.y, row.y) +
+                            (uint32_t)linalg::mul_q30(row.z, row.z);
+        const int32_t factor = linalg::kOneQ30 + linalg::kOneQ30 / 2 - (int32_t)(r2 / 2);
+        Vector3l out;
+        ASSERT_TRUE(dcm::Strapdown::rescale(row, out)) << length2;
+        EXPECT_EQ(out.x, linalg::mul_q30(factor, row.x)) << length2;
+        EXPECT_EQ(out.y, linalg::mul_q30(factor, row.y)) << length2;
+        EXPECT_EQ(out.z, linalg::mul_q30(factor, row.z)) << length2;
+    }
+}
