@@ -371,3 +371,23 @@ TEST(DcmExact, ARowNearUnitLengthIsRescaledToFirstOrder) {
         EXPECT_EQ(out.z, linalg::mul_q30(factor, row.z)) << length2;
     }
 }
+
+// A heading correction stands for the steps its mean covers, up to 20 (after an outage
+// the first sample must not make a jump): a mean over 19 steps turns less than one over
+// 20, and one over 25 exactly as much as one over 20.
+TEST(DcmExact, AHeadingCorrectionStandsForAtMost20Steps) {
+    float yaw_rad[3];
+    const int quiet_steps[3] = {12, 13, 18};  // the mean covers kHeadingSteps - 1 more: 19, 20, 25
+    for (int i = 0; i < 3; ++i) {
+        dcm::Dcm f;
+        ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+        for (int s = 0; s < quiet_steps[i]; ++s) f.update(Vector3f(), accel_for(Matrix3f::identity()));
+        f.reset_mag_reference(false);  // the next sample closes a mean alone, at the usual rate
+        f.correct_heading(dcm::dcm_from_euler(0, 0, 0.5f).mul_transpose(earth_field_uT()));
+        EXPECT_FALSE(f.status() & dcm::kStatusMagIgnored) << i;
+        yaw_rad[i] = f.euler_now().yaw_rad;
+    }
+    EXPECT_GT(std::fabs(yaw_rad[0]), 0.01f);
+    EXPECT_LT(std::fabs(yaw_rad[0]), std::fabs(yaw_rad[1]));
+    EXPECT_EQ(yaw_rad[1], yaw_rad[2]);
+}
