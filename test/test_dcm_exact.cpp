@@ -391,3 +391,15 @@ TEST(DcmExact, AHeadingCorrectionStandsForAtMost20Steps) {
     EXPECT_LT(std::fabs(yaw_rad[0]), std::fabs(yaw_rad[1]));
     EXPECT_EQ(yaw_rad[1], yaw_rad[2]);
 }
+
+// The low-pass starts at gravity (earth down), so the start-up's fast gain corrects from
+// the first windows: a board tilted by 10 deg just after a level start is followed by
+// more than a fifth of the way within 0.3 s (a third here; a low-pass started elsewhere would pass
+// through a length below g/2, where no correction is made).
+TEST(DcmExact, ATiltRightAfterTheStartIsCorrectedAtOnce) {
+    dcm::Dcm f;
+    ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const Matrix3f tilted = dcm::dcm_from_euler(10.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    for (int i = 0; i < 60; ++i) f.update(Vector3f(), accel_for(tilted));  // 0.3 s
+    EXPECT_GT(f.euler().roll_rad, 2.0f * linalg::kRadPerDeg);
+}
