@@ -403,3 +403,15 @@ TEST(DcmExact, ATiltRightAfterTheStartIsCorrectedAtOnce) {
     for (int i = 0; i < 60; ++i) f.update(Vector3f(), accel_for(tilted));  // 0.3 s
     EXPECT_GT(f.euler().roll_rad, 2.0f * linalg::kRadPerDeg);
 }
+
+// q14_ratio is a positive ratio in Q14 rounded to nearest (the coning term's 2/3: 10923,
+// not the truncated 10922).
+TEST(DcmExact, Q14RatioRoundsToNearest) {
+    for (int32_t num : {2, 1, 5}) {
+        for (int32_t den : {3, 7, 6}) {
+            const double exact = num * 16384.0 / den;
+            EXPECT_LE(std::fabs(linalg::q14_ratio(num, den) - exact), 0.5) << num << "/" << den;
+        }
+    }
+    EXPECT_EQ(linalg::q14_ratio(2, 3), 10923);
+}
