@@ -309,10 +309,14 @@ struct LearnRun {
 // 75 Hz; the learner is fed that field (no learned offset removed: it works from its
 // own estimate) and the gyro's turn (with 0.03 deg/s of noise); `learned` is the offset
 // it puts in use.
+// (reused: a learner to restart and use, else a new one; nan_turns: before every third
+// sample, a garbage one whose turn is not finite, given no steps.)
 LearnRun run_learner(const Vector3f& offset, float seconds, float rate_rad_s, bool z_only, float noise_uT,
-                     float prior_uT = calib::kLearnPriorUncalibrated_uT) {
+                     float prior_uT = calib::kLearnPriorUncalibrated_uT, calib::OffsetLearner* reused = nullptr,
+                     bool nan_turns = false) {
     const Vector3f earth(20.0f, 0.0f, 45.0f);
-    calib::OffsetLearner learner;
+    calib::OffsetLearner own;
+    calib::OffsetLearner& learner = reused ? *reused : own;
     learner.restart(prior_uT, Vector3f());
     LearnRun run;
     Matrix3f r;
@@ -330,6 +334,7 @@ LearnRun run_learner(const Vector3f& offset, float seconds, float rate_rad_s, bo
         if (i % 8 == 0 || i % 8 == 3 || i % 8 == 5) {  // 75 Hz
             const Vector3f raw = r.mul_transpose(earth) + offset +
                                  Vector3f(gauss(seed), gauss(seed), gauss(seed)) * noise_uT;
+            if (nan_turns && i % 24 == 3) learner.add(Vector3f(500.0f, -500.0f, 500.0f), Vector3f(NAN, 0.0f, 0.0f), 0, run.learned);
             const Vector3f before = learner.estimate_uT();
             learner.add(raw, turn, since, run.learned);
             turn = Vector3f();
@@ -691,4 +696,44 @@ TEST(Calibration, GyroSpreadUpToItsLimitExactlyIsStill) {
             EXPECT_EQ(r, beyond ? GyroCalibrator::Result::Moved : GyroCalibrator::Result::Done) << axis << " " << beyond;
         }
     }
+}
+
+// A restart forgets what was learned (the information, the estimate, the pair): a learner
+// that learned one board and is restarted learns the next exactly as a new one does.
+TEST(OffsetLearner, ARestartForgetsWhatWasLearned) {
+    calib::OffsetLearner used;
+    const LearnRun first = run_learner(Vector3f(30.0f, -20.0f, 10.0f), 20.0f, 1.57f, false, 0.2f,
+                                       calib::kLearnPriorUncalibrated_uT, &used);
+    ASSERT_GT(first.updates, 20);
+    const Vector3f offset(8.0f, -5.0f, 3.0f);
+    const LearnRun again = run_learner(offset, 10.0f, 1.57f, false, 0.2f, calib::kLearnPriorUncalibrated_uT, &used);
+    const LearnRun fresh = run_learner(offset, 10.0f, 1.57f, false, 0.2f);
+    EXPECT_TRUE(again.estimate == fresh.estimate);
+    EXPECT_TRUE(again.learned == fresh.learned);
+    EXPECT_NEAR(again.learned.x, offset.x, 1.0f);
+}
+
+// A sample whose turn is not finite (a broken gyro read) is not used: given between the
+// samples, it changes nothing the learner does.
+TEST(OffsetLearner, ASampleWithANonFiniteTurnIsNotUsed) {
+    const Vector3f offset(8.0f, -5.0f, 3.0f);
+    const float prior = calib::kLearnPriorUncalibrated_uT;
+    const LearnRun plain = run_learner(offset, 20.0f, 1.57f, false, 0.2f, prior);
+    const LearnRun interrupted = run_learner(offset, 20.0f, 1.57f, false, 0.2f, prior, nullptr, true);
+    ASSERT_GT(plain.updates, 20);
+    EXPECT_TRUE(interrupted.estimate == plain.estimate);
+    EXPECT_TRUE(interrupted.learned == plain.learned);
+    EXPECT_EQ(interrupted.updates, plain.updates);
+}
+
+// A sphere near the largest radius the Earth's field may have (90 uT: the quadric's
+// terms in the fit's scale are below 1) fits as well as a small one.
+TEST(Calibration, MagLargeSphereFits) {
+    MagCalibrator m;
+    m.restart(Vector3f());
+    feed_random(m, 2250, Vector3f(8.0f, -5.0f, 3.0f), Matrix3f::identity(), 90.0f, 0.2f, 31);
+    calib::Calibration c = calib::default_calibration();
+    ASSERT_EQ(m.finish(c), MagCalibrator::Quality::Ok);
+    EXPECT_NEAR(m.radius_uT(), 90.0f, 0.2f);
+    EXPECT_NEAR(c.mag_offset_uT.x, 8.0f, 0.1f);
 }

@@ -261,3 +261,157 @@ TEST(DcmExact, AHeadingErrorBeyond90DegIsCorrectedAsAt90) {
     EXPECT_GT(std::fabs(a.euler().yaw_rad - unturned.euler().yaw_rad), 0.5f * linalg::kRadPerDeg);
     EXPECT_FALSE(a.status() & dcm::kStatusMagIgnored);
 }
+
+// A field sample is brought forward by the latency turn, rounded to Q16 radians to
+// nearest (as every rounding on its way is): mirrored in y (a turn about z of -w for +w,
+// the field's y negated), the heading taken at once from one strong sample is mirrored
+// to the bit. A turn rounded down would be a unit larger one way than the other.
+TEST(DcmExact, TheFieldsLatencyTurnIsRoundedAlikeBothWays) {
+    const Vector3f field_uT(900.0f, 150.0f, 400.0f);  // strong: a unit of the turn moves y by ~0.4 of a Q5 count
+    int mirrored = 0;
+    for (int32_t counts = 128 * 30; counts <= 128 * 90; counts += 128 * 3) {  // 0.23 to 0.7 rad/s
+        Matrix3f r[2];
+        for (int side = 0; side < 2; ++side) {
+            const float sign = side == 0 ? 1.0f : -1.0f;
+            dcm::Dcm f;
+            ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+            f.update(Vector3f(), accel_for(Matrix3f::identity()));
+            // The second step's rate waits (not yet integrated: R stays I) and is the last.
+            f.update(Vector3f(0.0f, 0.0f, sign * (float)counts * dcm::kFloatGyroScale), accel_for(Matrix3f::identity()));
+            f.reset_mag_reference(true);
+            f.correct_heading(Vector3f(field_uT.x, sign * field_uT.y, field_uT.z));
+            r[side] = f.matrix();
+        }
+        EXPECT_EQ(r[0].a.x, r[1].a.x) << counts;
+        EXPECT_EQ(r[0].a.y, -r[1].a.y) << counts;
+        EXPECT_EQ(r[0].b.x, -r[1].b.x) << counts;
+        EXPECT_EQ(r[0].b.y, r[1].b.y) << counts;
+        EXPECT_GT(std::fabs(r[0].a.y), 0.1f) << counts << ": the heading taken from the sample";
+        mirrored += r[0].a.y == -r[1].a.y;
+    }
+    EXPECT_EQ(mirrored, 21);
+}
+
+// The output's Q15 factors and the compass latency in Q12 are their values rounded:
+// the lead in steps (up to 1.99 of them: 1.5 here), Q26 radians per unit, and the
+// latency held at 5.9 steps (10 asked); the coarse turn is the 16-bit factor's product.
+TEST(DcmExact, TheOutputAndLatencyFactorsAreTheirRoundedValues) {
+    dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
+    settings.output_lead_s = 1.5f * settings.step_s;
+    settings.mag_latency_s = 10.0f * settings.step_s;
+    dcm::DcmCoefficients k;
+    k.from_settings(settings);
+    k.derive_from_scales(settings);
+    EXPECT_EQ(k.lead_steps_q15, 49152);  // 1.5 * 2^15
+    EXPECT_NEAR(k.theta_q26_per_unit_q15, (double)k.turn_rad_per_unit() * 67108864.0 * 32768.0, 0.51);
+    EXPECT_NEAR(k.mag_latency_steps_q12, 5.9 * 4096.0, 0.51);
+    const Vector3l units(123456, -654321, 7777777);
+    const Vector3l coarse = k.theta_q26_coarse(units);
+    EXPECT_EQ(coarse.x, dcm::scale_q15(units.x, k.theta_q26_per_unit_q15));
+    EXPECT_EQ(coarse.y, dcm::scale_q15(units.y, k.theta_q26_per_unit_q15));
+    EXPECT_EQ(coarse.z, dcm::scale_q15(units.z, k.theta_q26_per_unit_q15));
+    EXPECT_NE(coarse.z, k.theta_q26(units).z) << "the 16-bit factor's product, not the Q30 one's";
+}
+
+// No tilt correction from a low-pass shorter than g/2: at |lp|^2 = min_lp2 exactly (the
+// sum of the mul_q30 squares it is compared as) none; with the limit a unit lower, one.
+TEST(DcmExact, NoTiltCorrectionFromALowPassAtTheLimit) {
+    OneWindow w;
+    const linalg::Matrix3q30 level = linalg::q30_from_matrix(Matrix3f::identity());
+    w.run(level, Vector3l(), Vector3l(1000, 0, -4000), 4);
+    const Vector3l lp = w.gravity.low_pass_ef();
+    const uint32_t lp2 = (uint32_t)linalg::mul_q30(lp.x, lp.x) + (uint32_t)linalg::mul_q30(lp.y, lp.y) +
+                         (uint32_t)linalg::mul_q30(lp.z, lp.z);
+    for (uint32_t below : {0u, 1u}) {
+        dcm::GravityCorrection gravity = w.gravity;
+        dcm::DcmCoefficients k = w.k;
+        k.min_lp2 = lp2 - below;
+        dcm::GyroBias bias;
+        gravity.correct_tilt(level, 0.0f, true, dcm::kDefaultDcmSettings, k, bias);
+        if (below)
+            EXPECT_NE(gravity.correction_units().y, 0);
+        else
+            EXPECT_TRUE(gravity.correction_units().x == 0 && gravity.correction_units().y == 0 &&
+                        gravity.correction_units().z == 0);
+    }
+}
+
+// The output leads by output_lead_s on every axis: turning at a steady 100 deg/s in roll
+// or in pitch, euler_now() is ahead of euler() by the rate times the lead.
+TEST(DcmExact, TheOutputLeadsOnRollAndPitch) {
+    for (int axis = 0; axis < 2; ++axis) {
+        dcm::Dcm filter;
+        ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), Vector3f()));
+        const float rate_rad_s = 100.0f * linalg::kRadPerDeg;
+        const Vector3f rate = axis == 0 ? Vector3f(rate_rad_s, 0, 0) : Vector3f(0, rate_rad_s, 0);
+        for (int i = 0; i < 40; ++i) {  // 0.2 s: 20 deg, the accelerometer turning with it
+            const float angle = rate_rad_s * filter.settings().step_s * (float)i;
+            filter.update(rate, accel_for(axis == 0 ? dcm::dcm_from_euler(angle, 0, 0) : dcm::dcm_from_euler(0, angle, 0)));
+        }
+        const dcm::EulerAngles now = filter.euler_now(), then = filter.euler();
+        const float lead_rad = axis == 0 ? now.roll_rad - then.roll_rad : now.pitch_rad - then.pitch_rad;
+        EXPECT_NEAR(lead_rad / linalg::kRadPerDeg, 100.0f * filter.settings().output_lead_s, 0.01f) << axis;
+    }
+}
+
+// Near unit length (|r|^2 within 1 +- 0.002) a row is rescaled by the first-order factor
+// (3 - r.r) / 2, to the bit (r.r as the sum of the mul_q30 squares); a row a little
+// longer or shorter than that window by the exact factor instead.
+TEST(DcmExact, ARowNearUnitLengthIsRescaledToFirstOrder) {
+    for (double length2 : {1.0015, 0.9985, 1.0005}) {
+        const double scale = std::sqrt(length2 / 3.0);
+        const Vector3l row = linalg::fixed_from_vector(Vector3f((float)scale, (float)-scale, (float)scale), linalg::kQ30);
+        const uint32_t r2 = (uint32_t)linalg::mul_q30(row.x, row.x) + (uint32_t)linalg::mul_q30(row.y, row.y) +
+                            (uint32_t)linalg::mul_q30(row.z, row.z);
+        const int32_t factor = linalg::kOneQ30 + linalg::kOneQ30 / 2 - (int32_t)(r2 / 2);
+        Vector3l out;
+        ASSERT_TRUE(dcm::Strapdown::rescale(row, out)) << length2;
+        EXPECT_EQ(out.x, linalg::mul_q30(factor, row.x)) << length2;
+        EXPECT_EQ(out.y, linalg::mul_q30(factor, row.y)) << length2;
+        EXPECT_EQ(out.z, linalg::mul_q30(factor, row.z)) << length2;
+    }
+}
+
+// A heading correction stands for the steps its mean covers, up to 20 (after an outage
+// the first sample must not make a jump): a mean over 19 steps turns less than one over
+// 20, and one over 25 exactly as much as one over 20.
+TEST(DcmExact, AHeadingCorrectionStandsForAtMost20Steps) {
+    float yaw_rad[3];
+    const int quiet_steps[3] = {12, 13, 18};  // the mean covers kHeadingSteps - 1 more: 19, 20, 25
+    for (int i = 0; i < 3; ++i) {
+        dcm::Dcm f;
+        ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+        for (int s = 0; s < quiet_steps[i]; ++s) f.update(Vector3f(), accel_for(Matrix3f::identity()));
+        f.reset_mag_reference(false);  // the next sample closes a mean alone, at the usual rate
+        f.correct_heading(dcm::dcm_from_euler(0, 0, 0.5f).mul_transpose(earth_field_uT()));
+        EXPECT_FALSE(f.status() & dcm::kStatusMagIgnored) << i;
+        yaw_rad[i] = f.euler_now().yaw_rad;
+    }
+    EXPECT_GT(std::fabs(yaw_rad[0]), 0.01f);
+    EXPECT_LT(std::fabs(yaw_rad[0]), std::fabs(yaw_rad[1]));
+    EXPECT_EQ(yaw_rad[1], yaw_rad[2]);
+}
+
+// The low-pass starts at gravity (earth down), so the start-up's fast gain corrects from
+// the first windows: a board tilted by 10 deg just after a level start is followed by
+// more than a fifth of the way within 0.3 s (a third here; a low-pass started elsewhere would pass
+// through a length below g/2, where no correction is made).
+TEST(DcmExact, ATiltRightAfterTheStartIsCorrectedAtOnce) {
+    dcm::Dcm f;
+    ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    const Matrix3f tilted = dcm::dcm_from_euler(10.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    for (int i = 0; i < 60; ++i) f.update(Vector3f(), accel_for(tilted));  // 0.3 s
+    EXPECT_GT(f.euler().roll_rad, 2.0f * linalg::kRadPerDeg);
+}
+
+// q14_ratio is a positive ratio in Q14 rounded to nearest (the coning term's 2/3: 10923,
+// not the truncated 10922).
+TEST(DcmExact, Q14RatioRoundsToNearest) {
+    for (int32_t num : {2, 1, 5}) {
+        for (int32_t den : {3, 7, 6}) {
+            const double exact = num * 16384.0 / den;
+            EXPECT_LE(std::fabs(linalg::q14_ratio(num, den) - exact), 0.5) << num << "/" << den;
+        }
+    }
+    EXPECT_EQ(linalg::q14_ratio(2, 3), 10923);
+}
