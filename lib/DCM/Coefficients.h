@@ -100,7 +100,6 @@ struct DcmCoefficients {
     Limit rest_accel_dev = {};                // rest_accel_deviation_m_s2, accel units
     int32_t bias_limit_fine = 0;             // bias_limit_rad_s, fine units
     int32_t ki_fine = 0;                     // ki_rp * the correction interval, fine units per rad/s
-    int32_t ki_measured_fine = 0;            // ki_rp_measured likewise
     int32_t kp_units = 0;                // kp_rp, units per rad/s
     uint32_t min_lp2 = 0;                // (g/2)^2 as correct_tilt's |lp|^2 / 2^30 (lp in accel units)
     uint16_t lead_steps_q15 = 0;         // output_lead_s / step_s, Q15
@@ -108,6 +107,7 @@ struct DcmCoefficients {
     int32_t theta_factor_q30 = 0;        // Q26 radians per unit, Q30; 0: the float path
     int32_t theta_units_limit = 0;       // the units that make kMaxTurnAxisQ26
     int16_t mag_latency_steps_q12 = 0;   // mag_latency_s in steps (below 6), Q12
+    int32_t ki_measured_fine = 0;        // ki_rp_measured * the correction interval, fine units per rad/s
 
     // From the settings alone (the estimator's constructor): an ordinary function, so
     // that the float work is one copy in flash and runs once.

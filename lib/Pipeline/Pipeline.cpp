@@ -48,7 +48,9 @@ int16_t centripetal_gain_q8(float airspeed_m_s) {
     return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
 }
 
-LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30) {
+// Both out of line (FIXED_COLD): in flight only; inlined, they grew the step's frame for
+// every board.
+FIXED_COLD LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30) {
     // a_y = f_y + g down_y in counts: down_y Q14 times g's counts, Q14.
     constexpr int16_t kGravityCounts = (int16_t)(kG / kAccelCount_m_s2 + 0.5f);
     constexpr int16_t kMarginCounts = (int16_t)(kG / kAccelCount_m_s2 * 0.0348995f + 0.5f);  // sin(2 deg)
@@ -57,8 +59,8 @@ LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30) {
     return LateralBounds{(a_y < 0 ? a_y : 0) - kMarginCounts, (a_y > 0 ? a_y : 0) + kMarginCounts};
 }
 
-linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z, int16_t gain_q8,
-                                       LateralBounds lateral) {
+FIXED_COLD linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z,
+                                                  int16_t gain_q8, LateralBounds lateral) {
     // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V.
     int32_t lateral_counts = linalg::mul_s16(gyro_z, gain_q8) >> 8;
     if (lateral_counts < lateral.lo) lateral_counts = lateral.lo;
@@ -266,9 +268,10 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     const calib::GyroCalibrator::Result r =
         gyro_cal_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count);
     ++st_.gyro_cal_steps;
-    // The window's samples for a start that is never still (not the step that starts:
-    // it has the start's work, and a still start takes the calibration's mean).
-    if (st_.phase == Phase::Calibrating && r != calib::GyroCalibrator::Result::Done &&
+    // The window's samples for a start that is never still, from the board's first move
+    // (a still board's gravity is the calibration's mean; not the step that starts: it has
+    // the start's work).
+    if (st_.phase == Phase::Calibrating && gyro_cal_.restarts() != 0 && r != calib::GyroCalibrator::Result::Done &&
         st_.gyro_cal_steps < kStartupDeadlineSteps)
         start_gravity_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count,
                            settings_.cal.gyro_bias_rad_s, 1.0f / kRateHz);

@@ -303,7 +303,6 @@ private:
     settings::Settings settings_;
     dcm::Dcm dcm_;
     calib::GyroCalibrator gyro_cal_;
-    StartGravity start_gravity_;  // the start's gravity if never still (StartGravity.h)
     calib::MagCalibrator mag_cal_;
     calib::OffsetLearner learner_;
     linalg::Vector3f learned_at_reference_uT_;  // the learned offset when the DCM last learned the field
@@ -348,6 +347,7 @@ private:
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
     };
     State st_;
+    StartGravity start_gravity_;  // the start's gravity if never still (StartGravity.h)
 };
 
 }  // namespace pipeline
