@@ -85,6 +85,27 @@ TEST(DcmHeading, TheMeanIsInEarthAxesOverKHeadingSteps) {
     EXPECT_EQ(mean.steps(), dcm::kHeadingSteps);
 }
 
+// Whatever the compass's rate against the step's, the mean is the sum over the samples
+// taken: one sample a step (a faster compass, or steps caught up after a stall) puts up
+// to kHeadingSteps of them in a mean.
+TEST(DcmHeading, TheMeanDividesByTheSamplesTaken) {
+    for (uint8_t n = 1; n <= dcm::kHeadingSteps; ++n) {
+        dcm::EarthFieldMean mean;
+        Vector3f expected;
+        for (uint8_t i = 0; i < n; ++i) {
+            const Vector3f field(20.0f + (float)i, 0.5f * (float)i, 45.0f - (float)i);
+            mean.add(earth_units(field), norm2_units(field), 1);
+            expected += field * (1.0f / (float)n);
+        }
+        Vector3f field;
+        float norm2 = 0.0f;
+        mean.take(field, norm2);
+        EXPECT_NEAR(field.x, expected.x, 1e-3f) << (int)n;
+        EXPECT_NEAR(field.y, expected.y, 1e-3f) << (int)n;
+        EXPECT_NEAR(field.z, expected.z, 1e-3f) << (int)n;
+    }
+}
+
 TEST(DcmHeading, TheLearnedFieldPassesAndADisturbanceDoesNot) {
     Gate g;
     EXPECT_EQ(g.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kEarthField);
