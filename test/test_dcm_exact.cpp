@@ -173,8 +173,9 @@ TEST(DcmExact, AWindowsMeanIsItsSumTimesTheRoundedInverse) {
         const int32_t expected = linalg::mul_q30(linalg::q30_ratio(1, c.n), sum_units);
         EXPECT_EQ(w.gyro_mean.x, expected) << (int)c.n;
         EXPECT_EQ(w.gyro_mean.y, -expected) << (int)c.n;
-        if (c.n == 3 || c.n == 5)
+        if (c.n == 3 || c.n == 5) {
             EXPECT_NE(expected, linalg::mul_q30(linalg::fixed_from_float(1.0f / c.n, linalg::kQ30), sum_units)) << (int)c.n;
+        }
     }
     for (uint8_t n = 6; n <= 9; ++n) {
         OneWindow w;

@@ -154,7 +154,9 @@ TEST(Pipeline, AGyroAtFullScaleOnEveryAxisIsNotIntegrated) {
     for (int i = 0; i < 200; ++i) {
         p.on_imu_sample(stuck);
         // The first kMaxSpikeRun steps the spike guard stands the previous sample in.
-        if (i >= pipeline::kMaxSpikeRun) EXPECT_TRUE(p.estimator().status() & dcm::kStatusGyroRejected) << i;
+        if (i >= pipeline::kMaxSpikeRun) {
+            EXPECT_TRUE(p.estimator().status() & dcm::kStatusGyroRejected) << i;
+        }
     }
     EXPECT_NEAR(p.angles().roll_deg, 0.0f, 0.1f);
     EXPECT_NEAR(p.angles().pitch_deg, 0.0f, 0.1f);

@@ -17,6 +17,7 @@
 //   Strapdown.h      Strapdown              integration and renormalisation (AP's matrix_update, normalize)
 //   Schedule.h       HeavySchedule          one heavy part a step
 //   Gravity.h        GravityCorrection      accel window, earth-frame low-pass, roll/pitch (VQF's updateAcc)
+//   Centripetal.h    TurnMean               the turn's centripetal acceleration off the window (AP's DCM, airspeed)
 //   Rest.h           RestDetector           rest detection (VQF's rest, Fusion's FusionOffset)
 //   GyroBias.h       GyroBias               the calibrated bias and the estimate
 //   Heading.h        EarthFieldMean,        the heading's mean and the disturbance gate (VQF's updateMag)
@@ -157,6 +158,9 @@ public:
     float cos_tilt() const { return linalg::float_from_fixed(strapdown_.r().c.z, linalg::kQ30); }
     // R's earth down, body y component (sin(roll) cos(pitch)), Q30.
     int32_t down_y_q30() const { return strapdown_.r().c.y; }
+    // The turn's centripetal correction (Centripetal.h): its gain and means, kept by the
+    // caller (the pipeline: it knows the airspeed); nullptr: none.
+    void set_turn(TurnMean* turn) { turn_ = turn; }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
     // Seed for the bias estimate, e.g. from a start-up calibration at rest.
@@ -231,6 +235,7 @@ private:
     HeavySchedule schedule_;             // which heavy part a step runs
     GyroBias bias_;                      // the calibrated bias and the estimate
     GravityCorrection gravity_;          // the accel window, its low-pass and the roll/pitch correction
+    TurnMean* turn_ = nullptr;           // the turn's centripetal correction, if flying (set_turn)
     RestDetector rest_;                  // rest, when the gyro reads its bias alone
     EarthFieldMean field_mean_;          // the field samples in earth axes, for the heading
     MagneticGate gate_;                  // the disturbance gate: which means are the earth field

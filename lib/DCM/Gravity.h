@@ -17,6 +17,7 @@
 
 #include <stdint.h>
 
+#include "Centripetal.h"
 #include "Coefficients.h"
 #include "GyroBias.h"
 
@@ -33,6 +34,9 @@ public:
         accel_sum_of_sums_ += accel_sum_;  // sum of (samples from this one on) a_j
         ++window_samples_;
     }
+    // The turn's centripetal acceleration off the window's accel sums (Centripetal.h),
+    // from its gyro sums less the calibrated bias (units) and the estimate's down_y (Q30).
+    void take_off_turn(TurnMean& turn, int32_t down_y_q30, const linalg::Vector3l& sensor_bias_units);
     // The window into the earth-frame low-pass (R body to earth, the steps not yet
     // integrated, what the step subtracts and the calibrated bias, in units); the window's
     // gyro mean less the calibrated bias (units) and accel mean (accel units) for the rest

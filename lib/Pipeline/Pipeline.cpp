@@ -39,50 +39,24 @@ uint32_t norm2(const linalg::Vector3i& v) {
 }
 }  // namespace
 
-// An int32 into int16's range.
-static int16_t sat16(int32_t v) { return v > 32767 ? 32767 : v < -32767 ? -32767 : (int16_t)v; }
-
 int16_t centripetal_gain_q8(float airspeed_m_s) {
     if (!(airspeed_m_s >= kCentripetalMinAirspeed_m_s)) return 0;  // NaN too
     const float v = airspeed_m_s < kCentripetalMaxAirspeed_m_s ? airspeed_m_s : kCentripetalMaxAirspeed_m_s;
     return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
 }
 
-// Both out of line (FIXED_COLD): in flight only; inlined, they grew the step's frame for
-// every board.
-FIXED_COLD LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30) {
-    // a_y = f_y + g down_y in counts: down_y Q14 times g's counts, Q14.
-    constexpr int16_t kGravityCounts = (int16_t)(kG / kAccelCount_m_s2 + 0.5f);
-    constexpr int16_t kMarginCounts = (int16_t)(kG / kAccelCount_m_s2 * 0.0348995f + 0.5f);  // sin(2 deg)
-    static_assert(kTurnBankMargin_deg == 2.0f, "kMarginCounts is g sin(kTurnBankMargin_deg)");
-    const int32_t a_y = (int32_t)accel_y_counts + (linalg::mul_s16((int16_t)(down_y_q30 >> 16), kGravityCounts) >> 14);
-    return LateralBounds{(a_y < 0 ? a_y : 0) - kMarginCounts, (a_y > 0 ? a_y : 0) + kMarginCounts};
-}
-
-FIXED_COLD linalg::Vector3i centripetal_corrected(const linalg::Vector3i& a, int16_t gyro_y, int16_t gyro_z,
-                                                  int16_t gain_q8, LateralBounds lateral) {
-    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V.
-    int32_t lateral_counts = linalg::mul_s16(gyro_z, gain_q8) >> 8;
-    if (lateral_counts < lateral.lo) lateral_counts = lateral.lo;
-    if (lateral_counts > lateral.hi) lateral_counts = lateral.hi;
-    return linalg::Vector3i(a.x, sat16((int32_t)a.y - lateral_counts),
-                            sat16((int32_t)a.z + (linalg::mul_s16(gyro_y, gain_q8) >> 8)));
-}
-
-// A rate in gyro counts, rounded and clamped (NaN: 0).
-static int16_t gyro_counts_of(float rate_rad_s) {
-    const float c = rate_rad_s / kGyroCount_rad_s;
-    if (!(c > -32767.0f)) return c < 0.0f ? -32767 : 0;
-    return c >= 32767.0f ? 32767 : (int16_t)(c < 0.0f ? c - 0.5f : c + 0.5f);
-}
-
 void AttitudePipeline::set_airspeed_m_s(float airspeed_m_s) {
     airspeed_m_s_ = airspeed_m_s;
-    centripetal_gain_q8_ = centripetal_gain_q8(airspeed_m_s);
-    // The calibrated bias in counts (the estimator's own residual is left: a fraction of
-    // a deg/s, a few tenths of a m/s^2 at cruise).
-    gyro_bias_y_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.y);
-    gyro_bias_z_counts_ = gyro_counts_of(settings_.cal.gyro_bias_rad_s.z);
+    if (st_.phase == Phase::Running) configure_turn();
+}
+
+void AttitudePipeline::configure_turn() {
+    constexpr int16_t kGravityCounts = (int16_t)(kG / kAccelCount_m_s2 + 0.5f);
+    const int16_t gain_q8 = centripetal_gain_q8(airspeed_m_s_);
+    // Landed or below the speed: the turn's mean starts again with the next flight.
+    if (gain_q8 == 0) turn_mean_ = dcm::TurnMean();
+    turn_mean_.configure(gain_q8, kGravityCounts);
+    dcm_.set_turn(gain_q8 != 0 ? &turn_mean_ : nullptr);
 }
 
 void AttitudePipeline::set_cruise_airspeed_m_s(float trim_m_s) {
@@ -114,7 +88,7 @@ AttitudePipeline::AttitudePipeline(const EventSink* events, const dcm::DcmSettin
 }
 
 AttitudePipeline::AttitudePipeline(const EventSink* events, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
-    : events_(events), settings_(), dcm_(dcm_settings), st_() {
+    : events_(events), settings_(), dcm_(dcm_settings), st_(), start_gravity_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f);
 }
 
@@ -261,6 +235,8 @@ void AttitudePipeline::start_estimator(const Vector3f& gravity) {
                      settings_.cal.mag_learned_uT);
     learned_at_reference_uT_ = settings_.cal.mag_learned_uT;
     st_.phase = Phase::Running;
+    turn_mean_ = dcm::TurnMean();  // the start's gravity is spent: its space holds the turn's mean
+    configure_turn();
     st_.output_acc = kRateHz;  // the first line comes with the first step
 }
 
@@ -373,17 +349,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         st_.output_due = true;
     }
     const bool heading_heavy = heading_corrected && dcm_.heading_due_next();
-    const linalg::Vector3i* accel = &s.accel;
-    linalg::Vector3i corrected;
-    if (centripetal_gain_q8_ != 0) {
-        // Gravity for the DCM: the turn's centripetal acceleration taken off (see
-        // kCentripetalMinAirspeed_m_s); the clip checks above saw the measured sample.
-        corrected = centripetal_corrected(s.accel, sat16((int32_t)s.gyro.y - gyro_bias_y_counts_),
-                                          sat16((int32_t)s.gyro.z - gyro_bias_z_counts_), centripetal_gain_q8_,
-                                          turn_lateral_bounds(s.accel.y, dcm_.down_y_q30()));
-        accel = &corrected;
-    }
-    dcm_.update(s.gyro, *accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
+    dcm_.update(s.gyro, s.accel, norm2(s.gyro) < kMaxCredibleRateCounts2, !accel_stuck, st_.output_due);
     // The board's turn for the compass learner: the gyro alone (the biases come off when
     // a field sample takes it).
     turn_counts_ += s.gyro;
@@ -474,7 +440,7 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
 
 void AttitudePipeline::start_gyro_calibration() {
     gyro_cal_.restart();
-    start_gravity_.restart();
+    if (st_.phase != Phase::Running) start_gravity_.restart();  // running: the space is the turn's
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
     if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);

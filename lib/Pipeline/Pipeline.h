@@ -101,31 +101,9 @@ constexpr float kCentripetalMinAirspeed_m_s = 9.0f;
 constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
 
 // The correction's gain: accel counts per gyro count of omega x v at this airspeed, Q8
-// (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum).
+// (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum). The
+// estimator takes it off its gravity window (lib/DCM/Centripetal.h).
 int16_t centripetal_gain_q8(float airspeed_m_s);
-// omega_z V is the lateral acceleration only while the relative wind turns with the
-// flight path. Turbulence yaws the aeroplane into a relative wind that changes while the
-// path hardly turns (README, "Flying in simulation").
-// The accelerometer and the estimate say what the lateral acceleration is: a_y = f_y +
-// g down_y (down_y = sin(roll) cos(pitch), earth down's body y component, the gyro
-// carries it through a turn's entry; a coordinated turn has f_y = 0, a flat skid g down_y
-// = 0). So omega_z V is held between 0 and that a_y, widened by kTurnBankMargin_deg of
-// bank: the estimate is moved toward what omega_z V says at most that far beyond what it
-// holds, a turn that lasts gets all of it (each step the bound moves on with the
-// estimate), a gust's yaw of a second or two hardly any. 2 deg: the bank error a turn's
-// entry leaves in the estimate (the gyro's +-3 % scale tolerance, MPU-6000 datasheet
-// 6.1, over a 45 deg roll, and the half degree the tilt holds before it).
-constexpr float kTurnBankMargin_deg = 2.0f;
-struct LateralBounds {
-    int32_t lo, hi;  // accel counts
-};
-LateralBounds turn_lateral_bounds(int16_t accel_y_counts, int32_t down_y_q30);
-// f - omega x v in the MPU6000's counts, gyro_counts less the sensor bias, the lateral
-// term omega_z V within bounds; each axis saturates at +-32767.
-linalg::Vector3i centripetal_corrected(const linalg::Vector3i& accel_counts, int16_t gyro_y_counts,
-                                       int16_t gyro_z_counts, int16_t gain_q8,
-                                       LateralBounds lateral = LateralBounds{-2147483647L, 2147483647L});
-
 enum class Phase : uint8_t {
     WaitImu,      // no sample yet
     Calibrating,  // measuring the gyro bias; nothing estimated yet
@@ -285,6 +263,8 @@ private:
     void step_calibration(const mpu6000::Sample& raw);
     void start_estimator(const linalg::Vector3f& gravity);
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
+    // The estimator's turn correction from the airspeed (once running: TurnMean's space).
+    void configure_turn();
     void step_mag_fit();
     void finish_mag_calibration();
     void report_deferred();
@@ -312,9 +292,6 @@ private:
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     float airspeed_m_s_ = 0.0f;
-    int16_t centripetal_gain_q8_ = 0;     // 0: no correction
-    int16_t gyro_bias_y_counts_ = 0;      // the calibrated bias the gyro counts carry
-    int16_t gyro_bias_z_counts_ = 0;
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
     // clears it in one loop instead of a store per member (less flash).
@@ -347,7 +324,13 @@ private:
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
     };
     State st_;
-    StartGravity start_gravity_;  // the start's gravity if never still (StartGravity.h)
+    // One space for two phases (RAM): before the estimator runs the start's gravity if
+    // never still (StartGravity.h), then the turn's mean (TurnMean: a plain struct, taken
+    // up by assignment in start_estimator; the phase never goes back).
+    union {
+        StartGravity start_gravity_;
+        dcm::TurnMean turn_mean_;
+    };
 };
 
 }  // namespace pipeline

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "Centripetal.h"
+
+#include "Fixed.h"
+
+namespace dcm {
+
+namespace {
+
+int32_t within(int32_t x, LateralBounds b) { return x < b.lo ? b.lo : (x > b.hi ? b.hi : x); }
+int32_t within(int32_t x, int32_t limit) { return x < -limit ? -limit : (x > limit ? limit : x); }
+
+// A window's omega V (counts): the rate's sum held to five full-scale samples, so that
+// its product with the gain (below 2^13 up to 60 m/s) stays within 32 bits.
+int32_t times_gain(int32_t rate_sum, int16_t gain_q8) {
+    constexpr int32_t kMaxRateSum = 5L * 32767L;
+    return (within(rate_sum, kMaxRateSum) * gain_q8) >> 8;
+}
+
+// A mean's step, (sum - mean) / 64 (TurnMean::kMeanShift): the high three bytes times
+// 4, not a loop of six shifts (the step's lowest bits, 1/64 of a count, are dropped).
+int32_t step_of_mean(int32_t difference_q8) {
+    static_assert(TurnMean::kMeanShift == 6, "a byte's shift less two");
+    return (difference_q8 >> 8) * 4;
+}
+
+// x n for a window's n samples: two shifts for the usual 4 (avr-gcc's 32-bit multiply
+// is a call).
+int32_t times_n(int32_t x, uint8_t n) { return n == 4 ? x * 4 : x * n; }
+
+}  // namespace
+
+LateralBounds lateral_bounds(int32_t a_y, int32_t margin) {
+    return LateralBounds{(a_y < 0 ? a_y : 0) - margin, (a_y > 0 ? a_y : 0) + margin};
+}
+
+void TurnMean::configure(int16_t gain_q8, int16_t gravity_counts) {
+    gain_q8_ = gain_q8;
+    gravity_counts_x4_ = (int16_t)(gravity_counts * 4);
+    // g sin(kTurnBankMargin_deg): sin(0.5 deg) = 143 / 2^14.
+    static_assert(kTurnBankMargin_deg == 0.5f, "143 / 2^14 is sin(kTurnBankMargin_deg)");
+    margin_counts_ = (int16_t)(((int32_t)gravity_counts * 143 + 8192) >> 14);
+}
+
+int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n) {
+    // Beyond 2^21 counts a window (500 g) is no turn: held, so the means stay in 32 bits.
+    const int32_t raw = within(raw_sum, 1L << 21);
+    // a_y = f_y + g down_y, and the margin with the scale error's share, g |down_y| / 32
+    // (3.1 %: at least g cos(roll) 0.03 roll), each summed over the window.
+    static_assert(kTurnBankScaleError <= 1.0f / 32.0f, "g |down_y| / 32 covers kTurnBankScaleError");
+    // (down_y Q14 times 4 g, >> 16: the high bytes, no shift loop.)
+    const int16_t gravity_y = (int16_t)(linalg::mul_s16((int16_t)(down_y_q30 >> 16), gravity_counts_x4_) >> 16);
+    const int32_t a_y = f_y_sum + times_n(gravity_y, n);
+    const int32_t margin = times_n(margin_counts_ + ((gravity_y < 0 ? -gravity_y : gravity_y) >> 5), n);
+    const int32_t clipped = within(raw, lateral_bounds(a_y, margin));
+    // mean += (sum - mean) / 64, Q8; the first window is the means.
+    if (!started_) {
+        started_ = true;
+        raw_q8_ = raw * 256;
+        a_y_q8_ = a_y * 256;
+        clipped_q8_ = clipped * 256;
+    }
+    raw_q8_ += step_of_mean(raw * 256 - raw_q8_);
+    a_y_q8_ += step_of_mean(a_y * 256 - a_y_q8_);
+    clipped_q8_ += step_of_mean(clipped * 256 - clipped_q8_);
+    const int32_t mean_bounded_q8 = within(raw_q8_, lateral_bounds(a_y_q8_, margin * 256));
+    return clipped + ((mean_bounded_q8 - clipped_q8_) >> 8);
+}
+
+FIXED_COLD void TurnMean::take_off(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
+                                   linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
+    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V; each
+    // held within the accelerometer's full scale a sample.
+    const int32_t full_scale = times_n(32767, n);
+    const int32_t lateral = within(lateral_sum(times_gain(rate_z_sum, gain_q8_), accel_sum.y, down_y_q30, n), full_scale);
+    const int32_t normal = within(times_gain(rate_y_sum, gain_q8_), full_scale);
+    accel_sum.y -= lateral;
+    accel_sum.z += normal;
+    // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all: the
+    // window's term (n samples' worth) times (n + 1) / 2.
+    accel_sum_of_sums.y -= (times_n(lateral, n) + lateral) >> 1;
+    accel_sum_of_sums.z += (times_n(normal, n) + normal) >> 1;
+}
+
+}  // namespace dcm
