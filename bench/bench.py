@@ -72,6 +72,9 @@ CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 10000, ""),
                  ("step_cycles_max", "estimator step, max cycles", 30000, ""),
                  ("step_cycles_avg_shake", "estimator step on `shake`, avg cycles", 10000, ""),
                  ("step_cycles_max_shake", "estimator step on `shake`, max cycles", 30000, ""),
+                 ("step_cycles_avg_flight", "estimator step in flight (TRIM_ARSPD_CM set), `tilt_tour`, avg cycles", 10000, ""),
+                 ("step_cycles_avg_flight_shake", "estimator step in flight, `shake`, avg cycles", 10000, ""),
+                 ("step_cycles_max_flight_shake", "estimator step in flight, `shake`, max cycles", 30000, ""),
                  ("euler_cycles_avg", "Euler extraction, avg cycles", 4000, ""),
                  ("loop_load_pct", "loop CPU load at 200 Hz", 25.0, "%"),
                  ("loop_cycles_max", "loop iteration, max cycles", 40000, ""),
@@ -216,7 +219,9 @@ def section_id(name):
     return None
 
 
-def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
+def measure_cycles(build, out_dir, seconds, scenario="tilt_tour", console=None, tag=""):
+    """apm25sim --profile on a scenario in STABILIZE; console: a line typed at the
+    firmware's console first (apm25sim --input), tag: the profile file's suffix."""
     sim = tool(build, "apm25sim")
     scen = tool(build, "scenario")
     elf = os.path.join(build, "firmware.elf")
@@ -232,7 +237,8 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
     if r.returncode != 0:
         log("scenario %s failed: %s" % (scenario, r.stderr.strip()))
         return None
-    prof = os.path.join(out_dir, "profile.csv" if scenario == "tilt_tour" else "profile_%s.csv" % scenario)
+    prof = os.path.join(out_dir, "profile.csv" if scenario == "tilt_tour" and not tag else
+                        "profile_%s%s.csv" % (scenario, tag))
     if os.path.exists(prof):
         os.remove(prof)
     cmd = [sim, "--elf", elf, "--trajectory", traj, "--seconds", str(seconds), "--profile", prof]
@@ -242,6 +248,11 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour"):
     with open(rc, "w") as f:
         f.write("t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8\n0.5,1500,1500,1500,1500,1500,1500,1500,2000\n")
     cmd += ["--rc", rc]
+    if console:
+        typed = os.path.join(out_dir, "scenarios", "console%s.txt" % tag)
+        with open(typed, "w") as f:
+            f.write(console + "\r\n")
+        cmd += ["--input", typed]
     log("cycles: %s (simavr, %g simulated s)" % (" ".join(os.path.relpath(c, REPO) if os.sep in c else c
                                                             for c in cmd), seconds))
     t0 = time.time()
@@ -578,6 +589,10 @@ def main():
     # Issue 10 measures a shaking board too (the vibration keeps the rest test and the
     # integrator hold busy).
     cycles_shake = measure_cycles(build, out_dir, args.seconds, "shake")
+    # In flight: a cruise speed configured and the throttle up (stabilize_rc), so the
+    # estimator takes the turn's centripetal acceleration off its gravity window.
+    cycles_flight = {name: measure_cycles(build, out_dir, args.seconds, name, "set TRIM_ARSPD_CM 1800", "_flight")
+                     for name in ("tilt_tour", "shake")}
     # Flash beside the cycles: the inlining decisions trade one for the other (Fixed.h).
     for name, c in (("tilt_tour", cycles), ("shake", cycles_shake)):
         st = c["sections"].get(1) if c else None
@@ -661,6 +676,7 @@ def main():
     # 4. figures and report
     sec = cycles["sections"] if cycles else {}
     sec_shake = cycles_shake["sections"] if cycles_shake else {}
+    step_of = lambda c, k: c["sections"][1][k] if c and 1 in c["sections"] else None
     ours_broad = results[OURS]
     have_all = trials and all(t in ours_broad for t in trials)
     figures = {
@@ -668,6 +684,9 @@ def main():
         "step_cycles_max": sec[1]["max"] if 1 in sec else None,
         "step_cycles_avg_shake": sec_shake[1]["avg"] if 1 in sec_shake else None,
         "step_cycles_max_shake": sec_shake[1]["max"] if 1 in sec_shake else None,
+        "step_cycles_avg_flight": step_of(cycles_flight["tilt_tour"], "avg"),
+        "step_cycles_avg_flight_shake": step_of(cycles_flight["shake"], "avg"),
+        "step_cycles_max_flight_shake": step_of(cycles_flight["shake"], "max"),
         "loop_cycles_max": sec[6]["max"] if 6 in sec else None,
         "euler_cycles_avg": sec[2]["avg"] if 2 in sec else None,
         "line_cycles_avg": sec[3]["avg"] if 3 in sec else None,
@@ -720,6 +739,12 @@ def main():
                     "(%s %%)." % (cycles_shake["seconds"], pick(1, "avg"), pick(1, "max"), pick(2, "avg"),
                                   pick(6, "avg"), pick(6, "max"),
                                   "%.1f" % cycles_shake["load"] if cycles_shake["load"] is not None else "–")]
+        rep += ["", "In flight (`set TRIM_ARSPD_CM 1800` typed at the console, the throttle up: the estimator "
+                "takes the turn's centripetal acceleration off its gravity window, lib/DCM/Centripetal.h): "
+                + "; ".join("`%s` estimator step %s avg / %s max" % (
+                    name, fmt(step_of(c, "avg"), 0) if step_of(c, "avg") is not None else "–",
+                    fmt(step_of(c, "max"), 0) if step_of(c, "max") is not None else "–")
+                    for name, c in sorted(cycles_flight.items(), reverse=True)) + "."]
     else:
         rep.append("Not measured (apm25sim, scenario or firmware.elf missing, or the run failed).")
     rep.append("")

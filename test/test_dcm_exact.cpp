@@ -8,6 +8,7 @@
 #include <cmath>
 #include <initializer_list>
 
+#include "Centripetal.h"
 #include "Gravity.h"
 #include "Strapdown.h"
 #include "dcm_test_support.h"
@@ -129,6 +130,39 @@ struct OneWindow {
 };
 
 }  // namespace
+
+// In flight the turn's term comes off the window with the calibrated bias taken off the
+// gyro's sums in whole counts, rounded (100.78 counts: 101): a board reading its bias
+// alone, level at 18 m/s, keeps its window as it is.
+TEST(DcmExact, TheTurnTermTakesTheCalibratedBiasOffInRoundedCounts) {
+    const Vector3l accel_counts(0, 0, -4096), gyro_counts(0, 101, 101);
+    const Vector3l sensor_bias_units(0, 100 * 256 + 130, 100 * 256 + 200);
+    dcm::TurnMean turn = dcm::TurnMean();
+    turn.configure(2048, 4096);  // about 18 m/s
+    OneWindow w;
+    for (uint8_t i = 0; i < 4; ++i) w.gravity.add(gyro_counts, accel_counts);
+    w.gravity.take_off_turn(turn, 0, sensor_bias_units);
+    ASSERT_TRUE(w.gravity.low_pass_window(linalg::q30_from_matrix(Matrix3f::identity()), 0, Vector3l(), sensor_bias_units,
+                                          false, 0.0f, w.k, w.gyro_mean, w.accel_mean, w.whole));
+    EXPECT_EQ(w.accel_mean.x, 0);
+    EXPECT_EQ(w.accel_mean.y, 0);
+    EXPECT_EQ(w.accel_mean.z, -4096 * 256);
+}
+
+// A reset (a start) leaves no correction from before it.
+TEST(DcmExact, AResetClearsTheCorrection) {
+    OneWindow w;
+    // About 0.25 g and 0.12 g of tilt at the float form's scale (4096 counts per m/s^2).
+    w.run(linalg::q30_from_matrix(Matrix3f::identity()), Vector3l(), Vector3l(10000, -5000, -38000), 4);
+    dcm::GyroBias bias;
+    w.gravity.correct_tilt(linalg::q30_from_matrix(Matrix3f::identity()), 0.0f, true, dcm::kDefaultDcmSettings, w.k, bias);
+    const Vector3l before = w.gravity.correction_units();
+    ASSERT_TRUE(before.x != 0 && before.y != 0);
+    w.gravity.reset(-4096 * 256);
+    EXPECT_EQ(w.gravity.correction_units().x, 0);
+    EXPECT_EQ(w.gravity.correction_units().y, 0);
+    EXPECT_EQ(w.gravity.correction_units().z, 0);
+}
 
 // The window's means over its usual four samples are exact: the gyro's less the
 // calibrated bias, and the earth-frame force's, whose sum is the matrix's 16-bit entries

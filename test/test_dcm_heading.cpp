@@ -154,6 +154,16 @@ TEST(DcmHeading, ANewFieldIsAdoptedAfterExactlyItsRecoverSteps) {
     EXPECT_EQ(g.one_step_means_to_adopt(kEarthNorm * 1.3f), (int)g.k.mag_recover_steps);
 }
 
+// A field that leaves the learned one's tolerance from a sample at its edge is steady
+// against that sample (the candidate) from its first mean: it counts its recover steps
+// from zero as any other.
+TEST(DcmHeading, AFieldLeavingFromTheEdgeCountsFromZero) {
+    Gate g;
+    const float tolerance = dcm::kDefaultDcmSettings.mag_norm_tolerance;
+    ASSERT_EQ(g.judge_one_step(kEarthNorm * (1.0f + 0.9f * tolerance)), dcm::FieldVerdict::kEarthField);
+    EXPECT_EQ(g.one_step_means_to_adopt(kEarthNorm * (1.0f + 1.1f * tolerance)), (int)g.k.mag_recover_steps);
+}
+
 // The turn that proves a new field fixed in the earth frame counts only while that field
 // stays the same: a field steady for 10 s while the board turned (too short to be
 // adopted), a different one for a moment, then the first again at rest is never

@@ -140,6 +140,10 @@ TEST(DcmGyroBias, StaysWithinTheLimitAndComposesTheOffset) {
     for (int i = 0; i < 100000; ++i) bias.integrate_tilt_error(-16384, 16384, 0, k);  // 1 rad of error
     EXPECT_NEAR(bias.estimate_rad_s(k).x, limit, 1e-5f);
     EXPECT_NEAR(bias.estimate_rad_s(k).y, -limit, 1e-5f);
+    // A rest mean far beyond the limit (a broken gyro, a turn the rest test took): held too.
+    for (int i = 0; i < 1000; ++i) bias.follow_rest_mean(units(k, Vector3f(-2.0f, 2.0f, 0.05f)), k);
+    EXPECT_NEAR(bias.estimate_rad_s(k).x, -limit, 1e-5f);
+    EXPECT_NEAR(bias.estimate_rad_s(k).y, limit, 1e-5f);
     bias.set_sensor_rad_s(Vector3f(0.01f, 0.0f, 0.0f), k);
     const Vector3l correction(5, 6, 7);
     const Vector3l offset = bias.offset_units(correction);
@@ -179,18 +183,19 @@ TEST(DcmGyroBias, AMeasuredBiasIntegratesWithTheMeasuredGain) {
 // the same motion read at the new scales is still rest; with means left at the old
 // scales the rest would end.
 TEST(DcmRest, ANewScaleKeepsTheRest) {
-    for (int axis = 0; axis < 2; ++axis) {
+    // A coarser gyro range (x2), a coarser accelerometer (x2), a finer gyro range (x0.5).
+    for (int axis = 0; axis < 3; ++axis) {
         RestFixture f;
         f.gyro_mean = units(f.k, Vector3f(4.0f, -3.0f, 3.0f) * kDegPerS);  // a bias read at rest
         for (int i = 0; i < 400; ++i) f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k);
         ASSERT_TRUE(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k));
-        const float gyro_ratio = axis == 0 ? 2.0f : 1.0f, accel_ratio = axis == 0 ? 1.0f : 2.0f;
+        const float gyro_ratio = axis == 0 ? 2.0f : (axis == 2 ? 0.5f : 1.0f), accel_ratio = axis == 1 ? 2.0f : 1.0f;
         const Vector3l mean_before = f.rest.gyro_mean();
         f.rest.rescale(gyro_ratio, accel_ratio);
-        EXPECT_NEAR(f.rest.gyro_mean().x, mean_before.x * gyro_ratio, 1) << (axis == 0 ? "gyro" : "accel");
+        EXPECT_NEAR(f.rest.gyro_mean().x, mean_before.x * gyro_ratio, 1) << axis;
         const Vector3l gyro = linalg::fixed_from_vector(f.gyro_mean.scaled(gyro_ratio), 0);
         const Vector3l accel = linalg::fixed_from_vector(f.accel_mean.scaled(accel_ratio), 0);
-        EXPECT_TRUE(f.rest.update(gyro, accel, Vector3l(), true, true, f.k)) << (axis == 0 ? "gyro" : "accel");
+        EXPECT_TRUE(f.rest.update(gyro, accel, Vector3l(), true, true, f.k)) << axis;
     }
 }
 

@@ -106,6 +106,8 @@ TEST(EulerHeading, BeyondTheDocumentedRangesFoldsWithin720ElseZero) {
     EXPECT_NEAR(dcm::heading_deg(-3.0f, -190.0f), 720.0f - yaw_deg - 190.0f, 1e-3f);
     EXPECT_EQ(dcm::heading_deg(0.0f, 800.0f), 0.0f);
     EXPECT_EQ(dcm::heading_deg(0.0f, -800.0f), 0.0f);
+    // Just beyond -720: two folds leave it a hair below 0: 0, not -0.5.
+    EXPECT_EQ(dcm::heading_deg(0.0f, -720.5f), 0.0f);
 }
 
 // A yaw of exactly 180 deg is +pi on both sides of the gimbal lock: away from it from
