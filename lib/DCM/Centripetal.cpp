@@ -10,23 +10,20 @@ namespace {
 int32_t within(int32_t x, LateralBounds b) { return x < b.lo ? b.lo : (x > b.hi ? b.hi : x); }
 int32_t within(int32_t x, int32_t limit) { return x < -limit ? -limit : (x > limit ? limit : x); }
 
-// A window's omega V (counts): the rate's sum held to five full-scale samples, so that
-// its product with the gain (below 2^13 up to 60 m/s) stays within 32 bits.
-int32_t times_gain(int32_t rate_sum, int16_t gain_q8) {
-    constexpr int32_t kMaxRateSum = 5L * 32767L;
-    return (within(rate_sum, kMaxRateSum) * gain_q8) >> 8;
+// A window's omega V (counts): the rate's mean over the window (rounded to a count:
+// 0.06 deg of bank at 18 m/s; a division only for a late window's n) times the gain, in
+// 16 bits (below 2^13 up to 60 m/s), times n.
+int32_t times_gain(int32_t rate_sum, uint8_t n, int16_t gain_q8) {
+    const int32_t mean = n == 4 ? (rate_sum + 2) >> 2 : rate_sum / n;
+    return times_n(linalg::mul_s16((int16_t)within(mean, 32767), gain_q8) >> 8, n);
 }
 
-// A mean's step, (sum - mean) / 64 (TurnMean::kMeanShift): the high three bytes times
-// 4, not a loop of six shifts (the step's lowest bits, 1/64 of a count, are dropped).
+// A mean's step, (sum - mean) / 16 (TurnMean::kMeanShift): the high three bytes times
+// 16, not a loop of four shifts (the step's lowest bits, 1/16 of a count, are dropped).
 int32_t step_of_mean(int32_t difference_q8) {
-    static_assert(TurnMean::kMeanShift == 6, "a byte's shift less two");
-    return (difference_q8 >> 8) * 4;
+    static_assert(TurnMean::kMeanShift == 4, "a byte's shift less four");
+    return (difference_q8 >> 8) * 16;
 }
-
-// x n for a window's n samples: two shifts for the usual 4 (avr-gcc's 32-bit multiply
-// is a call).
-int32_t times_n(int32_t x, uint8_t n) { return n == 4 ? x * 4 : x * n; }
 
 }  // namespace
 
@@ -53,7 +50,7 @@ int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q
     const int32_t a_y = f_y_sum + times_n(gravity_y, n);
     const int32_t margin = times_n(margin_counts_ + ((gravity_y < 0 ? -gravity_y : gravity_y) >> 5), n);
     const int32_t clipped = within(raw, lateral_bounds(a_y, margin));
-    // mean += (sum - mean) / 64, Q8; the first window is the means.
+    // mean += (sum - mean) / 16, Q8; the first window is the means.
     if (!started_) {
         started_ = true;
         raw_q8_ = raw * 256;
@@ -67,19 +64,14 @@ int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q
     return clipped + ((mean_bounded_q8 - clipped_q8_) >> 8);
 }
 
-FIXED_COLD void TurnMean::take_off(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
-                                   linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
-    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V; each
-    // held within the accelerometer's full scale a sample.
+FIXED_COLD void TurnMean::update(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
+                                 int32_t f_y_sum) {
+    // Each held within the accelerometer's full scale a sample.
     const int32_t full_scale = times_n(32767, n);
-    const int32_t lateral = within(lateral_sum(times_gain(rate_z_sum, gain_q8_), accel_sum.y, down_y_q30, n), full_scale);
-    const int32_t normal = within(times_gain(rate_y_sum, gain_q8_), full_scale);
-    accel_sum.y -= lateral;
-    accel_sum.z += normal;
-    // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all: the
-    // window's term (n samples' worth) times (n + 1) / 2.
-    accel_sum_of_sums.y -= (times_n(lateral, n) + lateral) >> 1;
-    accel_sum_of_sums.z += (times_n(normal, n) + normal) >> 1;
+    const int32_t lateral = within(lateral_sum(times_gain(rate_z_sum, n, gain_q8_), f_y_sum, down_y_q30, n), full_scale);
+    const int32_t normal = within(times_gain(rate_y_sum, n, gain_q8_), full_scale);
+    lateral_per_sample_ = n == 4 ? (lateral + 2) >> 2 : lateral / n;
+    normal_per_sample_ = n == 4 ? (normal + 2) >> 2 : normal / n;
 }
 
 }  // namespace dcm

@@ -47,11 +47,16 @@ struct LateralBounds {
 // 0 .. a_y (either side), widened by the margin.
 LateralBounds lateral_bounds(int32_t a_y, int32_t margin);
 
+// x n for a window's n samples: two shifts for the usual 4 (avr-gcc's 32-bit multiply
+// is a call).
+inline int32_t times_n(int32_t x, uint8_t n) { return n == 4 ? x * 4 : x * n; }
+
 // A plain struct (no constructor: the pipeline keeps it in a union, RAM); zero is
 // "no gain, no mean yet": the first window sets the means.
 class TurnMean {
 public:
-    static constexpr uint8_t kMeanShift = 6;  // 1 / 64 a window: 1.28 s at 50 Hz
+    static constexpr uint8_t kUpdateEvery = 4;  // windows: 12.5 Hz
+    static constexpr uint8_t kMeanShift = 4;    // 1 / 16 an update: 1.28 s at 12.5 Hz
     // The gain (accel counts per gyro count of omega x v, Q8; 0: no correction) and
     // gravity in accel counts; the means go on.
     void configure(int16_t gain_q8, int16_t gravity_counts);
@@ -60,15 +65,33 @@ public:
     // running sums' sum (each sample's share of the window's term, n (n + 1) / 2 of
     // them), from the gyro's sums less the calibrated bias (counts) and the estimate's
     // down_y (Q30).
+    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V. Worked
+    // out every kUpdateEvery-th window (12.5 Hz: a turn's term moves at the turn's pace, a
+    // gust's swings at a few hertz; the work is 32-bit arithmetic) and kept a sample's
+    // worth for the windows between.
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
-                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums);
+                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
+        if ((windows_++ & (kUpdateEvery - 1u)) == 0u) update(rate_y_sum, rate_z_sum, down_y_q30, n, accel_sum.y);
+        const int32_t lateral = times_n(lateral_per_sample_, n), normal = times_n(normal_per_sample_, n);
+        accel_sum.y -= lateral;
+        accel_sum.z += normal;
+        // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all:
+        // the window's term (n samples' worth) times (n + 1) / 2.
+        accel_sum_of_sums.y -= (times_n(lateral, n) + lateral) >> 1;
+        accel_sum_of_sums.z += (times_n(normal, n) + normal) >> 1;
+    }
     // The window's lateral term (counts summed over the window) from omega_z V's sum.
     int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
 
 private:
+    // The term a sample from the window's sums (f_y_sum: the accelerometer's y).
+    void update(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n, int32_t f_y_sum);
+
     int32_t raw_q8_, a_y_q8_, clipped_q8_;  // means of the windows' sums, Q8
     int16_t gain_q8_, gravity_counts_x4_, margin_counts_;
     bool started_;                          // the means hold a window (the first sets them)
+    uint8_t windows_;                       // counts the windows: the term is worked out every kUpdateEvery-th
+    int32_t lateral_per_sample_, normal_per_sample_;  // the term, accel counts a sample
 };
 
 }  // namespace dcm

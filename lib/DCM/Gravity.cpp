@@ -50,15 +50,6 @@ void GravityCorrection::clear_window() {
     window_samples_ = 0;
 }
 
-FIXED_COLD void GravityCorrection::take_off_turn(TurnMean& turn, int32_t down_y_q30, const Vector3l& sensor_bias_units) {
-    const uint8_t n = window_samples_;
-    if (n == 0) return;
-    // The calibrated bias in counts, rounded (units are counts * 2^8).
-    const int32_t bias_y = (sensor_bias_units.y + 128) >> 8, bias_z = (sensor_bias_units.z + 128) >> 8;
-    turn.take_off(gyro_sum_.y - (n == 4 ? bias_y * 4 : bias_y * n), gyro_sum_.z - (n == 4 ? bias_z * 4 : bias_z * n),
-                  down_y_q30, n, accel_sum_, accel_sum_of_sums_);
-}
-
 void GravityCorrection::rescale(float gyro_ratio, float accel_ratio) {
     if (gyro_ratio != 1.0f) correction_units_ = rescaled(correction_units_, gyro_ratio);
     if (accel_ratio != 1.0f) lp_ef_ = rescaled(lp_ef_, accel_ratio);
