@@ -73,6 +73,30 @@ TEST(Centripetal, CoordinatedTurnCorrectedToGravityAtTheBank) {
     }
 }
 
+// The bounds: 0 to a_y either side, widened by the margin, to the count.
+TEST(Centripetal, TheBoundsAreZeroToAyWidenedByTheMargin) {
+    EXPECT_EQ(dcm::lateral_bounds(0, 10).lo, -10);
+    EXPECT_EQ(dcm::lateral_bounds(0, 10).hi, 10);
+    EXPECT_EQ(dcm::lateral_bounds(300, 10).lo, -10);
+    EXPECT_EQ(dcm::lateral_bounds(300, 10).hi, 310);
+    EXPECT_EQ(dcm::lateral_bounds(-300, 10).lo, -310);
+    EXPECT_EQ(dcm::lateral_bounds(-300, 10).hi, 10);
+}
+
+// A steady coordinated turn, window after window: what the clipping takes is nothing,
+// what the mean gives back nothing; the term stays the one the first window took, to the
+// count, for a minute.
+TEST(Centripetal, ASteadyTurnsTermStaysTheSameToTheCount) {
+    const Turn t = coordinated_turn(30.0f, 18.0f);
+    const mpu6000::Sample s = imu(t.gyro_rad_s, t.accel_m_s2);
+    dcm::TurnMean turn = turn_at(18.0f);
+    const float first = take_off(turn, s, 30.0f).accel_m_s2.y;
+    for (int window = 1; window < 50 * 60; ++window) {
+        const float f_y = take_off(turn, s, 30.0f).accel_m_s2.y;
+        ASSERT_EQ(f_y, first) << window;
+    }
+}
+
 // Wings level, yawing at 20 deg/s (turbulence turning the aeroplane into the relative
 // wind): no bank provides that turn, so at most the margin of it is taken off (unbounded
 // it would be 6.3 m/s^2, 33 deg of false bank).

@@ -39,6 +39,22 @@ TEST(DcmCoefficients, LeadAndTurnFactorsInQ15BelowTwo) {
     EXPECT_EQ(beyond.theta_q26_per_unit_q15, 0u);
 }
 
+// The limits the sums are compared with, in the board's units: the hold rate, the rest
+// test's deviations (a float-form default would be 16 times too fine for the gyro).
+TEST(DcmCoefficients, TheLimitsAreInTheBoardsUnits) {
+    const dcm::DcmSettings& s = dcm::kDefaultDcmSettings;
+    const dcm::DcmCoefficients k = board_coefficients(s);
+    const dcm::Limit hold = dcm::limit_of(s.integrator_hold_rate_rad_s * k.units_per_rad_s);
+    EXPECT_EQ(k.hold_rate.limit2, hold.limit2);
+    EXPECT_EQ(k.hold_rate.shift, hold.shift);
+    const dcm::Limit gyro = dcm::limit_of(s.rest_gyro_deviation_rad_s * k.units_per_rad_s);
+    EXPECT_EQ(k.rest_gyro_dev.limit2, gyro.limit2);
+    EXPECT_EQ(k.rest_gyro_dev.shift, gyro.shift);
+    dcm::DcmCoefficients float_form;
+    float_form.from_settings(s);
+    EXPECT_FALSE(float_form.hold_rate.limit2 == hold.limit2 && float_form.hold_rate.shift == hold.shift);
+}
+
 // The compass latency in steps, Q12, held within 0..5.9 steps (the wait for the next
 // step and the 16-bit turn's range).
 TEST(DcmCoefficients, MagLatencyHeldWithinItsSteps) {
