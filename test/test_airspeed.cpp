@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The centripetal correction of the accelerometer from the airspeed (lib/Pipeline,
-// issue 24 item 3): gravity at the bank in a coordinated turn, off below the minimum
-// airspeed, clamped at the extremes.
+// The centripetal correction of the accelerometer from the airspeed (issue 24 item 3):
+// its gain from the airspeed (lib/Pipeline) and the gravity window's term
+// (lib/DCM/Centripetal.h): gravity at the bank in a coordinated turn, the bounds and the
+// turn's mean through turbulence, off below the minimum airspeed, held at the extremes;
+// the pipeline flying a turn with and without it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
