@@ -52,6 +52,34 @@ def make_flights(flight_dir, log):
     return {n: p for n, p in paths.items() if os.path.exists(p)}, None
 
 
+# Flights in turbulence on seeds no tuning has used (bench/motions.py's SEEDS): the
+# straight gusty flight, and the turn and the figure-eight in moderate turbulence (fly.py
+# --gust 1). What found the turn's runaway in turbulence (issue 24): kept in the bench.
+TURBULENT_SEEDS = (4057, 18233, 90511)
+TURBULENT_FLIGHTS = (("gusty", None), ("turn", 1), ("figure8", 1))
+
+
+def make_turbulent_flights(flight_dir, log):
+    """fly.py --flight NAME [--gust G] --seed S for each, cached as make_flights' are:
+    {file stem: (trajectory, state log)}."""
+    out = {}
+    for name, gust in TURBULENT_FLIGHTS:
+        for seed in TURBULENT_SEEDS:
+            stem = "%s%s_s%d" % (name, "_gust%d" % gust if gust is not None else "", seed)
+            traj, state = os.path.join(flight_dir, stem + ".csv.gz"), os.path.join(flight_dir, stem + "_log.csv")
+            if not (os.path.exists(traj) and os.path.exists(state) and
+                    min(os.path.getmtime(traj), os.path.getmtime(state)) > newest_source_mtime()):
+                cmd = [sys.executable, FLY, "--flight", name, "--seed", str(seed), "--out", traj, "--log", state,
+                       "--quiet"] + (["--gust", str(gust)] if gust is not None else [])
+                log("flights: " + " ".join(os.path.relpath(c, REPO) if os.sep in c else c for c in cmd[1:]))
+                r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=1800)
+                if r.returncode != 0:
+                    log("flights: %s failed (exit %d): %s" % (stem, r.returncode, r.stderr.strip()[-300:]))
+                    continue
+            out[stem] = (traj, state)
+    return out
+
+
 def worst_roll_error_replay(traj, est_path):
     """(worst |roll error| deg, its time s, true roll, estimated roll) over the turn, from
     replay's t,roll,pitch,yaw against the trajectory's truth at the nearest sample."""
@@ -159,6 +187,42 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         text = ", ".join("%s %.1f" % (k, v) for k, v in turn_worst.items())
         rep += ["Worst roll error during the 60 s, 30 deg turn (estimate - truth, deg): %s." % text, ""]
         log("the turn's worst roll error (deg): " + text)
+    # The same in turbulence on fresh seeds: ours without / with the cruise speed / with
+    # the sensor, VQF beside (the peer ours trails most there), total RMSE.
+    turbulent = make_turbulent_flights(flight_dir, log)
+    if turbulent:
+        trows, sums = [], {}
+        for stem, (traj, state) in turbulent.items():
+            cells = [stem]
+            for suffix, extra in (("", ()), ("_cruise", ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)),
+                                  ("_sensor", ("--airspeed-log", state))):
+                est = os.path.join(flight_dir, stem + "_estimate%s.csv" % suffix)
+                _, _, ours, err, _ = run_replay(("flight %s%s" % (stem, suffix), traj, est, replay, score, (), extra))
+                if err:
+                    errors.append("flight %s%s: %s" % (stem, suffix, err))
+                cells.append("%.2f" % ours["total"] if ours else "–")
+                if ours:
+                    sums.setdefault((stem.split("_s")[0], suffix), []).append(ours["total"])
+            if "VQF" in peers.PEERS:
+                tr = peers.load_trajectory(traj)
+                s_vqf = peers.score(tr["quat"], peers.PEERS["VQF"](tr), tr["movement"])
+                cells.append("%.2f" % s_vqf["total"])
+                sums.setdefault((stem.split("_s")[0], "vqf"), []).append(s_vqf["total"])
+            trows.append(cells)
+            log("flight %s: %s" % (stem, " | ".join(cells[1:])))
+        kinds = []
+        for name, gust in TURBULENT_FLIGHTS:
+            kind = "%s%s" % (name, "_gust%d" % gust if gust is not None else "")
+            vals = [sums.get((kind, k)) for k in ("", "_cruise", "_sensor", "vqf")]
+            kinds.append("| %s (mean of %d) | " % (kind, len(vals[0] or [])) +
+                         " | ".join("%.2f" % (sum(v) / len(v)) if v else "–" for v in vals) + " |")
+        rep += ["Flights in turbulence on seeds no tuning has used (`fly.py --flight NAME [--gust 1] --seed S`, "
+                "S = %s): total RMSE in degrees, ours without an airspeed / with the cruise speed / with the "
+                "airspeed sensor, and VQF." % ", ".join(str(x) for x in TURBULENT_SEEDS), "",
+                "| flight | ours | ours, cruise %g m/s | ours, airspeed sensor | VQF |" % TRIM_AIRSPEED_M_S,
+                "|---|---|---|---|---|"] + kinds + [""] + \
+               ["| file | ours | ours, cruise | ours, sensor | VQF |", "|---|---|---|---|---|"] + \
+               ["| " + " | ".join(r) + " |" for r in sorted(trows)] + [""]
     loop_texts = []
     for name, what in CLOSED_LOOP_TURNS:
         loop = closed_loop_turn(build, name)
