@@ -10,12 +10,15 @@ namespace {
 int32_t within(int32_t x, LateralBounds b) { return x < b.lo ? b.lo : (x > b.hi ? b.hi : x); }
 int32_t within(int32_t x, int32_t limit) { return x < -limit ? -limit : (x > limit ? limit : x); }
 
+// A window's sum a sample: rounded shifts for the usual 4 (times_n's inverse), a
+// division only for a late window's n.
+int32_t per_sample(int32_t sum, uint8_t n) { return n == 4 ? (sum + 2) >> 2 : sum / n; }
+
 // A window's omega V (counts): the rate's mean over the window (rounded to a count:
-// 0.06 deg of bank at 18 m/s; a division only for a late window's n) times the gain, in
-// 16 bits (below 2^13 up to 60 m/s), times n.
+// 0.06 deg of bank at 18 m/s) times the gain, in 16 bits (below 2^13 up to 60 m/s),
+// times n.
 int32_t times_gain(int32_t rate_sum, uint8_t n, int16_t gain_q8) {
-    const int32_t mean = n == 4 ? (rate_sum + 2) >> 2 : rate_sum / n;
-    return times_n(linalg::mul_s16((int16_t)within(mean, 32767), gain_q8) >> 8, n);
+    return times_n(linalg::mul_s16((int16_t)within(per_sample(rate_sum, n), 32767), gain_q8) >> 8, n);
 }
 
 // A mean's step, (sum - mean) / 16 (TurnMean::kMeanShift): the high three bytes times
@@ -70,8 +73,8 @@ FIXED_COLD void TurnMean::update(int32_t rate_y_sum, int32_t rate_z_sum, int32_t
     const int32_t full_scale = times_n(32767, n);
     const int32_t lateral = within(lateral_sum(times_gain(rate_z_sum, n, gain_q8_), f_y_sum, down_y_q30, n), full_scale);
     const int32_t normal = within(times_gain(rate_y_sum, n, gain_q8_), full_scale);
-    lateral_per_sample_ = n == 4 ? (lateral + 2) >> 2 : lateral / n;
-    normal_per_sample_ = n == 4 ? (normal + 2) >> 2 : normal / n;
+    lateral_per_sample_ = per_sample(lateral, n);
+    normal_per_sample_ = per_sample(normal, n);
 }
 
 }  // namespace dcm

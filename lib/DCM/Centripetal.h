@@ -61,12 +61,10 @@ public:
     // gravity in accel counts; the means go on.
     void configure(int16_t gain_q8, int16_t gravity_counts);
     bool active() const { return gain_q8_ != 0; }
-    // The window's sums less omega x v (lateral within the bounds): accel_sum and the
-    // running sums' sum (each sample's share of the window's term, n (n + 1) / 2 of
-    // them), from the gyro's sums less the calibrated bias (counts) and the estimate's
-    // down_y (Q30).
-    // omega x v = (0, omega_z V, -omega_y V): y loses omega_z V, z gains omega_y V. Worked
-    // out every kUpdateEvery-th window (12.5 Hz: a turn's term moves at the turn's pace, a
+    // The window's sums less omega x v = (0, omega_z V, -omega_y V), the lateral term
+    // within the bounds: accel_sum and the running sums' sum, from the gyro's sums less
+    // the calibrated bias (counts) and the estimate's down_y (Q30). The term is worked out
+    // every kUpdateEvery-th window (12.5 Hz: a turn's term moves at the turn's pace, a
     // gust's swings at a few hertz; the work is 32-bit arithmetic) and kept a sample's
     // worth for the windows between.
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
@@ -80,10 +78,10 @@ public:
         accel_sum_of_sums.y -= (times_n(lateral, n) + lateral) >> 1;
         accel_sum_of_sums.z += (times_n(normal, n) + normal) >> 1;
     }
-    // The window's lateral term (counts summed over the window) from omega_z V's sum.
-    int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
 
 private:
+    // The window's lateral term (counts summed over the window) from omega_z V's sum.
+    int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
     // The term a sample from the window's sums (f_y_sum: the accelerometer's y).
     void update(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n, int32_t f_y_sum);
 

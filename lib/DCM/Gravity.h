@@ -41,8 +41,8 @@ public:
         if (n == 0) return;
         // The calibrated bias in counts, rounded (units are counts * 2^8).
         const int32_t bias_y = (sensor_bias_units.y + 128) >> 8, bias_z = (sensor_bias_units.z + 128) >> 8;
-        turn.take_off(gyro_sum_.y - (n == 4 ? bias_y * 4 : bias_y * n), gyro_sum_.z - (n == 4 ? bias_z * 4 : bias_z * n),
-                      down_y_q30, n, accel_sum_, accel_sum_of_sums_);
+        turn.take_off(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), down_y_q30, n, accel_sum_,
+                      accel_sum_of_sums_);
     }
     // The window into the earth-frame low-pass (R body to earth, the steps not yet
     // integrated, what the step subtracts and the calibrated bias, in units); the window's
