@@ -206,16 +206,22 @@ TEST(Centripetal, ExtremesHeldWithoutOverflow) {
     }
 }
 
+// A pipeline started still at this bank (its gyro calibration and start), then given the
+// airspeed.
+void start_banked(pipeline::AttitudePipeline& pipe, float bank_deg, float airspeed_m_s) {
+    const Vector3f still(0.0f, -kG * std::sin(bank_deg * kDeg), -kG * std::cos(bank_deg * kDeg));
+    for (int i = 0; i < 400; ++i) pipe.on_imu_sample(imu(Vector3f(), still));
+    ASSERT_EQ(pipe.phase(), pipeline::Phase::Running);
+    pipe.set_airspeed_m_s(airspeed_m_s);
+}
+
 // The pipeline holds the bank of a long coordinated turn with the airspeed; without it
 // the estimate levels (the turn's lift taken for gravity).
 float bank_after_turn(float airspeed_given_m_s) {
     const float bank = 30.0f, v = 18.0f;
     pipeline::AttitudePipeline pipe;
     const Turn t = coordinated_turn(bank, v);
-    const Vector3f still(0.0f, -kG * std::sin(bank * kDeg), -kG * std::cos(bank * kDeg));
-    for (int i = 0; i < 400; ++i) pipe.on_imu_sample(imu(Vector3f(), still));
-    EXPECT_EQ(pipe.phase(), pipeline::Phase::Running);
-    pipe.set_airspeed_m_s(airspeed_given_m_s);
+    start_banked(pipe, bank, airspeed_given_m_s);
     for (int i = 0; i < 200 * 60; ++i) pipe.on_imu_sample(imu(t.gyro_rad_s, t.accel_m_s2));
     return pipe.angles().roll_deg;
 }
@@ -228,9 +234,7 @@ float bank_after_turn(float airspeed_given_m_s) {
 TEST(Centripetal, PipelineKeepsTheWingsLevelWhenGustsYawTheAeroplane) {
     pipeline::AttitudePipeline pipe;
     const Vector3f level(0.0f, 0.0f, -kG);
-    for (int i = 0; i < 400; ++i) pipe.on_imu_sample(imu(Vector3f(), level));
-    ASSERT_EQ(pipe.phase(), pipeline::Phase::Running);
-    pipe.set_airspeed_m_s(18.0f);
+    ASSERT_NO_FATAL_FAILURE(start_banked(pipe, 0.0f, 18.0f));
     float worst_roll_deg = 0.0f;
     for (int i = 0; i < 200 * 30; ++i) {
         const float yaw_rate_rad_s = 15.0f * kDeg * std::sin(2.0f * 3.14159265f * 0.2f * i / 200.0f);
@@ -249,10 +253,7 @@ TEST(Centripetal, PipelineHoldsTheBankOfATurnThroughTurbulence) {
     const float bank = 30.0f, v = 18.0f;
     pipeline::AttitudePipeline pipe;
     const Turn t = coordinated_turn(bank, v);
-    const Vector3f still(0.0f, -kG * std::sin(bank * kDeg), -kG * std::cos(bank * kDeg));
-    for (int i = 0; i < 400; ++i) pipe.on_imu_sample(imu(Vector3f(), still));
-    ASSERT_EQ(pipe.phase(), pipeline::Phase::Running);
-    pipe.set_airspeed_m_s(v);
+    ASSERT_NO_FATAL_FAILURE(start_banked(pipe, bank, v));
     float bank_sum_deg = 0.0f;
     int n = 0;
     for (int i = 0; i < 200 * 60; ++i) {
