@@ -59,13 +59,28 @@ TURBULENT_SEEDS = (4057, 18233, 90511)
 TURBULENT_FLIGHTS = (("gusty", None), ("turn", 1), ("figure8", 1))
 
 
+def turbulent_kind(name, gust):
+    return name + ("_gust%d" % gust if gust is not None else "")
+
+
+def airspeed_variants(state_log):
+    """Ours as the board would know its speed: not at all (replay's default, what a
+    hand-held board does), a configured cruise speed (TRIM_ARSPD_CM, no pitot) and the
+    airspeed sensor (the flight's logged airspeed, read every 8 steps as the firmware reads
+    the MPXV7002DP on A0): (file suffix, label, replay's arguments) each."""
+    return (("", "", ()),
+            ("_cruise", ", cruise speed", ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)),
+            ("_sensor", ", airspeed sensor", ("--airspeed-log", state_log)))
+
+
 def make_turbulent_flights(flight_dir, log):
     """fly.py --flight NAME [--gust G] --seed S for each, cached as make_flights' are:
-    {file stem: (trajectory, state log)}."""
+    {file stem: (kind, trajectory, state log)}."""
     out = {}
     for name, gust in TURBULENT_FLIGHTS:
+        kind = turbulent_kind(name, gust)
         for seed in TURBULENT_SEEDS:
-            stem = "%s%s_s%d" % (name, "_gust%d" % gust if gust is not None else "", seed)
+            stem = "%s_s%d" % (kind, seed)
             traj, state = os.path.join(flight_dir, stem + ".csv.gz"), os.path.join(flight_dir, stem + "_log.csv")
             if not (os.path.exists(traj) and os.path.exists(state) and
                     min(os.path.getmtime(traj), os.path.getmtime(state)) > newest_source_mtime()):
@@ -76,7 +91,7 @@ def make_turbulent_flights(flight_dir, log):
                 if r.returncode != 0:
                     log("flights: %s failed (exit %d): %s" % (stem, r.returncode, r.stderr.strip()[-300:]))
                     continue
-            out[stem] = (traj, state)
+            out[stem] = (kind, traj, state)
     return out
 
 
@@ -139,15 +154,8 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         traj = paths.get(name)
         if not traj:
             continue
-        # Ours as the board would know its speed: not at all (replay's default, what a
-        # hand-held board does), a configured cruise speed (TRIM_ARSPD_CM, no pitot) and the
-        # airspeed sensor (the flight's logged airspeed, read every 8 steps as the firmware
-        # reads the MPXV7002DP on A0).
-        variants = (("", "", ()),
-                    ("_cruise", ", cruise speed", ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)),
-                    ("_sensor", ", airspeed sensor", ("--airspeed-log", os.path.join(flight_dir, name + "_log.csv"))))
         cells = [name]
-        for suffix, what, extra in variants:
+        for suffix, what, extra in airspeed_variants(os.path.join(flight_dir, name + "_log.csv")):
             if suffix == "_sensor" and not os.path.exists(extra[1]):
                 cells.append("–")
                 continue
@@ -192,27 +200,26 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
     turbulent = make_turbulent_flights(flight_dir, log)
     if turbulent:
         trows, sums = [], {}
-        for stem, (traj, state) in turbulent.items():
+        for stem, (kind, traj, state) in turbulent.items():
             cells = [stem]
-            for suffix, extra in (("", ()), ("_cruise", ("--airspeed", "%g" % TRIM_AIRSPEED_M_S)),
-                                  ("_sensor", ("--airspeed-log", state))):
+            for suffix, what, extra in airspeed_variants(state):
                 est = os.path.join(flight_dir, stem + "_estimate%s.csv" % suffix)
-                _, _, ours, err, _ = run_replay(("flight %s%s" % (stem, suffix), traj, est, replay, score, (), extra))
+                _, _, ours, err, _ = run_replay(("flight %s%s" % (stem, what), traj, est, replay, score, (), extra))
                 if err:
-                    errors.append("flight %s%s: %s" % (stem, suffix, err))
+                    errors.append("flight %s%s: %s" % (stem, what, err))
                 cells.append("%.2f" % ours["total"] if ours else "–")
                 if ours:
-                    sums.setdefault((stem.split("_s")[0], suffix), []).append(ours["total"])
+                    sums.setdefault((kind, suffix), []).append(ours["total"])
             if "VQF" in peers.PEERS:
                 tr = peers.load_trajectory(traj)
                 s_vqf = peers.score(tr["quat"], peers.PEERS["VQF"](tr), tr["movement"])
                 cells.append("%.2f" % s_vqf["total"])
-                sums.setdefault((stem.split("_s")[0], "vqf"), []).append(s_vqf["total"])
+                sums.setdefault((kind, "vqf"), []).append(s_vqf["total"])
             trows.append(cells)
             log("flight %s: %s" % (stem, " | ".join(cells[1:])))
         kinds = []
         for name, gust in TURBULENT_FLIGHTS:
-            kind = "%s%s" % (name, "_gust%d" % gust if gust is not None else "")
+            kind = turbulent_kind(name, gust)
             vals = [sums.get((kind, k)) for k in ("", "_cruise", "_sensor", "vqf")]
             kinds.append("| %s (mean of %d) | " % (kind, len(vals[0] or [])) +
                          " | ".join("%.2f" % (sum(v) / len(v)) if v else "–" for v in vals) + " |")
