@@ -99,6 +99,20 @@ TEST(Centripetal, ASteadyTurnsTermStaysTheSameToTheCount) {
     }
 }
 
+// The bound on the mean follows a_y's mean: after a long yaw with the wings level (the
+// term held to the margin), a coordinated turn at its bank gets its whole term again once
+// the means have moved on (a stale a_y mean would keep it at the margin).
+TEST(Centripetal, TheMeansBoundFollowsTheBank) {
+    dcm::TurnMean turn = turn_at(18.0f);
+    const mpu6000::Sample yawing = imu(Vector3f(0.0f, 0.0f, 20.0f * kDeg), Vector3f(0.0f, 0.0f, -kG));
+    for (int window = 0; window < 50 * 20; ++window) take_off(turn, yawing, 0.0f);
+    const Turn t = coordinated_turn(30.0f, 18.0f);
+    const mpu6000::Sample turning = imu(t.gyro_rad_s, t.accel_m_s2);
+    Vector3f f;
+    for (int window = 0; window < 50 * 20; ++window) f = take_off(turn, turning, 30.0f).accel_m_s2;
+    EXPECT_NEAR(f.y, -kG * std::sin(30.0f * kDeg), 0.03f);
+}
+
 // Wings level, yawing at 20 deg/s (turbulence turning the aeroplane into the relative
 // wind): no bank provides that turn, so at most the margin of it is taken off (unbounded
 // it would be 6.3 m/s^2, 33 deg of false bank).

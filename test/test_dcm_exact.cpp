@@ -135,8 +135,9 @@ struct OneWindow {
 // gyro's sums in whole counts, rounded (100.78 counts: 101): a board reading its bias
 // alone, level at 18 m/s, keeps its window as it is.
 TEST(DcmExact, TheTurnTermTakesTheCalibratedBiasOffInRoundedCounts) {
-    const Vector3l accel_counts(0, 0, -4096), gyro_counts(0, 101, 101);
-    const Vector3l sensor_bias_units(0, 100 * 256 + 130, 100 * 256 + 200);
+    // y's bias beyond a byte (300.5 counts: 18 deg/s), z's within.
+    const Vector3l accel_counts(0, 0, -4096), gyro_counts(0, 301, 101);
+    const Vector3l sensor_bias_units(0, 300 * 256 + 130, 100 * 256 + 200);
     // The usual four samples, and a late correction's five.
     for (const uint8_t n : {4, 5}) {
         dcm::TurnMean turn = dcm::TurnMean();

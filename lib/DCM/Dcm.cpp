@@ -341,7 +341,6 @@ FIXED_COLD Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scal
 
 
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
-    using linalg::fixed_from_float;
     const uint16_t since_last = steps_since_mag_;
     steps_since_mag_ = 0;
     if (!mag_field.is_finite()) {
