@@ -156,8 +156,6 @@ public:
     // R's last entry, earth down's body z component: cos(roll) cos(pitch), the cosine of
     // the tilt (one entry, where matrix() converts nine).
     float cos_tilt() const { return linalg::float_from_fixed(strapdown_.r().c.z, linalg::kQ30); }
-    // R's earth down, body y component (sin(roll) cos(pitch)), Q30.
-    int32_t down_y_q30() const { return strapdown_.r().c.y; }
     // The turn's centripetal correction (Centripetal.h): its gain and means, kept by the
     // caller (the pipeline: it knows the airspeed); nullptr: none.
     void set_turn(TurnMean* turn) { turn_ = turn; }
