@@ -38,12 +38,15 @@ def newest_source_mtime():
     return newest
 
 
+def up_to_date(paths):
+    """Every file there and newer than sim/flight's sources (else fly.py writes it again)."""
+    return all(os.path.exists(p) for p in paths) and min(os.path.getmtime(p) for p in paths) > newest_source_mtime()
+
+
 def make_flights(flight_dir, log):
     """fly.py --all into flight_dir unless its files are newer than sim/flight's sources."""
     paths = {n: os.path.join(flight_dir, n + ".csv.gz") for n in FLIGHTS}
-    fresh = all(os.path.exists(p) for p in paths.values()) and \
-        min(os.path.getmtime(p) for p in paths.values()) > newest_source_mtime()
-    if not fresh:
+    if not up_to_date(paths.values()):
         log("flights: sim/flight/fly.py --all %s" % os.path.relpath(flight_dir, REPO))
         r = subprocess.run([sys.executable, FLY, "--all", flight_dir], stdout=subprocess.DEVNULL,
                            stderr=subprocess.PIPE, text=True, timeout=3600)
@@ -82,8 +85,7 @@ def make_turbulent_flights(flight_dir, log):
         for seed in TURBULENT_SEEDS:
             stem = "%s_s%d" % (kind, seed)
             traj, state = os.path.join(flight_dir, stem + ".csv.gz"), os.path.join(flight_dir, stem + "_log.csv")
-            if not (os.path.exists(traj) and os.path.exists(state) and
-                    min(os.path.getmtime(traj), os.path.getmtime(state)) > newest_source_mtime()):
+            if not up_to_date((traj, state)):
                 cmd = [sys.executable, FLY, "--flight", name, "--seed", str(seed), "--out", traj, "--log", state,
                        "--quiet"] + (["--gust", str(gust)] if gust is not None else [])
                 log("flights: " + " ".join(os.path.relpath(c, REPO) if os.sep in c else c for c in cmd[1:]))
