@@ -45,7 +45,8 @@ Window take_off(dcm::TurnMean& turn, const mpu6000::Sample& s, float bank_deg, u
     linalg::Vector3l sum(s.accel.x * n, s.accel.y * n, s.accel.z * n);
     const int32_t weight = n * (n + 1) / 2;  // sum over j of n - j + 1
     linalg::Vector3l sum_of_sums(s.accel.x * weight, s.accel.y * weight, s.accel.z * weight);
-    turn.take_off(s.gyro.y * n, s.gyro.z * n, down_y_q30_at(bank_deg), n, sum, sum_of_sums);
+    // Earth down in body axes at the bank, pitch 0 (z is not read).
+    turn.take_off(s.gyro.y * n, s.gyro.z * n, linalg::Vector3l(0, down_y_q30_at(bank_deg), 0), n, sum, sum_of_sums);
     const float per_count = s.accel_m_s2_per_count;
     return {Vector3f((float)sum.x, (float)sum.y, (float)sum.z) * (per_count / (float)n),
             Vector3f((float)sum_of_sums.x, (float)sum_of_sums.y, (float)sum_of_sums.z) * (per_count / (float)weight)};
@@ -212,7 +213,7 @@ TEST(Centripetal, ExtremesHeldWithoutOverflow) {
         turn.configure(top, 4096);
         const int32_t full = 5L * 32767L;
         linalg::Vector3l sum(0, sign * full, -full), sum_of_sums(0, sign * 3 * full, -3 * full);
-        turn.take_off(-sign * full, sign * full, 0, 5, sum, sum_of_sums);
+        turn.take_off(-sign * full, sign * full, linalg::Vector3l(), 5, sum, sum_of_sums);
         EXPECT_EQ(sum.y, 0) << sign;  // held at a_y (+ the margin): then at full scale
         EXPECT_EQ(sum.z, -full - sign * full) << sign;
         EXPECT_EQ(sum_of_sums.y, 0) << sign;
@@ -281,6 +282,81 @@ TEST(Centripetal, PipelineHoldsTheBankOfATurnThroughTurbulence) {
         }
     }
     EXPECT_NEAR(bank_sum_deg / (float)n, bank, 3.0f);
+}
+
+// The speed's change (Pipeline.h, longitudinal_counts): dV/dt in accel counts between two
+// flying speeds read close in time, nothing else.
+TEST(Centripetal, TheAirspeedsChangeIsTheLongitudinalAcceleration) {
+    const float count_m_s2 = 8.0f * kG / 32768.0f;
+    // 18 -> 18.2 m/s over 8 steps (40 ms): 5 m/s^2.
+    EXPECT_NEAR(pipeline::longitudinal_counts(18.0f, 18.2f, 8) * count_m_s2, 5.0f, 0.01f);
+    EXPECT_NEAR(pipeline::longitudinal_counts(18.2f, 18.0f, 8) * count_m_s2, -5.0f, 0.01f);
+    EXPECT_NEAR(pipeline::longitudinal_counts(18.0f, 18.2f, 16) * count_m_s2, 2.5f, 0.01f);
+    EXPECT_EQ(pipeline::longitudinal_counts(18.0f, 18.0f, 8), 0);
+    // Held at 2 g along the path.
+    EXPECT_NEAR(pipeline::longitudinal_counts(18.0f, 28.0f, 8) * count_m_s2, pipeline::kMaxLongitudinal_m_s2, 0.01f);
+    EXPECT_NEAR(pipeline::longitudinal_counts(28.0f, 18.0f, 8) * count_m_s2, -pipeline::kMaxLongitudinal_m_s2, 0.01f);
+    // Not from a speed below the correction's minimum (a launch), nor to one, nor from
+    // readings at once or far apart.
+    const float slow = pipeline::kCentripetalMinAirspeed_m_s - 0.1f, fast = pipeline::kCentripetalMinAirspeed_m_s + 0.1f;
+    EXPECT_EQ(pipeline::longitudinal_counts(slow, fast, 8), 0);
+    EXPECT_EQ(pipeline::longitudinal_counts(fast, slow, 8), 0);
+    EXPECT_NE(pipeline::longitudinal_counts(fast, fast + 0.2f, 8), 0);
+    EXPECT_EQ(pipeline::longitudinal_counts(18.0f, 18.2f, 0), 0);
+    EXPECT_EQ(pipeline::longitudinal_counts(18.0f, 18.2f, pipeline::kMaxAirspeedGapSteps + 1), 0);
+    EXPECT_NE(pipeline::longitudinal_counts(18.0f, 18.2f, pipeline::kMaxAirspeedGapSteps), 0);
+}
+
+// Level, speeding up at 1 m/s^2: the accelerometer reads it along x (6 deg of pitch) and
+// the term, held by a_x = f_x + g down_x, takes it off whole; a gust's change of airspeed
+// that the accelerometer does not feel (the path keeps its speed) is held to the margin.
+TEST(Centripetal, TheLongitudinalTermIsWhatTheAccelerometerFeels) {
+    const float count_m_s2 = 8.0f * kG / 32768.0f;
+    const int16_t one_m_s2 = (int16_t)std::lround(1.0f / count_m_s2);
+    for (const bool felt : {true, false}) {
+        dcm::TurnMean turn = dcm::TurnMean();
+        turn.configure(pipeline::centripetal_gain_q8(18.0f), (int16_t)std::lround(kG / count_m_s2), one_m_s2);
+        const mpu6000::Sample s = imu(Vector3f(), Vector3f(felt ? 1.0f : 0.0f, 0.0f, -kG));
+        Window w{};
+        for (int i = 0; i < 40; ++i) w = take_off(turn, s, 0.0f);
+        // A late window's five samples take off five samples' worth.
+        const Window late = take_off(turn, s, 0.0f, 5);
+        EXPECT_NEAR(late.accel_m_s2.x, w.accel_m_s2.x, 0.002f) << felt;
+        EXPECT_NEAR(late.weighted_m_s2.x, w.weighted_m_s2.x, 0.002f) << felt;
+        // What remains is gravity, level: f_x less the term.
+        if (felt) {
+            EXPECT_NEAR(w.accel_m_s2.x, 0.0f, 0.01f);
+            EXPECT_NEAR(w.weighted_m_s2.x, 0.0f, 0.01f);
+        } else {
+            // 0.5 deg of pitch at most (the margin: g sin 0.5 deg = 0.086 m/s^2).
+            EXPECT_LT(std::fabs(w.accel_m_s2.x), 0.09f);
+            EXPECT_GT(std::fabs(w.accel_m_s2.x), 0.05f);
+        }
+    }
+}
+
+// A climb's entry: 5 s of level cruise, then speeding up at 1 m/s^2 for 10 s, the airspeed
+// read as the firmware reads it (every 8 steps). Without the speed's change the estimate
+// pitches up toward the 5.8 deg the accelerometer says; with it the pitch stays level.
+float pitch_after_speeding_up(bool measured) {
+    pipeline::AttitudePipeline pipe;
+    start_banked(pipe, 0.0f, 15.0f);
+    float worst_deg = 0.0f;
+    for (int i = -200 * 5; i < 200 * 10; ++i) {
+        const float dv_dt = i < 0 ? 0.0f : 1.0f;
+        if (i % 8 == 0) {
+            const float v = 15.0f + dv_dt * (float)i / 200.0f;
+            if (measured) pipe.set_airspeed_m_s(v); else pipe.set_cruise_airspeed_m_s(v);
+        }
+        pipe.on_imu_sample(imu(Vector3f(), Vector3f(dv_dt, 0.0f, -kG)));
+        worst_deg = std::max(worst_deg, std::fabs(pipe.angles().pitch_deg));
+    }
+    return worst_deg;
+}
+
+TEST(Centripetal, PipelineKeepsThePitchWhileTheAeroplaneSpeedsUp) {
+    EXPECT_LT(pitch_after_speeding_up(true), 0.6f);
+    EXPECT_GT(pitch_after_speeding_up(false), 3.0f);  // a configured speed tells no change
 }
 
 TEST(Centripetal, PipelineHoldsTheBankOfATurnWithTheAirspeed) {

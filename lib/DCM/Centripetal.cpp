@@ -34,47 +34,59 @@ LateralBounds lateral_bounds(int32_t a_y, int32_t margin) {
     return LateralBounds{(a_y < 0 ? a_y : 0) - margin, (a_y > 0 ? a_y : 0) + margin};
 }
 
-void TurnMean::configure(int16_t gain_q8, int16_t gravity_counts) {
+void TurnMean::configure(int16_t gain_q8, int16_t gravity_counts, int16_t dv_dt_counts) {
     gain_q8_ = gain_q8;
+    dv_dt_counts_ = dv_dt_counts;
     gravity_counts_x4_ = (int16_t)(gravity_counts * 4);
     // g sin(kTurnBankMargin_deg): sin(0.5 deg) = 143 / 2^14.
     static_assert(kTurnBankMargin_deg == 0.5f, "143 / 2^14 is sin(kTurnBankMargin_deg)");
     margin_counts_ = (int16_t)(((int32_t)gravity_counts * 143 + 8192) >> 14);
 }
 
+TurnMean::AxisBound TurnMean::axis_bound(int32_t f_sum, int32_t down_q30, uint8_t n) const {
+    // a = f + g down, and the margin with the scale error's share, g |down| / 32 (3.1 %:
+    // at least g cos(roll) 0.03 roll).
+    static_assert(kTurnBankScaleError <= 1.0f / 32.0f, "g |down| / 32 covers kTurnBankScaleError");
+    // (down Q14 times 4 g, >> 16: the high bytes, no shift loop.)
+    const int16_t gravity = (int16_t)(linalg::mul_s16((int16_t)(down_q30 >> 16), gravity_counts_x4_) >> 16);
+    return AxisBound{f_sum + times_n(gravity, n), times_n(margin_counts_ + ((gravity < 0 ? -gravity : gravity) >> 5), n)};
+}
+
 int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n) {
     // Beyond 2^21 counts a window (500 g) is no turn: held, so the means stay in 32 bits.
     const int32_t raw = within(raw_sum, 1L << 21);
-    // a_y = f_y + g down_y, and the margin with the scale error's share, g |down_y| / 32
-    // (3.1 %: at least g cos(roll) 0.03 roll), each summed over the window.
-    static_assert(kTurnBankScaleError <= 1.0f / 32.0f, "g |down_y| / 32 covers kTurnBankScaleError");
-    // (down_y Q14 times 4 g, >> 16: the high bytes, no shift loop.)
-    const int16_t gravity_y = (int16_t)(linalg::mul_s16((int16_t)(down_y_q30 >> 16), gravity_counts_x4_) >> 16);
-    const int32_t a_y = f_y_sum + times_n(gravity_y, n);
-    const int32_t margin = times_n(margin_counts_ + ((gravity_y < 0 ? -gravity_y : gravity_y) >> 5), n);
-    const int32_t clipped = within(raw, lateral_bounds(a_y, margin));
+    const AxisBound y = axis_bound(f_y_sum, down_y_q30, n);
+    const int32_t clipped = within(raw, lateral_bounds(y.a, y.margin));
     // mean += (sum - mean) / 16, Q8; the first window is the means.
     if (!started_) {
         started_ = true;
         raw_q8_ = raw * 256;
-        a_y_q8_ = a_y * 256;
+        a_y_q8_ = y.a * 256;
         clipped_q8_ = clipped * 256;
     }
     raw_q8_ += step_of_mean(raw * 256 - raw_q8_);
-    a_y_q8_ += step_of_mean(a_y * 256 - a_y_q8_);
+    a_y_q8_ += step_of_mean(y.a * 256 - a_y_q8_);
     clipped_q8_ += step_of_mean(clipped * 256 - clipped_q8_);
-    const int32_t mean_bounded_q8 = within(raw_q8_, lateral_bounds(a_y_q8_, margin * 256));
+    const int32_t mean_bounded_q8 = within(raw_q8_, lateral_bounds(a_y_q8_, y.margin * 256));
     return clipped + ((mean_bounded_q8 - clipped_q8_) >> 8);
 }
 
-FIXED_COLD void TurnMean::update(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
-                                 int32_t f_y_sum) {
+FIXED_COLD void TurnMean::update(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
+                                 const linalg::Vector3l& f_sum, uint8_t window) {
+    if ((window & (2u * kUpdateEvery - 1u)) == 0u) update_longitudinal(down_q30.x, n, f_sum.x);
+    const int32_t f_y_sum = f_sum.y, down_y_q30 = down_q30.y;
     // Each held within the accelerometer's full scale a sample.
     const int32_t full_scale = times_n(32767, n);
     const int32_t lateral = within(lateral_sum(times_gain(rate_z_sum, n, gain_q8_), f_y_sum, down_y_q30, n), full_scale);
     const int32_t normal = within(times_gain(rate_y_sum, n, gain_q8_), full_scale);
-    lateral_per_sample_ = per_sample(lateral, n);
-    normal_per_sample_ = per_sample(normal, n);
+    term4_.y = per_sample(lateral, n) * 4;
+    term4_.z = -per_sample(normal, n) * 4;
+}
+
+FIXED_COLD void TurnMean::update_longitudinal(int32_t down_x_q30, uint8_t n, int32_t f_x_sum) {
+    const AxisBound x = axis_bound(f_x_sum, down_x_q30, n);
+    // dV/dt in 16 bits: within the full scale a sample as it is.
+    term4_.x = per_sample(within(times_n(dv_dt_counts_, n), lateral_bounds(x.a, x.margin)), n) * 4;
 }
 
 }  // namespace dcm

@@ -28,6 +28,16 @@
 // omega_z V's mean within a_y's mean; each window is clipped as above, and what the
 // clipping took off the mean beyond that is given back.
 //
+// Along the body's x axis the flight's change of speed does the same: a climb's speed
+// change reads as pitch, 6 deg a m/s^2. A measured airspeed's change tells it (dV/dt, the
+// pipeline's; a configured cruise speed has none), but a gust changes the airspeed while
+// the path's speed hardly changes (the aeroplane's inertia), and the accelerometer does
+// not feel it. So dV/dt is held between 0 and a_x = f_x + g down_x, the acceleration the
+// accelerometer and the estimate say there is, widened by the same margin, window by
+// window: a speed change the accelerometer feels is taken off, a gust's hardly. No mean
+// is given back here: a climb's dV/dt lasts seconds and sits inside its bound, and what
+// clipping takes off is the gusts' swings, which the accelerometer did not feel.
+//
 // Formats: accel and gyro counts summed over the window (n samples, 4 but for a late
 // correction); the means of those sums in Q8.
 #pragma once
@@ -44,7 +54,7 @@ constexpr float kTurnBankScaleError = 0.03f;
 struct LateralBounds {
     int32_t lo, hi;  // accel counts
 };
-// 0 .. a_y (either side), widened by the margin.
+// 0 .. a (either side: a_y, or a_x for dV/dt), widened by the margin.
 LateralBounds lateral_bounds(int32_t a_y, int32_t margin);
 
 // x n for a window's n samples: two shifts for the usual 4 (avr-gcc's 32-bit multiply
@@ -57,39 +67,67 @@ class TurnMean {
 public:
     static constexpr uint8_t kUpdateEvery = 4;  // windows: 12.5 Hz
     static constexpr uint8_t kMeanShift = 4;    // 1 / 16 an update: 1.28 s at 12.5 Hz
-    // The gain (accel counts per gyro count of omega x v, Q8; 0: no correction) and
-    // gravity in accel counts; the means go on.
-    void configure(int16_t gain_q8, int16_t gravity_counts);
+    // The gain (accel counts per gyro count of omega x v, Q8; 0: no correction), gravity
+    // and dV/dt in accel counts; the means go on.
+    void configure(int16_t gain_q8, int16_t gravity_counts, int16_t dv_dt_counts = 0);
     bool active() const { return gain_q8_ != 0; }
-    // The window's sums less omega x v = (0, omega_z V, -omega_y V), the lateral term
-    // within the bounds: accel_sum and the running sums' sum, from the gyro's sums less
-    // the calibrated bias (counts) and the estimate's down_y (Q30). The term is worked out
-    // every kUpdateEvery-th window (12.5 Hz: a turn's term moves at the turn's pace, a
-    // gust's swings at a few hertz; the work is 32-bit arithmetic) and kept a sample's
-    // worth for the windows between.
-    void take_off(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n,
+    // The window's sums less (dV/dt, omega_z V, -omega_y V), the first two within their
+    // bounds: accel_sum and the running sums' sum, from the gyro's sums less the
+    // calibrated bias (counts) and earth down in body axes (R's third row, Q30). The
+    // lateral and normal terms are worked out every kUpdateEvery-th window (12.5 Hz: a
+    // turn's term moves at the turn's pace, a gust's swings at a few hertz; the work is
+    // 32-bit arithmetic), dV/dt with every second of them (6.25 Hz: the speed changes at
+    // a climb's pace); each is kept for the windows between.
+    void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
                   linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
-        if ((windows_++ & (kUpdateEvery - 1u)) == 0u) update(rate_y_sum, rate_z_sum, down_y_q30, n, accel_sum.y);
-        const int32_t lateral = times_n(lateral_per_sample_, n), normal = times_n(normal_per_sample_, n);
-        accel_sum.y -= lateral;
-        accel_sum.z += normal;
+        const uint8_t window = windows_++;
+        if ((window & (kUpdateEvery - 1u)) == 0u)
+            update(rate_y_sum, rate_z_sum, down_q30, n, accel_sum, window);
         // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all:
-        // the window's term (n samples' worth) times (n + 1) / 2.
-        accel_sum_of_sums.y -= (times_n(lateral, n) + lateral) >> 1;
-        accel_sum_of_sums.z += (times_n(normal, n) + normal) >> 1;
+        // the window's term (n samples' worth) times (n + 1) / 2, 10 samples' worth for 4.
+        if (n == 4) {
+            take_off_term(term4_.x, term4_.x * 2 + (term4_.x >> 1), accel_sum.x, accel_sum_of_sums.x);
+            take_off_term(term4_.y, term4_.y * 2 + (term4_.y >> 1), accel_sum.y, accel_sum_of_sums.y);
+            take_off_term(term4_.z, term4_.z * 2 + (term4_.z >> 1), accel_sum.z, accel_sum_of_sums.z);
+        } else {
+            take_off_late(term4_.x, n, accel_sum.x, accel_sum_of_sums.x);
+            take_off_late(term4_.y, n, accel_sum.y, accel_sum_of_sums.y);
+            take_off_late(term4_.z, n, accel_sum.z, accel_sum_of_sums.z);
+        }
     }
 
 private:
+    static void take_off_term(int32_t term, int32_t term_weighted, int32_t& sum, int32_t& sum_of_sums) {
+        sum -= term;
+        sum_of_sums -= term_weighted;
+    }
+    // A late window's n samples (the term a sample is a quarter of the four's, exactly).
+    static void take_off_late(int32_t term4, uint8_t n, int32_t& sum, int32_t& sum_of_sums) {
+        const int32_t term = times_n(term4 >> 2, n);
+        take_off_term(term, (times_n(term, n) + term) >> 1, sum, sum_of_sums);
+    }
+    // a = f + g down on one axis (f_sum the accelerometer's sum there, down_q30 earth
+    // down's component) and the margin, each summed over the window's n samples.
+    struct AxisBound {
+        int32_t a, margin;
+    };
+    AxisBound axis_bound(int32_t f_sum, int32_t down_q30, uint8_t n) const;
     // The window's lateral term (counts summed over the window) from omega_z V's sum.
     int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
-    // The term a sample from the window's sums (f_y_sum: the accelerometer's y).
-    void update(int32_t rate_y_sum, int32_t rate_z_sum, int32_t down_y_q30, uint8_t n, int32_t f_y_sum);
+    // The terms from the window's sums (f_sum: the accelerometer's), dV/dt on every
+    // second call (window: the count of this one).
+    void update(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
+                const linalg::Vector3l& f_sum, uint8_t window);
+    // dV/dt within its bound (f_x_sum: the accelerometer's x).
+    void update_longitudinal(int32_t down_x_q30, uint8_t n, int32_t f_x_sum);
 
     int32_t raw_q8_, a_y_q8_, clipped_q8_;  // means of the windows' sums, Q8
-    int16_t gain_q8_, gravity_counts_x4_, margin_counts_;
+    int16_t gain_q8_, gravity_counts_x4_, margin_counts_, dv_dt_counts_;
     bool started_;                          // the means hold a window (the first sets them)
-    uint8_t windows_;                       // counts the windows: the term is worked out every kUpdateEvery-th
-    int32_t lateral_per_sample_, normal_per_sample_;  // the term, accel counts a sample
+    uint8_t windows_;                       // counts the windows: when the terms are worked out
+    // The terms taken off, four samples' worth (accel counts; x dV/dt, y omega_z V, z
+    // -omega_y V), each a multiple of 4.
+    linalg::Vector3l term4_;
 };
 
 }  // namespace dcm

@@ -35,13 +35,14 @@ public:
         ++window_samples_;
     }
     // The turn's centripetal acceleration off the window's accel sums (Centripetal.h),
-    // from its gyro sums less the calibrated bias (units) and the estimate's down_y (Q30).
-    void take_off_turn(TurnMean& turn, int32_t down_y_q30, const linalg::Vector3l& sensor_bias_units) {
+    // from its gyro sums less the calibrated bias (units) and earth down in body axes
+    // (R's third row, Q30).
+    void take_off_turn(TurnMean& turn, const linalg::Vector3l& down_q30, const linalg::Vector3l& sensor_bias_units) {
         const uint8_t n = window_samples_;
         if (n == 0) return;
         // The calibrated bias in counts, rounded (units are counts * 2^8).
         const int32_t bias_y = (sensor_bias_units.y + 128) >> 8, bias_z = (sensor_bias_units.z + 128) >> 8;
-        turn.take_off(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), down_y_q30, n, accel_sum_,
+        turn.take_off(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), down_q30, n, accel_sum_,
                       accel_sum_of_sums_);
     }
     // The window into the earth-frame low-pass (R body to earth, the steps not yet

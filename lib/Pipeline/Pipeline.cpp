@@ -45,22 +45,35 @@ int16_t centripetal_gain_q8(float airspeed_m_s) {
     return (int16_t)(v * (kGyroCount_rad_s / kAccelCount_m_s2 * 256.0f) + 0.5f);
 }
 
+int16_t longitudinal_counts(float before_m_s, float now_m_s, uint16_t steps) {
+    if (centripetal_gain_q8(before_m_s) == 0 || centripetal_gain_q8(now_m_s) == 0 || steps == 0u ||
+        steps > kMaxAirspeedGapSteps)
+        return 0;
+    float dv_dt = (now_m_s - before_m_s) * (float)kRateHz / (float)steps;
+    dv_dt = dv_dt > kMaxLongitudinal_m_s2 ? kMaxLongitudinal_m_s2 : (dv_dt < -kMaxLongitudinal_m_s2 ? -kMaxLongitudinal_m_s2 : dv_dt);
+    return (int16_t)lroundf(dv_dt * (1.0f / kAccelCount_m_s2));
+}
+
 void AttitudePipeline::set_airspeed_m_s(float airspeed_m_s) {
+    const int16_t dv_dt = longitudinal_counts(airspeed_m_s_, airspeed_m_s, (uint16_t)st_.steps - airspeed_step_);
+    airspeed_step_ = (uint16_t)st_.steps;
     airspeed_m_s_ = airspeed_m_s;
+    if (st_.phase == Phase::Running) configure_turn(dv_dt);
+}
+
+void AttitudePipeline::set_cruise_airspeed_m_s(float trim_m_s) {
+    // A configured speed has no change to tell: no longitudinal term.
+    airspeed_m_s_ = trim_m_s > 0.0f ? airspeed::cruise_in_turn_m_s(trim_m_s, dcm_.cos_tilt()) : 0.0f;
     if (st_.phase == Phase::Running) configure_turn();
 }
 
-void AttitudePipeline::configure_turn() {
+void AttitudePipeline::configure_turn(int16_t dv_dt_counts) {
     constexpr int16_t kGravityCounts = (int16_t)(kG / kAccelCount_m_s2 + 0.5f);
     const int16_t gain_q8 = centripetal_gain_q8(airspeed_m_s_);
     // Landed or below the speed: the turn's mean starts again with the next flight.
     if (gain_q8 == 0) turn_mean_ = dcm::TurnMean();
-    turn_mean_.configure(gain_q8, kGravityCounts);
+    turn_mean_.configure(gain_q8, kGravityCounts, dv_dt_counts);
     dcm_.set_turn(gain_q8 != 0 ? &turn_mean_ : nullptr);
-}
-
-void AttitudePipeline::set_cruise_airspeed_m_s(float trim_m_s) {
-    set_airspeed_m_s(trim_m_s > 0.0f ? airspeed::cruise_in_turn_m_s(trim_m_s, dcm_.cos_tilt()) : 0.0f);
 }
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {

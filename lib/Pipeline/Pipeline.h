@@ -104,6 +104,15 @@ constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
 // (0 below kCentripetalMinAirspeed_m_s or not finite; clamped at the maximum). The
 // estimator takes it off its gravity window (lib/DCM/Centripetal.h).
 int16_t centripetal_gain_q8(float airspeed_m_s);
+// Two measured airspeeds this many steps apart differ by the flight's acceleration along
+// the body's x axis (dV/dt, in still air: what gusts add the estimator bounds), which the
+// accelerometer reads as pitch (1 m/s^2 is 6 deg). ArduPilot's DCM differentiates its
+// velocity the same way.
+constexpr uint16_t kMaxAirspeedGapSteps = 40;  // readings further apart (0.2 s) are no derivative
+constexpr float kMaxLongitudinal_m_s2 = 20.0f;  // 2 g along the path: no aeroplane's, held
+// dV/dt in accel counts (0 unless both are flying speeds, centripetal_gain_q8 > 0, and at
+// most kMaxAirspeedGapSteps apart).
+int16_t longitudinal_counts(float before_m_s, float now_m_s, uint16_t steps);
 enum class Phase : uint8_t {
     WaitImu,      // no sample yet
     Calibrating,  // measuring the gyro bias; nothing estimated yet
@@ -197,8 +206,9 @@ public:
     void set_mag_present(bool present);
     bool mag_present() const { return st_.mag_present; }
 
-    // The airspeed along the body's x axis (m/s; 0: none, no correction) for the
-    // centripetal correction of the accelerometer: holds until set again.
+    // The measured airspeed along the body's x axis (m/s; 0: none, no correction) for the
+    // centripetal correction of the accelerometer, and with the reading before it the
+    // flight's dV/dt (longitudinal_counts): holds until set again.
     void set_airspeed_m_s(float airspeed_m_s);
     // A configured cruise speed instead (no sensor; 0: none), grown in a banked turn as
     // the lift needs (airspeed::cruise_in_turn_m_s): set it again as the bank changes.
@@ -264,7 +274,7 @@ private:
     void start_estimator(const linalg::Vector3f& gravity);
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
     // The estimator's turn correction from the airspeed (once running: TurnMean's space).
-    void configure_turn();
+    void configure_turn(int16_t dv_dt_counts = 0);
     void step_mag_fit();
     void finish_mag_calibration();
     void report_deferred();
@@ -292,6 +302,7 @@ private:
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     float airspeed_m_s_ = 0.0f;
+    uint16_t airspeed_step_ = 0;  // st_.steps's low half at the last measured airspeed
     linalg::Vector3f mag_cal_uT_;     // latest calibrated field
     // Every counter and flag, zero at the start: one plain struct, so the constructor
     // clears it in one loop instead of a store per member (less flash).
