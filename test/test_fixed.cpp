@@ -202,6 +202,40 @@ TEST(Fixed, HypotWithin2p5e5Relative) {
     EXPECT_NEAR((double)linalg::hypot_from_ratio(0x7FFFFFFFu, ratio), std::sqrt(2.0) * 0x7FFFFFFF, 5e4);
 }
 
+// Every input of the core, then the Q30 and float forms over their ranges, against
+// 1/sqrt in double.
+TEST(Fixed, InverseSqrtWithinItsStatedError) {
+    double worst = 0.0;
+    for (uint32_t xn = 0x4000u; xn < 0x10000u; ++xn) {
+        const double exact = 1.0 / std::sqrt(xn / 65536.0);
+        worst = std::max(worst, std::fabs(linalg::inverse_sqrt_q15((uint16_t)xn) / 32768.0 - exact) / exact);
+    }
+    EXPECT_LT(worst, 6e-5);
+    worst = 0.0;
+    for (uint32_t x = 1; x < 70000u; ++x) {
+        const double exact = 1073741824.0 / std::sqrt((double)x);
+        worst = std::max(worst, std::fabs(linalg::inverse_sqrt_q30(x) - exact) / exact);
+    }
+    for (const uint32_t x : {0x10000u, 0x3FFFFu, 0x12345678u, 0xFFFFFFFFu}) {
+        const double exact = 1073741824.0 / std::sqrt((double)x);
+        worst = std::max(worst, std::fabs(linalg::inverse_sqrt_q30(x) - exact) / exact);
+    }
+    EXPECT_LT(worst, 1e-4);
+    EXPECT_NEAR((double)linalg::inverse_sqrt_q30(1), 1073741824.0, 1073741824.0 * 1.6e-5);  // 2 in Q15 is 65535
+    EXPECT_EQ(linalg::inverse_sqrt_q30(0), 0x7FFFFFFFu);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> log_x(-120.0, 120.0);
+    worst = 0.0;
+    for (int i = 0; i < 200000; ++i) {
+        const float x = (float)std::pow(2.0, log_x(rng));
+        const double exact = 1.0 / std::sqrt((double)x);
+        worst = std::max(worst, std::fabs(linalg::inverse_sqrt(x) - exact) / exact);
+    }
+    EXPECT_LT(worst, 1e-4);
+    EXPECT_NEAR(linalg::inverse_sqrt(4.0f), 0.5f, 0.5f * 1.6e-5f);
+    for (const float bad : {0.0f, -1.0f, 1e-40f, INFINITY, NAN}) EXPECT_EQ(linalg::inverse_sqrt(bad), 0.0f) << bad;
+}
+
 // Random attitudes: the fixed-point angles against atan2/hypot in double on the same
 // float matrix. Up to 80 deg pitch: closer to the lock roll and yaw divide every error
 // of the entries by cos(pitch) (a fast turn's theta, rounded to 3.8e-6 rad, makes

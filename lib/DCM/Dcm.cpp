@@ -431,9 +431,11 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     }
 #endif
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
-    const float norm = sqrtf(norm2);
-    const float down_component = field_ef.z / norm;
-    const float inv_horizontal = 1.0f / sqrtf(horizontal2);
+    // (The integer inverse square root, to 1e-4: sqrtf and a division cost ~900 cycles.)
+    const float inv_norm = linalg::inverse_sqrt(norm2);
+    const float norm = norm2 * inv_norm;
+    const float down_component = field_ef.z * inv_norm;
+    const float inv_horizontal = linalg::inverse_sqrt(horizontal2);
     const float sin_error = field_ef.y * inv_horizontal;
     // The time this sample stands for (the low-passes below are in time, not samples).
     const float sample_dt = settings_->step_s * (float)(interval_steps < kMaxMagIntervalSteps ? interval_steps : kMaxMagIntervalSteps);

@@ -114,12 +114,11 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
 
 FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
                                      const DcmSettings& settings, const DcmCoefficients& k, GyroBias& bias) {
-    using linalg::hot::fixed_from_float;
     using linalg::mul_q30;
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). |lp|^2 / 2^30
     // in integers (a thousandth of its value at least: 1 g is 2^20 units at 8 g full
-    // scale), 2^15 / |lp| in float (a square root and a division) made a Q19 factor, the
-    // rest in Q30.
+    // scale), 2^15 / |lp| a Q19 factor from the integer inverse square root (to 1e-4:
+    // the gain's error, far below lp2's own thousandth), the rest in Q30.
     const Vector3l& lp = lp_ef_;
     const uint32_t lp2 = (uint32_t)mul_q30(lp.x, lp.x) + (uint32_t)mul_q30(lp.y, lp.y) + (uint32_t)mul_q30(lp.z, lp.z);
     if (lp2 <= k.min_lp2) {  // |lp| < g/2: no direction to trust
@@ -129,7 +128,8 @@ FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r
     // The unit vector's components in Q30: lp times 2^15 / sqrt(lp2) (at most 2^11 for
     // |lp| >= g/2), that factor in Q19 (within 2^30), the products' low 11 bits dropped
     // (2e-6 rad, below the Q14 the error is used in).
-    const int32_t inv_lp_q34 = fixed_from_float(32768.0f / sqrtf((float)lp2), 19);
+    const uint32_t inv_lp = linalg::inverse_sqrt_q30(lp2);  // 2^30 / |lp|, *16 is 2^34 / |lp|
+    const int32_t inv_lp_q34 = inv_lp >= (1UL << 27) ? 0x7FFFFFFF : (int32_t)(inv_lp << 4);
     const int32_t n = -(int32_t)((uint32_t)mul_q30(lp.y, inv_lp_q34) << 11);
     const int32_t e = (int32_t)((uint32_t)mul_q30(lp.x, inv_lp_q34) << 11);
     // In body axes: R^T (error_n, error_e, 0), the matrix in 16 bits (an error of 6e-5 of

@@ -95,6 +95,64 @@ Matrix3f matrix_from_q30(const Matrix3q30& m) {
     return Matrix3f(vector_from_q30(m.a), vector_from_q30(m.b), vector_from_q30(m.c));
 }
 
+// (The formats keep every shift to whole bytes, which are register moves on the AVR.)
+uint16_t inverse_sqrt_q15(uint16_t xn) {
+    // w = y/2 in Q16. The lines, minimax in relative error on [1/4, 1/2) and [1/2, 1):
+    // y = 2.53 - 2.295 t and y = 1.7875 - 0.81 t, as w = a - b t with b t from a 16x16
+    // product (b - 1 and t apart where b > 1).
+    const bool low = xn < 0x8000u;
+    uint32_t w = (low ? 82903u - xn : 58573u) - (mul_u16(low ? 9667u : 26542u, xn) >> 16);
+    for (uint8_t i = 0; i < 2; ++i) {
+        if (w > 0xFFFFu) w = 0xFFFFu;  // y = 2 is one beyond
+        // Newton's step as w <- w + w g with g = (1 - t y^2)/2 = 1/2 - 2 t w^2 in Q16
+        // (|g| < 0.03 from the lines): t w^2 in Q32 (< 2^31 then), g from its double.
+        const uint32_t t_w2_q32 = mul_u16(xn, (uint16_t)(mul_u16((uint16_t)w, (uint16_t)w) >> 16));
+        const int16_t g_q16 = (int16_t)(((int32_t)(0x80000000u - (t_w2_q32 << 1)) + 0x8000) >> 16);
+        const uint32_t step = (mul_u16((uint16_t)w, (uint16_t)(g_q16 < 0 ? -g_q16 : g_q16)) + 0x8000u) >> 16;
+        w = g_q16 < 0 ? w - step : w + step;
+    }
+    return (uint16_t)(w < 0x8000u ? 0x8000u : (w > 0xFFFFu ? 0xFFFFu : w));
+}
+
+uint32_t inverse_sqrt_q30(uint32_t x) {
+    if (x == 0) return 0x7FFFFFFFu;
+    // x = xn 2^-2h with xn in [2^14, 2^16): 2^30 / sqrt(x) = y_q15 2^(7 + h).
+    int8_t h = 0;
+    while (x >= 0x10000u) {
+        x >>= 2;
+        --h;
+    }
+    while (x < 0x4000u) {
+        x <<= 2;
+        ++h;
+    }
+    const uint32_t y_q15 = inverse_sqrt_q15((uint16_t)x);
+    return h >= -7 ? y_q15 << (uint8_t)(7 + h) : y_q15 >> 1;
+}
+
+float inverse_sqrt(float x) {
+    uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    const uint8_t biased = fixed_detail::bits_23_to_30(bits);
+    if ((bits & 0x80000000u) || biased == 0 || biased == 0xFFu) return 0.0f;
+    // x = s 2^e with the significand s in [1, 2); t = s/2 (e odd) or s/4 (e even), in
+    // [1/4, 1) in Q16, and x = t 2^k with k = e + 1 or e + 2, even.
+    const int16_t e = (int16_t)biased - 127;
+    uint16_t xn = (uint16_t)((bits | 0x800000u) >> 8);  // s in Q15: t = s/2 in Q16
+    int16_t k = (int16_t)(e + 1);
+    if ((e & 1) == 0) {
+        xn >>= 1;
+        k = (int16_t)(e + 2);
+    }
+    // 1/sqrt(x) = y 2^(-k/2), y in [1, 2): the float's bits directly (y in Q15 has its
+    // leading one at bit 15).
+    const uint16_t y = inverse_sqrt_q15(xn);
+    const uint32_t result = ((uint32_t)(uint16_t)(127 - k / 2) << 23) | ((uint32_t)(y & 0x7FFFu) << 8);
+    float r;
+    memcpy(&r, &result, sizeof r);
+    return r;
+}
+
 namespace fixed_detail {
 
 const uint8_t kPowersOfTwo[8] FIXED_PROGMEM = {1, 2, 4, 8, 16, 32, 64, 128};
