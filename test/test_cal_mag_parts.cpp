@@ -93,9 +93,10 @@ TEST(CalMagParts, PipelineFitsAPartAStepAndThenGivesTheVerdict) {
     EXPECT_NE(log.find("# cal mag: offset 8.00 -5.00 3.00 uT"), std::string::npos) << log;
     EXPECT_NEAR(p.settings().cal.mag_offset_uT.x, kHardIron.x, 0.05f);
     EXPECT_TRUE(p.settings().flags & settings::kFlagMagCalibrated);
-    // The latest field is calibrated with the new calibration at once.
+    // The latest field is calibrated with the new calibration at once (kept in the DCM's
+    // integer form: within 1/32 uT an axis of it, where the old calibration is 8 uT off).
     const Vector3f expected = calib::apply_mag(p.settings().cal, field_at((step - 1) / 3 * 3));
-    EXPECT_NEAR((p.field_uT() - expected).length(), 0.0f, 1e-4f);
+    EXPECT_NEAR((p.field_uT() - expected).length(), 0.0f, 0.055f);
 }
 
 }  // namespace

@@ -55,6 +55,26 @@ struct Gate {
 
 }  // namespace
 
+// A sample's integer form (made once where it arrives): uT * 32 truncated toward zero
+// as the step always took it, its squared strength in the norm sum's units, and no
+// integer form for NaN or an axis at 1 000 uT or beyond (no compass reads that).
+TEST(DcmHeading, AFieldSampleIsTakenInSixteenBitsOrNotAtAll) {
+    linalg::Vector3i q5;
+    ASSERT_TRUE(dcm::field_q5_of(Vector3f(20.0f, -3.51f, 45.0f), q5));
+    EXPECT_EQ(q5.x, 640);
+    EXPECT_EQ(q5.y, -112);  // -112.32 toward zero
+    EXPECT_EQ(q5.z, 1440);
+    EXPECT_EQ(dcm::field_norm2(q5), (640u * 640u >> 4) + (112u * 112u >> 4) + (1440u * 1440u >> 4));  // each axis >> 4
+    EXPECT_NEAR(dcm::field_norm2(q5) * dcm::kFieldNorm2PerUnit_uT2, 20.0f * 20.0f + 3.51f * 3.51f + 45.0f * 45.0f, 1.0f);
+    const Vector3f back = dcm::field_uT_of(q5);
+    EXPECT_NEAR(back.y, -3.5f, 1e-6f);
+    EXPECT_TRUE(dcm::field_q5_of(Vector3f(999.9f, 0.0f, -999.9f), q5));
+    for (const Vector3f bad : {Vector3f(1000.0f, 0.0f, 0.0f), Vector3f(0.0f, -1000.0f, 0.0f), Vector3f(0.0f, 0.0f, NAN),
+                               Vector3f(INFINITY, 0.0f, 0.0f)}) {
+        EXPECT_FALSE(dcm::field_q5_of(bad, q5)) << bad.x << " " << bad.y << " " << bad.z;
+    }
+}
+
 TEST(DcmHeading, TheMeanIsInEarthAxesOverKHeadingSteps) {
     dcm::EarthFieldMean mean;
     const Vector3f a(20.0f, 1.0f, 45.0f), b(20.0f, -1.0f, 45.0f), c(21.0f, 0.0f, 44.0f);

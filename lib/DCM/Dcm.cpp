@@ -19,7 +19,6 @@ constexpr uint16_t kMaxMagIntervalSteps = 20;
 constexpr uint8_t kMaxMagAgeSteps = 2;
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
-constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
 
 // Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
 int16_t q16_of(int32_t x_q26) {
@@ -45,7 +44,7 @@ void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
 
 Vector3f Dcm::gyro_bias_rad_s() const { return bias_.estimate_rad_s(k_); }
 
-Vector3f Dcm::last_mag_field() const { return linalg::scaled(last_field_q5_, 1.0f / (float)(1 << kFieldQ)); }
+Vector3f Dcm::last_mag_field() const { return field_uT_of(last_field_q5_); }
 
 
 void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
@@ -341,27 +340,20 @@ FIXED_COLD Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scal
 
 
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
-    const uint16_t since_last = steps_since_mag_;
-    steps_since_mag_ = 0;
-    if (!mag_field.is_finite()) {
+    linalg::Vector3i field;
+    if (!field_q5_of(mag_field, field)) {  // beyond any compass: garbage
+        steps_since_mag_ = 0;
         status_ |= kStatusMagIgnored;
         return;
     }
-    // In integers from here to the mean (~75 Hz): 16 bits, uT * 2^kFieldQ.
-    // (NaN was tested above; an infinity saturates and fails the range test.)
-    const float* in[3] = {&mag_field.x, &mag_field.y, &mag_field.z};
-    int16_t axis[3];
-    uint32_t sample_norm2 = 0;  // uT^2 * 2^(2 kFieldQ - kNorm2Shift)
-    for (uint8_t i = 0; i < 3; ++i) {
-        const int32_t q = linalg::hot::fixed_from_float(*in[i], kFieldQ);
-        if (q >= kMaxFieldQ || q <= -kMaxFieldQ) {  // beyond any compass: garbage
-            status_ |= kStatusMagIgnored;
-            return;
-        }
-        axis[i] = (int16_t)q;
-        sample_norm2 += (uint32_t)linalg::mul_s16(axis[i], axis[i]) >> kNorm2Shift;
-    }
-    const linalg::Vector3i field(axis[0], axis[1], axis[2]);
+    correct_heading(field, age_steps);
+}
+
+// In integers from here to the mean (~75 Hz): 16 bits, uT * 2^kFieldQ.
+void Dcm::correct_heading(const linalg::Vector3i& field, uint8_t age_steps) {
+    const uint16_t since_last = steps_since_mag_;
+    steps_since_mag_ = 0;
+    const uint32_t sample_norm2 = field_norm2(field);  // uT^2 * 2^(2 kFieldQ - kNorm2Shift)
     if (sample_norm2 == 0) {
         status_ |= kStatusMagIgnored;
         return;
@@ -373,7 +365,7 @@ void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     if (!initialised()) return;
     if (status_ & kStatusNoHeading) {
         // The first field sample after a start without one: take its heading as is.
-        init(last_accel_.scaled(k_.accel_m_s2_per_count), mag_field);
+        init(last_accel_.scaled(k_.accel_m_s2_per_count), last_mag_field());
         return;
     }
 

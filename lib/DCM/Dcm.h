@@ -111,6 +111,8 @@ public:
     // rejected (kStatusMagIgnored).
     // age_steps: steps the sample waited before this call (its latency grows by as much).
     void correct_heading(const linalg::Vector3f& mag_field, uint8_t age_steps = 0);
+    // The same for a sample already in the integer form (field_q5_of, where it arrived).
+    void correct_heading(const linalg::Vector3i& field_q5, uint8_t age_steps = 0);
     // The next update (without a line) integrates or corrects gravity: a caller with
     // deferrable work puts it on another step.
     bool heavy_due() const { return initialised() && HeavySchedule::blocks(next_heavy_part(false)); }

@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "Fixed.h"
+
 namespace dcm {
 
 namespace {
@@ -11,8 +13,8 @@ namespace {
 // (temperature, location) with 1.3 s.
 constexpr float kCandidateTau_s = 0.053f;
 constexpr float kReferenceTau_s = 1.32f;
-// The sums' units in uT^2 and uT.
-constexpr float kNorm2PerUnit = (float)(1L << kNorm2Shift) / (float)(1L << (2 * kFieldQ));
+constexpr int32_t kMaxFieldQ = (int32_t)(kMaxField_uT * (float)(1 << kFieldQ));
+// The sums' units in uT.
 constexpr float kEarthFieldPerUnit = 1.0f / (float)(1L << (kFieldQ + 14 - kEarthFieldShift));
 
 // 1/n for the few window lengths there are, without a float division.
@@ -28,10 +30,33 @@ float inverse(uint8_t n) {
 }
 }  // namespace
 
+bool field_q5_of(const linalg::Vector3f& field_uT, linalg::Vector3i& field_q5) {
+    if (!field_uT.is_finite()) return false;
+    const float* in[3] = {&field_uT.x, &field_uT.y, &field_uT.z};
+    int16_t* out[3] = {&field_q5.x, &field_q5.y, &field_q5.z};
+    for (uint8_t i = 0; i < 3; ++i) {
+        const int32_t q = linalg::fixed_from_float(*in[i], kFieldQ);
+        if (q >= kMaxFieldQ || q <= -kMaxFieldQ) return false;
+        *out[i] = (int16_t)q;
+    }
+    return true;
+}
+
+uint32_t field_norm2(const linalg::Vector3i& q5) {
+    const int16_t* axis = &q5.x;
+    uint32_t sum = 0;
+    for (uint8_t i = 0; i < 3; ++i) sum += (uint32_t)linalg::mul_s16(axis[i], axis[i]) >> kNorm2Shift;
+    return sum;
+}
+
+linalg::Vector3f field_uT_of(const linalg::Vector3i& field_q5) {
+    return linalg::scaled(field_q5, 1.0f / (float)(1 << kFieldQ));
+}
+
 void EarthFieldMean::take(linalg::Vector3f& field_ef_uT, float& norm2_uT2) {
     const float inv_samples = inverse(samples_);
     field_ef_uT = field_sum_.scaled(inv_samples * kEarthFieldPerUnit);
-    norm2_uT2 = (float)norm2_sum_ * (inv_samples * kNorm2PerUnit);
+    norm2_uT2 = (float)norm2_sum_ * (inv_samples * kFieldNorm2PerUnit_uT2);
     clear();
 }
 

@@ -122,9 +122,12 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     cal_field_uT_ = field_uT;
     if (st_.mag_cal_active) st_.cal_pending = true;
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
-    const float n = f.length();
-    if (!(n >= kMagMin_uT && n <= kMagMax_uT)) {
-        if (warn_of(EventKind::kMagNotEarth).allow(st_.steps, kWarnIntervalSteps)) tell(EventKind::kMagNotEarth, 0, 0, n, 0);
+    // The DCM's integer form, made once here (the range check takes its strength).
+    linalg::Vector3i f_q5;
+    const uint32_t n2 = dcm::field_q5_of(f, f_q5) ? dcm::field_norm2(f_q5) : 0;
+    if (!(n2 >= kMagMinNorm2 && n2 <= kMagMaxNorm2)) {
+        if (warn_of(EventKind::kMagNotEarth).allow(st_.steps, kWarnIntervalSteps))
+            tell(EventKind::kMagNotEarth, 0, 0, f.length(), 0);
         return;
     }
     // The learner takes the sample on a later step with neither an output line, a heading
@@ -147,7 +150,7 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         st_.steps_since_mag = 0;
         turn_counts_ = linalg::Vector3l();
     }
-    mag_cal_uT_ = f;
+    mag_cal_q5_ = f_q5;
     st_.mag_pending = true;
     st_.mag_wait_steps = 0;  // a sample still waiting is replaced by this one
     st_.have_mag = true;
@@ -188,7 +191,8 @@ void AttitudePipeline::learn_mag_offset(bool one_piece) {
         learner_.add(learn_field_uT_, dcm_.gyro_turn_q30(learn_turn_counts_, st_.learn_steps), st_.learn_steps, learned);
     }
     if (learned == before) return;
-    mag_cal_uT_ -= learned - before;
+    linalg::Vector3i shifted;
+    if (dcm::field_q5_of(field_uT() - (learned - before), shifted)) mag_cal_q5_ = shifted;
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
         forget_mag_reference(false);
 }
@@ -238,7 +242,7 @@ void AttitudePipeline::start_estimator(const Vector3f& gravity) {
         dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
     }
     dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
-    dcm_.init(gravity, st_.have_mag && st_.mag_present ? mag_cal_uT_ : Vector3f());
+    dcm_.init(gravity, st_.have_mag && st_.mag_present ? field_uT() : Vector3f());
     st_.mag_pending = false;
     // How far off the offset in use may be: a fraction of a uT after `cal mag` or
     // learning, tens of uT on a compass never calibrated.
@@ -368,7 +372,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     turn_counts_ += s.gyro;
     if (heading_corrected) {
         profile::begin(profile::kCompass);
-        dcm_.correct_heading(mag_cal_uT_, st_.mag_wait_steps);
+        dcm_.correct_heading(mag_cal_q5_, st_.mag_wait_steps);
         profile::end(profile::kCompass);
         st_.mag_pending = false;
         st_.mag_wait_steps = 0;
@@ -498,7 +502,8 @@ void AttitudePipeline::finish_mag_calibration() {
         mag_cal_.result(c);
         // The latest field (and a sample waiting for the heading's correction) was
         // calibrated the old way: the DCM takes the heading from the new one.
-        mag_cal_uT_ = calib::apply_mag(c, cal_field_uT_);
+        linalg::Vector3i recalibrated;
+        if (dcm::field_q5_of(calib::apply_mag(c, cal_field_uT_), recalibrated)) mag_cal_q5_ = recalibrated;
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
     }
     tell(EventKind::kMagCalDone, mag_cal_.coverage_pct(), mag_cal_.count(),

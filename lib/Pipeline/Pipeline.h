@@ -85,6 +85,9 @@ constexpr uint8_t kMaxSpikeRun = 10;            // up to 50 ms of glitch; longer
 constexpr uint8_t kAccelSaturationFaultSteps = 20;  // 100 ms of clipped accel: a stuck sensor, not a motion
 constexpr float kMagMin_uT = 10.0f;             // Earth: 25..65 uT; outside 10..200 = not the Earth
 constexpr float kMagMax_uT = 200.0f;
+// ... as the squared strengths of dcm::field_norm2.
+constexpr uint32_t kMagMinNorm2 = (uint32_t)(kMagMin_uT * kMagMin_uT / dcm::kFieldNorm2PerUnit_uT2);
+constexpr uint32_t kMagMaxNorm2 = (uint32_t)(kMagMax_uT * kMagMax_uT / dcm::kFieldNorm2PerUnit_uT2);
 // The estimator rejects a field whose strength is 10 % (~5 uT) off the one it learned:
 // a learned offset that has moved by half that since it learned the field makes it
 // learn the field again, before the shift can get a good field rejected.
@@ -234,7 +237,7 @@ public:
     // measured, field with the compass calibration): `mode raw`.
     linalg::Vector3f gyro_rad_s() const;
     linalg::Vector3f accel_m_s2() const { return last_.accel_m_s2(); }
-    const linalg::Vector3f& field_uT() const { return mag_cal_uT_; }
+    linalg::Vector3f field_uT() const { return dcm::field_uT_of(mag_cal_q5_); }
     // The body rates less every bias estimate, rad/s (MAVLink ATTITUDE).
     linalg::Vector3f body_rate_rad_s() const { return last_.gyro_rad_s() - gyro_bias_rad_s(); }
 
@@ -303,7 +306,7 @@ private:
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     float airspeed_m_s_ = 0.0f;
     uint16_t airspeed_step_ = 0;  // st_.steps's low half at the last measured airspeed
-    linalg::Vector3f mag_cal_uT_;     // latest calibrated field
+    linalg::Vector3i mag_cal_q5_;     // latest calibrated field (uT * 2^dcm::kFieldQ: dcm::field_q5_of)
     // Every counter and flag, zero at the start: one plain struct, so the constructor
     // clears it in one loop instead of a store per member (less flash).
     struct State {
