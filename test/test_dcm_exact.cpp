@@ -416,7 +416,8 @@ TEST(DcmExact, ARowNearUnitLengthIsRescaledToFirstOrder) {
 // 20, and one over 25 exactly as much as one over 20.
 TEST(DcmExact, AHeadingCorrectionStandsForAtMost20Steps) {
     float yaw_rad[3];
-    const int quiet_steps[3] = {12, 13, 18};  // the mean covers kHeadingSteps - 1 more: 19, 20, 25
+    constexpr int k = dcm::kHeadingSteps;
+    const int quiet_steps[3] = {20 - k, 21 - k, 26 - k};  // the mean covers kHeadingSteps - 1 more: 19, 20, 25
     for (int i = 0; i < 3; ++i) {
         dcm::Dcm f;
         ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT()));

@@ -79,13 +79,13 @@ TEST(DcmHeading, TheMeanIsInEarthAxesOverKHeadingSteps) {
     dcm::EarthFieldMean mean;
     const Vector3f a(20.0f, 1.0f, 45.0f), b(20.0f, -1.0f, 45.0f), c(21.0f, 0.0f, 44.0f);
     mean.add(earth_units(a), norm2_units(a), 3);
-    mean.add(earth_units(b), norm2_units(b), 3);
+    mean.add(earth_units(b), norm2_units(b), kMeanSteps - 5);
     EXPECT_FALSE(mean.complete());
     EXPECT_TRUE(mean.complete_after(1));
     EXPECT_FALSE(mean.complete_after(0));
     mean.add(earth_units(c), norm2_units(c), 2);
     ASSERT_TRUE(mean.complete());
-    EXPECT_EQ(mean.steps(), 8);
+    EXPECT_EQ(mean.steps(), kMeanSteps);
     Vector3f field;
     float norm2 = 0.0f;
     mean.take(field, norm2);

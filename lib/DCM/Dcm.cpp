@@ -397,7 +397,7 @@ void Dcm::correct_heading(const linalg::Vector3i& field, uint8_t age_steps) {
     // The samples are averaged in earth axes over kHeadingSteps (a fixed earth field is
     // the same vector there whatever the board did meanwhile), and the heading is
     // corrected from their mean: each sample costs the rotation into earth axes, the
-    // correction (the rest of this function) runs at 25 Hz.
+    // correction (the rest of this function) runs at 12.5 Hz.
     field_mean_.add(Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
                              row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
                              row_times(strapdown_.r().c, field_now) >> kEarthFieldShift),
@@ -405,7 +405,7 @@ void Dcm::correct_heading(const linalg::Vector3i& field, uint8_t age_steps) {
     if (field_mean_.complete()) correct_heading_from_mean();
 }
 
-// The heading's correction from a complete mean (kHeadingSteps samples, 25 Hz): out of
+// The heading's correction from a complete mean (kHeadingSteps steps, 12.5 Hz): out of
 // line (FIXED_OWN_FRAME), so that its float locals stay out of the 75 Hz part's frame.
 FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     uint16_t interval_steps = field_mean_.steps();

@@ -25,6 +25,7 @@ float inverse(uint8_t n) {
         case 3: return 1.0f / 3.0f;
         case 4: return 0.25f;
         case 5: return 0.2f;
+        case 6: return 1.0f / 6.0f;
         default: return 1.0f / (float)n;
     }
 }

@@ -10,7 +10,7 @@
 // Formats: the sums in integers (the earth-frame field in uT * 2^(kFieldQ + 14 -
 // kEarthFieldShift), the squared strengths in uT^2 * 2^(2 kFieldQ - kNorm2Shift));
 // the mean and everything the gate compares in float (uT; the dip as a sine): it runs
-// at 25 Hz.
+// at 12.5 Hz.
 #pragma once
 
 #include <stdint.h>

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The host replay tool and the scorer on scenarios and (when ../shared/data is present) a
 // real recording, and the simavr run scored with the same metric.
+#include "Coefficients.h"
 #include "accuracy_bounds.h"
 #include "e2e_support.h"
 
@@ -93,8 +94,9 @@ TEST(Replay, TraceWritesItsColumnsAndLeavesStdoutAlone) {
     EXPECT_GT(finite_after_start, 2500u);
     // The gravity correction is worked out on one step in kCorrectionDivider (4).
     EXPECT_NEAR((double)gravity_ran / (double)rows, 0.25, 0.03);
-    // The field means close at 25 Hz (one step in 8), and a clean field is used.
-    EXPECT_NEAR((double)heading_used / (double)rows, 0.125, 0.03);
+    // The field means close at 12.5 Hz (one step in kHeadingSteps, 16), and a clean field
+    // is used.
+    EXPECT_NEAR((double)heading_used / (double)rows, 1.0 / dcm::kHeadingSteps, 0.015);
     for (const auto& w : heading_words)
         EXPECT_TRUE(w.first == "used" || w.first == "not_due" || w.first == "disturbed" || w.first == "new_field" ||
                     w.first == "too_vertical") << w.first;
