@@ -41,6 +41,9 @@ void TurnMean::configure(int16_t gain_q8, int16_t gravity_counts, int16_t dv_dt_
     // g sin(kTurnBankMargin_deg): sin(0.5 deg) = 143 / 2^14.
     static_assert(kTurnBankMargin_deg == 0.5f, "143 / 2^14 is sin(kTurnBankMargin_deg)");
     margin_counts_ = (int16_t)(((int32_t)gravity_counts * 143 + 8192) >> 14);
+    // g sin(kTurnMinBank_deg): sin(5 deg) = 1428 / 2^14.
+    static_assert(kTurnMinBank_deg == 5.0f, "1428 / 2^14 is sin(kTurnMinBank_deg)");
+    turn_counts_ = (int16_t)(((int32_t)gravity_counts * 1428 + 8192) >> 14);
 }
 
 TurnMean::AxisBound TurnMean::axis_bound(int32_t f_sum, int32_t down_q30, uint8_t n) const {
@@ -67,6 +70,9 @@ int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q
     raw_q8_ += step_of_mean(raw * 256 - raw_q8_);
     a_y_q8_ += step_of_mean(y.a * 256 - a_y_q8_);
     clipped_q8_ += step_of_mean(clipped * 256 - clipped_q8_);
+    // Straight flight (a_y's mean within the least turn's): no turn to give back to.
+    const int32_t turn_q8 = times_n(turn_counts_, n) * 256;
+    if (a_y_q8_ < turn_q8 && a_y_q8_ > -turn_q8) return clipped;
     const int32_t mean_bounded_q8 = within(raw_q8_, lateral_bounds(a_y_q8_, y.margin * 256));
     return clipped + ((mean_bounded_q8 - clipped_q8_) >> 8);
 }
