@@ -100,6 +100,20 @@ TEST(DcmProperties, AFieldBeyondAnyCompassIsDroppedAtOnce) {
 
 // A field of the earth's strength but another dip is a disturbance too (a magnet can
 // keep the strength): the heading runs on the gyro.
+// A zero field (a compass that reads nothing, below 1/32 uT an axis) is no direction: it
+// is ignored, and the rest test does not take it for the field having moved.
+TEST(DcmProperties, AZeroFieldIsIgnored) {
+    CompassRun run(earth_field_uT());
+    run.run(6.0f, earth_field_uT());
+    ASSERT_TRUE(run.filter.status() & dcm::kStatusAtRest);
+    run.filter.correct_heading(Vector3f(0.01f, -0.02f, 0.0f));
+    EXPECT_TRUE(run.filter.status() & dcm::kStatusMagIgnored);
+    for (int i = 0; i < 8; ++i) {
+        run.filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+        EXPECT_TRUE(run.filter.status() & dcm::kStatusAtRest) << "step " << i;
+    }
+}
+
 TEST(DcmProperties, AFieldWithAnotherDipIsRejected) {
     CompassRun run(earth_field_uT());
     run.run(5.0f, earth_field_uT());
