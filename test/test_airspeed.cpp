@@ -159,17 +159,23 @@ TEST(Centripetal, AFlatSkidTurnIsTakenOffWhole) {
     EXPECT_NEAR(std::atan2(-f.y, -f.z) / kDeg, 0.0f, 0.1f);
 }
 
-// In a 30 deg turn through turbulence the yaw rate swings +-10 deg/s about the turn's:
-// each window clipped alone keeps the lower swings and loses the upper ones, a term short
-// of the turn's on the mean; the mean's share given back makes up most of it.
-TEST(Centripetal, TheTermsMeanIsTheTurnsThroughTheSwings) {
+// A 30 deg turn at 18 m/s through turbulence, the yaw rate swinging +-10 deg/s (0.5 Hz)
+// about the turn's, flown for 60 s through `turn`: how far the term's mean falls short of
+// the turn's omega_z V from 10 s on, and how far the windows clipped alone at the bank's
+// bound would (m/s^2), beside the turn's term.
+struct Shortfall {
+    double clipped, term, turn;
+};
+float yaw_swing_rad_s(int window) {
+    return 10.0f * kDeg * std::sin(2.0f * 3.14159265f * 0.5f * (float)window / 50.0f);
+}
+Shortfall turn_through_swings(dcm::TurnMean& turn) {
     const float bank = 30.0f, v = 18.0f;
     const Turn t = coordinated_turn(bank, v);
-    dcm::TurnMean turn = turn_at(v);
     double sum_lateral = 0.0, sum_clipped = 0.0;
     int n = 0;
     for (int window = 0; window < 50 * 60; ++window) {
-        const float swing_rad_s = 10.0f * kDeg * std::sin(2.0f * 3.14159265f * 0.5f * (float)window / 50.0f);
+        const float swing_rad_s = yaw_swing_rad_s(window);
         const mpu6000::Sample s = imu(t.gyro_rad_s + Vector3f(0.0f, 0.0f, swing_rad_s), t.accel_m_s2);
         const float lateral = -take_off(turn, s, bank).accel_m_s2.y;
         // The clipped term alone: the bound at the bank, sample by sample.
@@ -182,20 +188,28 @@ TEST(Centripetal, TheTermsMeanIsTheTurnsThroughTheSwings) {
             ++n;
         }
     }
+    const double turn_m_s2 = kG * std::sin(bank * kDeg);
+    return {turn_m_s2 - sum_clipped / n, turn_m_s2 - sum_lateral / n, turn_m_s2};
+}
+
+// In the turn through turbulence each window clipped alone keeps the lower swings and
+// loses the upper ones, a term short of the turn's on the mean; the mean's share given
+// back makes up most of it.
+TEST(Centripetal, TheTermsMeanIsTheTurnsThroughTheSwings) {
+    dcm::TurnMean turn = turn_at(18.0f);
+    const Shortfall s = turn_through_swings(turn);
     // Clipped alone the term is 18 % short; with the mean's share 3 %: a 0.5 Hz swing
     // still moves the 1.3 s mean beyond the bound at its peaks.
-    const double turn_m_s2 = kG * std::sin(bank * kDeg);
-    const double short_clipped = turn_m_s2 - sum_clipped / n, short_term = turn_m_s2 - sum_lateral / n;
-    EXPECT_GT(short_clipped, 0.1 * turn_m_s2);
-    EXPECT_LT(short_term, 0.2 * short_clipped);
-    EXPECT_GT(short_term, -0.01 * turn_m_s2);
+    EXPECT_GT(s.clipped, 0.1 * s.turn);
+    EXPECT_LT(s.term, 0.2 * s.clipped);
+    EXPECT_GT(s.term, -0.01 * s.turn);
 }
 
 // Straight flight in turbulence, wings rocked +-3 deg about level and the nose yawed
 // +-10 deg/s about the path (the estimate level): no turn, so nothing clipped is given
 // back, and the term stays within the bound of the window it was worked out on, 0 .. a_y
-// widened by the margin. (Given back, the swings' chance agreement over the 1.3 s mean took it up to
-// two margins beyond, roll the estimate held for seconds.)
+// widened by the margin. (Given back, the swings' chance agreement over the 1.3 s mean
+// took it up to two margins beyond, roll the estimate held for seconds.)
 TEST(Centripetal, StraightFlightInGustsGetsNothingGivenBack) {
     dcm::TurnMean turn = turn_at(18.0f);
     const float margin = kG * std::sin(dcm::kTurnBankMargin_deg * kDeg);
@@ -221,32 +235,12 @@ TEST(Centripetal, StraightFlightInGustsGetsNothingGivenBack) {
 // back), a 30 deg turn in turbulence gets its term's mean back once a_y's mean has moved
 // on to the bank (a mean held at level would keep the turn straight: 18 % short).
 TEST(Centripetal, ATurnAfterStraightFlightGetsItsMeanBack) {
-    const float bank = 30.0f, v = 18.0f;
-    const Turn t = coordinated_turn(bank, v);
-    dcm::TurnMean turn = turn_at(v);
-    for (int window = 0; window < 50 * 20; ++window) {
-        const float swing_rad_s = 10.0f * kDeg * std::sin(2.0f * 3.14159265f * 0.5f * (float)window / 50.0f);
-        take_off(turn, imu(Vector3f(0.0f, 0.0f, swing_rad_s), Vector3f(0.0f, 0.0f, -kG)), 0.0f);
-    }
-    double sum_lateral = 0.0, sum_clipped = 0.0;
-    int n = 0;
-    for (int window = 0; window < 50 * 60; ++window) {
-        const float swing_rad_s = 10.0f * kDeg * std::sin(2.0f * 3.14159265f * 0.5f * (float)window / 50.0f);
-        const float lateral = -take_off(turn, imu(t.gyro_rad_s + Vector3f(0.0f, 0.0f, swing_rad_s), t.accel_m_s2), bank)
-                                   .accel_m_s2.y;
-        const float raw = (t.gyro_rad_s.z + swing_rad_s) * v;
-        const float bound = kG * std::sin(bank * kDeg) * (1.0f + dcm::kTurnBankScaleError) +
-                            kG * std::sin(dcm::kTurnBankMargin_deg * kDeg);
-        if (window >= 50 * 10) {
-            sum_lateral += lateral;
-            sum_clipped += std::min(raw, bound);
-            ++n;
-        }
-    }
-    const double turn_m_s2 = kG * std::sin(bank * kDeg);
-    const double short_clipped = turn_m_s2 - sum_clipped / n, short_term = turn_m_s2 - sum_lateral / n;
-    EXPECT_GT(short_clipped, 0.1 * turn_m_s2);
-    EXPECT_LT(short_term, 0.2 * short_clipped);
+    dcm::TurnMean turn = turn_at(18.0f);
+    for (int window = 0; window < 50 * 20; ++window)
+        take_off(turn, imu(Vector3f(0.0f, 0.0f, yaw_swing_rad_s(window)), Vector3f(0.0f, 0.0f, -kG)), 0.0f);
+    const Shortfall s = turn_through_swings(turn);
+    EXPECT_GT(s.clipped, 0.1 * s.turn);
+    EXPECT_LT(s.term, 0.2 * s.clipped);
 }
 
 TEST(Centripetal, OffBelowTheMinimumAirspeedAndWithoutOne) {
