@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Gravity.h"
 
-#include <math.h>
-
 namespace dcm {
 
 using linalg::Vector3l;

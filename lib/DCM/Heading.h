@@ -24,8 +24,8 @@ constexpr uint8_t kNorm2Shift = 4;
 constexpr uint8_t kEarthFieldShift = 2;
 
 // A field sample in the heading's integer form, uT * 2^kFieldQ in 16 bits: false for
-// NaN or an axis at or beyond kMaxField_uT (no compass reads that: garbage). Made once where a sample arrives: the range check, the DCM and the rest test
-// all take this form.
+// NaN or an axis at or beyond kMaxField_uT (no compass reads that: garbage). Made once
+// where a sample arrives: the range check, the DCM and the rest test all take this form.
 bool field_q5_of(const linalg::Vector3f& field_uT, linalg::Vector3i& field_q5);
 // Its squared strength in the sums' units (uT^2 * 2^(2 kFieldQ - kNorm2Shift)).
 uint32_t field_norm2(const linalg::Vector3i& field_q5);
