@@ -90,8 +90,16 @@ void Mpu6000Model::internal_sample(double t_s) {
     const Vector3f accel_body((float)s.accel_m_s2[0], (float)s.accel_m_s2[1], (float)s.accel_m_s2[2]);
     const Vector3f gyro_chip_dps = mpu6000::body_to_chip(gyro_body) * linalg::kDegPerRad;
     const Vector3f accel_chip_g = mpu6000::body_to_chip(accel_body) * (1.0f / mpu6000::kStandardGravity_m_s2);
-    const float gyro_in[3] = {gyro_chip_dps.x, gyro_chip_dps.y, gyro_chip_dps.z};
-    const float accel_in[3] = {accel_chip_g.x, accel_chip_g.y, accel_chip_g.z};
+    // The ADCs convert within the configured full scale and the DLPF filters what they
+    // converted (Product Specification 3.1/3.2: the low-pass is digital): a shock beyond
+    // the range is clipped before it is filtered.
+    const float gyro_fs_dps = 32768.0f / mpu6000::gyro_lsb_per_dps((mpu6000::GyroRange)(regs_[mpu6000::REG_GYRO_CONFIG] & 0x18));
+    const float accel_fs_g = 32768.0f / mpu6000::accel_lsb_per_g((mpu6000::AccelRange)(regs_[mpu6000::REG_ACCEL_CONFIG] & 0x18));
+    auto within = [](float v, float fs) { return v > fs ? fs : (v < -fs ? -fs : v); };
+    const float gyro_in[3] = {within(gyro_chip_dps.x, gyro_fs_dps), within(gyro_chip_dps.y, gyro_fs_dps),
+                              within(gyro_chip_dps.z, gyro_fs_dps)};
+    const float accel_in[3] = {within(accel_chip_g.x, accel_fs_g), within(accel_chip_g.y, accel_fs_g),
+                               within(accel_chip_g.z, accel_fs_g)};
 
     // First-order low-pass at the configured bandwidth, one step per internal sample.
     const uint8_t dlpf = regs_[mpu6000::REG_CONFIG] & 0x07;
