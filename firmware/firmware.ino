@@ -534,7 +534,7 @@ void setup() {
     board::set_leds(true, false, false);
     serial_text::begin();
     say(TXT("# apm25-attitude 0.2.0: APM 2.5, 200 Hz loop\n"
-            "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 8 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
+            "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 16 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     store.load(pipe.settings());
     flight_io.begin();  // the outputs from here on (the loaded settings' end points), the receiver
     airspeed_begin();

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "Motions.h"
+#include "Mpu6000.h"
 #include "Rotation.h"
 #include "Trajectory.h"
 
@@ -235,10 +236,10 @@ struct SensorErrors {
 constexpr double kGyroDensity_dps_sqrt_hz = 0.005;
 constexpr double kAccelDensity_g_sqrt_hz = 400e-6;
 constexpr double kMagFloor_uT = 0.2;
-// The firmware's ranges (lib/MPU6000 kGyroRange 2000 deg/s, kAccelRange 8 g; lib/HMC5883
+// The firmware's ranges (lib/MPU6000 kGyroRange 2000 deg/s, kAccelRange 16 g; lib/HMC5883
 // kGain 1.3 Ga): one count of each chip.
 constexpr double kGyroLsb_dps = 1.0 / 16.4;
-constexpr double kAccelLsb_m_s2 = kGravity_m_s2 / 4096.0;
+constexpr double kAccelLsb_m_s2 = (double)mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
 constexpr double kMagLsb_uT = 100.0 / 1090.0;
 
 // A realistic uncalibrated APM 2.5, each value well inside its datasheet tolerance:
@@ -280,7 +281,7 @@ const char* const kOptionsHelp =
     "                          (MPU6000 0.005 deg/s/sqrt(Hz), 400 ug/sqrt(Hz); HMC5883L 0.2 uT);\n"
     "  --noise default         the fixed amounts (0.03 deg/s, 0.025 m/s^2, 0.2 uT rms)\n"
     "  --quantise              round to one count of each chip at the firmware's ranges\n"
-    "                          (1/16.4 deg/s, 8 g / 32768, 1/1090 G)\n"
+    "                          (1/16.4 deg/s, 16 g / 32768, 1/1090 G)\n"
     "  --seed N                another noise sequence (default: the fixed one); for the\n"
     "                          seeded motions also another motion (0: the default one)\n"
     "  --preset uncalibrated   a realistic uncalibrated board: gyro bias (1.5,-1,0.8) deg/s\n"

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "Mpu6000.h"
 #include "Pipeline.h"
 #include "PipelineText.h"
 
@@ -15,9 +16,9 @@ const linalg::Vector3f kLevel(0.0f, 0.0f, -9.80665f);
 
 inline void append_to_string(void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }
 
-// The sample the MPU6000 gives for these values (counts of its 2000 deg/s and 8 g ranges).
+// The sample the MPU6000 gives for these values (counts of the driver's ranges).
 inline mpu6000::Sample imu(const linalg::Vector3f& gyro, const linalg::Vector3f& accel) {
-    return mpu6000::sample_from_si(gyro, accel, 25.0f);
+    return mpu6000::sample_from_si(gyro, accel, 25.0f, mpu6000::kGyroRange, mpu6000::kAccelRange);
 }
 
 // A pipeline and the text of its events. Its parts point at each other: not copied.

@@ -11,6 +11,7 @@
 
 #include "Airspeed.h"
 #include "Params.h"
+#include "Mpu6000.h"
 #include "Pipeline.h"
 
 namespace {
@@ -20,8 +21,12 @@ using linalg::Vector3i;
 
 constexpr float kG = 9.80665f;
 constexpr float kDeg = 3.14159265f / 180.0f;
+// 1 g in the counts of the driver's accelerometer range.
+const int16_t kGravityCounts = (int16_t)std::lround(kG / mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange));
 
-mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) { return mpu6000::sample_from_si(gyro, accel, 25.0f); }
+mpu6000::Sample imu(const Vector3f& gyro, const Vector3f& accel) {
+    return mpu6000::sample_from_si(gyro, accel, 25.0f, mpu6000::kGyroRange, mpu6000::kAccelRange);
+}
 
 // A level coordinated turn at this bank and airspeed: body rates and specific force.
 struct Turn {
@@ -53,7 +58,7 @@ Window take_off(dcm::TurnMean& turn, const mpu6000::Sample& s, float bank_deg, u
 }
 dcm::TurnMean turn_at(float airspeed_m_s) {
     dcm::TurnMean turn = dcm::TurnMean();
-    turn.configure(pipeline::centripetal_gain_q8(airspeed_m_s), (int16_t)std::lround(kG / (8.0f * kG / 32768.0f)));
+    turn.configure(pipeline::centripetal_gain_q8(airspeed_m_s), kGravityCounts);
     return turn;
 }
 
@@ -262,7 +267,7 @@ TEST(Centripetal, ExtremesHeldWithoutOverflow) {
     // z gains omega_y V, each at most the accelerometer's full scale a sample.
     for (const int32_t sign : {1, -1}) {
         dcm::TurnMean turn = dcm::TurnMean();
-        turn.configure(top, 4096);
+        turn.configure(top, kGravityCounts);
         const int32_t full = 5L * 32767L;
         linalg::Vector3l sum(0, sign * full, -full), sum_of_sums(0, sign * 3 * full, -3 * full);
         turn.take_off(-sign * full, sign * full, linalg::Vector3l(), 5, sum, sum_of_sums);
@@ -339,7 +344,7 @@ TEST(Centripetal, PipelineHoldsTheBankOfATurnThroughTurbulence) {
 // The speed's change (Pipeline.h, longitudinal_counts): dV/dt in accel counts between two
 // flying speeds read close in time, nothing else.
 TEST(Centripetal, TheAirspeedsChangeIsTheLongitudinalAcceleration) {
-    const float count_m_s2 = 8.0f * kG / 32768.0f;
+    const float count_m_s2 = mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
     // 18 -> 18.2 m/s over 8 steps (40 ms): 5 m/s^2.
     EXPECT_NEAR(pipeline::longitudinal_counts(18.0f, 18.2f, 8) * count_m_s2, 5.0f, 0.01f);
     EXPECT_NEAR(pipeline::longitudinal_counts(18.2f, 18.0f, 8) * count_m_s2, -5.0f, 0.01f);
@@ -363,7 +368,7 @@ TEST(Centripetal, TheAirspeedsChangeIsTheLongitudinalAcceleration) {
 // the term, held by a_x = f_x + g down_x, takes it off whole; a gust's change of airspeed
 // that the accelerometer does not feel (the path keeps its speed) is held to the margin.
 TEST(Centripetal, TheLongitudinalTermIsWhatTheAccelerometerFeels) {
-    const float count_m_s2 = 8.0f * kG / 32768.0f;
+    const float count_m_s2 = mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
     const int16_t one_m_s2 = (int16_t)std::lround(1.0f / count_m_s2);
     for (const bool felt : {true, false}) {
         dcm::TurnMean turn = dcm::TurnMean();

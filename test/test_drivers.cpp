@@ -91,7 +91,7 @@ TEST(Mpu6000Driver, BeginConfiguresAndReadsBack) {
     EXPECT_EQ(chip.reg[mpu6000::REG_SMPLRT_DIV], 4);   // 1 kHz / 5 = 200 Hz
     EXPECT_EQ(chip.reg[mpu6000::REG_CONFIG], 0x03);    // DLPF 42 Hz
     EXPECT_EQ(chip.reg[mpu6000::REG_GYRO_CONFIG], 0x18);
-    EXPECT_EQ(chip.reg[mpu6000::REG_ACCEL_CONFIG], 0x10);
+    EXPECT_EQ(chip.reg[mpu6000::REG_ACCEL_CONFIG], 0x18);  // +-16 g
     EXPECT_EQ(chip.reg[mpu6000::REG_INT_ENABLE], 0x01);
     EXPECT_EQ(chip.reg[mpu6000::REG_INT_PIN_CFG], 0x30);
     for (uint32_t hz : chip.write_clocks) EXPECT_LE(hz, 1000000u);  // writes at <= 1 MHz
@@ -130,8 +130,8 @@ TEST(Mpu6000Driver, BurstAt8MHzDecodesToBodyFrame) {
     FakeMpu chip;
     mpu6000::Mpu6000 mpu(chip.device());
     ASSERT_EQ(mpu.begin().status, mpu6000::InitStatus::Ok);
-    // Level, at rest: chip z reads +1 g (body z = -chip z = -1 g). Gyro chip x = 16.4 LSB = 1 deg/s.
-    chip.set_sample(0, 0, 4096, 0, 164, 0, -328);
+    // Level, at rest: chip z reads +1 g (2048 LSB at 16 g; body z = -chip z = -1 g). Gyro chip x = 16.4 LSB = 1 deg/s.
+    chip.set_sample(0, 0, 2048, 0, 164, 0, -328);
     EXPECT_TRUE(mpu.data_ready());
     EXPECT_FALSE(mpu.data_ready());  // cleared by the read
     mpu6000::Sample s{};
@@ -139,7 +139,7 @@ TEST(Mpu6000Driver, BurstAt8MHzDecodesToBodyFrame) {
     ASSERT_EQ(mpu.read(s, raw), mpu6000::BurstStatus::Ok);
     ASSERT_EQ(chip.burst_clocks.size(), 1u);
     EXPECT_EQ(chip.burst_clocks[0], 8000000u);
-    EXPECT_EQ(raw[4], 0x10);
+    EXPECT_EQ(raw[4], 0x08);
     EXPECT_NEAR(s.accel_m_s2().z, -9.80665f, 1e-3f);
     EXPECT_NEAR(s.accel_m_s2().x, 0.0f, 1e-6f);
     EXPECT_NEAR(s.gyro_rad_s().y, 10.0f * linalg::kRadPerDeg, 1e-4f);   // body y = chip x

@@ -128,9 +128,9 @@ TEST(Pipeline, StuckAccelIsNotGravityButGyroIsIntegrated) {
     std::string& log = logged.log;
     for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));  // past the start-up ramp
     log.clear();
-    // 1 s of accel stuck at full scale on every axis (a broken sensor, 14 g): it must
+    // 1 s of accel stuck at full scale on every axis (a broken sensor, 28 g): it must
     // not tilt the estimate.
-    const float fs = 8.0f * 9.80665f;
+    const float fs = 32767.0f * mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);  // full scale
     mpu6000::Sample clipped = imu(kBias, Vector3f(fs, fs, -fs));
     clipped.accel_saturated = true;
     for (int i = 0; i < 200; ++i) p.on_imu_sample(clipped);
@@ -168,21 +168,31 @@ TEST(Pipeline, AGyroAtFullScaleOnEveryAxisIsNotIntegrated) {
 
 TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
     // A shake that clips one axis for 40 ms at each swing: the clipped samples are
-    // used, so the shake averages out as it does unclipped (withholding the clipped
-    // half of each swing would leave the other half and tilt the estimate).
-    pipeline::AttitudePipeline p(nullptr);
-    for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));
-    const float fs = 8.0f * 9.80665f;
-    for (int cycle = 0; cycle < 20; ++cycle) {
-        for (int i = 0; i < 8; ++i) {  // 40 ms of +x clipped
-            mpu6000::Sample s = imu(kBias, Vector3f(fs, 0.0f, -9.80665f));
-            s.accel_saturated = true;
-            p.on_imu_sample(s);
+    // used as they are, so the estimate is the one the same samples give unflagged
+    // (withholding the clipped half of each swing would leave the other half: tens of
+    // degrees of tilt). The bound: a full-scale square shake's own error, the swing of the
+    // first-order low-pass (40 ms of +-fs against its 3 s: +-fs 0.04 / 6) that the
+    // estimate follows.
+    auto pitch_after_shake = [](bool flagged) {
+        pipeline::AttitudePipeline p(nullptr);
+        for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));
+        const float fs = 32767.0f * mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);  // full scale
+        for (int cycle = 0; cycle < 20; ++cycle) {
+            for (int i = 0; i < 8; ++i) {  // 40 ms of +x clipped
+                mpu6000::Sample s = imu(kBias, Vector3f(fs, 0.0f, -9.80665f));
+                s.accel_saturated = flagged;
+                p.on_imu_sample(s);
+            }
+            for (int i = 0; i < 8; ++i) p.on_imu_sample(imu(kBias, Vector3f(-fs + 0.5f, 0.0f, -9.80665f)));
         }
-        for (int i = 0; i < 8; ++i) p.on_imu_sample(imu(kBias, Vector3f(-fs + 0.5f, 0.0f, -9.80665f)));
-    }
-    for (int i = 0; i < 20; ++i) p.on_imu_sample(imu(kBias, kLevel));
-    EXPECT_LT(std::fabs(p.angles().pitch_deg), 1.0f);
+        for (int i = 0; i < 20; ++i) p.on_imu_sample(imu(kBias, kLevel));
+        return p.angles().pitch_deg;
+    };
+    const float clipped = pitch_after_shake(true);
+    EXPECT_NEAR(clipped, pitch_after_shake(false), 0.01f);
+    const float fs = 32767.0f * mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
+    const float swing_deg = std::atan(fs * 0.04f / 6.0f / 9.80665f) / linalg::kRadPerDeg;
+    EXPECT_LT(std::fabs(clipped), swing_deg);
 }
 
 TEST(Pipeline, MagCalibrationCommand) {
@@ -305,11 +315,12 @@ TEST(RateLimiter, HeldSaturationWarningsAreTold) {
     for (int i = 0; i < 300; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     log.clear();
     // Accel clipped on one axis for five samples (a shake: the rise over a few samples is
-    // no spike), twice 1 s apart.
-    const float rise_g[] = {3.0f, 5.0f, 7.0f, 9.0f, 9.0f, 9.0f, 9.0f, 9.0f, 7.0f, 5.0f, 3.0f};
+    // no spike), twice 1 s apart: 2 g a sample to 17 g, beyond the 16 g full scale.
+    const float rise_g[] = {3.0f,  5.0f,  7.0f,  9.0f,  11.0f, 13.0f, 15.0f, 17.0f, 17.0f, 17.0f,
+                            17.0f, 17.0f, 15.0f, 13.0f, 11.0f, 9.0f,  7.0f,  5.0f,  3.0f};
     for (int burst = 0; burst < 2; ++burst) {
         for (const float g : rise_g) p.on_imu_sample(imu(Vector3f(), kLevel * g));
-        for (int i = 0; i < 189; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
+        for (int i = 0; i < 200 - (int)(sizeof rise_g / sizeof rise_g[0]); ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     }
     for (int i = 0; i < 2 * 200; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
     EXPECT_EQ(count_of(log, "# warn: MPU6000 accel saturated"), 2) << log;

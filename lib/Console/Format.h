@@ -7,7 +7,7 @@
 //   quat:  "qw:0.7071 qx:0.0000 qy:0.7071 qz:0.0000\n"   (body -> earth, scalar first)
 //   raw:   "gx:0.12 gy:-0.06 gz:0.00 ax:0.012 ay:-0.003 az:-1.001 mx:20.1 my:0.3 mz:45.2\n"
 //          calibrated: gyro deg/s (2 decimals: one LSB at 2000 deg/s is 0.06), accel g
-//          (3 decimals: one LSB at 8 g is 0.00024 g), field uT (1 decimal: one LSB at
+//          (3 decimals: one LSB at 16 g is 0.0005 g), field uT (1 decimal: one LSB at
 //          1.3 Ga is 0.09 uT); body axes x forward, y right, z down
 //
 // Angles are rounded to the nearest hundredth (half away from zero); a heading that
@@ -49,8 +49,8 @@ uint8_t format_quat_line(char buf[kLineMax], const linalg::Quaternion& q);
 // Longest raw line: nine fields at their bounds below, eight spaces and the '\n'.
 constexpr uint8_t kRawLineMax = 104;
 // Returns the length including the '\n', or 0 if a value is not finite or beyond what
-// the sensors can report, with margin: 9999 deg/s and 40 g (5x the configured 2000 deg/s
-// and 8 g), 999.9 uT (the HMC5883L's widest range is 8.1 Ga = 810 uT). Beyond is a
+// the sensors can report, with margin: 9999 deg/s and 40 g (5x the configured 2000 deg/s,
+// 2.5x the 16 g), 999.9 uT (the HMC5883L's widest range is 8.1 Ga = 810 uT). Beyond is a
 // decoding bug, never a reading. Longest line: 99 characters.
 uint8_t format_raw_line(char buf[kRawLineMax], const linalg::Vector3f& gyro_dps, const linalg::Vector3f& accel_g,
                         const linalg::Vector3f& field_uT);

@@ -114,9 +114,9 @@ FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r
                                      const DcmSettings& settings, const DcmCoefficients& k, GyroBias& bias) {
     using linalg::mul_q30;
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). |lp|^2 / 2^30
-    // in integers (a thousandth of its value at least: 1 g is 2^20 units at 8 g full
+    // in integers (a 256th of its value at least: 1 g is 2^19 units at 16 g full
     // scale), 2^15 / |lp| a Q19 factor from the integer inverse square root (to 1e-4:
-    // the gain's error, far below lp2's own thousandth), the rest in Q30.
+    // the gain's error, far below lp2's own 256th), the rest in Q30.
     const Vector3l& lp = lp_ef_;
     const uint32_t lp2 = (uint32_t)mul_q30(lp.x, lp.x) + (uint32_t)mul_q30(lp.y, lp.y) + (uint32_t)mul_q30(lp.z, lp.z);
     if (lp2 <= k.min_lp2) {  // |lp| < g/2: no direction to trust

@@ -10,8 +10,10 @@
 //                         also do, but costs 8.3 ms of group delay against 4.8 ms: one step)
 //   +-2000 deg/s          a hand-thrown or crashing board exceeds 1000 deg/s; 16.4 LSB/(deg/s)
 //                         still resolves 0.06 deg/s, far below the drift the DCM corrects
-//   +-8 g                 shocks and vibration of a vehicle pass 4 g; clipping would fake
-//                         the gravity direction. 4096 LSB/g = 0.24 mg resolution is ample.
+//   +-16 g                shocks pass 8 g (a hand's stroke, a tap, a landing); a clipped
+//                         sample is a rectified error that the gravity low-pass keeps as
+//                         tilt (ArduPilot sets 16 g too). 2048 LSB/g = 0.5 mg, a fifth of
+//                         the noise in the 42 Hz band (400 ug/sqrt(Hz), Product Spec 6.2).
 //   INT latched, cleared on any read (INT_PIN_CFG 0x30): the data-ready pin stays high
 //                         until the burst read, so polling it cannot miss a 50 us pulse.
 // Register writes at 1 MHz (datasheet limit for writes), sensor reads at 8 MHz.
@@ -41,7 +43,7 @@ constexpr uint32_t kReadClockHz = 8000000;
 constexpr uint16_t kRateHz = 200;
 constexpr Dlpf kDlpf = Dlpf::Hz42;
 constexpr GyroRange kGyroRange = GyroRange::Dps2000;
-constexpr AccelRange kAccelRange = AccelRange::G8;
+constexpr AccelRange kAccelRange = AccelRange::G16;
 constexpr uint8_t kIntPinCfgLatchClearOnRead = 0x30;  // LATCH_INT_EN | INT_RD_CLEAR
 constexpr uint16_t kResetWaitMs = 100;
 

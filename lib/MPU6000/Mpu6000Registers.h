@@ -117,8 +117,7 @@ constexpr float accel_m_s2_per_count(AccelRange range) {
 // The sample the sensor would give for these SI values (rounded to counts, clipped
 // at full scale, saturation flagged): a host test's or a model's input.
 Sample sample_from_si(const linalg::Vector3f& gyro_rad_s, const linalg::Vector3f& accel_m_s2,
-                      float temperature_c, GyroRange gyro_range = GyroRange::Dps2000,
-                      AccelRange accel_range = AccelRange::G8);
+                      float temperature_c, GyroRange gyro_range, AccelRange accel_range);
 
 // Decodes one 14-byte burst read from ACCEL_XOUT_H, in the configured ranges.
 // On NoSensor `out` is left untouched.

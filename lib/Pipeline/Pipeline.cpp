@@ -102,7 +102,7 @@ AttitudePipeline::AttitudePipeline(const EventSink* events, const dcm::DcmSettin
 
 AttitudePipeline::AttitudePipeline(const EventSink* events, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
     : events_(events), settings_(), dcm_(dcm_settings), st_(), start_gravity_() {
-    last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f);
+    last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f, mpu6000::kGyroRange, mpu6000::kAccelRange);
 }
 
 void AttitudePipeline::tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const {
@@ -339,7 +339,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // motion one axis clips for a few ms, and dropping those samples would bias the
     // estimator's low-passed gravity (BROAD's 10 g fast translation: 1.7 -> 5.2 deg
     // RMSE; its clipped samples never have two axes clipped at once). Two or more
-    // axes at full scale (at least 11 g) is not a motion but a stuck or broken sensor,
+    // axes at full scale (at least 22 g) is not a motion but a stuck or broken sensor,
     // and so is one axis clipped for longer than kAccelSaturationFaultSteps: then the
     // DCM is told the accel is not valid and gives gravity no weight that step
     // (Dcm::update). The gyro is integrated (saturated, it is a lower bound of the rate)

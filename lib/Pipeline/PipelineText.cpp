@@ -72,7 +72,7 @@ void write_event(void* out, const pipeline::AttitudePipeline& pipe, const pipeli
             const bool gyro = e.kind == EventKind::kGyroSaturated;
             w.str(TXT(TXT_WARN TXT_MPU)).str(gyro ? TXT(" gyro saturated") : TXT(" accel saturated"));
             if (e.count != 0) w.str(TXT(": ")).u32(e.count).str(TXT(" more samples"));
-            else w.str(gyro ? TXT(" (beyond 2000 deg/s)") : TXT(" (beyond 8 g)"));
+            else w.str(gyro ? TXT(" (beyond 2000 deg/s)") : TXT(" (beyond 16 g)"));
             break;
         }
         case EventKind::kMagNotEarth:
