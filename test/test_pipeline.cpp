@@ -195,6 +195,24 @@ TEST(Pipeline, BriefOneAxisClippingInAShakeIsStillUsed) {
     EXPECT_LT(std::fabs(clipped), swing_deg);
 }
 
+// A strong vibration whose peaks are one-sided (a fundamental and its second harmonic:
+// +20 / -60 m/s^2 at 30 Hz, jumping by several g a sample): every sample is used, so it
+// averages out (standing in for the samples that jump beyond 4 g, as a spike rule on the
+// accel did, kept its +20 side: 30 deg of tilt).
+TEST(Pipeline, StrongOneSidedVibrationAveragesOut) {
+    pipeline::AttitudePipeline p(nullptr);
+    for (int i = 0; i < 1200; ++i) p.on_imu_sample(imu(kBias, kLevel));
+    const float w = 2.0f * 3.14159265f * 30.0f;
+    for (int i = 0; i < 20 * 200; ++i) {
+        const float t = (float)i * 0.005f;
+        const float ax = 40.0f * (std::sin(w * t) + 0.5f * std::cos(2.0f * w * t));
+        p.on_imu_sample(imu(kBias, Vector3f(ax, 0.0f, -9.80665f)));
+    }
+    EXPECT_EQ(p.spikes(), 0u);
+    EXPECT_LT(std::fabs(p.angles().pitch_deg), 1.0f);
+    EXPECT_LT(std::fabs(p.angles().roll_deg), 1.0f);
+}
+
 TEST(Pipeline, MagCalibrationCommand) {
     LoggedPipeline logged;
     pipeline::AttitudePipeline& p = logged.p;

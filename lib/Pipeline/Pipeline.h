@@ -79,8 +79,6 @@ constexpr uint16_t kStartupDeadlineSteps = 260; // 1.3 s: the first line must be
 constexpr uint16_t kGyroCalTimeoutSteps = 2000; // `cal gyro` gives up after 10 s without a still second
 constexpr uint16_t kWarnIntervalSteps = 400;    // rate limit of each warning kind: 2 s
 constexpr float kSpikeGyroJump_rad_s = 17.45f;  // 1000 deg/s in one 5 ms step: not a rotation
-constexpr float kSpikeAccel_g = 4.0f;           // |a| above this right after a normal sample
-constexpr float kNormalAccel_g = 2.0f;
 constexpr uint8_t kMaxSpikeRun = 10;            // up to 50 ms of glitch; longer is real (a crash): use it
 constexpr uint8_t kAccelSaturationFaultSteps = 20;  // 100 ms of clipped accel: a stuck sensor, not a motion
 constexpr float kMagMin_uT = 10.0f;             // Earth: 25..65 uT; outside 10..200 = not the Earth
