@@ -78,6 +78,23 @@ inline D3 step_at(const Step& s, double t_s) {
     return out;
 }
 
+// A step of the velocity instead (the same shape, delta in units per second): the
+// value is its integral, so a stop can be abrupt where the start was gentle.
+inline D3 velocity_step_at(const Step& s, double t_s) {
+    D3 out;
+    if (t_s <= s.t0_s) return out;
+    if (t_s >= s.t0_s + s.dur_s) {
+        out.v = s.delta * (s.dur_s / 2 + (t_s - s.t0_s - s.dur_s));
+        out.d1 = s.delta;
+        return out;
+    }
+    const double u = (t_s - s.t0_s) / s.dur_s, w = 2 * kPi * u;
+    out.v = s.delta * s.dur_s * (u * u / 2 + (std::cos(w) - 1.0) / (4 * kPi * kPi));
+    out.d1 = s.delta * (u - std::sin(w) / (2 * kPi));
+    out.d2 = s.delta / s.dur_s * (1.0 - std::cos(w));
+    return out;
+}
+
 struct Wave {
     double on_s, off_s, ramp_s, amp, freq_hz, phase_rad;
 };
@@ -98,11 +115,13 @@ inline D3 wave_at(const Wave& w, double t_s) {
 struct Track {
     double base = 0.0;
     std::vector<Step> steps;
+    std::vector<Step> velocity_steps;
     std::vector<Wave> waves;
     D3 at(double t_s) const {
         D3 out;
         out.v = base;
         for (const Step& s : steps) out += step_at(s, t_s);
+        for (const Step& s : velocity_steps) out += velocity_step_at(s, t_s);
         for (const Wave& w : waves) out += wave_at(w, t_s);
         return out;
     }
@@ -208,7 +227,7 @@ inline void accel_ned(const Plan& p, double t_s, double a[3]) {
 // ---------------------------------------------------------------------------
 // The motions. Each draws its random parts from r; the ranges are in the comments.
 
-enum Kind { kNone = 0, kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping };
+enum Kind { kNone = 0, kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping, kKnocking };
 
 // Small hand wobble on every angle, from kStill_s - 0.5 to end_s.
 inline void add_wobble(Plan& p, Random& r, double amp_lo_deg, double amp_hi_deg, double f_lo, double f_hi) {
@@ -377,18 +396,24 @@ inline Plan car(Random& r) {
 }
 
 // Held still in a hand (tremor 0.1-0.3 deg at 3-8 Hz, 0.05-0.2 m/s^2 at 6-10 Hz, a slow
-// drift of 1-3 deg) and tapped every 1-3 s: a there-and-back displacement of 8-12 ms
-// peaking at 20-50 m/s^2, along the board's z (60 %) or x or y, with a 0.1-0.5 deg jolt.
-inline Plan tapping(Random& r) {
+// drift of 1-3 deg) and tapped every 1-3 s along the board's z (60 %) or x or y, with a
+// 0.1-0.5 deg jolt. A tap (knock false): a there-and-back displacement of 8-12 ms peaking
+// at 20-50 m/s^2, its push and pull alike. A knock (knock true): the board brought to
+// the same surface every time (one axis and side for the file) at 0.25-0.9 m/s over
+// 0.1-0.2 s and stopped by it in 8-12 ms, 60-150 m/s^2 one way only (beyond an 8 g
+// range), then lifted back over 0.3 s.
+inline Plan tapping(Random& r, bool knock) {
     Plan p;
     const double yaw_deg = r.between(0, 360);
     p.angle_deg[2].base = yaw_deg;
     const double length_s = r.between(60, 120);
     double t = kStill_s + 1.0;
     std::vector<Step> taps[3], jolts[3];
+    // A knock's surface is the same every time: its axis and side drawn once.
+    const double knock_pick = knock ? r.uniform() : 0.0, knock_sign = knock ? r.sign() : 0.0;
     while (t < length_s) {
         t += r.between(1, 3);
-        const double pick = r.uniform(), sign = r.sign();
+        const double pick = knock ? knock_pick : r.uniform(), sign = knock ? knock_sign : r.sign();
         const int axis = pick < 0.6 ? 2 : (pick < 0.8 ? 0 : 1);
         double dir[3] = {0, 0, 0};
         if (axis == 2) {
@@ -398,11 +423,24 @@ inline Plan tapping(Random& r) {
             dir[0] = sign * std::cos(a);
             dir[1] = sign * std::sin(a);
         }
-        const double peak = r.between(20, 50), half_s = r.between(0.008, 0.012) / 2;
-        const double there_m = peak * half_s * half_s / (2 * kPi);
-        for (int i = 0; i < 3; ++i) {
-            p.hand_m[i].steps.push_back(Step{t, half_s, there_m * dir[i]});
-            p.hand_m[i].steps.push_back(Step{t + half_s, half_s, -there_m * dir[i]});
+        if (knock) {
+            // The stop's peak is 2 v / its length (velocity_step_at's d2 at mid-way).
+            const double peak = r.between(60, 150), stop_s = r.between(0.008, 0.012);
+            const double speed = peak * stop_s / 2, approach_s = r.between(0.1, 0.2);
+            const double travel_m = speed * (approach_s + stop_s) / 2;
+            const double start_s = t - approach_s;
+            for (int i = 0; i < 3; ++i) {
+                p.hand_m[i].velocity_steps.push_back(Step{start_s, approach_s, speed * dir[i]});
+                p.hand_m[i].velocity_steps.push_back(Step{t, stop_s, -speed * dir[i]});
+                p.hand_m[i].steps.push_back(Step{t + stop_s + 0.1, 0.3, -travel_m * dir[i]});
+            }
+        } else {
+            const double peak = r.between(20, 50), half_s = r.between(0.008, 0.012) / 2;
+            const double there_m = peak * half_s * half_s / (2 * kPi);
+            for (int i = 0; i < 3; ++i) {
+                p.hand_m[i].steps.push_back(Step{t, half_s, there_m * dir[i]});
+                p.hand_m[i].steps.push_back(Step{t + half_s, half_s, -there_m * dir[i]});
+            }
         }
         const int jolt_axis = (int)(r.uniform() * 3) % 3;
         const double jolt_deg = r.sign() * r.between(0.1, 0.5);
@@ -433,7 +471,8 @@ inline Plan make_plan(Kind kind, uint64_t seed) {
         case kWalk: return walk(r);
         case kPendulum: return pendulum(r);
         case kCar: return car(r);
-        case kTapping: return tapping(r);
+        case kTapping: return tapping(r, false);
+        case kKnocking: return tapping(r, true);
         default: return Plan{};
     }
 }

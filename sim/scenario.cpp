@@ -4,9 +4,10 @@
 //   build/scenario NAME [--seconds S] [--rate HZ] [sensor-error options]   CSV on stdout
 //   build/scenario --list                             names, descriptions and the options
 //
-// The seeded motions (translate_slow, translate_fast, walk, pendulum, car, tapping; see
-// Motions.h) also move the board: specific force = R^T ((0, 0, -g) + a) with a the
-// analytic second derivative of the motion; their random parts come from --seed.
+// The seeded motions (translate_slow, translate_fast, walk, pendulum, car, tapping,
+// knocking; see Motions.h) also move the board: specific force = R^T ((0, 0, -g) + a)
+// with a the analytic second derivative of the motion; their random parts come from
+// --seed.
 //
 // Physically consistent: each scenario is an analytic attitude q(t) (body -> earth, NED,
 // built as Rz(yaw) Ry(pitch) Rx(roll) from smooth keyframed angles, any angle range);
@@ -172,6 +173,7 @@ std::vector<Scenario> scenarios() {
          sim::motion::kCar},
         {"tapping", "seeded: held in a shaking hand, tapped (20-50 m/s^2, 10 ms) every 1-3 s",
          sim::motion::kTapping},
+        {"knocking", "seeded: the same, knocked on a surface (60-150 m/s^2 stops, 10 ms) every 1-3 s", sim::motion::kKnocking},
     };
     for (const auto& m : motions) {
         const double end_s = sim::motion::make_plan(m.kind, 0).end_s;

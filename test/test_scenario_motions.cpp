@@ -13,7 +13,7 @@ namespace {
 
 using namespace sim::motion;
 
-const Kind kKinds[] = {kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping};
+const Kind kKinds[] = {kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping, kKnocking};
 const uint64_t kSeeds[] = {0, 1, 2, 3};
 
 // The velocity (NED, m/s), written from the plan's parts independently of accel_ned:
@@ -132,6 +132,10 @@ TEST(ScenarioMotions, AccelerationsInTheirStatedRanges) {
         const double tap = peak_accel(make_plan(kTapping, seed), 0.0001);
         EXPECT_GE(tap, 20.0);
         EXPECT_LE(tap, 50.5);
+        // Knocks of 60-150 m/s^2: the same taps, harder.
+        const double knock = peak_accel(make_plan(kKnocking, seed), 0.0001);
+        EXPECT_GE(knock, 60.0);
+        EXPECT_LE(knock, 151.0);
     }
 }
 

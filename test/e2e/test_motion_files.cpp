@@ -16,7 +16,7 @@ namespace {
 using e2e::run_command;
 using e2e::tool;
 
-const char* const kMotions[] = {"translate_slow", "translate_fast", "walk", "pendulum", "car", "tapping"};
+const char* const kMotions[] = {"translate_slow", "translate_fast", "walk", "pendulum", "car", "tapping", "knocking"};
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kGravity_m_s2 = 9.80665;
 
