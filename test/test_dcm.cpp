@@ -449,3 +449,17 @@ TEST(Dcm, BrokenAccelSamplesEndTheRest) {
         }
     }
 }
+
+// The start-up ramp's clock saturates: a board at rest holds its bias integrator only
+// during the ramp, not again when 16 bits of steps (327 s) have passed.
+TEST(Dcm, TheStartUpRampRunsOnceNotAgainAfter65536Steps) {
+    dcm::Dcm filter;
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), mag_for(Matrix3f::identity())));
+    const int ramp_steps = (int)(filter.settings().startup_s / filter.settings().step_s);
+    int held_after_ramp = 0;
+    for (int i = 0; i < 70000; ++i) {
+        filter.update(Vector3f(), accel_for(Matrix3f::identity()));
+        if (i > ramp_steps + 10 && (filter.status() & dcm::kStatusBiasHeld)) ++held_after_ramp;
+    }
+    EXPECT_EQ(held_after_ramp, 0);
+}
