@@ -463,3 +463,21 @@ TEST(Dcm, TheStartUpRampRunsOnceNotAgainAfter65536Steps) {
     }
     EXPECT_EQ(held_after_ramp, 0);
 }
+
+// A restart (init: a rebuild after an outage or a broken matrix) forgets the field
+// samples of the heading's unfinished mean: they were taken against the old attitude.
+TEST(Dcm, InitForgetsTheUnfinishedFieldMean) {
+    dcm::Dcm filter;
+    const Matrix3f level = Matrix3f::identity();
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    // Samples of a field turned by 90 deg, short of a whole mean (no step between).
+    for (int i = 0; i < 5; ++i) filter.correct_heading(mag_for(dcm::dcm_from_euler(0, 0, 1.5708f)));
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    float worst_deg = 0.0f;
+    for (int i = 0; i < 200; ++i) {
+        if (i % 3 == 0) filter.correct_heading(mag_for(level));
+        filter.update(Vector3f(), accel_for(level));
+        worst_deg = std::fmax(worst_deg, angle_between_deg(level, filter.matrix()));
+    }
+    EXPECT_LT(worst_deg, 0.1f);
+}

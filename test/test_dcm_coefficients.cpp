@@ -85,3 +85,12 @@ TEST(DcmCoefficients, TheCoarseTurnIsTheQ15FactorsProduct) {
 }
 
 }  // namespace
+
+// The rest means' low-pass factor per correction, dt / (tau + dt), rounded to Q14.
+TEST(DcmCoefficients, RestMeansLowPassFactorRoundedToQ14) {
+    const dcm::DcmSettings& s = dcm::kDefaultDcmSettings;
+    const dcm::DcmCoefficients k = board_coefficients(s);
+    const float dt = dcm::correction_dt_s(s);
+    const float alpha = dt / (dcm::kRestMeanTau_s + dt);
+    EXPECT_EQ(k.rest_alpha_q14, (int16_t)std::lround(16384.0f * alpha));
+}
