@@ -108,6 +108,26 @@ TEST(DcmExact, AFineTurnIsCarriedToQ25UpToItsLimit) {
     }
 }
 
+// At the gimbal lock (pitch +-90 deg) the carried yaw comes from R12 and R22: a turn
+// about the body's x axis, vertical there, is all heading, and the carry gives the yaw of
+// R (I + [theta x]) to first order, as it does away from the lock.
+TEST(DcmExact, ATurnIsCarriedAtTheGimbalLockToo) {
+    for (const float pitch_deg : {90.0f, -90.0f}) {
+        for (const float yaw_deg : {30.0f, -120.0f}) {
+            const Matrix3f r = dcm::dcm_from_euler(0.0f, pitch_deg * linalg::kRadPerDeg, yaw_deg * linalg::kRadPerDeg);
+            for (const float turn_rad : {0.01f, -0.02f}) {
+                const int32_t theta_q26 = (int32_t)std::lround(turn_rad * 67108864.0f);
+                const Matrix3f turned = r * dcm::dcm_from_euler(turn_rad, 0.0f, 0.0f);
+                const float expected_yaw = dcm::euler_from_dcm(turned).yaw_rad;
+                const dcm::EulerQ24 e = dcm::euler_carried_q24(r, theta_q26, 0, 0);
+                const float yaw = (float)e.yaw_q24 / 16777216.0f;
+                EXPECT_NEAR(wrap_deg((yaw - expected_yaw) * linalg::kDegPerRad), 0.0f, 0.01f)
+                    << pitch_deg << " " << yaw_deg << " " << turn_rad;
+            }
+        }
+    }
+}
+
 namespace {
 
 // One gravity window of `n` samples (counts) through low_pass_window, the low-pass set to
