@@ -481,3 +481,57 @@ TEST(Dcm, InitForgetsTheUnfinishedFieldMean) {
     }
     EXPECT_LT(worst_deg, 0.1f);
 }
+
+// While the board moves during the start, the heading is the mean of the compass's means
+// since the start (gain 1/t): means whose errors alternate +-5 deg (the tilt errors of
+// a motion, through the dip) leave it near their mean, where the start's 5/s gain
+// followed each one 40 % of the way.
+TEST(Dcm, TheStartsHeadingIsTheMeanOfTheCompassWhileMoving) {
+    dcm::Dcm filter;
+    const Matrix3f level = Matrix3f::identity();
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    const float dt = filter.settings().step_s;
+    const float rate_rad_s = 10.0f * linalg::kRadPerDeg;  // turning: no rest
+    const int mean_steps = dcm::kHeadingSteps;
+    float yaw_rad = 0.0f, worst_late_deg = 0.0f;
+    const int start_steps = (int)(filter.settings().startup_s / dt);
+    for (int i = 0; i < start_steps; ++i) {
+        yaw_rad += rate_rad_s * dt;
+        const float error_rad = ((i / mean_steps) % 2 == 0 ? 5.0f : -5.0f) * linalg::kRadPerDeg;
+        if (i % 3 == 0) filter.correct_heading(mag_for(dcm::dcm_from_euler(0, 0, yaw_rad + error_rad)));
+        filter.update(Vector3f(0, 0, rate_rad_s), accel_for(level));
+        ASSERT_FALSE(filter.status() & dcm::kStatusAtRest);
+        if (i > start_steps / 2)
+            worst_late_deg = std::fmax(worst_late_deg, std::fabs(wrap_deg((filter.euler().yaw_rad - yaw_rad) * linalg::kDegPerRad)));
+    }
+    EXPECT_LT(worst_late_deg, 0.5f);  // the 5/s gain: 1.2 deg
+}
+
+// A move of the compass's calibration during the start (a learned offset) begins the
+// mean again: the heading follows the newly calibrated field at the start's gain
+// instead of the mean's 1/t of 2 s.
+TEST(Dcm, ACalibrationMoveBeginsTheStartsMeanAgain) {
+    for (const bool restart : {false, true}) {
+        dcm::Dcm filter;
+        const Matrix3f level = Matrix3f::identity();
+        ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+        const float dt = filter.settings().step_s;
+        const float rate_rad_s = 10.0f * linalg::kRadPerDeg;
+        const float shift_rad = 10.0f * linalg::kRadPerDeg;  // the new calibration's north
+        float yaw_rad = 0.0f;
+        for (int i = 0; i < 500; ++i) {  // 2.5 s of the 3 s start
+            yaw_rad += rate_rad_s * dt;
+            if (i == 400 && restart) filter.restart_heading_mean();
+            const float seen_rad = yaw_rad + (i >= 400 ? shift_rad : 0.0f);
+            if (i % 3 == 0) filter.correct_heading(mag_for(dcm::dcm_from_euler(0, 0, seen_rad)));
+            filter.update(Vector3f(0, 0, rate_rad_s), accel_for(level));
+        }
+        // How far the heading went toward the shifted field in 0.5 s.
+        const float followed = wrap_deg((filter.euler().yaw_rad - yaw_rad) * linalg::kDegPerRad) / 10.0f;
+        if (restart) {
+            EXPECT_GT(followed, 0.7f);
+        } else {
+            EXPECT_LT(followed, 0.5f);
+        }
+    }
+}

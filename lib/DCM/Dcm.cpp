@@ -119,6 +119,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     field_mean_.clear();
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
+    heading_mean_from_ = 0;
     status_ |= kStatusInitialised;
     return true;
 }
@@ -475,11 +476,24 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
     const float steps = (float)interval_steps;
     const bool starting = steps_ < k_.startup_steps;
+    // At start, while the board moves, the heading is a constant to find from means that
+    // each carry their moment's tilt error through the dip: the mean of them all since the
+    // start (or since the compass's calibration last moved) is its least-squares estimate,
+    // the gain 1/t (VQF's kMagInit), within the start's kp_startup and the steady kp_yaw.
+    // At rest there is no motion's error to average out, and a gyro bias not yet learned
+    // would make a long mean lag: the start's gain.
+    float gain_1_s = settings_->kp_yaw_1_s;
+    if (starting) {
+        const float since_s = (float)(uint16_t)(steps_ - heading_mean_from_) * settings_->step_s;
+        float mean_gain_1_s = 1.0f / (since_s > sample_dt ? since_s : sample_dt);
+        if (mean_gain_1_s > settings_->kp_startup_1_s) mean_gain_1_s = settings_->kp_startup_1_s;
+        if (mean_gain_1_s > gain_1_s) gain_1_s = mean_gain_1_s;
+        if (status_ & kStatusAtRest) gain_1_s = settings_->kp_startup_1_s;
+    }
     // Into the turn not yet integrated (applied with the next integration): the row in
     // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
     // = 2.4e7 units: within 31 bits).
-    const int32_t size_units = linalg::fixed_from_float(
-        -heading_error * (starting ? settings_->kp_startup_1_s : settings_->kp_yaw_1_s) * steps * k_.units_per_rad_s, 0);
+    const int32_t size_units = linalg::fixed_from_float(-heading_error * gain_1_s * steps * k_.units_per_rad_s, 0);
     using linalg::q14_of;
     strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
                                  linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));

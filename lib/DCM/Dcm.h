@@ -143,7 +143,11 @@ public:
         // field was rejected, or the mean dropped), and one sample gives the new reference
         // and the heading's error at once, a whole mean (40 ms) sooner.
         field_mean_.restart_with_one_sample();
+        restart_heading_mean();
     }
+    // The compass's calibration moved (a learned offset): during the start the heading's
+    // mean begins again from the next sample (Dcm::correct_heading_from_mean).
+    void restart_heading_mean() { heading_mean_from_ = steps_; }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     // The last update turned the matrix or worked out the gravity correction (the
@@ -247,6 +251,7 @@ private:
     bool heavy_ = false;                 // the last update integrated or corrected gravity
     uint16_t steps_ = 0;                 // since init, saturated (the start-up ramp's clock)
     uint16_t steps_since_mag_ = 0;
+    uint16_t heading_mean_from_ = 0;     // the step the start's heading mean began at
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;

@@ -187,6 +187,7 @@ void AttitudePipeline::learn_mag_offset(bool one_piece) {
         learner_.add(learn_field_uT_, dcm_.gyro_turn_q30(learn_turn_counts_, st_.learn_steps), st_.learn_steps, learned);
     }
     if (learned == before) return;
+    dcm_.restart_heading_mean();
     linalg::Vector3i shifted;
     if (dcm::field_q5_of(field_uT() - (learned - before), shifted)) mag_cal_q5_ = shifted;
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
