@@ -323,7 +323,9 @@ TEST(Mpu6000Driver, FifoDeliversEverySampleInOrder) {
     for (int i = 0; i < 5; ++i) {
         ASSERT_EQ(mpu.read_fifo(s), mpu6000::BurstStatus::Ok);
         EXPECT_NEAR(s.accel_m_s2().z, -9.81f, 0.01f);
-        if (i > 0) EXPECT_GT(s.gyro_rad_s().z, prev.gyro_rad_s().z) << i;
+        if (i > 0) {
+            EXPECT_GT(s.gyro_rad_s().z, prev.gyro_rad_s().z) << i;
+        }
         prev = s;
     }
     EXPECT_EQ(mpu.fifo_samples(), 0u);

@@ -466,7 +466,9 @@ TEST(Mpu6000Model, FifoKeepsTheOrderOfChangingSamples) {
         mpu.read_registers(mpu6000::REG_FIFO_R_W, raw, sizeof raw);
         ASSERT_EQ(mpu6000::decode_burst(raw, mpu6000::GyroRange::Dps2000, mpu6000::AccelRange::G4, s),
                   mpu6000::BurstStatus::Ok);
-        if (i > 0) EXPECT_GT(s.gyro_rad_s().x, prev.gyro_rad_s().x) << i;
+        if (i > 0) {
+            EXPECT_GT(s.gyro_rad_s().x, prev.gyro_rad_s().x) << i;
+        }
         prev = s;
     }
 }

@@ -61,6 +61,14 @@ double Mpu6000Model::internal_rate_hz() const {
     return (dlpf == 0 || dlpf == 7) ? 8000.0 : 1000.0;
 }
 
+float Mpu6000Model::gyro_lsb_per_dps() const {
+    return mpu6000::gyro_lsb_per_dps((mpu6000::GyroRange)(regs_[mpu6000::REG_GYRO_CONFIG] & 0x18));
+}
+
+float Mpu6000Model::accel_lsb_per_g() const {
+    return mpu6000::accel_lsb_per_g((mpu6000::AccelRange)(regs_[mpu6000::REG_ACCEL_CONFIG] & 0x18));
+}
+
 void Mpu6000Model::advance_to(double t_s) {
     if (t_s < time_s_) return;
     while (next_internal_s_ <= t_s) {
@@ -93,8 +101,8 @@ void Mpu6000Model::internal_sample(double t_s) {
     // The ADCs convert within the configured full scale and the DLPF filters what they
     // converted (Product Specification 3.1/3.2: the low-pass is digital): a shock beyond
     // the range is clipped before it is filtered.
-    const float gyro_fs_dps = 32768.0f / mpu6000::gyro_lsb_per_dps((mpu6000::GyroRange)(regs_[mpu6000::REG_GYRO_CONFIG] & 0x18));
-    const float accel_fs_g = 32768.0f / mpu6000::accel_lsb_per_g((mpu6000::AccelRange)(regs_[mpu6000::REG_ACCEL_CONFIG] & 0x18));
+    const float gyro_fs_dps = 32768.0f / gyro_lsb_per_dps();
+    const float accel_fs_g = 32768.0f / accel_lsb_per_g();
     auto within = [](float v, float fs) { return v > fs ? fs : (v < -fs ? -fs : v); };
     const float gyro_in[3] = {within(gyro_chip_dps.x, gyro_fs_dps), within(gyro_chip_dps.y, gyro_fs_dps),
                               within(gyro_chip_dps.z, gyro_fs_dps)};
@@ -125,8 +133,8 @@ void Mpu6000Model::internal_sample(double t_s) {
 
 void Mpu6000Model::publish_sample(double t_s) {
     if (faults_.frozen.active(t_s)) return;
-    const float gyro_lsb = mpu6000::gyro_lsb_per_dps((mpu6000::GyroRange)(regs_[mpu6000::REG_GYRO_CONFIG] & 0x18));
-    const float accel_lsb = mpu6000::accel_lsb_per_g((mpu6000::AccelRange)(regs_[mpu6000::REG_ACCEL_CONFIG] & 0x18));
+    const float gyro_lsb = gyro_lsb_per_dps();
+    const float accel_lsb = accel_lsb_per_g();
     int16_t accel[3], gyro[3];
     for (int i = 0; i < 3; ++i) {
         accel[i] = linalg::saturate_int16(accel_g_filtered_[i] * accel_lsb);

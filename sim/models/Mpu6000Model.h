@@ -116,6 +116,9 @@ private:
     uint8_t read_register_for_spi(uint8_t reg);
     void write_register_from_spi(uint8_t reg, uint8_t value, double sck_hz);
     double internal_rate_hz() const;
+    // Counts per deg/s and per g of the configured ranges (GYRO_CONFIG, ACCEL_CONFIG).
+    float gyro_lsb_per_dps() const;
+    float accel_lsb_per_g() const;
     bool int_asserted() const;
 
     Trajectory trajectory_;
