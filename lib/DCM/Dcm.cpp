@@ -483,12 +483,13 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     // At rest there is no motion's error to average out, and a gyro bias not yet learned
     // would make a long mean lag: the start's gain.
     float gain_1_s = settings_->kp_yaw_1_s;
-    if (starting) {
+    if (starting && (status_ & kStatusAtRest)) {
+        gain_1_s = settings_->kp_startup_1_s;
+    } else if (starting) {
         const float since_s = (float)(uint16_t)(steps_ - heading_mean_from_) * settings_->step_s;
         float mean_gain_1_s = 1.0f / (since_s > sample_dt ? since_s : sample_dt);
         if (mean_gain_1_s > settings_->kp_startup_1_s) mean_gain_1_s = settings_->kp_startup_1_s;
         if (mean_gain_1_s > gain_1_s) gain_1_s = mean_gain_1_s;
-        if (status_ & kStatusAtRest) gain_1_s = settings_->kp_startup_1_s;
     }
     // Into the turn not yet integrated (applied with the next integration): the row in
     // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
