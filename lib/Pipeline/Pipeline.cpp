@@ -187,11 +187,18 @@ void AttitudePipeline::learn_mag_offset(bool one_piece) {
         learner_.add(learn_field_uT_, dcm_.gyro_turn_q30(learn_turn_counts_, st_.learn_steps), st_.learn_steps, learned);
     }
     if (learned == before) return;
-    dcm_.restart_heading_mean();
-    linalg::Vector3i shifted;
-    if (dcm::field_q5_of(field_uT() - (learned - before), shifted)) mag_cal_q5_ = shifted;
+    recalibrate_latest_field(field_uT() - (learned - before));
     if ((learned - learned_at_reference_uT_).length_squared() > kMagReferenceShift_uT * kMagReferenceShift_uT)
         forget_mag_reference(false);
+}
+
+// The compass calibration moved: the latest field (and a sample waiting for the
+// heading's correction) is taken in the new one, and the start's heading mean begins
+// again (its samples were calibrated the old way).
+void AttitudePipeline::recalibrate_latest_field(const Vector3f& field_uT) {
+    linalg::Vector3i q5;
+    if (dcm::field_q5_of(field_uT, q5)) mag_cal_q5_ = q5;
+    dcm_.restart_heading_mean();
 }
 
 // The DCM takes the next calibrated sample as the earth field (and, take_heading, its
@@ -499,10 +506,8 @@ void AttitudePipeline::finish_mag_calibration() {
     if (q == calib::MagCalibrator::Quality::Ok) {
         calib::Calibration& c = settings_.cal;
         mag_cal_.result(c);
-        // The latest field (and a sample waiting for the heading's correction) was
-        // calibrated the old way: the DCM takes the heading from the new one.
-        linalg::Vector3i recalibrated;
-        if (dcm::field_q5_of(calib::apply_mag(c, cal_field_uT_), recalibrated)) mag_cal_q5_ = recalibrated;
+        // The DCM takes the heading from the new calibration.
+        recalibrate_latest_field(calib::apply_mag(c, cal_field_uT_));
         settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
     }
     tell(EventKind::kMagCalDone, mag_cal_.coverage_pct(), mag_cal_.count(),

@@ -289,6 +289,7 @@ private:
     void take_learner_sample(const linalg::Vector3f& field_uT);
     void learn_mag_offset(bool one_piece);
     void forget_mag_reference(bool take_heading);
+    void recalibrate_latest_field(const linalg::Vector3f& field_uT);
 
     const EventSink* events_;
     settings::Settings settings_;
