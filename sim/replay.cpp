@@ -2,7 +2,7 @@
 // build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
 //
 //   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]
-//                [--airspeed M_S | --airspeed-log LOG.csv] [--trace FILE.csv]
+//                [--airspeed M_S | --airspeed-log LOG.csv] [--trace FILE.csv] [--samples FILE.csv]
 //
 // The same pipeline as the board, minus the AVR: the simulator's register models
 // (sim/models) answer the very drivers the firmware runs (lib/MPU6000, lib/HMC5883)
@@ -15,7 +15,8 @@
 // declination) at the firmware's output rate. --log sends the pipeline's "# " lines
 // (calibration, warnings) to stderr. --trace writes, per estimator step (200 Hz), the
 // error against the trajectory's truth and what each correction did (lib/DCM/Trace.h):
-// stdout is the same with or without it.
+// stdout is the same with or without it. --samples writes the estimator's input, decoded,
+// as a trajectory file (a peer on the same samples as ours).
 #include <cstdio>
 #include <cstdlib>
 #include <cmath>
@@ -65,7 +66,12 @@ void usage(FILE* out) {
             "               status bits and the matrix R as a quaternion (body to NED; the\n"
             "               errors are those of the printed angles, R carried forward) and\n"
             "               the accelerometer's sample as the step used it (m/s^2).\n"
-            "               stdout is unchanged.\n");
+            "               stdout is unchanged.\n"
+            "  --samples FILE.csv  the estimator's input as a trajectory file: per\n"
+            "               MPU6000 sample (200 Hz) the gyro and accelerometer as the\n"
+            "               driver decoded them, the latest compass read (uT, held; NaN\n"
+            "               before the first) and the truth at that time, so that a peer\n"
+            "               can run on what the firmware sees. stdout is unchanged.\n");
 }
 
 // The estimator's settings by name, for --set (DcmSettings in lib/DCM/Dcm.h).
@@ -289,6 +295,26 @@ private:
 
 }  // namespace
 
+// --samples: one trajectory row per MPU6000 sample as the drivers decoded it (gyro
+// rad/s and accel m/s^2 in body axes, the latest compass read in uT, held until the
+// next; NaN before the first), with the truth at that time: the estimator's own input,
+// for a peer to run on what the firmware sees (the sensor models' ranges, resolution,
+// low-pass and rates) instead of the recording as it is.
+void write_sample_row(FILE* out, double t_s, const mpu6000::Sample& sample, const sim::TrajectorySample& truth,
+                      sim::TrajectorySample& row) {
+    const linalg::Vector3f gyro = sample.gyro_rad_s(), accel = sample.accel_m_s2();
+    row.t_s = t_s;
+    row.gyro_rad_s[0] = gyro.x;
+    row.gyro_rad_s[1] = gyro.y;
+    row.gyro_rad_s[2] = gyro.z;
+    row.accel_m_s2[0] = accel.x;
+    row.accel_m_s2[1] = accel.y;
+    row.accel_m_s2[2] = accel.z;
+    for (int i = 0; i < 4; ++i) row.quat[i] = truth.quat[i];
+    row.movement = truth.movement;
+    fputs(sim::format_trajectory_row(row).c_str(), out);
+}
+
 // The state log's airspeed (sim/flight/flightio.py LOG_HEADER: t and airspeed_m_s
 // columns), as (t, airspeed) pairs; false with a message when unreadable.
 bool load_airspeed_log(const std::string& path, std::vector<std::pair<double, double>>& out) {
@@ -338,6 +364,7 @@ int main(int argc, char** argv) {
     double airspeed_m_s = 0.0;
     std::vector<std::pair<double, double>> airspeed_log;
     std::string trace_path;
+    std::string samples_path;
     dcm::DcmSettings dcm_settings = dcm::kDefaultDcmSettings;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -361,6 +388,8 @@ int main(int argc, char** argv) {
             if (!load_airspeed_log(argv[++i], airspeed_log)) return 1;
         } else if (a == "--trace" && i + 1 < argc) {
             trace_path = argv[++i];
+        } else if (a == "--samples" && i + 1 < argc) {
+            samples_path = argv[++i];
         } else if (a == "--log") {
             log = true;
         } else if (a == "--set" && i + 1 < argc) {
@@ -389,14 +418,22 @@ int main(int argc, char** argv) {
         return 2;
     }
     const double end_s = seconds > 0.0 ? seconds : trajectory.duration_s();
-    FILE* trace_file = nullptr;
-    if (!trace_path.empty()) {
-        trace_file = fopen(trace_path.c_str(), "w");
-        if (!trace_file) {
-            fprintf(stderr, "replay: cannot write %s\n", trace_path.c_str());
-            return 1;
+    // The optional outputs: none when not asked for; a file that cannot be written is an
+    // error before anything runs.
+    bool unwritable = false;
+    const auto open_output = [&unwritable](const std::string& out_path) -> FILE* {
+        if (out_path.empty()) return nullptr;
+        FILE* f = fopen(out_path.c_str(), "w");
+        if (!f) {
+            fprintf(stderr, "replay: cannot write %s\n", out_path.c_str());
+            unwritable = true;
         }
-    }
+        return f;
+    };
+    FILE* trace_file = open_output(trace_path);
+    FILE* samples_file = open_output(samples_path);
+    if (unwritable) return 1;
+    if (samples_file) fputs(sim::kTrajectoryHeader, samples_file);
 
     sim::Mpu6000Model mpu_model(trajectory);
     sim::Hmc5883Model mag_model(trajectory);
@@ -428,6 +465,8 @@ int main(int argc, char** argv) {
     printf("t,roll,pitch,yaw\n");
     uint32_t last_mag_read_step = 0;
     size_t airspeed_cursor = 0;
+    sim::TrajectorySample as_read{};  // --samples: the latest values as the drivers decoded them
+    for (double& m : as_read.mag_uT) m = NAN;
     while (board.t_s < end_s) {
         // Wait for the data-ready line, as the loop does.
         while (!mpu_model.int_pin_high() && board.t_s < end_s) board.advance(mpu_model.next_event_s());
@@ -440,9 +479,15 @@ int main(int argc, char** argv) {
         }
         if (mag_ok && mag_model.drdy_pin_high() && pipe.steps() - last_mag_read_step >= pipeline::kMagReadMinSteps) {
             linalg::Vector3f field_uT;
-            if (mag.read(field_uT) == hmc5883::ReadStatus::Ok) pipe.on_mag_sample(field_uT);
+            if (mag.read(field_uT) == hmc5883::ReadStatus::Ok) {
+                pipe.on_mag_sample(field_uT);
+                as_read.mag_uT[0] = field_uT.x;
+                as_read.mag_uT[1] = field_uT.y;
+                as_read.mag_uT[2] = field_uT.z;
+            }
             last_mag_read_step = pipe.steps();
         }
+        if (samples_file) write_sample_row(samples_file, board.t_s, sample, trajectory.at(board.t_s), as_read);
         if (pipe.steps() % 8u == 0u) {
             if (!airspeed_log.empty()) {
                 while (airspeed_cursor + 1 < airspeed_log.size() && airspeed_log[airspeed_cursor + 1].first <= board.t_s)
@@ -463,9 +508,9 @@ int main(int argc, char** argv) {
             print_centideg(a.heading_centideg, '\n');
         }
     }
-    if (trace_file && fclose(trace_file) != 0) {
-        fprintf(stderr, "replay: cannot write %s\n", trace_path.c_str());
-        return 1;
-    }
-    return 0;
+    const bool trace_lost = trace_file && fclose(trace_file) != 0;
+    if (trace_lost) fprintf(stderr, "replay: cannot write %s\n", trace_path.c_str());
+    const bool samples_lost = samples_file && fclose(samples_file) != 0;
+    if (samples_lost) fprintf(stderr, "replay: cannot write %s\n", samples_path.c_str());
+    return trace_lost || samples_lost ? 1 : 0;
 }

@@ -70,7 +70,9 @@ TEST(Replay, TraceWritesItsColumnsAndLeavesStdoutAlone) {
         for (std::istringstream l(line); std::getline(l, row, ',');) f.push_back(row);
         ASSERT_EQ(f.size(), names.size()) << line;
         const double t = std::stod(f[t_col]);
-        if (last_t >= 0.0) ASSERT_NEAR(t - last_t, 0.005, 1e-3) << "one row per 5 ms step: " << line;
+        if (last_t >= 0.0) {
+            ASSERT_NEAR(t - last_t, 0.005, 1e-3) << "one row per 5 ms step: " << line;
+        }
         last_t = t;
         ++rows;
         gravity_ran += f[gravity] == "ran";
@@ -104,6 +106,88 @@ TEST(Replay, TraceWritesItsColumnsAndLeavesStdoutAlone) {
 
     const e2e::CommandResult bad =
         e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --trace /nonexistent/dir/trace.csv");
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+}
+
+// One CSV row as numbers (a field that is not a number, "nan" aside, fails the test).
+std::vector<double> numbers_of(const std::string& line) {
+    std::vector<double> v;
+    std::string field;
+    for (std::istringstream l(line); std::getline(l, field, ',');) {
+        char* end = nullptr;
+        v.push_back(std::strtod(field.c_str(), &end));
+        EXPECT_TRUE(end && *end == '\0' && end != field.c_str()) << "not a number: " << field << " in " << line;
+    }
+    return v;
+}
+
+// --samples writes the estimator's input as a trajectory file: a row per 5 ms step, the
+// gyro and accelerometer as the MPU6000 driver decoded them, the compass as last read
+// (NaN before the first), the truth copied; stdout is left as it was. On a scenario of
+// ideal sensors the decoded values are the scenario's own, within what the chips' low-pass
+// (~5 ms of a slow tilt tour) and resolution change.
+TEST(Replay, SamplesAreTheEstimatorsInputAsATrajectory) {
+    E2E_REQUIRE_TOOLS("replay", "scenario");
+    const std::string csv = e2e::scenario_csv("tilt_tour", 20);
+    const std::string samples = e2e::work_dir() + "/samples." + std::to_string(getpid()) + ".csv";
+    const e2e::CommandResult plain = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
+    const e2e::CommandResult dumped =
+        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --samples " + samples);
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    ASSERT_EQ(dumped.exit_code, 0) << dumped.err;
+    EXPECT_GT(plain.out.size(), 1000u);
+    EXPECT_TRUE(plain.out == dumped.out) << "stdout differs with --samples";
+
+    // The scenario's rows (t, gyro, accel, field, quaternion, movement), by time.
+    std::vector<std::vector<double>> truth;
+    {
+        std::istringstream in(e2e::read_text(csv));
+        std::string line;
+        ASSERT_TRUE(std::getline(in, line));
+        while (std::getline(in, line)) truth.push_back(numbers_of(line));
+    }
+    ASSERT_GT(truth.size(), 1000u);
+    std::istringstream in(e2e::read_text(samples));
+    std::string line;
+    ASSERT_TRUE(std::getline(in, line));
+    EXPECT_EQ(line, "t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz,movement");
+    size_t rows = 0, with_field = 0, cursor = 0;
+    double last_t = -1.0, worst_gyro_deg_s = 0.0, worst_accel_m_s2 = 0.0, worst_field_uT = 0.0;
+    bool field_seen = false;
+    while (std::getline(in, line)) {
+        const std::vector<double> v = numbers_of(line);
+        ASSERT_EQ(v.size(), 15u) << line;
+        const double t = v[0];
+        if (last_t >= 0.0) {
+            ASSERT_NEAR(t - last_t, 0.005, 1e-4) << "one row per 5 ms sample: " << line;
+        }
+        last_t = t;
+        ++rows;
+        for (int i = 1; i <= 6; ++i) ASSERT_TRUE(std::isfinite(v[i])) << line;
+        const bool field = std::isfinite(v[7]) && std::isfinite(v[8]) && std::isfinite(v[9]);
+        if (field_seen) {
+            ASSERT_TRUE(field) << "the field is held once read: " << line;
+        }
+        field_seen = field_seen || field;
+        with_field += field;
+        while (cursor + 1 < truth.size() && truth[cursor + 1][0] <= t) ++cursor;
+        const std::vector<double>& s = truth[cursor];
+        for (int i = 10; i <= 14; ++i) ASSERT_EQ(v[i], s[i]) << "the truth at t is copied: " << line;
+        if (t < 1.0) continue;
+        for (int i = 1; i <= 3; ++i) worst_gyro_deg_s = std::max(worst_gyro_deg_s, std::fabs(v[i] - s[i]) * 57.29578);
+        for (int i = 4; i <= 6; ++i) worst_accel_m_s2 = std::max(worst_accel_m_s2, std::fabs(v[i] - s[i]));
+        for (int i = 7; i <= 9; ++i) worst_field_uT = std::max(worst_field_uT, std::fabs(v[i] - s[i]));
+    }
+    EXPECT_GT(rows, 3900u);  // 20 s at 200 Hz from the loop's start
+    EXPECT_GT(with_field, rows - 100u) << "the compass is read from the start";
+    EXPECT_LT(worst_gyro_deg_s, 1.0);
+    EXPECT_LT(worst_accel_m_s2, 0.2);
+    EXPECT_LT(worst_field_uT, 1.5);
+    std::remove(samples.c_str());
+
+    const e2e::CommandResult bad =
+        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --samples /nonexistent/dir/samples.csv");
     EXPECT_EQ(bad.exit_code, 1);
     EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
 }
