@@ -292,6 +292,35 @@ TEST(Dcm, ASlowSteadyTurnIsNotTakenForABiasTheCompassSeesIt) {
     EXPECT_LT(std::fabs(run.yaw_error_deg()), 0.2f);
 }
 
+// A slow yaw oscillation (30 deg, a 20 s period: 9.4 deg/s at most): at each turning
+// point the rate ramps through zero at 3 deg/s^2, gyro and accelerometer as steady as at
+// rest and the field moving less than 1 uT in 1.5 s. The rest test once took those
+// stretches for rest and learned the ramping rate as bias (1-2 deg/s, 10 deg of heading
+// through kp_yaw); the gyro mean must now stay where a rest began.
+TEST(Dcm, ASlowYawOscillationIsNotTakenForARest) {
+    dcm::Dcm filter;
+    const Matrix3f level = Matrix3f::identity();
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    const float dt = filter.settings().step_s;
+    const float amplitude_rad = 30.0f * linalg::kRadPerDeg, omega_rad_s = 2.0f * 3.14159265f / 20.0f;
+    float worst_yaw_error_deg = 0.0f;
+    int rest_steps = 0;
+    for (int i = 0; i < 12000; ++i) {  // 60 s
+        const float t = (float)i * dt;
+        const float yaw_rad = amplitude_rad * sinf(omega_rad_s * t);
+        const Matrix3f truth = dcm::dcm_from_euler(0, 0, yaw_rad);
+        if (i % 3 == 0) filter.correct_heading(mag_for(truth));
+        filter.update(Vector3f(0, 0, amplitude_rad * omega_rad_s * cosf(omega_rad_s * t)), accel_for(level));
+        rest_steps += (filter.status() & dcm::kStatusAtRest) != 0;
+        if (t > 5.0f)
+            worst_yaw_error_deg = std::max(worst_yaw_error_deg,
+                                           std::fabs(wrap_deg((filter.euler().yaw_rad - yaw_rad) * linalg::kDegPerRad)));
+    }
+    EXPECT_LT(std::fabs(filter.gyro_bias_rad_s().z * linalg::kDegPerRad), 0.05f);
+    EXPECT_LT(worst_yaw_error_deg, 0.5f);
+    EXPECT_LT(rest_steps, 200) << "1 s of 60 counted as rest";
+}
+
 TEST(Dcm, HoldsTheIntegratorOnALastingTurnNotOnAVibration) {
     dcm::Dcm filter;
     ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), mag_for(Matrix3f::identity())));

@@ -4,6 +4,7 @@
 // the rest mean, integrates the tilt error and stays bounded.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "GyroBias.h"
@@ -32,6 +33,13 @@ struct RestFixture {
         gyro_mean = units(k, Vector3f(1.0f, -0.5f, 0.3f) * kDegPerS);  // a bias, read at rest
         accel_mean = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, -9.81f) * k.accel_units_per_m_s2, 0);
         rest.reset(accel_mean);
+        settle();
+    }
+    // A board that has been still a while: the 0.5 s means there (5 s of windows that are
+    // not whole, so no rest is counted). A rest's clock starts once the gyro mean stops
+    // moving (ASlowTurnIsNoRest).
+    void settle() {
+        for (int i = 0; i < 250; ++i) rest.update(gyro_mean, accel_mean, Vector3l(), false, true, k);
     }
     // Updates until the rest test passes; the number of updates it took (or -1).
     int updates_to_rest(const Vector3l& mean_off_bias, bool compass_watching, int limit = 400) {
@@ -76,6 +84,55 @@ TEST(DcmRest, AMovingGyroOrAccelOrAShortWindowIsNoRest) {
     RestFixture h;
     for (int i = 0; i < 300; ++i) n += h.rest.update(h.gyro_mean, h.accel_mean, Vector3l(), false, true, h.k);
     EXPECT_EQ(n, 0);
+}
+
+// A slow turn whose rate changes slowly passes the deviation test and, below 2 deg/s,
+// the compass's; its mean moving from where the rest began tells it: a yaw rate ramping
+// through zero at 2 deg/s^2 (a pendulum's twist turning back) is never rest, while the
+// same board held still is, after the 0.5 s mean has come to the bias (the fixture).
+TEST(DcmRest, ASlowTurnIsNoRest) {
+    RestFixture f;
+    const float ramp_deg_s2 = 2.0f, window_s = 0.02f;
+    int rests = 0;
+    for (int i = -150; i <= 150; ++i) {  // -6 .. +6 deg/s over 6 s
+        const Vector3l rate = units(f.k, Vector3f(0.0f, 0.0f, ramp_deg_s2 * window_s * (float)i * kDegPerS));
+        rests += f.rest.update(f.gyro_mean + rate, f.accel_mean, Vector3l(), true, true, f.k);
+    }
+    EXPECT_EQ(rests, 0);
+    // A gentler ramp, 0.2 deg/s^2: the mean moves 0.5 deg/s in 2.5 s, so a rest (1.5 s)
+    // can begin and lasts until it has moved that far, and begins again there.
+    RestFixture g;
+    float most_moved_deg_s = 0.0f, start_deg_s = 0.0f;
+    bool at_rest = false;
+    for (int i = -750; i <= 750; ++i) {  // -3 .. +3 deg/s over 30 s
+        const float rate_deg_s = 0.2f * window_s * (float)i;
+        const bool rest = g.rest.update(g.gyro_mean + units(g.k, Vector3f(0.0f, 0.0f, rate_deg_s * kDegPerS)),
+                                        g.accel_mean, Vector3l(), true, true, g.k);
+        const float mean_deg_s = (float)(g.rest.gyro_mean().z - g.gyro_mean.z) / g.k.units_per_rad_s / kDegPerS;
+        if (rest && !at_rest) start_deg_s = mean_deg_s;
+        if (rest) most_moved_deg_s = std::max(most_moved_deg_s, std::fabs(mean_deg_s - start_deg_s));
+        at_rest = rest;
+    }
+    EXPECT_LT(most_moved_deg_s, 0.5f);
+    // Still: rest after rest_min_s, and it lasts.
+    RestFixture h;
+    EXPECT_EQ(h.updates_to_rest(Vector3l(), true), h.k.rest_min_corrections + 1);
+    for (int i = 0; i < 500; ++i) ASSERT_TRUE(h.rest.update(h.gyro_mean, h.accel_mean, Vector3l(), true, true, h.k)) << i;
+}
+
+// The gyro mean starts from the first window after reset, as the accelerometer's does:
+// a board still from its start with a 3 deg/s reading is rest after rest_min_s, not
+// after the mean has crept up from zero.
+TEST(DcmRest, TheFirstWindowIsTheGyroMean) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    dcm::RestDetector rest;
+    const Vector3l gyro = units(k, Vector3f(3.0f, 0.0f, -2.0f) * kDegPerS);
+    const Vector3l accel = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, -9.81f) * k.accel_units_per_m_s2, 0);
+    rest.reset(accel);
+    int n = 0;
+    while (n < 400 && !rest.update(gyro, accel, Vector3l(), true, true, k)) ++n;
+    EXPECT_EQ(n, k.rest_min_corrections + 1);
+    EXPECT_NEAR((double)rest.gyro_mean().x, (double)gyro.x, 2.0);
 }
 
 // The field moving by more than 1 uT in body axes ends a rest; the HMC5883L's noise
