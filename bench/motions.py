@@ -32,7 +32,7 @@ import tune  # noqa: E402
 
 SEEDS = (4057, 18233, 90511)
 KINDS = [("translation", ("translate_slow", "translate_fast")), ("carrying", ("walk", "pendulum", "car")),
-         ("tapping", ("tapping", "knocking"))]
+         ("tapping", ("tapping", "knocking")), ("rotation", ("slow_rotation",))]
 # A real board's sensor errors: +uncal (hard iron and all) and +imu (a calibrated
 # compass: what the motion itself does to the heading). Ideal sensors ("", []) would
 # add a third of the section's time (the peers in Python are its cost).

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Seeded motions for build/scenario (issue 24, "data that cannot be overfitted"): a board
-// moved by a hand, carried while walking, swinging on a string, riding in a car, tapped.
+// moved by a hand, carried while walking, swinging on a string, riding in a car, tapped,
+// turned slowly back and forth.
 //
 // Each motion is a Plan drawn from a seed: sums of smooth parts whose value and first two
 // time derivatives are analytic, so that the linear acceleration the accelerometer sees is
@@ -227,7 +228,8 @@ inline void accel_ned(const Plan& p, double t_s, double a[3]) {
 // ---------------------------------------------------------------------------
 // The motions. Each draws its random parts from r; the ranges are in the comments.
 
-enum Kind { kNone = 0, kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping, kKnocking };
+// (A new kind goes last: the kind is part of each plan's seed.)
+enum Kind { kNone = 0, kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping, kKnocking, kSlowRotation };
 
 // Small hand wobble on every angle, from kStill_s - 0.5 to end_s.
 inline void add_wobble(Plan& p, Random& r, double amp_lo_deg, double amp_hi_deg, double f_lo, double f_hi) {
@@ -460,6 +462,37 @@ inline Plan tapping(Random& r, bool knock) {
     return p;
 }
 
+// Turned slowly back and forth on a pan-tilt head or a slow turntable (a camera's pan, a
+// board shown round): bouts of 20-40 s, half of them about one axis alone (a turntable's
+// yaw, a tilt head's roll or pitch), the others about all three; yaw swings 15-60 deg,
+// roll and pitch 5-25 deg, each a sine of a 10-40 s period (peak rates 1-38 deg/s an
+// axis, up to 50 as a bout fades; at each turning point the rate passes slowly through
+// zero, 0.1-24 deg/s^2, as steady as a board at rest), faded in and out over 2-4 s,
+// pauses of 2-6 s between; the mount's vibration (0.005-0.02 deg at 3-8 Hz, a rate of
+// 0.1-1 deg/s).
+inline Plan slow_rotation(Random& r) {
+    Plan p;
+    p.angle_deg[2].base = r.between(0, 360);
+    const double length_s = r.between(90, 150);
+    double t = kStill_s;
+    while (t < length_s) {
+        const double dur_s = r.between(20, 40), ramp_s = r.between(2, 4);
+        const int only_axis = r.uniform() < 0.5 ? (int)(r.uniform() * 3) % 3 : -1;
+        for (int i = 0; i < 3; ++i) {
+            const double amp_deg = i == 2 ? r.between(15, 60) : r.between(5, 25);
+            const double period_s = r.between(10, 40), phase_rad = r.between(0, 2 * kPi);
+            if (only_axis >= 0 && i != only_axis) continue;
+            p.angle_deg[i].waves.push_back(Wave{t, t + dur_s, ramp_s, amp_deg, 1.0 / period_s, phase_rad});
+        }
+        t += dur_s + r.between(2, 6);
+    }
+    p.end_s = t;
+    for (int i = 0; i < 3; ++i)
+        p.angle_deg[i].waves.push_back(
+            Wave{kStill_s - 0.5, p.end_s, 1.0, r.between(0.005, 0.02), r.between(3, 8), r.between(0, 2 * kPi)});
+    return p;
+}
+
 // The plan of kind drawn from seed (0: the fixed default motion).
 inline Plan make_plan(Kind kind, uint64_t seed) {
     Random r;
@@ -473,6 +506,7 @@ inline Plan make_plan(Kind kind, uint64_t seed) {
         case kCar: return car(r);
         case kTapping: return tapping(r, false);
         case kKnocking: return tapping(r, true);
+        case kSlowRotation: return slow_rotation(r);
         default: return Plan{};
     }
 }

@@ -5,7 +5,7 @@
 //   build/scenario --list                             names, descriptions and the options
 //
 // The seeded motions (translate_slow, translate_fast, walk, pendulum, car, tapping,
-// knocking; see Motions.h) also move the board: specific force = R^T ((0, 0, -g) + a)
+// knocking, slow_rotation; see Motions.h) also move the board: specific force = R^T ((0, 0, -g) + a)
 // with a the analytic second derivative of the motion; their random parts come from
 // --seed.
 //
@@ -174,6 +174,8 @@ std::vector<Scenario> scenarios() {
         {"tapping", "seeded: held in a shaking hand, tapped (20-50 m/s^2, 10 ms) every 1-3 s",
          sim::motion::kTapping},
         {"knocking", "seeded: the same, knocked on a surface (60-150 m/s^2 stops, 10 ms) every 1-3 s", sim::motion::kKnocking},
+        {"slow_rotation", "seeded: turned slowly back and forth, yaw 15-60 deg, roll and pitch 5-25 deg, 10-40 s periods",
+         sim::motion::kSlowRotation},
     };
     for (const auto& m : motions) {
         const double end_s = sim::motion::make_plan(m.kind, 0).end_s;

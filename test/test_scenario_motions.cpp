@@ -13,7 +13,7 @@ namespace {
 
 using namespace sim::motion;
 
-const Kind kKinds[] = {kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping, kKnocking};
+const Kind kKinds[] = {kTranslateSlow, kTranslateFast, kWalk, kPendulum, kCar, kTapping, kKnocking, kSlowRotation};
 const uint64_t kSeeds[] = {0, 1, 2, 3};
 
 // The velocity (NED, m/s), written from the plan's parts independently of accel_ned:
@@ -214,6 +214,34 @@ TEST(ScenarioMotions, SeedsChangeTheMotionAndNoSeedIsFixed) {
         EXPECT_GT(differ_c, 50) << "kind " << kind;
         EXPECT_GT(differ_d, 50) << "kind " << kind;
         EXPECT_EQ(a.end_s, b.end_s);
+    }
+}
+
+// The slow rotation: no linear acceleration, every axis turned, the rate within 50 deg/s
+// an axis (the sines' 38 and their fading), and, the mount's vibration aside (each
+// track's last wave), turning slowly for long: the yaw rate between 0.05 and 2 deg/s,
+// as steady as at rest but turning, for 5 s or more of the file (what a rest test must
+// not take for rest).
+TEST(ScenarioMotions, SlowRotationTurnsSlowlyAndReversesSlowly) {
+    for (uint64_t seed : kSeeds) {
+        Plan p = make_plan(kSlowRotation, seed);
+        for (Track& track : p.angle_deg) track.waves.pop_back();
+        EXPECT_GE(p.end_s, 90.0);
+        EXPECT_LT(peak_accel(p, 0.01), 1e-12) << "seed " << seed;
+        double peak_rate[3] = {0, 0, 0}, slow_s = 0.0;
+        const double h = 1e-4;
+        for (double t = kStill_s; t < p.end_s; t += 0.01) {
+            for (int i = 0; i < 3; ++i) {
+                const double rate = (p.angle_deg[i].at(t + h).v - p.angle_deg[i].at(t - h).v) / (2 * h);
+                peak_rate[i] = std::fmax(peak_rate[i], std::fabs(rate));
+                if (i == 2 && std::fabs(rate) < 2.0 && std::fabs(rate) > 0.05) slow_s += 0.01;
+            }
+        }
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_GT(peak_rate[i], 1.0) << "seed " << seed << " axis " << i;
+            EXPECT_LT(peak_rate[i], 50.0) << "seed " << seed << " axis " << i;
+        }
+        EXPECT_GT(slow_s, 5.0) << "seed " << seed;
     }
 }
 
