@@ -120,6 +120,44 @@ TEST(DcmRest, ASlowTurnIsNoRest) {
     for (int i = 0; i < 500; ++i) ASSERT_TRUE(h.rest.update(h.gyro_mean, h.accel_mean, Vector3l(), true, true, h.k)) << i;
 }
 
+// The mean may wander during a rest, on each axis, up to kRestMeanMove_rad_s (0.5 deg/s)
+// from where the rest began: 0.3 deg/s keeps the rest, 0.7 ends it. A new accelerometer
+// scale (the gyro's unchanged) leaves the rest's start where it was.
+TEST(DcmRest, TheMeanMayMoveHalfADegreePerSecond) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (bool rescale : {false, true}) {
+            RestFixture f;
+            ASSERT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
+            Vector3f step_rad_s;
+            (axis == 0 ? step_rad_s.x : axis == 1 ? step_rad_s.y : step_rad_s.z) = 0.3f * kDegPerS;
+            const Vector3l first = f.gyro_mean + units(f.k, step_rad_s);
+            for (int i = 0; i < 250; ++i)  // 5 s: the mean is there
+                ASSERT_TRUE(f.rest.update(first, f.accel_mean, Vector3l(), true, true, f.k)) << axis << " " << i;
+            if (rescale) {
+                f.rest.rescale(1.0f, 2.0f);
+                f.accel_mean = linalg::fixed_from_vector(f.accel_mean.scaled(2.0f), 0);
+            }
+            const Vector3l second = f.gyro_mean + units(f.k, step_rad_s * (0.7f / 0.3f));
+            int rest_steps = 0;
+            for (int i = 0; i < 250; ++i) rest_steps += f.rest.update(second, f.accel_mean, Vector3l(), true, true, f.k);
+            // The mean passes 0.5 deg/s within 0.5 s; the rest would come back after 1.5 s
+            // more, counted from there: 3.5 of the 5 s at most.
+            EXPECT_LT(rest_steps, 180) << "axis " << axis << (rescale ? ", rescaled" : "");
+            EXPECT_GT(rest_steps, 100) << "axis " << axis << (rescale ? ", rescaled" : "");
+        }
+    }
+}
+
+// A field that moves starts the count from zero, as any other end of a rest does.
+TEST(DcmRest, AFieldMoveStartsTheCountFromZero) {
+    RestFixture f;
+    const Vector3i field(20 * 32, 0, 45 * 32);  // uT Q5
+    f.rest.watch_field(field);
+    ASSERT_GT(f.updates_to_rest(Vector3l(), true), 0);
+    f.rest.watch_field(Vector3i(field.x + 48, field.y, field.z));  // 1.5 uT
+    EXPECT_EQ(f.updates_to_rest(Vector3l(), true), f.k.rest_min_corrections + 1);
+}
+
 // The gyro mean starts from the first window after reset, as the accelerometer's does:
 // a board still from its start with a 3 deg/s reading is rest after rest_min_s, not
 // after the mean has crept up from zero.
@@ -129,10 +167,20 @@ TEST(DcmRest, TheFirstWindowIsTheGyroMean) {
     const Vector3l gyro = units(k, Vector3f(3.0f, 0.0f, -2.0f) * kDegPerS);
     const Vector3l accel = linalg::fixed_from_vector(Vector3f(0.0f, 0.0f, -9.81f) * k.accel_units_per_m_s2, 0);
     rest.reset(accel);
+    rest.rescale(2.0f, 1.0f);  // a new scale before the first window: still unknown
     int n = 0;
     while (n < 400 && !rest.update(gyro, accel, Vector3l(), true, true, k)) ++n;
     EXPECT_EQ(n, k.rest_min_corrections + 1);
     EXPECT_NEAR((double)rest.gyro_mean().x, (double)gyro.x, 2.0);
+    // Only the first: a board moving from its start (10 deg/s more on the second window,
+    // no rest) moves the mean by the low-pass's factor, not to the window.
+    dcm::RestDetector moving;
+    moving.reset(accel);
+    moving.update(gyro, accel, Vector3l(), true, true, k);
+    const Vector3l faster = gyro + units(k, Vector3f(10.0f, 0.0f, 0.0f) * kDegPerS);
+    EXPECT_FALSE(moving.update(faster, accel, Vector3l(), true, true, k));
+    const double alpha = (double)k.rest_alpha_q14 / 16384.0;
+    EXPECT_NEAR((double)moving.gyro_mean().x, (double)gyro.x + alpha * (double)(faster.x - gyro.x), 4.0);
 }
 
 // The field moving by more than 1 uT in body axes ends a rest; the HMC5883L's noise
