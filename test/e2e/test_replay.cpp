@@ -29,19 +29,35 @@ TEST(Replay, LevelRestWithinHalfADegree) {
     EXPECT_GT(rows, 2500u);
 }
 
+// replay on csv as it is and with `option FILE` (FILE in the e2e work directory, its
+// path in path): exit 0 both, stdout non-empty and byte for byte the same (the option's
+// file is only written, never read back).
+void run_with_output_option(const std::string& csv, const std::string& option, std::string& path) {
+    path = e2e::work_dir() + "/" + option.substr(2) + "." + std::to_string(getpid()) + ".csv";
+    const e2e::CommandResult plain = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
+    const e2e::CommandResult with =
+        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " " + option + " " + path);
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    ASSERT_EQ(with.exit_code, 0) << with.err;
+    EXPECT_GT(plain.out.size(), 1000u);
+    EXPECT_TRUE(plain.out == with.out) << "stdout differs with " << option;
+}
+
+// The option's file in a folder that does not exist: exit 1 and a message.
+void expect_unwritable_output_fails(const std::string& csv, const std::string& option) {
+    const e2e::CommandResult bad =
+        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " " + option + " /nonexistent/dir/out.csv");
+    EXPECT_EQ(bad.exit_code, 1) << option;
+    EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+}
+
 // --trace writes a row per estimator step with the errors and what each correction did,
 // and leaves stdout byte for byte as it was (the trace is only written, never read back).
 TEST(Replay, TraceWritesItsColumnsAndLeavesStdoutAlone) {
     E2E_REQUIRE_TOOLS("replay", "scenario");
     const std::string csv = e2e::scenario_csv("tilt_tour", 20);
-    const std::string trace = e2e::work_dir() + "/trace." + std::to_string(getpid()) + ".csv";
-    const e2e::CommandResult plain = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
-    const e2e::CommandResult traced =
-        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --trace " + trace);
-    ASSERT_EQ(plain.exit_code, 0) << plain.err;
-    ASSERT_EQ(traced.exit_code, 0) << traced.err;
-    EXPECT_GT(plain.out.size(), 1000u);
-    EXPECT_TRUE(plain.out == traced.out) << "stdout differs with --trace";
+    std::string trace;
+    ASSERT_NO_FATAL_FAILURE(run_with_output_option(csv, "--trace", trace));
 
     std::istringstream in(e2e::read_text(trace));
     std::string row;
@@ -104,10 +120,7 @@ TEST(Replay, TraceWritesItsColumnsAndLeavesStdoutAlone) {
                     w.first == "too_vertical") << w.first;
     std::remove(trace.c_str());
 
-    const e2e::CommandResult bad =
-        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --trace /nonexistent/dir/trace.csv");
-    EXPECT_EQ(bad.exit_code, 1);
-    EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+    expect_unwritable_output_fails(csv, "--trace");
 }
 
 // One CSV row as numbers (a field that is not a number, "nan" aside, fails the test).
@@ -130,14 +143,8 @@ std::vector<double> numbers_of(const std::string& line) {
 TEST(Replay, SamplesAreTheEstimatorsInputAsATrajectory) {
     E2E_REQUIRE_TOOLS("replay", "scenario");
     const std::string csv = e2e::scenario_csv("tilt_tour", 20);
-    const std::string samples = e2e::work_dir() + "/samples." + std::to_string(getpid()) + ".csv";
-    const e2e::CommandResult plain = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
-    const e2e::CommandResult dumped =
-        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --samples " + samples);
-    ASSERT_EQ(plain.exit_code, 0) << plain.err;
-    ASSERT_EQ(dumped.exit_code, 0) << dumped.err;
-    EXPECT_GT(plain.out.size(), 1000u);
-    EXPECT_TRUE(plain.out == dumped.out) << "stdout differs with --samples";
+    std::string samples;
+    ASSERT_NO_FATAL_FAILURE(run_with_output_option(csv, "--samples", samples));
 
     // The scenario's rows (t, gyro, accel, field, quaternion, movement), by time.
     std::vector<std::vector<double>> truth;
@@ -186,10 +193,7 @@ TEST(Replay, SamplesAreTheEstimatorsInputAsATrajectory) {
     EXPECT_LT(worst_field_uT, 1.5);
     std::remove(samples.c_str());
 
-    const e2e::CommandResult bad =
-        e2e::run_command(e2e::tool("replay") + " --trajectory " + csv + " --samples /nonexistent/dir/samples.csv");
-    EXPECT_EQ(bad.exit_code, 1);
-    EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+    expect_unwritable_output_fails(csv, "--samples");
 }
 
 // replay on a scenario, its output scored: the score's output (total_rmse_deg, ...).
