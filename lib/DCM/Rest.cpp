@@ -83,10 +83,11 @@ bool RestDetector::update(const Vector3l& gyro_mean_units, const Vector3l& accel
     // the accelerometer's: from zero the mean would move toward the bias for a second,
     // and a moving mean is no rest (mean_moved).
     using linalg::hot::mul_q14_unit;
-    const int16_t gyro_alpha_q14 = start_counts_.x == kMeanUnknown ? (int16_t)(1 << 14) : k.rest_alpha_q14;
+    const bool first_window = start_counts_.x == kMeanUnknown;
+    const int16_t gyro_alpha_q14 = first_window ? (int16_t)(1 << 14) : k.rest_alpha_q14;
     gyro_mean_ += Vector3l(mul_q14_unit(gyro_alpha_q14, gyro_change.x), mul_q14_unit(gyro_alpha_q14, gyro_change.y),
                            mul_q14_unit(gyro_alpha_q14, gyro_change.z));
-    if (start_counts_.x == kMeanUnknown) start_counts_.x = 0;
+    if (first_window) start_counts_.x = 0;
     accel_mean_ += Vector3l(mul_q14_unit(k.rest_alpha_q14, accel_change.x), mul_q14_unit(k.rest_alpha_q14, accel_change.y),
                             mul_q14_unit(k.rest_alpha_q14, accel_change.z));
     // A bias does not move within a rest (the MPU6000 drifts 0.2 deg/s a minute as it
