@@ -422,6 +422,31 @@ TEST(Centripetal, PipelineHoldsTheBankOfATurnWithTheAirspeed) {
     EXPECT_LT(bank_after_turn(8.0f), 25.0f);  // below the minimum: no correction
 }
 
+// Without an airspeed the turn's lift is taken for gravity: the estimate levels, and the
+// gravity integrator takes the tilt error that stays for a gyro bias. Calibrated still at
+// the start, a bias is only the gyro's drift since (GyroBias.h): the estimate stays
+// within a quarter of bias_limit_rad_s on every axis (with the whole limit it learned
+// 6.8 deg/s), and a false bias does not roll the estimate beyond level (the worst roll
+// error 25.5 deg; 33.6 with the whole limit).
+TEST(Centripetal, ATurnWithoutAnAirspeedTeachesNoBiasBeyondTheDrift) {
+    const float bank = 30.0f, v = 18.0f;
+    pipeline::AttitudePipeline pipe;
+    const Turn t = coordinated_turn(bank, v);
+    ASSERT_NO_FATAL_FAILURE(start_banked(pipe, bank, 0.0f));
+    ASSERT_TRUE(pipe.estimator().gyro_bias_measured());
+    const float drift_limit_rad_s = 0.25f * dcm::kDefaultDcmSettings.bias_limit_rad_s;
+    float worst_bias_rad_s = 0.0f, worst_roll_error_deg = 0.0f;
+    for (int i = 0; i < 200 * 60; ++i) {
+        pipe.on_imu_sample(imu(t.gyro_rad_s, t.accel_m_s2));
+        const Vector3f b = pipe.estimator().gyro_bias_rad_s();
+        worst_bias_rad_s = std::max({worst_bias_rad_s, std::fabs(b.x), std::fabs(b.y), std::fabs(b.z)});
+        worst_roll_error_deg = std::max(worst_roll_error_deg, std::fabs(pipe.angles().roll_deg - bank));
+    }
+    EXPECT_LE(worst_bias_rad_s, drift_limit_rad_s + 1e-4f);
+    EXPECT_GT(worst_bias_rad_s, 0.5f * drift_limit_rad_s);  // the integrator did learn: at the bound
+    EXPECT_LT(worst_roll_error_deg, 28.0f);
+}
+
 }  // namespace
 
 namespace {

@@ -139,7 +139,7 @@ TEST(DcmProperties, ANearlyVerticalFieldGivesNoHeading) {
     EXPECT_LT(std::fabs(wrap_deg(run.yaw_deg() - yaw_before)), 0.5f);
 }
 
-// The bias estimate stays within bias_limit_rad_s on every axis.
+// The bias estimate stays within bias_limit_rad_s on every axis, a quarter of it once calibrated.
 TEST(DcmProperties, TheBiasLimitHoldsOnEveryAxis) {
     dcm::Dcm filter;
     const float limit = filter.settings().bias_limit_rad_s;
@@ -157,6 +157,13 @@ TEST(DcmProperties, TheBiasLimitHoldsOnEveryAxis) {
     b = filter.gyro_bias_rad_s();
     EXPECT_NEAR(b.x, 0.01f, 1e-5f);
     EXPECT_NEAR(b.y, -0.02f, 1e-5f);
+    EXPECT_NEAR(b.z, 0.03f, 1e-5f);
+    // Calibrated at this start: a quarter of the limit (GyroBias.h).
+    filter.set_gyro_bias_measured();
+    filter.set_gyro_bias_rad_s(Vector3f(1.0f, -1.0f, 0.03f));
+    b = filter.gyro_bias_rad_s();
+    EXPECT_NEAR(b.x, 0.25f * limit, 1e-4f);
+    EXPECT_NEAR(b.y, -0.25f * limit, 1e-4f);
     EXPECT_NEAR(b.z, 0.03f, 1e-5f);
 }
 

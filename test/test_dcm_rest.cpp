@@ -257,6 +257,35 @@ TEST(DcmGyroBias, StaysWithinTheLimitAndComposesTheOffset) {
     EXPECT_EQ(bias.sensor_units().x, units(k, Vector3f(0.01f, 0.0f, 0.0f)).x);
 }
 
+// Once the calibration at this start measured the bias, the estimate is the gyro's drift
+// since: a quarter of the limit (2.5 deg/s), from gravity's integral and from a rest
+// alike. A rest's measurement alone keeps the whole limit: the sensor's bias may then be
+// the chip's whole zero-rate output.
+TEST(DcmGyroBias, ACalibratedBiasStaysWithinAQuarterOfTheLimit) {
+    const dcm::DcmCoefficients k = float_form_coefficients();
+    const float limit = dcm::kDefaultDcmSettings.bias_limit_rad_s;
+    dcm::GyroBias calibrated;
+    calibrated.set_calibrated();
+    EXPECT_TRUE(calibrated.measured());
+    for (int i = 0; i < 100000; ++i) calibrated.integrate_tilt_error(-16384, 16384, 0, k);  // 1 rad of error
+    EXPECT_NEAR(calibrated.estimate_rad_s(k).x, 0.25f * limit, 1e-5f);
+    EXPECT_NEAR(calibrated.estimate_rad_s(k).y, -0.25f * limit, 1e-5f);
+    for (int i = 0; i < 1000; ++i) calibrated.follow_rest_mean(units(k, Vector3f(-2.0f, 2.0f, 0.01f)), k);
+    EXPECT_NEAR(calibrated.estimate_rad_s(k).x, -0.25f * limit, 1e-5f);
+    EXPECT_NEAR(calibrated.estimate_rad_s(k).z, 0.01f, 1e-5f);  // within: as measured
+    dcm::GyroBias rested;
+    rested.set_measured();
+    EXPECT_TRUE(rested.measured());
+    for (int i = 0; i < 100000; ++i) rested.integrate_tilt_error(-16384, 16384, 0, k);
+    EXPECT_NEAR(rested.estimate_rad_s(k).x, limit, 1e-5f);
+    EXPECT_NEAR(rested.estimate_rad_s(k).y, -limit, 1e-5f);
+    // A calibration after a rest narrows it too (the pipeline's calibration finishing
+    // while the estimator runs).
+    rested.set_calibrated();
+    rested.integrate_tilt_error(0, 0, 0, k);
+    EXPECT_NEAR(rested.estimate_rad_s(k).x, 0.25f * limit, 1e-5f);
+}
+
 // The tilt error's integral: ki_rp_1_s2 * error * dt per correction, against the error.
 TEST(DcmGyroBias, IntegratesTheTiltErrorAgainstIt) {
     const dcm::DcmCoefficients k = float_form_coefficients();

@@ -100,8 +100,9 @@ public:
     // step subtracts it with the estimator's own bias estimate.
     void set_sensor_bias_rad_s(const linalg::Vector3f& bias);
     // The bias was just measured on a still board (the start-up calibration): the gravity
-    // integrator slows to ki_rp_measured (a rest does the same by itself).
-    void set_gyro_bias_measured() { bias_.set_measured(); }
+    // integrator slows to ki_rp_measured (a rest does the same by itself), and the
+    // estimate stays within a quarter of bias_limit_rad_s (GyroBias.h).
+    void set_gyro_bias_measured() { bias_.set_calibrated(); }
     bool gyro_bias_measured() const { return bias_.measured(); }
 
     // A new magnetometer sample (call when one arrives, e.g. 75 Hz): turned into earth

@@ -23,7 +23,7 @@ struct DcmSettings {
     float accel_max_g;               // beyond any accelerometer's range: such a sample is garbage, g
     float accel_lowpass_s;           // time constant of the earth-frame accel low-pass, s
     float integrator_hold_rate_rad_s;// mean rate (0.5 s) above which the bias integrator is held, rad/s
-    float bias_limit_rad_s;          // bound on each axis of the gyro-bias estimate, rad/s
+    float bias_limit_rad_s;          // bound on each axis of the gyro-bias estimate (a quarter once calibrated), rad/s
     float mag_norm_tolerance;        // |field| may differ from the learned one by this fraction
     float mag_dip_tolerance;         // field.down/|field| may differ from the learned one by this
     float mag_recover_s;             // a different field steady this long becomes the reference, s

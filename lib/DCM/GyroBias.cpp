@@ -52,9 +52,10 @@ void GyroBias::integrate_tilt_error(int16_t ex_q14, int16_t ey_q14, int16_t ez_q
 
 void GyroBias::clamp(const DcmCoefficients& k) {
     int32_t* axis[3] = {&fine_.x, &fine_.y, &fine_.z};
+    const int32_t limit = (measured_ & kByCalibration) ? k.bias_limit_fine >> kCalibratedLimitShift : k.bias_limit_fine;
     for (uint8_t i = 0; i < 3; ++i) {
-        if (*axis[i] > k.bias_limit_fine) *axis[i] = k.bias_limit_fine;
-        if (*axis[i] < -k.bias_limit_fine) *axis[i] = -k.bias_limit_fine;
+        if (*axis[i] > limit) *axis[i] = limit;
+        if (*axis[i] < -limit) *axis[i] = -limit;
     }
 }
 

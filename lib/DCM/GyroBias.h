@@ -5,7 +5,8 @@
 // its bias alone). What the step subtracts from every sample is offset_units().
 //
 // Formats: units (gyro counts * 2^8, Coefficients.h); the estimate in fine units
-// (units * 2^8: the rest's slow steps are kept), bounded by bias_limit_rad_s.
+// (units * 2^8: the rest's slow steps are kept), bounded by bias_limit_rad_s (a quarter
+// of it once calibrated).
 #pragma once
 
 #include <stdint.h>
@@ -14,8 +15,19 @@
 
 namespace dcm {
 
+// Once the calibration at this start has measured the bias, the estimate holds what the
+// gyro drifts with temperature: the MPU-6000's zero-rate output moves by 20 deg/s over
+// its 125 degC range (product specification 6.1), 0.16 deg/s a degree, so a quarter of
+// the 10 deg/s limit (2.5 deg/s) covers a board 15 degC warmer than at power-on (the
+// warm-up is 0.2 deg/s a minute). More is a tilt error that a sustained acceleration
+// left, not the gyro: a 30 deg banked turn without an airspeed teaches 6-10 deg/s.
+// VQF bounds its moving bias estimate at 2 deg/s. Never measured, a bias is the chip's
+// whole zero-rate output: bias_limit_rad_s itself.
+constexpr uint8_t kCalibratedLimitShift = 2;
+
 class GyroBias {
 public:
+    static constexpr uint8_t kByRest = 1, kByCalibration = 2;
     // The estimate rounded to units, and the calibrated bias.
     linalg::Vector3l units() const {
         return linalg::Vector3l((fine_.x + 128) >> 8, (fine_.y + 128) >> 8, (fine_.z + 128) >> 8);
@@ -37,10 +49,14 @@ public:
 
     // At rest: estimate += alpha (rest mean - estimate), alpha = rest_bias_alpha_q30.
     void follow_rest_mean(const linalg::Vector3l& rest_mean_units, const DcmCoefficients& k);
-    // The bias was measured on a still board (the start-up calibration, a rest): from now
-    // the gravity integrator uses ki_rp_measured (DcmSettings.h).
-    void set_measured() { measured_ = true; }
-    bool measured() const { return measured_; }
+    // The bias was measured on a still board: from now the gravity integrator uses
+    // ki_rp_measured (DcmSettings.h). set_measured: a rest measured the estimate;
+    // set_calibrated: the sensor's calibration did, at this start (the pipeline's still
+    // second), so the estimate is only what the gyro drifts after it: bounded by a
+    // quarter of bias_limit_rad_s from then on (kCalibratedLimitShift).
+    void set_measured() { measured_ |= kByRest; }
+    void set_calibrated() { measured_ |= kByRest | kByCalibration; }
+    bool measured() const { return measured_ != 0; }
     // The gravity correction's integral: estimate -= ki error (the error in Q14 radians).
     void integrate_tilt_error(int16_t ex_q14, int16_t ey_q14, int16_t ez_q14, const DcmCoefficients& k);
     // A change in fine units (the compass integrator, ki_yaw), then bounded.
@@ -54,7 +70,7 @@ private:
 
     linalg::Vector3l fine_;          // the estimate, fine units
     linalg::Vector3l sensor_units_;  // the calibrated bias (set_sensor_rad_s), units
-    bool measured_ = false;          // set_measured() since the start
+    uint8_t measured_ = 0;           // kByRest, kByCalibration: what measured the bias
 };
 
 }  // namespace dcm
