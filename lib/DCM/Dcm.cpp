@@ -289,7 +289,8 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     const bool starting = steps_ < k_.startup_steps;
     const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
     // No bias learning while rotating fast: gyro scale errors look like bias there
-    // (ArduPilot's rule). What counts is the turn that lasts, the 0.5 s mean rate of
+    // (ArduPilot's rule), and a vehicle's turn holds a centripetal acceleration the
+    // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is the turn that lasts, the 0.5 s mean rate of
     // the rest test: a scale error on a vibration (an 8 Hz wobble at 50 deg/s) makes an
     // error that averages out, while a hand's or a vehicle's turn does not (shake, a
     // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;

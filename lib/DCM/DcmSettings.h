@@ -51,7 +51,14 @@ struct DcmSettings {
 // find), 33 s once it was measured still (the start-up calibration, a rest), when what
 // is left to follow is the MPU6000's drift as it warms (0.2 deg/s a minute follows with
 // a lag of 0.1 deg/s, 0.1 deg of tilt) and a 10 s acceleration teaches a third as much
-// false bias. Rest: a hand-held board's tremor stays below 2 deg/s and
+// false bias. Nor does it learn while the board turns lastingly (the 0.5 s mean rate
+// beyond integrator_hold_rate, 10 deg/s): a gyro scale error (+-3 %) makes a lasting
+// turn's rate look like bias, and a vehicle's turn holds a centripetal acceleration
+// omega v that the accelerometer reads as tilt for as long as the turn lasts, all of it
+// without an airspeed and the gusts' share with one: an aeroplane at 18 m/s banked 18
+// deg turns at 10 deg/s (ArduPilot's 20 deg/s lets every turn up to 32 deg of bank
+// teach the bias), a car at 10 m/s round a 57 m bend too. Rest: a hand-held board's
+// tremor stays below 2 deg/s and
 // 0.5 m/s^2 (VQF's thresholds); 1.5 s of it is rest.
 // The two latencies: the MPU6000's 42 Hz DLPF delays the gyro by 4.8 ms (Register
 // Map 4.3), of which the step's end-point integration takes back 2.5 ms: the output
@@ -70,7 +77,7 @@ constexpr DcmSettings kDefaultDcmSettings = {
     3.0f,                           // startup_s
     16.0f,                          // accel_max_g
     3.0f,                           // accel_lowpass_s
-    20.0f * linalg::kRadPerDeg,     // integrator_hold_rate_rad_s (ArduPilot's 20 deg/s)
+    10.0f * linalg::kRadPerDeg,     // integrator_hold_rate_rad_s (see above; ArduPilot's 20 deg/s)
     10.0f * linalg::kRadPerDeg,     // bias_limit_rad_s
     0.1f,                           // mag_norm_tolerance
     0.1f,                           // mag_dip_tolerance
