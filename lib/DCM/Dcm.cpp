@@ -290,11 +290,12 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
     // No bias learning while rotating fast: gyro scale errors look like bias there
     // (ArduPilot's rule), and a vehicle's turn holds a centripetal acceleration the
-    // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is the turn that lasts, the 0.5 s mean rate of
-    // the rest test: a scale error on a vibration (an 8 Hz wobble at 50 deg/s) makes an
-    // error that averages out, while a hand's or a vehicle's turn does not (shake, a
-    // board never still since power-on with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4;
-    // BROAD 1.57 -> 1.58). A rejected gyro sample in the window holds it too (step()).
+    // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is
+    // the turn that lasts, the 0.5 s mean rate of the rest test: a scale error on a
+    // vibration (an 8 Hz wobble at 50 deg/s) makes an error that averages out, while a
+    // hand's or a vehicle's turn does not (shake, a board never still since power-on
+    // with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4; BROAD 1.57 -> 1.58). A rejected
+    // gyro sample in the window holds it too (step()).
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
     const bool hold_integrator = rotating_fast_ || starting;

@@ -20,8 +20,8 @@ namespace dcm {
 // its 125 degC range (product specification 6.1), 0.16 deg/s a degree, so a quarter of
 // the 10 deg/s limit (2.5 deg/s) covers a board 15 degC warmer than at power-on (the
 // warm-up is 0.2 deg/s a minute). More is a tilt error that a sustained acceleration
-// left, not the gyro: a 30 deg banked turn without an airspeed teaches 6-10 deg/s.
-// VQF bounds its moving bias estimate at 2 deg/s. Never measured, a bias is the chip's
+// left, not the gyro: a turn flown without an airspeed below the integrator's hold rate
+// (30 deg of bank at 36 m/s) teaches 3.8 deg/s. VQF bounds its moving bias estimate at 2 deg/s. Never measured, a bias is the chip's
 // whole zero-rate output: bias_limit_rad_s itself.
 constexpr uint8_t kCalibratedLimitShift = 2;
 
