@@ -285,20 +285,39 @@ TEST(DcmProperties, AFieldBeforeTheFirstSampleIsTheReference) {
     EXPECT_LT(angle_between_deg(truth, filter.matrix()), 0.5f);
 }
 
-// With a yaw integral gain (ki_yaw, off by default) the compass's heading error teaches
-// the vertical gyro bias, in the right direction.
-TEST(DcmProperties, AYawIntegralLearnsTheVerticalBiasFromTheCompass) {
+// A board that never kept still (a start in flight): nothing has measured its bias, and
+// level only the compass sees the vertical part. The yaw integral (ki_yaw, kp_yaw^2 / 4:
+// critically damped) learns it in the right direction within two minutes, and the
+// heading comes back from the b / kp_yaw (8 deg) it would stand off without.
+TEST(DcmProperties, AYawIntegralLearnsTheVerticalBiasFromTheCompassUntilMeasured) {
     dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
-    settings.ki_yaw_1_s2 = 0.02f;
-    settings.rest_bias_s = 0.0f;  // not from the rest test
+    settings.rest_min_s = 1000.0f;  // no rest within the run: the bias stays unmeasured
+    const float bias_deg_s = 0.8f;
     dcm::Dcm filter(settings);
     ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
-    const float bias_rad_s = 0.5f * linalg::kRadPerDeg;
     for (int i = 0; i < 200 * 120; ++i) {
         if (i % 3 == 0) filter.correct_heading(earth_field_uT());
-        filter.update(Vector3f(0, 0, bias_rad_s), accel_for(Matrix3f::identity()));
+        filter.update(Vector3f(0, 0, bias_deg_s * linalg::kRadPerDeg), accel_for(Matrix3f::identity()));
     }
-    EXPECT_NEAR(filter.gyro_bias_rad_s().z * linalg::kDegPerRad, 0.5f, 0.1f);
+    ASSERT_FALSE(filter.gyro_bias_measured());
+    EXPECT_NEAR(filter.gyro_bias_rad_s().z * linalg::kDegPerRad, bias_deg_s, 0.1f);
+    EXPECT_LT(std::fabs(filter.euler().yaw_rad) * linalg::kDegPerRad, 1.0f);
+}
+
+// Once the start's calibration (or a rest) has measured the bias, the compass teaches
+// none: what drifts after it (the same 0.8 deg/s here) stays out of the estimate, so a
+// compass error can never become one (DcmSettings.h).
+TEST(DcmProperties, TheCompassTeachesNoBiasOnceItWasMeasured) {
+    dcm::DcmSettings settings = dcm::kDefaultDcmSettings;
+    settings.rest_min_s = 1000.0f;
+    dcm::Dcm filter(settings);
+    ASSERT_TRUE(filter.init(accel_for(Matrix3f::identity()), earth_field_uT()));
+    filter.set_gyro_bias_measured();
+    for (int i = 0; i < 200 * 60; ++i) {
+        if (i % 3 == 0) filter.correct_heading(earth_field_uT());
+        filter.update(Vector3f(0, 0, 0.8f * linalg::kRadPerDeg), accel_for(Matrix3f::identity()));
+    }
+    EXPECT_EQ(filter.gyro_bias_rad_s().z, 0.0f);
 }
 
 // A compass sampled at the step rate (more samples in a heading mean than the usual

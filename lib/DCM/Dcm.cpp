@@ -500,7 +500,8 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     using linalg::q14_of;
     strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
                                  linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
-    if (!rotating_fast_ && !starting && settings_->ki_yaw_1_s2 != 0.0f) {
+    // The compass teaches the bias only while nothing else has measured it (DcmSettings.h).
+    if (!rotating_fast_ && !starting && !bias_.measured() && settings_->ki_yaw_1_s2 != 0.0f) {
 #if DCM_TRACE
         const Vector3f bias_before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif

@@ -16,7 +16,7 @@ struct DcmSettings {
     float ki_rp_1_s2;                // roll/pitch integral gain (gyro-bias estimate), 1/s^2
     float ki_rp_measured_1_s2;       // ... once the bias was measured on a still board, 1/s^2
     float kp_yaw_1_s;                // yaw proportional gain, 1/s
-    float ki_yaw_1_s2;               // yaw integral gain, 1/s^2
+    float ki_yaw_1_s2;               // yaw integral gain while no rest or calibration has measured the bias, 1/s^2
     float kp_startup_1_s;            // roll/pitch P gain at start, ramping down to the steady one; the
                                      // heading's at rest and at most while moving (then 1/t), 1/s
     float startup_s;                 // length of the start-up ramp (also speeds up the accel low-pass), s
@@ -40,11 +40,17 @@ struct DcmSettings {
 // (bench/tune.py) cross-validates them on the BROAD recordings (tuned on one half,
 // scored on the other) and scores them on the scenarios with a real board's errors.
 // The gyro bias is learned from gravity (the two horizontal axes, ki_rp) and at rest
-// (every axis, rest_*), never from the compass (ki_yaw 0): the compass's errors (a
-// residual hard iron, a nearby magnet) are degrees and turn with the heading, so an
-// integrator on them learns a false bias that makes the heading drift whenever the
-// compass is disturbed (mag_disturbance with an uncalibrated compass: 9.6 -> 5.9 deg;
-// VQF makes the same choice). The accelerometer cannot tell a sustained acceleration
+// (every axis, rest_*); from the compass (the vertical axis, ki_yaw) only until a rest
+// or the start's calibration has measured it. The compass's errors (a residual hard
+// iron, a nearby magnet) are degrees and turn with the heading, so an integrator on them
+// learns a false bias that makes the heading drift whenever the compass is disturbed
+// (mag_disturbance with an uncalibrated compass, ki_yaw always on: 9.6 -> 5.9 deg; VQF
+// makes the same choice). But on a board never still since power-on (started in flight,
+// carried) nothing has measured the bias, the chip's +-20 deg/s at worst, and while it
+// flies level nothing but the compass sees its vertical part: the heading stands b /
+// kp_yaw off (0.8 deg/s: 8 deg) for as long. ki_yaw = kp_yaw^2 / 4 makes that heading
+// loop critically damped: a compass error does not ring, and 4 deg of it held for 10 s
+// teaches 0.1 deg/s. The accelerometer cannot tell a sustained acceleration
 // (a car's corner, a climb's speed change, a hand's stroke) from tilt, and the
 // integrator learns what the tilt error holds for its time constant kp_rp / ki_rp: 10 s
 // while the bias is unknown (a board that never kept still: up to degrees per second to
@@ -72,7 +78,7 @@ constexpr DcmSettings kDefaultDcmSettings = {
     0.1f,                           // ki_rp_1_s2
     0.03f,                          // ki_rp_measured_1_s2
     0.1f,                           // kp_yaw_1_s
-    0.0f,                           // ki_yaw_1_s2: no bias from the compass (see above)
+    0.0025f,                        // ki_yaw_1_s2: kp_yaw^2 / 4, until the bias is measured (see above)
     5.0f,                           // kp_startup_1_s
     3.0f,                           // startup_s
     16.0f,                          // accel_max_g
