@@ -2,6 +2,7 @@
 // build/scenario: synthetic trajectories in the format of ../shared/SIM.md.
 //
 //   build/scenario NAME [--seconds S] [--rate HZ] [sensor-error options]   CSV on stdout
+//   build/scenario --from FILE [sensor-error options]     the errors on a trajectory file
 //   build/scenario --list                             names, descriptions and the options
 //
 // The seeded motions (translate_slow, translate_fast, walk, pendulum, car, tapping,
@@ -293,7 +294,10 @@ const char* const kOptionsHelp =
     "                          (0.1,-0.08,0.2) m/s^2 and scale (1.02,0.985,1.01), hard iron\n"
     "                          (6,-4,9) uT, soft iron scales (1.04,0.97,1.01) with cross terms\n"
     "                          (0.02,-0.015,0.01), datasheet noise, quantised; later options\n"
-    "                          override single values\n";
+    "                          override single values\n"
+    "  --from FILE             the errors on a trajectory file's measured columns (a flight\n"
+    "                          of sim/flight/fly.py), its truth kept; noise only with\n"
+    "                          --noise or --preset\n";
 
 void print_list(const std::vector<Scenario>& list) {
     for (const Scenario& s : list) {
@@ -330,13 +334,90 @@ bool parse_list(const char* text, double* out, int n_min, int n_max, int& n) {
 
 double quantised(double v, double lsb) { return std::round(v / lsb) * lsb; }
 
+// The sensor-error model's state over a file: the noise levels (per sample), the two
+// noise sequences and the bias's random walk.
+struct Measuring {
+    double gyro_sigma_rad_s, accel_sigma_m_s2, mag_sigma_uT;
+    double walk_step_dps;  // the random walk's step per sample
+    Noise noise, walk_noise;
+    double walk_dps[3] = {0, 0, 0};
+
+    // noise: the datasheet's densities at rate_hz, or the fixed amounts, or none.
+    enum class Level { kNone, kDefault, kDatasheet };
+    Measuring(const SensorErrors& err, double rate_hz, Level level) {
+        if (err.seed != 0) noise.state ^= err.seed * 0xD1B54A32D192ED03ull;
+        walk_noise.state = noise.state ^ 0x5851F42D4C957F2Dull;  // its own: the options never shift the default noise
+        const bool datasheet = level == Level::kDatasheet, none = level == Level::kNone;
+        gyro_sigma_rad_s = none ? 0.0 : datasheet ? kGyroDensity_dps_sqrt_hz * std::sqrt(rate_hz / 2.0) * kDeg : kGyroNoise_rad_s;
+        accel_sigma_m_s2 = none ? 0.0
+                           : datasheet ? kAccelDensity_g_sqrt_hz * kGravity_m_s2 * std::sqrt(rate_hz / 2.0)
+                                       : kAccelNoise_m_s2;
+        mag_sigma_uT = none ? 0.0 : datasheet ? kMagFloor_uT : kMagNoise_uT;
+        // Random walk: each step adds sigma * sqrt(dt) with sigma in deg/s per sqrt(s).
+        walk_step_dps = err.gyro_walk_dps_per_sqrt_min / std::sqrt(60.0) * std::sqrt(1.0 / rate_hz);
+    }
+
+    // The measured columns of one sample from the true rate, specific force and field in
+    // body axes (SensorErrors' model; extra_bias_rad_s and vibration_m_s2: a scenario's own).
+    void measure(const SensorErrors& err, double t_s, const double extra_bias_rad_s[3], double vibration_m_s2,
+                 double gyro[3], double accel[3], const double field_body[3], double mag[3]) {
+        for (int i = 0; i < 3; ++i)
+            mag[i] = err.soft_iron[i][0] * field_body[0] + err.soft_iron[i][1] * field_body[1] +
+                     err.soft_iron[i][2] * field_body[2] + err.hard_iron_uT[i];
+        for (int i = 0; i < 3; ++i) {
+            const double bias_dps = err.gyro_bias_dps[i] + err.gyro_drift_dps_per_min[i] * t_s / 60.0 + walk_dps[i];
+            gyro[i] += extra_bias_rad_s[i] + bias_dps * kDeg + gyro_sigma_rad_s * noise.gauss();
+            accel[i] = err.accel_scale[i] * accel[i] + err.accel_offset_m_s2[i];
+            accel[i] += accel_sigma_m_s2 * noise.gauss() + vibration_m_s2 * noise.gauss();
+            mag[i] += mag_sigma_uT * noise.gauss();
+            if (walk_step_dps > 0.0) walk_dps[i] += walk_step_dps * walk_noise.gauss();
+        }
+    }
+};
+
+void quantise(double gyro[3], double accel[3], double mag[3]) {
+    for (int i = 0; i < 3; ++i) {
+        gyro[i] = quantised(gyro[i], kGyroLsb_dps * kDeg);
+        accel[i] = quantised(accel[i], kAccelLsb_m_s2);
+        mag[i] = quantised(mag[i], kMagLsb_uT);
+    }
+}
+
+// --from FILE: the sensor errors on a trajectory's measured columns (a flight of
+// sim/flight/fly.py, a recording), its truth and movement as they are; noise only as
+// --noise asks (the file has its own). 0 on success.
+int errors_on_file(const std::string& path, const SensorErrors& err, Measuring::Level level) {
+    sim::Trajectory in;
+    if (!in.load(path)) {
+        std::fprintf(stderr, "scenario: %s\n", in.error().c_str());
+        return 1;
+    }
+    if (in.size() < 2 || !(in.duration_s() > 0.0)) {
+        std::fprintf(stderr, "scenario: %s: needs two samples or more\n", path.c_str());
+        return 1;
+    }
+    const double rate_hz = (double)(in.size() - 1) / in.duration_s();
+    Measuring m(err, rate_hz, level);
+    const double no_extra[3] = {0, 0, 0};
+    std::fputs(sim::kTrajectoryHeader, stdout);
+    for (size_t k = 0; k < in.size(); ++k) {
+        sim::TrajectorySample row = in[k];
+        const double field_body[3] = {row.mag_uT[0], row.mag_uT[1], row.mag_uT[2]};
+        m.measure(err, row.t_s, no_extra, 0.0, row.gyro_rad_s, row.accel_m_s2, field_body, row.mag_uT);
+        if (err.quantise) quantise(row.gyro_rad_s, row.accel_m_s2, row.mag_uT);
+        std::fputs(sim::format_trajectory_row(row).c_str(), stdout);
+    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     const std::vector<Scenario> list = scenarios();
-    std::string name;
+    std::string name, from;
     double seconds = -1.0, rate_hz = 400.0;
     SensorErrors err;
+    bool noise_asked = false;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         const bool has_value = i + 1 < argc;
@@ -346,6 +427,7 @@ int main(int argc, char** argv) {
             return 0;
         } else if (arg == "--help" || arg == "-h") {
             std::printf("usage: scenario NAME [--seconds S] [--rate HZ] [options] > FILE.csv\n"
+                        "       scenario --from TRAJECTORY.csv[.gz] [options] > FILE.csv\n"
                         "       scenario --list\n%s\nscenarios:\n", kOptionsHelp);
             print_list(list);
             return 0;
@@ -359,6 +441,7 @@ int main(int argc, char** argv) {
                 return 1;
             }
             set_uncalibrated(err);
+            noise_asked = true;
         } else if ((arg == "--gyro-bias" || arg == "--gyro-drift" || arg == "--accel-offset" ||
                     arg == "--accel-scale" || arg == "--hard-iron") && has_value) {
             double* out = arg == "--gyro-bias"      ? err.gyro_bias_dps
@@ -404,16 +487,29 @@ int main(int argc, char** argv) {
                 return 1;
             }
             err.datasheet_noise = v == "datasheet";
+            noise_asked = true;
         } else if (arg == "--quantise" || arg == "--quantize") {
             err.quantise = true;
         } else if (arg == "--seed" && has_value) {
             err.seed = std::strtoull(argv[++i], nullptr, 10);
+        } else if (arg == "--from" && has_value) {
+            from = argv[++i];
         } else if (name.empty() && arg[0] != '-') {
             name = arg;
         } else {
             std::fprintf(stderr, "scenario: unknown argument '%s' (try --help)\n", arg.c_str());
             return 1;
         }
+    }
+    if (!from.empty()) {
+        if (!name.empty() || seconds >= 0.0) {
+            std::fprintf(stderr, "scenario: --from takes the file's motion and length: no NAME or --seconds\n");
+            return 1;
+        }
+        const Measuring::Level level = !noise_asked ? Measuring::Level::kNone
+                                       : err.datasheet_noise ? Measuring::Level::kDatasheet
+                                                             : Measuring::Level::kDefault;
+        return errors_on_file(from, err, level);
     }
     const Scenario* scenario = nullptr;
     for (const Scenario& s : list)
@@ -435,18 +531,7 @@ int main(int argc, char** argv) {
     };
 
     const Extras& x = scenario->extras;
-    Noise noise;
-    if (err.seed != 0) noise.state ^= err.seed * 0xD1B54A32D192ED03ull;
-    Noise walk_noise;  // its own sequence, so the options never shift the default noise
-    walk_noise.state = noise.state ^ 0x5851F42D4C957F2Dull;
-    const double gyro_sigma_rad_s =
-        err.datasheet_noise ? kGyroDensity_dps_sqrt_hz * std::sqrt(rate_hz / 2.0) * kDeg : kGyroNoise_rad_s;
-    const double accel_sigma_m_s2 =
-        err.datasheet_noise ? kAccelDensity_g_sqrt_hz * kGravity_m_s2 * std::sqrt(rate_hz / 2.0) : kAccelNoise_m_s2;
-    const double mag_sigma_uT = err.datasheet_noise ? kMagFloor_uT : kMagNoise_uT;
-    // Random walk: each step adds sigma * sqrt(dt) with sigma in deg/s per sqrt(s).
-    const double walk_step_dps = err.gyro_walk_dps_per_sqrt_min / std::sqrt(60.0) * std::sqrt(1.0 / rate_hz);
-    double walk_dps[3] = {0, 0, 0};
+    Measuring m(err, rate_hz, err.datasheet_noise ? Measuring::Level::kDatasheet : Measuring::Level::kDefault);
     std::fputs(sim::kTrajectoryHeader, stdout);
     const long n = (long)std::floor(seconds * rate_hz + 1e-9);
     const double h_s = 1e-5;
@@ -476,26 +561,9 @@ int main(int argc, char** argv) {
         double field_body[3];
         earth_to_body(q, field_ned, field_body);
         double mag[3];
-        for (int i = 0; i < 3; ++i)
-            mag[i] = err.soft_iron[i][0] * field_body[0] + err.soft_iron[i][1] * field_body[1] +
-                     err.soft_iron[i][2] * field_body[2] + err.hard_iron_uT[i];
-
-        for (int i = 0; i < 3; ++i) {
-            const double bias_dps = err.gyro_bias_dps[i] + err.gyro_drift_dps_per_min[i] * t_s / 60.0 + walk_dps[i];
-            gyro[i] += x.gyro_bias_rad_s[i] + bias_dps * kDeg + gyro_sigma_rad_s * noise.gauss();
-            accel[i] = err.accel_scale[i] * accel[i] + err.accel_offset_m_s2[i];
-            accel[i] += accel_sigma_m_s2 * noise.gauss() + x.vibration_m_s2 * noise.gauss();
-            mag[i] += mag_sigma_uT * noise.gauss();
-            if (walk_step_dps > 0.0) walk_dps[i] += walk_step_dps * walk_noise.gauss();
-        }
+        m.measure(err, t_s, x.gyro_bias_rad_s, x.vibration_m_s2, gyro, accel, field_body, mag);
         accel[2] += x.vibration_tone_m_s2 * std::sin(2 * kPi * 25.0 * t_s);
-        if (err.quantise) {
-            for (int i = 0; i < 3; ++i) {
-                gyro[i] = quantised(gyro[i], kGyroLsb_dps * kDeg);
-                accel[i] = quantised(accel[i], kAccelLsb_m_s2);
-                mag[i] = quantised(mag[i], kMagLsb_uT);
-            }
-        }
+        if (err.quantise) quantise(gyro, accel, mag);
         sim::TrajectorySample row{t_s, {gyro[0], gyro[1], gyro[2]}, {accel[0], accel[1], accel[2]},
                                   {mag[0], mag[1], mag[2]}, {q.w, q.x, q.y, q.z}, t_s >= kStartup_s};
         std::fputs(sim::format_trajectory_row(row).c_str(), stdout);

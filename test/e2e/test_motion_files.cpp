@@ -150,6 +150,41 @@ TEST_P(MotionFile, SensorErrorsLeaveTheTruth) {
     EXPECT_NEAR(bias_dps[2] / still, 0.8, 0.05);
 }
 
+// --from FILE puts the same errors on a trajectory's measured columns (a flight of
+// fly.py): the truth, times and movement as they were, the gyro off by the bias; without
+// a noise option nothing else (a gyro bias alone moves only the gyro), with the preset
+// the other columns move too.
+TEST_P(MotionFile, SensorErrorsOnAFileKeepItsTruth) {
+    sim::Trajectory ideal, biased, board;
+    const std::string source = motion_file(GetParam(), "--seed 5");
+    ASSERT_TRUE(load(source, ideal));
+    const std::string biased_path = e2e::work_dir() + "/from_" + GetParam() + "_bias.csv";
+    const std::string board_path = e2e::work_dir() + "/from_" + GetParam() + "_board.csv";
+    ASSERT_EQ(run_command(tool("scenario") + " --from " + source + " --gyro-bias 2,-1,0.5 > " + biased_path).exit_code, 0);
+    ASSERT_EQ(run_command(tool("scenario") + " --from " + source + " --preset uncalibrated > " + board_path).exit_code, 0);
+    ASSERT_TRUE(load(biased_path, biased));
+    ASSERT_TRUE(load(board_path, board));
+    ASSERT_EQ(ideal.size(), biased.size());
+    ASSERT_EQ(ideal.size(), board.size());
+    const double bias_dps[3] = {2.0, -1.0, 0.5};
+    double moved = 0.0;
+    for (size_t k = 0; k < ideal.size(); ++k) {
+        ASSERT_EQ(ideal[k].t_s, biased[k].t_s);
+        ASSERT_EQ(ideal[k].movement, board[k].movement);
+        for (int c = 0; c < 4; ++c) ASSERT_EQ(ideal[k].quat[c], board[k].quat[c]);
+        for (int i = 0; i < 3; ++i) {
+            ASSERT_NEAR((biased[k].gyro_rad_s[i] - ideal[k].gyro_rad_s[i]) / kDeg, bias_dps[i], 1e-4) << k;
+            ASSERT_NEAR(biased[k].accel_m_s2[i], ideal[k].accel_m_s2[i], 1e-5 * (1.0 + std::fabs(ideal[k].accel_m_s2[i])));
+            ASSERT_NEAR(biased[k].mag_uT[i], ideal[k].mag_uT[i], 1e-5 * (1.0 + std::fabs(ideal[k].mag_uT[i])));
+            moved += std::fabs(board[k].accel_m_s2[i] - ideal[k].accel_m_s2[i]) + std::fabs(board[k].mag_uT[i] - ideal[k].mag_uT[i]);
+        }
+    }
+    EXPECT_GT(moved / (double)ideal.size(), 1.0) << "the preset's accel and compass errors are on the file";
+    // A file it cannot read is a clear error, not an empty file.
+    const e2e::CommandResult missing = run_command(tool("scenario") + " --from " + e2e::work_dir() + "/no_such_file.csv");
+    EXPECT_NE(missing.exit_code, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Seeded, MotionFile, ::testing::ValuesIn(kMotions));
 
 }  // namespace
