@@ -141,6 +141,70 @@ def closed_loop_turn(build, name="turn"):
     return path, worst
 
 
+# The uncalibrated preset's IMU errors, the compass left calibrated (bench/motions.py's +imu).
+IMU_ERRORS = ("--preset", "uncalibrated", "--hard-iron", "0,0,0", "--soft-iron", "1,1,1")
+
+
+def make_imu_flights(build, flights, flight_dir, log):
+    """Each flight of make_turbulent_flights through `scenario --from` with IMU_ERRORS (the
+    flight's seed for the noise), cached while newer than its source and the scenario tool:
+    {stem+imu: (kind, trajectory, state log)}."""
+    import gzip
+    scenario = os.path.join(build, "scenario")
+    out = {}
+    for stem, (kind, traj, state) in flights.items():
+        path = os.path.join(flight_dir, stem + "+imu.csv.gz")
+        fresh = os.path.exists(path) and os.path.getmtime(path) > max(os.path.getmtime(traj), os.path.getmtime(scenario))
+        if not fresh:
+            seed = stem.rsplit("_s", 1)[1]
+            cmd = [scenario, "--from", traj] + list(IMU_ERRORS) + ["--seed", seed]
+            log("flights: scenario --from %s %s --seed %s" % (os.path.relpath(traj, REPO), " ".join(IMU_ERRORS), seed))
+            r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=600)
+            if r.returncode != 0:
+                log("flights: %s+imu failed (exit %d): %s" % (stem, r.returncode, r.stderr.decode()[-300:]))
+                continue
+            with gzip.open(path + ".tmp", "wb") as f:
+                f.write(r.stdout)
+            os.replace(path + ".tmp", path)
+        out[stem + "+imu"] = (kind, path, state)
+    return out
+
+
+def turbulent_report(flights, flight_dir, replay, score, run_replay, errors, log, intro):
+    """Ours in the three airspeed modes and VQF on each flight of {stem: (kind, trajectory,
+    state log)}: a table of the kinds' means and one of the files (markdown lines)."""
+    import peers
+    trows, sums = [], {}
+    for stem, (kind, traj, state) in flights.items():
+        cells = [stem]
+        for suffix, what, extra in airspeed_variants(state):
+            est = os.path.join(flight_dir, stem + "_estimate%s.csv" % suffix)
+            _, _, ours, err, _ = run_replay(("flight %s%s" % (stem, what), traj, est, replay, score, (), extra))
+            if err:
+                errors.append("flight %s%s: %s" % (stem, what, err))
+            cells.append("%.2f" % ours["total"] if ours else "–")
+            if ours:
+                sums.setdefault((kind, suffix), []).append(ours["total"])
+        if "VQF" in peers.PEERS:
+            tr = peers.load_trajectory(traj)
+            s_vqf = peers.score(tr["quat"], peers.PEERS["VQF"](tr), tr["movement"])
+            cells.append("%.2f" % s_vqf["total"])
+            sums.setdefault((kind, "vqf"), []).append(s_vqf["total"])
+        trows.append(cells)
+        log("flight %s: %s" % (stem, " | ".join(cells[1:])))
+    kinds = []
+    for name, gust in TURBULENT_FLIGHTS:
+        kind = turbulent_kind(name, gust)
+        vals = [sums.get((kind, k)) for k in ("", "_cruise", "_sensor", "vqf")]
+        kinds.append("| %s (mean of %d) | " % (kind, len(vals[0] or [])) +
+                     " | ".join("%.2f" % (sum(v) / len(v)) if v else "–" for v in vals) + " |")
+    return [intro, "",
+            "| flight | ours | ours, cruise %g m/s | ours, airspeed sensor | VQF |" % TRIM_AIRSPEED_M_S,
+            "|---|---|---|---|---|"] + kinds + [""] + \
+           ["| file | ours | ours, cruise | ours, sensor | VQF |", "|---|---|---|---|---|"] + \
+           ["| " + " | ".join(r) + " |" for r in sorted(trows)] + [""]
+
+
 def flight_section(build, out_dir, run_replay, peer_names, log):
     import peers
     flight_dir = os.path.join(out_dir, "flights")
@@ -198,40 +262,23 @@ def flight_section(build, out_dir, run_replay, peer_names, log):
         rep += ["Worst roll error during the 60 s, 30 deg turn (estimate - truth, deg): %s." % text, ""]
         log("the turn's worst roll error (deg): " + text)
     # The same in turbulence on fresh seeds: ours without / with the cruise speed / with
-    # the sensor, VQF beside (the peer ours trails most there), total RMSE.
+    # the sensor, VQF beside (the peer ours trails most there), total RMSE; and the same
+    # flights as an uncalibrated board's IMU would measure them.
     turbulent = make_turbulent_flights(flight_dir, log)
     if turbulent:
-        trows, sums = [], {}
-        for stem, (kind, traj, state) in turbulent.items():
-            cells = [stem]
-            for suffix, what, extra in airspeed_variants(state):
-                est = os.path.join(flight_dir, stem + "_estimate%s.csv" % suffix)
-                _, _, ours, err, _ = run_replay(("flight %s%s" % (stem, what), traj, est, replay, score, (), extra))
-                if err:
-                    errors.append("flight %s%s: %s" % (stem, what, err))
-                cells.append("%.2f" % ours["total"] if ours else "–")
-                if ours:
-                    sums.setdefault((kind, suffix), []).append(ours["total"])
-            if "VQF" in peers.PEERS:
-                tr = peers.load_trajectory(traj)
-                s_vqf = peers.score(tr["quat"], peers.PEERS["VQF"](tr), tr["movement"])
-                cells.append("%.2f" % s_vqf["total"])
-                sums.setdefault((kind, "vqf"), []).append(s_vqf["total"])
-            trows.append(cells)
-            log("flight %s: %s" % (stem, " | ".join(cells[1:])))
-        kinds = []
-        for name, gust in TURBULENT_FLIGHTS:
-            kind = turbulent_kind(name, gust)
-            vals = [sums.get((kind, k)) for k in ("", "_cruise", "_sensor", "vqf")]
-            kinds.append("| %s (mean of %d) | " % (kind, len(vals[0] or [])) +
-                         " | ".join("%.2f" % (sum(v) / len(v)) if v else "–" for v in vals) + " |")
-        rep += ["Flights in turbulence on seeds no tuning has used (`fly.py --flight NAME [--gust 1] --seed S`, "
-                "S = %s): total RMSE in degrees, ours without an airspeed / with the cruise speed / with the "
-                "airspeed sensor, and VQF." % ", ".join(str(x) for x in TURBULENT_SEEDS), "",
-                "| flight | ours | ours, cruise %g m/s | ours, airspeed sensor | VQF |" % TRIM_AIRSPEED_M_S,
-                "|---|---|---|---|---|"] + kinds + [""] + \
-               ["| file | ours | ours, cruise | ours, sensor | VQF |", "|---|---|---|---|---|"] + \
-               ["| " + " | ".join(r) + " |" for r in sorted(trows)] + [""]
+        seeds = ", ".join(str(x) for x in TURBULENT_SEEDS)
+        rep += turbulent_report(turbulent, flight_dir, replay, score, run_replay, errors, log,
+                                "Flights in turbulence on seeds no tuning has used (`fly.py --flight NAME [--gust 1] "
+                                "--seed S`, S = %s): total RMSE in degrees, ours without an airspeed / with the cruise "
+                                "speed / with the airspeed sensor, and VQF." % seeds)
+        with_imu = make_imu_flights(build, turbulent, flight_dir, log)
+        if with_imu:
+            rep += turbulent_report(with_imu, flight_dir, replay, score, run_replay, errors, log,
+                                    "The same flights with an uncalibrated board's IMU (`scenario --from FILE %s "
+                                    "--seed S`: the gyro's bias (1.5, -1, 0.8) deg/s and its drift, the "
+                                    "accelerometer's offset and scale, datasheet noise, quantised; the compass "
+                                    "calibrated). Started in the air, nothing measures the bias: total RMSE in "
+                                    "degrees, as above." % " ".join(IMU_ERRORS))
     loop_texts = []
     for name, what in CLOSED_LOOP_TURNS:
         loop = closed_loop_turn(build, name)
