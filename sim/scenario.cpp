@@ -392,11 +392,12 @@ int errors_on_file(const std::string& path, const SensorErrors& err, Measuring::
         std::fprintf(stderr, "scenario: %s\n", in.error().c_str());
         return 1;
     }
-    if (in.size() < 2 || !(in.duration_s() > 0.0)) {
-        std::fprintf(stderr, "scenario: %s: needs two samples or more\n", path.c_str());
+    const double span_s = in.size() < 2 ? 0.0 : in[in.size() - 1].t_s - in[0].t_s;
+    if (!(span_s > 0.0)) {
+        std::fprintf(stderr, "scenario: %s: needs two samples or more, in time order\n", path.c_str());
         return 1;
     }
-    const double rate_hz = (double)(in.size() - 1) / in.duration_s();
+    const double rate_hz = (double)(in.size() - 1) / span_s;
     Measuring m(err, rate_hz, level);
     const double no_extra[3] = {0, 0, 0};
     std::fputs(sim::kTrajectoryHeader, stdout);
