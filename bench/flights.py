@@ -174,7 +174,7 @@ def turbulent_report(flights, flight_dir, replay, score, run_replay, errors, log
     """Ours in the three airspeed modes and VQF on each flight of {stem: (kind, trajectory,
     state log)}: a table of the kinds' means and one of the files (markdown lines)."""
     import peers
-    trows, sums = [], {}
+    trows, sums, totals = [], {}, {}
     for stem, (kind, traj, state) in flights.items():
         cells = [stem]
         for suffix, what, extra in airspeed_variants(state):
@@ -185,11 +185,13 @@ def turbulent_report(flights, flight_dir, replay, score, run_replay, errors, log
             cells.append("%.2f" % ours["total"] if ours else "–")
             if ours:
                 sums.setdefault((kind, suffix), []).append(ours["total"])
+                totals[(stem, suffix)] = ours["total"]
         if "VQF" in peers.PEERS:
             tr = peers.load_trajectory(traj)
             s_vqf = peers.score(tr["quat"], peers.PEERS["VQF"](tr), tr["movement"])
             cells.append("%.2f" % s_vqf["total"])
             sums.setdefault((kind, "vqf"), []).append(s_vqf["total"])
+            totals[(stem, "vqf")] = s_vqf["total"]
         trows.append(cells)
         log("flight %s: %s" % (stem, " | ".join(cells[1:])))
     kinds = []
@@ -198,9 +200,17 @@ def turbulent_report(flights, flight_dir, replay, score, run_replay, errors, log
         vals = [sums.get((kind, k)) for k in ("", "_cruise", "_sensor", "vqf")]
         kinds.append("| %s (mean of %d) | " % (kind, len(vals[0] or [])) +
                      " | ".join("%.2f" % (sum(v) / len(v)) if v else "–" for v in vals) + " |")
+    # Issue 24 asks each flight to be ahead of VQF: how many are, per airspeed mode.
+    ahead = []
+    for suffix in ("", "_cruise", "_sensor"):
+        pairs = [(totals[(stem, suffix)], totals[(stem, "vqf")]) for stem in flights
+                 if (stem, suffix) in totals and (stem, "vqf") in totals]
+        ahead.append("%d of %d" % (sum(o < v for o, v in pairs), len(pairs)))
     return [intro, "",
             "| flight | ours | ours, cruise %g m/s | ours, airspeed sensor | VQF |" % TRIM_AIRSPEED_M_S,
             "|---|---|---|---|---|"] + kinds + [""] + \
+           ["Files where ours is ahead of VQF: %s (without an airspeed / with the cruise speed / with the "
+            "sensor)." % " / ".join(ahead), ""] + \
            ["| file | ours | ours, cruise | ours, sensor | VQF |", "|---|---|---|---|---|"] + \
            ["| " + " | ".join(r) + " |" for r in sorted(trows)] + [""]
 
