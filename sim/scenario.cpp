@@ -334,20 +334,21 @@ bool parse_list(const char* text, double* out, int n_min, int n_max, int& n) {
 
 double quantised(double v, double lsb) { return std::round(v / lsb) * lsb; }
 
-// The sensor-error model's state over a file: the noise levels (per sample), the two
+// The sensor-error model over a file: the errors, the noise levels (per sample), the two
 // noise sequences and the bias's random walk.
 struct Measuring {
+    const SensorErrors& err;
     double gyro_sigma_rad_s, accel_sigma_m_s2, mag_sigma_uT;
     double walk_step_dps;  // the random walk's step per sample
     Noise noise, walk_noise;
     double walk_dps[3] = {0, 0, 0};
 
-    // noise: the datasheet's densities at rate_hz, or the fixed amounts, or none.
-    enum class Level { kNone, kDefault, kDatasheet };
-    Measuring(const SensorErrors& err, double rate_hz, Level level) {
+    // noisy: white noise at rate_hz, the datasheet's densities or the fixed amounts as err
+    // says; else none.
+    Measuring(const SensorErrors& errors, double rate_hz, bool noisy) : err(errors) {
         if (err.seed != 0) noise.state ^= err.seed * 0xD1B54A32D192ED03ull;
         walk_noise.state = noise.state ^ 0x5851F42D4C957F2Dull;  // its own: the options never shift the default noise
-        const bool datasheet = level == Level::kDatasheet, none = level == Level::kNone;
+        const bool datasheet = err.datasheet_noise, none = !noisy;
         gyro_sigma_rad_s = none ? 0.0 : datasheet ? kGyroDensity_dps_sqrt_hz * std::sqrt(rate_hz / 2.0) * kDeg : kGyroNoise_rad_s;
         accel_sigma_m_s2 = none ? 0.0
                            : datasheet ? kAccelDensity_g_sqrt_hz * kGravity_m_s2 * std::sqrt(rate_hz / 2.0)
@@ -359,8 +360,8 @@ struct Measuring {
 
     // The measured columns of one sample from the true rate, specific force and field in
     // body axes (SensorErrors' model; extra_bias_rad_s and vibration_m_s2: a scenario's own).
-    void measure(const SensorErrors& err, double t_s, const double extra_bias_rad_s[3], double vibration_m_s2,
-                 double gyro[3], double accel[3], const double field_body[3], double mag[3]) {
+    void measure(double t_s, const double extra_bias_rad_s[3], double vibration_m_s2, double gyro[3], double accel[3],
+                 const double field_body[3], double mag[3]) {
         for (int i = 0; i < 3; ++i)
             mag[i] = err.soft_iron[i][0] * field_body[0] + err.soft_iron[i][1] * field_body[1] +
                      err.soft_iron[i][2] * field_body[2] + err.hard_iron_uT[i];
@@ -386,7 +387,7 @@ void quantise(double gyro[3], double accel[3], double mag[3]) {
 // --from FILE: the sensor errors on a trajectory's measured columns (a flight of
 // sim/flight/fly.py, a recording), its truth and movement as they are; noise only as
 // --noise asks (the file has its own). 0 on success.
-int errors_on_file(const std::string& path, const SensorErrors& err, Measuring::Level level) {
+int errors_on_file(const std::string& path, const SensorErrors& err, bool noisy) {
     sim::Trajectory in;
     if (!in.load(path)) {
         std::fprintf(stderr, "scenario: %s\n", in.error().c_str());
@@ -398,13 +399,13 @@ int errors_on_file(const std::string& path, const SensorErrors& err, Measuring::
         return 1;
     }
     const double rate_hz = (double)(in.size() - 1) / span_s;
-    Measuring m(err, rate_hz, level);
+    Measuring m(err, rate_hz, noisy);
     const double no_extra[3] = {0, 0, 0};
     std::fputs(sim::kTrajectoryHeader, stdout);
     for (size_t k = 0; k < in.size(); ++k) {
         sim::TrajectorySample row = in[k];
         const double field_body[3] = {row.mag_uT[0], row.mag_uT[1], row.mag_uT[2]};
-        m.measure(err, row.t_s, no_extra, 0.0, row.gyro_rad_s, row.accel_m_s2, field_body, row.mag_uT);
+        m.measure(row.t_s, no_extra, 0.0, row.gyro_rad_s, row.accel_m_s2, field_body, row.mag_uT);
         if (err.quantise) quantise(row.gyro_rad_s, row.accel_m_s2, row.mag_uT);
         std::fputs(sim::format_trajectory_row(row).c_str(), stdout);
     }
@@ -507,10 +508,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "scenario: --from takes the file's motion and length: no NAME or --seconds\n");
             return 1;
         }
-        const Measuring::Level level = !noise_asked ? Measuring::Level::kNone
-                                       : err.datasheet_noise ? Measuring::Level::kDatasheet
-                                                             : Measuring::Level::kDefault;
-        return errors_on_file(from, err, level);
+        return errors_on_file(from, err, noise_asked);
     }
     const Scenario* scenario = nullptr;
     for (const Scenario& s : list)
@@ -532,7 +530,7 @@ int main(int argc, char** argv) {
     };
 
     const Extras& x = scenario->extras;
-    Measuring m(err, rate_hz, err.datasheet_noise ? Measuring::Level::kDatasheet : Measuring::Level::kDefault);
+    Measuring m(err, rate_hz, true);
     std::fputs(sim::kTrajectoryHeader, stdout);
     const long n = (long)std::floor(seconds * rate_hz + 1e-9);
     const double h_s = 1e-5;
@@ -562,7 +560,7 @@ int main(int argc, char** argv) {
         double field_body[3];
         earth_to_body(q, field_ned, field_body);
         double mag[3];
-        m.measure(err, t_s, x.gyro_bias_rad_s, x.vibration_m_s2, gyro, accel, field_body, mag);
+        m.measure(t_s, x.gyro_bias_rad_s, x.vibration_m_s2, gyro, accel, field_body, mag);
         accel[2] += x.vibration_tone_m_s2 * std::sin(2 * kPi * 25.0 * t_s);
         if (err.quantise) quantise(gyro, accel, mag);
         sim::TrajectorySample row{t_s, {gyro[0], gyro[1], gyro[2]}, {accel[0], accel[1], accel[2]},
