@@ -21,8 +21,9 @@ namespace dcm {
 // the 10 deg/s limit (2.5 deg/s) covers a board 15 degC warmer than at power-on (the
 // warm-up is 0.2 deg/s a minute). More is a tilt error that a sustained acceleration
 // left, not the gyro: a turn flown without an airspeed below the integrator's hold rate
-// (30 deg of bank at 36 m/s) teaches 3.8 deg/s. VQF bounds its moving bias estimate at 2 deg/s. Never measured, a bias is the chip's
-// whole zero-rate output: bias_limit_rad_s itself.
+// (30 deg of bank at 36 m/s) teaches 3.8 deg/s. VQF bounds its moving bias estimate at
+// 2 deg/s. Never measured, a bias is the chip's whole zero-rate output: bias_limit_rad_s
+// itself.
 constexpr uint8_t kCalibratedLimitShift = 2;
 
 class GyroBias {
