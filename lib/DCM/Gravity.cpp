@@ -132,11 +132,13 @@ FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r
     const int32_t e = (int32_t)((uint32_t)mul_q30(lp.x, inv_lp_q34) << 11);
     // In body axes: R^T (error_n, error_e, 0), the matrix in 16 bits (an error of 6e-5 of
     // the correction).
-    using linalg::hot::mul_q14;
     using linalg::q14_of;
-    const Vector3l error(mul_q14(q14_of(r.a.x), n) + mul_q14(q14_of(r.b.x), e),
-                         mul_q14(q14_of(r.a.y), n) + mul_q14(q14_of(r.b.y), e),
-                         mul_q14(q14_of(r.a.z), n) + mul_q14(q14_of(r.b.z), e));
+    const Vector3l error(linalg::hot::mul_q14(q14_of(r.a.x), n) + linalg::hot::mul_q14(q14_of(r.b.x), e),
+                         linalg::hot::mul_q14(q14_of(r.a.y), n) + linalg::hot::mul_q14(q14_of(r.b.y), e),
+                         linalg::hot::mul_q14(q14_of(r.a.z), n) + linalg::hot::mul_q14(q14_of(r.b.z), e));
+    // The gain's and the low-pass turn's products below as ordinary calls: five calls at
+    // 50 Hz cost a few cycles a step, their inline copies some 100 bytes of flash each.
+    using linalg::mul_q14;
     const float kp = startup_left > 0.0f
                          ? settings.kp_rp_1_s + (settings.kp_startup_1_s - settings.kp_rp_1_s) * startup_left
                          : settings.kp_rp_1_s;
