@@ -464,6 +464,17 @@ TEST(DcmExact, ATiltRightAfterTheStartIsCorrectedAtOnce) {
     EXPECT_GT(f.euler().roll_rad, 2.0f * linalg::kRadPerDeg);
 }
 
+// A start from a mean (the calibration's, a never-still window's) has nothing for the
+// fast gain to pull in: the same 10 deg that a start from one sample follows by a third
+// within 0.3 s (above) is an acceleration after it (a gust), followed at the steady gain.
+TEST(DcmExact, AStartFromAMeanFollowsNoAccelerationFast) {
+    dcm::Dcm f;
+    ASSERT_TRUE(f.init(accel_for(Matrix3f::identity()), earth_field_uT(), true));
+    const Matrix3f tilted = dcm::dcm_from_euler(10.0f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    for (int i = 0; i < 60; ++i) f.update(Vector3f(), accel_for(tilted));  // 0.3 s
+    EXPECT_LT(f.euler().roll_rad, 1.5f * linalg::kRadPerDeg);
+}
+
 // q14_ratio is a positive ratio in Q14 rounded to nearest (the coning term's 2/3: 10923,
 // not the truncated 10922).
 TEST(DcmExact, Q14RatioRoundsToNearest) {

@@ -179,6 +179,29 @@ TEST(DcmProperties, NoBiasIsLearnedFromAWrongStart) {
     EXPECT_LT(tilt_error_deg(truth, filter.matrix()), 1.0f);
 }
 
+// A start that was never still begins from the window's mean with a bias nothing measured:
+// gravity learns it from the first correction (held, a 1.5 deg/s bias would tilt the
+// estimate by b (tau_LP + 1/kp) until the start-up ends). A still start's mean comes with
+// the bias measured: the start-up holds the integrator as after a start from one sample.
+TEST(DcmProperties, ANeverStillStartLearnsTheBiasFromTheStart) {
+    const Matrix3f level = Matrix3f::identity();
+    const Vector3f bias_rad_s(1.5f * linalg::kRadPerDeg, 0.0f, 0.0f);
+    dcm::Dcm never_still, still;
+    ASSERT_TRUE(never_still.init(accel_for(level), mag_for(level), true));
+    ASSERT_TRUE(still.init(accel_for(level), mag_for(level), true));
+    still.set_gyro_bias_measured();
+    const int startup_steps = (int)(never_still.settings().startup_s / never_still.settings().step_s);
+    for (int i = 0; i < startup_steps - 4; ++i) {  // shaken sideways: no rest to measure it
+        const Vector3f shaken = accel_for(level) + Vector3f(0.0f, (i / 40) % 2 ? 2.0f : -2.0f, 0.0f);
+        never_still.update(bias_rad_s, shaken);
+        still.update(Vector3f(), shaken);
+    }
+    EXPECT_FALSE(never_still.status() & dcm::kStatusBiasHeld);
+    EXPECT_GT(never_still.gyro_bias_rad_s().x * linalg::kDegPerRad, 0.1f);
+    EXPECT_TRUE(still.status() & dcm::kStatusBiasHeld);
+    EXPECT_LT(still.gyro_bias_rad_s().length() * linalg::kDegPerRad, 0.01f);
+}
+
 // The float form after the counts form's scales (a tool that sets both): the float
 // samples are read in their own units again, whichever scale was set.
 TEST(DcmProperties, TheFloatFormAfterOtherScalesReadsItsOwnUnits) {

@@ -107,6 +107,58 @@ TEST(StartGravity, PipelineStartsFromTheMeanWhenNeverStill) {
     EXPECT_FALSE(p.estimator().gyro_bias_measured());  // the bias still to find: ki_rp
 }
 
+// ... and through the start-up that follows, the gust goes on: the estimator started from
+// a mean (Dcm::init's gravity_is_mean) follows it at the steady gain, not the start-up's
+// (which rolled it 5.3 deg).
+TEST(StartGravity, TheStartUpAfterTheMeanDoesNotFollowTheGust) {
+    pipeline::AttitudePipeline p;
+    float worst_roll_deg = 0.0f;
+    int lines = 0;
+    for (int i = 0; i < 1200; ++i) {
+        const float side_m_s2 = 3.0f * sinf(2.0f * kPi * 1.5f * kDt_s * i);
+        p.on_imu_sample(imu(Vector3f(), kLevel + Vector3f(0.0f, side_m_s2, 0.0f)));
+        if (!p.output_due()) continue;
+        ++lines;
+        worst_roll_deg = fmaxf(worst_roll_deg, fabsf(p.angles().roll_deg));
+    }
+    ASSERT_GT(lines, 20);
+    EXPECT_LT(worst_roll_deg, 2.5f);
+}
+
+// A still start is a mean too (the calibration's second): a board picked up and shaken
+// right after it (a hand launch) is followed at the steady gain, not the start-up's.
+TEST(StartGravity, AStillStartFollowsAShakeAfterItAtTheSteadyGain) {
+    pipeline::AttitudePipeline p;
+    int i = 0;
+    for (; i < 400 && p.phase() != pipeline::Phase::Running; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
+    ASSERT_EQ(p.phase(), pipeline::Phase::Running);
+    float worst_roll_deg = 0.0f;
+    for (int j = 0; j < 400; ++j) {  // 2 s of the start-up
+        const float side_m_s2 = 3.0f * sinf(2.0f * kPi * 1.5f * kDt_s * j);
+        p.on_imu_sample(imu(Vector3f(), kLevel + Vector3f(0.0f, side_m_s2, 0.0f)));
+        if (p.output_due()) worst_roll_deg = fmaxf(worst_roll_deg, fabsf(p.angles().roll_deg));
+    }
+    EXPECT_LT(worst_roll_deg, 2.5f);  // the start-up's gain: 5.4
+}
+
+// A restart after an outage starts from the one sample it has: that one may be a shock's
+// (20 deg off), and the start-up's fast gain takes most of it back within the second.
+TEST(StartGravity, ARestartFromOneSamplePullsItInFast) {
+    pipeline::AttitudePipeline p;
+    for (int i = 0; i < 400 && p.phase() != pipeline::Phase::Running; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
+    ASSERT_EQ(p.phase(), pipeline::Phase::Running);
+    for (int i = 0; i < 200; ++i) p.on_imu_sample(imu(Vector3f(), kLevel));
+    p.restart_estimator();
+    p.on_imu_sample(imu(Vector3f(), gravity_rolled(20.0f * linalg::kRadPerDeg)));
+    float roll_deg = NAN;
+    for (int i = 0; i < 200; ++i) {  // 1 s
+        p.on_imu_sample(imu(Vector3f(), kLevel));
+        if (p.output_due()) roll_deg = p.angles().roll_deg;
+    }
+    ASSERT_FALSE(std::isnan(roll_deg));
+    EXPECT_LT(fabsf(roll_deg), 4.0f);  // 2.1 (the steady gain alone: 9.7)
+}
+
 // A still start measures the bias: the estimator's gravity integrator starts slow
 // (ki_rp_measured_1_s2, DcmSettings.h).
 TEST(StartGravity, AStillStartMeasuresTheBias) {

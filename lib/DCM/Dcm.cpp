@@ -81,7 +81,7 @@ bool Dcm::accel_plausible(const Vector3f& a) const {
 
 // TRIAD (Shuster & Oh 1981, as in the thesis): the rows of R are the earth axes
 // in body coordinates, so they are built directly from the two observations.
-bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
+bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field, bool gravity_is_mean) {
     if (!accel_m_s2.is_finite()) return false;
     const Vector3f down = (-accel_m_s2).normalized();  // specific force points up
     if (down.is_zero()) return false;
@@ -120,6 +120,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field) {
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     heading_mean_from_ = 0;
+    start_from_mean_ = gravity_is_mean;
     status_ |= kStatusInitialised;
     return true;
 }
@@ -221,8 +222,8 @@ void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok,
         status_ |= kStatusGyroRejected;
         rotating_fast_ = true;  // a broken gyro read: no bias learning on it (below, correct_gravity)
     }
-    // Start-up (steps_ < k_.startup_steps): faster gains, no bias learning (correct_gravity).
-    if (rotating_fast_ || steps_ < k_.startup_steps) status_ |= kStatusBiasHeld;
+    // Start-up (steps_ < k_.startup_steps): no bias learning but after a never-still start (correct_gravity).
+    if (rotating_fast_ || start_holds_integrator()) status_ |= kStatusBiasHeld;
 
     // Gravity. The specific force is low-passed in the (estimated) earth frame, as
     // VQF does: there a linear acceleration averages out over the filter's time,
@@ -281,6 +282,16 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
 #endif
 }
 
+// The start's tilt error is not a gyro bias (a wrong first sample, a launch off the
+// stand): the integrator waits for the start-up to end. Except after a start that was
+// never still: its gravity is the window's mean, and the bias that nothing measured
+// (the saved calibration's, or none: the chip's +-20 deg/s) is what gravity has to
+// learn first; while it waits, the proportional loop holds b / kp of tilt (1.5 deg at
+// 1.5 deg/s) and the dip turns it into 2.5 times as much heading.
+bool Dcm::start_holds_integrator() const {
+    return steps_ < k_.startup_steps && !(start_from_mean_ && !bias_.measured());
+}
+
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
 // and the roll/pitch error (correct_tilt).
 FIXED_OWN_FRAME void Dcm::correct_gravity() {
@@ -288,6 +299,15 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     schedule_.gravity_done();
     const bool starting = steps_ < k_.startup_steps;
     const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
+    // The start-up's fast gain (kp_startup) pulls in a start from one sample, whatever the
+    // moment's acceleration put in it. A start from a mean (the still calibration's, a
+    // never-still window's: Pipeline) is as good as gravity gets; a fast gain would only
+    // follow the accelerations since (a gust's 2-3 m/s^2 at 5/s: degrees of tilt within
+    // 0.3 s, 2.5 times as much heading through the dip). The low-pass's start-up ramp
+    // stays: a bias nothing measured turns the estimate from the first step, and inside
+    // the loop a 3 s low-pass makes its answer slow and ringing (second order, damping
+    // 1 / (2 sqrt(kp tau)): 0.29 at 3 s, 1 at 0.25 s).
+    const float tilt_startup_left = start_from_mean_ ? 0.0f : startup_left;
     // No bias learning while rotating fast: gyro scale errors look like bias there
     // (ArduPilot's rule), and a vehicle's turn holds a centripetal acceleration the
     // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is
@@ -298,7 +318,7 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     // gyro sample in the window holds it too (step()).
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
-    const bool hold_integrator = rotating_fast_ || starting;
+    const bool hold_integrator = rotating_fast_ || start_holds_integrator();
     // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
     if (turn_ != nullptr && turn_->active()) gravity_.take_off_turn(*turn_, strapdown_.r().c, bias_.sensor_units());
     Vector3l gyro_mean, accel_mean;
@@ -315,13 +335,13 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
         const bool direction = lp_norm > 0.5f * kGravity_m_s2;
         trace_->gravity = direction ? GravityEvent::kRan : GravityEvent::kNoDirection;
         trace_->integrator_held = hold_integrator;
-        trace_->gravity_kp_1_s = settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * startup_left;
+        trace_->gravity_kp_1_s = settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * tilt_startup_left;
         trace_->tilt_error_n_rad = direction ? -lp.y / lp_norm : 0.0f;
         trace_->tilt_error_e_rad = direction ? lp.x / lp_norm : 0.0f;
         bias_before = traced_bias_rad_s();
     }
 #endif
-    gravity_.correct_tilt(strapdown_.r(), startup_left, hold_integrator, *settings_, k_, bias_);
+    gravity_.correct_tilt(strapdown_.r(), tilt_startup_left, hold_integrator, *settings_, k_, bias_);
 #if DCM_TRACE
     if (trace_) trace_->bias_from_gravity_rad_s += traced_bias_rad_s() - bias_before;
 #endif

@@ -73,7 +73,10 @@ public:
     // K = -a/|a| (earth down in body), I = (K x m) x K normalised (north), J = K x I.
     // With a zero or unusable field, yaw starts at 0 and kStatusNoHeading is set.
     // Returns false (and stays uninitialised) when gravity is unusable.
-    bool init(const linalg::Vector3f& accel_m_s2, const linalg::Vector3f& mag_field);
+    // gravity_is_mean: accel_m_s2 is a mean over the start's window (a still board's, or
+    // one that was never still, carried by the gyro), not one sample: the start-up's fast
+    // gravity gain has nothing to pull in (correct_gravity).
+    bool init(const linalg::Vector3f& accel_m_s2, const linalg::Vector3f& mag_field, bool gravity_is_mean = false);
 
     // One fixed step: the corrected rate and the accel sample are summed; every
     // kIntegrationSteps steps the summed turn rotates R (R <- R exp([theta x]), with
@@ -230,6 +233,8 @@ private:
     linalg::Vector3f last_mag_field() const;
     void recover();
     bool accel_plausible(const linalg::Vector3f& a) const;
+    // The start-up holds the bias integrator (correct_gravity).
+    bool start_holds_integrator() const;
 
     // The settings (not a copy: 84 bytes of RAM; they must outlive the estimator, as
     // kDefaultDcmSettings and a tool's own set do) and what follows from them, once.
@@ -256,6 +261,7 @@ private:
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool rotating_fast_ = false;
+    bool start_from_mean_ = false;       // init's gravity_is_mean
 #if DCM_TRACE
     DcmTrace* trace_ = nullptr;          // set_trace (host only)
     // The bias estimate now, for the trace's split of its changes by source.

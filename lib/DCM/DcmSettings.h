@@ -17,8 +17,9 @@ struct DcmSettings {
     float ki_rp_measured_1_s2;       // ... once the bias was measured on a still board, 1/s^2
     float kp_yaw_1_s;                // yaw proportional gain, 1/s
     float ki_yaw_1_s2;               // yaw integral gain while no rest or calibration has measured the bias, 1/s^2
-    float kp_startup_1_s;            // roll/pitch P gain at start, ramping down to the steady one; the
-                                     // heading's at rest and at most while moving (then 1/t), 1/s
+    float kp_startup_1_s;            // roll/pitch P gain at a start from one sample (not from a mean:
+                                     // Dcm::init), ramping down to the steady one; the heading's at
+                                     // rest and at most while moving (then 1/t), 1/s
     float startup_s;                 // length of the start-up ramp (also speeds up the accel low-pass), s
     float accel_max_g;               // beyond any accelerometer's range: such a sample is garbage, g
     float accel_lowpass_s;           // time constant of the earth-frame accel low-pass, s

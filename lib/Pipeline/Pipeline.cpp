@@ -242,13 +242,13 @@ const mpu6000::Sample& AttitudePipeline::guard(const mpu6000::Sample& s) {
 // first (a fresh object copied in) and given its scales; at the first start it is as the
 // constructor made it with the scales set when the calibration began (nothing else
 // touches it while calibrating): only the sensor bias is set.
-void AttitudePipeline::start_estimator(const Vector3f& gravity) {
+void AttitudePipeline::start_estimator(const Vector3f& gravity, bool gravity_is_mean) {
     if (st_.phase == Phase::Running) {
         dcm_ = dcm::Dcm(dcm_.settings());
         dcm_.set_sample_scales(last_.gyro_rad_s_per_count, last_.accel_m_s2_per_count);
     }
     dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
-    dcm_.init(gravity, st_.have_mag && st_.mag_present ? field_uT() : Vector3f());
+    dcm_.init(gravity, st_.have_mag && st_.mag_present ? field_uT() : Vector3f(), gravity_is_mean);
     st_.mag_pending = false;
     // How far off the offset in use may be: a fraction of a uT after `cal mag` or
     // learning, tens of uT on a compass never calibrated.
@@ -282,7 +282,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         // this one would overrun its 5 ms.
         st_.start_message = StartMessage::kBias;
         if (st_.phase == Phase::Calibrating) {
-            start_estimator(gyro_cal_.mean_accel_m_s2());
+            start_estimator(gyro_cal_.mean_accel_m_s2(), true);
         } else {
             dcm_.set_sensor_bias_rad_s(settings_.cal.gyro_bias_rad_s);
             dcm_.set_gyro_bias_rad_s(Vector3f());  // the estimator's residual starts again
@@ -300,7 +300,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         // by the gyro (StartGravity.h), keep measuring in the background (the event on the
         // next step, as the bias's).
         st_.start_message = StartMessage::kNotStill;
-        start_estimator(start_gravity_.mean_m_s2());
+        start_estimator(start_gravity_.mean_m_s2(), true);
         return;
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
@@ -338,7 +338,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     }
     if (st_.reinit_pending) {
         st_.reinit_pending = false;
-        start_estimator(s.accel_m_s2());  // a restart after an outage (rare): a long step
+        start_estimator(s.accel_m_s2(), false);  // a restart after an outage (rare): a long step
     }
 
     // A clipped accelerometer sample still points roughly the right way: in a violent

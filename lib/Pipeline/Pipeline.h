@@ -272,7 +272,8 @@ public:
 
 private:
     void step_calibration(const mpu6000::Sample& raw);
-    void start_estimator(const linalg::Vector3f& gravity);
+    // gravity_is_mean: the window's mean, not one sample (Dcm::init).
+    void start_estimator(const linalg::Vector3f& gravity, bool gravity_is_mean);
     const mpu6000::Sample& guard(const mpu6000::Sample& s);
     // The estimator's turn correction from the airspeed (once running: TurnMean's space).
     void configure_turn(int16_t dv_dt_counts = 0);
