@@ -21,11 +21,11 @@ int32_t times_gain(int32_t rate_sum, uint8_t n, int16_t gain_q8) {
     return times_n(linalg::mul_s16((int16_t)within(per_sample(rate_sum, n), 32767), gain_q8) >> 8, n);
 }
 
-// A mean's step, (sum - mean) / 16 (TurnMean::kMeanShift): the high three bytes times
-// 16, not a loop of four shifts (the step's lowest bits, 1/16 of a count, are dropped).
+// A mean's step, (sum - mean) / 32 (TurnMean::kMeanShift): the high three bytes times
+// 8, not a loop of five shifts (the step's lowest bits, 1/32 of a count, are dropped).
 int32_t step_of_mean(int32_t difference_q8) {
-    static_assert(TurnMean::kMeanShift == 4, "a byte's shift less four");
-    return (difference_q8 >> 8) * 16;
+    static_assert(TurnMean::kMeanShift == 5, "a byte's shift less five");
+    return (difference_q8 >> 8) * 8;
 }
 
 }  // namespace
@@ -34,16 +34,22 @@ LateralBounds lateral_bounds(int32_t a_y, int32_t margin) {
     return LateralBounds{(a_y < 0 ? a_y : 0) - margin, (a_y > 0 ? a_y : 0) + margin};
 }
 
+// g sin(kTurnBankMargin_deg): sin(0.5 deg) = 143 / 2^14.
+static_assert(kTurnBankMargin_deg == 0.5f, "143 / 2^14 is sin(kTurnBankMargin_deg)");
+constexpr int16_t kSinMarginQ14 = 143;
+// g sin(kTurnMinBank_deg): sin(5 deg) = 1428 / 2^14.
+static_assert(kTurnMinBank_deg == 5.0f, "1428 / 2^14 is sin(kTurnMinBank_deg)");
+constexpr int16_t kSinTurnQ14 = 1428;
+
 void TurnMean::configure(int16_t gain_q8, int16_t gravity_counts, int16_t dv_dt_counts) {
     gain_q8_ = gain_q8;
     dv_dt_counts_ = dv_dt_counts;
     gravity_counts_x4_ = (int16_t)(gravity_counts * 4);
-    // g sin(kTurnBankMargin_deg): sin(0.5 deg) = 143 / 2^14.
-    static_assert(kTurnBankMargin_deg == 0.5f, "143 / 2^14 is sin(kTurnBankMargin_deg)");
-    margin_counts_ = (int16_t)(((int32_t)gravity_counts * 143 + 8192) >> 14);
-    // g sin(kTurnMinBank_deg): sin(5 deg) = 1428 / 2^14.
-    static_assert(kTurnMinBank_deg == 5.0f, "1428 / 2^14 is sin(kTurnMinBank_deg)");
-    turn_counts_ = (int16_t)(((int32_t)gravity_counts * 1428 + 8192) >> 14);
+}
+
+int16_t TurnMean::gravity_times(int16_t sin_q14) const {
+    // (4 g sin 2^14) / 2^16 rounded: g sin, as (g sin 2^14 + 2^13) >> 14.
+    return (int16_t)((linalg::mul_s16(gravity_counts_x4_, sin_q14) + 32768) >> 16);
 }
 
 TurnMean::AxisBound TurnMean::axis_bound(int32_t f_sum, int32_t down_q30, uint8_t n) const {
@@ -52,7 +58,8 @@ TurnMean::AxisBound TurnMean::axis_bound(int32_t f_sum, int32_t down_q30, uint8_
     static_assert(kTurnBankScaleError <= 1.0f / 32.0f, "g |down| / 32 covers kTurnBankScaleError");
     // (down Q14 times 4 g, >> 16: the high bytes, no shift loop.)
     const int16_t gravity = (int16_t)(linalg::mul_s16((int16_t)(down_q30 >> 16), gravity_counts_x4_) >> 16);
-    return AxisBound{f_sum + times_n(gravity, n), times_n(margin_counts_ + ((gravity < 0 ? -gravity : gravity) >> 5), n)};
+    return AxisBound{f_sum + times_n(gravity, n),
+                     times_n(gravity_times(kSinMarginQ14) + ((gravity < 0 ? -gravity : gravity) >> 5), n)};
 }
 
 int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n) {
@@ -60,7 +67,7 @@ int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q
     const int32_t raw = within(raw_sum, 1L << 21);
     const AxisBound y = axis_bound(f_y_sum, down_y_q30, n);
     const int32_t clipped = within(raw, lateral_bounds(y.a, y.margin));
-    // mean += (sum - mean) / 16, Q8; the first window is the means.
+    // mean += (sum - mean) / 32, Q8; the first window is the means.
     if (!started_) {
         started_ = true;
         raw_q8_ = raw * 256;
@@ -71,28 +78,35 @@ int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q
     a_y_q8_ += step_of_mean(y.a * 256 - a_y_q8_);
     clipped_q8_ += step_of_mean(clipped * 256 - clipped_q8_);
     // Straight flight (a_y's mean within the least turn's): no turn to give back to.
-    const int32_t turn_q8 = times_n(turn_counts_, n) * 256;
+    const int32_t turn_q8 = times_n(gravity_times(kSinTurnQ14), n) * 256;
     if (a_y_q8_ < turn_q8 && a_y_q8_ > -turn_q8) return clipped;
     const int32_t mean_bounded_q8 = within(raw_q8_, lateral_bounds(a_y_q8_, y.margin * 256));
     return clipped + ((mean_bounded_q8 - clipped_q8_) >> 8);
 }
 
-FIXED_COLD void TurnMean::update(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
-                                 const linalg::Vector3l& f_sum, uint8_t window) {
-    if ((window & (2u * kUpdateEvery - 1u)) == 0u) update_longitudinal(down_q30.x, n, f_sum.x);
-    const int32_t f_y_sum = f_sum.y, down_y_q30 = down_q30.y;
+FIXED_COLD void TurnMean::update(const linalg::Vector3l& down_q30, uint8_t n, const linalg::Vector3l& f_sum,
+                                 uint8_t window) {
+    if ((window & 7u) == 0u) update_longitudinal(down_q30.x, n, f_sum.x);
+    // Four samples' worth of the means since the last update: kUpdateEvery windows'
+    // (times 2), or the first window's alone (times 4).
+    static_assert(kUpdateEvery == 2, "two windows' means a sample are two samples' worth");
+    const uint8_t shift = started_ ? 1 : 2;
+    // (Shifted unsigned: a left shift of a negative value is undefined.)
+    const int32_t rate_y = (int32_t)((uint32_t)rate_y_means_ << shift), rate_z = (int32_t)((uint32_t)rate_z_means_ << shift),
+                  f_y = (int32_t)((uint32_t)f_y_means_ << shift);
+    rate_y_means_ = rate_z_means_ = f_y_means_ = 0;
     // Each held within the accelerometer's full scale a sample.
-    const int32_t full_scale = times_n(32767, n);
-    const int32_t lateral = within(lateral_sum(times_gain(rate_z_sum, n, gain_q8_), f_y_sum, down_y_q30, n), full_scale);
-    const int32_t normal = within(times_gain(rate_y_sum, n, gain_q8_), full_scale);
-    term4_.y = per_sample(lateral, n) * 4;
-    term4_.z = -per_sample(normal, n) * 4;
+    const int32_t full_scale = 4L * 32767;
+    const int32_t lateral = within(lateral_sum(times_gain(rate_z, 4, gain_q8_), f_y, down_q30.y, 4), full_scale);
+    const int32_t normal = within(times_gain(rate_y, 4, gain_q8_), full_scale);
+    term_.y = (int16_t)per_sample(lateral, 4);
+    term_.z = (int16_t)-per_sample(normal, 4);
 }
 
 FIXED_COLD void TurnMean::update_longitudinal(int32_t down_x_q30, uint8_t n, int32_t f_x_sum) {
     const AxisBound x = axis_bound(f_x_sum, down_x_q30, n);
     // dV/dt in 16 bits: within the full scale a sample as it is.
-    term4_.x = per_sample(within(times_n(dv_dt_counts_, n), lateral_bounds(x.a, x.margin)), n) * 4;
+    term_.x = (int16_t)per_sample(within(times_n(dv_dt_counts_, n), lateral_bounds(x.a, x.margin)), n);
 }
 
 }  // namespace dcm

@@ -74,8 +74,8 @@ inline int32_t times_n(int32_t x, uint8_t n) { return n == 4 ? x * 4 : x * n; }
 // "no gain, no mean yet": the first window sets the means.
 class TurnMean {
 public:
-    static constexpr uint8_t kUpdateEvery = 4;  // windows: 12.5 Hz
-    static constexpr uint8_t kMeanShift = 4;    // 1 / 16 an update: 1.28 s at 12.5 Hz
+    static constexpr uint8_t kUpdateEvery = 2;  // windows: 25 Hz
+    static constexpr uint8_t kMeanShift = 5;    // 1 / 32 an update: 1.28 s at 25 Hz
     // The gain (accel counts per gyro count of omega x v, Q8; 0: no correction), gravity
     // and dV/dt in accel counts; the means go on.
     void configure(int16_t gain_q8, int16_t gravity_counts, int16_t dv_dt_counts = 0);
@@ -83,25 +83,35 @@ public:
     // The window's sums less (dV/dt, omega_z V, -omega_y V), the first two within their
     // bounds: accel_sum and the running sums' sum, from the gyro's sums less the
     // calibrated bias (counts) and earth down in body axes (R's third row, Q30). The
-    // lateral and normal terms are worked out every kUpdateEvery-th window (12.5 Hz: a
+    // lateral and normal terms are worked out every kUpdateEvery-th window (25 Hz: a
     // turn's term moves at the turn's pace, a gust's swings at a few hertz; the work is
-    // 32-bit arithmetic), dV/dt with every second of them (6.25 Hz: the speed changes at
-    // a climb's pace); each is kept for the windows between.
+    // 32-bit arithmetic), dV/dt every eighth window (6.25 Hz: the speed changes at a
+    // climb's pace); each is kept for the windows between. The lateral and normal terms
+    // come from the rates' and a_y's means over the windows they stand for, not the last
+    // window's: one 20 ms window's rate, held for the windows between, is a sample at the
+    // update rate, and an oscillation at that rate or its multiples (a propeller's
+    // vibration the airframe answers, folded by the sampling) comes out a steady term
+    // (from the last of four windows: a flight climbing at full throttle rolled 2.6 deg
+    // with the cruise speed, README "Flying in simulation"); the mean over the 40 ms it is
+    // held for passes nothing at 25 Hz and its multiples, and what is near 12.5 Hz comes
+    // out with its sign alternating.
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
                   linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
         const uint8_t window = windows_++;
-        if ((window & (kUpdateEvery - 1u)) == 0u)
-            update(rate_y_sum, rate_z_sum, down_q30, n, accel_sum, window);
+        rate_y_means_ += mean_of(rate_y_sum, n);
+        rate_z_means_ += mean_of(rate_z_sum, n);
+        f_y_means_ += mean_of(accel_sum.y, n);
+        if ((window & (kUpdateEvery - 1u)) == 0u) update(down_q30, n, accel_sum, window);
         // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all:
         // the window's term (n samples' worth) times (n + 1) / 2, 10 samples' worth for 4.
         if (n == 4) {
-            take_off_term(term4_.x, term4_.x * 2 + (term4_.x >> 1), accel_sum.x, accel_sum_of_sums.x);
-            take_off_term(term4_.y, term4_.y * 2 + (term4_.y >> 1), accel_sum.y, accel_sum_of_sums.y);
-            take_off_term(term4_.z, term4_.z * 2 + (term4_.z >> 1), accel_sum.z, accel_sum_of_sums.z);
+            take_off_four(term_.x, accel_sum.x, accel_sum_of_sums.x);
+            take_off_four(term_.y, accel_sum.y, accel_sum_of_sums.y);
+            take_off_four(term_.z, accel_sum.z, accel_sum_of_sums.z);
         } else {
-            take_off_late(term4_.x, n, accel_sum.x, accel_sum_of_sums.x);
-            take_off_late(term4_.y, n, accel_sum.y, accel_sum_of_sums.y);
-            take_off_late(term4_.z, n, accel_sum.z, accel_sum_of_sums.z);
+            take_off_late(term_.x, n, accel_sum.x, accel_sum_of_sums.x);
+            take_off_late(term_.y, n, accel_sum.y, accel_sum_of_sums.y);
+            take_off_late(term_.z, n, accel_sum.z, accel_sum_of_sums.z);
         }
     }
 
@@ -110,11 +120,19 @@ private:
         sum -= term;
         sum_of_sums -= term_weighted;
     }
-    // A late window's n samples (the term a sample is a quarter of the four's, exactly).
-    static void take_off_late(int32_t term4, uint8_t n, int32_t& sum, int32_t& sum_of_sums) {
-        const int32_t term = times_n(term4 >> 2, n);
-        take_off_term(term, (times_n(term, n) + term) >> 1, sum, sum_of_sums);
+    // The usual window's 4 samples (a sample's term, counts).
+    static void take_off_four(int16_t term, int32_t& sum, int32_t& sum_of_sums) {
+        const int32_t term4 = (int32_t)term * 4;
+        take_off_term(term4, term4 * 2 + (term4 >> 1), sum, sum_of_sums);
     }
+    // A late window's n samples.
+    static void take_off_late(int16_t term, uint8_t n, int32_t& sum, int32_t& sum_of_sums) {
+        const int32_t term_n = times_n(term, n);
+        take_off_term(term_n, (times_n(term_n, n) + term_n) >> 1, sum, sum_of_sums);
+    }
+    // A window's sum a sample, rounded (within the sensor's 16 bits): two shifts for the
+    // usual 4, the division only for a late window's n.
+    static int32_t mean_of(int32_t sum, uint8_t n) { return n == 4 ? (sum + 2) >> 2 : sum / n; }
     // a = f + g down on one axis (f_sum the accelerometer's sum there, down_q30 earth
     // down's component) and the margin, each summed over the window's n samples.
     struct AxisBound {
@@ -123,21 +141,25 @@ private:
     AxisBound axis_bound(int32_t f_sum, int32_t down_q30, uint8_t n) const;
     // The window's lateral term (counts summed over the window) from omega_z V's sum.
     int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
-    // The terms from the window's sums (f_sum: the accelerometer's), dV/dt on every
-    // second call (window: the count of this one).
-    void update(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
-                const linalg::Vector3l& f_sum, uint8_t window);
+    // The lateral and normal terms from the means since the last update (four samples'
+    // worth of them), dV/dt from this window's sums (f_sum: the accelerometer's) on every
+    // eighth window (window: the count of this one).
+    void update(const linalg::Vector3l& down_q30, uint8_t n, const linalg::Vector3l& f_sum, uint8_t window);
     // dV/dt within its bound (f_x_sum: the accelerometer's x).
     void update_longitudinal(int32_t down_x_q30, uint8_t n, int32_t f_x_sum);
+    // g sin of an angle whose sine is sin_q14 / 2^14, accel counts (the margin's, a turn's).
+    int16_t gravity_times(int16_t sin_q14) const;
 
     int32_t raw_q8_, a_y_q8_, clipped_q8_;  // means of the windows' sums, Q8
-    int16_t gain_q8_, gravity_counts_x4_, margin_counts_, dv_dt_counts_;
-    int16_t turn_counts_;                   // g sin(kTurnMinBank_deg), accel counts
+    // The windows' means a sample summed since the last update (gyro counts less the
+    // calibrated bias; the accelerometer's y, counts): kUpdateEvery of them, doubled, are
+    // four samples' worth of their mean.
+    int32_t rate_y_means_, rate_z_means_, f_y_means_;
+    int16_t gain_q8_, gravity_counts_x4_, dv_dt_counts_;
     bool started_;                          // the means hold a window (the first sets them)
     uint8_t windows_;                       // counts the windows: when the terms are worked out
-    // The terms taken off, four samples' worth (accel counts; x dV/dt, y omega_z V, z
-    // -omega_y V), each a multiple of 4.
-    linalg::Vector3l term4_;
+    // The terms taken off, a sample's (accel counts; x dV/dt, y omega_z V, z -omega_y V).
+    linalg::Vector3i term_;
 };
 
 }  // namespace dcm
