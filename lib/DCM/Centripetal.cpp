@@ -10,10 +10,6 @@ namespace {
 int32_t within(int32_t x, LateralBounds b) { return x < b.lo ? b.lo : (x > b.hi ? b.hi : x); }
 int32_t within(int32_t x, int32_t limit) { return x < -limit ? -limit : (x > limit ? limit : x); }
 
-// A window's sum a sample: rounded shifts for the usual 4 (times_n's inverse), a
-// division only for a late window's n.
-int32_t per_sample(int32_t sum, uint8_t n) { return n == 4 ? (sum + 2) >> 2 : sum / n; }
-
 // A window's omega V (counts): the rate's mean over the window (rounded to a count:
 // 0.06 deg of bank at 18 m/s) times the gain, in 16 bits (below 2^13 up to 60 m/s),
 // times n.

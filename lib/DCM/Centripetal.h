@@ -69,6 +69,9 @@ LateralBounds lateral_bounds(int32_t a_y, int32_t margin);
 // x n for a window's n samples: two shifts for the usual 4 (avr-gcc's 32-bit multiply
 // is a call).
 inline int32_t times_n(int32_t x, uint8_t n) { return n == 4 ? x * 4 : x * n; }
+// A window's sum a sample: rounded shifts for the usual 4 (times_n's inverse), a
+// division only for a late window's n.
+inline int32_t per_sample(int32_t sum, uint8_t n) { return n == 4 ? (sum + 2) >> 2 : sum / n; }
 
 // A plain struct (no constructor: the pipeline keeps it in a union, RAM); zero is
 // "no gain, no mean yet": the first window sets the means.
@@ -98,9 +101,9 @@ public:
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
                   linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
         const uint8_t window = windows_++;
-        rate_y_means_ += mean_of(rate_y_sum, n);
-        rate_z_means_ += mean_of(rate_z_sum, n);
-        f_y_means_ += mean_of(accel_sum.y, n);
+        rate_y_means_ += per_sample(rate_y_sum, n);
+        rate_z_means_ += per_sample(rate_z_sum, n);
+        f_y_means_ += per_sample(accel_sum.y, n);
         if ((window & (kUpdateEvery - 1u)) == 0u) update(down_q30, n, accel_sum, window);
         // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all:
         // the window's term (n samples' worth) times (n + 1) / 2, 10 samples' worth for 4.
@@ -130,9 +133,6 @@ private:
         const int32_t term_n = times_n(term, n);
         take_off_term(term_n, (times_n(term_n, n) + term_n) >> 1, sum, sum_of_sums);
     }
-    // A window's sum a sample, rounded (within the sensor's 16 bits): two shifts for the
-    // usual 4, the division only for a late window's n.
-    static int32_t mean_of(int32_t sum, uint8_t n) { return n == 4 ? (sum + 2) >> 2 : sum / n; }
     // a = f + g down on one axis (f_sum the accelerometer's sum there, down_q30 earth
     // down's component) and the margin, each summed over the window's n samples.
     struct AxisBound {
