@@ -27,6 +27,10 @@ BUILD_GOALS := all firmware attitude-only tools sim fly test bench tune upload s
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean
+# Each goal is a make of its own (below): two at once (make -j2 all venv) would both
+# build what they share, the venv at the same time. Goals run one after the other here;
+# each build is parallel inside with the -j given.
+.NOTPARALLEL:
 
 # A quick check (dpkg-query), apt-get only when something is missing.
 deps:
