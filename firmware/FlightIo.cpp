@@ -59,6 +59,7 @@ void FlightIo::poll(uint32_t now_us, uint32_t now_ms) {
 void FlightIo::after_estimator_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample, bool output,
                                     const pipeline::AnglesCentideg* angles) {
     ++control_count_;
+    if (pipe.starting()) return;  // the estimator's start fills the step: on the next one
     if (control_count_ >= kControlDivider ||
         (output && control_count_ >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
         control_step(now_us, now_ms, &sample, angles);

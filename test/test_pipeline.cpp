@@ -49,7 +49,10 @@ TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
         p.on_imu_sample(imu(kBias, kLevel));
         if (p.output_due() && first_output < 0) first_output = i;
     }
-    EXPECT_EQ(first_output, calib::kGyroWindow - 1);  // the step that finished the calibration
+    // The step that finished the calibration started the estimator, the next told the
+    // bias; the step after those two has a field sample (every third): the first line on
+    // the one after it.
+    EXPECT_EQ(first_output, calib::kGyroWindow - 1 + 3);
     EXPECT_EQ(p.phase(), pipeline::Phase::Running);
     // The mean of what the sensor gave: kBias in whole counts.
     EXPECT_NEAR(p.settings().cal.gyro_bias_rad_s.x, imu(kBias, kLevel).gyro_rad_s().x, 1e-6f);
@@ -77,19 +80,41 @@ TEST(Pipeline, MovingBoardStillStartsBeforeTheDeadline) {
     LoggedPipeline logged;
     pipeline::AttitudePipeline& p = logged.p;
     std::string& log = logged.log;
-    int first_output = -1;
-    for (int i = 0; i < 400 && first_output < 0; ++i) {
+    int start = -1;
+    for (int i = 0; i < 400 && start < 0; ++i) {
         const float wobble = (i % 20 < 10) ? 0.2f : -0.2f;  // +-11 deg/s
         p.on_imu_sample(imu(Vector3f(0.0f, 0.0f, wobble), kLevel));
-        if (p.output_due()) first_output = i;
+        EXPECT_FALSE(p.output_due()) << i;
+        if (p.phase() == pipeline::Phase::Running) start = i;
     }
-    EXPECT_EQ(first_output, pipeline::kStartupDeadlineSteps - 1);
+    EXPECT_EQ(start, pipeline::kStartupDeadlineSteps - 1);
     EXPECT_NE(log.find("# calibrating gyro: board moved, retrying"), std::string::npos);
-    // The warning goes out on the step after the start (that one carries Dcm::init).
+    // The warning goes out on the step after the start (that one carries Dcm::init), the
+    // first line on the step after the warning's.
+    EXPECT_TRUE(p.starting());
     EXPECT_EQ(log.find("# warn: board not still"), std::string::npos);
     p.on_imu_sample(imu(Vector3f(), kLevel));
     EXPECT_NE(log.find("# warn: board not still"), std::string::npos);
+    EXPECT_TRUE(p.starting());
+    EXPECT_FALSE(p.output_due());
+    p.on_imu_sample(imu(Vector3f(), kLevel));
+    EXPECT_FALSE(p.starting());
+    EXPECT_TRUE(p.output_due());
     EXPECT_TRUE(p.gyro_calibrating());  // measuring on in the background
+}
+
+TEST(Pipeline, TheLinesAfterTheStartKeepTheirRate) {
+    // The first line waits out the start's two long steps; the next ones come at the
+    // rate from it (not two at once to catch up).
+    pipeline::AttitudePipeline p;
+    std::vector<int> lines;
+    for (int i = 0; i < calib::kGyroWindow + 40; ++i) {
+        p.on_imu_sample(imu(kBias, kLevel));
+        if (p.output_due()) lines.push_back(i);
+    }
+    ASSERT_GE(lines.size(), 5u);
+    EXPECT_EQ(lines[0], calib::kGyroWindow + 1);
+    for (size_t k = 1; k < lines.size(); ++k) EXPECT_EQ(lines[k] - lines[k - 1], 4) << k;  // 50 Hz of 200
 }
 
 TEST(Pipeline, OutputRateFollowsTheSetting) {
@@ -409,7 +434,7 @@ TEST(PipelineEvents, StartTellsCalibrationThenTheBiasOnTheStepAfterTheStart) {
     int start_step = -1;
     for (int i = 0; i < 300; ++i) {
         p.on_imu_sample(imu(kBias, kLevel));
-        if (p.output_due() && start_step < 0) start_step = (int)p.steps();
+        if (p.phase() == pipeline::Phase::Running && start_step < 0) start_step = (int)p.steps();
     }
     ASSERT_GE(r.events.size(), 2u);
     EXPECT_EQ(r.events[0].kind, EventKind::kGyroCalStart);

@@ -260,7 +260,7 @@ void AttitudePipeline::start_estimator(const Vector3f& gravity, bool gravity_is_
     st_.phase = Phase::Running;
     turn_mean_ = dcm::TurnMean();  // the start's gravity is spent: its space holds the turn's mean
     configure_turn();
-    st_.output_acc = kRateHz;  // the first line comes with the first step
+    st_.output_acc = kRateHz;  // the first line comes with the first step it fits on
 }
 
 void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
@@ -322,7 +322,9 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     if (st_.start_message == StartMessage::kBias) tell(EventKind::kGyroBias);
     if (st_.start_message == StartMessage::kNotStill)
         tell(EventKind::kNotStill, 0, 0, 0.0f, (settings_.flags & settings::kFlagGyroCalibrated) ? 1 : 0);
-    st_.start_message = StartMessage::kNone;
+    st_.start_message = st_.start_message == StartMessage::kTold || st_.start_message == StartMessage::kNone
+                            ? StartMessage::kNone
+                            : StartMessage::kTold;
     const mpu6000::Sample& s = guard(raw);  // last_, the sample the step uses
     if (st_.phase == Phase::WaitImu) {
         st_.phase = Phase::Calibrating;
@@ -357,8 +359,9 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // A field sample (into earth axes, and the heading's correction every kHeadingSteps)
     // waits out a step on which the DCM integrates or corrects gravity, up to
     // kMaxMagWaitSteps: its age is counted in the latency compensation. A line (Euler
-    // angles and formatting) is not made on a step with a field sample: it moves to the
-    // next step, 5 ms later (samples come at least two steps apart). The DCM brings its
+    // angles and formatting) is not made on a step with a field sample, nor on the
+    // start's two (starting()): it moves to the next step, 5 ms later (samples come at
+    // least two steps apart). The DCM brings its
     // matrix up to date for the line. (The parts' costs: README "Performance".)
     bool heading_corrected = st_.mag_pending && st_.mag_present;
     if (heading_corrected && st_.mag_wait_steps < kMaxMagWaitSteps && dcm_.heavy_due()) {
@@ -366,7 +369,10 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         ++st_.mag_wait_steps;
     }
     st_.output_acc = (uint16_t)(st_.output_acc + settings_.rate_hz);
-    if (st_.output_acc >= kRateHz && !heading_corrected) {
+    if (starting()) {
+        // The first line on the step after the start's two, the next ones a period after it.
+        st_.output_acc = settings_.rate_hz < kRateHz ? (uint16_t)(kRateHz - settings_.rate_hz) : 0u;
+    } else if (st_.output_acc >= kRateHz && !heading_corrected) {
         st_.output_acc = (uint16_t)(st_.output_acc - kRateHz);
         if (st_.output_acc >= kRateHz) st_.output_acc = 0;  // rate lowered: no burst of lines
         st_.output_due = true;

@@ -121,8 +121,9 @@ enum class Phase : uint8_t {
 };
 
 // An event of the start, told on the step after the one that starts the estimator
-// (with the start's work and the line's words that step would overrun its 5 ms).
-enum class StartMessage : uint8_t { kNone, kBias, kNotStill };
+// (with the start's work and the line's words that step would overrun its 5 ms); kTold
+// on the step after that: the event's words took the one before.
+enum class StartMessage : uint8_t { kNone, kBias, kNotStill, kTold };
 
 struct Angles {
     float roll_deg;
@@ -223,6 +224,11 @@ public:
     void on_mag_sample(const linalg::Vector3f& field_uT);
     // True once per output period after on_imu_sample (only while Running).
     bool output_due() const { return st_.output_due; }
+    // The step that ended the gyro calibration (it started the estimator: the TRIAD in
+    // floats, ~22k cycles) or the next (it tells the start's event, ~12k): long steps, so
+    // the first output line comes on the step after them, and so should other long work
+    // that can wait (the flight control step).
+    bool starting() const { return st_.start_message != StartMessage::kNone; }
     // Current angles (Euler extraction in integers, then floats; call when due).
     Angles angles() const;
     // The same in printed hundredths, with no float after the matrix entries (cheaper
