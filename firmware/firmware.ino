@@ -296,10 +296,16 @@ static bool answer(const console::Command& c, uint8_t part) {
 }
 
 // Received bytes -> parsed commands, while the command queue has room (when it has none,
-// the bytes wait in Serial's ring).
+// the bytes wait in Serial's ring). In a step (in_step) a line's end waits in the ring
+// for the loop: its parse (a `set`: ~25k cycles) on top of a long step would be the
+// loop's longest iteration; the step only keeps the ring from filling.
 static void take_gcs_heartbeat();
-static void take_console_input() {
+static void take_console_input(bool in_step = false) {
     while (!commands.full() && !mavlink_input.ready()) {
+        if (in_step && !mavlink_mode()) {
+            const int next = Serial.peek();
+            if (next == '\r' || next == '\n') return;
+        }
         const int b = Serial.read();
         if (b < 0) return;
         // In `mode mavlink`, a ground station's frames are set aside (not garbage to
@@ -504,7 +510,7 @@ static void step(uint32_t now_us) {
         pipe.on_imu_sample(sample);
         board::mark_end(board::kSecEstimator);
         airspeed_step();
-        take_console_input();
+        take_console_input(true);
         if (pipe.phase() == pipeline::Phase::Running) user_attitude_step(pipe);
         pipeline::AnglesCentideg c;
         const bool output = pipe.output_due();
