@@ -424,6 +424,23 @@ TEST(Centripetal, TheLongitudinalTermIsWhatTheAccelerometerFeels) {
     }
 }
 
+// dV/dt is worked out every eighth window (6.25 Hz, the pace of a climb's change of
+// speed) and held between: a new airspeed's derivative is taken off from the next eighth
+// window, not before (and not at twice the rate: its work is every eighth window's).
+TEST(Centripetal, TheLongitudinalTermIsWorkedOutEveryEighthWindow) {
+    const float count_m_s2 = mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
+    const int16_t one_m_s2 = (int16_t)std::lround(1.0f / count_m_s2);
+    const int16_t gain = pipeline::centripetal_gain_q8(18.0f);
+    dcm::TurnMean turn = dcm::TurnMean();
+    turn.configure(gain, kGravityCounts, one_m_s2);
+    const mpu6000::Sample s = imu(Vector3f(), Vector3f(1.0f, 0.0f, -kG));  // the accelerometer feels it
+    EXPECT_NEAR(take_off(turn, s, 0.0f).accel_m_s2.x, 0.0f, 0.01f);  // window 0 works it out
+    turn.configure(gain, kGravityCounts, 0);                         // the speed stops changing
+    for (int window = 1; window < 8; ++window)
+        EXPECT_NEAR(take_off(turn, s, 0.0f).accel_m_s2.x, 0.0f, 0.01f) << window;  // held
+    EXPECT_NEAR(take_off(turn, s, 0.0f).accel_m_s2.x, 1.0f, 0.01f);  // window 8: no change to take off
+}
+
 // A climb's entry: 5 s of level cruise, then speeding up at 1 m/s^2 for 10 s, the airspeed
 // read as the firmware reads it (every 8 steps). Without the speed's change the estimate
 // pitches up toward the 5.8 deg the accelerometer says; with it the pitch stays level.
