@@ -708,6 +708,7 @@ def main():
     sec_shake = cycles_shake["sections"] if cycles_shake else {}
     step_of = lambda c, k: c["sections"][1][k] if c and 1 in c["sections"] else None
     running_of = lambda c: c["running_step_avg"] if c else None
+    loop_max_of = lambda c: c["sections"][6]["max"] if c and 6 in c["sections"] else None
     ours_broad = results[OURS]
     have_all = trials and all(t in ours_broad for t in trials)
     figures = {
@@ -722,9 +723,8 @@ def main():
         "step_cycles_avg_running_shake": running_of(cycles_shake),
         "step_cycles_avg_running_flight": running_of(cycles_flight["tilt_tour"]),
         "step_cycles_avg_running_flight_shake": running_of(cycles_flight["shake"]),
-        "loop_cycles_max": max([c["sections"][6]["max"] for c in (cycles, cycles_shake, cycles_flight["tilt_tour"],
-                                                                 cycles_flight["shake"]) if c and 6 in c["sections"]],
-                               default=None),
+        "loop_cycles_max": max([m for m in map(loop_max_of, (cycles, cycles_shake, cycles_flight["tilt_tour"],
+                                                             cycles_flight["shake"])) if m is not None], default=None),
         "euler_cycles_avg": sec[2]["avg"] if 2 in sec else None,
         "line_cycles_avg": sec[3]["avg"] if 3 in sec else None,
         "loop_load_pct": cycles["load"] if cycles else None,
@@ -781,7 +781,7 @@ def main():
                 + "; ".join("`%s` estimator step %s avg / %s max, loop %s max" % (
                     name, fmt(step_of(c, "avg"), 0) if step_of(c, "avg") is not None else "–",
                     fmt(step_of(c, "max"), 0) if step_of(c, "max") is not None else "–",
-                    fmt(c["sections"][6]["max"], 0) if c and 6 in c["sections"] else "–")
+                    fmt(loop_max_of(c), 0) if loop_max_of(c) is not None else "–")
                     for name, c in sorted(cycles_flight.items(), reverse=True)) + "."]
         runs = [("`tilt_tour`", cycles), ("`shake`", cycles_shake), ("`tilt_tour` in flight", cycles_flight["tilt_tour"]),
                 ("`shake` in flight", cycles_flight["shake"])]
