@@ -81,7 +81,7 @@ int32_t TurnMean::lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q
 }
 
 FIXED_COLD void TurnMean::update(const linalg::Vector3l& down_q30, uint8_t n, const linalg::Vector3l& f_sum,
-                                 uint8_t window) {
+                                 uint8_t window, bool start_tilt) {
     if ((window & 7u) == 0u) update_longitudinal(down_q30.x, n, f_sum.x);
     // Four samples' worth of the means since the last update: kUpdateEvery windows'
     // (times 2), or the first window's alone (times 4).
@@ -93,7 +93,9 @@ FIXED_COLD void TurnMean::update(const linalg::Vector3l& down_q30, uint8_t n, co
     rate_y_means_ = rate_z_means_ = f_y_means_ = 0;
     // Each held within the accelerometer's full scale a sample.
     const int32_t full_scale = 4L * 32767;
-    const int32_t lateral = within(lateral_sum(times_gain(rate_z, 4, gain_q8_), f_y, down_q30.y, 4), full_scale);
+    // The start's tilt is no witness of bank (Centripetal.h): a_y is f_y alone then.
+    const int32_t down_y_q30 = start_tilt ? 0 : down_q30.y;
+    const int32_t lateral = within(lateral_sum(times_gain(rate_z, 4, gain_q8_), f_y, down_y_q30, 4), full_scale);
     const int32_t normal = within(times_gain(rate_y, 4, gain_q8_), full_scale);
     term_.y = (int16_t)per_sample(lateral, 4);
     term_.z = (int16_t)-per_sample(normal, 4);

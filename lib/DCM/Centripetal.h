@@ -34,6 +34,17 @@
 // estimate for seconds, and the heading took it through the dip at start-up: a straight
 // gusty flight with the airspeed 1.74 deg RMSE against 1.27 without).
 //
+// At a start in flight the estimate's tilt is the start window's accelerometer mean, off
+// by what the gusts accelerated the aeroplane meanwhile (1-3 deg), and a_y read through it
+// widens the bound by that error: the yaw of an aeroplane weathervaning into a growing
+// crosswind (a degree a second, for seconds) then fits inside the bound, is taken off as a
+// turn's, and holds the estimate at the start's error, which the dip turns into heading
+// (README, "Flying in simulation"). So while the start's tilt is unproven, the
+// start-up (startup_s: three of the tilt loop's time constants 1 / kp_rp, 95 % of the
+// start's error gone), a_y is the accelerometer's f_y alone: a start inside a coordinated
+// turn (f_y = 0) is held to the margin for those seconds, and its estimate starts the turn
+// over from where the tilt loop left it.
+//
 // Along the body's x axis the flight's change of speed does the same: a climb's speed
 // change reads as pitch, 6 deg a m/s^2. A measured airspeed's change tells it (dV/dt, the
 // pipeline's; a configured cruise speed has none), but a gust changes the airspeed while
@@ -85,7 +96,8 @@ public:
     bool active() const { return gain_q8_ != 0; }
     // The window's sums less (dV/dt, omega_z V, -omega_y V), the first two within their
     // bounds: accel_sum and the running sums' sum, from the gyro's sums less the
-    // calibrated bias (counts) and earth down in body axes (R's third row, Q30). The
+    // calibrated bias (counts) and earth down in body axes (R's third row, Q30; while
+    // start_tilt, the start-up's, a_y's bound leaves it out). The
     // lateral and normal terms are worked out every kUpdateEvery-th window (25 Hz: a
     // turn's term moves at the turn's pace, a gust's swings at a few hertz; the work is
     // 32-bit arithmetic), dV/dt every eighth window (6.25 Hz: the speed changes at a
@@ -99,12 +111,12 @@ public:
     // held for passes nothing at 25 Hz and its multiples, and what is near 12.5 Hz comes
     // out with its sign alternating.
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
-                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums) {
+                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums, bool start_tilt = false) {
         const uint8_t window = windows_++;
         rate_y_means_ += per_sample(rate_y_sum, n);
         rate_z_means_ += per_sample(rate_z_sum, n);
         f_y_means_ += per_sample(accel_sum.y, n);
-        if ((window & (kUpdateEvery - 1u)) == 0u) update(down_q30, n, accel_sum, window);
+        if ((window & (kUpdateEvery - 1u)) == 0u) update(down_q30, n, accel_sum, window, start_tilt);
         // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all:
         // the window's term (n samples' worth) times (n + 1) / 2, 10 samples' worth for 4.
         if (n == 4) {
@@ -143,8 +155,9 @@ private:
     int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
     // The lateral and normal terms from the means since the last update (four samples'
     // worth of them), dV/dt from this window's sums (f_sum: the accelerometer's) on every
-    // eighth window (window: the count of this one).
-    void update(const linalg::Vector3l& down_q30, uint8_t n, const linalg::Vector3l& f_sum, uint8_t window);
+    // eighth window (window: the count of this one); start_tilt: take_off's.
+    void update(const linalg::Vector3l& down_q30, uint8_t n, const linalg::Vector3l& f_sum, uint8_t window,
+                bool start_tilt);
     // dV/dt within its bound (f_x_sum: the accelerometer's x).
     void update_longitudinal(int32_t down_x_q30, uint8_t n, int32_t f_x_sum);
     // g sin of an angle whose sine is sin_q14 / 2^14, accel counts (the margin's, a turn's).
