@@ -96,13 +96,13 @@ def airspeed_variants(state_log):
             ("_sensor", ", airspeed sensor", ("--airspeed-log", state_log)))
 
 
-def make_turbulent_flights(flight_dir, log):
-    """fly.py --flight NAME [--gust G] --seed S for each, cached as make_flights' are:
-    {file stem: (kind, trajectory, state log)}."""
+def make_turbulent_flights(flight_dir, log, flights=TURBULENT_FLIGHTS, seeds=TURBULENT_SEEDS):
+    """fly.py --flight NAME [--gust G] --seed S for each (NAME, G) of flights and S of
+    seeds, cached as make_flights' are: {file stem: (kind, trajectory, state log)}."""
     out = {}
-    for name, gust in TURBULENT_FLIGHTS:
+    for name, gust in flights:
         kind = turbulent_kind(name, gust)
-        for seed in TURBULENT_SEEDS:
+        for seed in seeds:
             stem = "%s_s%d" % (kind, seed)
             traj, state = os.path.join(flight_dir, stem + ".csv.gz"), os.path.join(flight_dir, stem + "_log.csv")
             if not up_to_date((traj, state)):

@@ -72,8 +72,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     log = lambda m: print("[fresh] " + m, file=sys.stderr, flush=True)
 
-    flights.TURBULENT_FLIGHTS, flights.TURBULENT_SEEDS = tuple(a.flights), tuple(a.seeds)
-    files = flights.make_turbulent_flights(a.out, log)
+    files = flights.make_turbulent_flights(a.out, log, a.flights, a.seeds)
     if a.imu:
         # The scenario tool of the project's own build (a variant's may hold only replay and score).
         files.update(flights.make_imu_flights(os.path.join(REPO, "build"), dict(files), a.out, log))
