@@ -325,7 +325,7 @@ TEST(Centripetal, ExtremesHeldWithoutOverflow) {
         turn.configure(top, kGravityCounts);
         const int32_t full = 5L * 32767L;
         linalg::Vector3l sum(0, sign * full, -full), sum_of_sums(0, sign * 3 * full, -3 * full);
-        turn.take_off(-sign * full, sign * full, linalg::Vector3l(), 5, sum, sum_of_sums);
+        turn.take_off(-sign * full, sign * full, linalg::Vector3l(), 5, sum, sum_of_sums, false);
         EXPECT_EQ(sum.y, 0) << sign;  // held at a_y (+ the margin): then at full scale
         EXPECT_EQ(sum.z, -full - sign * full) << sign;
         EXPECT_EQ(sum_of_sums.y, 0) << sign;

@@ -111,7 +111,7 @@ public:
     // held for passes nothing at 25 Hz and its multiples, and what is near 12.5 Hz comes
     // out with its sign alternating.
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
-                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums, bool start_tilt = false) {
+                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums, bool start_tilt) {
         const uint8_t window = windows_++;
         rate_y_means_ += per_sample(rate_y_sum, n);
         rate_z_means_ += per_sample(rate_z_sum, n);
