@@ -553,6 +553,39 @@ TEST(DcmProperties, ASamplesAgeCountsUpToTwoSteps) {
     EXPECT_EQ(two.euler().roll_rad, five.euler().roll_rad);
 }
 
+// A sample's wait counts in its latency step for step: a field that waited two steps
+// is turned forward by them and gives the heading a fresh sample gives; the same field
+// taken as fresh holds the heading behind by the turn of those two steps.
+TEST(DcmProperties, ASamplesWaitIsTurnedForwardStepForStep) {
+    dcm::Dcm waited, fresh, misdated;
+    const Matrix3f level = Matrix3f::identity();
+    ASSERT_TRUE(waited.init(accel_for(level), mag_for(level)));
+    ASSERT_TRUE(fresh.init(accel_for(level), mag_for(level)));
+    ASSERT_TRUE(misdated.init(accel_for(level), mag_for(level)));
+    const float dt = fresh.settings().step_s, latency_s = fresh.settings().mag_latency_s;
+    const float rate_rad_s = 2.0f;
+    double yaw_rad = 0.0;
+    for (int i = 0; i < 2000; ++i) {
+        if (i % 3 == 0) {
+            const Vector3f now = mag_for(dcm::dcm_from_euler(0, 0, (float)(yaw_rad - rate_rad_s * latency_s)));
+            const Vector3f old = mag_for(dcm::dcm_from_euler(0, 0, (float)(yaw_rad - rate_rad_s * (latency_s + 2.0f * dt))));
+            fresh.correct_heading(now, 0);
+            waited.correct_heading(old, 2);
+            misdated.correct_heading(old, 0);
+        }
+        yaw_rad += rate_rad_s * dt;
+        for (dcm::Dcm* f : {&waited, &fresh, &misdated}) f->update(Vector3f(0, 0, rate_rad_s), accel_for(level));
+    }
+    const float two_steps_deg = 2.0f * dt * rate_rad_s / linalg::kRadPerDeg;
+    const float fresh_deg = fresh.euler().yaw_rad / linalg::kRadPerDeg;
+    const float waited_off = wrap_deg(waited.euler().yaw_rad / linalg::kRadPerDeg - fresh_deg);
+    const float misdated_off = wrap_deg(misdated.euler().yaw_rad / linalg::kRadPerDeg - fresh_deg);
+    RecordProperty("waited_off_deg", std::to_string(waited_off));
+    RecordProperty("misdated_off_deg", std::to_string(misdated_off));
+    EXPECT_LT(std::fabs(waited_off), 0.2f * two_steps_deg);
+    EXPECT_LT(misdated_off, -0.5f * two_steps_deg);  // behind the turn
+}
+
 // A field sample of zero (a compass that reads nothing) is no direction: ignored, and
 // the heading goes on from the samples before and after.
 TEST(DcmProperties, AFieldOfZeroIsIgnored) {
