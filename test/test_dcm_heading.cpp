@@ -103,6 +103,13 @@ TEST(DcmHeading, TheMeanIsInEarthAxesOverKHeadingSteps) {
     mean.add(earth_units(a), norm2_units(a), 1);
     EXPECT_TRUE(mean.complete());
     EXPECT_EQ(mean.steps(), dcm::kHeadingSteps);
+    // ... and that mean is the sample itself: the sums taken and forgotten before it
+    // count for nothing.
+    mean.take(field, norm2);
+    EXPECT_NEAR(field.x, a.x, 1e-4f);
+    EXPECT_NEAR(field.y, a.y, 1e-4f);
+    EXPECT_NEAR(field.z, a.z, 1e-4f);
+    EXPECT_NEAR(norm2, a.length_squared(), 0.05f);
 }
 
 // Whatever the compass's rate against the step's, the mean is the sum over the samples

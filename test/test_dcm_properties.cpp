@@ -167,6 +167,25 @@ TEST(DcmProperties, TheBiasLimitHoldsOnEveryAxis) {
     EXPECT_NEAR(b.z, 0.03f, 1e-5f);
 }
 
+// A bias set is what the very next step subtracts: a gyro reading exactly that bias is
+// a board at rest, and no step turns it (the gravity correction, a few steps away, must
+// not be what puts the new bias into the sums).
+TEST(DcmProperties, ABiasSetIsSubtractedFromTheNextStep) {
+    dcm::Dcm filter;
+    const Matrix3f level = Matrix3f::identity();
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    const Vector3f bias_rad_s(0.05f, -0.04f, 0.06f);  // within bias_limit_rad_s (0.17)
+    filter.set_gyro_bias_rad_s(bias_rad_s);
+    float worst_rad = 0.0f;
+    for (int i = 0; i < 4 * dcm::Dcm::kIntegrationSteps; ++i) {
+        filter.update(bias_rad_s, accel_for(level));
+        const float turned_rad = angle_between_deg(level, filter.matrix()) * linalg::kRadPerDeg;
+        worst_rad = turned_rad > worst_rad ? turned_rad : worst_rad;
+    }
+    // One step of that bias would turn 0.09 / 200 = 4.4e-4 rad.
+    EXPECT_LT(worst_rad, 2e-5f);
+}
+
 // The start-up ramp's fast gain pulls a wrong start in; the integrator is held meanwhile
 // (that error is not a gyro bias).
 TEST(DcmProperties, NoBiasIsLearnedFromAWrongStart) {
