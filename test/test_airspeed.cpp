@@ -65,20 +65,24 @@ dcm::TurnMean turn_at(float airspeed_m_s) {
     return turn;
 }
 
+// The usual window of 4 samples, and windows of 1 to 3 (a broken read left out of the
+// gravity window) or 5 (a correction late by a step) alike.
 TEST(Centripetal, CoordinatedTurnCorrectedToGravityAtTheBank) {
-    for (float bank : {-45.0f, -30.0f, 10.0f, 30.0f, 60.0f}) {
-        for (float v : {12.0f, 18.0f, 30.0f}) {
-            const Turn t = coordinated_turn(bank, v);
-            const mpu6000::Sample s = imu(t.gyro_rad_s, t.accel_m_s2);
-            // The estimate at the true bank: the bank provides the whole turn.
-            dcm::TurnMean turn = turn_at(v);
-            const Window w = take_off(turn, s, bank);
-            // Gravity at the bank: -g (0, sin phi, cos phi), in the sums and in the
-            // running sums' sum alike.
-            for (const Vector3f& f : {w.accel_m_s2, w.weighted_m_s2}) {
-                EXPECT_NEAR(f.x, 0.0f, 0.01f);
-                EXPECT_NEAR(f.y, -kG * std::sin(bank * kDeg), 0.03f) << bank << " deg at " << v << " m/s";
-                EXPECT_NEAR(f.z, -kG * std::cos(bank * kDeg), 0.03f) << bank << " deg at " << v << " m/s";
+    for (uint8_t n = 1; n <= 5; ++n) {
+        for (float bank : {-45.0f, -30.0f, 10.0f, 30.0f, 60.0f}) {
+            for (float v : {12.0f, 18.0f, 30.0f}) {
+                const Turn t = coordinated_turn(bank, v);
+                const mpu6000::Sample s = imu(t.gyro_rad_s, t.accel_m_s2);
+                // The estimate at the true bank: the bank provides the whole turn.
+                dcm::TurnMean turn = turn_at(v);
+                const Window w = take_off(turn, s, bank, n);
+                // Gravity at the bank: -g (0, sin phi, cos phi), in the sums and in the
+                // running sums' sum alike.
+                for (const Vector3f& f : {w.accel_m_s2, w.weighted_m_s2}) {
+                    EXPECT_NEAR(f.x, 0.0f, 0.01f);
+                    EXPECT_NEAR(f.y, -kG * std::sin(bank * kDeg), 0.03f) << bank << " deg at " << v << " m/s, n " << (int)n;
+                    EXPECT_NEAR(f.z, -kG * std::cos(bank * kDeg), 0.03f) << bank << " deg at " << v << " m/s, n " << (int)n;
+                }
             }
         }
     }
@@ -129,6 +133,21 @@ TEST(Centripetal, AYawRateWithoutTheBankIsHeldToTheMargin) {
     for (float sign : {1.0f, -1.0f}) {
         const mpu6000::Sample s = imu(Vector3f(0.0f, 0.0f, sign * 20.0f * kDeg), Vector3f(0.0f, 0.0f, -kG));
         dcm::TurnMean turn = turn_at(18.0f);
+        for (int window = 0; window < 200; ++window) {
+            const Vector3f f = take_off(turn, s, 0.0f).accel_m_s2;
+            EXPECT_NEAR(std::atan2(-f.y, -f.z) / kDeg, sign * dcm::kTurnBankMargin_deg, 0.05f) << window;
+        }
+    }
+}
+
+// Beyond 2^21 counts a window (500 g) omega V is no turn and is held there, keeping its
+// sign: reached at the gyro's full scale with a gain above the pipeline's (3 414 at its
+// 60 m/s limit: 1.75e6 counts), as an accelerometer of another range would give.
+TEST(Centripetal, OmegaVBeyondAnyTurnIsHeldWithItsSign) {
+    for (float sign : {1.0f, -1.0f}) {
+        const mpu6000::Sample s = imu(Vector3f(0.0f, 0.0f, sign * 1990.0f * kDeg), Vector3f(0.0f, 0.0f, -kG));
+        dcm::TurnMean turn = dcm::TurnMean();
+        turn.configure(16000, kGravityCounts);  // 8.2e6 counts a window unheld
         for (int window = 0; window < 200; ++window) {
             const Vector3f f = take_off(turn, s, 0.0f).accel_m_s2;
             EXPECT_NEAR(std::atan2(-f.y, -f.z) / kDeg, sign * dcm::kTurnBankMargin_deg, 0.05f) << window;
