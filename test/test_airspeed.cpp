@@ -88,6 +88,15 @@ TEST(Centripetal, CoordinatedTurnCorrectedToGravityAtTheBank) {
     }
 }
 
+// A window's sum a sample: for the usual 4 rounded to the nearest count (a half up), and
+// the inverse of times_n for any window.
+TEST(Centripetal, APerSampleMeanIsRoundedAndUndoesTimesN) {
+    for (int32_t sum = -41; sum <= 41; ++sum)
+        EXPECT_EQ(dcm::per_sample(sum, 4), (int32_t)std::floor((double)sum / 4.0 + 0.5)) << sum;
+    for (uint8_t n = 1; n <= 5; ++n)
+        for (int32_t x : {-32767, -5, -1, 0, 1, 7, 32767}) EXPECT_EQ(dcm::per_sample(dcm::times_n(x, n), n), x) << (int)n;
+}
+
 // The bounds: 0 to a_y either side, widened by the margin, to the count.
 TEST(Centripetal, TheBoundsAreZeroToAyWidenedByTheMargin) {
     EXPECT_EQ(dcm::lateral_bounds(0, 10).lo, -10);

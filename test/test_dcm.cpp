@@ -94,6 +94,19 @@ TEST(Dcm, GyroTurnIsTheCountsLessEveryBias) {
     const Vector3f spin = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(32767L * 32, 0, -32767L * 32), 32));
     EXPECT_NEAR(spin.x, 1.5f, 1e-4f);
     EXPECT_NEAR(spin.z, -1.5f, 1e-4f);
+    // A count of more than 4000 deg/s full scale is beyond the integer factor (the float
+    // path): the same turn, the same saturation.
+    const float coarse_rad_s = 0.0025f;
+    filter.set_sample_scales(coarse_rad_s, 0.0024f);
+    const Vector3f coarse = linalg::vector_from_q30(filter.gyro_turn_q30(counts, steps));
+    const Vector3f coarse_expected = (Vector3f(3000.0f, -1200.0f, 25.0f) * coarse_rad_s - sensor_bias - estimator_bias) *
+                                     ((float)steps * dt);
+    EXPECT_NEAR(coarse.x, coarse_expected.x, 1e-5f);
+    EXPECT_NEAR(coarse.y, coarse_expected.y, 1e-5f);
+    EXPECT_NEAR(coarse.z, coarse_expected.z, 1e-5f);
+    const Vector3f coarse_spin = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(32767L * 32, 0, -32767L * 32), 32));
+    EXPECT_NEAR(coarse_spin.x, 1.5f, 1e-4f);
+    EXPECT_NEAR(coarse_spin.z, -1.5f, 1e-4f);
 }
 
 TEST(Dcm, RemovesAConstantGyroBiasAtRest) {

@@ -202,7 +202,9 @@ TEST(DcmRest, AFieldThatMovesEndsTheRest) {
 // does one of 0.81 uT along two axes at once (1.15 uT in all, no axis beyond 1 uT); 0.5 uT
 // along two (0.71 uT) does not. (A mutant that checked only x and y lived before this.)
 TEST(DcmRest, AFieldMoveOnAnyAxisOrAcrossTwoEndsTheRest) {
-    const Vector3i field(20 * 32, 0, 45 * 32);  // uT Q5
+    // Off magnetic north: a field on every axis, so that a difference taken as a sum on
+    // one of them would show.
+    const Vector3i field(20 * 32, -5 * 32, 45 * 32);  // uT Q5
     struct Move {
         int16_t dx, dy, dz;
         bool ends;
