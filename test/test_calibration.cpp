@@ -91,6 +91,10 @@ TEST(Calibration, GyroRestartsOnAccelChange) {
     // NaN counts as movement, never as data.
     for (int i = 0; i < 50; ++i) g.add(kBias, kLevel);
     EXPECT_EQ(g.add(Vector3f(std::nanf(""), 0.0f, 0.0f), kLevel), GyroCalibrator::Result::Moved);
+    // So is a reading beyond the fine counts' range (16 m/s^2), held at the range's end,
+    // even one whose counts would wrap round to the level board's: 32 m/s^2 above it.
+    for (int i = 0; i < 50; ++i) g.add(kBias, kLevel);
+    EXPECT_EQ(g.add(kBias, Vector3f(kLevel.x, kLevel.y, kLevel.z + 32.0f)), GyroCalibrator::Result::Moved);
 }
 
 TEST(Calibration, SteadySpinIsNotABias) {
@@ -302,6 +306,7 @@ struct LearnRun {
     uint16_t updates = 0;
     uint16_t rejected = 0;
     float largest_step_uT = 0.0f;  // of the estimate
+    int first_use_sample = -1;     // the compass sample at which an offset first went in use
 };
 
 // A board turning at rate_rad_s about an axis that itself wanders (body frame),
@@ -313,11 +318,11 @@ struct LearnRun {
 // sample, a garbage one whose turn is not finite, given no steps.)
 LearnRun run_learner(const Vector3f& offset, float seconds, float rate_rad_s, bool z_only, float noise_uT,
                      float prior_uT = calib::kLearnPriorUncalibrated_uT, calib::OffsetLearner* reused = nullptr,
-                     bool nan_turns = false) {
+                     bool nan_turns = false, bool as_constructed = false) {
     const Vector3f earth(20.0f, 0.0f, 45.0f);
     calib::OffsetLearner own;
     calib::OffsetLearner& learner = reused ? *reused : own;
-    learner.restart(prior_uT, Vector3f());
+    if (!as_constructed) learner.restart(prior_uT, Vector3f());
     LearnRun run;
     Matrix3f r;
     uint32_t seed = 21;
@@ -337,6 +342,7 @@ LearnRun run_learner(const Vector3f& offset, float seconds, float rate_rad_s, bo
             if (nan_turns && i % 24 == 3) learner.add(Vector3f(500.0f, -500.0f, 500.0f), Vector3f(NAN, 0.0f, 0.0f), 0, run.learned);
             const Vector3f before = learner.estimate_uT();
             learner.add(raw, turn, since, run.learned);
+            if (run.first_use_sample < 0 && !(run.learned == Vector3f())) run.first_use_sample = i;
             turn = Vector3f();
             const float step = (learner.estimate_uT() - before).length();
             if (step > run.largest_step_uT) run.largest_step_uT = step;
@@ -362,6 +368,22 @@ TEST(OffsetLearner, FindsTheHardIronWhileTurning) {
     // uncalibrated compass.
     const LearnRun early = run_learner(offset, 10.0f, 1.57f, false, 0.2f);
     EXPECT_LT((early.learned - offset).length(), 1.0f);
+}
+
+// A learner as constructed is one restarted for an uncalibrated compass with no offset in
+// use: the same offsets put in use, step for step.
+TEST(OffsetLearner, AsConstructedItIsRestartedForAnUncalibratedCompass) {
+    for (const Vector3f offset : {Vector3f(8.0f, -5.0f, 3.0f), Vector3f(-6.0f, 4.0f, -5.0f)}) {
+        const LearnRun restarted = run_learner(offset, 10.0f, 1.57f, false, 0.2f);
+        const LearnRun constructed =
+            run_learner(offset, 10.0f, 1.57f, false, 0.2f, calib::kLearnPriorUncalibrated_uT, nullptr, false, true);
+        ASSERT_GE(restarted.first_use_sample, 0) << offset.x;
+        EXPECT_EQ(constructed.first_use_sample, restarted.first_use_sample);
+        EXPECT_EQ(constructed.learned.x, restarted.learned.x);
+        EXPECT_EQ(constructed.learned.y, restarted.learned.y);
+        EXPECT_EQ(constructed.learned.z, restarted.learned.z);
+        EXPECT_EQ(constructed.updates, restarted.updates);
+    }
 }
 
 TEST(OffsetLearner, StillBoardLearnsNothing) {
