@@ -541,6 +541,25 @@ TEST(Dcm, InitForgetsTheUnfinishedFieldMean) {
     EXPECT_LT(worst_deg, 0.1f);
 }
 
+// A new start forgets the last one's gravity correction too: a filter that was correcting
+// a 20 deg tilt error, started again level, turns not at all from its first step (the old
+// correction in the gyro's offset would turn it until the next gravity step).
+TEST(Dcm, InitForgetsTheGravityCorrection) {
+    dcm::Dcm filter;
+    const Matrix3f level = Matrix3f::identity();
+    const Matrix3f tilted = dcm::dcm_from_euler(20.0f * linalg::kRadPerDeg, 0, 0);
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    for (int i = 0; i < 100; ++i) filter.update(Vector3f(), accel_for(tilted));  // correcting toward it
+    ASSERT_GT(angle_between_deg(level, filter.matrix()), 1.0f);
+    ASSERT_TRUE(filter.init(accel_for(level), mag_for(level)));
+    float worst_rad = 0.0f;
+    for (int i = 0; i < 2 * dcm::Dcm::kIntegrationSteps; ++i) {
+        filter.update(Vector3f(), accel_for(level));
+        worst_rad = std::fmax(worst_rad, angle_between_deg(level, filter.matrix()) * linalg::kRadPerDeg);
+    }
+    EXPECT_LT(worst_rad, 2e-5f);
+}
+
 // While the board moves during the start, the heading is the mean of the compass's means
 // since the start (gain 1/t): means whose errors alternate +-5 deg (the tilt errors of
 // a motion, through the dip) leave it near their mean, where the start's 5/s gain

@@ -186,6 +186,30 @@ TEST(DcmProperties, ABiasSetIsSubtractedFromTheNextStep) {
     EXPECT_LT(worst_rad, 2e-5f);
 }
 
+// So is a calibrated (sensor) bias set, and a bias carried to new sample scales: the
+// gyro reading them is a board at rest from the next step.
+TEST(DcmProperties, ASensorBiasAndANewScaleAreSubtractedFromTheNextStep) {
+    const Matrix3f level = Matrix3f::identity();
+    const Vector3f bias_rad_s(0.05f, -0.04f, 0.06f);
+    auto worst_turn_rad = [&](dcm::Dcm& filter, const Vector3f& gyro_rad_s) {
+        float worst = 0.0f;
+        for (int i = 0; i < 4 * dcm::Dcm::kIntegrationSteps; ++i) {
+            filter.update(gyro_rad_s, accel_for(level));
+            worst = std::fmax(worst, angle_between_deg(level, filter.matrix()) * linalg::kRadPerDeg);
+        }
+        return worst;
+    };
+    dcm::Dcm sensor;
+    ASSERT_TRUE(sensor.init(accel_for(level), mag_for(level)));
+    sensor.set_sensor_bias_rad_s(bias_rad_s);
+    EXPECT_LT(worst_turn_rad(sensor, bias_rad_s), 2e-5f);
+    dcm::Dcm rescaled;
+    ASSERT_TRUE(rescaled.init(accel_for(level), mag_for(level)));
+    rescaled.set_gyro_bias_rad_s(bias_rad_s);
+    rescaled.set_sample_scales(0.0005f, 0.0024f);  // a finer gyro count: 0.05 rad/s is 100 of them
+    EXPECT_LT(worst_turn_rad(rescaled, bias_rad_s), 2e-5f);
+}
+
 // The start-up ramp's fast gain pulls a wrong start in; the integrator is held meanwhile
 // (that error is not a gyro bias).
 TEST(DcmProperties, NoBiasIsLearnedFromAWrongStart) {

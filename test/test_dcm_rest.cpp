@@ -221,6 +221,20 @@ TEST(DcmRest, AFieldMoveOnAnyAxisOrAcrossTwoEndsTheRest) {
     }
 }
 
+// A field that jumps across most of the range on every axis at once (a magnet slapped
+// on, a broken read) moves: its squares summed would pass 2^31, so each axis decides.
+TEST(DcmRest, AFieldJumpAcrossTheRangeEndsTheRest) {
+    for (int16_t sign : {1, -1}) {
+        const Vector3i from((int16_t)(-sign * 450 * 32), (int16_t)(-sign * 450 * 32), (int16_t)(-sign * 450 * 32));
+        const Vector3i to((int16_t)(sign * 450 * 32), (int16_t)(sign * 450 * 32), (int16_t)(sign * 450 * 32));
+        RestFixture f;
+        f.rest.watch_field(from);
+        ASSERT_GT(f.updates_to_rest(Vector3l(), true), 0);
+        f.rest.watch_field(to);
+        EXPECT_FALSE(f.rest.update(f.gyro_mean, f.accel_mean, Vector3l(), true, true, f.k)) << sign;
+    }
+}
+
 TEST(DcmGyroBias, FollowsTheRestMeanWithRestBiasSeconds) {
     const dcm::DcmCoefficients k = float_form_coefficients();
     dcm::GyroBias bias;
