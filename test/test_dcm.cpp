@@ -75,38 +75,31 @@ TEST(Dcm, OneIntegrationIsARotationToAFewE7) {
 // The compass learner's turn: the gyro's counts summed over some steps, less the
 // calibrated bias and the estimator's, in Q30 radians; saturated at 1.5 rad an axis.
 TEST(Dcm, GyroTurnIsTheCountsLessEveryBias) {
-    dcm::Dcm filter;
-    const float scale_rad_s = 0.001065f;  // a count of the 2000 deg/s range
-    filter.set_sample_scales(scale_rad_s, 0.0024f);
-    const Vector3f sensor_bias(0.02f, -0.01f, 0.005f), estimator_bias(0.001f, 0.002f, -0.003f);
-    filter.set_sensor_bias_rad_s(sensor_bias);
-    filter.set_gyro_bias_rad_s(estimator_bias);
-    const float dt = filter.settings().step_s;
-    const uint16_t steps = 8;
-    const linalg::Vector3l counts(3000L * steps, -1200L * steps, 25L * steps);
-    const Vector3f turn = linalg::vector_from_q30(filter.gyro_turn_q30(counts, steps));
-    const Vector3f expected = (Vector3f(3000.0f, -1200.0f, 25.0f) * scale_rad_s - sensor_bias - estimator_bias) *
-                              ((float)steps * dt);
-    EXPECT_NEAR(turn.x, expected.x, 1e-6f);
-    EXPECT_NEAR(turn.y, expected.y, 1e-6f);
-    EXPECT_NEAR(turn.z, expected.z, 1e-6f);
-    // 32 steps at the full scale: 5.6 rad, saturated.
-    const Vector3f spin = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(32767L * 32, 0, -32767L * 32), 32));
-    EXPECT_NEAR(spin.x, 1.5f, 1e-4f);
-    EXPECT_NEAR(spin.z, -1.5f, 1e-4f);
-    // A count of more than 4000 deg/s full scale is beyond the integer factor (the float
-    // path): the same turn, the same saturation.
-    const float coarse_rad_s = 0.0025f;
-    filter.set_sample_scales(coarse_rad_s, 0.0024f);
-    const Vector3f coarse = linalg::vector_from_q30(filter.gyro_turn_q30(counts, steps));
-    const Vector3f coarse_expected = (Vector3f(3000.0f, -1200.0f, 25.0f) * coarse_rad_s - sensor_bias - estimator_bias) *
-                                     ((float)steps * dt);
-    EXPECT_NEAR(coarse.x, coarse_expected.x, 1e-5f);
-    EXPECT_NEAR(coarse.y, coarse_expected.y, 1e-5f);
-    EXPECT_NEAR(coarse.z, coarse_expected.z, 1e-5f);
-    const Vector3f coarse_spin = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(32767L * 32, 0, -32767L * 32), 32));
-    EXPECT_NEAR(coarse_spin.x, 1.5f, 1e-4f);
-    EXPECT_NEAR(coarse_spin.z, -1.5f, 1e-4f);
+    // A count of the 2000 deg/s range (the integer factor), and one of more than 4000
+    // deg/s full scale (beyond it: the float path): the same turn, the same saturation.
+    struct Scale {
+        float rad_s_per_count, tolerance_rad;
+    };
+    for (const Scale scale : {Scale{0.001065f, 1e-6f}, Scale{0.0025f, 1e-5f}}) {
+        dcm::Dcm filter;
+        filter.set_sample_scales(scale.rad_s_per_count, 0.0024f);
+        const Vector3f sensor_bias(0.02f, -0.01f, 0.005f), estimator_bias(0.001f, 0.002f, -0.003f);
+        filter.set_sensor_bias_rad_s(sensor_bias);
+        filter.set_gyro_bias_rad_s(estimator_bias);
+        const float dt = filter.settings().step_s;
+        const uint16_t steps = 8;
+        const linalg::Vector3l counts(3000L * steps, -1200L * steps, 25L * steps);
+        const Vector3f turn = linalg::vector_from_q30(filter.gyro_turn_q30(counts, steps));
+        const Vector3f expected =
+            (Vector3f(3000.0f, -1200.0f, 25.0f) * scale.rad_s_per_count - sensor_bias - estimator_bias) * ((float)steps * dt);
+        EXPECT_NEAR(turn.x, expected.x, scale.tolerance_rad) << scale.rad_s_per_count;
+        EXPECT_NEAR(turn.y, expected.y, scale.tolerance_rad) << scale.rad_s_per_count;
+        EXPECT_NEAR(turn.z, expected.z, scale.tolerance_rad) << scale.rad_s_per_count;
+        // 32 steps at the full scale: 5.6 rad or more, saturated.
+        const Vector3f spin = linalg::vector_from_q30(filter.gyro_turn_q30(linalg::Vector3l(32767L * 32, 0, -32767L * 32), 32));
+        EXPECT_NEAR(spin.x, 1.5f, 1e-4f) << scale.rad_s_per_count;
+        EXPECT_NEAR(spin.z, -1.5f, 1e-4f) << scale.rad_s_per_count;
+    }
 }
 
 TEST(Dcm, RemovesAConstantGyroBiasAtRest) {
