@@ -32,16 +32,34 @@ constexpr uint32_t kI2cTimeoutUs = 3000;
 
 // Cycle markers read by the simulator's benchmark (apm25sim --profile): a section id
 // written to GPIOR0 when it starts and to GPIOR1 when it ends (one OUT instruction each).
+// The task table (Tasks.cpp) brackets each task with its section; some tasks mark parts
+// of their work too. 7..12 and 14 are the estimator's parts (lib/LinAlg/Profile.h).
 enum Section : uint8_t {
     kSecEstimator = 1,  // the pipeline's step: guard, calibration, Dcm::update (+ heading)
     kSecEuler = 2,
     kSecFormat = 3,     // one output line, not the UART send
     kSecMpuRead = 4,
     kSecMagRead = 5,
-    kSecLoop = 6,       // one loop iteration's work, from data-ready seen to work done
-    kSecControl = 13,   // the flight control step (every 4th loop step: 50 Hz, the servo frame)
+    kSecLoop = 6,       // one sample's work, from data-ready seen to its tasks done
+    kSecControl = 13,   // the flight control step (50 Hz, the servo frame)
+    kSecConsoleReply = 15,  // one part of a console reply
     kSecGcsRequest = 16,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
-    kSecGcsReply = 17,    // one PARAM_VALUE, or the RC_CHANNELS + SERVO_OUTPUT_RAW pair, packed
+    kSecGcsReply = 17,    // one PARAM_VALUE packed and queued
+    kSecCompassTask = 18,  // the compass task: DRDY watched, a read when due (5 inside)
+    kSecAirspeed = 19,
+    kSecInputInStep = 20,  // the console's received bytes, on a sample
+    kSecUser = 21,         // user_attitude_step
+    kSecOutput = 22,       // the output line task: Euler (2), formatting (3), queueing
+    kSecLeds = 23,
+    kSecPump = 24,         // queued text handed to Serial
+    kSecInput = 25,        // the console's received bytes, between samples
+    kSecGcsStreams = 26,   // RC_CHANNELS + SERVO_OUTPUT_RAW packed and queued
+    kSecGcsSave = 27,      // a save started after a PARAM_SET
+    kSecStore = 28,        // the settings store's EEPROM work
+    kSecRetry = 29,        // the sensors' retries while down
+    kSecUserLoop = 30,     // user_loop
+    kSecFlightPoll = 31,   // the receiver's frames; the control step without samples (13)
+    kSecSecond = 32,       // once a second: load, LEDs, HEARTBEAT, held-back warnings
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

@@ -2,6 +2,7 @@
 #include "FlightIo.h"
 
 #include "Board.h"
+#include "Vehicle.h"
 
 #if APM25_FLIGHT
 
@@ -11,12 +12,12 @@
 using text::Flash;
 using text::Writer;
 
-// The control step, every 4th loop step (50 Hz) right after the estimator's: the servo
-// pulse only changes once a 20 ms period, so a faster step would compute widths that are
-// never sent. It moves onto the output line's steps when the output rate is 50 Hz or
-// less, to take the angles the line worked out (the Euler extraction is the step's
-// largest part). Without samples (the MPU6000 gone) the loop runs it on its own every
-// 20 ms, without an attitude: the receiver, MANUAL and the failsafe go on.
+// The control step, every 4th sample (50 Hz) after the estimator's: the servo pulse only
+// changes once a 20 ms period, so a faster step would compute widths that are never
+// sent. It moves onto the output line's samples when the output rate is 50 Hz or less,
+// to take the angles the line worked out (the Euler extraction is the step's largest
+// part). Without samples (the MPU6000 gone) the loop runs it on its own every 20 ms,
+// without an attitude: the receiver, MANUAL and the failsafe go on.
 constexpr uint8_t kControlDivider = 4;
 constexpr uint16_t kControlPeriodUs = 20000;
 
@@ -31,8 +32,8 @@ constexpr int32_t kCdsPerCountQ10 =
 // percent): on the ground, or gliding, the velocity is not the cruise's.
 constexpr int16_t kIdleThrottle = 100;
 
-extern pipeline::AttitudePipeline pipe;  // the sketch's (FlightIo.h)
-extern Imu imu;
+using vehicle::imu;
+using vehicle::pipe;
 
 FlightIo::FlightIo(const text::Sink* out)
     : out_(out), control_(pipe.settings().flight, flight::FlightControl::ConfiguredLater{}) {}
@@ -51,18 +52,26 @@ void FlightIo::configure() { control_.configure(); }
 
 void FlightIo::poll(uint32_t now_us, uint32_t now_ms) {
     while (rc_input::poll(ppm_)) control_.on_frame(ppm_.frame_us(), now_ms);
-    if (now_us - last_control_us_ >= kControlPeriodUs + kControlPeriodUs / 4u) {  // no samples
+    // Only when the samples have stopped: while they flow, the sample task runs it (the
+    // estimator's start holds it for two long steps: the line after them takes it).
+    const bool samples_stopped = !imu.ok() || imu.us_since_sample(now_us) >= kControlPeriodUs;
+    if (samples_stopped && now_us - last_control_us_ >= kControlPeriodUs + kControlPeriodUs / 4u) {
+        board::mark_begin(board::kSecControl);
         control_step(now_us, now_ms, nullptr, nullptr);
+        board::mark_end(board::kSecControl);
     }
 }
 
-void FlightIo::after_estimator_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample, bool output,
-                                    const pipeline::AnglesCentideg* angles) {
+bool FlightIo::control_due(bool output_line) {
     ++control_count_;
-    if (pipe.starting()) return;  // the estimator's start fills the step: on the next one
-    if (control_count_ >= kControlDivider ||
-        (output && control_count_ >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u))
-        control_step(now_us, now_ms, &sample, angles);
+    if (pipe.starting()) return false;  // the estimator's start fills the step: on the next one
+    return control_count_ >= kControlDivider ||
+           (output_line && control_count_ >= kControlDivider / 2u && pipe.settings().rate_hz <= 50u);
+}
+
+void FlightIo::control_run(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample,
+                           const pipeline::AnglesCentideg* angles) {
+    control_step(now_us, now_ms, &sample, angles);
 }
 
 // angles: the output line's, or nullptr; sample: this step's, or nullptr (no attitude).
@@ -70,7 +79,6 @@ void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sam
                             const pipeline::AnglesCentideg* angles) {
     last_control_us_ = now_us;
     control_count_ = 0;
-    board::mark_begin(board::kSecControl);
     flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
     control_.update_signal(now_ms);
     if (att.valid && control_.wants_attitude()) {  // MANUAL and no receiver yet need none
@@ -89,7 +97,6 @@ void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sam
     uint16_t widths[flight::kChannels];
     control_.step(now_ms, att, widths);
     servo_outputs::set(widths);
-    board::mark_end(board::kSecControl);
     say_events();
 }
 
@@ -189,7 +196,8 @@ void FlightIo::begin() {}
 void FlightIo::loop_starts(uint32_t) {}
 void FlightIo::configure() {}
 void FlightIo::poll(uint32_t, uint32_t) {}
-void FlightIo::after_estimator_step(uint32_t, uint32_t, const mpu6000::Sample&, bool, const pipeline::AnglesCentideg*) {}
+bool FlightIo::control_due(bool) { return false; }
+void FlightIo::control_run(uint32_t, uint32_t, const mpu6000::Sample&, const pipeline::AnglesCentideg*) {}
 bool FlightIo::powered() const { return false; }
 mav::PlaneMode FlightIo::plane_mode() const { return mav::PlaneMode::Manual; }
 bool FlightIo::failsafe() const { return false; }

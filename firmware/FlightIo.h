@@ -6,9 +6,9 @@
 // same calls do nothing, the `flight`, `rc` and `servo` commands answer an error, and
 // none of those parts is in the firmware.
 //
-// It flies the sketch's own pipeline and IMU (firmware.ino's `pipe` and `imu`), named
-// rather than held as references: the compiler then knows where they are and keeps the
-// attitude's code specialised for them, as in the sketch.
+// It flies the vehicle's pipeline and IMU (Vehicle.h), named rather than held as
+// references: the compiler then knows where they are and keeps the attitude's code
+// specialised for them.
 #pragma once
 
 #include <stdint.h>
@@ -41,10 +41,14 @@ public:
     // Every loop(): the receiver's frames; without samples (the MPU6000 gone) the
     // control step on its own every 20 ms, without an attitude.
     void poll(uint32_t now_us, uint32_t now_ms);
-    // After each estimator step: the control step when it is due. output: an output line
-    // was due on this step; angles: the angles it worked out, or nullptr.
-    void after_estimator_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample, bool output,
-                              const pipeline::AnglesCentideg* angles);
+    // Sample task (counts the samples): the control step is due every kControlDivider
+    // samples (50 Hz, the servo frame), on the output line's sample when the line rate is
+    // 50 Hz or less (to take the angles the line worked out), never on the estimator's
+    // start (its long steps).
+    bool control_due(bool output_line);
+    // Sample task: the control step on this sample (its angles, if the line has them).
+    void control_run(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample& sample,
+                     const pipeline::AnglesCentideg* angles);
 
     // The receiver's throttle above idle: the aeroplane flies at its cruise speed.
     bool powered() const;

@@ -56,7 +56,7 @@ const char* const kUsage =
     "  --eeprom-cuts T1:T2:STEP  with --eeprom FILE: also write the chip as a power cut at\n"
     "                   T1, T1+STEP, ... (<= T2, simulated seconds) leaves it (what --seconds\n"
     "                   at that time writes) to FILE.cut0, FILE.cut1, ...: one run for many cuts\n"
-    "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..31 written\n"
+    "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..63 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
     "                   run,1,C,C,C,C with C = cycles from the first start to the last end of section 6\n"

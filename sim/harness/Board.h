@@ -61,7 +61,7 @@ bool stop_requested();
 
 // Cycle counts between GPIOR0 (start) and GPIOR1 (end) writes of one section id
 // (1..kMaxSectionId; other values are ignored).
-constexpr int kMaxSectionId = 31;
+constexpr int kMaxSectionId = 63;
 struct SectionProfile {
     uint64_t count = 0, total = 0, min = UINT64_MAX, max = 0;
     uint64_t started_at = 0;

@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "AirspeedInput.h"
+
+#include "Airspeed.h"
+#include "ArduinoCore.h"
+#include "Vehicle.h"
+
+namespace airspeed_input {
+
+using vehicle::pipe;
+
+constexpr uint8_t kReadings = 8;
+static State state_ = State::kZero;
+static bool started = false;
+static uint16_t zero = 0;
+static uint16_t n = 0;
+static uint32_t sum = 0;
+
+State state() { return state_; }
+
+void begin() {
+    ADMUX = _BV(REFS0);  // AVcc reference, channel 0 (MUX5 in ADCSRB clear)
+    ADCSRB &= (uint8_t)~_BV(MUX5);
+    ADCSRA |= _BV(ADEN) | _BV(ADSC);
+}
+
+void step() {
+    if (state_ == State::kNone) {
+        // No sensor: the configured cruise speed (TRIM_ARSPD_CM, grown in a banked turn as
+        // the lift needs), only while the receiver's throttle is above idle (FlightIo).
+        const flight::FlightSettings& fs = pipe.settings().flight;
+        if (fs.trim_arspd_cm == 0u || pipe.steps() % kReadings != 0u) return;
+        pipe.set_cruise_airspeed_m_s(vehicle::flight_io.powered() ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
+        return;
+    }
+    if (ADCSRA & _BV(ADSC)) return;
+    const uint16_t counts = ADC;
+    ADCSRA |= _BV(ADSC);
+    if (!started) {  // the first conversion is the ADC's longer first one: not used
+        started = true;
+        return;
+    }
+    sum += counts;
+    ++n;
+    if (state_ == State::kZero) {
+        if (pipe.phase() != pipeline::Phase::Running || n < kReadings) return;
+        zero = (uint16_t)(sum / n);
+        state_ = airspeed::present(zero) ? State::kSensor : State::kNone;
+        if (state_ == State::kNone) vehicle::say(TXT("# airspeed: no sensor on A0"));
+    } else if (n >= kReadings) {
+        pipe.set_airspeed_m_s(airspeed::airspeed_m_s(sum, (uint8_t)n, zero));
+    } else {
+        return;
+    }
+    sum = 0;
+    n = 0;
+}
+
+}  // namespace airspeed_input

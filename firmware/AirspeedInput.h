@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The airspeed sensor on A0 (an MPXV7002DP pitot; lib/Pipeline/Airspeed.h converts), for
+// the estimator's centripetal correction. Never blocking: each sample reads the
+// conversion the previous one started (13 ADC clocks at 125 kHz, long done 5 ms later)
+// and starts the next. While the gyro calibrates (the board still) the readings are the
+// sensor's zero; a zero far from 2.5 V is no sensor, and the configured cruise speed
+// (TRIM_ARSPD_CM) is used instead. Then the mean of each kReadings readings is the
+// airspeed.
+#pragma once
+
+#include <stdint.h>
+
+namespace airspeed_input {
+
+enum class State : uint8_t { kZero, kSensor, kNone };
+
+// In setup(): the ADC on channel 0 and its first conversion.
+void begin();
+// Sample task: a reading, and the pipeline's airspeed.
+void step();
+State state();
+
+}  // namespace airspeed_input

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "ConsoleLink.h"
+
+#include "AirspeedInput.h"
+#include "ArduinoCore.h"
+#include "Console.h"
+#include "GcsLink.h"
+#include "LoopLoad.h"
+#include "Port.h"
+#include "PipelineText.h"
+#include "SerialText.h"
+#include "Tasks.h"
+#include "Vehicle.h"
+
+namespace console_link {
+
+using text::Flash;
+using text::Writer;
+using vehicle::compass;
+using vehicle::flight_io;
+using vehicle::imu;
+using vehicle::out;
+using vehicle::pipe;
+
+static console::LineReader reader;
+static console::CommandQueue commands;
+static uint8_t reply_part = 0;  // the next part of the reply to commands.peek()
+
+void forget_partial_line() { reader = console::LineReader(); }
+
+// Received bytes -> parsed commands, while the command queue has room (when it has none,
+// the bytes wait in Serial's ring). In a step (in_step) a line's end waits in the ring
+// for the loop: its parse (a `set`) on top of a long step would be the loop's longest
+// iteration; the step only keeps the ring from filling.
+static void take(bool in_step) {
+    mav::Parser& frames = gcs_link::parser();
+    while (!commands.full() && !frames.ready()) {
+        if (in_step && !port::mavlink_mode()) {
+            const int next = Serial.peek();
+            if (next == '\r' || next == '\n') return;
+        }
+        const int b = Serial.read();
+        if (b < 0) return;
+        // In MAVLink a ground station's frames are set aside (not garbage to answer). In
+        // a text mode every byte is the console's too (0xFD/0xFE in garbage would hide the
+        // next ~260 bytes), and the parser only looks for a ground station's HEARTBEAT.
+        const bool was_mavlink = port::mavlink_mode();
+        if (frames.consume((uint8_t)b)) {
+            gcs_link::take_heartbeat();
+            if (was_mavlink || port::mavlink_mode()) continue;
+        }
+        const console::Command c = reader.feed((uint8_t)b);
+        if (c.id != console::CommandId::None) commands.push(c);
+    }
+}
+
+void take_input() { take(false); }
+void take_input_in_step() { take(true); }
+
+static Flash ok_or_failed(bool ok) { return ok ? TXT("ok") : TXT("FAILED"); }
+
+void print_settings_line() {
+    const settings::Settings& s = pipe.settings();
+    char buf[14];
+    Writer(out).str(TXT("# settings: rate ")).u32(s.rate_hz).str(TXT(" Hz, decl "))
+        .str(buf, text::format_centi(buf, s.declination_centideg)).str(TXT(" deg, mode "))
+        .str(console::mode_name(s.mode)).str(TXT(", compass cal "))
+        .str((s.flags & settings::kFlagMagCalibrated) ? TXT("yes") : TXT("none")).end();
+}
+
+// `status`, a line (a part: console::kPartReply) at a time: false past the last part.
+static bool print_status(uint8_t part) {
+    Writer w(out);
+    switch (part) {
+        case 0: {
+            w.str(TXT("# status: " TXT_MPU " ")).str(ok_or_failed(imu.ok())).str(TXT(", " TXT_HMC " "))
+                .str(ok_or_failed(compass.ok()));
+            if (!compass.ok()) w.str(TXT(" (yaw gyro-only)"));
+            const pipeline::Phase ph = pipe.phase();
+            w.str(TXT(", estimator "))
+                .str(ph == pipeline::Phase::Running       ? TXT("running")
+                     : ph == pipeline::Phase::Calibrating ? TXT("calibrating")
+                                                          : TXT("waiting for " TXT_MPU))
+                .end();
+            return true;
+        }
+        case 1: {
+            char buf[14];
+            w.str(TXT("# load ")).u32(loop_load::percent()).str(TXT("%, overruns ")).u32(imu.missed_samples())
+                .str(TXT(", spikes ")).u32(pipe.spikes()).str(TXT(", uptime "))
+                .str(buf, text::format_centi(buf, (int32_t)(millis() / 10u))).str(TXT(" s, airspeed "));
+            const airspeed_input::State a = airspeed_input::state();
+            if (a == airspeed_input::State::kSensor)
+                w.str(buf, text::format_centi(buf, (int32_t)(pipe.airspeed_m_s() * 100.0f))).str(TXT(" m/s"));
+            else
+                w.str(a == airspeed_input::State::kNone ? TXT("none") : TXT("zeroing"));
+            w.end();
+            return true;
+        }
+        case 2: pipeline_text::write_bias_status(out, pipe); return true;
+        case 3: pipeline_text::write_compass_status(out, pipe); return true;
+        case 4: print_settings_line(); return true;
+        case 5: tasks::print_status_line(out); return true;
+        case 6: return flight_io.print_status_line();
+        default: return false;
+    }
+}
+
+// Writes part `part` of the reply to c (and runs c with part 0); false when c's reply
+// has no such part (it is complete).
+static bool answer(const console::Command& c, uint8_t part) {
+    switch (c.id) {
+        case console::CommandId::Error: return console::print_error(c, part, out);
+        case console::CommandId::Help: return console::print_help(part, out);
+        case console::CommandId::Status: return print_status(part);
+        case console::CommandId::Show:
+            if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            break;
+        default: break;
+    }
+    if (part > 0) return false;
+    switch (c.id) {
+        case console::CommandId::Save: vehicle::store.start_save(pipe.settings()); break;
+        case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
+        case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
+        case console::CommandId::Defaults:
+            pipe.restore_defaults();
+            flight_io.configure();
+            console::print_defaults(out);
+            break;
+        case console::CommandId::Flight:
+        case console::CommandId::Show: flight_io.answer(c); break;  // flight manual|stabilize, rc, servo
+        case console::CommandId::Mode:
+            port::set_gcs_link(false);  // the mode typed, not the ground station's
+            console::apply_setting(c, pipe.settings(), out);
+            break;
+        default:  // rate, decl, set, get
+            console::apply_setting(c, pipe.settings(), out);
+            if (c.id == console::CommandId::Set) flight_io.configure();
+            break;
+    }
+    return true;
+}
+
+// Output queue bytes a part takes, at most: a line of up to console::kPartReply
+// characters, in MAVLink STATUSTEXT, two frames (<= 94 characters after "# ").
+static uint16_t part_bytes() { return port::mavlink_mode() ? 2u * mav::kMaxFrame : console::kPartReply; }
+// Both fit the empty queues, else a part would never run.
+static_assert(2u * mav::kMaxFrame + mav::kAttitudeFrame <= serial_text::kCapacity - 1u + SERIAL_TX_BUFFER_SIZE - 1u &&
+                  console::kPartReply + fmt::kRawLineMax <= serial_text::kCapacity - 1u + SERIAL_TX_BUFFER_SIZE - 1u,
+              "serial_text's queue and Serial's ring hold a reply part and an output line");
+
+// A part waits, in the port's language, with room for it and an output line after it.
+static bool due(bool mavlink) {
+    return !commands.empty() && port::mavlink_mode() == mavlink &&
+           serial_text::room() >= part_bytes() + gcs_link::output_line_bytes();
+}
+bool reply_due_text() { return due(false); }
+bool reply_due_mavlink() { return due(true); }
+
+void reply() {
+    if (answer(commands.peek(), reply_part)) {
+        ++reply_part;
+    } else {
+        commands.pop();
+        reply_part = 0;
+    }
+}
+
+}  // namespace console_link

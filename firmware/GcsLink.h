@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The ground station link (lib/MavLink: Parser, ParamLink): a ground station's requests
+// answered, its parameters and commands, HEARTBEAT and SYS_STATUS once a second, the
+// radio and servo pages' streams. Replies go through the same queue as everything else,
+// each only when it fits whole with an output line after it and ends before the next
+// sample is due (the task table's budgets), so no sample is missed and no frame
+// dropped: a PARAM_REQUEST_LIST's ~100 PARAM_VALUEs go out a few per sample as the UART
+// drains them (~37 bytes each, ~3 ms at 115200 baud).
+#pragma once
+
+#include <stdint.h>
+
+#include "MavLink.h"
+
+namespace gcs_link {
+
+// The frames received (ConsoleLink feeds it the port's bytes).
+mav::Parser& parser();
+// Called for every frame end: a ground station's HEARTBEAT switches a text mode to
+// MAVLink; in a text mode the other requests are not answered (the ground station asks
+// again once the board speaks MAVLink).
+void take_heartbeat();
+// Output queue bytes an output line takes at most in the port's language.
+uint16_t output_line_bytes();
+
+// Loop tasks, each with its budget: a request (PARAM_SET, COMMAND_LONG ...), the
+// defaults' line after PREFLIGHT_STORAGE, a save after a PARAM_SET, one PARAM_VALUE,
+// the RC_CHANNELS + SERVO_OUTPUT_RAW pair at 5 Hz.
+bool request_due();
+void take_request();
+bool defaults_line_due();
+void say_defaults();
+bool save_due();
+void save();
+bool param_value_due();
+void send_param_value();
+bool streams_due();
+void send_streams();
+// Once a second in MAVLink: HEARTBEAT and SYS_STATUS (a ground station drops a link
+// after ~3 s without a heartbeat).
+void send_heartbeat_and_status();
+
+}  // namespace gcs_link

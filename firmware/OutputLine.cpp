@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "OutputLine.h"
+
+#include "Board.h"
+#include "Port.h"
+#include "SerialText.h"
+#include "Vehicle.h"
+
+namespace output_line {
+
+using vehicle::pipe;
+using vehicle::tick;
+
+static pipeline::RateLimiter warn_angle;
+
+bool due() {
+    tick.output = pipe.output_due();
+    return tick.output;
+}
+
+// True when it worked out the angles in hundredths (c).
+static bool emit(uint32_t now_ms, pipeline::AnglesCentideg& c) {
+    const fmt::OutputMode mode = port::output_mode();
+    if (mode == fmt::OutputMode::Quiet) return false;
+    // Plot and csv lines print hundredths, which the integer path gives without a float;
+    // MAVLink's ATTITUDE carries floats.
+    pipeline::Angles a{};
+    if (mode == fmt::OutputMode::Mavlink) {
+        board::mark_begin(board::kSecEuler);
+        a = pipe.angles();
+        board::mark_end(board::kSecEuler);
+    } else if (mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv) {
+        board::mark_begin(board::kSecEuler);
+        c = pipe.angles_centideg();
+        board::mark_end(board::kSecEuler);
+    }
+    char line[fmt::kRawLineMax];
+    uint8_t n;
+    board::mark_begin(board::kSecFormat);
+    if (mode == fmt::OutputMode::Quat) {
+        n = fmt::format_quat_line(line, pipe.quaternion());
+    } else if (mode == fmt::OutputMode::Raw) {
+        const float inv_g = 1.0f / dcm::kGravity_m_s2;
+        n = fmt::format_raw_line(line, pipe.gyro_rad_s() * linalg::kDegPerRad, pipe.accel_m_s2() * inv_g,
+                                 pipe.field_uT());
+    } else if (mode == fmt::OutputMode::Mavlink) {
+        n = port::mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg, a.heading_deg,
+                                   pipe.body_rate_rad_s());
+    } else if (mode == fmt::OutputMode::Csv) {
+        n = fmt::format_csv_line_centideg(line, now_ms, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
+    } else {
+        n = fmt::format_plot_line_centideg(line, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
+    }
+    board::mark_end(board::kSecFormat);
+    if (n > 0) serial_text::write_line_if_room(line, n);
+    else if (warn_angle.allow(now_ms, 2000)) vehicle::say(TXT(TXT_WARN "output not finite: line skipped"));
+    return mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv;
+}
+
+void run() { tick.have_angles = emit(tick.now_ms, tick.angles); }
+
+void say_skipped() {
+    if (const uint16_t n = warn_angle.deferred(millis(), 2000))
+        text::Writer(vehicle::out).str(TXT(TXT_WARN "output not finite: ")).u32(n).str(TXT(" more lines skipped")).end();
+}
+
+}  // namespace output_line

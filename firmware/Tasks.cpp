@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The task table: every periodic job of the firmware, how often it runs, the time it may
+// take and the profiling section that measures it (lib/Scheduler/Scheduler.h says how
+// the scheduler runs the two tables). `make bench` prints each task's cycles against its
+// budget; `status` says which ran over it.
+//
+// The budgets: a sample's tasks must leave the loop time to see the next sample, 5 ms
+// after this one; a sample is missed when it is read more than 1.5 periods (7.5 ms)
+// after the previous one, so a loop task must end by kDeadlineUs after the last sample,
+// and it starts only when its budget says it will. Each budget is what the task takes at
+// most (apm25sim --profile: make bench) with a margin; the MAVLink rows' include packing
+// the "# " lines into STATUSTEXT frames.
+#include "Tasks.h"
+
+#include "AirspeedInput.h"
+#include "ArduinoCore.h"
+#include "Board.h"
+#include "ConsoleLink.h"
+#include "GcsLink.h"
+#include "LoopLoad.h"
+#include "OutputLine.h"
+#include "Scheduler.h"
+#include "SerialText.h"
+#include "UserCode.h"
+#include "Vehicle.h"
+
+extern volatile unsigned long timer0_overflow_count;  // the Arduino core's millis() clock (wiring.c)
+
+namespace tasks {
+
+using sched::kAlways;
+using vehicle::pipe;
+using vehicle::tick;
+
+constexpr uint16_t kDeadlineUs = 7300;
+
+// The sample tasks' own steps.
+static void compass_service() { vehicle::compass.service(tick.now_ms); }
+static void estimator_step() {
+    if (vehicle::imu.pacing_on_timer()) pipe.imu_doubtful();
+    pipe.on_imu_sample(tick.sample);
+}
+static bool estimator_running() { return pipe.phase() == pipeline::Phase::Running; }
+static void user_step() { user_attitude_step(pipe); }
+static bool control_due() { return vehicle::flight_io.control_due(tick.output); }
+static void control_run() {
+    vehicle::flight_io.control_run(tick.now_us, tick.now_ms, tick.sample, tick.have_angles ? &tick.angles : nullptr);
+}
+// ... and the loop tasks'.
+static void store_service() { vehicle::store.service(); }
+static void sensor_retries() {
+    const uint32_t now_ms = millis();
+    if (vehicle::imu.retry(now_ms)) pipe.restart_estimator();
+    vehicle::compass.retry(now_ms);
+}
+static void flight_poll() { vehicle::flight_io.poll(micros(), millis()); }
+static void once_a_second() {
+    loop_load::new_second();
+    vehicle::update_leds();
+    gcs_link::send_heartbeat_and_status();
+    output_line::say_skipped();
+}
+
+// On each sample, in this order (5 ms for all of them, with the read).
+//     name         due test                         run                          period budget_us section
+#define SAMPLE_TASKS(X)                                                                                          \
+    X(compass,      nullptr,                         compass_service,                  1, 1400, kSecCompassTask)  \
+    X(estimator,    nullptr,                         estimator_step,                   1, 2300, kSecEstimator)    \
+    X(airspeed,     nullptr,                         airspeed_input::step,             1,  300, kSecAirspeed)     \
+    X(input_step,   nullptr,                         console_link::take_input_in_step, 1,  300, kSecInputInStep)  \
+    X(user,         estimator_running,               user_step,                        1,  200, kSecUser)         \
+    X(output,       output_line::due,                output_line::run,                 1, 1200, kSecOutput)       \
+    X(control,      control_due,                     control_run,                      1, 1200, kSecControl)      \
+    X(leds,         nullptr,                         vehicle::update_leds,            50,  100, kSecLeds)
+
+// Between samples, on each pass of the loop, in this order, each when due and when it
+// ends before kDeadlineUs (kAlways: whenever due).
+//     name         due test                         run                             budget_us section         flags
+#define LOOP_TASKS(X)                                                                                            \
+    X(pump,         nullptr,                         serial_text::pump,                 800, kSecPump,         kAlways) \
+    X(input,        nullptr,                         console_link::take_input,         2000, kSecInput,        kAlways) \
+    X(reply,        console_link::reply_due_text,    console_link::reply,              2300, kSecConsoleReply, 0)       \
+    X(statustext,   console_link::reply_due_mavlink, console_link::reply,              3000, kSecConsoleReply, 0)       \
+    X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           5300, kSecGcsRequest,   0)       \
+    X(gcs_defaults, gcs_link::defaults_line_due,     gcs_link::say_defaults,           5300, kSecGcsRequest,   0)       \
+    X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
+    X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
+    X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
+    X(store,        nullptr,                         store_service,                     300, kSecStore,        kAlways) \
+    X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
+    X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
+    X(flight,       nullptr,                         flight_poll,                       800, kSecFlightPoll,   kAlways) \
+    X(second,       loop_load::second_due,           once_a_second,                    1000, kSecSecond,       kAlways)
+
+// The rows' ids (stats[]), names (`status`) and the periodic rows' counters.
+#define SAMPLE_ID(name, ...) kTask_##name,
+#define LOOP_ID(name, ...) kTask_##name,
+enum TaskId : uint8_t { SAMPLE_TASKS(SAMPLE_ID) LOOP_TASKS(LOOP_ID) kTasks };
+#define TASK_NAME(name, ...) #name "\0"
+static const char kNames[] PROGMEM = SAMPLE_TASKS(TASK_NAME) LOOP_TASKS(TASK_NAME);
+#define PHASE(name, ...) uint8_t name;
+static struct { SAMPLE_TASKS(PHASE) } phase;
+static sched::TaskStats stats[kTasks];
+
+// The scheduler's clock: timer0 (the core's millis() timer: 4 us a count at 16 MHz / 64)
+// with its overflow count's low byte above it, read with interrupts held as micros()
+// does: 4 us ticks over 262 ms, a few cycles a read.
+struct Clock {
+    static constexpr uint8_t kUsPerTick = 4;
+    __attribute__((always_inline)) static uint16_t ticks() {
+        const uint8_t sreg = SREG;
+        cli();
+        uint8_t overflows = (uint8_t)timer0_overflow_count;
+        const uint8_t count = TCNT0;
+        if ((TIFR0 & _BV(TOV0)) && count < 255u) ++overflows;  // an overflow not yet counted
+        SREG = sreg;
+        return (uint16_t)((uint16_t)overflows << 8 | count);
+    }
+    // No sample can be late while the MPU6000 is down: nothing waits then.
+    static uint32_t us_since_sample() { return vehicle::imu.ok() ? vehicle::imu.us_since_sample(micros()) : 0u; }
+};
+using Timing = sched::Timing<Clock>;
+
+static void run_sample_tasks() {
+    uint16_t start = Clock::ticks();
+#define SAMPLE_ROW(name, due, run, period, budget_us, section) \
+    SCHED_SAMPLE_TASK(name, due, run, period, budget_us, board::section)
+    SAMPLE_TASKS(SAMPLE_ROW)
+    (void)start;
+}
+
+static void run_loop_tasks() {
+    const uint32_t since_sample_us = Clock::us_since_sample();
+    const uint16_t pass_start = Clock::ticks();
+    constexpr uint16_t deadline_us = kDeadlineUs;
+#define LOOP_ROW(name, due, run, budget_us, section, flags) \
+    SCHED_LOOP_TASK(name, due, run, budget_us, board::section, flags)
+    LOOP_TASKS(LOOP_ROW)
+}
+
+void loop_starts() {
+    const uint32_t now_us = micros();
+    loop_load::start(now_us);
+    vehicle::flight_io.loop_starts(now_us);
+    vehicle::update_leds();
+}
+
+void loop_pass() {
+    run_loop_tasks();
+    const uint32_t now_us = micros();
+    if (!vehicle::imu.sample_ready(now_us)) {
+        board::idle_until_interrupt();  // until the next sample, a byte, a tick
+        return;
+    }
+    board::mark_begin(board::kSecLoop);
+    tick.now_us = now_us;
+    tick.now_ms = millis();
+    tick.output = tick.have_angles = false;
+    if (vehicle::imu.read(tick.sample, now_us, tick.now_ms)) run_sample_tasks();
+    board::mark_end(board::kSecLoop);
+    loop_load::add_sample_work(now_us, micros());
+}
+
+// "# tasks: N runs over budget (NAME Kx, max M us)": the task with the most, a line that
+// fits a reply part (console::kPartReply); `make bench` gives each task's figures.
+void print_status_line(const text::Sink* out) {
+    uint32_t total = 0;
+    uint8_t worst = 0;
+    for (uint8_t i = 0; i < kTasks; ++i) {
+        total += stats[i].overruns;
+        if (stats[i].overruns > stats[worst].overruns) worst = i;
+    }
+    text::Writer w(out);
+    w.str(TXT("# tasks: ")).u32(total).str(TXT(" runs over budget"));
+    if (total != 0) {
+        const char* name = kNames;
+        for (uint8_t i = 0; i < worst; ++i) name += strlen_P(name) + 1;
+        w.str(TXT(" (")).str(text::flash(name)).chr(' ').u32(stats[worst].overruns).str(TXT("x, max "))
+            .u32((uint32_t)stats[worst].max_ticks * Clock::kUsPerTick).str(TXT(" us)"));
+    }
+    w.end();
+}
+
+}  // namespace tasks
