@@ -191,9 +191,7 @@ bool solve(float a[][kMaxUnknowns + 1], uint8_t n) {
     return true;
 }
 
-// Symmetric square root of a symmetric positive matrix near I (Newton-Schulz:
-// Y -> Y T, Z -> T Z, T = (3I - Z Y) / 2; quadratic convergence while |I - A| < 1).
-// False when it has not converged (A too far from I: soft iron beyond any limit).
+// Newton-Schulz's T = (3I - Z Y) / 2 from the product Z Y (root_start, root_part).
 Matrix3f newton_schulz_t(const Matrix3f& zy) {
     return Matrix3f(Vector3f(1.5f - 0.5f * zy.a.x, -0.5f * zy.a.y, -0.5f * zy.a.z),
                     Vector3f(-0.5f * zy.b.x, 1.5f - 0.5f * zy.b.y, -0.5f * zy.b.z),

@@ -100,11 +100,12 @@ private:
 // ArduPilot's CompassCalibrator does, but without storing the samples: the fits are
 // linear in their parameters, so their normal equations are sums of the monomials
 // x^i y^j z^k (i + j + k <= 4) of the samples, 35 sums accumulated as they come
-// (140 B; the fit then works in the same memory, grown to 220 B). The samples are centred on a pivot (the centre already in use) and scaled
-// by 1/64 uT, so that the float32 sums (AVR's double is 32-bit too) keep their
-// precision. A fit is refused, with the reason, when the board did not see enough
-// directions, when the residual is larger than a clean compass gives, or when the
-// result is not an Earth-like field or a plausible soft iron.
+// (140 B; the fit then works in the same memory, grown to 220 B). The samples are
+// centred on a pivot (the centre already in use) and scaled by 1/64 uT, so that the
+// float32 sums (AVR's double is 32-bit too) keep their precision. A fit is refused, with
+// the reason, when the board did not see enough directions, when the residual is larger
+// than a clean compass gives, or when the result is not an Earth-like field or a
+// plausible soft iron.
 constexpr uint8_t kMagCalSeconds = 30;
 constexpr uint16_t kMagCalMinSamples = 200;     // at 75 Hz the 30 s give ~2 250
 // Of the 26 direction cells (the cube's faces, edges and corners seen from the
@@ -271,17 +272,15 @@ constexpr float kLearnMinCos = 0.94f;           // pairs at least 20 deg apart: 
 // the gyro's scale error over the turn (0.5 % of 60 deg of a 45 uT field: 0.25 uT), the
 // sample's timing against the gyro (a few ms of a 200 deg/s turn: 1.5 uT) and the
 // field's change as the hand moves the board through a room's gradients (a few uT/m
-// over tens of cm). Measured on the BROAD recordings (calibrated compass, pairs less
-// each recording's best offset): 1.56 uT rms on the odd trials, 1.54 on the even ones.
+// over tens of cm). Recorded pairs with a calibrated compass agree (docs/estimator.md).
 constexpr float kLearnPairNoise_uT = 1.5f;
-// The part of the pairs' error that does not average out over a recording (gradients
-// along the path, soft iron left after calibration): each BROAD recording's pairs,
-// solved for one offset, give 0.97 uT rms an axis on the odd trials, 0.78 on the even
-// ones (those without a magnet or a phone on the board); the truth, a few tenths.
+// The part of the pairs' error that does not average out over a session (gradients
+// along the path, soft iron left after calibration): about 1 uT an axis, as recorded
+// sessions' pairs solved for one offset show (docs/estimator.md).
 constexpr float kLearnSystematic_uT = 1.0f;
 // Sigmas from the start before x is put in use: the test is made on 3 axes at every
-// pair, ~10 independent looks a recording (1 000 pairs over a memory of 100): 3.6 sigmas
-// (two-sided 3e-4 a look) keeps a false start below ~1 % a recording.
+// pair, ~10 independent looks a session (1 000 pairs over a memory of 100): 3.6 sigmas
+// (two-sided 3e-4 a look) keeps a false start below ~1 % a session.
 constexpr float kLearnSignificance = 3.6f;
 // ... on this many pairs in a row (~1 s of turning): one pair can carry x over the line
 // by its own error; a hard iron stays there, the next pairs confirm it.
@@ -291,7 +290,8 @@ constexpr uint8_t kLearnConfirmPairs = 2;
 // not explained by any offset near x: it is dropped.
 constexpr float kLearnGate = 4.0f;
 // The dropped share (averaged over ~kLearnMemoryPairs pairs) beyond which the field is
-// not a hard iron at all: the pair noise's tails drop ~1 % (BROAD, calibrated).
+// not a hard iron at all: the pair noise's tails drop ~1 % of the pairs of a calibrated
+// compass.
 constexpr float kLearnMaxRejectShare = 0.1f;
 constexpr uint16_t kLearnMaxPairSteps = 400;    // 2 s at 200 Hz
 // ~2 pairs a second while turning: a minute of turning to follow a change, and one
@@ -305,13 +305,14 @@ constexpr float kLearnMaxOffset_uT = 50.0f;
 constexpr float kLearnPriorUncalibrated_uT = 30.0f;
 constexpr float kLearnPriorCalibrated_uT = 1.0f;
 
-// Cost on the AVR (figures: `make bench`, the README): a pair's update in float is more
-// than a 5 ms step can carry beside the estimator's own work; so a sample only composes
-// the turn (a quaternion product in Q30) and stores a pair that completes, and the pair is
-// worked out by solve_part() in kSolveParts parts (the residual in fixed point, the 3x3
-// solve in float, the estimate), on the caller's next steps with room for them (the Pipeline: the long one on a step without
-// the DCM's heavy parts, none with a heading correction or a line), before the next
-// sample: the same arithmetic as one update.
+// Cost on the AVR (figures: `make bench`, docs/performance.md): a pair's update in float
+// is more than a 5 ms step can carry beside the estimator's own work; so a sample only
+// composes the turn (a quaternion product in Q30) and stores a pair that completes, and
+// the pair is worked out by solve_part() in kSolveParts parts (the residual in fixed
+// point, the 3x3 solve in float, the estimate), on the caller's next steps with room for
+// them (the Pipeline: the long one on a step without the DCM's heavy parts, none with a
+// heading correction or a line), before the next sample: the same arithmetic as one
+// update.
 class OffsetLearner {
 public:
     // Starts afresh from the offset in use (in_use_uT: the estimate's start and the

@@ -154,10 +154,9 @@ text::Flash mode_name(fmt::OutputMode m);
 // rates or 21 decls, whose replies (13..20 bytes) go out nearly as fast as their lines
 // (9..15 bytes) arrive, so that pastes of ~75 rate or ~60 decl lines fit. Garbage makes
 // an error line (~50 bytes of reply) for every ~20 bytes received wherever its line ends
-// are close: the 20 KB stream of random bytes with commands between
-// (e2e ConsoleInput.RandomBytesStreamWithCommandsBetween) keeps at most 18 commands, 24
-// bytes, waiting (apm25sim, a command staying until its reply's last line is out), and
-// beyond kErrorBytes (40) a bad line is merged (below).
+// are close, faster than the UART answers: beyond kErrorBytes (40) a bad line is merged
+// (below), so that a stream of random bytes with commands between (the console's e2e
+// tests) never crowds out a command.
 class CommandQueue {
 public:
     static constexpr uint8_t kBytes = 64;  // a power of two (index wrap by mask)

@@ -10,9 +10,9 @@ namespace {
 
 // Hundredths of an angle, rounded half away from zero, in integers: the angle read in
 // Q15 from its bits (|deg| < 360.005: < 2^24), times 100 (< 2^31), rounded (integer
-// shifts and one 32-bit multiply where a float multiply, add and conversion were library
-// calls on the 2560; the Q15 truncation,
-// < 3.1e-5 deg, moves a value only within 0.003 % of a half count). False for NaN,
+// shifts and one 32-bit multiply where a float multiply, add and conversion would be
+// library calls on the 2560; the Q15 truncation, < 3.1e-5 deg, moves a value only within
+// 0.003 % of a half count). False for NaN,
 // infinities and anything beyond a full turn (|c| > 36000), which is not an attitude
 // angle.
 bool centi_angle(float deg, int32_t& out) {
@@ -68,7 +68,7 @@ char* put_centi(char* p, int32_t c) {
     return p;
 }
 
-// A label from flash (TXT: in SRAM the labels of the four formats took ~80 bytes).
+// A label from flash (TXT: in SRAM the four formats' labels would hold RAM for good).
 char* put(char* p, text::Flash s) {
     for (const char* q = s.p;; ++q) {
         const char ch = (char)text::flash_byte(q);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The serial output lines (../shared/SIM.md contract), formatted with integers only:
-// Serial.print(float, 2) does float divisions a digit on the 2560 (README "Performance").
+// Serial.print(float, 2) does float divisions a digit on the 2560 (docs/performance.md).
 //
 //   plot:  "roll:-1.23 pitch:4.56 yaw:271.80\n"   (degrees; yaw = heading 0..360)
 //   csv:   header "t_ms,roll,pitch,yaw\n", rows "1234,-1.23,4.56,271.80\n"

@@ -31,7 +31,7 @@ namespace settings {
 constexpr uint8_t kMagic0 = 'A';
 constexpr uint8_t kMagic1 = 'T';
 // 2: the compass calibration gained the soft-iron cross terms and the learned offset.
-// 3: the flight settings (issue 21).
+// 3: the flight settings (ArduPlane's parameters, lib/Params).
 constexpr uint8_t kSettingsVersion = 3;
 constexpr uint8_t kV2PayloadLength = 65;  // rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
 constexpr uint8_t kFlightBytes = 166;     // params::encode_flight (checked by params' tests)

@@ -1,59 +1,31 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The turn's centripetal acceleration taken off the gravity window (Premerlani &
 // Bizard, "Direction Cosine Matrix IMU: Theory", eq. 26; ArduPilot's AP_AHRS_DCM with an
-// airspeed): in steady flight the velocity is (V, 0, 0) along the body's x axis and the
-// accelerometer reads f = omega x v - g_body, so gravity is f - omega x v = f - (0,
-// omega_z V, -omega_y V). The gain (accel counts per gyro count of omega x v at the
-// airspeed, Q8) is the pipeline's: it knows the airspeed (lib/Pipeline, Airspeed.h).
+// airspeed). In steady flight the velocity is (V, 0, 0) along the body's x axis and the
+// accelerometer reads f = omega x v - g_body, so gravity is
+//   f - (dV/dt, omega_z V, -omega_y V)     (body axes)
+// The gain (accel counts per gyro count of omega x v at the airspeed, Q8) and dV/dt are
+// the pipeline's: it knows the airspeed (lib/Pipeline, Airspeed.h).
 //
-// omega_z V is the lateral acceleration only while the relative wind turns with the
-// flight path. Turbulence yaws the aeroplane into a relative wind that changes while the
-// path hardly turns (README, "Flying in simulation"). The accelerometer and the estimate
-// say what the lateral acceleration is: a_y = f_y + g down_y (down_y = sin(roll)
-// cos(pitch), earth down's body y component, the gyro carries it through a turn's entry;
-// a coordinated turn has f_y = 0, a flat skid g down_y = 0). So omega_z V is held between
-// 0 and that a_y, widened by a margin of bank: the estimate is moved toward what omega_z
-// V says at most that far beyond what it holds, a turn that lasts gets all of it (each
-// window the bound moves on with the estimate), a gust's yaw hardly any. The margin is
-// the bank error a turn's entry can leave in the estimate: the gyro's +-3 % scale
-// tolerance (MPU-6000 datasheet 6.1) over the bank, and the half degree the tilt holds
-// before it.
-//
-// In a turn through turbulence omega_z V swings about its mean (the gusts' yaw) while
-// a_y, the bank, stays: clipping the swings at a bound at their mean takes off the upper
-// ones only, the term's mean falls short of the turn's, the estimate rolls toward level
-// and the bound with it: the estimate runs away (a 30 deg turn in moderate turbulence
-// levelled to 5 deg). So the bound holds the term's mean as well: its mean over 1.3 s
-// (short against a turn, seconds long against a gust's yaw swing) is what the bounds allow
-// omega_z V's mean within a_y's mean; each window is clipped as above, and what the
-// clipping took off the mean beyond that is given back. Only in a turn: while a_y's mean
-// stays within g sin(kTurnMinBank_deg) of level the aeroplane flies straight, the gusts
-// rocking its wings and yawing it about its path, and there is no turn's term whose
-// upper swings the clipping took: nothing is given back (given back, the yaw swings' and
-// the bank's chance agreement over a second put up to two margins of roll into the
-// estimate for seconds, and the heading took it through the dip at start-up: a straight
-// gusty flight with the airspeed 1.74 deg RMSE against 1.27 without).
-//
-// At a start in flight the estimate's tilt is the start window's accelerometer mean, off
-// by what the gusts accelerated the aeroplane meanwhile (1-3 deg), and a_y read through it
-// widens the bound by that error: the yaw of an aeroplane weathervaning into a growing
-// crosswind (a degree a second, for seconds) then fits inside the bound, is taken off as a
-// turn's, and holds the estimate at the start's error, which the dip turns into heading
-// (README, "Flying in simulation"). So while the start's tilt is unproven, the
-// start-up (startup_s: three of the tilt loop's time constants 1 / kp_rp, 95 % of the
-// start's error gone), a_y is the accelerometer's f_y alone: a start inside a coordinated
-// turn (f_y = 0) is held to the margin for those seconds, and its estimate starts the turn
-// over from where the tilt loop left it.
-//
-// Along the body's x axis the flight's change of speed does the same: a climb's speed
-// change reads as pitch, 6 deg a m/s^2. A measured airspeed's change tells it (dV/dt, the
-// pipeline's; a configured cruise speed has none), but a gust changes the airspeed while
-// the path's speed hardly changes (the aeroplane's inertia), and the accelerometer does
-// not feel it. So dV/dt is held between 0 and a_x = f_x + g down_x, the acceleration the
-// accelerometer and the estimate say there is, widened by the same margin, window by
-// window: a speed change the accelerometer feels is taken off, a gust's hardly. No mean
-// is given back here: a climb's dV/dt lasts seconds and sits inside its bound, and what
-// clipping takes off is the gusts' swings, which the accelerometer did not feel.
+// The rules, each with its reason (the whole argument: docs/estimator.md):
+// - omega_z V is held between 0 and a_y = f_y + g down_y (down_y = sin(roll) cos(pitch),
+//   earth down's body y component), widened by a margin of bank: turbulence yaws the
+//   aeroplane into a new relative wind while its path hardly turns, and only a lateral
+//   acceleration the accelerometer and the estimate agree on is a turn's. The margin is
+//   the bank error a turn's entry can leave: kTurnBankMargin_deg and the gyro's
+//   kTurnBankScaleError of the bank (+-3 % scale tolerance, MPU-6000 product
+//   specification 6.1).
+// - In a turn (a_y's 1.3 s mean beyond g sin kTurnMinBank_deg) what the clipping took off
+//   the term's mean beyond what the bounds allow it is given back: clipping only the
+//   gusts' upper swings would leave the term short of the turn's, and the estimate
+//   would roll toward level and its bound with it. In straight flight nothing is given
+//   back: there is no turn's term to restore.
+// - While the start's tilt is unproven (start_tilt: startup_s, three of the tilt loop's
+//   time constants) a_y is f_y alone: read through the start's tilt error, a_y would
+//   widen the bound by that error.
+// - dV/dt is held between 0 and a_x = f_x + g down_x, widened by the same margin, window
+//   by window: a speed change the accelerometer feels is taken off (6 deg of pitch a
+//   m/s^2), a gust's change of airspeed hardly. No mean is given back.
 //
 // Formats: accel and gyro counts summed over the window (n samples, 4 but for a late
 // correction); the means of those sums in Q8.
@@ -65,10 +37,13 @@
 
 namespace dcm {
 
+// The margin of bank: the half degree of tilt error the estimate holds before a turn,
+// plus kTurnBankScaleError of the bank.
 constexpr float kTurnBankMargin_deg = 0.5f;
 // The least bank that is a turn: a scale aeroplane's gentlest turns bank 10-15 deg, and
 // the wings' rocking in turbulence averages out over the 1.3 s mean to a few degrees.
 constexpr float kTurnMinBank_deg = 5.0f;
+// The gyro's scale tolerance (MPU-6000 product specification 6.1: +-3 %).
 constexpr float kTurnBankScaleError = 0.03f;
 
 struct LateralBounds {
@@ -96,20 +71,12 @@ public:
     bool active() const { return gain_q8_ != 0; }
     // The window's sums less (dV/dt, omega_z V, -omega_y V), the first two within their
     // bounds: accel_sum and the running sums' sum, from the gyro's sums less the
-    // calibrated bias (counts) and earth down in body axes (R's third row, Q30; while
-    // start_tilt, the start-up's, a_y's bound leaves it out). The
-    // lateral and normal terms are worked out every kUpdateEvery-th window (25 Hz: a
-    // turn's term moves at the turn's pace, a gust's swings at a few hertz; the work is
-    // 32-bit arithmetic), dV/dt every eighth window (6.25 Hz: the speed changes at a
-    // climb's pace); each is kept for the windows between. The lateral and normal terms
-    // come from the rates' and a_y's means over the windows they stand for, not the last
-    // window's: one 20 ms window's rate, held for the windows between, is a sample at the
-    // update rate, and an oscillation at that rate or its multiples (a propeller's
-    // vibration the airframe answers, folded by the sampling) comes out a steady term
-    // (from the last of four windows: a flight climbing at full throttle rolled 2.6 deg
-    // with the cruise speed, README "Flying in simulation"); the mean over the 40 ms it is
-    // held for passes nothing at 25 Hz and its multiples, and what is near 12.5 Hz comes
-    // out with its sign alternating.
+    // calibrated bias (counts) and earth down in body axes (R's third row, Q30;
+    // start_tilt: a_y's bound leaves it out). The lateral and normal terms are worked out
+    // every kUpdateEvery-th window (25 Hz: a turn's pace) from the means over the windows
+    // they stand for (one window's rate, held, would alias a vibration at 25 Hz or its
+    // multiples into a steady term); dV/dt every eighth window (6.25 Hz: a climb's pace).
+    // Each is kept for the windows between.
     void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
                   linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums, bool start_tilt) {
         const uint8_t window = windows_++;

@@ -90,7 +90,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field, bool gravi
     // North: the field's component perpendicular to down. Without a usable field,
     // the body x axis projected on the horizontal (yaw 0), or body y at pitch 90.
     Vector3f north;
-    // (d x m) x d = m - d (d . m) for a unit d: one dot product where two cross products were.
+    // (d x m) x d = m - d (d . m) for a unit d: one dot product, not two cross products.
     const float field_down = mag_field.is_finite() ? down.dot(mag_field) : 0.0f;
     if (mag_field.is_finite()) north = (mag_field - down * field_down).normalized();
     if (north.is_zero()) {
@@ -228,11 +228,11 @@ void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok,
     // Gravity. The specific force is low-passed in the (estimated) earth frame, as
     // VQF does: there a linear acceleration averages out over the filter's time,
     // since velocity stays bounded, while in body axes it does not. Samples are
-    // not weighted by how close |a| is to 1 g: dropping the large ones biases that
-    // average (BROAD's fast translation, up to 10 g, shows it: 16 deg RMSE with
-    // weighting, 0.7 without). Only a sample beyond any accelerometer's range is
-    // garbage and skipped, and so is one whose gyro is beyond any range: the whole
-    // read is broken then (a glitch on the bus, a spike).
+    // not weighted by how close |a| is to 1 g: a translation's acceleration averages
+    // out only as a whole, and dropping or shrinking its large samples (a fast shake's
+    // peaks, up to 10 g) leaves the rest of it in the average as tilt. Only a sample
+    // beyond any accelerometer's range is garbage and skipped, and so is one whose gyro
+    // is beyond any range: the whole read is broken then (a glitch on the bus, a spike).
     // The samples are summed here, in integers, and low-passed at the correction's pace
     // (50 Hz): the low-pass is seconds long, so the mean of four samples loses nothing.
     if (gyro_ok && accel_ok) {
@@ -254,7 +254,7 @@ void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok,
     // two-sample coning algorithm: the rotation vector of a rotation whose axis moved
     // within the interval). The sums are integers: counts * 2^kTurnFraction less the
     // offset in the same units (the bias to 1/256 of a count). The error against a
-    // 200 Hz update on BROAD's fast rotations: README, Performance.
+    // 200 Hz update on fast rotations: docs/performance.md.
     if (gyro_ok) {
         last_gyro_ = gyro;
         strapdown_.add_turn(Vector3l(in_turn_units(gyro.x) - offset_units_.x, in_turn_units(gyro.y) - offset_units_.y,
@@ -313,9 +313,9 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is
     // the turn that lasts, the 0.5 s mean rate of the rest test: a scale error on a
     // vibration (an 8 Hz wobble at 50 deg/s) makes an error that averages out, while a
-    // hand's or a vehicle's turn does not (shake, a board never still since power-on
-    // with a 2 deg/s bias: 17.8 -> 12.6 deg, VQF 14.4; BROAD 1.57 -> 1.58). A rejected
-    // gyro sample in the window holds it too (step()).
+    // hand's or a vehicle's turn does not: the instantaneous rate would hold the
+    // integrator through every wobble of a board that is never still, and its bias would
+    // go unlearned. A rejected gyro sample in the window holds it too (take_sample()).
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
     const bool hold_integrator = rotating_fast_ || start_holds_integrator();
@@ -447,7 +447,8 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     }
 #endif
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
-    // (The integer inverse square root, to 1e-4: sqrtf and a division cost ~900 cycles.)
+    // (The integer inverse square root, to 1e-4: no sqrtf and no division, the float
+    // library's dearest calls on the AVR.)
     const float inv_norm = linalg::inverse_sqrt(norm2);
     const float norm = norm2 * inv_norm;
     const float down_component = field_ef.z * inv_norm;

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-step Direction Cosine Matrix attitude estimator with drift correction,
-// after W. Premerlani and P. Bizard, "Direction Cosine Matrix IMU: Theory" (2009).
+// after W. Premerlani and P. Bizard, "Direction Cosine Matrix IMU: Theory" (2009): the
+// update (eq. 17, here as an exact rotation: Strapdown.h), the renormalisation (eqs.
+// 18-21), the roll/pitch error (eq. 27: Gravity.h), the heading error (eqs. 31-33,
+// Dcm::correct_heading) and the centripetal term (eq. 26: Centripetal.h).
 //
 // Frames: body x forward, y right, z down; earth north-east-down, referenced to
 // MAGNETIC north (the declination is added only when a heading is reported, so
@@ -85,7 +88,7 @@ public:
     // non-finite gyro sample is rejected (not summed); a non-finite or absurd accel
     // sample gets no weight.
     // line_due: an output line follows this step; the matrix is brought up to date for it
-    // (Dcm::integrate when two or more steps wait; one is carried by euler_now()).
+    // (Strapdown::integrate when two or more steps wait; one is carried by euler_now()).
     // The sample in the sensor's counts (the firmware's path: integer sums at 200 Hz and
     // fixed point in the parts that use them), scaled by set_sample_scales; the gyro
     // counts carry the sensor bias set by set_sensor_bias_rad_s. gyro_valid false: the
@@ -155,9 +158,9 @@ public:
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     // The last update turned the matrix or worked out the gravity correction (the
-    // step's two heavy parts, each on its own
-    // step): a caller with deferrable work (the compass learner) puts only a short piece
-    // of it on this step, so that the step stays under 30 k.
+    // step's two heavy parts, each on its own step): a caller with deferrable work (the
+    // compass learner) puts only a short piece of it on this step, so that the step stays
+    // within its budget (the estimator step's maximum in `make bench`).
     bool heavy_step() const { return heavy_; }
     uint8_t status() const { return status_; }
     uint16_t recoveries() const { return recoveries_; }
@@ -171,7 +174,7 @@ public:
     void set_turn(TurnMean* turn) { turn_ = turn; }
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
-    // Seed for the bias estimate, e.g. from a start-up calibration at rest.
+    // A start value for the bias estimate, e.g. from a start-up calibration at rest.
     void set_gyro_bias_rad_s(const linalg::Vector3f& bias);
     const DcmSettings& settings() const { return *settings_; }
 #if DCM_TRACE

@@ -37,64 +37,56 @@ struct DcmSettings {
     float output_lead_s;             // the output is R carried forward by this, s
 };
 
-// One set for everything, each value with its physical reason; `make tune`
-// (bench/tune.py) cross-validates them on the BROAD recordings (tuned on one half,
-// scored on the other) and scores them on the scenarios with a real board's errors.
+// One set for everything, each value with its physical reason beside it; `make tune`
+// (bench/tune.py) cross-validates them on recordings (tuned on one half, scored on the
+// other) and scores them on scenarios with a real board's errors (docs/estimator.md).
 // The gyro bias is learned from gravity (the two horizontal axes, ki_rp) and at rest
 // (every axis, rest_*); from the compass (the vertical axis, ki_yaw) only until a rest
-// or the start's calibration has measured it. The compass's errors (a residual hard
+// or the start's calibration has measured it: the compass's errors (a residual hard
 // iron, a nearby magnet) are degrees and turn with the heading, so an integrator on them
 // learns a false bias that makes the heading drift whenever the compass is disturbed
-// (mag_disturbance with an uncalibrated compass, ki_yaw always on: 9.6 -> 5.9 deg; VQF
-// makes the same choice). But on a board never still since power-on (started in flight,
-// carried) nothing has measured the bias, the chip's +-20 deg/s at worst, and while it
-// flies level nothing but the compass sees its vertical part: the heading stands b /
-// kp_yaw off (0.8 deg/s: 8 deg) for as long. ki_yaw = kp_yaw^2 / 4 makes that heading
-// loop critically damped: a compass error does not ring, and 4 deg of it held for 10 s
-// teaches 0.1 deg/s. The accelerometer cannot tell a sustained acceleration
-// (a car's corner, a climb's speed change, a hand's stroke) from tilt, and the
-// integrator learns what the tilt error holds for its time constant kp_rp / ki_rp: 10 s
-// while the bias is unknown (a board that never kept still: up to degrees per second to
-// find), 33 s once it was measured still (the start-up calibration, a rest), when what
-// is left to follow is the MPU6000's drift as it warms (0.2 deg/s a minute follows with
-// a lag of 0.1 deg/s, 0.1 deg of tilt) and a 10 s acceleration teaches a third as much
-// false bias. Nor does it learn while the board turns lastingly (the 0.5 s mean rate
-// beyond integrator_hold_rate, 10 deg/s): a gyro scale error (+-3 %) makes a lasting
-// turn's rate look like bias, and a vehicle's turn holds a centripetal acceleration
-// omega v that the accelerometer reads as tilt for as long as the turn lasts, all of it
-// without an airspeed and the gusts' share with one: an aeroplane at 18 m/s banked 18
-// deg turns at 10 deg/s (ArduPilot's 20 deg/s lets every turn up to 32 deg of bank
-// teach the bias), a car at 10 m/s round a 57 m bend too. Rest: a hand-held board's
-// tremor stays below 2 deg/s and
-// 0.5 m/s^2 (VQF's thresholds); 1.5 s of it is rest.
-// The two latencies: the MPU6000's 42 Hz DLPF delays the gyro by 4.8 ms (Register
-// Map 4.3), of which the step's end-point integration takes back 2.5 ms: the output
-// leads by 3 ms. A field sample is ~5 ms old when the step uses it (the HMC5883L's
-// 8-sample average, the wait for the next step), and BROAD's own magnetometer lags
-// its gyro by ~10 ms more: 8 ms serves both (BROAD 1.83 -> 1.56 deg mean total,
-// scenarios 0.50 -> 0.40 deg, against 12 ms and no lead).
+// (VQF makes the same choice).
 constexpr DcmSettings kDefaultDcmSettings = {
     0.005f,                         // step_s: 200 Hz
     1.0f,                           // kp_rp_1_s
+    // The tilt integrator learns what the tilt error holds for kp_rp / ki_rp, a sustained
+    // acceleration's too: 10 s while the bias is unknown (up to degrees per second to
+    // find); 33 s once measured still, when only the MPU6000's warm-up drift is left
+    // (0.2 deg/s a minute, followed with a lag of 0.1 deg/s).
     0.1f,                           // ki_rp_1_s2
     0.03f,                          // ki_rp_measured_1_s2
     0.1f,                           // kp_yaw_1_s
+    // On a board never still since power-on only the compass sees the bias's vertical
+    // part in level flight: without ki_yaw the heading stands b / kp_yaw off (0.8 deg/s:
+    // 8 deg). kp_yaw^2 / 4 makes that loop critically damped: a compass error does not
+    // ring.
     0.0025f,                        // ki_yaw_1_s2: kp_yaw^2 / 4, until the bias is measured (see above)
     5.0f,                           // kp_startup_1_s
     3.0f,                           // startup_s
     16.0f,                          // accel_max_g
     3.0f,                           // accel_lowpass_s
+    // No bias learning while the board turns lastingly: a gyro scale error (+-3 %) makes
+    // the turn's rate look like bias, and its centripetal acceleration reads as tilt. An
+    // aeroplane at 18 m/s banked 18 deg turns at 10 deg/s (ArduPilot's 20 deg/s lets every
+    // turn up to 32 deg of bank teach the bias).
     10.0f * linalg::kRadPerDeg,     // integrator_hold_rate_rad_s (see above; ArduPilot's 20 deg/s)
     10.0f * linalg::kRadPerDeg,     // bias_limit_rad_s
     0.1f,                           // mag_norm_tolerance
     0.1f,                           // mag_dip_tolerance
     20.0f,                          // mag_recover_s
     20.0f * linalg::kRadPerDeg,     // mag_new_min_rate_rad_s (VQF's magNewMinGyr)
+    // A field sample is ~5 ms old when the step uses it (the HMC5883L's 8-sample average,
+    // the wait for the next step), and the recordings the values are tuned on have their
+    // magnetometer ~10 ms further behind their gyro: 8 ms serves both.
     0.008f,                         // mag_latency_s
+    // Rest: a hand-held board's tremor stays below 2 deg/s and 0.5 m/s^2 (VQF's
+    // thresholds); 1.5 s of it is rest.
     2.0f * linalg::kRadPerDeg,      // rest_gyro_deviation_rad_s
     0.5f,                           // rest_accel_deviation_m_s2
     1.5f,                           // rest_min_s
     1.0f,                           // rest_bias_s
+    // The MPU6000's 42 Hz DLPF delays the gyro by 4.8 ms (Register Map 4.3), of which the
+    // step's end-point integration takes back 2.5 ms: the output leads by 3 ms.
     0.003f,                         // output_lead_s
 };
 

@@ -184,7 +184,7 @@ Matrix3f dcm_from_euler(float roll_rad, float pitch_rad, float yaw_rad) {
 
 float heading_deg(float yaw_rad, float declination_deg) {
     // yaw within +-180 deg and the declination within +-180 give -360 < h < 360: two
-    // folds, where fmodf would cost ~300 B of AVR flash.
+    // folds, where fmodf would bring avr-libc's routine into the flash.
     float h = yaw_rad * linalg::kDegPerRad + declination_deg;
     if (h < 0.0f) h += 360.0f;
     if (h < 0.0f) h += 360.0f;

@@ -20,8 +20,8 @@
 // output prints, of the same formulas in double (test_fixed.cpp, up to 80 deg pitch:
 // nearer the lock roll and yaw are ill-conditioned for any arithmetic), and the same
 // bits on the host. The output path (euler_carried_q24 then angles_centideg) has no
-// float after the nine entries (README, Performance), and the lines print its hundredths
-// as they are.
+// float after the nine entries (its cost: docs/performance.md), and the lines print its
+// hundredths as they are.
 #pragma once
 
 #include <stdint.h>

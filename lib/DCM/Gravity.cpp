@@ -74,8 +74,9 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     // step's sample by the steps not yet integrated (this one among them), so the
     // steps are (n - j + 1) - pending, and sum_j phi_j x a_j is
     // w dt x (sum_j (n - j + 1) a_j - pending sum_j a_j): the first sum is the sum
-    // of the running sums, three additions a step. (Weighting each sample, not the
-    // mean, matters under a 10 g shake while turning: BROAD 16, 1.99 -> 1.69 deg.)
+    // of the running sums, three additions a step. (Each sample is turned by its own
+    // phi_j, not the mean by the mean turn: under a 10 g shake while turning, the
+    // acceleration changes within the window and the two differ.)
     // In integers: counts * 2^8, the turn per step in 16 bits (Q14 radians: the term
     // is a few percent of the sum, its rounding 6e-5 rad of it).
     // (A subtraction per pending step, a step or two: opaque keeps avr-gcc from making
@@ -137,7 +138,7 @@ FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r
                          linalg::hot::mul_q14(q14_of(r.a.y), n) + linalg::hot::mul_q14(q14_of(r.b.y), e),
                          linalg::hot::mul_q14(q14_of(r.a.z), n) + linalg::hot::mul_q14(q14_of(r.b.z), e));
     // The gain's and the low-pass turn's products below as ordinary calls: five calls at
-    // 50 Hz cost a few cycles a step, their inline copies some 100 bytes of flash each.
+    // 50 Hz add little to a step, where each inline copy would add its code to the flash.
     using linalg::mul_q14;
     const float kp = startup_left > 0.0f
                          ? settings.kp_rp_1_s + (settings.kp_startup_1_s - settings.kp_rp_1_s) * startup_left

@@ -91,11 +91,11 @@ public:
     // A field's strength (uT) and dip (its down component over its strength) as the
     // reference.
     void learn(float norm, float down_component);
-    // One mean field: its strength, dip, the steps it stands for and the time they take
-    // (s, capped), and the gyro's rate meanwhile (units per step).
     // The learned strength (uT, 0: forgotten) and sine of the dip (host tools: the trace).
     float ref_norm() const { return ref_norm_; }
     float ref_down() const { return ref_down_; }
+    // One mean field: its strength, dip, the steps it stands for and the time they take
+    // (s, capped), and the gyro's rate meanwhile (units per step).
     FieldVerdict judge(float norm, float down_component, uint16_t interval_steps, float sample_dt_s,
                        const linalg::Vector3l& rate_units, const DcmSettings& settings, const DcmCoefficients& k);
 

@@ -28,10 +28,10 @@ void Strapdown::end_step() {
 // with the three factors from their series to a^6 (sin(a)/a, cos a) and a^4 ((1 - cos a)
 // /a^2): below 4e-7 an update up to a = 0.5 rad (1 430 deg/s at 50 Hz). The update is
 // then a rotation to that order and keeps R orthonormal by itself: rounding leaves
-// ~1e-7 an update, so renormalisation (which costs half an update) runs every
-// kRenormaliseEvery updates, and row c is rebuilt as a x b at each (rows a and b are
-// what the update turns). The paper's first-order R (I + [theta x]) is not a rotation:
-// it stretches each row by a^2/2 an update, which renormalising at every update hid.
+// ~1e-7 an update, so renormalisation runs only every kRenormaliseEvery updates, and row
+// c is rebuilt as a x b at each (rows a and b are what the update turns). The paper's
+// first-order R (I + [theta x]) (eq. 17) is not a rotation: it stretches each row by
+// a^2/2 an update, which renormalising at every update hides.
 FIXED_OWN_FRAME void Strapdown::integrate(const DcmCoefficients& k) {
     profile::begin(profile::kIntegration);
     using linalg::hot::mul_q14;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What the estimator's corrections did on a step, for the host's `replay --trace`
-// (issue 24: which corrections ran and why, while the board moves). Host only: the
+// (which corrections ran and why, while the board moves). Host only: the
 // trace's code is in `#if DCM_TRACE` blocks, 1 on the host and 0 on the AVR, so the
 // firmware's code and RAM are the same with or without it (and `make mutate` builds
 // without it: instrumentation, not the estimator). Dcm only writes here, never reads
@@ -21,7 +21,7 @@
 
 namespace dcm {
 
-// Why the gravity correction did not run on a step.
+// What the gravity correction did on a step.
 enum class GravityEvent : uint8_t {
     kNotDue,        // not a correction step (every kCorrectionDivider): the last one's rate is applied
     kRan,           // worked out: the low-pass's direction against earth down
@@ -45,7 +45,7 @@ struct DcmTrace {
     float tilt_error_n_rad = 0.0f;         // the low-pass's direction error, estimated earth axes
     float tilt_error_e_rad = 0.0f;         // (kept from the last correction)
     HeadingEvent heading = HeadingEvent::kNotDue;
-    float heading_error_deg = 0.0f;        // what the field mean said (asin of its east share), last mean
+    float heading_error_deg = 0.0f;        // the last field mean's horizontal angle from north (atan2)
     float field_norm_uT = 0.0f;            // the last mean's strength and dip (deg), and the reference's
     float field_dip_deg = 0.0f;
     float ref_norm_uT = 0.0f;

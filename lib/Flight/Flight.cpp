@@ -9,7 +9,7 @@ namespace flight {
 
 namespace {
 
-// a / b rounded to the nearest, half away from zero (b > 0).
+// v held within [lo, hi].
 int32_t clamp32(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 bool bit(uint8_t mask, uint8_t index) { return ((mask >> index) & 1u) != 0u; }

@@ -8,7 +8,7 @@
 //   -> the mixer (plain aileron/elevator/throttle/rudder on OUT1-4 in ArduPlane's order,
 //      elevons or V-tail) -> widths (SERVOn_* end points, reverse, limits).
 //
-// Conventions (README "Flying"): roll positive = right wing down, pitch positive = nose
+// Conventions (docs/flight.md): roll positive = right wing down, pitch positive = nose
 // up (lib/DCM's Euler angles). A normalised surface command is in centi-degrees, 4500 =
 // full throw, positive = roll right (aileron), nose up (elevator), nose right (rudder);
 // throttle is in tenths of a percent, 0..1000. With no reverse set, a receiver channel
@@ -87,7 +87,7 @@ uint8_t switch_position(uint16_t width_us);
 // integrator sums I tau x rate error x dt, is limited to imax and does not grow while
 // the output is saturated. In integers (centi-degrees, centi-degrees per second) with the
 // gains turned into fixed-point factors when they change (axis_terms): the AVR has no
-// float unit, and a float controller cost several times its share of the loop.
+// float unit, and every float operation of a controller would be a library call.
 
 // The gains as the step uses them.
 struct AxisTerms {

@@ -9,7 +9,7 @@ int32_t fixed_from_float(float x, uint8_t frac_bits) { return hot::fixed_from_fl
 #ifdef __AVR__
 // The called form in the registers the call brings its operands in (a in r22..r25,
 // x in r18..r21, the result in r22..r25) and the call-clobbered r26, r27, r30, r31
-// for the sum: no register to save, where the inline form's register choice made the
+// for the sum: no register to save, where the inline form's register choice makes a
 // called copy save fourteen. The same sums as mul_u32_shr30 in another order: the
 // products of a's and x's low bytes first, so that those two registers take the
 // sum's two high bytes. The sign of the product waits in the T flag.

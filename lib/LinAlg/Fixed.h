@@ -26,7 +26,7 @@
 //     renormalisation, a new field's heading, the learner's solve) calls.
 //   - mul_q30 is called even on the hot list: its called form keeps to the
 //     call-clobbered registers (Fixed.cpp), while a function with many inline copies
-//     (the integration) ran out of registers and spilled to a deep frame, slower and
+//     (the integration) runs out of registers and spills to a deep frame, slower and
 //     larger than the calls. hot::mul_q30 is the host's form and the reference.
 //   - The Euler output (atan2_q24 ...) runs once a line, all inline (its own target).
 #pragma once
@@ -320,8 +320,8 @@ FIXED_INLINE int32_t mul_s16_shr16(int16_t r, int32_t x) {
 FIXED_INLINE int32_t mul_q14(int16_t r, int32_t x) { return (int32_t)((uint32_t)mul_s16_shr16(r, x) << 2); }
 // mul_q14 rounded to the unit instead of to 4 units, for |x| < 2^29 (the shift moves to
 // x): where the product is a low-pass's step. A step of 0.04 that comes in 4-unit
-// multiples stops 50 units short of the mean it follows (Dcm::detect_rest's rest means:
-// their offset became the gyro bias, rest_bias 0.02 -> 0.09 deg).
+// multiples stops 50 units short of the mean it follows (RestDetector::update's rest
+// means: their offset would become the gyro bias at rest).
 FIXED_INLINE int32_t mul_q14_unit(int16_t r, int32_t x) { return mul_s16_shr16(r, (int32_t)((uint32_t)x << 2)); }
 }  // namespace hot
 // The same as ordinary calls (Fixed.cpp).
@@ -431,12 +431,12 @@ FIXED_INLINE int32_t atan2_q24(bool y_negative, uint32_t y_magnitude, bool x_neg
     return y_negative && y_magnitude != 0 ? -a : a;
 }
 
-// Inverse square roots without a float call (sqrtf and a division cost ~900 cycles
-// on the AVR), from 16x16 multiplies (Fixed.cpp). The core: 1/sqrt(t) in Q15 for
-// t = xn / 2^16 in [1/4, 1) (2 at t = 1/4 read as 65535), a line on each half of the
-// range (2.3 % at most), then two of Newton's steps y <- y (3 - t y^2) / 2, each
-// leaving 1.5 times the square of the relative error: within 6e-5 of 1/sqrt(t) for
-// every xn (test_fixed.cpp).
+// Inverse square roots without a float call (sqrtf and a division are the float
+// library's dearest calls on the AVR), from 16x16 multiplies (Fixed.cpp). The core:
+// 1/sqrt(t) in Q15 for t = xn / 2^16 in [1/4, 1) (2 at t = 1/4 read as 65535), a line
+// on each half of the range (2.3 % at most), then two of Newton's steps
+// y <- y (3 - t y^2) / 2, each leaving 1.5 times the square of the relative error:
+// within 6e-5 of 1/sqrt(t) for every xn (test_fixed.cpp).
 uint16_t inverse_sqrt_q15(uint16_t xn);
 // 2^30 / sqrt(x) for x >= 1 (x in steps of four bits brought into [2^14, 2^16)):
 // within 1e-4 of itself. x = 0 gives 2^31 - 1.

@@ -45,14 +45,14 @@ constexpr float kPi = 3.14159265358979f;
 constexpr float kDegPerRad = 57.2957795130823f;
 constexpr float kRadPerDeg = 0.0174532925199433f;
 
-// atan2 to within 1.2e-5 rad (0.0007 deg) for any finite input, in about a third
-// of avr-libc's atan2f time: one division and an odd
-// degree-9 polynomial fitted (least maximum error) to atan on [0, 1], with the
-// octant folded in by symmetry. atan2(0, 0) = 0; NaN in gives 0 out.
+// atan2 to within 1.2e-5 rad (0.0007 deg) for any finite input, cheaper than
+// avr-libc's atan2f: one division and an odd degree-9 polynomial fitted (least maximum
+// error) to atan on [0, 1], with the octant folded in by symmetry. atan2(0, 0) = 0; NaN
+// in gives 0 out.
 float fast_atan2(float y, float x);
 
-// Operations are out of line (LinAlg.cpp): inlined, each float operation is a
-// call with its own register shuffling, and the estimator grew to 9 KB of flash.
+// Operations are out of line (LinAlg.cpp): inlined, each float operation is a call
+// with its own register shuffling, copied into every caller's flash.
 struct Vector3f {
     float x, y, z;
 

@@ -2,8 +2,9 @@
 // Cycle markers for the simulator's profiler (apm25sim --profile, ../shared/SIM.md):
 // a section id written to GPIOR0 where the section starts and to GPIOR1 where it
 // ends, one OUT instruction each on the AVR and nothing on the host. The firmware's
-// own sections are in firmware/Board.h (1..6); the parts of the estimator step,
-// which lives in lib/, are these, so that `make bench` shows where its cycles go.
+// own sections are in firmware/Board.h (the numbers not used here); the parts of the
+// estimator step, which lives in lib/, are these, so that `make bench` shows where its
+// cycles go.
 #pragma once
 
 #include <stdint.h>

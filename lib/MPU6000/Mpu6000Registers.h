@@ -100,7 +100,7 @@ constexpr float kStandardGravity_m_s2 = 9.80665f;
 
 // The same sensitivities as scale factors, constant expressions (a float division is
 // the 2560's slowest library call and the decode runs 200 times a second; a switch here
-// became a 68-byte table in RAM).
+// becomes a table in RAM).
 constexpr float gyro_rad_s_per_count(GyroRange range) {
     return range == GyroRange::Dps250    ? linalg::kRadPerDeg / 131.0f
            : range == GyroRange::Dps500  ? linalg::kRadPerDeg / 65.5f

@@ -349,7 +349,8 @@ void copy_id(char out[kParamIdLen + 1], const char* id) {
 // the hosts this builds on are; their fields naturally aligned): a copy of the
 // zero-filled payload decodes it, as the generated mavlink_msg_*_decode does. The copy
 // takes at most the payload's bytes: on x86-64 GCC ignores MAVPACKED on the typedef and
-// pads COMMAND_LONG's 33 bytes to 36 (ASan found the read past Received's end).
+// pads COMMAND_LONG's 33 bytes to 36, and a copy of the whole struct would read past
+// Received's end.
 template <class Message>
 void copy_payload(Message& m, const Received& rx) {
     memset(&m, 0, sizeof m);

@@ -20,7 +20,7 @@
 // Why these HEARTBEAT values: QGroundControl creates a vehicle for a heartbeat from
 // component MAV_COMP_ID_AUTOPILOT1 (1) unless its type is GCS, ONBOARD_CONTROLLER, GIMBAL
 // or ADSB (MultiVehicleManager). The board flies a plane with ArduPlane's modes and
-// parameter names (issue 21), so it says what ArduPlane says: MAV_TYPE_FIXED_WING,
+// parameter names, so it says what ArduPlane says: MAV_TYPE_FIXED_WING,
 // MAV_AUTOPILOT_ARDUPILOTMEGA and custom_mode = ArduPlane's mode number, which Mission
 // Planner, QGroundControl and MAVProxy name (MANUAL, STABILIZE, FBWA). base_mode: custom
 // mode enabled, manual input enabled, stabilize enabled outside MANUAL, and armed: the

@@ -345,13 +345,13 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
 
     // A clipped accelerometer sample still points roughly the right way: in a violent
     // motion one axis clips for a few ms, and dropping those samples would bias the
-    // estimator's low-passed gravity (BROAD's 10 g fast translation: 1.7 -> 5.2 deg
-    // RMSE; its clipped samples never have two axes clipped at once). Two or more
-    // axes at full scale (at least 22 g) is not a motion but a stuck or broken sensor,
-    // and so is one axis clipped for longer than kAccelSaturationFaultSteps: then the
-    // DCM is told the accel is not valid and gives gravity no weight that step
-    // (Dcm::update). The gyro is integrated (saturated, it is a lower bound of the rate)
-    // unless the rate is beyond any MEMS gyro's.
+    // estimator's low-passed gravity (they are one side of the motion's acceleration,
+    // which averages out only as a whole). Two or more axes at full scale (at least
+    // 22 g) is not a motion but a stuck or broken sensor, and so is one axis clipped for
+    // longer than kAccelSaturationFaultSteps: then the DCM is told the accel is not
+    // valid and gives gravity no weight that step (Dcm::update). The gyro is integrated
+    // (saturated, it is a lower bound of the rate) unless the rate is beyond any MEMS
+    // gyro's.
     st_.accel_saturated_steps = s.accel_saturated ? (uint8_t)(st_.accel_saturated_steps < 255 ? st_.accel_saturated_steps + 1 : 255) : 0;
     const bool accel_stuck = s.accel_saturated && (clipped_axes(s.accel) >= 2 ||
                                                    st_.accel_saturated_steps > kAccelSaturationFaultSteps);
@@ -361,8 +361,8 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // kMaxMagWaitSteps: its age is counted in the latency compensation. A line (Euler
     // angles and formatting) is not made on a step with a field sample, nor on the
     // start's two (starting()): it moves to the next step, 5 ms later (samples come at
-    // least two steps apart). The DCM brings its
-    // matrix up to date for the line. (The parts' costs: README "Performance".)
+    // least two steps apart). The DCM brings its matrix up to date for the line. (The
+    // parts' costs: docs/performance.md.)
     bool heading_corrected = st_.mag_pending && st_.mag_present;
     if (heading_corrected && st_.mag_wait_steps < kMaxMagWaitSteps && dcm_.heavy_due()) {
         heading_corrected = false;
@@ -410,12 +410,12 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
     // heading's correction from its mean or its first heading (Dcm::heading_due_next; a
     // field sample's own short work leaves room). On a step with the DCM's integration
     // or gravity correction (Dcm::heavy_step) only one short piece of it fits within the
-    // step's budget: a sample or a part of the solve but its long second one. A pair's solve takes three such steps, and the
-    // samples that come meanwhile wait (the turn goes on summing). Each step kept from
-    // the learner delays the offset it finds, and in a fast turn with a compass never
-    // calibrated the first one ends the heading's freeze on a field the disturbance test
-    // rejects (fast+uncal over ten noise seeds: 2.98 deg with the heavy steps kept from
-    // the learner, 2.92 with its short pieces on them).
+    // step's budget: a sample or a part of the solve but its long second one. A pair's
+    // solve takes three such steps, and the samples that come meanwhile wait (the turn
+    // goes on summing). Each step kept from the learner delays the offset it finds, and
+    // in a fast turn with a compass never calibrated the first offset is what ends the
+    // heading's freeze on a field the disturbance test rejects: so the short pieces go on
+    // the heavy steps too.
     if (st_.output_due || heading_heavy) return;
     const bool short_room = dcm_.heavy_step();
     bool fit_step = false;
@@ -525,10 +525,9 @@ void AttitudePipeline::finish_mag_calibration() {
     if (st_.phase == Phase::Running) {
         forget_mag_reference(true);
         // The estimator's bias residual was learned partly from heading corrections
-        // against the old calibration (a simulated tumble with 8 uT of hard iron, `cal
-        // mag` at its end: kept, the heading at rest swung from -0.9 to +0.9 deg over
-        // the next 15 s; dropped, it settles from -0.9 to 0.0): it goes with it, and
-        // is learned again.
+        // against the old calibration: kept, it turns the heading at rest while the new
+        // field's corrections unlearn it. It goes with the old calibration and is
+        // learned again.
         dcm_.set_gyro_bias_rad_s(Vector3f());
     }
 }

@@ -19,8 +19,8 @@
 // If the board is never still for kStartupDeadlineSteps the estimator starts anyway
 // with the saved bias (or zero) and the measurement goes on in the background.
 // Each step, on the sample in the MPU6000's counts: a spike replaced by the previous
-// sample (guard), the accelerometer's centripetal term taken off when an airspeed is
-// set, Dcm::update at the fixed 5 ms step (the DCM subtracts the calibrated bias; an
+// sample (guard), Dcm::update at the fixed 5 ms step (the DCM subtracts the calibrated
+// bias and, when an airspeed is set, the turn's centripetal term: configure_turn; an
 // accelerometer stuck at full scale gets no gravity weight that step, a rate beyond any
 // gyro's is not integrated), then Dcm::correct_heading with the latest field sample
 // (waiting out up to kMaxMagWaitSteps of the DCM's heavy steps), and on a step with room
@@ -65,7 +65,7 @@ constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the b
 // firmware and in the host replay tool.
 constexpr uint8_t kMagReadMinSteps = 2;
 // The offset learner takes a field sample at most every this many steps (25 Hz): each
-// sample costs it a turn composed (README "Performance"), and pairs close at 20 deg of
+// sample costs it a turn composed (docs/performance.md), and pairs close at 20 deg of
 // turn (kLearnMinCos) whatever the rate; the gyro's turn between two samples is summed as a
 // rotation vector, whose error over 40 ms (at most 0.2 rad at 300 deg/s) is below 0.003 rad.
 constexpr uint8_t kLearnMinSteps = 8;
@@ -137,7 +137,8 @@ using AnglesCentideg = dcm::AnglesCentideg;
 // A per-kind rate limiter for warnings: allow() is true at most once per interval; what
 // it holds back is not lost: once the interval since the last line is over, deferred()
 // gives how many were held (and zero again), for a "N more" line that starts the next
-// interval (while some are held, allow() holds the next ones too: that line counts them). A plain struct that starts zeroed: declare it static or value-initialise it
+// interval (while some are held, allow() holds the next ones too: that line counts
+// them). A plain struct that starts zeroed: declare it static or value-initialise it
 // (`RateLimiter r{};`).
 struct RateLimiter {
     bool allow(uint32_t now_steps, uint16_t interval_steps);
@@ -225,14 +226,14 @@ public:
     // True once per output period after on_imu_sample (only while Running).
     bool output_due() const { return st_.output_due; }
     // The step that ended the gyro calibration (it started the estimator: the TRIAD in
-    // floats, ~22k cycles) or the next (it tells the start's event, ~12k): long steps, so
-    // the first output line comes on the step after them, and so should other long work
-    // that can wait (the flight control step).
+    // floats) or the next (it tells the start's event): long steps, so the first output
+    // line comes on the step after them, and so should other long work that can wait
+    // (the flight control step).
     bool starting() const { return st_.start_message != StartMessage::kNone; }
     // Current angles (Euler extraction in integers, then floats; call when due).
     Angles angles() const;
     // The same in printed hundredths, with no float after the matrix entries (cheaper
-    // than angles(): section 2, README "Performance"): what the plot and csv lines print.
+    // than angles(): docs/performance.md): what the plot and csv lines print.
     AnglesCentideg angles_centideg() const;
     // The same attitude as a unit quaternion, body to the true-north earth frame
     // (declination applied like the heading's): `mode quat`.
