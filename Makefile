@@ -11,6 +11,7 @@
 #                   sketch built by arduino-builder
 #   make bench      cycles, size and accuracy against the peers (build/bench/report.md)
 #   make tune       cross-validation of the estimator's gains on the BROAD recordings
+#   make docs       docs/parameters.md from the parameter table (lib/Params)
 #   make deps       install what is missing (apt-get; through sudo when not root)
 #   make upload PORT=/dev/ttyACM0    flash with avrdude (wiring protocol, 115200)
 #   make monitor PORT=/dev/ttyACM0   watch the serial output (115200)
@@ -23,7 +24,7 @@
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
                 libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-BUILD_GOALS := all firmware attitude-only tools sim fly test bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
+BUILD_GOALS := all firmware attitude-only tools docs sim fly test bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean

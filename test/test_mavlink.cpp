@@ -736,7 +736,7 @@ TEST(ParamLink, RepliesSinglesFirstThenTheWholeListOnce) {
     EXPECT_EQ(n, (unsigned)mav::ParamReplies::kSingles);
 }
 
-// --- The README's parameter table ---------------------------------------------------------
+// --- The parameter reference's table (docs/parameters.md) ----------------------------------
 
 std::vector<std::string> split_cells(const std::string& line) {
     std::vector<std::string> cells;
@@ -753,9 +753,9 @@ std::vector<std::string> split_cells(const std::string& line) {
     return cells;
 }
 
-TEST(MavLink, ReadmeParameterTableIsTheCodes) {
+TEST(MavLink, ParameterReferenceTableIsTheCodes) {
     std::string path(__FILE__);
-    path = path.substr(0, path.rfind('/')) + "/../README.md";
+    path = path.substr(0, path.rfind('/')) + "/../docs/parameters.md";
     FILE* f = fopen(path.c_str(), "r");
     ASSERT_NE(f, nullptr) << path;
     std::vector<std::string> lines;
@@ -767,8 +767,8 @@ TEST(MavLink, ReadmeParameterTableIsTheCodes) {
     }
     fclose(f);
     size_t at = 0;
-    while (at < lines.size() && lines[at] != "#### Parameters") ++at;
-    ASSERT_LT(at, lines.size()) << "no '#### Parameters' heading";
+    while (at < lines.size() && lines[at] != "# Parameters") ++at;
+    ASSERT_LT(at, lines.size()) << "no '# Parameters' heading";
     while (at < lines.size() && lines[at].rfind("| name | unit | range | default |", 0) != 0) ++at;
     ASSERT_LT(at, lines.size()) << "no table after it";
     at += 2;
@@ -804,7 +804,7 @@ TEST(MavLink, ReadmeParameterTableIsTheCodes) {
     for (uint16_t i = 0; i < params::count(); ++i) {
         params::Info in;
         params::info(i, in);
-        EXPECT_EQ(covered[i], 1) << in.name << " in the README's table " << covered[i] << " times";
+        EXPECT_EQ(covered[i], 1) << in.name << " in the reference's table " << covered[i] << " times";
     }
 }
 

@@ -13,6 +13,16 @@
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
 #endif
 
+// What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
+// parameter reference, docs/parameters.md, is printed from these (tools/paramdoc, make
+// docs). Only host builds keep the words: on the AVR the macro is empty, the row ends in
+// a trailing comma, and the table in flash is what it would be without them.
+#if defined(__AVR__)
+#define PARAM_DOC(display_name, units, description)
+#else
+#define PARAM_DOC(display_name, units, description) display_name, units, description
+#endif
+
 namespace params {
 
 namespace {
@@ -30,59 +40,170 @@ struct Row {
     uint8_t stride;
     uint16_t offset;
     float min, max, def;
+#if !defined(__AVR__)
+    const char* display_name;  // a few words (ArduPilot's @DisplayName)
+    const char* units;         // "" for none
+    const char* description;   // what it does here, in a sentence or three
+#endif
 };
 
 #define AT(member) ((uint16_t)offsetof(Settings, member))
 constexpr uint8_t kEp = (uint8_t)sizeof(flight::EndPoints);
 constexpr uint8_t kN = flight::kChannels;
 
-// The ranges are ArduPilot's where it documents one (RLL2SRV_TCONST 0.4..1.0, P 0.1..4,
-// I 0..1, D 0..0.2, IMAX 0..4500, PTCH2SRV_RLL 0.7..1.5), widths the PPM decoder's
-// plausible ones. Defaults: ArduPlane's P (1.0) and D (roll 0.08, pitch 0.04), TCONST 0.5,
-// IMAX 3000; I ArduPlane 3's 0.04, not the 0.3 of its later releases: the integrator
-// trims steady moments, and 0.3 also stores an upset's rate error (a 20 N m roll upset of
-// the simulated Rascal left -15 deg of aileron that banked it 5 deg the other way for
-// 2 s; 0.04: 2.5 deg). LIM_ROLL_CD 4500, LIM_PITCH_MAX/MIN +-2500 as issue 21 asks;
-// end points 1000..2000 around 1500.
+// The ranges are ArduPilot's where it documents one, the widths' the PPM decoder's
+// plausible ones. The defaults are ArduPlane's but for the integrator gains: ArduPlane 3's
+// 0.04, not the 0.3 of its later releases, which also stores an upset's rate error and
+// answers it with surface the other way once the upset is over.
 const Row kRows[] PARAM_TABLE = {
-    {"RLL2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.roll.tconst_s), 0.4f, 1.0f, 0.5f},
-    {"RLL2SRV_P", Type::Float, 0, 1, 0, AT(flight.roll.p), 0.1f, 4.0f, 1.0f},
-    {"RLL2SRV_I", Type::Float, 0, 1, 0, AT(flight.roll.i), 0.0f, 1.0f, 0.04f},
-    {"RLL2SRV_D", Type::Float, 0, 1, 0, AT(flight.roll.d), 0.0f, 0.2f, 0.08f},
-    {"RLL2SRV_IMAX", Type::Int16, 0, 1, 0, AT(flight.roll.imax_cd), 0.0f, 4500.0f, 3000.0f},
-    {"PTCH2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.pitch.tconst_s), 0.4f, 1.0f, 0.5f},
-    {"PTCH2SRV_P", Type::Float, 0, 1, 0, AT(flight.pitch.p), 0.1f, 4.0f, 1.0f},
-    {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.04f},
-    {"PTCH2SRV_D", Type::Float, 0, 1, 0, AT(flight.pitch.d), 0.0f, 0.2f, 0.04f},
-    {"PTCH2SRV_IMAX", Type::Int16, 0, 1, 0, AT(flight.pitch.imax_cd), 0.0f, 4500.0f, 3000.0f},
-    {"PTCH2SRV_RLL", Type::Float, 0, 1, 0, AT(flight.pitch_roll_ff), 0.7f, 1.5f, 1.0f},
-    {"LIM_ROLL_CD", Type::Int16, 0, 1, 0, AT(flight.lim_roll_cd), 0.0f, 9000.0f, 4500.0f},
-    {"LIM_PITCH_MAX", Type::Int16, 0, 1, 0, AT(flight.lim_pitch_max_cd), 0.0f, 9000.0f, 2500.0f},
-    {"LIM_PITCH_MIN", Type::Int16, 0, 1, 0, AT(flight.lim_pitch_min_cd), -9000.0f, 0.0f, -2500.0f},
-    {"FS_GLIDE_PITCH", Type::Int16, 0, 1, 0, AT(flight.fs_pitch_cd), -3000.0f, 0.0f, -500.0f},
-    {"THR_FS_VALUE", Type::UInt16, 0, 1, 0, AT(flight.thr_fs_value_us), 800.0f, 1100.0f, 950.0f},
-    {"THR_FS_OUT", Type::UInt8, 0, 1, 0, AT(flight.thr_fs_pct), 0.0f, 100.0f, 0.0f},
-    {"ARSPD_FBW_MIN", Type::UInt8, 0, 1, 0, AT(flight.arspd_min_m_s), 5.0f, 50.0f, 9.0f},
-    {"ARSPD_FBW_MAX", Type::UInt8, 0, 1, 0, AT(flight.arspd_max_m_s), 5.0f, 50.0f, 22.0f},
-    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 0.0f},
-    {"FLTMODE_CH", Type::UInt8, 0, 1, 0, AT(flight.fltmode_ch), 0.0f, 8.0f, 8.0f},
-    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 2.0f, 0.0f},
-    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 2.0f, 2.0f},
-    {"RCMAP_ROLL", Type::UInt8, 0, 1, 0, AT(flight.rcmap[0]), 1.0f, 8.0f, 1.0f},
-    {"RCMAP_PITCH", Type::UInt8, 0, 1, 0, AT(flight.rcmap[1]), 1.0f, 8.0f, 2.0f},
-    {"RCMAP_THROTTLE", Type::UInt8, 0, 1, 0, AT(flight.rcmap[2]), 1.0f, 8.0f, 3.0f},
-    {"RCMAP_YAW", Type::UInt8, 0, 1, 0, AT(flight.rcmap[3]), 1.0f, 8.0f, 4.0f},
-    {"ELEVON_OUTPUT", Type::UInt8, 0, 1, 0, AT(flight.elevon_output), 0.0f, 1.0f, 0.0f},
-    {"VTAIL_OUTPUT", Type::UInt8, 0, 1, 0, AT(flight.vtail_output), 0.0f, 1.0f, 0.0f},
-    {"RC#_MIN", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].min_us), 800.0f, 2200.0f, 1000.0f},
-    {"RC#_MAX", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].max_us), 800.0f, 2200.0f, 2000.0f},
-    {"RC#_TRIM", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].trim_us), 800.0f, 2200.0f, 1500.0f},
-    {"RC#_REVERSED", Type::Bit, 1, kN, 0, AT(flight.rc_reversed), 0.0f, 1.0f, 0.0f},
-    {"SERVO#_MIN", Type::UInt16, 1, kN, kEp, AT(flight.servo[0].min_us), 800.0f, 2200.0f, 1000.0f},
-    {"SERVO#_MAX", Type::UInt16, 1, kN, kEp, AT(flight.servo[0].max_us), 800.0f, 2200.0f, 2000.0f},
-    {"SERVO#_TRIM", Type::UInt16, 1, kN, kEp, AT(flight.servo[0].trim_us), 800.0f, 2200.0f, 1500.0f},
-    {"SERVO#_REVERSED", Type::Bit, 1, kN, 0, AT(flight.servo_reversed), 0.0f, 1.0f, 0.0f},
-    {"COMPASS_DEC", Type::DeclRad, 0, 1, 0, AT(declination_centideg), -3.1416f, 3.1416f, 0.0f},
+    {"RLL2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.roll.tconst_s), 0.4f, 1.0f, 0.5f,
+     PARAM_DOC("Roll time constant", "s",
+               "How fast STABILIZE brings the bank to the one asked for: the roll error over this time is the "
+               "demanded roll rate. 0.5 s suits most models; less than the aeroplane can achieve does not help.")},
+    {"RLL2SRV_P", Type::Float, 0, 1, 0, AT(flight.roll.p), 0.1f, 4.0f, 1.0f,
+     PARAM_DOC("Roll proportional gain", "deg/deg",
+               "Degrees of aileron per degree of roll error, as ArduPilot's roll controller takes it: a "
+               "feed-forward of (P - I TCONST) TCONST - D on the demanded roll rate. Higher answers harder; too "
+               "high oscillates.")},
+    {"RLL2SRV_I", Type::Float, 0, 1, 0, AT(flight.roll.i), 0.0f, 1.0f, 0.04f,
+     PARAM_DOC("Roll integrator gain", "1/s",
+               "Trims out a lasting roll error (an aileron out of trim, a steady moment): the roll-rate error "
+               "times I TCONST is summed, within RLL2SRV_IMAX, and does not grow while the aileron is at full "
+               "throw. 0: no integrator.")},
+    {"RLL2SRV_D", Type::Float, 0, 1, 0, AT(flight.roll.d), 0.0f, 0.2f, 0.08f,
+     PARAM_DOC("Roll damping gain", "deg/(deg/s)",
+               "Degrees of aileron per deg/s of roll-rate error (the demanded rate less the gyro's): damps the "
+               "roll. Higher resists turbulence; too high oscillates.")},
+    {"RLL2SRV_IMAX", Type::Int16, 0, 1, 0, AT(flight.roll.imax_cd), 0.0f, 4500.0f, 3000.0f,
+     PARAM_DOC("Roll integrator limit", "cdeg",
+               "The most aileron the integrator may hold, in centi-degrees of surface: 4500 is full throw, 3000 "
+               "two thirds of it.")},
+    {"PTCH2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.pitch.tconst_s), 0.4f, 1.0f, 0.5f,
+     PARAM_DOC("Pitch time constant", "s",
+               "How fast STABILIZE brings the pitch to the one asked for: the pitch error over this time is the "
+               "demanded pitch rate.")},
+    {"PTCH2SRV_P", Type::Float, 0, 1, 0, AT(flight.pitch.p), 0.1f, 4.0f, 1.0f,
+     PARAM_DOC("Pitch proportional gain", "deg/deg",
+               "Degrees of elevator per degree of pitch error (a feed-forward on the demanded pitch rate, as "
+               "RLL2SRV_P).")},
+    {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.04f,
+     PARAM_DOC("Pitch integrator gain", "1/s",
+               "Trims out a lasting pitch error (an elevator out of trim): the pitch-rate error times I TCONST is "
+               "summed, within PTCH2SRV_IMAX, and does not grow while the elevator is at full throw. 0: no "
+               "integrator.")},
+    {"PTCH2SRV_D", Type::Float, 0, 1, 0, AT(flight.pitch.d), 0.0f, 0.2f, 0.04f,
+     PARAM_DOC("Pitch damping gain", "deg/(deg/s)",
+               "Degrees of elevator per deg/s of pitch-rate error (the demanded rate less the gyro's): damps the "
+               "pitch.")},
+    {"PTCH2SRV_IMAX", Type::Int16, 0, 1, 0, AT(flight.pitch.imax_cd), 0.0f, 4500.0f, 3000.0f,
+     PARAM_DOC("Pitch integrator limit", "cdeg",
+               "The most elevator the integrator may hold, in centi-degrees of surface (4500: full throw).")},
+    {"PTCH2SRV_RLL", Type::Float, 0, 1, 0, AT(flight.pitch_roll_ff), 0.7f, 1.5f, 1.0f,
+     PARAM_DOC("Roll compensation", "",
+               "Turn coordination in STABILIZE and the failsafe: the pitch rate a level turn needs at the present "
+               "bank, g / V tan(bank) sin(bank) cos(pitch), times this gain, is added to the demanded pitch rate "
+               "(V: the mean of ARSPD_FBW_MIN and ARSPD_FBW_MAX). Raise it if the aeroplane loses height in "
+               "turns.")},
+    {"LIM_ROLL_CD", Type::Int16, 0, 1, 0, AT(flight.lim_roll_cd), 0.0f, 9000.0f, 4500.0f,
+     PARAM_DOC("Maximum bank angle", "cdeg",
+               "The bank that full roll stick asks for in STABILIZE, either way; the stick centred asks for the "
+               "wings level.")},
+    {"LIM_PITCH_MAX", Type::Int16, 0, 1, 0, AT(flight.lim_pitch_max_cd), 0.0f, 9000.0f, 2500.0f,
+     PARAM_DOC("Maximum pitch angle", "cdeg", "The pitch that full up (back) stick asks for in STABILIZE.")},
+    {"LIM_PITCH_MIN", Type::Int16, 0, 1, 0, AT(flight.lim_pitch_min_cd), -9000.0f, 0.0f, -2500.0f,
+     PARAM_DOC("Minimum pitch angle", "cdeg",
+               "The pitch that full down stick asks for in STABILIZE (negative: nose down).")},
+    {"FS_GLIDE_PITCH", Type::Int16, 0, 1, 0, AT(flight.fs_pitch_cd), -3000.0f, 0.0f, -500.0f,
+     PARAM_DOC("Failsafe glide pitch", "cdeg",
+               "The pitch FAILSAFE holds, wings level, while the receiver is lost (negative: nose down, a gentle "
+               "glide). This firmware's own name.")},
+    {"THR_FS_VALUE", Type::UInt16, 0, 1, 0, AT(flight.thr_fs_value_us), 800.0f, 1100.0f, 950.0f,
+     PARAM_DOC("Throttle failsafe value", "us",
+               "A receiver frame whose throttle channel (RCMAP_THROTTLE, as received) is below this width is the "
+               "PPM encoder's or the receiver's failsafe, not the pilot's: its mode switch is not read, and after "
+               "0.5 s without a good frame the board enters FAILSAFE. Set the receiver's own failsafe below it.")},
+    {"THR_FS_OUT", Type::UInt8, 0, 1, 0, AT(flight.thr_fs_pct), 0.0f, 100.0f, 0.0f,
+     PARAM_DOC("Failsafe throttle", "%",
+               "The throttle on OUT3 in FAILSAFE and from power-up until the receiver's first good frame, percent "
+               "of SERVO3_MIN to SERVO3_MAX (0: the motor off). This firmware's own name.")},
+    {"ARSPD_FBW_MIN", Type::UInt8, 0, 1, 0, AT(flight.arspd_min_m_s), 5.0f, 50.0f, 9.0f,
+     PARAM_DOC("Minimum airspeed", "m/s",
+               "With ARSPD_FBW_MAX, the airspeed the turn coordination (PTCH2SRV_RLL) assumes: the mean of the "
+               "two, whether or not an airspeed sensor is fitted.")},
+    {"ARSPD_FBW_MAX", Type::UInt8, 0, 1, 0, AT(flight.arspd_max_m_s), 5.0f, 50.0f, 22.0f,
+     PARAM_DOC("Maximum airspeed", "m/s",
+               "With ARSPD_FBW_MIN, the airspeed the turn coordination (PTCH2SRV_RLL) assumes: the mean of the "
+               "two.")},
+    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 0.0f,
+     PARAM_DOC("Cruise airspeed", "cm/s",
+               "For a board without the airspeed sensor on A0: the speed the estimator takes for the centripetal "
+               "acceleration of a turn (omega x V, taken off the accelerometer) while the throttle stick is above "
+               "10 %, grown in a banked turn as the lift needs, V / sqrt(cos bank). 0: no correction; below 9 m/s "
+               "none either. A fitted sensor's reading is used instead.")},
+    {"FLTMODE_CH", Type::UInt8, 0, 1, 0, AT(flight.fltmode_ch), 0.0f, 8.0f, 8.0f,
+     PARAM_DOC("Flight mode channel", "",
+               "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
+               "ArduPlane's six bands. 0: no switch, the console's `flight` command only.")},
+    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 2.0f, 0.0f,
+     PARAM_DOC("Flight mode 1", "",
+               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 2 STABILIZE (ArduPlane's numbers; "
+               "1 flies as MANUAL).")},
+    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 2.0f, 2.0f,
+     PARAM_DOC("Flight mode n", "",
+               "The mode of the switch's position n (2: 1231 to 1360 us, 3: to 1490, 4: to 1620, 5: to 1749, 6: "
+               "above): 0 MANUAL, 2 STABILIZE.")},
+    {"RCMAP_ROLL", Type::UInt8, 0, 1, 0, AT(flight.rcmap[0]), 1.0f, 8.0f, 1.0f,
+     PARAM_DOC("Roll channel", "", "The receiver channel of the roll (aileron) stick.")},
+    {"RCMAP_PITCH", Type::UInt8, 0, 1, 0, AT(flight.rcmap[1]), 1.0f, 8.0f, 2.0f,
+     PARAM_DOC("Pitch channel", "", "The receiver channel of the pitch (elevator) stick.")},
+    {"RCMAP_THROTTLE", Type::UInt8, 0, 1, 0, AT(flight.rcmap[2]), 1.0f, 8.0f, 3.0f,
+     PARAM_DOC("Throttle channel", "",
+               "The receiver channel of the throttle stick, which THR_FS_VALUE watches.")},
+    {"RCMAP_YAW", Type::UInt8, 0, 1, 0, AT(flight.rcmap[3]), 1.0f, 8.0f, 4.0f,
+     PARAM_DOC("Yaw channel", "", "The receiver channel of the rudder stick.")},
+    {"ELEVON_OUTPUT", Type::UInt8, 0, 1, 0, AT(flight.elevon_output), 0.0f, 1.0f, 0.0f,
+     PARAM_DOC("Elevon output", "",
+               "1: elevons, the left on OUT1 and the right on OUT2, each half of the elevator and half of the "
+               "aileron command (ArduPlane's MIXING_GAIN 0.5): left (elevator - aileron) / 2, right (elevator + "
+               "aileron) / 2. ArduPlane's values 1 to 4 choose the signs; here SERVO1_REVERSED and "
+               "SERVO2_REVERSED do.")},
+    {"VTAIL_OUTPUT", Type::UInt8, 0, 1, 0, AT(flight.vtail_output), 0.0f, 1.0f, 0.0f,
+     PARAM_DOC("V-tail output", "",
+               "1: a V-tail, the left ruddervator on OUT2 and the right on OUT4, each half of the elevator and "
+               "half of the rudder command: left (elevator - rudder) / 2, right (elevator + rudder) / 2.")},
+    {"RC#_MIN", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].min_us), 800.0f, 2200.0f, 1000.0f,
+     PARAM_DOC("RC minimum", "us",
+               "Receiver channel n's width at the stick's low end (what `rc` shows there). With RCn_TRIM and "
+               "RCn_MAX it turns a stick channel's width (one RCMAP_* names) into a command; the mode switch and "
+               "the widths passed to OUT5 to OUT8 (channels 5 to 8) are used as received.")},
+    {"RC#_MAX", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].max_us), 800.0f, 2200.0f, 2000.0f,
+     PARAM_DOC("RC maximum", "us", "Receiver channel n's width at the stick's high end.")},
+    {"RC#_TRIM", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].trim_us), 800.0f, 2200.0f, 1500.0f,
+     PARAM_DOC("RC trim", "us",
+               "Receiver channel n's width with the stick centred: no command (the throttle runs from RCn_MIN to "
+               "RCn_MAX).")},
+    {"RC#_REVERSED", Type::Bit, 1, kN, 0, AT(flight.rc_reversed), 0.0f, 1.0f, 0.0f,
+     PARAM_DOC("RC reversed", "",
+               "1: stick channel n is read the other way (for a radio that sends, say, nose up below its trim).")},
+    {"SERVO#_MIN", Type::UInt16, 1, kN, kEp, AT(flight.servo[0].min_us), 800.0f, 2200.0f, 1000.0f,
+     PARAM_DOC("Servo minimum", "us",
+               "Output n's shortest pulse: no pulse on OUTn is ever shorter. A surface's full throw one way; on "
+               "OUT3 the throttle's zero.")},
+    {"SERVO#_MAX", Type::UInt16, 1, kN, kEp, AT(flight.servo[0].max_us), 800.0f, 2200.0f, 2000.0f,
+     PARAM_DOC("Servo maximum", "us",
+               "Output n's longest pulse: no pulse on OUTn is ever longer. A surface's full throw the other way; "
+               "on OUT3 full throttle.")},
+    {"SERVO#_TRIM", Type::UInt16, 1, kN, kEp, AT(flight.servo[0].trim_us), 800.0f, 2200.0f, 1500.0f,
+     PARAM_DOC("Servo trim", "us",
+               "Output n's neutral: a surface with no command, centred with it; OUT5 to OUT8 are reversed about "
+               "it. OUT3, the throttle, does not use it.")},
+    {"SERVO#_REVERSED", Type::Bit, 1, kN, 0, AT(flight.servo_reversed), 0.0f, 1.0f, 0.0f,
+     PARAM_DOC("Servo reversed", "",
+               "1: output n moves the other way: a surface about its trim, the throttle from SERVO3_MAX down.")},
+    {"COMPASS_DEC", Type::DeclRad, 0, 1, 0, AT(declination_centideg), -3.1416f, 3.1416f, 0.0f,
+     PARAM_DOC("Compass declination", "rad",
+               "The angle from true north to magnetic north, east positive, added to the heading the board "
+               "reports: `decl` sets the same in degrees. Kept to a hundredth of a degree.")},
 };
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
@@ -245,6 +366,17 @@ bool all_valid(const Settings& s) {
     }
     return ends_in_order(s.flight.rc) && ends_in_order(s.flight.servo);
 }
+
+#if !defined(__AVR__)
+uint8_t row_count() { return kRowCount; }
+
+bool row_doc(uint8_t row, RowDoc& out) {
+    if (row >= kRowCount) return false;
+    const Row& r = kRows[row];
+    out = RowDoc{r.name, r.first, r.count, r.type, r.min, r.max, r.def, r.display_name, r.units, r.description};
+    return true;
+}
+#endif
 
 namespace {
 

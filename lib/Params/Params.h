@@ -64,4 +64,22 @@ uint16_t flight_bytes();
 // Every parameter within its range and the end points in order (settings::is_valid).
 bool all_valid(const settings::Settings& s);
 
+#if !defined(__AVR__)
+// A row of the table as written, with its words: what the parameter reference
+// (docs/parameters.md, printed by tools/paramdoc) is made of. Host builds only: the
+// firmware keeps no text.
+struct RowDoc {
+    const char* name;          // '#' stands for the number in a numbered row
+    uint8_t first, count;      // the numbers: first .. first + count - 1 (count 1: a single one)
+    Type type;
+    float min, max, def;
+    const char* display_name;  // a few words (ArduPilot's @DisplayName)
+    const char* units;         // "" for none (ArduPilot's @Units)
+    const char* description;   // what it does in this firmware (ArduPilot's @Description)
+};
+uint8_t row_count();
+// Row `row` of the table (0 .. row_count()-1); false past the end.
+bool row_doc(uint8_t row, RowDoc& out);
+#endif
+
 }  // namespace params
