@@ -42,7 +42,7 @@ enum Section : uint8_t {
     kSecMagRead = 5,
     kSecLoop = 6,       // one sample's work, from data-ready seen to its tasks done
     kSecControl = 13,   // the flight control step (50 Hz, the servo frame)
-    kSecConsoleReply = 15,  // one part of a console reply
+    kSecConsoleReply = 15,  // one part of a console reply, as text
     kSecGcsRequest = 16,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
     kSecGcsReply = 17,    // one PARAM_VALUE packed and queued
     kSecCompassTask = 18,  // the compass task: DRDY watched, a read when due (5 inside)
@@ -60,6 +60,7 @@ enum Section : uint8_t {
     kSecUserLoop = 30,     // user_loop
     kSecFlightPoll = 31,   // the receiver's frames; the control step without samples (13)
     kSecSecond = 32,       // once a second: load, LEDs, HEARTBEAT, held-back warnings
+    kSecStatusText = 33,   // one part of a console reply, as STATUSTEXT frames
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

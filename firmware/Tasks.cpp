@@ -67,9 +67,9 @@ static void once_a_second() {
     X(compass,      nullptr,                         compass_service,                  1, 1400, kSecCompassTask)  \
     X(estimator,    nullptr,                         estimator_step,                   1, 2300, kSecEstimator)    \
     X(airspeed,     nullptr,                         airspeed_input::step,             1,  300, kSecAirspeed)     \
-    X(input_step,   nullptr,                         console_link::take_input_in_step, 1,  300, kSecInputInStep)  \
+    X(input_step,   nullptr,                         console_link::take_input_in_step, 1, 1000, kSecInputInStep)  \
     X(user,         estimator_running,               user_step,                        1,  200, kSecUser)         \
-    X(output,       output_line::due,                output_line::run,                 1, 1200, kSecOutput)       \
+    X(output,       output_line::due,                output_line::run,                 1, 1800, kSecOutput)       \
     X(control,      control_due,                     control_run,                      1, 1200, kSecControl)      \
     X(leds,         nullptr,                         vehicle::update_leds,            50,  100, kSecLeds)
 
@@ -80,13 +80,13 @@ static void once_a_second() {
     X(pump,         nullptr,                         serial_text::pump,                 800, kSecPump,         kAlways) \
     X(input,        nullptr,                         console_link::take_input,         2000, kSecInput,        kAlways) \
     X(reply,        console_link::reply_due_text,    console_link::reply,              2300, kSecConsoleReply, 0)       \
-    X(statustext,   console_link::reply_due_mavlink, console_link::reply,              3000, kSecConsoleReply, 0)       \
+    X(statustext,   console_link::reply_due_mavlink, console_link::reply,              3000, kSecStatusText,   0)       \
     X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           5300, kSecGcsRequest,   0)       \
     X(gcs_defaults, gcs_link::defaults_line_due,     gcs_link::say_defaults,           5300, kSecGcsRequest,   0)       \
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
-    X(store,        nullptr,                         store_service,                     300, kSecStore,        kAlways) \
+    X(store,        nullptr,                         store_service,                    1500, kSecStore,        kAlways) \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
     X(flight,       nullptr,                         flight_poll,                       800, kSecFlightPoll,   kAlways) \
