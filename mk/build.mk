@@ -20,7 +20,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools sim fly test bench tune upload size attitude-only
+.PHONY: all firmware tools sim fly test bench tune upload size attitude-only big
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -125,6 +125,42 @@ size: $(FW_BUILD)/firmware.elf
 	  "$(if $(FW_DEFS),attitude-only firmware,firmware)", s[".text"]+s[".data"], s[".data"]+s[".bss"] }'
 
 # ---------------------------------------------------------------------------
+# The firmware past 128 KB (make big -> build/big/firmware.elf, for the test e2e.Beyond128K):
+# the same objects linked after test/sketch/padding.S, a function of FLASH_BUDGET bytes less
+# the firmware's flash in .text, which the linker script puts after the PROGMEM data and the
+# start-up code and before every function of the firmware: their code moves up by that much,
+# past 0x20000 for its last part (where EIND and the linker's trampolines reach it), as the
+# features to come will move it. -q keeps the relocations in the ELF, for the test to follow
+# every function pointer (the flash bytes are the same with or without it).
+# Beside it, two controls that the test must see fail: the image linked without trampolines
+# (--no-stubs: a word address of code above 128 KB wraps round), and 64 KB of padding before
+# the PROGMEM data (which then lies past LPM's reach).
+FLASH_BUDGET := 204800
+BIG_BUILD    := $(FW_BUILD)/big
+BIG_LINK      = $(AVR_CXX) $(AVR_LDFLAGS) -Wl,-q $(BIG_LDFLAGS) $< $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@
+big: $(BIG_BUILD)/firmware.elf $(BIG_BUILD)/no-trampolines.elf $(BIG_BUILD)/progmem-high.elf
+$(BIG_BUILD)/firmware.elf: BIG_LDFLAGS := -Wl,-Map,$(BIG_BUILD)/firmware.map
+$(BIG_BUILD)/no-trampolines.elf: BIG_LDFLAGS := -Wl,--no-stubs
+$(BIG_BUILD)/padding.S.o: test/sketch/padding.S $(FW_BUILD)/firmware.elf
+	@mkdir -p $(dir $@)
+	$(Q)flash=$$(avr-size -A $(FW_BUILD)/firmware.elf | awk '/^\.text|^\.data/ {s+=$$2} END {print s}'); \
+	  pad=$$(($(FLASH_BUDGET) - flash)); [ $$pad -gt 0 ] || pad=0; \
+	  $(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=$$pad -x assembler-with-cpp -c $< -o $@
+$(BIG_BUILD)/padding-low.S.o: test/sketch/padding.S
+	@mkdir -p $(dir $@)
+	$(Q)$(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=65536 -DAPM25_PAD_BELOW_PROGMEM -x assembler-with-cpp -c $< -o $@
+$(BIG_BUILD)/firmware.elf: $(BIG_BUILD)/padding.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (padded to the $(FLASH_BUDGET)-byte budget))
+	$(Q)$(BIG_LINK)
+	@avr-size -A $@ | awk '/^\.text|^\.data/ {s+=$$2} END { printf "# padded firmware: flash %d bytes (of 253952)\n", s }'
+$(BIG_BUILD)/no-trampolines.elf: $(BIG_BUILD)/padding.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (a control))
+	$(Q)$(BIG_LINK)
+$(BIG_BUILD)/progmem-high.elf: $(BIG_BUILD)/padding-low.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (a control))
+	$(Q)$(BIG_LINK)
+
+# ---------------------------------------------------------------------------
 # Host tools and tests (CMake + GoogleTest). CMake is configured every time (a second or
 # so): its source globs and the optional tools are read at configure time, so a new file
 # is never missed. The compiler's output goes to a log, shown when something fails.
@@ -166,7 +202,7 @@ fly: firmware tools venv
 	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
 
-test: firmware attitude-only tools venv
+test: firmware attitude-only big tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)
 
 bench: firmware attitude-only tools
