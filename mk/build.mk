@@ -160,6 +160,22 @@ $(BIG_BUILD)/progmem-high.elf: $(BIG_BUILD)/padding-low.S.o $(FW_OBJ) $(BUILD)/a
 	$(call say,LINK,$@ (a control))
 	$(Q)$(BIG_LINK)
 
+# Flash per library (make bench, bench/flash.py): the firmware built again with -g, whose
+# debug lines (stabs, avr-gcc 5.4's -g) name the source file of every instruction as LTO
+# inlined it, linked with a map (which names the libgcc, libc and libm members and the
+# start-up code); and linked once more with -q, for its relocations (which code uses each
+# PROGMEM string or table; binutils reads no stabs lines from an ELF that keeps them).
+# Its flash bytes are the firmware's: flash.py checks it.
+ATTR_BUILD := $(BUILD)/flash-attr
+ATTR_OBJ   := $(patsubst $(FW_BUILD)/%,$(ATTR_BUILD)/%,$(FW_OBJ))
+.PHONY: flash-attr
+flash-attr: $(FW_BUILD)/firmware.elf
+	@$(MAKE) --no-print-directory -f mk/build.mk BUILD=$(ATTR_BUILD) MAVLINK_DIR=$(MAVLINK_DIR) VENV=$(VENV) \
+	  AVR_OPT="$(AVR_OPT) -g" AVR_LDFLAGS="$(AVR_LDFLAGS) -g -Wl,-Map,$(ATTR_BUILD)/firmware.map" \
+	  $(ATTR_BUILD)/firmware.elf
+	@[ $(ATTR_BUILD)/firmware-relocs.elf -nt $(ATTR_BUILD)/firmware.elf ] || \
+	  $(AVR_CXX) $(AVR_LDFLAGS) -g -Wl,-q $(ATTR_OBJ) $(ATTR_BUILD)/avr/core.a -lm -o $(ATTR_BUILD)/firmware-relocs.elf
+
 # ---------------------------------------------------------------------------
 # Host tools and tests (CMake + GoogleTest). CMake is configured every time (a second or
 # so): its source globs and the optional tools are read at configure time, so a new file
@@ -205,7 +221,7 @@ fly: firmware tools venv
 test: firmware attitude-only big tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)
 
-bench: firmware attitude-only tools
+bench: firmware attitude-only tools flash-attr
 	python3 bench/bench.py --build $(BUILD)
 
 # Cross-validation of the estimator's settings on the BROAD recordings (bench/tune.py).
