@@ -47,24 +47,21 @@ SPI_DIR  := $(ARDUINO_AVR)/libraries/SPI/src
 EEPROM_DIR := $(ARDUINO_AVR)/libraries/EEPROM/src
 LIB_DIRS := $(sort $(dir $(wildcard lib/*/)))
 
-# TWI_BUFFER_LENGTH: twi.c's three buffers hold one transfer; the longest here is the
-# HMC5883L's six data bytes (the core's default, 32, spends 72 bytes of RAM on nothing).
+# The flags: mk/avr-flags.mk, shared with platformio.ini. The link takes the optimisation
+# and the target's flags too: with LTO it compiles the program.
+include mk/avr-flags.mk
 AVR_DEFS  := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -DARDUINO=10819 -DARDUINO_AVR_MEGA2560 -DARDUINO_ARCH_AVR \
-             -DTWI_BUFFER_LENGTH=8
+             $(AVR_SHARED_DEFS)
 AVR_INC   := -I$(CORE_DIR) -I$(ARDUINO_AVR)/variants/mega -I$(WIRE_DIR) -I$(WIRE_DIR)/utility \
              -I$(SPI_DIR) -I$(EEPROM_DIR) $(addprefix -I,$(LIB_DIRS)) -Ifirmware
-# -mcall-prologues -mrelax: 1.5 KB less flash for +0.4 % loop cycles (measured with --profile)
-# -mstrict-X: the X register only where the AVR can address through it (it has no
-# displacement): smaller, and the estimator step no slower (README "Performance").
-# -flto-partition=one: the whole program in one LTO unit, which inlines and clones with
-# every caller in view (the link is one job here anyway).
-AVR_OPT   := -Os -flto -ffunction-sections -fdata-sections -mcall-prologues -mrelax -mstrict-X
+AVR_OPT   := $(AVR_SHARED_OPT)
 AVR_CFLAGS   := $(AVR_DEFS) $(AVR_OPT) -std=gnu11
-AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 -fno-exceptions -fno-threadsafe-statics \
-                -fno-rtti -DDECIMAL_DIG=__DECIMAL_DIG__
+# DECIMAL_DIG: WString.cpp needs it, which Debian's gcc 5.4 leaves undefined in C++11.
+AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 $(AVR_SHARED_CXX) -DDECIMAL_DIG=__DECIMAL_DIG__
 # The project's own files: every warning is an error.
-PROJECT_WARN := -Wall -Wextra -Werror -Wdouble-promotion
-AVR_LDFLAGS  := -mmcu=$(MCU) -Os -flto -flto-partition=one -fuse-linker-plugin -Wl,--gc-sections -mcall-prologues -mrelax -mstrict-X
+PROJECT_WARN := $(AVR_SHARED_WARN) -Werror
+AVR_LDFLAGS  := -mmcu=$(MCU) $(filter -O% -flto,$(AVR_SHARED_OPT)) $(AVR_SHARED_LINK) \
+                $(filter -m%,$(AVR_SHARED_OPT))
 
 CORE_SRC := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcard $(CORE_DIR)/*.S) \
             $(WIRE_DIR)/Wire.cpp $(WIRE_DIR)/utility/twi.c $(SPI_DIR)/SPI.cpp
@@ -84,8 +81,10 @@ firmware: $(FW_BUILD)/firmware.hex size
 attitude-only:
 	@$(MAKE) --no-print-directory -f mk/build.mk APM25_FLIGHT=0 firmware
 
-# The core's objects follow this file's flags (TWI_BUFFER_LENGTH ...).
+# The core's objects follow this file's flags (TWI_BUFFER_LENGTH ...), every object the
+# shared flags.
 $(CORE_OBJ): mk/build.mk
+$(CORE_OBJ) $(FW_OBJ): mk/avr-flags.mk
 
 $(BUILD)/avr/arduino/%.c.o: $(ARDUINO_AVR)/%.c
 	@mkdir -p $(dir $@)
