@@ -843,6 +843,9 @@ def main():
                                                               fmt(size_attitude_only["ram"])))
         rep.append("")
 
+    # Flash per library and the budget: bench/flash.py.
+    import flash
+    rep += [flash.flash_section(build)[0]]
     # accuracy
     rep += ["## Accuracy on the BROAD recordings", ""]
     if trials:

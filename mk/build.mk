@@ -20,7 +20,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools sim fly test bench tune upload size attitude-only docs
+.PHONY: all firmware tools sim fly test bench tune upload size attitude-only big docs
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -47,24 +47,21 @@ SPI_DIR  := $(ARDUINO_AVR)/libraries/SPI/src
 EEPROM_DIR := $(ARDUINO_AVR)/libraries/EEPROM/src
 LIB_DIRS := $(sort $(dir $(wildcard lib/*/)))
 
-# TWI_BUFFER_LENGTH: twi.c's three buffers hold one transfer; the longest here is the
-# HMC5883L's six data bytes (the core's default, 32, spends 72 bytes of RAM on nothing).
+# The flags: mk/avr-flags.mk, shared with platformio.ini. The link takes the optimisation
+# and the target's flags too: with LTO it compiles the program.
+include mk/avr-flags.mk
 AVR_DEFS  := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -DARDUINO=10819 -DARDUINO_AVR_MEGA2560 -DARDUINO_ARCH_AVR \
-             -DTWI_BUFFER_LENGTH=8
+             $(AVR_SHARED_DEFS)
 AVR_INC   := -I$(CORE_DIR) -I$(ARDUINO_AVR)/variants/mega -I$(WIRE_DIR) -I$(WIRE_DIR)/utility \
              -I$(SPI_DIR) -I$(EEPROM_DIR) $(addprefix -I,$(LIB_DIRS)) -Ifirmware
-# -mcall-prologues -mrelax: 1.5 KB less flash for +0.4 % loop cycles (measured with --profile)
-# -mstrict-X: the X register only where the AVR can address through it (it has no
-# displacement): smaller, and the estimator step no slower (README "Performance").
-# -flto-partition=one: the whole program in one LTO unit, which inlines and clones with
-# every caller in view (the link is one job here anyway).
-AVR_OPT   := -Os -flto -ffunction-sections -fdata-sections -mcall-prologues -mrelax -mstrict-X
+AVR_OPT   := $(AVR_SHARED_OPT)
 AVR_CFLAGS   := $(AVR_DEFS) $(AVR_OPT) -std=gnu11
-AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 -fno-exceptions -fno-threadsafe-statics \
-                -fno-rtti -DDECIMAL_DIG=__DECIMAL_DIG__
+# DECIMAL_DIG: WString.cpp needs it, which Debian's gcc 5.4 leaves undefined in C++11.
+AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 $(AVR_SHARED_CXX) -DDECIMAL_DIG=__DECIMAL_DIG__
 # The project's own files: every warning is an error.
-PROJECT_WARN := -Wall -Wextra -Werror -Wdouble-promotion
-AVR_LDFLAGS  := -mmcu=$(MCU) -Os -flto -flto-partition=one -fuse-linker-plugin -Wl,--gc-sections -mcall-prologues -mrelax -mstrict-X
+PROJECT_WARN := $(AVR_SHARED_WARN) -Werror
+AVR_LDFLAGS  := -mmcu=$(MCU) $(filter -O% -flto,$(AVR_SHARED_OPT)) $(AVR_SHARED_LINK) \
+                $(filter -m%,$(AVR_SHARED_OPT))
 
 CORE_SRC := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcard $(CORE_DIR)/*.S) \
             $(WIRE_DIR)/Wire.cpp $(WIRE_DIR)/utility/twi.c $(SPI_DIR)/SPI.cpp
@@ -84,8 +81,10 @@ firmware: $(FW_BUILD)/firmware.hex size
 attitude-only:
 	@$(MAKE) --no-print-directory -f mk/build.mk APM25_FLIGHT=0 firmware
 
-# The core's objects follow this file's flags (TWI_BUFFER_LENGTH ...).
+# The core's objects follow this file's flags (TWI_BUFFER_LENGTH ...), every object the
+# shared flags.
 $(CORE_OBJ): mk/build.mk
+$(CORE_OBJ) $(FW_OBJ): mk/avr-flags.mk
 
 $(BUILD)/avr/arduino/%.c.o: $(ARDUINO_AVR)/%.c
 	@mkdir -p $(dir $@)
@@ -123,6 +122,58 @@ size: $(FW_BUILD)/firmware.elf
 	@avr-size -A $< | awk '/^\.text|^\.data|^\.bss/ {s[$$1]=$$2} END { \
 	  printf "# %s: flash %d bytes (of 253952), static RAM %d bytes (of 8192)\n", \
 	  "$(if $(FW_DEFS),attitude-only firmware,firmware)", s[".text"]+s[".data"], s[".data"]+s[".bss"] }'
+
+# ---------------------------------------------------------------------------
+# The firmware past 128 KB (make big -> build/big/firmware.elf, for the test e2e.Beyond128K):
+# the same objects linked after test/sketch/padding.S, a function of FLASH_BUDGET bytes less
+# the firmware's flash in .text, which the linker script puts after the PROGMEM data and the
+# start-up code and before every function of the firmware: their code moves up by that much,
+# past 0x20000 for its last part (where EIND and the linker's trampolines reach it), as the
+# features to come will move it. -q keeps the relocations in the ELF, for the test to follow
+# every function pointer (the flash bytes are the same with or without it).
+# Beside it, two controls that the test must see fail: the image linked without trampolines
+# (--no-stubs: a word address of code above 128 KB wraps round), and 64 KB of padding before
+# the PROGMEM data (which then lies past LPM's reach).
+FLASH_BUDGET := 204800
+BIG_BUILD    := $(FW_BUILD)/big
+BIG_LINK      = $(AVR_CXX) $(AVR_LDFLAGS) -Wl,-q $(BIG_LDFLAGS) $< $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@
+big: $(BIG_BUILD)/firmware.elf $(BIG_BUILD)/no-trampolines.elf $(BIG_BUILD)/progmem-high.elf
+$(BIG_BUILD)/firmware.elf: BIG_LDFLAGS := -Wl,-Map,$(BIG_BUILD)/firmware.map
+$(BIG_BUILD)/no-trampolines.elf: BIG_LDFLAGS := -Wl,--no-stubs
+$(BIG_BUILD)/padding.S.o: test/sketch/padding.S $(FW_BUILD)/firmware.elf
+	@mkdir -p $(dir $@)
+	$(Q)flash=$$(avr-size -A $(FW_BUILD)/firmware.elf | awk '/^\.text|^\.data/ {s+=$$2} END {print s}'); \
+	  pad=$$(($(FLASH_BUDGET) - flash)); [ $$pad -gt 0 ] || pad=0; \
+	  $(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=$$pad -x assembler-with-cpp -c $< -o $@
+$(BIG_BUILD)/padding-low.S.o: test/sketch/padding.S
+	@mkdir -p $(dir $@)
+	$(Q)$(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=65536 -DAPM25_PAD_BELOW_PROGMEM -x assembler-with-cpp -c $< -o $@
+$(BIG_BUILD)/firmware.elf: $(BIG_BUILD)/padding.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (padded to the $(FLASH_BUDGET)-byte budget))
+	$(Q)$(BIG_LINK)
+	@avr-size -A $@ | awk '/^\.text|^\.data/ {s+=$$2} END { printf "# padded firmware: flash %d bytes (of 253952)\n", s }'
+$(BIG_BUILD)/no-trampolines.elf: $(BIG_BUILD)/padding.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (a control))
+	$(Q)$(BIG_LINK)
+$(BIG_BUILD)/progmem-high.elf: $(BIG_BUILD)/padding-low.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (a control))
+	$(Q)$(BIG_LINK)
+
+# Flash per library (make bench, bench/flash.py): the firmware built again with -g, whose
+# debug lines (stabs, avr-gcc 5.4's -g) name the source file of every instruction as LTO
+# inlined it, linked with a map (which names the libgcc, libc and libm members and the
+# start-up code); and linked once more with -q, for its relocations (which code uses each
+# PROGMEM string or table; binutils reads no stabs lines from an ELF that keeps them).
+# Its flash bytes are the firmware's: flash.py checks it.
+ATTR_BUILD := $(BUILD)/flash-attr
+ATTR_OBJ   := $(patsubst $(FW_BUILD)/%,$(ATTR_BUILD)/%,$(FW_OBJ))
+.PHONY: flash-attr
+flash-attr: $(FW_BUILD)/firmware.elf
+	@$(MAKE) --no-print-directory -f mk/build.mk BUILD=$(ATTR_BUILD) MAVLINK_DIR=$(MAVLINK_DIR) VENV=$(VENV) \
+	  AVR_OPT="$(AVR_OPT) -g" AVR_LDFLAGS="$(AVR_LDFLAGS) -g -Wl,-Map,$(ATTR_BUILD)/firmware.map" \
+	  $(ATTR_BUILD)/firmware.elf
+	@[ $(ATTR_BUILD)/firmware-relocs.elf -nt $(ATTR_BUILD)/firmware.elf ] || \
+	  $(AVR_CXX) $(AVR_LDFLAGS) -g -Wl,-q $(ATTR_OBJ) $(ATTR_BUILD)/avr/core.a -lm -o $(ATTR_BUILD)/firmware-relocs.elf
 
 # ---------------------------------------------------------------------------
 # Host tools and tests (CMake + GoogleTest). CMake is configured every time (a second or
@@ -174,10 +225,10 @@ fly: firmware tools venv
 	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
 
-test: firmware attitude-only tools venv
+test: firmware attitude-only big tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)
 
-bench: firmware attitude-only tools
+bench: firmware attitude-only tools flash-attr
 	python3 bench/bench.py --build $(BUILD)
 
 # Cross-validation of the estimator's settings on the BROAD recordings (bench/tune.py).
