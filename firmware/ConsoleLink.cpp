@@ -106,6 +106,13 @@ static bool print_status(uint8_t part) {
     }
 }
 
+// `save` and `defaults` work longer than a reply line (the record encoded; every setting
+// and the controllers' gains set again): their work is a part of its own, the `command`
+// task with its own budget, and their line the next part.
+static bool heavy(const console::Command& c) {
+    return c.id == console::CommandId::Save || c.id == console::CommandId::Defaults;
+}
+
 // Writes part `part` of the reply to c (and runs c with part 0); false when c's reply
 // has no such part (it is complete).
 static bool answer(const console::Command& c, uint8_t part) {
@@ -118,16 +125,21 @@ static bool answer(const console::Command& c, uint8_t part) {
             break;
         default: break;
     }
-    if (part > 0) return false;
-    switch (c.id) {
-        case console::CommandId::Save: vehicle::store.start_save(pipe.settings()); break;
-        case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
-        case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
-        case console::CommandId::Defaults:
+    if (heavy(c)) {  // part 0 the work (the `command` task), part 1 its line
+        if (part == 1 && c.id == console::CommandId::Defaults) console::print_defaults(out);
+        if (part > 0) return false;
+        if (c.id == console::CommandId::Save) {
+            vehicle::store.start_save(pipe.settings());
+        } else {
             pipe.restore_defaults();
             flight_io.configure();
-            console::print_defaults(out);
-            break;
+        }
+        return true;
+    }
+    if (part > 0) return false;
+    switch (c.id) {
+        case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
+        case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
         case console::CommandId::Flight:
         case console::CommandId::Show: flight_io.answer(c); break;  // flight manual|stabilize, rc, servo
         case console::CommandId::Mode:
@@ -152,11 +164,15 @@ static_assert(2u * mav::kMaxFrame + mav::kAttitudeFrame <= serial_text::kCapacit
 
 // A part waits, in the port's language, with room for it and an output line after it.
 static bool due(bool mavlink) {
-    return !commands.empty() && port::mavlink_mode() == mavlink &&
+    return !commands.empty() && !(reply_part == 0 && heavy(commands.peek())) && port::mavlink_mode() == mavlink &&
            serial_text::room() >= part_bytes() + gcs_link::output_line_bytes();
 }
 bool reply_due_text() { return due(false); }
 bool reply_due_mavlink() { return due(true); }
+bool command_due() {
+    return !commands.empty() && reply_part == 0 && heavy(commands.peek()) &&
+           serial_text::room() >= part_bytes() + gcs_link::output_line_bytes();
+}
 
 void reply() {
     if (answer(commands.peek(), reply_part)) {

@@ -29,6 +29,8 @@ void forget_partial_line();
 // costs more: each row has its own budget).
 bool reply_due_text();
 bool reply_due_mavlink();
+// ... and the work of `save` and `defaults`, longer than a line, a part with its own budget.
+bool command_due();
 void reply();
 
 // "# settings: rate ... mode ...": at start-up and in `status`.

@@ -325,7 +325,9 @@ def check_placement(elf, checks):
 
 # Figures that follow from the cycles spent: the loop's load (status, SYS_STATUS) and the
 # uptime a reply is formatted at.
-TIMING_TEXT = [(re.compile(r"load \d+%"), "load N%"), (re.compile(r"uptime [0-9.]+ s"), "uptime T s")]
+TIMING_TEXT = [(re.compile(r"load \d+%"), "load N%"), (re.compile(r"uptime [0-9.]+ s"), "uptime T s"),
+               # the task table's overrun counts and longest runs (status)
+               (re.compile(r"# tasks: .*"), "# tasks: T")]
 # MAVLink fields that are measured time: (message id, payload offset, length).
 TIMING_FIELDS = {1: [(12, 2)],   # SYS_STATUS.load
                  36: [(0, 4)]}   # SERVO_OUTPUT_RAW.time_usec
@@ -343,7 +345,10 @@ WIDTH_FIELDS = {65: (4, 18, RC_TOLERANCE_US),       # RC_CHANNELS chan1..18_raw
                 36: (4, 8, SERVO_TOLERANCE_US)}     # SERVO_OUTPUT_RAW servo1..8_raw
 # Messages matched by their time stamp (time_boot_ms, the first field): which output step a
 # mode switch typed at the console lands on is timing too.
-KEYED_MESSAGES = (30, 65)  # ATTITUDE, RC_CHANNELS
+KEYED_MESSAGES = (30,)  # ATTITUDE
+# Messages sent when a loop pass finds their period over: the millisecond they are stamped
+# with is timing; matched in order, their stamps within this many ms.
+ORDERED_MESSAGES = {65: 5}  # RC_CHANNELS (5 Hz)
 
 
 def split_stream(data):
@@ -392,6 +397,19 @@ def streams(data):
     return kinds
 
 
+# ATTITUDE's angles and rates: a compass sample is read on the first step that sees its
+# DRDY pin high, so one whose edge falls near a step's start may be read a step apart when
+# the two images' steps start a few cycles apart; the heading and the learned biases then
+# differ by hundredths of a degree: within 1e-3 rad and rad/s.
+ATTITUDE_TOLERANCE = 1e-3
+
+
+def attitude_close(p, q):
+    full = lambda b: bytes(b) + bytes(28 - len(b))  # MAVLink 2 trims the payload's trailing zeros
+    a, b = struct.unpack("<I6f", full(p)), struct.unpack("<I6f", full(q))
+    return a[0] == b[0] and all(abs(x - y) <= ATTITUDE_TOLERANCE for x, y in zip(a[1:], b[1:]))
+
+
 def widths_close(msgid, p, q):
     off, n, tol = WIDTH_FIELDS[msgid]
     if len(p) != len(q) or p[:off] != q[:off] or p[off + 2 * n:] != q[off + 2 * n:]:
@@ -408,11 +426,22 @@ def compare_kind(kind, x, y):
         dx, dy = {key(r): r for r in x}, {key(r): r for r in y}
         both = [k for k in dx if k in dy]
         same = (lambda p, q: p == q) if msgid not in WIDTH_FIELDS else (lambda p, q: widths_close(msgid, p, q))
+        if msgid == 30:
+            same = attitude_close
         bad = [k for k in both if not same(dx[k], dy[k])]
         if bad:
             return "%d of %d matched by time differ, first %r vs %r" % (len(bad), len(both), dx[bad[0]], dy[bad[0]])
         if len(both) < 0.95 * max(len(dx), len(dy)):
             return "only %d of %d vs %d matched by time" % (len(both), len(dx), len(dy))
+        return None
+    if msgid in ORDERED_MESSAGES:
+        if abs(len(x) - len(y)) > 1:
+            return "%d vs %d frames" % (len(x), len(y))
+        stamp = lambda p: struct.unpack_from("<I", p, 0)[0]
+        for i, (p, q) in enumerate(zip(x, y)):
+            if abs(stamp(p) - stamp(q)) > ORDERED_MESSAGES[msgid] or \
+                    not widths_close(msgid, bytes(4) + p[4:], bytes(4) + q[4:]):
+                return "frame %d differs: %r vs %r" % (i, p, q)
         return None
     if kind == "plot lines":  # from the start to the switch to another mode: one more or less
         if abs(len(x) - len(y)) > 1:
