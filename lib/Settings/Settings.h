@@ -22,7 +22,7 @@
 
 #include <stdint.h>
 
-#include "Calibration.h"
+#include "SensorCalibration.h"
 #include "FlightSettings.h"
 #include "OutputMode.h"
 
