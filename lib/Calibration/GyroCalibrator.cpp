@@ -38,7 +38,7 @@ GyroCalibrator::Result GyroCalibrator::add(const linalg::Vector3i& gyro_counts, 
         accel_scale_ = accel_m_s2_per_count;
         spread_max_[0] = (uint16_t)linalg::constrain(kGyroSpreadMax_rad_s / gyro_rad_s_per_count, 0.0f, 65535.0f);
         spread_max_[1] = (uint16_t)linalg::constrain(kAccelSpreadMax_m_s2 / accel_m_s2_per_count, 0.0f, 65535.0f);
-        const float g_counts = 9.80665f / accel_m_s2_per_count;
+        const float g_counts = linalg::kGravity_m_s2 / accel_m_s2_per_count;
         const float lo = g_counts * (1.0f - kAccelNormTol_g), hi = g_counts * (1.0f + kAccelNormTol_g);
         norm2_min_ = (uint32_t)linalg::constrain(lo * lo, 0.0f, 4.0e9f);
         norm2_max_ = (uint32_t)linalg::constrain(hi * hi, 0.0f, 4.0e9f);
