@@ -13,7 +13,7 @@
 #                   sketch built by arduino-builder
 #   make bench      cycles, size and accuracy against the peers (build/bench/report.md)
 #   make tune       cross-validation of the estimator's gains on the BROAD recordings
-#   make docs       docs/parameters.md from the parameter table (lib/Params)
+#   make docs       docs/parameters.md from the parameter table (lib/Settings/Params.cpp)
 #   make deps       install what is missing (apt-get; through sudo when not root)
 #   make upload PORT=/dev/ttyACM0    flash with avrdude (wiring protocol, 115200)
 #   make monitor PORT=/dev/ttyACM0   watch the serial output (115200)

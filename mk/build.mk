@@ -195,10 +195,10 @@ else
 endif
 
 # The parameter reference, docs/parameters.md, printed from the parameter table
-# (lib/Params/Params.cpp) by build/paramdoc; the ctest docs.parameters_current fails when
+# (lib/Settings/Params.cpp) by build/paramdoc; the ctest docs.parameters_current fails when
 # the committed file is not what the table says.
 docs: tools
-	$(call say,DOCS,docs/parameters.md from lib/Params/Params.cpp)
+	$(call say,DOCS,docs/parameters.md from lib/Settings/Params.cpp)
 	$(Q)$(BUILD)/paramdoc > docs/parameters.md.tmp && mv docs/parameters.md.tmp docs/parameters.md || \
 	  { rm -f docs/parameters.md.tmp; exit 1; }
 

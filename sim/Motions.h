@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "Constants.h"
 #include "Rotation.h"
 
 namespace sim {
@@ -37,7 +38,7 @@ struct Random {
     }
     double gauss() {
         const double u1 = uniform() + 1e-300, u2 = uniform();
-        return std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * 3.14159265358979323846 * u2);
+        return std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * linalg::dbl::kPi * u2);
     }
     double between(double lo, double hi) { return lo + (hi - lo) * uniform(); }
     double sign() { return uniform() < 0.5 ? -1.0 : 1.0; }
@@ -45,9 +46,9 @@ struct Random {
 
 namespace motion {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
-constexpr double kGravity_m_s2 = 9.80665;
+using linalg::dbl::kGravity_m_s2;
+using linalg::dbl::kPi;
+constexpr double kDeg = linalg::dbl::kRadPerDeg;  // x * kDeg: x degrees in rad
 constexpr double kStill_s = 3.0;  // every motion starts after this long at rest
 
 // A value and its first two time derivatives.

@@ -17,6 +17,8 @@
 
 #include <cmath>
 
+#include "Constants.h"
+
 namespace score {
 
 struct Quat {
@@ -46,8 +48,8 @@ inline bool quat_finite(const Quat& q) {
            quat_norm(q) > 1e-9;
 }
 
-inline double deg2rad(double d) { return d * (M_PI / 180.0); }
-inline double rad2deg(double r) { return r * (180.0 / M_PI); }
+inline double deg2rad(double d) { return d * linalg::dbl::kRadPerDeg; }
+inline double rad2deg(double r) { return r * linalg::dbl::kDegPerRad; }
 
 // Body -> earth quaternion of aerospace Z-Y-X Euler angles: R = Rz(yaw) Ry(pitch) Rx(roll),
 // i.e. q = q_z(yaw) * q_y(pitch) * q_x(roll).

@@ -32,6 +32,8 @@
 #include <string>
 #include <vector>
 
+#include "Constants.h"
+#include "Hmc5883.h"
 #include "Motions.h"
 #include "Mpu6000.h"
 #include "Rotation.h"
@@ -39,11 +41,11 @@
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
-constexpr double kGravity_m_s2 = 9.80665;
+using linalg::dbl::kGravity_m_s2;
+using linalg::dbl::kPi;
+using linalg::dbl::kRadPerDeg;
 constexpr const double* kEarthField_uT = sim::kEarthFieldNed_uT;  // NED
-constexpr double kGyroNoise_rad_s = 0.03 * kDeg;
+constexpr double kGyroNoise_rad_s = 0.03 * kRadPerDeg;
 constexpr double kAccelNoise_m_s2 = 0.025;
 constexpr double kMagNoise_uT = 0.2;
 constexpr double kStartup_s = 2.0;
@@ -83,7 +85,7 @@ std::vector<Scenario> scenarios() {
     {
         Scenario s{"rest_bias", "rest with a +2 deg/s gyro bias on every axis (the truth stays still)",
                    {{0, 0, 0, 0}, {60, 0, 0, 0}}, {}};
-        for (double& b : s.extras.gyro_bias_rad_s) b = 2.0 * kDeg;
+        for (double& b : s.extras.gyro_bias_rad_s) b = 2.0 * kRadPerDeg;
         list.push_back(s);
     }
     {
@@ -212,7 +214,7 @@ Quat attitude(const Scenario& s, double t_s) {
         roll += s.extras.wobble_deg * std::sin(2 * kPi * 8.0 * t_s);
         pitch += s.extras.wobble_deg * std::cos(2 * kPi * 8.0 * t_s + 0.3);
     }
-    return sim::from_euler(roll * kDeg, pitch * kDeg, yaw * kDeg);
+    return sim::from_euler(roll * kRadPerDeg, pitch * kRadPerDeg, yaw * kRadPerDeg);
 }
 
 using Noise = sim::Random;  // the fixed sequences of the default files
@@ -243,9 +245,9 @@ constexpr double kAccelDensity_g_sqrt_hz = 400e-6;
 constexpr double kMagFloor_uT = 0.2;
 // The firmware's ranges (lib/MPU6000 kGyroRange 2000 deg/s, kAccelRange 16 g; lib/HMC5883
 // kGain 1.3 Ga): one count of each chip.
-constexpr double kGyroLsb_dps = 1.0 / 16.4;
+constexpr double kGyroLsb_dps = 1.0 / mpu6000::kGyroLsbPerDps2000;
 constexpr double kAccelLsb_m_s2 = (double)mpu6000::accel_m_s2_per_count(mpu6000::kAccelRange);
-constexpr double kMagLsb_uT = 100.0 / 1090.0;
+const double kMagLsb_uT = linalg::dbl::kMicroteslaPerGauss / (double)hmc5883::lsb_per_gauss(hmc5883::kGain);
 
 // A realistic uncalibrated APM 2.5, each value well inside its datasheet tolerance:
 // gyro zero-rate offset (MPU6000 +-20 deg/s initial) of 1-1.5 deg/s, drifting as the board
@@ -349,7 +351,7 @@ struct Measuring {
         if (err.seed != 0) noise.state ^= err.seed * 0xD1B54A32D192ED03ull;
         walk_noise.state = noise.state ^ 0x5851F42D4C957F2Dull;  // its own: the options never shift the default noise
         const bool datasheet = err.datasheet_noise, none = !noisy;
-        gyro_sigma_rad_s = none ? 0.0 : datasheet ? kGyroDensity_dps_sqrt_hz * std::sqrt(rate_hz / 2.0) * kDeg : kGyroNoise_rad_s;
+        gyro_sigma_rad_s = none ? 0.0 : datasheet ? kGyroDensity_dps_sqrt_hz * std::sqrt(rate_hz / 2.0) * kRadPerDeg : kGyroNoise_rad_s;
         accel_sigma_m_s2 = none ? 0.0
                            : datasheet ? kAccelDensity_g_sqrt_hz * kGravity_m_s2 * std::sqrt(rate_hz / 2.0)
                                        : kAccelNoise_m_s2;
@@ -367,7 +369,7 @@ struct Measuring {
                      err.soft_iron[i][2] * field_body[2] + err.hard_iron_uT[i];
         for (int i = 0; i < 3; ++i) {
             const double bias_dps = err.gyro_bias_dps[i] + err.gyro_drift_dps_per_min[i] * t_s / 60.0 + walk_dps[i];
-            gyro[i] += extra_bias_rad_s[i] + bias_dps * kDeg + gyro_sigma_rad_s * noise.gauss();
+            gyro[i] += extra_bias_rad_s[i] + bias_dps * kRadPerDeg + gyro_sigma_rad_s * noise.gauss();
             accel[i] = err.accel_scale[i] * accel[i] + err.accel_offset_m_s2[i];
             accel[i] += accel_sigma_m_s2 * noise.gauss() + vibration_m_s2 * noise.gauss();
             mag[i] += mag_sigma_uT * noise.gauss();
@@ -378,7 +380,7 @@ struct Measuring {
 
 void quantise(double gyro[3], double accel[3], double mag[3]) {
     for (int i = 0; i < 3; ++i) {
-        gyro[i] = quantised(gyro[i], kGyroLsb_dps * kDeg);
+        gyro[i] = quantised(gyro[i], kGyroLsb_dps * kRadPerDeg);
         accel[i] = quantised(accel[i], kAccelLsb_m_s2);
         mag[i] = quantised(mag[i], kMagLsb_uT);
     }

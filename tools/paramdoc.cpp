@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // paramdoc: prints the parameter reference, docs/parameters.md, from the parameter table
-// (lib/Params/Params.cpp: each row's name, type, range, default and the words beside it).
+// (lib/Settings/Params.cpp: each row's name, type, range, default and the words beside it).
 //
 //   build/paramdoc > docs/parameters.md      (what `make docs` does)
 //
@@ -27,7 +27,7 @@ void print_name(const params::RowDoc& r) {
 int main() {
     const uint8_t rows = params::row_count();
     printf("# Parameters\n\n");
-    printf("<!-- Printed by tools/paramdoc from the parameter table in lib/Params/Params.cpp: `make docs`\n"
+    printf("<!-- Printed by tools/paramdoc from the parameter table in lib/Settings/Params.cpp: `make docs`\n"
            "     writes this file, and the test docs.parameters_current fails when it is not what the\n"
            "     table says. Edit the table, not this file. -->\n\n");
     printf("The flight settings and the declination as named parameters: the console lists them with\n"

@@ -15,7 +15,7 @@
 //   flight manual|stabilize  the flight mode (the mode switch's next move overrides it)
 //   rc                   the receiver's eight channel widths, us (radio set-up)
 //   servo                the eight output widths, us
-//   params               every parameter (lib/Params) and its value, one a line
+//   params               every parameter (lib/Settings/Params.h) and its value, one a line
 //   get NAME             one parameter
 //   set NAME VALUE       set one (range-checked; `save` keeps it)
 //

@@ -19,12 +19,9 @@
 #include <stdint.h>
 
 #include "LinAlg.h"
+#include "OutputMode.h"
 
 namespace fmt {
-
-// The stored byte of Settings::mode: values are never renumbered (EEPROM records hold them).
-enum class OutputMode : uint8_t { Plot = 0, Csv = 1, Quiet = 2, Quat = 3, Raw = 4, Mavlink = 5 };
-constexpr OutputMode kLastOutputMode = OutputMode::Mavlink;
 
 // Longest line: "roll:-180.00 pitch:-90.00 yaw:359.99\n" or a csv row with a 10-digit
 // time stamp; 48 leaves room.

@@ -90,7 +90,7 @@ constexpr DcmSettings kDefaultDcmSettings = {
     0.003f,                         // output_lead_s
 };
 
-constexpr float kGravity_m_s2 = 9.80665f;
+using linalg::kGravity_m_s2;
 // Beyond any MEMS gyro's range (the MPU6000 stops at 2000 deg/s = 35 rad/s): such a
 // sample is garbage, not a rotation, and is not integrated.
 constexpr float kMaxCredibleRate_rad_s = 50.0f;

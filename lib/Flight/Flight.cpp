@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Flight.h"
 
+#include "Constants.h"
+
 #ifdef __AVR__
 #include <avr/pgmspace.h>
 #endif
@@ -23,8 +25,8 @@ int32_t demand_cd(int16_t stick_cd, int16_t limit_cd) {
     return x < 0 ? -d : d;
 }
 
-constexpr float kDegPerRad = 57.2957795f;
-constexpr float kGravity_m_s2 = 9.80665f;
+using linalg::kDegPerRad;
+using linalg::kGravity_m_s2;
 constexpr int32_t kMaxCoordinatedBank_cd = 8000;  // AP_PitchController's limit
 
 }  // namespace

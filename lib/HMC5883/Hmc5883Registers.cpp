@@ -44,7 +44,7 @@ DataStatus decode_data(const uint8_t raw[kDataLength], Gain gain, Vector3f& fiel
     if (all_zero || all_ones) return DataStatus::NoSensor;
     const Counts c = counts_from_data(raw);
     if (c.x == kOverflow || c.y == kOverflow || c.z == kOverflow) return DataStatus::Overflow;
-    const float uT_per_lsb = 100.0f / lsb_per_gauss(gain);
+    const float uT_per_lsb = linalg::kMicroteslaPerGauss / lsb_per_gauss(gain);
     field_uT = chip_to_body(Vector3f((float)c.x, (float)c.y, (float)c.z)) * uT_per_lsb;
     return DataStatus::Ok;
 }

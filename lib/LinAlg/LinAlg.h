@@ -14,6 +14,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "Constants.h"
+
 namespace linalg {
 
 // True if x is neither NaN nor infinite: the exponent bits are not all ones (IEEE
@@ -40,10 +42,6 @@ inline float safe_asin(float x) {
 
 // sqrt defined for every input: negatives and NaN give 0.
 inline float safe_sqrt(float x) { return (x > 0.0f && is_finite(x)) ? sqrtf(x) : 0.0f; }
-
-constexpr float kPi = 3.14159265358979f;
-constexpr float kDegPerRad = 57.2957795130823f;
-constexpr float kRadPerDeg = 0.0174532925199433f;
 
 // atan2 to within 1.2e-5 rad (0.0007 deg) for any finite input, cheaper than
 // avr-libc's atan2f: one division and an odd degree-9 polynomial fitted (least maximum

@@ -7,22 +7,22 @@ using linalg::Vector3f;
 
 float gyro_lsb_per_dps(GyroRange range) {
     switch (range) {
-        case GyroRange::Dps250: return 131.0f;
-        case GyroRange::Dps500: return 65.5f;
-        case GyroRange::Dps1000: return 32.8f;
+        case GyroRange::Dps250: return (float)kGyroLsbPerDps250;
+        case GyroRange::Dps500: return (float)kGyroLsbPerDps500;
+        case GyroRange::Dps1000: return (float)kGyroLsbPerDps1000;
         case GyroRange::Dps2000: break;
     }
-    return 16.4f;
+    return (float)kGyroLsbPerDps2000;
 }
 
 float accel_lsb_per_g(AccelRange range) {
     switch (range) {
-        case AccelRange::G2: return 16384.0f;
-        case AccelRange::G4: return 8192.0f;
-        case AccelRange::G8: return 4096.0f;
+        case AccelRange::G2: return (float)kAccelLsbPerG2;
+        case AccelRange::G4: return (float)kAccelLsbPerG4;
+        case AccelRange::G8: return (float)kAccelLsbPerG8;
         case AccelRange::G16: break;
     }
-    return 2048.0f;
+    return (float)kAccelLsbPerG16;
 }
 
 static bool is_saturated(int16_t v) { return v == 32767 || v == -32768; }

@@ -58,7 +58,13 @@ enum class AccelRange : uint8_t { G2 = 0x00, G4 = 0x08, G8 = 0x10, G16 = 0x18 };
 // Sample rate = 1 kHz / (1 + SMPLRT_DIV) with the DLPF on (Register Map 4.2).
 constexpr uint8_t smplrt_div_for_hz(uint16_t rate_hz) { return (uint8_t)(1000u / rate_hz - 1u); }
 
-// Sensitivity per configured range (Product Specification 6.1 and 6.2).
+// Sensitivity per configured range (Product Specification 6.1 and 6.2): LSB per deg/s
+// and LSB per g, written once; in double for the host's models (sim/), rounded once to
+// float where the firmware uses them.
+constexpr double kGyroLsbPerDps250 = 131.0, kGyroLsbPerDps500 = 65.5, kGyroLsbPerDps1000 = 32.8,
+                 kGyroLsbPerDps2000 = 16.4;
+constexpr double kAccelLsbPerG2 = 16384.0, kAccelLsbPerG4 = 8192.0, kAccelLsbPerG8 = 4096.0,
+                 kAccelLsbPerG16 = 2048.0;
 float gyro_lsb_per_dps(GyroRange range);
 float accel_lsb_per_g(AccelRange range);
 
@@ -96,22 +102,23 @@ struct Sample {
     float temperature_c() const { return temperature_c_from_raw(temperature_raw); }
 };
 
-constexpr float kStandardGravity_m_s2 = 9.80665f;
+// Standard gravity by the name this driver's users know it (linalg's, not another value).
+constexpr float kStandardGravity_m_s2 = linalg::kGravity_m_s2;
 
 // The same sensitivities as scale factors, constant expressions (a float division is
 // the 2560's slowest library call and the decode runs 200 times a second; a switch here
 // becomes a table in RAM).
 constexpr float gyro_rad_s_per_count(GyroRange range) {
-    return range == GyroRange::Dps250    ? linalg::kRadPerDeg / 131.0f
-           : range == GyroRange::Dps500  ? linalg::kRadPerDeg / 65.5f
-           : range == GyroRange::Dps1000 ? linalg::kRadPerDeg / 32.8f
-                                         : linalg::kRadPerDeg / 16.4f;
+    return range == GyroRange::Dps250    ? linalg::kRadPerDeg / (float)kGyroLsbPerDps250
+           : range == GyroRange::Dps500  ? linalg::kRadPerDeg / (float)kGyroLsbPerDps500
+           : range == GyroRange::Dps1000 ? linalg::kRadPerDeg / (float)kGyroLsbPerDps1000
+                                         : linalg::kRadPerDeg / (float)kGyroLsbPerDps2000;
 }
 constexpr float accel_m_s2_per_count(AccelRange range) {
-    return range == AccelRange::G2   ? kStandardGravity_m_s2 / 16384.0f
-           : range == AccelRange::G4 ? kStandardGravity_m_s2 / 8192.0f
-           : range == AccelRange::G8 ? kStandardGravity_m_s2 / 4096.0f
-                                     : kStandardGravity_m_s2 / 2048.0f;
+    return range == AccelRange::G2   ? linalg::kGravity_m_s2 / (float)kAccelLsbPerG2
+           : range == AccelRange::G4 ? linalg::kGravity_m_s2 / (float)kAccelLsbPerG4
+           : range == AccelRange::G8 ? linalg::kGravity_m_s2 / (float)kAccelLsbPerG8
+                                     : linalg::kGravity_m_s2 / (float)kAccelLsbPerG16;
 }
 
 // The sample the sensor would give for these SI values (rounded to counts, clipped

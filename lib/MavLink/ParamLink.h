@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// MAVLink's parameter protocol over lib/Params' table, as ArduPilot answers it:
+// MAVLink's parameter protocol over the parameter table (lib/Settings/Params.h), as
+// ArduPilot answers it:
 //
 //   PARAM_REQUEST_LIST  -> PARAM_VALUE for every index 0 .. count-1, in order, paced by
 //                          the caller (a few per loop as the serial queue has room)

@@ -9,12 +9,14 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "Constants.h"
+
 namespace airspeed {
 
 constexpr float kAdcFullScale_mV = 5000.0f;  // the ADC's reference: the board's 5 V
 constexpr uint16_t kAdcCounts = 1024;
 constexpr float kSensitivity_Pa_per_mV = 1.0f;  // 1 V per kPa at 5 V supply
-constexpr float kAirDensity_kg_m3 = 1.225f;     // ISA sea level: indicated airspeed
+using linalg::kAirDensity_kg_m3;                // ISA sea level: indicated airspeed
 constexpr float kPa_per_count = kAdcFullScale_mV / kAdcCounts * kSensitivity_Pa_per_mV;
 
 // A fitted sensor reads 2.5 V at rest, +-6.25 % of its supply (0.3125 V) for its offset;

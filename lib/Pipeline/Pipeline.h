@@ -46,7 +46,7 @@
 #include "Calibration.h"
 #include "Dcm.h"
 #include "LinAlg.h"
-#include "Mpu6000Registers.h"
+#include "Mpu6000.h"
 #include "Settings.h"
 #include "StartGravity.h"
 
@@ -73,8 +73,8 @@ constexpr uint8_t kLearnMinSteps = 8;
 // (an integration may be followed by a gravity correction: two in a row at most).
 constexpr uint8_t kMaxMagWaitSteps = 2;
 
-constexpr uint16_t kRateHz = 200;               // the MPU6000's sample rate = the estimator step
-constexpr float kStep_s = 0.005f;
+using mpu6000::kRateHz;                         // the MPU6000's sample rate = the estimator step
+constexpr float kStep_s = 1.0f / kRateHz;
 constexpr uint16_t kStartupDeadlineSteps = 260; // 1.3 s: the first line must be out within 2 s of reset
 constexpr uint16_t kGyroCalTimeoutSteps = 2000; // `cal gyro` gives up after 10 s without a still second
 constexpr uint16_t kWarnIntervalSteps = 400;    // rate limit of each warning kind: 2 s

@@ -81,7 +81,8 @@ void Hmc5883Model::measure(double t_s) {
         const TrajectorySample s = trajectory_.at(t_s - (double)(averaged - 1 - i) * kAveragedSampleSpacing_s);
         sum_uT += Vector3f((float)s.mag_uT[0], (float)s.mag_uT[1], (float)s.mag_uT[2]);
     }
-    const Vector3f chip_Ga = hmc5883::body_to_chip(sum_uT * (1.0f / (float)averaged)) * 0.01f;
+    const Vector3f chip_Ga =
+        hmc5883::body_to_chip(sum_uT * (1.0f / (float)averaged)) * (1.0f / linalg::kMicroteslaPerGauss);
     float field_Ga[3] = {chip_Ga.x, chip_Ga.y, chip_Ga.z};
     // Self-test (datasheet "Self Test Operation"): the chip measures the external
     // field, then the field with the offset straps on, and outputs the difference:

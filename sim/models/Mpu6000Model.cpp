@@ -20,7 +20,7 @@ constexpr uint8_t kIntRdClear = 0x10;        // INT_PIN_CFG bit 4
 constexpr uint8_t kRegTempOutH = 0x41;
 constexpr uint8_t kRegGyroXoutH = 0x43;
 constexpr uint8_t kLastDataReg = 0x48;
-constexpr double kPi = 3.14159265358979323846;
+using linalg::dbl::kPi;
 
 // DLPF bandwidths in Hz by DLPF_CFG (Register Map 4.3 table); 0 and 7 are "off".
 constexpr float kGyroBandwidth_hz[8] = {256, 188, 98, 42, 20, 10, 5, 256};
@@ -97,7 +97,7 @@ void Mpu6000Model::internal_sample(double t_s) {
     const Vector3f gyro_body((float)s.gyro_rad_s[0], (float)s.gyro_rad_s[1], (float)s.gyro_rad_s[2]);
     const Vector3f accel_body((float)s.accel_m_s2[0], (float)s.accel_m_s2[1], (float)s.accel_m_s2[2]);
     const Vector3f gyro_chip_dps = mpu6000::body_to_chip(gyro_body) * linalg::kDegPerRad;
-    const Vector3f accel_chip_g = mpu6000::body_to_chip(accel_body) * (1.0f / mpu6000::kStandardGravity_m_s2);
+    const Vector3f accel_chip_g = mpu6000::body_to_chip(accel_body) * (1.0f / linalg::kGravity_m_s2);
     // The ADCs convert within the configured full scale and the DLPF filters what they
     // converted (Product Specification 3.1/3.2: the low-pass is digital): a shock beyond
     // the range is clipped before it is filtered.

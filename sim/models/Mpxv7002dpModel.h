@@ -7,16 +7,17 @@
 
 #include <algorithm>
 
+#include "Constants.h"
+
 namespace sim {
 
 struct Mpxv7002dpModel {
     static constexpr double kSupply_mV = 5000.0;
-    static constexpr double kAirDensity_kg_m3 = 1.225;
 
     // The output in millivolts for an airspeed (m/s, along the pitot), held within the
     // 0.5..4.5 V the range gives.
     static double output_mV(double airspeed_m_s) {
-        const double pressure_kPa = 0.5 * kAirDensity_kg_m3 * airspeed_m_s * airspeed_m_s * 1e-3;
+        const double pressure_kPa = 0.5 * linalg::dbl::kAirDensity_kg_m3 * airspeed_m_s * airspeed_m_s * 1e-3;
         const double mV = kSupply_mV * (0.2 * pressure_kPa + 0.5);
         return std::min(std::max(mV, 0.1 * kSupply_mV), 0.9 * kSupply_mV);
     }

@@ -22,16 +22,16 @@
 
 #include <stdint.h>
 
-#include "Calibration.h"
+#include "SensorCalibration.h"
 #include "FlightSettings.h"
-#include "Format.h"
+#include "OutputMode.h"
 
 namespace settings {
 
 constexpr uint8_t kMagic0 = 'A';
 constexpr uint8_t kMagic1 = 'T';
 // 2: the compass calibration gained the soft-iron cross terms and the learned offset.
-// 3: the flight settings (ArduPlane's parameters, lib/Params).
+// 3: the flight settings (ArduPlane's parameters, the parameter table: Params.h).
 constexpr uint8_t kSettingsVersion = 3;
 constexpr uint8_t kV2PayloadLength = 65;  // rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
 constexpr uint8_t kFlightBytes = 166;     // params::encode_flight (checked by params' tests)
@@ -57,7 +57,7 @@ struct Settings {
     fmt::OutputMode mode;
     uint8_t flags;                 // Flags
     calib::Calibration cal;
-    flight::FlightSettings flight;  // lib/Params has their names, ranges and defaults
+    flight::FlightSettings flight;  // Params.h has their names, ranges and defaults
 
     float declination_deg() const { return (float)declination_centideg * 0.01f; }
 };

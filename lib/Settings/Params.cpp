@@ -4,6 +4,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "Constants.h"
+
 #ifdef __AVR__
 #include <avr/pgmspace.h>
 #define PARAM_TABLE PROGMEM
@@ -208,7 +210,7 @@ const Row kRows[] PARAM_TABLE = {
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
 
-constexpr float kRadPerCentideg = 3.14159265f / 18000.0f;
+constexpr float kRadPerCentideg = linalg::kPi / 18000.0f;
 
 // The row holding index, and the instance within it; false past the end.
 bool locate(uint16_t index, Row& row, uint8_t& instance) {
