@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The settings record (lib/Console/Settings.h) in the ATmega2560's EEPROM, in two slots
-// (lib/Console/RecordSlots.h): a power cut during `save` leaves the previous settings.
+// The settings record (lib/Settings/Settings.h) in the ATmega2560's EEPROM, in two slots
+// (lib/Settings/RecordSlots.h): a power cut during `save` leaves the previous settings.
 //
 // Loading happens once at start. Saving writes one byte per loop iteration while the
 // EEPROM is ready (a byte takes 3.4 ms to program: writing all of them at once would

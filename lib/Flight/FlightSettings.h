@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The flight settings: gains, limits, channel map, receiver and servo end points,
-// failsafe values. Names follow ArduPlane's parameters (lib/Params lists them with their
+// failsafe values. Names follow ArduPlane's parameters (lib/Settings/Params.cpp lists them with their
 // ranges and defaults: the defaults live there only, params::apply_defaults).
 //
 // Units: widths in microseconds; angles in centi-degrees (ArduPilot's _CD); gains as
