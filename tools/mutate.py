@@ -82,6 +82,15 @@ def build_pch(out):
     PCH_DIR = d if r.returncode == 0 else None
 
 
+# The host unit tests as CMakeLists.txt globs them: test/<Library>/ and test/sim/, not the
+# folders of the other suites.
+OTHER_SUITES = ("e2e", "fuzz", "sketch", "flight", "mavlink", "view", "compass", "support")
+
+
+def unit_test_sources():
+    return sorted(f for f in glob.glob("test/*/*.cpp") if f.split("/")[1] not in OTHER_SUITES)
+
+
 def obj_name(src):
     return src.replace("/", "__") + ".o"
 
@@ -113,7 +122,7 @@ def base_build(out, files, jobs):
     lib_srcs = sorted(glob.glob("lib/*/*.cpp"))
     if not MAVLINK_DIR:
         lib_srcs = [s for s in lib_srcs if not s.startswith("lib/MavLink/")]
-    test_srcs = sorted(glob.glob("test/test_*.cpp"))
+    test_srcs = unit_test_sources()
     jobs_list = [(s, False) for s in lib_srcs] + [(s, True) for s in test_srcs]
 
     def build(item):

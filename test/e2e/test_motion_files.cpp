@@ -3,7 +3,7 @@
 // reproduces its true quaternion; its specific force, turned to the earth frame and freed
 // of gravity, integrates to a board that ends at rest; seeds change the motion, no seed is
 // the fixed default; the sensor-error options leave the truth alone.
-// test/test_scenario_motions.cpp checks the motions' algebra (sim/Motions.h).
+// test/sim/test_scenario_motions.cpp checks the motions' algebra (sim/Motions.h).
 #include <cmath>
 #include <string>
 

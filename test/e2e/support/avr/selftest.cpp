@@ -326,7 +326,7 @@ void burst(uint8_t out[14], const int16_t v[7]) {
 }
 
 // MPU6000 bytes -> body-frame SI values per axis and range; absent patterns flagged
-// (test_decode.cpp).
+// (test/MPU6000/test_mpu6000_registers.cpp).
 void check_decode_mpu6000() {
     const float d2r = linalg::kRadPerDeg;
     uint8_t raw[14];
@@ -380,7 +380,7 @@ void check_decode_mpu6000() {
 }
 
 // HMC5883L: X, Z, Y register order, axes, gain scales, -4096 overflow and absent
-// patterns (test_decode.cpp).
+// patterns (test/HMC5883/test_hmc5883_registers.cpp).
 void check_decode_hmc5883() {
     const uint8_t raw[6] = {0x00, 0x64, 0xFF, 0x38, 0x01, 0x2C};  // X 100, Z -200, Y 300
     const hmc5883::Counts c = hmc5883::counts_from_data(raw);

@@ -10,7 +10,7 @@
 #include "Calibration.h"
 #include "Pipeline.h"
 #include "PipelineText.h"
-#include "pipeline_test_support.h"
+#include "../Pipeline/pipeline_test_support.h"
 
 namespace {
 

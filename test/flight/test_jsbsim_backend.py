@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Checks of the JSBSim flight backend (sim/flight, issue 22), one group per run:
 
-    build/venv/bin/python test/flight/test_flight.py GROUP --work DIR [--tools build]
+    build/venv/bin/python test/flight/test_jsbsim_backend.py GROUP --work DIR [--tools build]
 
 GROUP is one of:
   protocol      the servo packet parser and the JSON reply against ArduPilot's SITL JSON

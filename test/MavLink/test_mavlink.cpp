@@ -755,7 +755,7 @@ std::vector<std::string> split_cells(const std::string& line) {
 
 TEST(MavLink, ParameterReferenceTableIsTheCodes) {
     std::string path(__FILE__);
-    path = path.substr(0, path.rfind('/')) + "/../docs/parameters.md";
+    path = path.substr(0, path.rfind('/')) + "/../../docs/parameters.md";
     FILE* f = fopen(path.c_str(), "r");
     ASSERT_NE(f, nullptr) << path;
     std::vector<std::string> lines;
