@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The console's flight commands (lib/Console): set, get, flight, rc, servo, params parsed,
+// queued and answered.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "Console.h"
+#include "Params.h"
+#include "Settings.h"
+
+TEST(FlightConsole, SetGetFlightShowParse) {
+    console::Command c = console::parse_line("set RLL2SRV_P 0.55");
+    ASSERT_EQ(c.id, console::CommandId::Set);
+    EXPECT_EQ(c.arg, params::find("RLL2SRV_P"));
+    EXPECT_EQ(c.value, 5500);
+    c = console::parse_line("set servo1_min 1100");
+    ASSERT_EQ(c.id, console::CommandId::Set);
+    EXPECT_EQ(c.value, 1100 * console::kParamScale);
+    EXPECT_EQ(console::parse_line("set SERVO1_MIN 1100.5").error, console::Error::ParamRange);
+    EXPECT_EQ(console::parse_line("set SERVO1_MIN 3000").error, console::Error::ParamRange);
+    EXPECT_EQ(console::parse_line("set NOPE 1").error, console::Error::UnknownParam);
+    EXPECT_EQ(console::parse_line("set RLL2SRV_P").error, console::Error::MissingArgument);
+    EXPECT_EQ(console::parse_line("set RLL2SRV_P x").error, console::Error::BadNumber);
+    EXPECT_EQ(console::parse_line("get LIM_ROLL_CD").id, console::CommandId::Get);
+    EXPECT_EQ(console::parse_line("flight stabilize").arg, 1);
+    EXPECT_EQ(console::parse_line("flight manual").arg, 0);
+    EXPECT_EQ(console::parse_line("flight acro").error, console::Error::BadFlightMode);
+    EXPECT_EQ(console::parse_line("rc").arg, console::kShowRc);
+    EXPECT_EQ(console::parse_line("servo").arg, console::kShowServo);
+    EXPECT_EQ(console::parse_line("params").arg, console::kShowParams);
+    EXPECT_EQ(console::parse_line("rc 1").error, console::Error::ExtraArgument);
+    // Through the queue, across the ring's wrap.
+    console::CommandQueue q;
+    for (int round = 0; round < 30; ++round) {
+        for (const char* line : {"set RLL2SRV_D -0.0", "set LIM_PITCH_MIN -2000", "get RC8_TRIM", "flight stabilize",
+                                 "servo", "set RC1_MIN 3000", "params"}) {
+            const console::Command in = console::parse_line(line);
+            ASSERT_TRUE(q.push(in));
+            const console::Command back = q.pop();
+            EXPECT_EQ(back.id, in.id) << line;
+            EXPECT_EQ(back.error, in.error) << line;
+            EXPECT_EQ(back.arg, in.arg) << line;
+            EXPECT_EQ(back.value, in.value) << line;
+        }
+    }
+}
+
+TEST(FlightConsole, SetAndGetReplies) {
+    std::string out;
+    const text::Sink sink{&out, [](void* ctx, const char* d, uint8_t n) { static_cast<std::string*>(ctx)->append(d, n); }};
+    settings::Settings s = settings::defaults();
+    EXPECT_TRUE(console::apply_setting(console::parse_line("set ptch2srv_p 0.7"), s, &sink));
+    EXPECT_EQ(out, "# PTCH2SRV_P 0.7000\n");
+    out.clear();
+    console::apply_setting(console::parse_line("get RC3_MAX"), s, &sink);
+    EXPECT_EQ(out, "# RC3_MAX 2000\n");
+    out.clear();
+    console::apply_setting(console::parse_line("set SERVO1_MIN 1600"), s, &sink);
+    EXPECT_NE(out.find("# error: SERVO1_MIN"), std::string::npos) << out;
+    EXPECT_EQ(s.flight.servo[0].min_us, 1000);
+    out.clear();
+    console::print_error(console::parse_line("set RLL2SRV_P 9"), &sink);
+    EXPECT_EQ(out, "# error: RLL2SRV_P must be 0.1000..4.0000; nothing changed\n");
+}

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The PPM decoder (lib/Flight/Ppm): captures of rising edges in, frames out; the timer's
+// wrap, short and implausible frames, a glitch, captures lost.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "Ppm.h"
+
+using flight::PpmDecoder;
+
+namespace {
+
+// Rising-edge captures of one PPM frame (Timer5 ticks, wrapping at 40000) from `t` on,
+// then the sync gap to a 22.5 ms frame; returns the next frame's start.
+uint32_t ppm_frame(const std::vector<uint16_t>& widths_us, uint32_t t_ticks, std::vector<uint16_t>& captures) {
+    uint32_t t = t_ticks;
+    captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    for (uint16_t w : widths_us) {
+        t += 2u * w;
+        captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    }
+    return t_ticks + 45000u;  // 22.5 ms
+}
+
+// Feeds frames; returns how many were accepted, the last accepted in `last`.
+int feed_all(PpmDecoder& d, const std::vector<uint16_t>& captures, std::vector<uint16_t>* last = nullptr) {
+    int accepted = 0;
+    for (uint16_t c : captures)
+        if (d.feed(c)) {
+            ++accepted;
+            if (last) last->assign(d.frame_us(), d.frame_us() + flight::kChannels);
+        }
+    return accepted;
+}
+
+const std::vector<uint16_t> kFrame = {1100, 1200, 1300, 1400, 1500, 1600, 1700, 1900};
+
+}  // namespace
+
+TEST(PpmDecoder, GoodFramesAcceptedFromTheSecondWholeOne) {
+    PpmDecoder d;
+    std::vector<uint16_t> caps, last;
+    uint32_t t = 12345;
+    for (int i = 0; i < 5; ++i) t = ppm_frame(kFrame, t, caps);
+    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));  // the edge after the last sync gap
+    // A frame closes at the next frame's first edge. Frame 1 has no sync before it (its
+    // widths are ignored); frame 2 is whole but follows no whole frame; 3, 4, 5 are
+    // accepted.
+    EXPECT_EQ(feed_all(d, caps, &last), 3);
+    EXPECT_EQ(last, kFrame);
+}
+
+TEST(PpmDecoder, WidthsExactThroughTheTimerWrap) {
+    PpmDecoder d;
+    std::vector<uint16_t> caps, last;
+    uint32_t t = 39000;  // the timer wraps inside the first frames
+    const std::vector<uint16_t> odd = {800, 2200, 1501, 999, 1000, 2000, 1234, 1777};
+    for (int i = 0; i < 6; ++i) t = ppm_frame(odd, t, caps);
+    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    EXPECT_EQ(feed_all(d, caps, &last), 4);
+    EXPECT_EQ(last, odd);
+}
+
+TEST(PpmDecoder, ShortFrameAndImplausibleWidthsRejected) {
+    std::vector<uint16_t> caps;
+    uint32_t t = 0;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    // A 7-channel frame, then a good one (rejected too: it follows an unstable count),
+    // then good ones again.
+    t = ppm_frame(std::vector<uint16_t>(kFrame.begin(), kFrame.end() - 1), t, caps);
+    t = ppm_frame(kFrame, t, caps);
+    t = ppm_frame(kFrame, t, caps);
+    // A width of 700 us and one of 2300 us: each frame rejected.
+    std::vector<uint16_t> low = kFrame, high = kFrame;
+    low[2] = 700;
+    high[5] = 2300;
+    t = ppm_frame(low, t, caps);
+    t = ppm_frame(high, t, caps);
+    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    // Accepted: frame 3 (after a whole 2), not 4 (7 widths), not 5 (after 7), 6, not 7
+    // (700 us), not 8 (2300 us).
+    PpmDecoder d;
+    EXPECT_EQ(feed_all(d, caps), 2);
+}
+
+TEST(PpmDecoder, GlitchSplittingAPulseCostsTheFrameNotAWrongWidth) {
+    std::vector<uint16_t> caps, last;
+    uint32_t t = 500;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    // A spurious edge 300 us into channel 4: two short widths, nine in all.
+    const size_t start = caps.size();
+    t = ppm_frame(kFrame, t, caps);
+    const uint16_t glitch = (uint16_t)((caps[start + 3] + 600u) % PpmDecoder::kPeriodTicks);
+    caps.insert(caps.begin() + (long)start + 4, glitch);
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    PpmDecoder d;
+    int n = 0;
+    for (uint16_t c : caps)
+        if (d.feed(c)) {
+            ++n;
+            EXPECT_EQ(std::vector<uint16_t>(d.frame_us(), d.frame_us() + 8), kFrame);
+        }
+    // Accepted: frame 3, not the glitched 4, not 5 (after a 9-count), 6, 7.
+    EXPECT_EQ(n, 3);
+}
+
+TEST(PpmDecoder, ResetDropsTheFrameInProgress) {
+    std::vector<uint16_t> caps;
+    uint32_t t = 0;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    t = ppm_frame(kFrame, t, caps);
+    PpmDecoder d;
+    // Three frames and the fourth's first 5 edges: frame 3 accepted at the 4th's first edge.
+    EXPECT_EQ(feed_all(d, std::vector<uint16_t>(caps.begin(), caps.begin() + 27 + 5)), 1);
+    d.reset();  // captures lost mid-frame
+    std::vector<uint16_t> more;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, more);
+    more.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    EXPECT_EQ(feed_all(d, more), 1);  // as from power-up: the third whole frame is the first accepted
+}

@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// lib/Params for the flight settings: the parameter table (index, name, defaults), set's
+// checks, the version 3 record and the upgrade of a version 2 one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "Flight.h"
+#include "Params.h"
+#include "Settings.h"
+
+TEST(FlightParams, TableIndexNameAndDefaults) {
+    const uint16_t n = params::count();
+    EXPECT_GE(n, 90u);
+    EXPECT_LT(n, 255u);
+    params::Info in;
+    std::vector<std::string> names;
+    for (uint16_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(params::info(i, in));
+        EXPECT_LE(std::strlen(in.name), params::kNameMax);
+        EXPECT_EQ(params::find(in.name), (int16_t)i) << in.name;
+        for (const auto& s : names) EXPECT_NE(s, in.name);
+        names.push_back(in.name);
+    }
+    EXPECT_FALSE(params::info(n, in));
+    EXPECT_EQ(params::find("rc8_reversed"), params::find("RC8_REVERSED"));
+    EXPECT_EQ(params::find("RC9_MIN"), -1);
+    const settings::Settings s = settings::defaults();
+    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("RLL2SRV_P")), 1.0f);
+    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("SERVO3_TRIM")), 1500.0f);
+    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("FLTMODE1")), 0.0f);
+    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("FLTMODE6")), 2.0f);
+    EXPECT_FLOAT_EQ(params::get(s, (uint16_t)params::find("THR_FS_VALUE")), 950.0f);
+    EXPECT_EQ(s.flight.rcmap[flight::kThrottle], 3);
+    EXPECT_TRUE(params::all_valid(s));
+}
+
+TEST(FlightParams, SetChecksRangeWholenessAndEndPointOrder) {
+    settings::Settings s = settings::defaults();
+    const uint16_t p = (uint16_t)params::find("RLL2SRV_P");
+    EXPECT_TRUE(params::set(s, p, 1.25f));
+    EXPECT_FLOAT_EQ(s.flight.roll.p, 1.25f);
+    EXPECT_FALSE(params::set(s, p, 5.0f));
+    EXPECT_FALSE(params::set(s, p, std::nanf("")));
+    EXPECT_FLOAT_EQ(s.flight.roll.p, 1.25f);
+    const uint16_t trim = (uint16_t)params::find("SERVO2_TRIM");
+    EXPECT_FALSE(params::set(s, trim, 1500.5f));
+    EXPECT_FALSE(params::set(s, trim, 2100.0f)) << "above SERVO2_MAX";
+    EXPECT_EQ(s.flight.servo[1].trim_us, 1500);
+    EXPECT_TRUE(params::set(s, trim, 1520.0f));
+    EXPECT_EQ(s.flight.servo[1].trim_us, 1520);
+    const uint16_t rev = (uint16_t)params::find("RC5_REVERSED");
+    EXPECT_TRUE(params::set(s, rev, 1.0f));
+    EXPECT_EQ(s.flight.rc_reversed, 0x10);
+    const uint16_t dec = (uint16_t)params::find("COMPASS_DEC");
+    EXPECT_TRUE(params::set(s, dec, 0.1f));
+    EXPECT_EQ(s.declination_centideg, 573);  // 0.1 rad = 5.73 deg
+    EXPECT_NEAR(params::get(s, dec), 0.1f, 1e-4f);
+}
+
+TEST(FlightParams, RecordVersion3RoundTripsAndVersion2StillLoads) {
+    EXPECT_EQ(params::flight_bytes(), settings::kFlightBytes);
+    settings::Settings in = settings::defaults();
+    in.rate_hz = 20;
+    ASSERT_TRUE(params::set(in, (uint16_t)params::find("PTCH2SRV_D"), 0.05f));
+    ASSERT_TRUE(params::set(in, (uint16_t)params::find("SERVO7_REVERSED"), 1.0f));
+    ASSERT_TRUE(params::set(in, (uint16_t)params::find("RC3_MIN"), 1050.0f));
+    uint8_t rec[settings::kRecordSize];
+    settings::encode(in, rec);
+    EXPECT_EQ(rec[2], 3);
+    settings::Settings out;
+    ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
+    for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(params::get(out, i), params::get(in, i)) << i;
+    EXPECT_EQ(out.flags & settings::kFlagUpgraded, 0);
+
+    // A version 2 record as the previous firmware wrote it: rate, decl, mode, flags,
+    // calibration, CRC; EEPROM beyond it erased.
+    uint8_t v2[settings::kRecordSize];
+    std::memset(v2, 0xFF, sizeof v2);
+    settings::Settings old = settings::defaults();
+    old.rate_hz = 25;
+    old.declination_centideg = -345;
+    old.mode = fmt::OutputMode::Csv;
+    old.flags = settings::kFlagMagCalibrated;
+    old.cal.mag_offset_uT = linalg::Vector3f(8.0f, -5.0f, 3.0f);
+    settings::encode(old, v2);
+    v2[2] = 2;
+    v2[3] = settings::kV2PayloadLength;
+    std::memset(v2 + 4 + settings::kV2PayloadLength, 0xFF, settings::kRecordSize - 4u - settings::kV2PayloadLength);
+    const uint16_t crc = settings::crc16(v2, 4 + settings::kV2PayloadLength);
+    v2[4 + settings::kV2PayloadLength] = (uint8_t)(crc & 0xFF);
+    v2[5 + settings::kV2PayloadLength] = (uint8_t)(crc >> 8);
+    settings::Settings up;
+    ASSERT_EQ(settings::decode(v2, up), settings::LoadResult::Ok);
+    EXPECT_EQ(up.rate_hz, 25);
+    EXPECT_EQ(up.declination_centideg, -345);
+    EXPECT_EQ(up.mode, fmt::OutputMode::Csv);
+    EXPECT_TRUE(up.cal.mag_offset_uT == old.cal.mag_offset_uT);
+    EXPECT_EQ(up.flags, settings::kFlagMagCalibrated | settings::kFlagUpgraded);
+    EXPECT_FLOAT_EQ(up.flight.roll.p, 1.0f) << "flight settings at defaults";
+    // Saved again: version 3, the upgrade flag not stored.
+    settings::encode(up, rec);
+    ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
+    EXPECT_EQ(out.flags, settings::kFlagMagCalibrated);
+    // A v2 record with a bad CRC is refused, never misread.
+    v2[10] ^= 0x40;
+    EXPECT_EQ(settings::decode(v2, up), settings::LoadResult::BadCrc);
+}
