@@ -1,11 +1,13 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Mutation testing of the estimator's libraries (issue 25): `make mutate`.
+"""Mutation testing of the estimator's and the flight code's libraries: `make mutate`.
 
 universalmutator (`mutate`, PyPI) writes every mutant of each selected source file; a
 seeded sample of them is compiled, one at a time, into a test binary of only the host
 unit tests that include a selected library (build/mutate/), and run with a timeout.
 A mutant the tests fail on (or that hangs) is killed; one they pass survives. The
 kill score is printed per library, then each survivor (file, line, original, mutant).
+The tests of the mutated library's own folder (test/<Library>/) run first: most kills
+then cost only those.
 
 Mutants that cannot change behaviour (equivalent ones) are listed in
 test/mutants_equivalent.txt, keyed by the file, the mutated line's text and its
@@ -41,7 +43,27 @@ LIBRARIES = collections.OrderedDict([
     ("lib/DCM", ["lib/DCM/*.cpp", "lib/DCM/[!T]*.h", "lib/DCM/T[!r]*.h"]),
     ("lib/LinAlg/Fixed", ["lib/LinAlg/Fixed.*"]),
     ("lib/Calibration", ["lib/Calibration/*.cpp", "lib/Calibration/*.h"]),
+    # Flight.h and Ppm.h hold code (inline maps, the signal timeout, the decoder's limits);
+    # FlightSettings.h only declares the settings record, which every test includes
+    # through Settings.h (a mutant of it would rebuild them all): left out.
+    ("lib/Flight", ["lib/Flight/*.cpp", "lib/Flight/Flight.h", "lib/Flight/Ppm.h"]),
 ])
+
+
+def library_named(name):
+    """The LIBRARIES key for a name as given: lib/Flight, Flight, Fixed, LinAlg/Fixed."""
+    for lib in LIBRARIES:
+        if name.rstrip("/") in (lib, lib[len("lib/"):], lib.rsplit("/", 1)[-1]):
+            return lib
+    sys.exit("mutate: no library %s (one of %s)" % (name, ", ".join(LIBRARIES)))
+
+
+def own_tests_first(lib, test_srcs):
+    """The tests in the library's own folder (test/DCM/ for lib/DCM, test/LinAlg/ for
+    lib/LinAlg/Fixed) first, the rest after, each in its order: GoogleTest runs them in
+    link order, and the first failure ends the run."""
+    folder = "test/" + lib.split("/")[1] + "/"
+    return sorted(test_srcs, key=lambda s: not s.startswith(folder))
 EQUIVALENT_FILE = "test/mutants_equivalent.txt"
 # The trace (lib/DCM/Trace.h) is host-only instrumentation for replay: left out.
 LIB_FLAGS = ["-O1", "-DDCM_TRACE=0"]
@@ -326,7 +348,7 @@ def load_equivalent():
 # One mutant: the mutated file in the worker's copy, its dependents recompiled, the
 # binary linked and run.
 
-def test_mutant(m, worker, base, lib_objs, test_objs, deps, obj_dir, timeout_s):
+def test_mutant(m, lib, worker, base, lib_objs, test_objs, deps, obj_dir, timeout_s):
     src_path = os.path.join(worker, m["file"])
     shutil.copyfile(m["mutant"], src_path)
     try:
@@ -343,7 +365,8 @@ def test_mutant(m, worker, base, lib_objs, test_objs, deps, obj_dir, timeout_s):
             if r.returncode != 0:
                 return "invalid", ""
             changed[s] = o
-        objs = [changed.get(s, os.path.abspath(os.path.join(obj_dir, obj_name(s)))) for s in lib_objs + test_objs]
+        objs = [changed.get(s, os.path.abspath(os.path.join(obj_dir, obj_name(s))))
+                for s in lib_objs + own_tests_first(lib, test_objs)]
         binary = os.path.abspath(os.path.join(worker, "tests"))
         ok, log = link(binary, objs)
         if not ok:
@@ -365,11 +388,12 @@ def test_mutant(m, worker, base, lib_objs, test_objs, deps, obj_dir, timeout_s):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build")
-    ap.add_argument("--mutants", default="300", help="how many viable mutants in all (split evenly over the "
+    ap.add_argument("--mutants", default="400", help="how many viable mutants in all (split evenly over the "
                     "libraries), or 'all'")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("-j", "--jobs", type=int, default=2)
-    ap.add_argument("--library", action="append", help="only this library (lib/DCM, lib/LinAlg/Fixed, ...)")
+    ap.add_argument("--library", action="append", help="only this library (lib/DCM, lib/LinAlg/Fixed, lib/Flight, "
+                    "...; or its last name: DCM, Fixed, Flight); repeat for more")
     ap.add_argument("--survivors-of", metavar="REPORT", help="run only the survivors a previous report lists "
                     "(build/mutate/report.txt: after writing tests for them)")
     args = ap.parse_args()
@@ -390,7 +414,8 @@ def main():
     os.chdir(base)
     files = selected_files()
     if args.library:
-        files = collections.OrderedDict((f, l) for f, l in files.items() if l in args.library)
+        chosen = [library_named(n) for n in args.library]
+        files = collections.OrderedDict((f, l) for f, l in files.items() if l in chosen)
 
     out = os.path.join(ROOT, out)
     if os.path.exists("/usr/include/gtest/gtest.h"):
@@ -429,9 +454,16 @@ def main():
     mutants = generate(out, files, mutate_bin)
     equivalent = load_equivalent()
     # Shuffled before the equivalent ones are taken out: listing one leaves the rest of
-    # the sample as it was (the next mutant in the order takes its place).
-    rng = random.Random(args.seed)
-    rng.shuffle(mutants)
+    # the sample as it was (the next mutant in the order takes its place). Each library's
+    # mutants apart, with the same seed: a library's sample is the same whichever others
+    # run beside it (--library DCM draws what the whole run draws for lib/DCM).
+    by_lib = collections.OrderedDict()
+    for m in mutants:
+        by_lib.setdefault(files[m["file"]], []).append(m)
+    mutants = []
+    for lib_mutants in by_lib.values():
+        random.Random(args.seed).shuffle(lib_mutants)
+        mutants += lib_mutants
     pool = collections.OrderedDict((lib, []) for lib in LIBRARIES if lib in files.values())
     n_equivalent = collections.Counter()
     if args.survivors_of:
@@ -491,7 +523,7 @@ def main():
                     break
                 lib, m = nm
                 w = free.pop()
-                fut = ex.submit(test_mutant, m, w, base, lib_objs, test_objs, deps, obj_dir, timeout_s)
+                fut = ex.submit(test_mutant, m, lib, w, base, lib_objs, test_objs, deps, obj_dir, timeout_s)
                 in_flight[fut] = (lib, m, w)
             if not in_flight:
                 break
@@ -511,6 +543,9 @@ def main():
                 if status == "survived":
                     survivors.append((lib, m))
                     print("#   survived: %s:%d: %s -> %s" % (m["file"], m["line"], m["orig"], m["new"]))
+                elif status == "killed" and args.survivors_of:
+                    # After tests were written for them: which test fails on each.
+                    print("#   killed by %s: %s:%d: %s -> %s" % (how, m["file"], m["line"], m["orig"], m["new"]))
                 done_count += 1
                 if done_count % 25 == 0:
                     print("#   %d mutants run (%.0f s)" % (done_count, time.time() - start))
