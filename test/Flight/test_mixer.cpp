@@ -3,6 +3,8 @@
 // aux channels on OUT5-8, reverse and limits.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include "Flight.h"
 #include "Settings.h"
 
@@ -51,4 +53,107 @@ TEST(Mixer, PlainElevonAndVtail) {
     flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{0, 0, 0, 0}, aux, out);
     EXPECT_EQ(out[4], 1000);
     EXPECT_EQ(out[5], 1000);
+}
+
+namespace {
+
+// Outputs off the defaults: each its own end points, some reversed.
+settings::Settings odd_outputs() {
+    settings::Settings s = defaults();
+    s.flight.servo[0] = flight::EndPoints{1050, 1950, 1480};
+    s.flight.servo[1] = flight::EndPoints{1100, 2000, 1530};
+    s.flight.servo[2] = flight::EndPoints{1020, 1980, 1500};
+    s.flight.servo[3] = flight::EndPoints{990, 2010, 1510};
+    return s;
+}
+
+const int16_t kCommands[] = {-4500, -3001, -900, -1, 0, 1, 77, 901, 2999, 4500};
+
+}  // namespace
+
+TEST(Mixer, PlainAeroplaneEachSurfaceOnItsOutput) {
+    for (uint8_t reversed : {0x00, 0x0F, 0x05, 0x0A}) {
+        settings::Settings s = odd_outputs();
+        s.flight.servo_reversed = reversed;
+        const flight::Scales sc = flight::scales_of(s.flight);
+        uint16_t out[8];
+        for (int16_t a : kCommands)
+            for (int16_t e : {-4500, -450, 0, 1333}) {
+                const int16_t r = (int16_t)(-a / 2), t = (int16_t)(500 + a / 10);
+                flight::mix(s.flight, sc, flight::Surfaces{a, e, t, r}, nullptr, out);
+                EXPECT_EQ(out[0], flight::angle_to_width(a, s.flight.servo[0], (reversed & 1) != 0));
+                EXPECT_EQ(out[1], flight::angle_to_width(e, s.flight.servo[1], (reversed & 2) != 0));
+                EXPECT_EQ(out[2], flight::throttle_to_width(t, s.flight.servo[2], (reversed & 4) != 0));
+                EXPECT_EQ(out[3], flight::angle_to_width(r, s.flight.servo[3], (reversed & 8) != 0));
+            }
+    }
+}
+
+TEST(Mixer, ElevonsCarryTheElevatorInTheirSumAndTheAileronInTheirDifference) {
+    // Left = (elevator - aileron) / 2 on OUT1, right = (elevator + aileron) / 2 on OUT2:
+    // right + left is the elevator, right - left the aileron (to the halving's rounding
+    // toward zero); OUT3 and OUT4 as the plain aeroplane's.
+    settings::Settings s = odd_outputs();
+    s.flight.elevon_output = 1;
+    const flight::Scales sc = flight::scales_of(s.flight);
+    uint16_t out[8];
+    for (int16_t a : kCommands)
+        for (int16_t e : kCommands) {
+            flight::mix(s.flight, sc, flight::Surfaces{a, e, 250, 300}, nullptr, out);
+            const int left = (e - a) / 2, right = (e + a) / 2;
+            ASSERT_LE(std::abs(right + left - e), 1);
+            ASSERT_LE(std::abs(right - left - a), 1);
+            EXPECT_EQ(out[0], flight::angle_to_width((int16_t)left, s.flight.servo[0], false)) << a << " " << e;
+            EXPECT_EQ(out[1], flight::angle_to_width((int16_t)right, s.flight.servo[1], false)) << a << " " << e;
+            EXPECT_EQ(out[2], flight::throttle_to_width(250, s.flight.servo[2], false));
+            EXPECT_EQ(out[3], flight::angle_to_width(300, s.flight.servo[3], false));
+        }
+    // Full elevator and full aileron together: one elevon at full throw, the other at trim.
+    flight::mix(s.flight, sc, flight::Surfaces{4500, 4500, 0, 0}, nullptr, out);
+    EXPECT_EQ(out[0], 1480);
+    EXPECT_EQ(out[1], 2000);
+    flight::mix(s.flight, sc, flight::Surfaces{4500, -4500, 0, 0}, nullptr, out);
+    EXPECT_EQ(out[0], 1050);
+    EXPECT_EQ(out[1], 1530);
+}
+
+TEST(Mixer, VtailCarriesTheElevatorInItsSumAndTheRudderInItsDifference) {
+    // Left = (elevator - rudder) / 2 on OUT2, right = (elevator + rudder) / 2 on OUT4; the
+    // aileron stays on OUT1.
+    settings::Settings s = odd_outputs();
+    s.flight.vtail_output = 1;
+    s.flight.servo_reversed = 0x02;  // the left ruddervator's servo mounted the other way
+    const flight::Scales sc = flight::scales_of(s.flight);
+    uint16_t out[8];
+    for (int16_t r : kCommands)
+        for (int16_t e : kCommands) {
+            flight::mix(s.flight, sc, flight::Surfaces{-700, e, 250, r}, nullptr, out);
+            const int left = (e - r) / 2, right = (e + r) / 2;
+            EXPECT_EQ(out[0], flight::angle_to_width(-700, s.flight.servo[0], false));
+            EXPECT_EQ(out[1], flight::angle_to_width((int16_t)left, s.flight.servo[1], true)) << r << " " << e;
+            EXPECT_EQ(out[3], flight::angle_to_width((int16_t)right, s.flight.servo[3], false)) << r << " " << e;
+        }
+}
+
+TEST(Mixer, AuxOutputsAreTheirChannelsReversedAboutTheirTrimWithinLimits) {
+    settings::Settings s = defaults();
+    for (uint8_t i = 4; i < 8; ++i) s.flight.servo[i] = flight::EndPoints{1100, 1900, (uint16_t)(1480 + 20 * (i - 4))};
+    s.flight.servo_reversed = 0x50;  // OUT5 and OUT7
+    const flight::Scales sc = flight::scales_of(s.flight);
+    uint16_t out[8];
+    const uint16_t aux[4] = {1700, 1700, 1000, 2000};
+    flight::mix(s.flight, sc, flight::Surfaces{0, 0, 0, 0}, aux, out);
+    EXPECT_EQ(out[4], 2 * 1480 - 1700);
+    EXPECT_EQ(out[5], 1700);
+    EXPECT_EQ(out[6], 1900) << "2 x 1520 - 1000, held at the maximum";
+    EXPECT_EQ(out[7], 1900) << "held at the maximum";
+    const uint16_t low[4] = {1950, 1050, 1888, 1111};
+    flight::mix(s.flight, sc, flight::Surfaces{0, 0, 0, 0}, low, out);
+    EXPECT_EQ(out[4], 1100) << "2 x 1480 - 1950, held at the minimum";
+    EXPECT_EQ(out[5], 1100);
+    EXPECT_EQ(out[6], 2 * 1520 - 1888);
+    EXPECT_EQ(out[7], 1111);
+    // No receiver: each at its trim, reversed or not.
+    flight::mix(s.flight, sc, flight::Surfaces{0, 0, 0, 0}, nullptr, out);
+    for (uint8_t i = 4; i < 8; ++i) EXPECT_EQ(out[i], 1480 + 20 * (i - 4)) << (int)i;
 }

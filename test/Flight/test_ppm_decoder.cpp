@@ -121,3 +121,98 @@ TEST(PpmDecoder, ResetDropsTheFrameInProgress) {
     more.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
     EXPECT_EQ(feed_all(d, more), 1);  // as from power-up: the third whole frame is the first accepted
 }
+
+namespace {
+
+// Captures from widths in timer ticks (0.5 us), each frame's sync gap given in ticks too.
+uint32_t ppm_ticks(const std::vector<uint32_t>& widths_ticks, uint32_t gap_ticks, uint32_t t_ticks,
+                   std::vector<uint16_t>& captures) {
+    uint32_t t = t_ticks;
+    captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    for (uint32_t w : widths_ticks) {
+        t += w;
+        captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    }
+    return t + gap_ticks;
+}
+
+}  // namespace
+
+TEST(PpmDecoder, WidthsRoundedToTheNearestMicrosecondAcrossTheWrap) {
+    // Odd tick counts are half microseconds: rounded up. The frames start just before the
+    // timer wraps, so that widths straddle it.
+    const std::vector<uint32_t> ticks = {2999, 3000, 3001, 3002, 1601, 4399, 4400, 2001};
+    const std::vector<uint16_t> us = {1500, 1500, 1501, 1501, 801, 2200, 2200, 1001};
+    for (uint32_t start : {39990u, 39000u, 35000u, 100u}) {
+        std::vector<uint16_t> caps, last;
+        uint32_t t = start;
+        for (int i = 0; i < 6; ++i) t = ppm_ticks(ticks, 9001 + (uint32_t)i * 997, t, caps);
+        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        PpmDecoder d;
+        EXPECT_EQ(feed_all(d, caps, &last), 4) << start;
+        EXPECT_EQ(last, us) << start;
+    }
+}
+
+TEST(PpmDecoder, ASyncGapIsOver3000us) {
+    const std::vector<uint32_t> widths(8, 2000);  // 1000 us each
+    // A gap of 3000.5 us (6001 ticks) rounds to 3001 and closes the frame ...
+    for (uint32_t gap : {6001u, 6002u, 30000u}) {
+        std::vector<uint16_t> caps;
+        uint32_t t = 7;
+        for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, gap, t, caps);
+        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        PpmDecoder d;
+        EXPECT_EQ(feed_all(d, caps), 3) << gap;
+    }
+    // ... 3000 us does not: it is a width, and too long for one.
+    for (uint32_t gap : {5999u, 6000u}) {
+        std::vector<uint16_t> caps;
+        uint32_t t = 7;
+        for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, i == 0 ? 30000u : gap, t, caps);
+        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        PpmDecoder d;
+        EXPECT_EQ(feed_all(d, caps), 0) << gap;
+    }
+}
+
+TEST(PpmDecoder, WidthsJustOutsideThePlausibleOnesCostTheirFrameOnly) {
+    for (uint16_t bad : {799, 2201, 0, 3000}) {
+        std::vector<uint16_t> caps, last;
+        uint32_t t = 0;
+        for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+        std::vector<uint16_t> odd = kFrame;
+        odd[6] = bad;
+        t = ppm_frame(odd, t, caps);
+        for (int i = 0; i < 2; ++i) t = ppm_frame(kFrame, t, caps);
+        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        // Accepted: frame 3, not 4, then 5 (a whole count before it) and 6.
+        PpmDecoder d;
+        EXPECT_EQ(feed_all(d, caps, &last), 3) << bad;
+        EXPECT_EQ(last, kFrame);
+    }
+    // The ends themselves are plausible.
+    std::vector<uint16_t> caps, last;
+    const std::vector<uint16_t> ends = {800, 2200, 800, 2200, 800, 2200, 800, 2200};
+    uint32_t t = 0;
+    for (int i = 0; i < 4; ++i) t = ppm_frame(ends, t, caps);
+    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    PpmDecoder d;
+    EXPECT_EQ(feed_all(d, caps, &last), 2);
+    EXPECT_EQ(last, ends);
+}
+
+TEST(PpmDecoder, ALongRunWithoutASyncGapThenFramesAgain) {
+    // Three frames (the third accepted), then 300 edges 1 ms apart (a stuck encoder: the
+    // count saturates), then frames: the second whole one after the run is accepted.
+    std::vector<uint16_t> caps, last;
+    uint32_t t = 0;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    for (int i = 0; i < 300; ++i, t += 2000u) caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    t += 8000u;  // a sync gap
+    for (int i = 0; i < 4; ++i) t = ppm_frame(kFrame, t, caps);
+    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    PpmDecoder d;
+    EXPECT_EQ(feed_all(d, caps, &last), 1 + 3);
+    EXPECT_EQ(last, kFrame);
+}
