@@ -11,6 +11,8 @@
 #   make fly        the firmware in simavr flies a JSBSim aeroplane (FLIGHT=turn GUST=1 SECONDS=30)
 #   make test       every test: host GoogleTest units, the simavr end-to-end suite, the
 #                   sketch built by arduino-builder
+#   make unit       the host unit tests alone (test/<Library>/, test/sim/): built and run in
+#                   seconds (FILTER='Mixer.*' for some)
 #   make bench      cycles, size and accuracy against the peers (build/bench/report.md)
 #   make tune       cross-validation of the estimator's gains on the BROAD recordings
 #   make docs       docs/parameters.md from the parameter table (lib/Settings/Params.cpp)
@@ -26,7 +28,7 @@
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
                 libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-BUILD_GOALS := all firmware attitude-only big tools docs sim fly test bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
+BUILD_GOALS := all firmware attitude-only big tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean

@@ -20,7 +20,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools sim fly test bench tune upload size attitude-only big docs
+.PHONY: all firmware tools unit sim fly test bench tune upload size attitude-only big docs
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -193,6 +193,23 @@ else
 	   $(MAKE) --no-print-directory -C $(HOST_BUILD) -j$(NPROC); } > $(HOST_LOG) 2>&1 || \
 	 { grep -E -B2 -A12 'error|Error' $(HOST_LOG) | head -80; echo "# host build failed: see $(HOST_LOG)"; exit 1; }
 endif
+
+# The host unit tests alone (test/<Library>/ and test/sim/): their target built (and the
+# libraries it links, none of the simulator's tools) and run once, in seconds. CMake is
+# configured first, as for tools, so that a new test file is never missed.
+# FILTER='Mixer.*:PpmDecoder.*' runs only those (GoogleTest's --gtest_filter).
+FILTER ?=
+unit:
+	$(call say,UNIT,host unit tests in $(HOST_BUILD) (build log: $(HOST_LOG)))
+	@mkdir -p $(HOST_BUILD)
+	@{ cmake -S . -B $(HOST_BUILD) -DCMAKE_BUILD_TYPE=Release -DTOOLS_DIR=$(abspath $(BUILD)) && \
+	   $(MAKE) --no-print-directory -C $(HOST_BUILD) -j$(NPROC) unit_tests; } > $(HOST_LOG) 2>&1 || \
+	 { grep -E -B2 -A12 'error|Error' $(HOST_LOG) | head -80; echo "# unit tests' build failed: see $(HOST_LOG)"; exit 1; }
+	@cd $(HOST_BUILD) && start=$$(date +%s%N) && \
+	  { ./unit_tests --gtest_brief=1 $(if $(FILTER),--gtest_filter='$(FILTER)') > unit_tests.log 2>&1; status=$$?; }; \
+	  grep -v '^Running main()' unit_tests.log; \
+	  echo "# unit: run in $$(( ($$(date +%s%N) - start) / 1000000 )) ms (output: $(HOST_BUILD)/unit_tests.log)"; \
+	  exit $$status
 
 # The parameter reference, docs/parameters.md, printed from the parameter table
 # (lib/Settings/Params.cpp) by build/paramdoc; the ctest docs.parameters_current fails when
