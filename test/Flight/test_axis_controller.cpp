@@ -117,6 +117,9 @@ TEST(AxisController, TermsAreTheGainsInFixedPointRounded) {
     EXPECT_EQ(big.inv_tau_q12, 32767);
     EXPECT_EQ(big.kd_q14, 32767);
     EXPECT_EQ(big.kp_ff_q12, 0);
+    // Half a unit rounds up: D = 2^-15 is exactly half of Q14's unit.
+    EXPECT_EQ(flight::axis_terms(flight::AxisGains{0.5f, 1.0f, 0.0f, 1.0f / 32768.0f, 0}, 0.02f).kd_q14, 1);
+    EXPECT_EQ(flight::axis_terms(flight::AxisGains{0.5f, 1.0f, 0.0f, 1.0f / 65536.0f, 0}, 0.02f).kd_q14, 0);
 }
 
 TEST(AxisController, MeasuredRatesDampAndTheDemandedRateLeads) {
@@ -300,6 +303,11 @@ TEST(AxisController, FullThrowExactlyIsSaturated) {
     EXPECT_EQ(down.step(t, -4499, 0, 0), -4500);
     up.step(t, 4500, 0, 0);
     down.step(t, -4499, 0, 0);
+    EXPECT_EQ(up.integrator_deg(), deg_of_q16(4500));
+    EXPECT_EQ(down.integrator_deg(), deg_of_q16(-4499));
+    // Saturated, even the least part the pinned way is held: a rate error of 1 cd/s.
+    up.step(t, 1, 0, 0);
+    down.step(t, -1, 0, 0);
     EXPECT_EQ(up.integrator_deg(), deg_of_q16(4500));
     EXPECT_EQ(down.integrator_deg(), deg_of_q16(-4499));
 }

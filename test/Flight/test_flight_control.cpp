@@ -212,6 +212,47 @@ TEST(FlightControl, FailsafeTimingToTheMillisecond) {
     r.fc.update_signal(3900);
     EXPECT_EQ(r.fc.state(), flight::State::Failsafe);
     EXPECT_EQ(r.fc.failsafe_cause(), flight::FailsafeCause::Encoder);
+    // Frames that stopped long before the signal is next looked at: lost.
+    r.rc[2] = 1100;
+    r.fc.on_frame(r.rc, 5000);
+    r.fc.update_signal(5000);
+    ASSERT_EQ(r.fc.state(), flight::State::Manual);
+    r.fc.update_signal(10200);
+    EXPECT_EQ(r.fc.state(), flight::State::Failsafe);
+    EXPECT_EQ(r.fc.failsafe_cause(), flight::FailsafeCause::Lost);
+}
+
+TEST(FlightControl, ChannelOneCanBeTheThrottleOrTheModeSwitch) {
+    Rig r;
+    r.s.flight.rcmap[0] = 3;
+    r.s.flight.rcmap[2] = 1;  // throttle on channel 1, roll on 3
+    r.rc[0] = 1200;
+    r.rc[2] = 1500;
+    r.fc.on_frame(r.rc, 0);
+    r.fc.update_signal(0);
+    ASSERT_EQ(r.fc.state(), flight::State::Manual);
+    r.rc[0] = 900;
+    for (uint32_t t = 20; t <= 600; t += 20) r.fc.on_frame(r.rc, t);
+    r.fc.update_signal(600);
+    EXPECT_EQ(r.fc.state(), flight::State::Failsafe);
+    EXPECT_EQ(r.fc.failsafe_cause(), flight::FailsafeCause::Encoder);
+    Rig m;
+    m.s.flight.fltmode_ch = 1;
+    m.rc[0] = 2000;  // switch high on channel 1: STABILIZE
+    m.run(0.1f);
+    EXPECT_EQ(m.fc.state(), flight::State::Stabilize);
+}
+
+TEST(FlightControl, EventsAreSixBitsApart) {
+    const uint8_t events[6] = {flight::kEvFailsafeLost, flight::kEvFailsafeEncoder, flight::kEvFailsafeEnd,
+                               flight::kEvSensorFallback, flight::kEvAttitudeBack, flight::kEvModeChanged};
+    uint8_t all = 0;
+    for (uint8_t e : events) {
+        EXPECT_EQ(e & (e - 1), 0) << (int)e << " is one bit";
+        EXPECT_NE(e, 0);
+        EXPECT_EQ(all & e, 0) << (int)e << " is its own bit";
+        all = (uint8_t)(all | e);
+    }
 }
 
 TEST(FlightControl, NoSignalHoldsEveryOutputAtTrimAndTheThrottleAtItsFailsafeValue) {
@@ -298,6 +339,10 @@ TEST(FlightControl, AChoiceInFailsafeWaitsForTheSignal) {
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
     r.fc.choose((flight::Mode)1);  // not a mode here
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
+    r.fc.choose(flight::Mode::Stabilize);
+    r.fc.choose((flight::Mode)5);  // ArduPlane's FBWA: not one here either
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
+    EXPECT_EQ(r.fc.state(), flight::State::Manual);
     // Before the first frame too.
     Rig n;
     n.fc.choose(flight::Mode::Stabilize);
@@ -364,11 +409,18 @@ TEST(FlightControl, RcMapAndReversedChannelsInManual) {
     EXPECT_EQ(sc.in[0].down, flight::angle_input_scale(f.rc[1]).down);
     EXPECT_EQ(sc.in[2].up, flight::throttle_input_scale(f.rc[5]).up);
     EXPECT_EQ(sc.in[3].up, flight::angle_input_scale(f.rc[4]).up);
+    r.s.flight.rc[3] = flight::EndPoints{1150, 1850, 1480};
+    r.s.flight.rc[7] = flight::EndPoints{1200, 1800, 1540};
     r.s.flight.rcmap[0] = 0;
     r.s.flight.rcmap[3] = 9;
+    r.s.flight.rcmap[1] = 8;
     sc = flight::scales_of(f);
     EXPECT_EQ(sc.in[0].up, flight::angle_input_scale(f.rc[0]).up);
     EXPECT_EQ(sc.in[3].up, flight::angle_input_scale(f.rc[3]).up);
+    EXPECT_EQ(sc.in[3].down, flight::angle_input_scale(f.rc[3]).down);
+    EXPECT_EQ(sc.in[1].up, flight::angle_input_scale(f.rc[7]).up) << "channel 8 is one of the eight";
+    EXPECT_EQ(sc.in[1].down, flight::angle_input_scale(f.rc[7]).down);
+    r.s.flight.rcmap[1] = 1;
     // The encoder's failsafe reads the mapped throttle channel.
     r.s.flight.rcmap[0] = 2;
     r.s.flight.rcmap[3] = 5;
@@ -435,6 +487,7 @@ settings::Settings flown_settings() {
     s.flight.thr_fs_pct = 30;
     s.flight.servo[0] = kProbe;
     s.flight.servo[1] = kProbe;
+    s.flight.servo[3] = kProbe;
     return s;
 }
 
@@ -473,7 +526,8 @@ TEST(FlightControl, StabilizeAndFailsafeAreTheAxisControllersOnTheEstimate) {
     r.rc[4] = 1234;
     r.rc[7] = 2000;
     fly(1000, true, 1);  // STABILIZE from the first frame: the controllers start afresh
-    EXPECT_EQ(r.out[3], 1700);
+    EXPECT_EQ(r.out[3], flight::angle_to_width(flight::width_to_angle(1700, r.s.flight.rc[3], false), probe, false));
+    EXPECT_TRUE(r.fc.wants_attitude());
     EXPECT_EQ(r.out[2], 1600);
     EXPECT_EQ(r.out[4], 1234);
     // The console chooses STABILIZE again: nothing changes.
@@ -492,7 +546,7 @@ TEST(FlightControl, StabilizeAndFailsafeAreTheAxisControllersOnTheEstimate) {
     b.reset();
     fly(600, false, 2);
     EXPECT_EQ(r.fc.state(), flight::State::Failsafe);
-    EXPECT_EQ(r.out[3], 1500);
+    EXPECT_EQ(r.out[3], 5000);
     EXPECT_EQ(r.out[2], 1300);
     EXPECT_EQ(r.out[4], 1500);
     // Back: STABILIZE afresh.
@@ -508,11 +562,14 @@ TEST(FlightControl, StabilizeAndFailsafeAreTheAxisControllersOnTheEstimate) {
     // FAILSAFE without an attitude: the surfaces at trim; with it again, afresh.
     fly(480, false, 1);
     r.att.valid = false;
+    r.fc.take_events();
     fly(200, false, 0);
     EXPECT_EQ(r.fc.state(), flight::State::Failsafe);
+    EXPECT_FALSE(r.fc.without_attitude()) << "FAILSAFE is no STABILIZE to fall back from";
+    EXPECT_EQ(r.fc.take_events(), flight::kEvFailsafeLost);
     EXPECT_EQ(r.out[0], 5000);
     EXPECT_EQ(r.out[1], 5000);
-    EXPECT_EQ(r.out[3], 1500);
+    EXPECT_EQ(r.out[3], 5000);
     EXPECT_EQ(r.out[2], 1300);
     r.att.valid = true;
     b.reset();
@@ -600,4 +657,19 @@ TEST(FlightControl, SticksDemandTheirLimitsAndRollErrorsGoTheShortWayRound) {
     EXPECT_EQ(aileron_at(17990), -1801);
     EXPECT_EQ(aileron_at(-18010), -1801) << "an error of 180.1 deg is -179.9";
     EXPECT_EQ(aileron_at(18010), 1801);
+    // The turn is 360 deg to the centi-degree: P' 0.25 (a quarter of the error, rounded
+    // away from zero) at errors of 180.02 and 180.03 deg, i.e. -179.98 and -179.97.
+    r.s.flight.roll = flight::AxisGains{1.0f, 0.25f, 0.0f, 0.0f, 0};
+    r.fc.configure();
+    r.rc[0] = 2000;  // a demand of 19.99 deg
+    auto width_at = [&r](int32_t roll_cd) {
+        r.att.roll_cd = roll_cd;
+        r.run(0.02f);
+        return r.out[0];
+    };
+    EXPECT_EQ(width_at(-16003), flight::angle_to_width(-4500, kProbe, false)) << "-17998 / 4 = -4499.5";
+    EXPECT_EQ(width_at(-16004), flight::angle_to_width(-4499, kProbe, false)) << "-17997 / 4 = -4499.25";
+    r.rc[0] = 1000;  // -19.99 deg
+    EXPECT_EQ(width_at(16003), flight::angle_to_width(4500, kProbe, false));
+    EXPECT_EQ(width_at(16004), flight::angle_to_width(4499, kProbe, false));
 }

@@ -12,14 +12,18 @@ using flight::PpmDecoder;
 
 namespace {
 
+// Timer5 counts 0.5 us ticks from 0 to its TOP, 39999 (a 20 ms period), and wraps: the
+// captures the interrupt stores wrap there (the board's fact, not the decoder's constant).
+constexpr uint32_t kTimerTicks = 40000;
+
 // Rising-edge captures of one PPM frame (Timer5 ticks, wrapping at 40000) from `t` on,
 // then the sync gap to a 22.5 ms frame; returns the next frame's start.
 uint32_t ppm_frame(const std::vector<uint16_t>& widths_us, uint32_t t_ticks, std::vector<uint16_t>& captures) {
     uint32_t t = t_ticks;
-    captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    captures.push_back((uint16_t)(t % kTimerTicks));
     for (uint16_t w : widths_us) {
         t += 2u * w;
-        captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        captures.push_back((uint16_t)(t % kTimerTicks));
     }
     return t_ticks + 45000u;  // 22.5 ms
 }
@@ -44,7 +48,7 @@ TEST(PpmDecoder, GoodFramesAcceptedFromTheSecondWholeOne) {
     std::vector<uint16_t> caps, last;
     uint32_t t = 12345;
     for (int i = 0; i < 5; ++i) t = ppm_frame(kFrame, t, caps);
-    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));  // the edge after the last sync gap
+    caps.push_back((uint16_t)(t % kTimerTicks));  // the edge after the last sync gap
     // A frame closes at the next frame's first edge. Frame 1 has no sync before it (its
     // widths are ignored); frame 2 is whole but follows no whole frame; 3, 4, 5 are
     // accepted.
@@ -58,7 +62,7 @@ TEST(PpmDecoder, WidthsExactThroughTheTimerWrap) {
     uint32_t t = 39000;  // the timer wraps inside the first frames
     const std::vector<uint16_t> odd = {800, 2200, 1501, 999, 1000, 2000, 1234, 1777};
     for (int i = 0; i < 6; ++i) t = ppm_frame(odd, t, caps);
-    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    caps.push_back((uint16_t)(t % kTimerTicks));
     EXPECT_EQ(feed_all(d, caps, &last), 4);
     EXPECT_EQ(last, odd);
 }
@@ -78,7 +82,7 @@ TEST(PpmDecoder, ShortFrameAndImplausibleWidthsRejected) {
     high[5] = 2300;
     t = ppm_frame(low, t, caps);
     t = ppm_frame(high, t, caps);
-    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    caps.push_back((uint16_t)(t % kTimerTicks));
     // Accepted: frame 3 (after a whole 2), not 4 (7 widths), not 5 (after 7), 6, not 7
     // (700 us), not 8 (2300 us).
     PpmDecoder d;
@@ -92,10 +96,10 @@ TEST(PpmDecoder, GlitchSplittingAPulseCostsTheFrameNotAWrongWidth) {
     // A spurious edge 300 us into channel 4: two short widths, nine in all.
     const size_t start = caps.size();
     t = ppm_frame(kFrame, t, caps);
-    const uint16_t glitch = (uint16_t)((caps[start + 3] + 600u) % PpmDecoder::kPeriodTicks);
+    const uint16_t glitch = (uint16_t)((caps[start + 3] + 600u) % kTimerTicks);
     caps.insert(caps.begin() + (long)start + 4, glitch);
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
-    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    caps.push_back((uint16_t)(t % kTimerTicks));
     PpmDecoder d;
     int n = 0;
     for (uint16_t c : caps)
@@ -118,7 +122,7 @@ TEST(PpmDecoder, ResetDropsTheFrameInProgress) {
     d.reset();  // captures lost mid-frame
     std::vector<uint16_t> more;
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, more);
-    more.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    more.push_back((uint16_t)(t % kTimerTicks));
     EXPECT_EQ(feed_all(d, more), 1);  // as from power-up: the third whole frame is the first accepted
 }
 
@@ -128,10 +132,10 @@ namespace {
 uint32_t ppm_ticks(const std::vector<uint32_t>& widths_ticks, uint32_t gap_ticks, uint32_t t_ticks,
                    std::vector<uint16_t>& captures) {
     uint32_t t = t_ticks;
-    captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    captures.push_back((uint16_t)(t % kTimerTicks));
     for (uint32_t w : widths_ticks) {
         t += w;
-        captures.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        captures.push_back((uint16_t)(t % kTimerTicks));
     }
     return t + gap_ticks;
 }
@@ -147,7 +151,7 @@ TEST(PpmDecoder, WidthsRoundedToTheNearestMicrosecondAcrossTheWrap) {
         std::vector<uint16_t> caps, last;
         uint32_t t = start;
         for (int i = 0; i < 6; ++i) t = ppm_ticks(ticks, 9001 + (uint32_t)i * 997, t, caps);
-        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        caps.push_back((uint16_t)(t % kTimerTicks));
         PpmDecoder d;
         EXPECT_EQ(feed_all(d, caps, &last), 4) << start;
         EXPECT_EQ(last, us) << start;
@@ -161,7 +165,7 @@ TEST(PpmDecoder, ASyncGapIsOver3000us) {
         std::vector<uint16_t> caps;
         uint32_t t = 7;
         for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, gap, t, caps);
-        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        caps.push_back((uint16_t)(t % kTimerTicks));
         PpmDecoder d;
         EXPECT_EQ(feed_all(d, caps), 3) << gap;
     }
@@ -170,7 +174,7 @@ TEST(PpmDecoder, ASyncGapIsOver3000us) {
         std::vector<uint16_t> caps;
         uint32_t t = 7;
         for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, i == 0 ? 30000u : gap, t, caps);
-        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        caps.push_back((uint16_t)(t % kTimerTicks));
         PpmDecoder d;
         EXPECT_EQ(feed_all(d, caps), 0) << gap;
     }
@@ -185,7 +189,7 @@ TEST(PpmDecoder, WidthsJustOutsideThePlausibleOnesCostTheirFrameOnly) {
         odd[6] = bad;
         t = ppm_frame(odd, t, caps);
         for (int i = 0; i < 2; ++i) t = ppm_frame(kFrame, t, caps);
-        caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+        caps.push_back((uint16_t)(t % kTimerTicks));
         // Accepted: frame 3, not 4, then 5 (a whole count before it) and 6.
         PpmDecoder d;
         EXPECT_EQ(feed_all(d, caps, &last), 3) << bad;
@@ -196,23 +200,74 @@ TEST(PpmDecoder, WidthsJustOutsideThePlausibleOnesCostTheirFrameOnly) {
     const std::vector<uint16_t> ends = {800, 2200, 800, 2200, 800, 2200, 800, 2200};
     uint32_t t = 0;
     for (int i = 0; i < 4; ++i) t = ppm_frame(ends, t, caps);
-    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    caps.push_back((uint16_t)(t % kTimerTicks));
     PpmDecoder d;
     EXPECT_EQ(feed_all(d, caps, &last), 2);
     EXPECT_EQ(last, ends);
 }
 
 TEST(PpmDecoder, ALongRunWithoutASyncGapThenFramesAgain) {
-    // Three frames (the third accepted), then 300 edges 1 ms apart (a stuck encoder: the
-    // count saturates), then frames: the second whole one after the run is accepted.
+    // Three frames (the third accepted), then edges 1 ms apart (a stuck encoder: the count
+    // saturates), then frames: the second whole one after the run is accepted.
     std::vector<uint16_t> caps, last;
     uint32_t t = 0;
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
-    for (int i = 0; i < 300; ++i, t += 2000u) caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    for (int i = 0; i < 300; ++i, t += 2000u) caps.push_back((uint16_t)(t % kTimerTicks));
     t += 8000u;  // a sync gap
     for (int i = 0; i < 4; ++i) t = ppm_frame(kFrame, t, caps);
-    caps.push_back((uint16_t)(t % PpmDecoder::kPeriodTicks));
+    caps.push_back((uint16_t)(t % kTimerTicks));
     PpmDecoder d;
     EXPECT_EQ(feed_all(d, caps, &last), 1 + 3);
+    EXPECT_EQ(last, kFrame);
+}
+
+TEST(PpmDecoder, ResetRightAfterASyncGapStartsAsFromPowerUp) {
+    std::vector<uint16_t> caps;
+    uint32_t t = 0;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    caps.push_back((uint16_t)(t % kTimerTicks));  // closes frame 3: the count is 0 again
+    PpmDecoder d;
+    EXPECT_EQ(feed_all(d, caps), 1);
+    d.reset();
+    // The next edge starts afresh: the first frame is not counted, the second follows no
+    // whole frame, the third is accepted.
+    std::vector<uint16_t> more;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, more);
+    more.push_back((uint16_t)(t % kTimerTicks));
+    EXPECT_EQ(feed_all(d, more), 1);
+}
+
+TEST(PpmDecoder, ASyncGapAcrossTheWrapFromMidPeriod) {
+    // 20 ms frames whose last edge is at 10 ms of the timer's period (20000 ticks) and whose
+    // sync gap of 11.5 ms ends at 1.5 ms of the next period: widths of 1062.5 us.
+    const std::vector<uint32_t> widths(8, 2125);
+    std::vector<uint16_t> caps, last;
+    uint32_t t = 3000;
+    for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, 23000, t, caps);
+    caps.push_back((uint16_t)(t % kTimerTicks));
+    PpmDecoder d;
+    EXPECT_EQ(feed_all(d, caps, &last), 3);
+    EXPECT_EQ(last, std::vector<uint16_t>(8, 1063));
+}
+
+TEST(PpmDecoder, ASplitPulseCostsItsFrameAndTheNextWhateverTheTiming) {
+    // A frame of nine widths (channel 4 split in two), its last one 1000 us, the next frame
+    // starting 2000 ticks into the timer's period: then two whole frames after the next are
+    // accepted.
+    std::vector<uint16_t> caps, last;
+    uint32_t t = 0;
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    const std::vector<uint32_t> split = {2200, 2400, 2600, 600, 2200, 3000, 3200, 3400, 2000};
+    uint32_t sum = 0;
+    for (uint32_t w : split) sum += w;
+    uint32_t gap = (kTimerTicks + 3000u - (t + sum) % kTimerTicks) % kTimerTicks;
+    if (gap < 8000u) gap += kTimerTicks;
+    t = ppm_ticks(split, gap, t, caps);
+    ASSERT_EQ(t % kTimerTicks, 3000u);
+    for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
+    caps.push_back((uint16_t)(t % kTimerTicks));
+    // Accepted: frame 3, not the split one, not the one after it, then both of the others.
+    PpmDecoder d;
+    EXPECT_EQ(feed_all(d, caps, &last), 1 + 2);
     EXPECT_EQ(last, kFrame);
 }
