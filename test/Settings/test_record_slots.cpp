@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The settings record's two EEPROM slots (lib/Console/RecordSlots): the choice at start,
+// The settings record's two EEPROM slots (lib/Settings/RecordSlots): the choice at start,
 // and a power cut after every byte of a save, on a host image of the chip.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// lib/Params for the flight settings: the parameter table (index, name, defaults), set's
+// The flight parameters (lib/Settings/Params): the table (index, name, defaults), set's
 // checks, the version 3 record and the upgrade of a version 2 one.
 #include <gtest/gtest.h>
 

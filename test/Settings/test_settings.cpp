@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The EEPROM settings record (lib/Console/Settings).
+// The EEPROM settings record (lib/Settings/Settings).
 #include <gtest/gtest.h>
 
 #include <cstring>
