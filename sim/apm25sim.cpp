@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // build/apm25sim: the firmware ELF on a simulated APM 2.5 (simavr ATmega2560 at 16 MHz,
-// MPU6000 on SPI, HMC5883L on I2C), sensors fed from a trajectory file. The command
+// MPU6000 and MS5611 on SPI, HMC5883L on I2C, a u-blox GPS on UART1), sensors fed from a
+// trajectory file or a physics backend. The command
 // line and output are the contract in ../shared/SIM.md; --help lists the extensions.
 #include <csignal>
 #include <cmath>
@@ -15,6 +16,7 @@
 
 #include "Board.h"
 #include "FaultSpec.h"
+#include "Geodesy.h"
 #include "Mpxv7002dpModel.h"
 #include "PhysicsLink.h"
 #include "RcLink.h"
@@ -32,9 +34,13 @@ const char* const kUsage =
     "                [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X]\n"
     "                [--physics-rate HZ] [--physics-timeout S] [--physics-log FILE]\n"
     "                [--earth-field N,E,D] [--verbose]\n"
+    "                [--gps ublox|nmea|none] [--gps-baud B] [--gps-fix-after S] [--gps-latency S]\n"
+    "                [--baro ms5611|none] [--baro-noise HPA] [--baro-temp C] [--home LAT,LON,ALT_M]\n"
+    "                [--seed N]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
-    "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6). The sensors read the trajectory\n"
+    "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6), MS5611 on SPI (CS pin 40 = PG1),\n"
+    "a u-blox GPS on UART1 (RXD1 PD2, TXD1 PD3: the GPS port). The sensors read the trajectory\n"
     "(held at its last sample after its end), or the physics backend's state (--physics). stdout:\n"
     "exactly the bytes the firmware sends on UART0.\n"
     "\n"
@@ -111,17 +117,54 @@ const char* const kUsage =
     "                   drives it instead). A frame unanswered for 1 s is sent again (same\n"
     "                   frame_count, said on stderr); airspeed, when sent, is the pitot's: the\n"
     "                   APM 2.5's MPXV7002DP on A0 (ADC0), 2.5 V + 1 V/kPa of 1/2 1.225 v^2,\n"
-    "                   held within 0.5..4.5 V; position, velocity and wind are read but no\n"
-    "                   sensor uses them yet. Runs until SIGINT/SIGTERM unless\n"
-    "                   --seconds. Exit status 4 when the backend stops answering or answers\n"
-    "                   something that is not a state\n"
+    "                   held within 0.5..4.5 V; position and velocity (NED metres and m/s from\n"
+    "                   --home) drive the GPS and the barometer; wind is read, not used. Runs\n"
+    "                   until SIGINT/SIGTERM unless --seconds. Exit status 4 when the backend\n"
+    "                   stops answering or answers something that is not a state. With --serial\n"
+    "                   a ground station watches the flying board, in real time by default\n"
+    "                   (lock-step and --speed pacing together: the slower of the two sets it)\n"
     "  --physics-rate HZ  the frame_rate asked of the backend, 400..10000 (default 1000)\n"
     "  --physics-log FILE  every state the sensors read, as a trajectory file (the header\n"
-    "                   t,gx,...,qz,movement; the backend's true attitude): replay, score and\n"
-    "                   the peers run on a flight as on any recording\n"
+    "                   t,gx,...,qz,movement,n,e,d; the backend's true attitude and position):\n"
+    "                   replay, score and the peers run on a flight as on any recording, and\n"
+    "                   apm25sim --trajectory flies it again with the GPS and the barometer\n"
     "  --physics-timeout S  give up on a silent backend after S s (default 30)\n"
     "  --earth-field N,E,D  the earth field for --physics, uT NED (default 20,0,45)\n"
     "  --verbose        print the sensor models' protocol counters on stderr at the end\n"
+    "  --gps KIND       the module on the GPS port (UART1): ublox (default), a u-blox 6 (NEO-6M)\n"
+    "                   that starts factory-new: NMEA (GGA, GLL, GSA, GSV, RMC, VTG) at 1 Hz at\n"
+    "                   9600 baud 8N1, taking UBX and NMEA in; it answers $PUBX,41 (port\n"
+    "                   protocols and baud), $PUBX,40 (NMEA rates), CFG-PRT, CFG-MSG, CFG-RATE,\n"
+    "                   CFG-NAV5, CFG-SBAS, CFG-CFG (ACK-ACK / ACK-NAK; polls answered), MON-VER and\n"
+    "                   NAV polls, and sends NAV-POSLLH, NAV-STATUS, NAV-DOP, NAV-SOL, NAV-VELNED\n"
+    "                   at the measurement rate and message rates configured (u-blox 6 protocol\n"
+    "                   specification; bad checksums ignored and counted). nmea: a module that\n"
+    "                   only speaks NMEA at 1 Hz and ignores everything it receives. none: nothing\n"
+    "                   on the GPS port. Position: the trajectory's n,e,d columns or the backend's\n"
+    "                   position (else still at --home), reported 0.2 s late with a slow ~1 m\n"
+    "                   random walk (Gauss-Markov, 30 s) and 0.1 m/s velocity noise, 10 satellites,\n"
+    "                   hDOP 0.9. The line is 8N1 at each end's own baud: the module's bytes reach\n"
+    "                   UART1 RX (only while RXEN1 is set) as a UART at the firmware's UBRR1 /\n"
+    "                   U2X1 samples them, so a mismatch delivers other bytes with framing\n"
+    "                   errors, or nothing; likewise the firmware's bytes to the module, which\n"
+    "                   drops characters with a bad stop bit. docs/simulator.md has the details\n"
+    "  --gps-baud B     the module's baud at power-up (default 9600: factory-new)\n"
+    "  --gps-fix-after S  the first 3D fix: the first epoch leaving at or after S simulated\n"
+    "                   seconds (default 3); before it gpsFix 0 and NMEA status V\n"
+    "  --gps-latency S  measurement to output (default 0.2): what arrives is the truth S\n"
+    "                   seconds earlier, stamped (iTOW) with the time it was true\n"
+    "  --baro KIND      ms5611 (default): the MS5611 behind pin 40 on the SPI bus, answering only\n"
+    "                   while pin 40 is low: RESET 0x1E, PROM 0xA0-0xAE (the datasheet's example\n"
+    "                   coefficients, AN520's CRC-4), CONVERT D1 0x40-0x48 / D2 0x50-0x58 taking\n"
+    "                   the datasheet's maximum time for the OSR, ADC READ 0x00 (0 before the\n"
+    "                   conversion ends); D1 and D2 the datasheet's compensation inverted at the\n"
+    "                   standard atmosphere's pressure for the height. none: nobody behind pin 40\n"
+    "  --baro-noise HPA  1-sigma pressure noise per conversion (default 0.1 hPa)\n"
+    "  --baro-temp C    the chip's temperature (default: the standard atmosphere's at the height)\n"
+    "  --home LAT,LON,ALT_M  the origin of the positions: degrees, metres above mean sea level\n"
+    "                   (default 7.135045,-73.119421,1028: the thesis' field)\n"
+    "  --seed N         the GPS and barometer models' noise (default 1; the same seed, the same\n"
+    "                   run)\n"
     "\n"
     "Bus check: the barometer chip select (pin 40 = PG1, PORTG bit 1) must be high whenever the\n"
     "MPU6000 chip select (pin 53) is low, checked when pin 53 goes low and at every SPI byte.\n"
@@ -169,6 +212,7 @@ int main(int argc, char** argv) {
     sim::PhysicsOptions physics;
     double earth_field_uT[3] = {sim::kEarthFieldNed_uT[0], sim::kEarthFieldNed_uT[1], sim::kEarthFieldNed_uT[2]};
     std::vector<std::string> faults;
+    sim::GeodeticPoint home{sim::kHomeLat_deg, sim::kHomeLon_deg, sim::kHomeAlt_m};
     double seconds = -1.0;
     bool verbose = false;
     for (int i = 1; i < argc; ++i) {
@@ -263,11 +307,94 @@ int main(int argc, char** argv) {
             }
         } else if (arg == "--verbose") {
             verbose = true;
+        } else if (arg == "--gps") {
+            const std::string kind = value("--gps");
+            if (kind == "ublox") {
+                options.gps.kind = sim::GpsKind::kUblox;
+                options.gps_attached = true;
+            } else if (kind == "nmea") {
+                options.gps.kind = sim::GpsKind::kNmea;
+                options.gps_attached = true;
+            } else if (kind == "none") {
+                options.gps_attached = false;
+            } else {
+                std::fprintf(stderr, "apm25sim: --gps '%s': ublox, nmea or none\n", kind.c_str());
+                return 1;
+            }
+        } else if (arg == "--gps-baud") {
+            const char* text = value("--gps-baud");
+            char* end = nullptr;
+            const long baud = std::strtol(text, &end, 10);
+            if (*end != '\0' || (baud != 4800 && baud != 9600 && baud != 19200 && baud != 38400 && baud != 57600 &&
+                                  baud != 115200)) {
+                std::fprintf(stderr, "apm25sim: --gps-baud '%s': 4800, 9600, 19200, 38400, 57600 or 115200\n", text);
+                return 1;
+            }
+            options.gps.baud = (uint32_t)baud;
+        } else if (arg == "--gps-fix-after" || arg == "--gps-latency") {
+            const char* text = value(arg.c_str());
+            char* end = nullptr;
+            const double v = std::strtod(text, &end);
+            if (*end != '\0' || !(v >= 0.0) || v > 1e6 || (arg == "--gps-latency" && v > 5.0)) {
+                std::fprintf(stderr, "apm25sim: %s '%s': seconds >= 0%s\n", arg.c_str(), text,
+                             arg == "--gps-latency" ? ", at most 5" : "");
+                return 1;
+            }
+            (arg == "--gps-fix-after" ? options.gps.first_fix_s : options.gps.latency_s) = v;
+        } else if (arg == "--baro") {
+            const std::string kind = value("--baro");
+            if (kind != "ms5611" && kind != "none") {
+                std::fprintf(stderr, "apm25sim: --baro '%s': ms5611 or none\n", kind.c_str());
+                return 1;
+            }
+            options.baro_attached = kind == "ms5611";
+        } else if (arg == "--baro-noise") {
+            const char* text = value("--baro-noise");
+            char* end = nullptr;
+            const double hpa = std::strtod(text, &end);
+            if (*end != '\0' || !(hpa >= 0.0) || hpa > 100.0) {
+                std::fprintf(stderr, "apm25sim: --baro-noise '%s': hPa, 0..100\n", text);
+                return 1;
+            }
+            options.baro.noise_pa = hpa * 100.0;
+        } else if (arg == "--baro-temp") {
+            const char* text = value("--baro-temp");
+            char* end = nullptr;
+            const double c = std::strtod(text, &end);
+            if (*end != '\0' || !(c >= -40.0 && c <= 85.0)) {
+                std::fprintf(stderr, "apm25sim: --baro-temp '%s': degC, -40..85 (the chip's range)\n", text);
+                return 1;
+            }
+            options.baro.fixed_temperature = true;
+            options.baro.temperature_c = c;
+        } else if (arg == "--home") {
+            const char* text = value("--home");
+            double lat = 0, lon = 0, alt = 0;
+            char tail = 0;
+            if (std::sscanf(text, "%lf,%lf,%lf%c", &lat, &lon, &alt, &tail) != 3 || !(std::fabs(lat) <= 85.0) ||
+                !(std::fabs(lon) <= 180.0) || !(alt >= -500.0 && alt <= 9000.0)) {
+                std::fprintf(stderr,
+                             "apm25sim: --home '%s': LAT,LON,ALT_M in degrees (|lat| <= 85) and metres above sea "
+                             "level (-500..9000)\n",
+                             text);
+                return 1;
+            }
+            home = sim::GeodeticPoint{lat, lon, alt};
+        } else if (arg == "--seed") {
+            const char* text = value("--seed");
+            char* end = nullptr;
+            const unsigned long long seed = std::strtoull(text, &end, 10);
+            if (*end != '\0' || text[0] == '-' || text[0] == 0) {
+                std::fprintf(stderr, "apm25sim: --seed '%s': a whole number >= 0\n", text);
+                return 1;
+            }
+            options.gps.seed = options.baro.seed = (uint64_t)seed;
         } else {
             std::fprintf(stderr, "apm25sim: unknown argument '%s'\n%s", arg.c_str(), kUsage);
             return 1;
         }
     }
+    options.gps.home = options.baro.home = home;
     const bool use_physics = !physics_spec.empty();
     if (options.elf_path.empty() || trajectory_path.empty() == !use_physics) {
         std::fprintf(stderr, "apm25sim: --elf and one of --trajectory or --physics are required\n%s", kUsage);
@@ -354,8 +481,8 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "apm25sim: cannot write the physics log '%s'\n", physics_log_path.c_str());
                 return 1;
             }
-            std::fputs(sim::kTrajectoryHeader, physics_log);
-            std::fputs(sim::format_trajectory_row(trajectory[0]).c_str(), physics_log);
+            std::fputs(sim::kTrajectoryHeaderNed, physics_log);
+            std::fputs(sim::format_trajectory_row_ned(trajectory[0]).c_str(), physics_log);
         }
         std::string error;
         if (!take_backend_rc(first, 0.0, rc_from_backend, rc, nullptr, error)) {
@@ -367,7 +494,7 @@ int main(int argc, char** argv) {
     sim::Board board(trajectory, options);
     for (const std::string& spec : faults) {
         std::string error;
-        if (!sim::apply_fault_spec(spec, board.mpu(), board.mag(), board.bus_faults(), error)) {
+        if (!sim::apply_fault_spec(spec, board.fault_targets(), error)) {
             std::fprintf(stderr, "apm25sim: %s\n", error.c_str());
             return 1;
         }
@@ -404,7 +531,7 @@ int main(int argc, char** argv) {
                     const sim::TrajectorySample sample = sim::physics_sample(state, t, earth_field_uT);
                     board.append_sample(sample, 1.0);
                     if (state.has_airspeed) board.set_a0_mV(sim::Mpxv7002dpModel::output_mV(state.airspeed_m_s));
-                    if (physics_log) std::fputs(sim::format_trajectory_row(sample).c_str(), physics_log);
+                    if (physics_log) std::fputs(sim::format_trajectory_row_ned(sample).c_str(), physics_log);
                     if (take_backend_rc(state, t, rc_from_backend, rc, &board, error)) {
                         ran = board.run(std::min(t, seconds));
                         last_t = t;

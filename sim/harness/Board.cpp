@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdarg>
 #include <cstring>
+#include <algorithm>
 
 #include "avr_adc.h"
 #include "avr_eeprom.h"
@@ -41,6 +42,14 @@ constexpr double kEepromWrite_s = 3.4e-3;
 constexpr uint16_t kUcsr0a = 0xC0;
 constexpr uint16_t kUbrr0l = 0xC4;
 constexpr uint16_t kUbrr0h = 0xC5;
+// UART1, the GPS port (datasheet "Register Summary").
+constexpr uint16_t kUcsr1a = 0xC8;
+constexpr uint16_t kUcsr1b = 0xC9;
+constexpr uint16_t kUbrr1l = 0xCC;
+constexpr uint16_t kUbrr1h = 0xCD;
+constexpr uint8_t kU2x = 1u << 1;    // UCSRnA
+constexpr uint8_t kRxen = 1u << 4;   // UCSRnB
+constexpr uint16_t kSpcr = 0x4C;     // SPI control: CPOL bit 3, CPHA bit 2
 constexpr uint16_t kGpior0 = 0x3E;  // profiling: section start
 constexpr uint16_t kGpior1 = 0x4A;  // profiling: section end
 constexpr uint8_t kMpuCsBit = 0;    // PB0, Arduino pin 53
@@ -100,6 +109,17 @@ void twi_output_hook(avr_irq_t*, uint32_t value, void* param) {
 }
 void uart_output_hook(avr_irq_t*, uint32_t value, void* param) {
     static_cast<Board*>(param)->on_uart_byte((uint8_t)value);
+}
+void uart1_output_hook(avr_irq_t*, uint32_t value, void* param) {
+    static_cast<Board*>(param)->on_uart1_byte((uint8_t)value);
+}
+void uart1_xoff_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->set_uart1_held(true); }
+void uart1_xon_hook(avr_irq_t*, uint32_t, void* param) { static_cast<Board*>(param)->set_uart1_held(false); }
+void ubrr1l_write_hook(avr_t*, avr_io_addr_t addr, uint8_t v, void* param) {
+    static_cast<Board*>(param)->on_ubrr1l_write(addr, v);
+}
+avr_cycle_count_t gps_timer(avr_t*, avr_cycle_count_t, void* param) {
+    return static_cast<Board*>(param)->on_gps_tick();
 }
 avr_cycle_count_t sensor_timer(avr_t*, avr_cycle_count_t, void* param) {
     return static_cast<Board*>(param)->on_sensor_tick();
@@ -171,7 +191,20 @@ void request_stop() { g_stop_requested = 1; }
 bool stop_requested() { return g_stop_requested != 0; }
 
 Board::Board(const Trajectory& trajectory, const BoardOptions& options)
-    : mpu_(trajectory), mag_(trajectory), options_(options) {}
+    : mpu_(trajectory), mag_(trajectory), options_(options) {
+    if (options_.gps_attached) gps_.reset(new UbloxModel(trajectory, options_.gps));
+    if (options_.baro_attached) baro_.reset(new Ms5611Model(trajectory, options_.baro));
+}
+
+FaultTargets Board::fault_targets() {
+    FaultTargets t;
+    t.mpu = &mpu_;
+    t.mag = &mag_;
+    t.bus = &bus_faults_;
+    t.gps = gps_ ? &gps_->faults() : nullptr;
+    t.baro = baro_ ? &baro_->faults() : nullptr;
+    return t;
+}
 
 Board::~Board() {
     if (avr_) avr_terminate(avr_);
@@ -234,6 +267,12 @@ bool Board::init() {
     uart_input_irq_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
     avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF), uart_xoff_hook, this);
     avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON), uart_xon_hook, this);
+    // UART1 (the GPS port) the same: no stdio echo of what the firmware sends the GPS, no
+    // sleep when the firmware polls it.
+    avr_ioctl(avr_, AVR_IOCTL_UART_GET_FLAGS('1'), &uart_flags);
+    uart_flags &= ~(uint32_t)(AVR_UART_FLAG_STDIO | AVR_UART_FLAG_POLL_SLEEP);
+    avr_ioctl(avr_, AVR_IOCTL_UART_SET_FLAGS('1'), &uart_flags);
+    if (gps_ && !init_gps_port()) return false;
 
     // SPI: take over the SPDR write so a byte lasts what the configured clock says.
     spi_ = static_cast<avr_spi_t*>(avr_->io[AVR_DATA_TO_IO(kSpdr)].w.param);
@@ -321,6 +360,7 @@ void Board::advance_models() {
     const double t_s = time_s();
     mpu_.advance_to(t_s);
     mag_.advance_to(t_s);
+    if (baro_) baro_->advance_to(t_s);
 }
 
 void Board::update_pins() {
@@ -374,6 +414,13 @@ void Board::on_spi_byte_done() {
     check_bus("during an SPI transfer");
     uint8_t miso = 0x00;  // nobody drives MISO
     if (mpu_cs_low_) miso = mpu_.transfer(spi_out_byte_, sck_hz());
+    // The MS5611 answers only while pin 40 is low (with pin 53 low too, a violation
+    // reported above, both drive MISO: the bus reads their AND).
+    if (baro_ && baro_cs_low_) {
+        const int mode = (avr_->data[kSpcr] >> 2) & 0x03;  // CPOL:CPHA
+        const uint8_t baro_miso = baro_->transfer(spi_out_byte_, mode);
+        miso = mpu_cs_low_ ? (uint8_t)(miso & baro_miso) : baro_miso;
+    }
     // simavr's SPI input sets the received byte and raises SPIF (as its own completion).
     avr_raise_irq(spi_->io.irq + SPI_IRQ_INPUT, miso);
     update_pins();
@@ -398,6 +445,13 @@ void Board::check_bus(const char* when) {
 void Board::on_port_change(char port, bool direction, uint8_t value) {
     if (port == 'B') (direction ? ddr_b_ : port_b_) = value;
     if (port == 'G') (direction ? ddr_g_ : port_g_) = value;
+    // Pin 40 low (an output driven low): the MS5611 is selected.
+    const bool baro_selected = (ddr_g_ & (1u << kBaroCsBit)) && !(port_g_ & (1u << kBaroCsBit));
+    if (baro_selected != baro_cs_low_) {
+        advance_models();
+        baro_cs_low_ = baro_selected;
+        if (baro_) baro_->set_chip_select(baro_selected);
+    }
     const bool selected = mpu_selected();
     if (selected != mpu_cs_low_) {
         advance_models();
@@ -570,6 +624,124 @@ uint64_t Board::on_uart_input_tick() {
     return avr_->cycle + cycles_per_char;
 }
 
+// --- the GPS port (UART1) -----------------------------------------------------------
+
+// simavr's UART1 module ("uart" named '1' in the core's list of I/O modules).
+bool Board::init_gps_port() {
+    for (avr_io_t* port = avr_->io_port; port != nullptr; port = port->next) {
+        if (port->kind == nullptr || std::strcmp(port->kind, "uart") != 0) continue;
+        avr_uart_t* uart = reinterpret_cast<avr_uart_t*>(port);  // io is its first member
+        if (uart->name == '1') uart1_ = uart;
+    }
+    avr_uart_t* uart = static_cast<avr_uart_t*>(uart1_);
+    if (!uart || uart->ubrrl.reg != kUbrr1l) {
+        error_ = "simavr's atmega2560 has no UART1 where this harness expects it";
+        return false;
+    }
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('1'), UART_IRQ_OUTPUT), uart1_output_hook, this);
+    uart1_input_irq_ = avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('1'), UART_IRQ_INPUT);
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('1'), UART_IRQ_OUT_XOFF), uart1_xoff_hook, this);
+    avr_irq_register_notify(avr_io_getirq(avr_, AVR_IOCTL_UART_GETIRQ('1'), UART_IRQ_OUT_XON), uart1_xon_hook, this);
+    ubrr1l_original_ = avr_->io[AVR_DATA_TO_IO(kUbrr1l)].w.c;
+    ubrr1l_original_param_ = avr_->io[AVR_DATA_TO_IO(kUbrr1l)].w.param;
+    if (ubrr1l_original_) {
+        avr_->io[AVR_DATA_TO_IO(kUbrr1l)].w.c = ubrr1l_write_hook;
+        avr_->io[AVR_DATA_TO_IO(kUbrr1l)].w.param = this;
+    }
+    arm_gps_timer();
+    return true;
+}
+
+// The bit time the firmware set on USART1 (UBRR1, U2X1): its receiver's and transmitter's.
+double Board::uart1_bit_s() const {
+    const unsigned ubrr = (unsigned)avr_->data[kUbrr1l] | ((unsigned)(avr_->data[kUbrr1h] & 0x0F) << 8);
+    return usart_bit_s(kCpuHz, ubrr, (avr_->data[kUcsr1a] & kU2x) != 0);
+}
+
+// simavr 1.6 counts 11 bits a character (a parity bit 8N1 does not send): its RX pump
+// would lag the GPS line by a tenth. A character is 10 bit times.
+void Board::on_ubrr1l_write(uint16_t addr, uint8_t value) {
+    ubrr1l_original_(avr_, addr, value, ubrr1l_original_param_);
+    avr_uart_t* uart = static_cast<avr_uart_t*>(uart1_);
+    const unsigned ubrr = (unsigned)avr_->data[kUbrr1l] | ((unsigned)(avr_->data[kUbrr1h] & 0x0F) << 8);
+    uart->cycles_per_byte = (avr_cycle_count_t)10u * ((avr_->data[kUcsr1a] & kU2x) ? 8u : 16u) * (ubrr + 1u);
+}
+
+// A byte the firmware writes to UDR1: on the line to the module at the firmware's baud,
+// after the one before it (the USART's shift register sends one at a time).
+void Board::on_uart1_byte(uint8_t byte) {
+    if (!gps_) return;
+    UartFrame f;
+    f.bit_s = uart1_bit_s();
+    f.start_s = std::max(time_s(), uart1_tx_free_s_);
+    f.byte = byte;
+    uart1_tx_free_s_ = f.end_s();
+    ++gps_port_.bytes_from_firmware;
+    gps_->line_in(f);
+    arm_gps_timer();
+}
+
+void Board::arm_gps_timer() {
+    if (!gps_) return;
+    double next_s = gps_->next_event_s();
+    next_s = std::min(next_s, uart1_rx_.next_ready_s());
+    if (!uart1_pending_.empty()) next_s = std::min(next_s, uart1_pending_.front().ready_s);
+    next_s = std::min(next_s, time_s() + 0.01);
+    uint64_t when = (uint64_t)std::ceil(next_s * kCpuHz);
+    if (when <= avr_->cycle) when = avr_->cycle + 1;
+    if (gps_timer_at_ != 0 && gps_timer_at_ <= when) return;  // armed early enough
+    avr_cycle_timer_cancel(avr_, gps_timer, this);
+    avr_cycle_timer_register(avr_, when - avr_->cycle, gps_timer, this);
+    gps_timer_at_ = when;
+}
+
+// The module's line into the firmware's USART1 receiver, decoded at the baud the firmware
+// set (UartLine.h): at equal baud the module's bytes, else what a UART makes of them.
+// Each character is raised on simavr's UART1 RX at the start of its frame: simavr hands it
+// to the core one character time later, when the stop bit is in, as the chip's RXC1.
+uint64_t Board::on_gps_tick() {
+    gps_timer_at_ = 0;
+    const double now_s = time_s();
+    gps_->advance_to(now_s);
+    UartFrame f;
+    const bool receiving = (avr_->data[kUcsr1b] & kRxen) != 0;
+    while (gps_->pop_frame(f)) {
+        // With RXEN1 off the USART does not look at the line (datasheet 22.8): the frames
+        // are lost, and its receiver starts afresh once enabled.
+        if (receiving) uart1_rx_.push(f);
+        else ++gps_port_.dropped_receiver_off;
+    }
+    if (!receiving) {
+        uart1_rx_.reset();
+        uart1_pending_.clear();
+    }
+    uart1_rx_.set_bit_s(uart1_bit_s());
+    uart1_scratch_.clear();
+    uart1_rx_.decode(now_s, uart1_scratch_);
+    for (const UartChar& c : uart1_scratch_) uart1_pending_.push_back(c);
+    while (!uart1_pending_.empty() && uart1_pending_.front().ready_s <= now_s) {
+        const UartChar c = uart1_pending_.front();
+        if (uart1_held_) {
+            ++gps_port_.held_chars;            // simavr's RX FIFO is full: wait a character
+            break;
+        } else {
+            if (!c.framing_ok) ++gps_port_.framing_errors;  // the chip sets FE1 and keeps the byte
+            ++gps_port_.bytes_to_firmware;
+            avr_raise_irq(uart1_input_irq_, c.byte);
+        }
+        uart1_pending_.pop_front();
+    }
+    double next_s = gps_->next_event_s();
+    next_s = std::min(next_s, uart1_rx_.next_ready_s());
+    if (!uart1_pending_.empty())
+        next_s = std::min(next_s, uart1_held_ ? now_s + uart1_bit_s() * 10.0 : uart1_pending_.front().ready_s);
+    next_s = std::min(next_s, now_s + 0.01);
+    uint64_t next_cycle = (uint64_t)std::ceil(next_s * kCpuHz);
+    if (next_cycle <= avr_->cycle) next_cycle = avr_->cycle + 1;
+    gps_timer_at_ = next_cycle;
+    return next_cycle;
+}
+
 // --- receiver (PPM on ICP5) and servo outputs -----------------------------------
 
 // The PPM line is PL1's pin IRQ. simavr connects a timer's capture input to its ICP pin
@@ -666,7 +838,10 @@ void Board::write_servo_pulses(bool all) {
 }
 
 void Board::append_sample(const TrajectorySample& sample, double keep_s) {
-    for (Trajectory* t : {&mpu_.trajectory(), &mag_.trajectory()}) {
+    std::vector<Trajectory*> trajectories = {&mpu_.trajectory(), &mag_.trajectory()};
+    if (gps_) trajectories.push_back(&gps_->trajectory());
+    if (baro_) trajectories.push_back(&baro_->trajectory());
+    for (Trajectory* t : trajectories) {
         t->append(sample);
         // Trimmed now and then, not at every sample (the erase moves the whole history).
         if (t->size() > 4096 && (*t)[0].t_s < sample.t_s - 2.0 * keep_s) t->drop_before(sample.t_s - keep_s);
@@ -807,6 +982,35 @@ void Board::print_counters(FILE* out) const {
     std::fprintf(out, "# apm25sim: UART0 input %llu of %llu bytes typed, %llu character times held by XOFF\n",
                  (unsigned long long)(input_consumed_ + input_pos_),
                  (unsigned long long)(input_consumed_ + options_.input.size()), (unsigned long long)uart_input_held_chars_);
+    if (gps_) {
+        const UbloxCounters& g = gps_->counters();
+        const ubx::StreamParser::Counters& pc = gps_->parser_counters();
+        std::fprintf(out,
+                     "# apm25sim: GPS baud=%u in=0x%04x out=0x%04x rate_ms=%u epochs=%u ubx_out=%u nmea_out=%u "
+                     "tx_dropped=%u bytes_out=%u silenced=%u garbage=%u bytes_in=%u framing_in=%u deaf=%u "
+                     "nmea_only_ignored=%u protocol_ignored=%u ubx_in=%u ubx_bad_ck=%u nmea_in=%u nmea_bad_ck=%u "
+                     "acks=%u naks=%u polls=%u pubx41=%u pubx40=%u port_changes=%u not_modelled=%u\n",
+                     gps_->baud(), gps_->in_proto(), gps_->out_proto(), gps_->meas_rate_ms(), g.epochs,
+                     g.ubx_messages_out, g.nmea_sentences_out, g.tx_dropped_messages, g.bytes_out, g.bytes_silenced,
+                     g.garbage_bytes, g.bytes_in, g.framing_errors_in, g.ignored_deaf, g.ignored_nmea_only,
+                     g.ignored_protocol, pc.ubx_frames, pc.ubx_bad_checksum, pc.nmea_sentences, pc.nmea_bad_checksum,
+                     g.acks, g.naks, g.polls, g.pubx41, g.pubx40, g.port_changes, g.not_modelled);
+        std::fprintf(out,
+                     "# apm25sim: GPS port to_firmware=%u framing=%u receiver_off=%u held_chars=%llu "
+                     "from_firmware=%u\n",
+                     gps_port_.bytes_to_firmware, gps_port_.framing_errors, gps_port_.dropped_receiver_off,
+                     (unsigned long long)gps_port_.held_chars, gps_port_.bytes_from_firmware);
+    }
+    if (baro_) {
+        const Ms5611Counters& b = baro_->counters();
+        std::fprintf(out,
+                     "# apm25sim: MS5611 transactions=%u bytes=%u resets=%u conversions=%u prom_reads=%u "
+                     "adc_reads=%u adc_zero=%u read_converting=%u cmd_converting=%u cmd_resetting=%u unknown=%u "
+                     "absent_bytes=%u wrong_mode=%u\n",
+                     b.transactions, b.bytes, b.resets, b.conversions, b.prom_reads, b.adc_reads, b.adc_reads_zero,
+                     b.reads_during_conversion, b.commands_during_conversion, b.commands_during_reset,
+                     b.unknown_commands, b.bytes_while_absent, b.bytes_wrong_spi_mode);
+    }
     if (options_.serial)
         std::fprintf(out, "# apm25sim: tcp:%d: %llu TX bytes dropped (client not reading)\n", options_.serial->port(),
                      (unsigned long long)options_.serial->dropped());

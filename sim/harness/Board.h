@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The APM 2.5 board around a simavr ATmega2560 (../shared/SIM.md, ../shared/APM25.md):
 // MPU6000 on SPI (CS pin 53 = PB0, INT on PE6), HMC5883L on TWI (7-bit 0x1E, DRDY on
-// pin 31 = PC6), the barometer chip select (pin 40 = PG1) watched, UART0 to a sink.
+// pin 31 = PC6), the MS5611 on SPI behind pin 40 = PG1 (its chip select watched), a
+// u-blox GPS on UART1 (the GPS port), UART0 to a sink.
 //
 // simavr 1.6 corrections made here:
 // - SPI: the SPDR write hook is replaced so a byte takes 8 x the configured SCK divider
@@ -9,13 +10,18 @@
 // - TWI: after each TWCR write, simavr's pending TWI state timer (1 us per bit in 1.6)
 //   is re-armed at the bit time TWBR/TWPS give: 16 + 2 * TWBR * 4^TWPS cycles per bit.
 // - EEPROM: a write keeps EEPE set for the chip's 3.4 ms (simavr 1.6: no time at all).
+// - UART1: simavr 1.6 paces a character at 11 bit times (it counts a parity bit that
+//   8N1 has not), slower than the GPS line: after each UBRR1L write the character time is
+//   set to 10 bit times.
 // - Time is avr->cycle / 16 MHz; the sensor models are advanced to it before every
-//   bus byte and by a cycle timer at each of their events (at least every 1 ms).
+//   bus byte and by a cycle timer at each of their events (at least every 1 ms); the
+//   GPS line by its own timer at each character and event.
 #pragma once
 
 #include <stdint.h>
 
 #include <cstdio>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,9 +29,12 @@
 #include "FaultSpec.h"
 #include "Hmc5883Model.h"
 #include "Mpu6000Model.h"
+#include "Ms5611Model.h"
 #include "RcLink.h"
 #include "SerialLink.h"
 #include "Trajectory.h"
+#include "UartLine.h"
+#include "UbloxModel.h"
 
 struct avr_t;
 struct avr_spi_t;
@@ -52,6 +61,21 @@ struct BoardOptions {
     // --eeprom-cuts T1:T2:STEP: the EEPROM as a power cut at T1, T1+STEP, ... <= T2 leaves
     // it, written to eeprom_path.cut0, .cut1, ... (cuts_step_s 0: none)
     double eeprom_cuts_from_s = 0.0, eeprom_cuts_to_s = 0.0, eeprom_cuts_step_s = 0.0;
+    // --gps: the GPS module on UART1 (false: --gps none, nothing on the GPS port).
+    bool gps_attached = true;
+    UbloxOptions gps;
+    // --baro: the MS5611 behind pin 40 (false: --baro none, nobody behind the chip select).
+    bool baro_attached = true;
+    Ms5611Options baro;
+};
+
+// What the GPS port carried, counted by the harness.
+struct GpsPortCounters {
+    uint32_t bytes_to_firmware = 0;       // characters raised on UART1 RX
+    uint32_t framing_errors = 0;          // of them, with a low stop bit (garbage of a baud mismatch)
+    uint32_t dropped_receiver_off = 0;    // module bytes on the line while RXEN1 was off (ignored)
+    uint64_t held_chars = 0;              // character times a byte waited for simavr's RX FIFO (XOFF)
+    uint32_t bytes_from_firmware = 0;     // UDR1 writes that went to the line
 };
 
 // Asks a running Board::run to return at its next instruction boundary (async-signal-safe:
@@ -84,6 +108,10 @@ public:
     Mpu6000Model& mpu() { return mpu_; }
     Hmc5883Model& mag() { return mag_; }
     BusFaults& bus_faults() { return bus_faults_; }
+    UbloxModel* gps() { return gps_.get(); }   // null with --gps none
+    Ms5611Model* baro() { return baro_.get(); } // null with --baro none
+    FaultTargets fault_targets();
+    const GpsPortCounters& gps_port_counters() const { return gps_port_; }
 
     uint32_t bus_violations() const { return bus_violations_; }
     bool write_profile(const std::string& path) const;
@@ -100,6 +128,10 @@ public:
     void on_twcr_write(uint16_t addr, uint8_t value);
     void on_eecr_write(uint16_t addr, uint8_t value);
     void on_uart_byte(uint8_t byte);
+    void on_uart1_byte(uint8_t byte);
+    void on_ubrr1l_write(uint16_t addr, uint8_t value);
+    uint64_t on_gps_tick();
+    void set_uart1_held(bool held) { uart1_held_ = held; }
     uint64_t on_sensor_tick();
     uint64_t on_uart_input_tick();
     void on_uart_input_timer_ended() { input_timer_armed_ = false; }
@@ -131,6 +163,9 @@ private:
     bool load_eeprom();
     bool write_eeprom(const std::string& path) const;
     void take_eeprom_cuts();
+    double uart1_bit_s() const;
+    void arm_gps_timer();
+    bool init_gps_port();
     uint8_t* eeprom_bytes() const;
     double sck_hz() const;
     bool init_rc();
@@ -142,6 +177,8 @@ private:
     Hmc5883Model mag_;
     BusFaults bus_faults_;
     BoardOptions options_;
+    std::unique_ptr<UbloxModel> gps_;
+    std::unique_ptr<Ms5611Model> baro_;
     std::string error_;
 
     avr_t* avr_ = nullptr;
@@ -159,6 +196,7 @@ private:
     uint8_t spi_out_byte_ = 0;
     uint8_t port_b_ = 0, ddr_b_ = 0, port_g_ = 0, ddr_g_ = 0;
     bool mpu_cs_low_ = false;
+    bool baro_cs_low_ = false;
     bool twi_selected_ = false;
     int int_level_ = -1, drdy_level_ = -1;
     uint32_t bus_violations_ = 0;
@@ -173,6 +211,20 @@ private:
     uint64_t input_consumed_ = 0;         // bytes typed and dropped from `input` (a live client's)
     bool input_timer_armed_ = false;      // uart_input_timer is registered
     Pacer pacer_{0.0};
+
+    // The GPS port (UART1): the firmware's USART1 receiving the module's line, and the
+    // line the firmware sends on.
+    avr_irq_t* uart1_input_irq_ = nullptr;
+    void* uart1_ = nullptr;              // simavr's avr_uart_t for UART1
+    void (*ubrr1l_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
+    void* ubrr1l_original_param_ = nullptr;
+    UartReceiver uart1_rx_;
+    std::deque<UartChar> uart1_pending_;  // decoded, raised on RX at ready_s
+    std::vector<UartChar> uart1_scratch_;
+    double uart1_tx_free_s_ = 0.0;       // the firmware's TX line is busy until then
+    bool uart1_held_ = false;            // simavr's RX FIFO is full (XOFF)
+    uint64_t gps_timer_at_ = 0;          // the cycle the GPS timer is armed for (0: none)
+    GpsPortCounters gps_port_;
 
     // --rc: the PPM line on PL1 (and Timer5's capture input when simavr does not wire it).
     std::unique_ptr<PpmEncoder> ppm_;

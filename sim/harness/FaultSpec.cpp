@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "FaultSpec.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,7 +30,25 @@ const char* const kFaultHelp =
     "  mag:drdy-stuck-high    DRDY stays high\n"
     "  i2c:sda-low            a slave holds SDA low: every I2C address is NACKed\n"
     "                         (simavr 1.6 cannot show a stuck bus; Wire sees errors, not a hang)\n"
-    "Examples: --fault mpu:absent@2.0-5.0  --fault mag:overflow@2-5  --fault gyro:saturate@2-3\n";
+    "  GPS faults act on what leaves the module in the window (an epoch measured before T1 and\n"
+    "  sent after it is already affected); an error with --gps none:\n"
+    "  gps:no-fix             the fix is lost: gpsFix 0, flags 0, numSV 2, NMEA status V; the\n"
+    "                         module talks on, the last position held (a loss of sky)\n"
+    "  gps:silent             no byte reaches the firmware (a cut TX wire); without @ the whole\n"
+    "                         run: a module that never answers anything\n"
+    "  gps:deaf               the module ignores every byte from the firmware (a cut RX wire):\n"
+    "                         no ACK, no baud change; it keeps talking as configured\n"
+    "  gps:garbage            random bytes on the line: bursts of 1-16 every 10-90 ms, among\n"
+    "                         (and inside) the module's messages, at the module's baud\n"
+    "  gps:glitch[=M]         the reported position jumps M metres north (default 50)\n"
+    "  gps:sats=N             N satellites used: N >= 4 a 3D fix with DOPs and errors grown\n"
+    "                         by (10/N)^1.5, N = 3 a 2D fix, N <= 2 no fix (N 0..12)\n"
+    "  baro:absent            the MS5611 does not answer: MISO reads 0x00, commands ignored\n"
+    "                         (its PROM then reads all 0, whose CRC-4 is 0: check for it)\n"
+    "  baro:stuck             every conversion returns the last D1 / D2 from before the window\n"
+    "  baro:spike             D1 reads with bit 19 flipped: ~100 hPa (~900 m) off\n"
+    "Examples: --fault mpu:absent@2.0-5.0  --fault mag:overflow@2-5  --fault gyro:saturate@2-3\n"
+    "          --fault gps:no-fix@20-30  --fault gps:glitch=50@40-45  --fault baro:spike@12-12.2\n";
 
 namespace {
 
@@ -103,24 +122,83 @@ bool parse_fault_spec(const std::string& spec, FaultSpec& out, std::string& erro
 
 bool apply_fault_spec(const std::string& spec, Mpu6000Model& mpu, Hmc5883Model& mag, BusFaults& bus,
                       std::string& error) {
+    FaultTargets targets;
+    targets.mpu = &mpu;
+    targets.mag = &mag;
+    targets.bus = &bus;
+    return apply_fault_spec(spec, targets, error);
+}
+
+bool apply_fault_spec(const std::string& spec, const FaultTargets& targets, std::string& error) {
     FaultSpec f;
     if (!parse_fault_spec(spec, f, error)) return false;
-    Mpu6000Faults& mf = mpu.faults();
-    Hmc5883Faults& hf = mag.faults();
+    const std::string target = f.what.substr(0, f.what.find(':'));
+    if ((target == "gps" && !targets.gps) || (target == "baro" && !targets.baro)) {
+        error = "fault '" + spec + "': no " + (target == "gps" ? std::string("GPS (--gps none)") : "barometer (--baro none)") +
+                " on this board";
+        return false;
+    }
+    const bool imu = target == "mpu" || target == "gyro" || target == "accel" || target == "imu";
+    if ((imu && !targets.mpu) || (target == "mag" && !targets.mag) || (target == "i2c" && !targets.bus)) {
+        error = "fault '" + spec + "': that part is not attached";
+        return false;
+    }
+    // Faults that carry a value in each window.
+    ValueWindows* valued = nullptr;
+    double value = 0.0;
+    if (f.what == "gps:glitch") {
+        valued = &targets.gps->glitch;
+        value = 50.0;
+        if (f.has_value) {
+            char* end = nullptr;
+            value = std::strtod(f.value.c_str(), &end);
+            if (*end != 0 || !std::isfinite(value) || std::fabs(value) > 100000.0) {
+                error = "fault '" + spec + "': gps:glitch takes metres, e.g. gps:glitch=50";
+                return false;
+            }
+        }
+    } else if (f.what == "gps:sats") {
+        valued = &targets.gps->satellites;
+        char* end = nullptr;
+        const long n = f.has_value ? std::strtol(f.value.c_str(), &end, 10) : -1;
+        if (!f.has_value || *end != 0 || n < 0 || n > 12) {
+            error = "fault '" + spec + "': gps:sats needs a satellite count 0..12, e.g. gps:sats=4";
+            return false;
+        }
+        value = (double)n;
+    }
+    if (valued) {
+        for (const ValueWindow& w : valued->windows()) {
+            if (w.window.overlaps(f.window)) {
+                error = "fault '" + spec + "': its window overlaps an earlier '" + f.what + "' window (" +
+                        describe(w.window) + ")";
+                return false;
+            }
+        }
+        valued->add(f.window, value);
+        return true;
+    }
     const bool identity = f.what == "mpu:whoami" || f.what == "mag:id";
     TimeWindows* windows = nullptr;
-    if (f.what == "mpu:absent") windows = &mf.absent;
-    else if (f.what == "mpu:int-stuck-low") windows = &mf.int_stuck_low;
-    else if (f.what == "mpu:frozen") windows = &mf.frozen;
-    else if (f.what == "gyro:saturate") windows = &mf.gyro_saturate;
-    else if (f.what == "accel:saturate") windows = &mf.accel_saturate;
-    else if (f.what == "imu:spike") windows = &mf.spike;
-    else if (f.what == "mag:absent") windows = &hf.absent;
-    else if (f.what == "mag:overflow") windows = &hf.overflow;
-    else if (f.what == "mag:spike") windows = &hf.spike;
-    else if (f.what == "mag:drdy-stuck-low") windows = &hf.drdy_stuck_low;
-    else if (f.what == "mag:drdy-stuck-high") windows = &hf.drdy_stuck_high;
-    else if (f.what == "i2c:sda-low") windows = &bus.i2c_sda_low;
+    if (f.what == "mpu:absent") windows = &targets.mpu->faults().absent;
+    else if (f.what == "mpu:int-stuck-low") windows = &targets.mpu->faults().int_stuck_low;
+    else if (f.what == "mpu:frozen") windows = &targets.mpu->faults().frozen;
+    else if (f.what == "gyro:saturate") windows = &targets.mpu->faults().gyro_saturate;
+    else if (f.what == "accel:saturate") windows = &targets.mpu->faults().accel_saturate;
+    else if (f.what == "imu:spike") windows = &targets.mpu->faults().spike;
+    else if (f.what == "mag:absent") windows = &targets.mag->faults().absent;
+    else if (f.what == "mag:overflow") windows = &targets.mag->faults().overflow;
+    else if (f.what == "mag:spike") windows = &targets.mag->faults().spike;
+    else if (f.what == "mag:drdy-stuck-low") windows = &targets.mag->faults().drdy_stuck_low;
+    else if (f.what == "mag:drdy-stuck-high") windows = &targets.mag->faults().drdy_stuck_high;
+    else if (f.what == "i2c:sda-low") windows = &targets.bus->i2c_sda_low;
+    else if (f.what == "gps:no-fix") windows = &targets.gps->no_fix;
+    else if (f.what == "gps:silent") windows = &targets.gps->silent;
+    else if (f.what == "gps:deaf") windows = &targets.gps->deaf;
+    else if (f.what == "gps:garbage") windows = &targets.gps->garbage;
+    else if (f.what == "baro:absent") windows = &targets.baro->absent;
+    else if (f.what == "baro:stuck") windows = &targets.baro->stuck;
+    else if (f.what == "baro:spike") windows = &targets.baro->spike;
     else if (!identity) {
         error = "fault '" + spec + "': unknown TARGET:KIND '" + f.what + "' (see --help)";
         return false;
@@ -152,6 +230,7 @@ bool apply_fault_spec(const std::string& spec, Mpu6000Model& mpu, Hmc5883Model& 
             error = "fault '" + spec + "': mpu:whoami needs a byte value, e.g. mpu:whoami=0x70";
             return false;
         }
+        Mpu6000Faults& mf = targets.mpu->faults();
         if (mf.who_am_i >= 0) {
             error = "fault '" + spec + "': mpu:whoami given twice";
             return false;
@@ -163,6 +242,7 @@ bool apply_fault_spec(const std::string& spec, Mpu6000Model& mpu, Hmc5883Model& 
         error = "fault '" + spec + "': mag:id needs three characters, e.g. mag:id=H44";
         return false;
     }
+    Hmc5883Faults& hf = targets.mag->faults();
     if (hf.id[0] >= 0) {
         error = "fault '" + spec + "': mag:id given twice";
         return false;

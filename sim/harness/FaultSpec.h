@@ -12,7 +12,9 @@
 
 #include "Hmc5883Model.h"
 #include "Mpu6000Model.h"
+#include "Ms5611Model.h"
 #include "TimeWindow.h"
+#include "UbloxModel.h"
 
 namespace sim {
 
@@ -36,9 +38,22 @@ struct FaultSpec {
 // sentence naming the SPEC.
 bool parse_fault_spec(const std::string& spec, FaultSpec& out, std::string& error);
 
+// What the faults can reach. A null GPS or barometer: that part is not on the board
+// (--gps none, --baro none), and a fault aimed at it is an error.
+struct FaultTargets {
+    Mpu6000Model* mpu = nullptr;
+    Hmc5883Model* mag = nullptr;
+    BusFaults* bus = nullptr;
+    UbloxFaults* gps = nullptr;
+    Ms5611Faults* baro = nullptr;
+};
+
 // Parses SPEC and adds it to the models or the bus. On error (malformed SPEC, unknown
-// kind, a value where none is taken, a window that overlaps an earlier SPEC of the same
-// kind) returns false, sets `error` and changes nothing.
+// kind, a value where none is taken or a bad one, a window that overlaps an earlier SPEC
+// of the same kind, a part that is not attached) returns false, sets `error` and changes
+// nothing.
+bool apply_fault_spec(const std::string& spec, const FaultTargets& targets, std::string& error);
+// The same for the IMU, the compass and the bus only.
 bool apply_fault_spec(const std::string& spec, Mpu6000Model& mpu, Hmc5883Model& mag, BusFaults& bus,
                       std::string& error);
 

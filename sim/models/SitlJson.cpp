@@ -283,6 +283,8 @@ TrajectorySample physics_sample(const PhysicsState& state, double t_s, const dou
     for (int i = 0; i < 3; ++i) {
         sample.gyro_rad_s[i] = state.gyro_rad_s[i];
         sample.accel_m_s2[i] = state.accel_body_m_s2[i];
+        sample.ned_m[i] = state.position_m[i];
+        sample.vel_ned_m_s[i] = state.velocity_m_s[i];
     }
     for (int i = 0; i < 4; ++i) sample.quat[i] = state.quat[i];
     const Quat q{state.quat[0], state.quat[1], state.quat[2], state.quat[3]};

@@ -53,7 +53,8 @@ struct PhysicsState {
 bool parse_physics_state(const std::string& datagram, PhysicsState& state, std::string& error);
 
 // The sensor models' sample at simulated time t_s: the backend's body rates and specific
-// force, its attitude, and the earth field (NED, uT) seen in the body frame.
+// force, its attitude, the earth field (NED, uT) seen in the body frame, and its position
+// and velocity (NED from the origin, for the GPS and the barometer).
 TrajectorySample physics_sample(const PhysicsState& state, double t_s, const double earth_field_ned_uT[3]);
 
 // The receiver row the backend's `rc` asks for at t_s: all of rc_1..rc_8 (further

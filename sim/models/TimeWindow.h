@@ -51,4 +51,32 @@ private:
     std::vector<TimeWindow> windows_;
 };
 
+// Disjoint windows of one fault kind that each carry a value (a glitch's metres, a
+// satellite count).
+struct ValueWindow {
+    TimeWindow window;
+    double value = 0.0;
+};
+
+class ValueWindows {
+public:
+    // Adds `w` with `value`; false (nothing added) when it overlaps one already held.
+    bool add(const TimeWindow& w, double value) {
+        for (const ValueWindow& o : windows_)
+            if (o.window.overlaps(w)) return false;
+        windows_.push_back(ValueWindow{w, value});
+        return true;
+    }
+    // The window active at t_s, or nullptr.
+    const ValueWindow* active(double t_s) const {
+        for (const ValueWindow& w : windows_)
+            if (w.window.active(t_s)) return &w;
+        return nullptr;
+    }
+    const std::vector<ValueWindow>& windows() const { return windows_; }
+
+private:
+    std::vector<ValueWindow> windows_;
+};
+
 }  // namespace sim
