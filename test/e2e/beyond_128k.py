@@ -39,6 +39,9 @@ import struct
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench"))
+from flash import demangle  # noqa: E402  (one reader of avr-c++filt, bench/flash.py's)
+
 BOUNDARY_CALL = 0x20000  # 128 KB: above it, code is reached through EIND (trampolines)
 BOUNDARY_LPM = 0x10000   # 64 KB: LPM (pgm_read_byte) reads below it
 UPLOAD_MAX = 253952      # the Mega 2560's bootloader leaves this much for the sketch
@@ -132,17 +135,6 @@ class Elf:
         return None
 
 
-def demangle(names):
-    """{mangled: readable} through avr-c++filt (names unchanged when it is missing)."""
-    names = sorted(set(names))
-    try:
-        out = subprocess.run(["avr-c++filt"], input="\n".join(names), capture_output=True, text=True,
-                             check=True).stdout.splitlines()
-        if len(out) == len(names):
-            return dict(zip(names, out))
-    except (OSError, subprocess.CalledProcessError):
-        pass
-    return {n: n for n in names}
 
 
 def jmp_target(w1, w2):
