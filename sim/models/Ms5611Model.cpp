@@ -57,7 +57,7 @@ double temperature_c100(const uint16_t prom[8], uint32_t d2) {
 constexpr double Ms5611Model::kConversion_s[5];
 
 // Word 0: this model's factory word; 1..6: the datasheet's example C1..C6; 7: a serial
-// code, CRC-4 (AN520) = 0x3 in the low 4 bits (test/sim_models checks it).
+// code, CRC-4 (AN520) = 0x3 in the low 4 bits (test/sim/test_ms5611_model.cpp checks it).
 const uint16_t Ms5611Model::kProm[8] = {0x0C4D, 40127, 36924, 23317, 23282, 33464, 28312, 0x5A33};
 
 Ms5611Model::Ms5611Model(const Trajectory& trajectory, const Ms5611Options& options)

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """End-to-end checks of apm25sim's GPS (UART1) and MS5611 (SPI, chip select 40) models.
 
-  e2e_models.py run --tools BUILD_DIR --work WORK_DIR [--only NAME ...]
+  gps_baro_models.py run --tools BUILD_DIR --work WORK_DIR [--only NAME ...]
 
 Checks (each prints 'ok NAME' or 'FAIL NAME: why'; the exit status is 1 if any failed):
   help           --help names the new options and faults; bad values are refused

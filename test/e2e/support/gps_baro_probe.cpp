@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A tiny AVR program that talks to apm25sim's GPS on UART1 and MS5611 on SPI as a driver
-// would, and prints what it got on UART0 (test/sim_models/e2e_models.py builds and runs it).
+// would, and prints what it got on UART0 (test/e2e/gps_baro_models.py builds and runs it).
 // Not a driver: just enough to show the models work through simavr's USART1, the SPI
 // bus and the chip selects, with the board's timing.
 //
