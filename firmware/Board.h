@@ -61,7 +61,8 @@ enum Section : uint8_t {
     kSecFlightPoll = 31,   // the receiver's frames; the control step without samples (13)
     kSecSecond = 32,       // once a second: load, LEDs, HEARTBEAT, held-back warnings
     kSecStatusText = 33,   // one part of a console reply, as STATUSTEXT frames
-    kSecCommand = 34,      // the work of `save` or `defaults` typed at the console
+    kSecCommand = 34,      // the work of `save`, `defaults` or `set` typed at the console
+    kSecGcsDefaults = 35,  // the defaults' line after a ground station's PREFLIGHT_STORAGE
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

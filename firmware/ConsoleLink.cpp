@@ -106,11 +106,13 @@ static bool print_status(uint8_t part) {
     }
 }
 
-// `save` and `defaults` work longer than a reply line (the record encoded; every setting
-// and the controllers' gains set again): their work is a part of its own, the `command`
-// task with its own budget, and their line the next part.
+// `save`, `defaults` and `set` work longer than a reply line (the record encoded; every
+// setting and the controllers' gains set again; a name looked up in the parameter table
+// and the controllers configured): their work is a part of its own, the `command` task
+// with its own budget (`set` says its line there), and the defaults' line the next part.
 static bool heavy(const console::Command& c) {
-    return c.id == console::CommandId::Save || c.id == console::CommandId::Defaults;
+    return c.id == console::CommandId::Save || c.id == console::CommandId::Defaults ||
+           c.id == console::CommandId::Set;
 }
 
 // Writes part `part` of the reply to c (and runs c with part 0); false when c's reply
@@ -130,6 +132,9 @@ static bool answer(const console::Command& c, uint8_t part) {
         if (part > 0) return false;
         if (c.id == console::CommandId::Save) {
             vehicle::store.start_save(pipe.settings());
+        } else if (c.id == console::CommandId::Set) {
+            console::apply_setting(c, pipe.settings(), out);
+            flight_io.configure();
         } else {
             pipe.restore_defaults();
             flight_io.configure();
@@ -146,9 +151,8 @@ static bool answer(const console::Command& c, uint8_t part) {
             port::set_gcs_link(false);  // the mode typed, not the ground station's
             console::apply_setting(c, pipe.settings(), out);
             break;
-        default:  // rate, decl, set, get
+        default:  // rate, decl, get
             console::apply_setting(c, pipe.settings(), out);
-            if (c.id == console::CommandId::Set) flight_io.configure();
             break;
     }
     return true;
