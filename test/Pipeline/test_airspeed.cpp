@@ -47,7 +47,7 @@ TEST(AirspeedSensor, TrimAirspeedParameterDefaultsOffAndRoundTrips) {
     uint8_t bytes[settings::kFlightBytes];
     params::encode_flight(s, bytes);
     settings::Settings back = settings::defaults();
-    params::decode_flight(bytes, back);
+    params::decode_flight(bytes, settings::kFlightBytes, back);
     EXPECT_EQ(back.flight.trim_arspd_cm, 1800u);
 }
 
