@@ -18,6 +18,18 @@ static uint32_t sum = 0;
 
 State state() { return state_; }
 
+// What a board without the pitot flies on: the cruise speed, or no turn correction.
+static void say_no_sensor() {
+    const uint16_t trim_cm_s = pipe.settings().flight.trim_arspd_cm;
+    text::Writer w(vehicle::out);
+    w.str(TXT("# airspeed: no sensor on A0: "));
+    if (trim_cm_s == 0u)
+        w.str(TXT("TRIM_ARSPD_CM 0, no turn correction (sustained turns spiral down)"));
+    else
+        w.str(TXT("cruise speed TRIM_ARSPD_CM ")).fixed2((float)trim_cm_s * 0.01f).str(TXT(" m/s assumed"));
+    w.end();
+}
+
 void begin() {
     ADMUX = _BV(REFS0);  // AVcc reference, channel 0 (MUX5 in ADCSRB clear)
     ADCSRB &= (uint8_t)~_BV(MUX5);
@@ -46,7 +58,7 @@ void step() {
         if (pipe.phase() != pipeline::Phase::Running || n < kReadings) return;
         zero = (uint16_t)(sum / n);
         state_ = airspeed::present(zero) ? State::kSensor : State::kNone;
-        if (state_ == State::kNone) vehicle::say(TXT("# airspeed: no sensor on A0"));
+        if (state_ == State::kNone) say_no_sensor();
     } else if (n >= kReadings) {
         pipe.set_airspeed_m_s(airspeed::airspeed_m_s(sum, (uint8_t)n, zero));
     } else {

@@ -137,12 +137,20 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Maximum airspeed", "m/s",
                "With ARSPD_FBW_MIN, the airspeed the turn coordination (PTCH2SRV_RLL) assumes without a sensor "
                "and with TRIM_ARSPD_CM 0: the mean of the two.")},
-    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 0.0f,
+    // TRIM_ARSPD_CM's default: the top of a 1-1.5 m trainer's cruise (12-15 m/s; ArduPlane's
+    // 12). Too low a speed leaves part of a turn's centripetal acceleration in the gravity
+    // the estimator levels on: it reads less bank than flown, STABILIZE banks further and
+    // the turn tightens into a spiral. Too high a speed reads more bank than flown, and
+    // STABILIZE banks less than asked: the safe side, so the default errs high.
+    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 1500.0f,
      PARAM_DOC("Cruise airspeed", "cm/s",
                "For a board without the airspeed sensor on A0: the speed the estimator takes for the centripetal "
                "acceleration of a turn (omega x V, taken off the accelerometer) while the throttle stick is above "
-               "10 %, grown in a banked turn as the lift needs, V / sqrt(cos bank). 0: no correction; below 9 m/s "
-               "none either. A fitted sensor's reading is used instead.")},
+               "10 %, grown in a banked turn as the lift needs, V / sqrt(cos bank), and the turn coordination's "
+               "airspeed. Set it to the model's cruise speed; if in doubt, higher rather than lower: a speed too "
+               "low reads less bank than flown in a turn and STABILIZE tightens the turn, one too high banks less "
+               "than asked. 0: no correction (sustained turns then spiral down); below 9 m/s none either. A fitted "
+               "sensor's reading is used instead.")},
     {"FLTMODE_CH", Type::UInt8, 0, 1, 0, AT(flight.fltmode_ch), 0.0f, 8.0f, 8.0f,
      PARAM_DOC("Flight mode channel", "",
                "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
