@@ -54,9 +54,18 @@ constexpr uint8_t kEp = (uint8_t)sizeof(flight::EndPoints);
 constexpr uint8_t kN = flight::kChannels;
 
 // The ranges are ArduPilot's where it documents one, the widths' the PPM decoder's
-// plausible ones. The defaults are ArduPlane's but for the integrator gains: ArduPlane 3's
-// 0.04, not the 0.3 of its later releases, which also stores an upset's rate error and
-// answers it with surface the other way once the upset is over.
+// plausible ones. The defaults are ArduPlane's but for the integrator gains. Roll: ArduPlane
+// 3's 0.04, not the 0.3 of its later releases, which also stores an upset's rate error and
+// answers it with surface the other way once the upset is over; a lasting roll error is only
+// an aileron out of trim. Pitch: ArduPlane's later 0.3, since the elevator a pitch needs
+// moves with the airspeed and the power: at full power the speed doubles within seconds and
+// the trim elevator pitches the nose up as it does. The integrator takes such an offset up
+// with a time constant of P' / (TCONST I), P' / TCONST being the feed-forward's 0.77-0.9 deg
+// of surface per deg of error: 22 s at 0.04, 2.6 s at 0.3, faster than the speed builds up
+// (about 5 s), so that it follows the elevator the climb needs instead of lagging it.
+// TCONST 0.5 s is slower than a trainer's roll and pitch response (a few tenths of a
+// second), so the demanded rates are ones it can fly; P 1 and D 0.08 (roll), 0.04 (pitch)
+// and IMAX 3000 (two thirds of the throw) are ArduPlane's, for models of this size.
 const Row kRows[] PARAM_TABLE = {
     {"RLL2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.roll.tconst_s), 0.4f, 1.0f, 0.5f,
      PARAM_DOC("Roll time constant", "s",
@@ -88,9 +97,10 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Pitch proportional gain", "deg/deg",
                "Degrees of elevator per degree of pitch error (a feed-forward on the demanded pitch rate, as "
                "RLL2SRV_P).")},
-    {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.04f,
+    {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.3f,
      PARAM_DOC("Pitch integrator gain", "1/s",
-               "Trims out a lasting pitch error (an elevator out of trim): the pitch-rate error times I TCONST is "
+               "Trims out a lasting pitch error (an elevator out of trim, the elevator a faster or full-power flight "
+               "needs): the pitch-rate error times I TCONST is "
                "summed, within PTCH2SRV_IMAX, and does not grow while the elevator is at full throw. 0: no "
                "integrator.")},
     {"PTCH2SRV_D", Type::Float, 0, 1, 0, AT(flight.pitch.d), 0.0f, 0.2f, 0.04f,
