@@ -56,7 +56,7 @@ def make_flights(flight_dir, log):
 
 
 # Flights in turbulence on seeds no tuning has used (bench/motions.py's SEEDS): the
-# straight gusty flight, and the turn and the figure-eight in moderate turbulence (fly.py
+# straight gusty flight, and the turn and the figure-eight in light turbulence (fly.py
 # --gust 1). What found the turn's runaway in turbulence (issue 24): kept in the bench.
 TURBULENT_SEEDS = (4057, 18233, 90511)
 TURBULENT_FLIGHTS = (("gusty", None), ("turn", 1), ("figure8", 1))

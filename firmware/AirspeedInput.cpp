@@ -18,6 +18,21 @@ static uint32_t sum = 0;
 
 State state() { return state_; }
 
+// What a board without the pitot flies on: the cruise speed, or no turn correction.
+static void say_no_sensor(bool moving) {
+    const uint16_t trim_cm_s = pipe.settings().flight.trim_arspd_cm;
+    text::Writer w(vehicle::out);
+    if (moving)
+        w.str(TXT("# airspeed: the board was moving at start (a restart in flight?): no pitot zero taken, "));
+    else
+        w.str(TXT("# airspeed: no sensor on A0: "));
+    if (trim_cm_s == 0u)
+        w.str(TXT("TRIM_ARSPD_CM 0, no turn correction (sustained turns spiral down)"));
+    else
+        w.str(TXT("cruise speed TRIM_ARSPD_CM ")).fixed2((float)trim_cm_s * 0.01f).str(TXT(" m/s assumed"));
+    w.end();
+}
+
 void begin() {
     ADMUX = _BV(REFS0);  // AVcc reference, channel 0 (MUX5 in ADCSRB clear)
     ADCSRB &= (uint8_t)~_BV(MUX5);
@@ -45,8 +60,14 @@ void step() {
     if (state_ == State::kZero) {
         if (pipe.phase() != pipeline::Phase::Running || n < kReadings) return;
         zero = (uint16_t)(sum / n);
-        state_ = airspeed::present(zero) ? State::kSensor : State::kNone;
-        if (state_ == State::kNone) vehicle::say(TXT("# airspeed: no sensor on A0"));
+        // A zero is what the pitot reads in still air, so only a board the start's gyro
+        // calibration found still gives one: one that never was (it starts measuring on,
+        // pipe.gyro_calibrating()) may be flying, and its zero would be the flight's dynamic
+        // pressure, within the sensor's offset tolerance at cruise (0.2 kPa at 18 m/s) and
+        // reading every airspeed as none. It flies on the cruise speed instead, as without one.
+        const bool moving = pipe.gyro_calibrating();
+        state_ = airspeed::present(zero) && !moving ? State::kSensor : State::kNone;
+        if (state_ == State::kNone) say_no_sensor(moving && airspeed::present(zero));
     } else if (n >= kReadings) {
         pipe.set_airspeed_m_s(airspeed::airspeed_m_s(sum, (uint8_t)n, zero));
     } else {

@@ -4,8 +4,9 @@
 // conversion the previous one started (13 ADC clocks at 125 kHz, long done 5 ms later)
 // and starts the next. While the gyro calibrates (the board still) the readings are the
 // sensor's zero; a zero far from 2.5 V is no sensor, and the configured cruise speed
-// (TRIM_ARSPD_CM) is used instead. Then the mean of each kReadings readings is the
-// airspeed.
+// (TRIM_ARSPD_CM) is used instead, as it is when the start's gyro calibration never found
+// the board still (it may be flying: no still-air zero to take). Then the mean of each
+// kReadings readings is the airspeed.
 #pragma once
 
 #include <stdint.h>

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "FlightIo.h"
 
+#include "AirspeedInput.h"
 #include "Board.h"
 #include "Vehicle.h"
 
@@ -41,7 +42,7 @@ FlightIo::FlightIo(const text::Sink* out)
 void FlightIo::begin() {
     uint16_t widths[flight::kChannels];
     control_.configure();  // the loaded settings
-    control_.step(0, flight::Attitude{0, 0, 0, 0, false}, widths);
+    control_.step(0, flight::Attitude{0, 0, 0, 0, false, 0}, widths);
     servo_outputs::begin(widths);
     rc_input::begin();
 }
@@ -79,7 +80,8 @@ void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sam
                             const pipeline::AnglesCentideg* angles) {
     last_control_us_ = now_us;
     control_count_ = 0;
-    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running};
+    flight::Attitude att{0, 0, 0, 0, sample != nullptr && imu.ok() && pipe.phase() == pipeline::Phase::Running,
+                         0};
     control_.update_signal(now_ms);
     if (att.valid && control_.wants_attitude()) {  // MANUAL and no receiver yet need none
         const pipeline::AnglesCentideg a = angles != nullptr ? *angles : pipe.angles_centideg();
@@ -93,6 +95,11 @@ void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sam
         }
         att.roll_rate_cds = (((int32_t)sample->gyro.x * kCdsPerCountQ10) >> 10) - bias_cds_[0];
         att.pitch_rate_cds = (((int32_t)sample->gyro.y * kCdsPerCountQ10) >> 10) - bias_cds_[1];
+        // The pitot's airspeed for the turn coordination (at least 1: 0 is "none measured").
+        if (airspeed_input::state() == airspeed_input::State::kSensor) {
+            const float v_cm_s = pipe.airspeed_m_s() * 100.0f;
+            att.airspeed_cm_s = v_cm_s >= 6000.0f ? 6000u : (v_cm_s >= 1.0f ? (uint16_t)v_cm_s : 1u);
+        }
     }
     uint16_t widths[flight::kChannels];
     control_.step(now_ms, att, widths);

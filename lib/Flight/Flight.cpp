@@ -195,6 +195,13 @@ int16_t turn_gain_cds(float airspeed_m_s, float roll_ff) {
     return q(kGravity_m_s2 / airspeed_m_s * kDegPerRad * 100.0f * roll_ff, 1.0f);
 }
 
+uint16_t coordination_airspeed_cm_s(const FlightSettings& s, uint16_t measured_cm_s) {
+    const uint16_t min_cm_s = (uint16_t)(s.arspd_min_m_s * 100u);
+    if (measured_cm_s != 0u) return measured_cm_s > min_cm_s ? measured_cm_s : min_cm_s;
+    if (s.trim_arspd_cm != 0u) return s.trim_arspd_cm;
+    return (uint16_t)((s.arspd_min_m_s + s.arspd_max_m_s) * 50u);
+}
+
 int32_t turn_rate_offset_cds(int32_t roll_cd, int32_t pitch_cd, int16_t gain_cds) {
     if (roll_cd > 9000 || roll_cd < -9000) return 0;  // inverted: no coordination
     const uint16_t f = lookup(kTanSinQ12, clamp32(roll_cd, -kMaxCoordinatedBank_cd, kMaxCoordinatedBank_cd));
@@ -304,6 +311,12 @@ Surfaces FlightControl::stabilize(const Attitude& att, int32_t roll_demand_cd, i
     int32_t roll_error_cd = roll_demand_cd - att.roll_cd;
     if (roll_error_cd > 18000) roll_error_cd -= 36000;  // the short way round
     if (roll_error_cd < -18000) roll_error_cd += 36000;
+    // g / V again only when the airspeed changed (a division: each new pitot reading).
+    const uint16_t v_cm_s = coordination_airspeed_cm_s(s_, att.airspeed_cm_s);
+    if (v_cm_s != turn_airspeed_cm_s_) {
+        turn_airspeed_cm_s_ = v_cm_s;
+        turn_gain_cds_ = turn_gain_cds((float)v_cm_s * 0.01f, s_.pitch_roll_ff);
+    }
     const int32_t offset = turn_rate_offset_cds(att.roll_cd, att.pitch_cd, turn_gain_cds_);
     Surfaces out{};
     out.aileron_cd = roll_.step(roll_terms_, roll_error_cd, 0, att.roll_rate_cds);
@@ -315,7 +328,8 @@ void FlightControl::configure() {
     scales_ = scales_of(s_);
     roll_terms_ = axis_terms(s_.roll, kControlDt_s);
     pitch_terms_ = axis_terms(s_.pitch, kControlDt_s);
-    turn_gain_cds_ = turn_gain_cds(0.5f * (float)(s_.arspd_min_m_s + s_.arspd_max_m_s), s_.pitch_roll_ff);
+    turn_airspeed_cm_s_ = coordination_airspeed_cm_s(s_, 0);
+    turn_gain_cds_ = turn_gain_cds((float)turn_airspeed_cm_s_ * 0.01f, s_.pitch_roll_ff);
 }
 
 void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[kChannels]) {
@@ -337,7 +351,7 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
     const int16_t fs_throttle = (int16_t)(s_.thr_fs_pct * 10u);
     if (state_ == State::Failsafe) {
         Surfaces sf{0, 0, fs_throttle, 0};
-        if (att.valid) sf = stabilize(att, 0, s_.fs_pitch_cd);
+        if (att.valid) sf = stabilize(att, 0, (int32_t)s_.trim_pitch_cd + s_.fs_pitch_cd);
         sf.throttle = fs_throttle;
         sf.rudder_cd = 0;
         mix(s_, scales_, sf, nullptr, out_us);
@@ -354,7 +368,9 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
     Surfaces sf{in[kRoll], in[kPitch], in[kThrottle], in[kYaw]};
     if (state_ == State::Stabilize && !fallback) {
         const int32_t roll_demand = demand_cd(sf.aileron_cd, s_.lim_roll_cd);
+        // The stick's pitch from the trim (ArduPlane's stabilize_pitch adds TRIM_PITCH_CD).
         const int32_t pitch_demand =
+            s_.trim_pitch_cd +
             demand_cd(sf.elevator_cd, sf.elevator_cd >= 0 ? s_.lim_pitch_max_cd : (int16_t)-s_.lim_pitch_min_cd);
         const Surfaces c = stabilize(att, roll_demand, pitch_demand);
         sf.aileron_cd = c.aileron_cd;

@@ -154,7 +154,13 @@ struct Attitude {
     int32_t roll_rate_cds;   // body x, centi-degrees per second
     int32_t pitch_rate_cds;  // body y
     bool valid;              // false: the estimator is not running or the IMU failed
+    uint16_t airspeed_cm_s;  // measured (the pitot), for the turn coordination; 0: none measured
 };
+
+// The airspeed the turn coordination takes (cm/s), as AP_PitchController: the measured one,
+// not below ARSPD_FBW_MIN; without one the cruise speed (TRIM_ARSPD_CM), or when that is 0
+// the mean of ARSPD_FBW_MIN and ARSPD_FBW_MAX.
+uint16_t coordination_airspeed_cm_s(const FlightSettings& s, uint16_t measured_cm_s);
 
 // Something for the firmware to say on the console (bits of FlightControl::take_events).
 enum Event : uint8_t {
@@ -214,6 +220,7 @@ private:
     AxisTerms roll_terms_;
     AxisTerms pitch_terms_;
     int16_t turn_gain_cds_ = 0;
+    uint16_t turn_airspeed_cm_s_ = 0;  // the airspeed turn_gain_cds_ is for
     AxisController roll_;
     AxisController pitch_;
     uint16_t rc_us_[kChannels] = {};

@@ -42,7 +42,8 @@ struct FlightSettings {
     int16_t lim_roll_cd;        // LIM_ROLL_CD: full roll stick in STABILIZE, centi-degrees of bank
     int16_t lim_pitch_max_cd;   // LIM_PITCH_MAX: full up stick
     int16_t lim_pitch_min_cd;   // LIM_PITCH_MIN: full down stick (negative)
-    int16_t fs_pitch_cd;        // FS_GLIDE_PITCH: the failsafe glide's pitch (negative: nose down)
+    int16_t fs_pitch_cd;        // FS_GLIDE_PITCH: the failsafe glide's pitch from the trim (negative: nose down)
+    int16_t trim_pitch_cd;      // TRIM_PITCH_CD: the pitch held with the stick centred, added to every demand
     uint16_t thr_fs_value_us;   // THR_FS_VALUE: throttle channel below this = the encoder's failsafe
     uint8_t thr_fs_pct;         // THR_FS_OUT: throttle output in failsafe, percent
     uint8_t arspd_min_m_s;      // ARSPD_FBW_MIN: the airspeed assumed (no sensor) is the mean of

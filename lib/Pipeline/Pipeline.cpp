@@ -274,6 +274,18 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         st_.gyro_cal_steps < kStartupDeadlineSteps)
         start_gravity_.add(raw.gyro, raw.accel, raw.gyro_rad_s_per_count, raw.accel_m_s2_per_count,
                            settings_.cal.gyro_bias_rad_s, 1.0f / kRateHz);
+    if (r == calib::GyroCalibrator::Result::Done && st_.phase == Phase::Running && st_.start_moved) {
+        // Measuring on after a moving start: a constant-rate turn looks still; a bias far
+        // from the one in use is such a turn, not the gyro's.
+        const float off_rad_s = (gyro_cal_.bias() - settings_.cal.gyro_bias_rad_s).length();
+        st_.start_moved = false;
+        if (!(off_rad_s <= kMaxBiasChangeInMotion_rad_s)) {
+            st_.gyro_cal_active = false;
+            tell(EventKind::kGyroBiasRefused, 0, 0, off_rad_s * linalg::kDegPerRad,
+                 (settings_.flags & settings::kFlagGyroCalibrated) ? 1 : 0);
+            return;
+        }
+    }
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
@@ -300,6 +312,7 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
         // by the gyro (StartGravity.h), keep measuring in the background (the event on the
         // next step, as the bias's).
         st_.start_message = StartMessage::kNotStill;
+        st_.start_moved = true;
         start_estimator(start_gravity_.mean_m_s2(), true);
         return;
     }
@@ -472,6 +485,7 @@ void AttitudePipeline::start_gyro_calibration() {
     if (st_.phase != Phase::Running) start_gravity_.restart();  // running: the space is the turn's
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
+    st_.start_moved = false;  // asked for (`cal gyro`): the user says the board is still
     if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);
 }
 

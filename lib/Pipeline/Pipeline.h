@@ -77,6 +77,14 @@ using mpu6000::kRateHz;                         // the MPU6000's sample rate = t
 constexpr float kStep_s = 1.0f / kRateHz;
 constexpr uint16_t kStartupDeadlineSteps = 260; // 1.3 s: the first line must be out within 2 s of reset
 constexpr uint16_t kGyroCalTimeoutSteps = 2000; // `cal gyro` gives up after 10 s without a still second
+// After a start that was never still (the board may be flying: a restart in the air), the
+// calibration that goes on measuring is only taken within this of the bias in use (the
+// saved one, or zero). A steady turn passes the still test (its rate is constant, and |accel|
+// stays within 10 % of 1 g below ~25 deg of bank) and would be learned as bias: at 15 m/s
+// even 5 deg of bank turns at 3 deg/s. The MPU6000's bias moves by about this between two
+// starts ~20 deg C apart (its zero-rate output: +-20 deg/s over -40..85 deg C); a bias
+// refused here is left to the estimator's own bias learning.
+constexpr float kMaxBiasChangeInMotion_rad_s = 0.0524f;  // 3 deg/s
 constexpr uint16_t kWarnIntervalSteps = 400;    // rate limit of each warning kind: 2 s
 constexpr float kSpikeGyroJump_rad_s = 17.45f;  // 1000 deg/s in one 5 ms step: not a rotation
 constexpr uint8_t kMaxSpikeRun = 10;            // up to 50 ms of glitch; longer is real (a crash): use it
@@ -157,6 +165,8 @@ enum class EventKind : uint8_t {
     kGyroCalTimeout,   // `cal gyro` gave up (never still for 1 s): the bias unchanged
     kGyroBias,         // the calibration's result: settings().cal.gyro_bias_rad_s
     kNotStill,         // never still: started anyway; code 1 with the saved bias, 0 with zero
+    kGyroBiasRefused,  // a calibration after a moving start, value deg/s off the bias in use: not
+                       // taken (code 1: the saved bias kept, 0: zero)
     kSpike,            // MPU6000 samples replaced by the previous one; total so far
     kGyroSaturated,    // MPU6000 gyro at its full scale (used: a lower bound)
     kAccelSaturated,   // MPU6000 accel at its full scale
@@ -343,6 +353,7 @@ private:
         bool learn_pending;             // learn_field_uT_ waits for a step without output
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
+        bool start_moved;               // the start was never still: the calibration measuring on may see a turn
     };
     State st_;
     // One space for two phases (RAM): before the estimator runs the start's gravity if

@@ -61,6 +61,11 @@ void write_event(void* out, const pipeline::AttitudePipeline& pipe, const pipeli
             w.str(TXT(TXT_WARN "board not still: starting with ")).str(e.code ? TXT("the saved") : TXT("zero"))
                 .str(TXT(" gyro bias, measuring on"));
             break;
+        case EventKind::kGyroBiasRefused:
+            w.str(TXT(TXT_WARN "gyro calibration in motion (a steady turn?): ")).fixed2(e.value)
+                .str(TXT(" deg/s off the bias in use, not taken; keeping ")).str(e.code ? TXT("the saved") : TXT("zero"))
+                .str(TXT(" gyro bias"));
+            break;
         case EventKind::kSpike:
             w.str(TXT(TXT_WARN TXT_MPU " spike: "));
             if (e.count == 0) w.str(TXT("previous sample used instead ("));

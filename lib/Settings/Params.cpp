@@ -54,9 +54,18 @@ constexpr uint8_t kEp = (uint8_t)sizeof(flight::EndPoints);
 constexpr uint8_t kN = flight::kChannels;
 
 // The ranges are ArduPilot's where it documents one, the widths' the PPM decoder's
-// plausible ones. The defaults are ArduPlane's but for the integrator gains: ArduPlane 3's
-// 0.04, not the 0.3 of its later releases, which also stores an upset's rate error and
-// answers it with surface the other way once the upset is over.
+// plausible ones. The defaults are ArduPlane's but for the integrator gains. Roll: ArduPlane
+// 3's 0.04, not the 0.3 of its later releases, which also stores an upset's rate error and
+// answers it with surface the other way once the upset is over; a lasting roll error is only
+// an aileron out of trim. Pitch: ArduPlane's later 0.3, since the elevator a pitch needs
+// moves with the airspeed and the power: at full power the speed doubles within seconds and
+// the trim elevator pitches the nose up as it does. The integrator takes such an offset up
+// with a time constant of P' / (TCONST I), P' / TCONST being the feed-forward's 0.77-0.9 deg
+// of surface per deg of error: 22 s at 0.04, 2.6 s at 0.3, faster than the speed builds up
+// (about 5 s), so that it follows the elevator the climb needs instead of lagging it.
+// TCONST 0.5 s is slower than a trainer's roll and pitch response (a few tenths of a
+// second), so the demanded rates are ones it can fly; P 1 and D 0.08 (roll), 0.04 (pitch)
+// and IMAX 3000 (two thirds of the throw) are ArduPlane's, for models of this size.
 const Row kRows[] PARAM_TABLE = {
     {"RLL2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.roll.tconst_s), 0.4f, 1.0f, 0.5f,
      PARAM_DOC("Roll time constant", "s",
@@ -88,9 +97,10 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Pitch proportional gain", "deg/deg",
                "Degrees of elevator per degree of pitch error (a feed-forward on the demanded pitch rate, as "
                "RLL2SRV_P).")},
-    {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.04f,
+    {"PTCH2SRV_I", Type::Float, 0, 1, 0, AT(flight.pitch.i), 0.0f, 1.0f, 0.3f,
      PARAM_DOC("Pitch integrator gain", "1/s",
-               "Trims out a lasting pitch error (an elevator out of trim): the pitch-rate error times I TCONST is "
+               "Trims out a lasting pitch error (an elevator out of trim, the elevator a faster or full-power flight "
+               "needs): the pitch-rate error times I TCONST is "
                "summed, within PTCH2SRV_IMAX, and does not grow while the elevator is at full throw. 0: no "
                "integrator.")},
     {"PTCH2SRV_D", Type::Float, 0, 1, 0, AT(flight.pitch.d), 0.0f, 0.2f, 0.04f,
@@ -104,7 +114,8 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Roll compensation", "",
                "Turn coordination in STABILIZE and the failsafe: the pitch rate a level turn needs at the present "
                "bank, g / V tan(bank) sin(bank) cos(pitch), times this gain, is added to the demanded pitch rate "
-               "(V: the mean of ARSPD_FBW_MIN and ARSPD_FBW_MAX). Raise it if the aeroplane loses height in "
+               "(V: the airspeed sensor's reading, at least ARSPD_FBW_MIN; without a sensor TRIM_ARSPD_CM, or the "
+               "mean of ARSPD_FBW_MIN and ARSPD_FBW_MAX when that is 0). Raise it if the aeroplane loses height in "
                "turns.")},
     {"LIM_ROLL_CD", Type::Int16, 0, 1, 0, AT(flight.lim_roll_cd), 0.0f, 9000.0f, 4500.0f,
      PARAM_DOC("Maximum bank angle", "cdeg",
@@ -117,8 +128,8 @@ const Row kRows[] PARAM_TABLE = {
                "The pitch that full down stick asks for in STABILIZE (negative: nose down).")},
     {"FS_GLIDE_PITCH", Type::Int16, 0, 1, 0, AT(flight.fs_pitch_cd), -3000.0f, 0.0f, -500.0f,
      PARAM_DOC("Failsafe glide pitch", "cdeg",
-               "The pitch FAILSAFE holds, wings level, while the receiver is lost (negative: nose down, a gentle "
-               "glide). This firmware's own name.")},
+               "The pitch FAILSAFE holds, wings level, while the receiver is lost, from TRIM_PITCH_CD (negative: "
+               "nose down of the trim, a gentle glide). This firmware's own name.")},
     {"THR_FS_VALUE", Type::UInt16, 0, 1, 0, AT(flight.thr_fs_value_us), 800.0f, 1100.0f, 950.0f,
      PARAM_DOC("Throttle failsafe value", "us",
                "A receiver frame whose throttle channel (RCMAP_THROTTLE, as received) is below this width is the "
@@ -130,18 +141,26 @@ const Row kRows[] PARAM_TABLE = {
                "of SERVO3_MIN to SERVO3_MAX (0: the motor off). This firmware's own name.")},
     {"ARSPD_FBW_MIN", Type::UInt8, 0, 1, 0, AT(flight.arspd_min_m_s), 5.0f, 50.0f, 9.0f,
      PARAM_DOC("Minimum airspeed", "m/s",
-               "With ARSPD_FBW_MAX, the airspeed the turn coordination (PTCH2SRV_RLL) assumes: the mean of the "
-               "two, whether or not an airspeed sensor is fitted.")},
+               "The least airspeed the turn coordination (PTCH2SRV_RLL) takes from the airspeed sensor; without a "
+               "sensor and with TRIM_ARSPD_CM 0 it assumes the mean of this and ARSPD_FBW_MAX.")},
     {"ARSPD_FBW_MAX", Type::UInt8, 0, 1, 0, AT(flight.arspd_max_m_s), 5.0f, 50.0f, 22.0f,
      PARAM_DOC("Maximum airspeed", "m/s",
-               "With ARSPD_FBW_MIN, the airspeed the turn coordination (PTCH2SRV_RLL) assumes: the mean of the "
-               "two.")},
-    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 0.0f,
+               "With ARSPD_FBW_MIN, the airspeed the turn coordination (PTCH2SRV_RLL) assumes without a sensor "
+               "and with TRIM_ARSPD_CM 0: the mean of the two.")},
+    // TRIM_ARSPD_CM's default: the top of a 1-1.5 m trainer's cruise (12-15 m/s; ArduPlane's
+    // 12). Too low a speed leaves part of a turn's centripetal acceleration in the gravity
+    // the estimator levels on: it reads less bank than flown, STABILIZE banks further and
+    // the turn tightens into a spiral. Too high a speed reads more bank than flown, and
+    // STABILIZE banks less than asked: the safe side, so the default errs high.
+    {"TRIM_ARSPD_CM", Type::UInt16, 0, 1, 0, AT(flight.trim_arspd_cm), 0.0f, 5000.0f, 1500.0f,
      PARAM_DOC("Cruise airspeed", "cm/s",
                "For a board without the airspeed sensor on A0: the speed the estimator takes for the centripetal "
                "acceleration of a turn (omega x V, taken off the accelerometer) while the throttle stick is above "
-               "10 %, grown in a banked turn as the lift needs, V / sqrt(cos bank). 0: no correction; below 9 m/s "
-               "none either. A fitted sensor's reading is used instead.")},
+               "10 %, grown in a banked turn as the lift needs, V / sqrt(cos bank), and the turn coordination's "
+               "airspeed. Set it to the model's cruise speed; if in doubt, higher rather than lower: a speed too "
+               "low reads less bank than flown in a turn and STABILIZE tightens the turn, one too high banks less "
+               "than asked. 0: no correction (sustained turns then spiral down); below 9 m/s none either. A fitted "
+               "sensor's reading is used instead.")},
     {"FLTMODE_CH", Type::UInt8, 0, 1, 0, AT(flight.fltmode_ch), 0.0f, 8.0f, 8.0f,
      PARAM_DOC("Flight mode channel", "",
                "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
@@ -202,6 +221,14 @@ const Row kRows[] PARAM_TABLE = {
     {"SERVO#_REVERSED", Type::Bit, 1, kN, 0, AT(flight.servo_reversed), 0.0f, 1.0f, 0.0f,
      PARAM_DOC("Servo reversed", "",
                "1: output n moves the other way: a surface about its trim, the throttle from SERVO3_MAX down.")},
+    // Rows added after version 3 of the record go here, after the flight rows before them
+    // (Settings.h: an older record is then the new one's first part).
+    {"TRIM_PITCH_CD", Type::Int16, 0, 1, 0, AT(flight.trim_pitch_cd), -4500.0f, 4500.0f, 0.0f,
+     PARAM_DOC("Pitch trim", "cdeg",
+               "The pitch STABILIZE holds with the stick centred, and the reference of the stick's pitch and of "
+               "the failsafe glide (FS_GLIDE_PITCH is added to it), as ArduPlane adds it to every pitch it asks "
+               "for. Find it in the set-up: trim the model for level cruise in MANUAL, read the pitch the board "
+               "shows, set it here. 0 holds the board level, and a model whose trim is nose up then sinks.")},
     {"COMPASS_DEC", Type::DeclRad, 0, 1, 0, AT(declination_centideg), -3.1416f, 3.1416f, 0.0f,
      PARAM_DOC("Compass declination", "rad",
                "The angle from true north to magnetic north, east positive, added to the heading the board "
@@ -413,10 +440,10 @@ void encode_flight(const Settings& s, uint8_t out[settings::kFlightBytes]) {
     flight_part(s, 0, settings::kFlightBytes, out);
 }
 
-void decode_flight(const uint8_t in[settings::kFlightBytes], Settings& s) {
+void decode_flight(const uint8_t* in, uint8_t len, Settings& s) {
     uint16_t at = 0;
     each_flight_value(s, [&](uint8_t* p, uint8_t n) {
-        if (at + n <= settings::kFlightBytes) memcpy(p, in + at, n);
+        if (at + n <= len && at + n <= settings::kFlightBytes) memcpy(p, in + at, n);
         at = (uint16_t)(at + n);
     });
 }

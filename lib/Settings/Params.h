@@ -54,11 +54,14 @@ void apply_defaults(settings::Settings& s);
 // The flight settings in the EEPROM record (settings::encode): the rows that live in
 // Settings::flight, in table order, each value little-endian in its type's size, a Bit
 // row's eight bits as one byte: settings::kFlightBytes bytes. A new row changes the
-// record: it needs a new record version.
+// record: it needs a new record version, and goes after the flight rows there are (an
+// older record is then the new one's first part: Settings.h).
 void encode_flight(const settings::Settings& s, uint8_t out[settings::kFlightBytes]);
 // Bytes from..from+n-1 (within kFlightBytes) of what encode_flight writes.
 void flight_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* out);
-void decode_flight(const uint8_t in[settings::kFlightBytes], settings::Settings& s);
+// The first n bytes (an older record's, n <= kFlightBytes): the values they hold whole
+// are read, the others left as they are.
+void decode_flight(const uint8_t* in, uint8_t n, settings::Settings& s);
 // What encode_flight writes (a test holds it to settings::kFlightBytes).
 uint16_t flight_bytes();
 // Every parameter within its range and the end points in order (settings::is_valid).

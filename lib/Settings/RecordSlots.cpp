@@ -53,7 +53,9 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     out.newest_cut = p.newest_cut;
     out.write = p.write;
     out.next_sequence = p.next_sequence;
-    if (p.load >= 0 && info[(uint8_t)p.load].record_length != settings::kRecordSize) {
+    // This firmware's record, or version 3's (Settings.h: it loads, the newer rows at defaults).
+    if (p.load >= 0 && info[(uint8_t)p.load].record_length != settings::kRecordSize &&
+        info[(uint8_t)p.load].record_length != settings::kV3RecordSize) {
         s = settings::defaults();
         out.result = settings::LoadResult::OldVersion;  // another firmware's record layout
         return out;

@@ -86,9 +86,11 @@ FIXED_COLD LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     for (uint8_t i = 0; i < kRecordSize; ++i) blank = blank && (in[i] == 0xFFu || in[i] == 0x00u);
     if (blank) return LoadResult::Blank;
     if (in[0] != kMagic0 || in[1] != kMagic1) return LoadResult::BadMagic;
-    // Version 2's payload is version 3's first part: read it, flight settings at defaults.
+    // Version 2's payload is this version's first part: read it, flight settings at
+    // defaults. Version 3's lacks only the rows added since: they keep their defaults.
     const bool v2 = in[2] == 2u && in[3] == kV2PayloadLength;
-    if (!v2 && (in[2] != kSettingsVersion || in[3] != kPayloadLength)) return LoadResult::OldVersion;
+    const bool v3 = in[2] == 3u && in[3] == kV3PayloadLength;
+    if (!v2 && !v3 && (in[2] != kSettingsVersion || in[3] != kPayloadLength)) return LoadResult::OldVersion;
     const uint8_t len = in[3];
     const uint16_t crc = (uint16_t)(in[4 + len] | (uint16_t)((uint16_t)in[5 + len] << 8));
     if (crc != crc16(in, (uint16_t)(4u + len))) return LoadResult::BadCrc;
@@ -100,7 +102,7 @@ FIXED_COLD LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     out.flags = in[8];
     memcpy(&out.cal, in + 9, sizeof out.cal);
     if (v2) out.flags = (uint8_t)(out.flags | kFlagUpgraded);
-    else params::decode_flight(in + 4 + kV2PayloadLength, out);
+    else params::decode_flight(in + 4 + kV2PayloadLength, (uint8_t)(len - kV2PayloadLength), out);
     if ((in[8] & kFlagUpgraded) != 0u || !is_valid(out)) {
         out = defaults();
         return LoadResult::BadValue;

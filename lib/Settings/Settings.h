@@ -7,7 +7,7 @@
 //          3  payload length    kPayloadLength
 //          4  payload           little-endian fields, floats as IEEE-754 bytes:
 //             4  rate, 5 decl (int16), 7 mode, 8 flags, 9 calibration (15 floats)
-//             69 the flight settings (version 3): params::encode_flight, the parameter
+//             69 the flight settings (version 3 on): params::encode_flight, the parameter
 //                table's rows in order (a Bit row's eight bits one byte), kFlightBytes
 //          4+len  CRC-16/CCITT-FALSE of bytes 0 .. 3+len, little-endian
 //
@@ -17,7 +17,10 @@
 //
 // A version 2 record (a 65-byte payload, no flight settings) still loads: its rate,
 // declination, mode and calibration are kept, the flight settings are the defaults and
-// kFlagUpgraded says so (the firmware tells the user, `save` writes version 3).
+// kFlagUpgraded says so (the firmware tells the user, `save` writes this version).
+// A version 3 record is this version's first kV3FlightBytes of flight settings: it loads
+// whole, and the rows added since (at the table's end) take their defaults, as ArduPilot
+// gives a new parameter its default.
 #pragma once
 
 #include <stdint.h>
@@ -32,11 +35,15 @@ constexpr uint8_t kMagic0 = 'A';
 constexpr uint8_t kMagic1 = 'T';
 // 2: the compass calibration gained the soft-iron cross terms and the learned offset.
 // 3: the flight settings (ArduPlane's parameters, the parameter table: Params.h).
-constexpr uint8_t kSettingsVersion = 3;
+// 4: TRIM_PITCH_CD after the version 3 rows.
+constexpr uint8_t kSettingsVersion = 4;
 constexpr uint8_t kV2PayloadLength = 65;  // rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
-constexpr uint8_t kFlightBytes = 166;     // params::encode_flight (checked by params' tests)
+constexpr uint8_t kFlightBytes = 168;     // params::encode_flight (checked by params' tests)
+constexpr uint8_t kV3FlightBytes = 166;   // version 3's flight settings: the rows before TRIM_PITCH_CD
 constexpr uint8_t kPayloadLength = kV2PayloadLength + kFlightBytes;
 constexpr uint8_t kRecordSize = 4 + kPayloadLength + 2;
+constexpr uint8_t kV3PayloadLength = kV2PayloadLength + kV3FlightBytes;
+constexpr uint8_t kV3RecordSize = 4 + kV3PayloadLength + 2;
 constexpr uint16_t kEepromAddress = 0;
 
 constexpr uint8_t kRateMinHz = 1;

@@ -461,7 +461,7 @@ struct Beside {
     explicit Beside(const flight::FlightSettings& f)
         : roll_terms(flight::axis_terms(f.roll, 0.02f)),
           pitch_terms(flight::axis_terms(f.pitch, 0.02f)),
-          turn_gain(flight::turn_gain_cds(0.5f * (float)(f.arspd_min_m_s + f.arspd_max_m_s), f.pitch_roll_ff)) {}
+          turn_gain(flight::turn_gain_cds((float)f.trim_arspd_cm * 0.01f, f.pitch_roll_ff)) {}
     void reset() {
         roll.reset();
         pitch.reset();
@@ -484,6 +484,8 @@ settings::Settings flown_settings() {
     s.flight.arspd_max_m_s = 25;
     s.flight.pitch_roll_ff = 1.2f;
     s.flight.fs_pitch_cd = -700;
+    s.flight.trim_pitch_cd = 300;
+    s.flight.trim_arspd_cm = 1650;
     s.flight.thr_fs_pct = 30;
     s.flight.servo[0] = kProbe;
     s.flight.servo[1] = kProbe;
@@ -515,7 +517,8 @@ TEST(FlightControl, StabilizeAndFailsafeAreTheAxisControllersOnTheEstimate) {
             r.att = moving(t, r.att.valid);
             r.fc.step(t, r.att, r.out);
             if (phase == 0) continue;  // MANUAL: nothing beside
-            const int32_t demand = phase == 1 ? 0 : r.s.flight.fs_pitch_cd;
+            // The stick centred: the trim; the failsafe's glide from the trim.
+            const int32_t demand = r.s.flight.trim_pitch_cd + (phase == 1 ? 0 : r.s.flight.fs_pitch_cd);
             b.step(r.att, -r.att.roll_cd, demand, ail, elev);
             ASSERT_EQ(r.out[0], flight::angle_to_width(ail, probe, false)) << "t " << t << " phase " << phase;
             ASSERT_EQ(r.out[1], flight::angle_to_width(elev, probe, false)) << "t " << t << " phase " << phase;
@@ -672,4 +675,55 @@ TEST(FlightControl, SticksDemandTheirLimitsAndRollErrorsGoTheShortWayRound) {
     r.rc[0] = 1000;  // -19.99 deg
     EXPECT_EQ(width_at(16003), flight::angle_to_width(4500, kProbe, false));
     EXPECT_EQ(width_at(16004), flight::angle_to_width(4499, kProbe, false));
+}
+
+// The turn coordination's airspeed: the pitot's when there is one (not below ARSPD_FBW_MIN,
+// as AP_PitchController), else the cruise speed, else the mean of ARSPD_FBW_MIN and _MAX.
+TEST(FlightControl, TurnCoordinationTakesTheMeasuredAirspeed) {
+    settings::Settings s = flown_settings();  // ARSPD 10..25 m/s, TRIM_ARSPD_CM 16.5 m/s
+    EXPECT_EQ(flight::coordination_airspeed_cm_s(s.flight, 2100), 2100);
+    EXPECT_EQ(flight::coordination_airspeed_cm_s(s.flight, 1), 1000) << "at least ARSPD_FBW_MIN";
+    EXPECT_EQ(flight::coordination_airspeed_cm_s(s.flight, 0), 1650) << "no pitot: the cruise speed";
+    s.flight.trim_arspd_cm = 0;
+    EXPECT_EQ(flight::coordination_airspeed_cm_s(s.flight, 0), 1750) << "nor a cruise speed: the mean";
+    s.flight.trim_arspd_cm = 1650;
+
+    // In STABILIZE, a banked attitude with the sticks centred. A pitot reading v flies as a
+    // board without one whose cruise speed is v (the coordination's only input that differs),
+    // step for step while v changes; and a slower measured airspeed asks more up elevator.
+    Rig measured, cruise, slow;
+    measured.s = s;
+    slow.s = s;
+    for (Rig* r : {&measured, &cruise, &slow}) {
+        if (r == &cruise) r->s = s;
+        r->rc[7] = 2000;  // STABILIZE
+        r->fc.configure();
+    }
+    const uint16_t speeds[] = {1200, 2400, 1800, 1800, 1000, 3000, 1500};
+    int checked = 0;
+    for (uint32_t t = 0; t < 7000; t += 20) {
+        const uint16_t v = speeds[(t / 500) % 7];
+        if (cruise.s.flight.trim_arspd_cm != v) {  // the twin's cruise speed follows (configure: afresh)
+            cruise.s.flight.trim_arspd_cm = v;
+            cruise.fc.configure();
+        }
+        const flight::Attitude att{4000 + (int32_t)(t % 300), 300, 500, -200, true, v};
+        flight::Attitude none = att;
+        none.airspeed_cm_s = 0;
+        flight::Attitude at_min = att;
+        at_min.airspeed_cm_s = 1000;  // ARSPD_FBW_MIN
+        measured.fc.on_frame(measured.rc, t);
+        cruise.fc.on_frame(cruise.rc, t);
+        slow.fc.on_frame(slow.rc, t);
+        measured.fc.step(t, att, measured.out);
+        cruise.fc.step(t, none, cruise.out);
+        slow.fc.step(t, at_min, slow.out);
+        if (t % 500 == 0) continue;  // the twin's configure() restarted its integrators
+        ASSERT_EQ(measured.out[1], cruise.out[1]) << "t " << t << " v " << v;
+        if (v > 1000) {
+            EXPECT_GT(slow.out[1], measured.out[1]) << "t " << t << " v " << v;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 200);
 }

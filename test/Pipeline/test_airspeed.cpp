@@ -34,20 +34,20 @@ TEST(AirspeedSensor, CountsToAirspeedWithTheMeasuredZero) {
 
 namespace {
 
-// The cruise speed of a board without a sensor (TRIM_ARSPD_CM): off by default, in cm/s
-// within ArduPlane's 0..5000, kept by the settings record.
-TEST(AirspeedSensor, TrimAirspeedParameterDefaultsOffAndRoundTrips) {
+// The cruise speed of a board without a sensor (TRIM_ARSPD_CM): on by default (a default
+// of 0 spirals in sustained turns), in cm/s within ArduPlane's 0..5000, kept by the record.
+TEST(AirspeedSensor, TrimAirspeedParameterDefaultsOnAndRoundTrips) {
     settings::Settings s = settings::defaults();
     const int16_t p = params::find("TRIM_ARSPD_CM");
     ASSERT_GE(p, 0);
-    EXPECT_EQ(s.flight.trim_arspd_cm, 0u);
+    EXPECT_EQ(s.flight.trim_arspd_cm, 1500u);
     EXPECT_FALSE(params::set(s, (uint16_t)p, 5001.0f));
     EXPECT_FALSE(params::set(s, (uint16_t)p, -1.0f));
     EXPECT_TRUE(params::set(s, (uint16_t)p, 1800.0f));
     uint8_t bytes[settings::kFlightBytes];
     params::encode_flight(s, bytes);
     settings::Settings back = settings::defaults();
-    params::decode_flight(bytes, back);
+    params::decode_flight(bytes, settings::kFlightBytes, back);
     EXPECT_EQ(back.flight.trim_arspd_cm, 1800u);
 }
 

@@ -61,7 +61,7 @@ TEST(FlightParams, SetChecksRangeWholenessAndEndPointOrder) {
     EXPECT_NEAR(params::get(s, dec), 0.1f, 1e-4f);
 }
 
-TEST(FlightParams, RecordVersion3RoundTripsAndVersion2StillLoads) {
+TEST(FlightParams, RecordVersion4RoundTripsAndVersion2StillLoads) {
     EXPECT_EQ(params::flight_bytes(), settings::kFlightBytes);
     settings::Settings in = settings::defaults();
     in.rate_hz = 20;
@@ -70,7 +70,7 @@ TEST(FlightParams, RecordVersion3RoundTripsAndVersion2StillLoads) {
     ASSERT_TRUE(params::set(in, (uint16_t)params::find("RC3_MIN"), 1050.0f));
     uint8_t rec[settings::kRecordSize];
     settings::encode(in, rec);
-    EXPECT_EQ(rec[2], 3);
+    EXPECT_EQ(rec[2], 4);
     settings::Settings out;
     ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
     for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(params::get(out, i), params::get(in, i)) << i;
@@ -101,11 +101,54 @@ TEST(FlightParams, RecordVersion3RoundTripsAndVersion2StillLoads) {
     EXPECT_TRUE(up.cal.mag_offset_uT == old.cal.mag_offset_uT);
     EXPECT_EQ(up.flags, settings::kFlagMagCalibrated | settings::kFlagUpgraded);
     EXPECT_FLOAT_EQ(up.flight.roll.p, 1.0f) << "flight settings at defaults";
-    // Saved again: version 3, the upgrade flag not stored.
+    // Saved again: this version, the upgrade flag not stored.
     settings::encode(up, rec);
     ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
     EXPECT_EQ(out.flags, settings::kFlagMagCalibrated);
     // A v2 record with a bad CRC is refused, never misread.
     v2[10] ^= 0x40;
     EXPECT_EQ(settings::decode(v2, up), settings::LoadResult::BadCrc);
+}
+
+// TRIM_PITCH_CD: ArduPlane's name, centi-degrees within +-45 deg, 0 by default; the last
+// flight row, so that a version 3 record (without it) loads whole with it at its default.
+TEST(FlightParams, TrimPitchIsNewInVersion4AndVersion3StillLoads) {
+    settings::Settings s = settings::defaults();
+    const int16_t p = params::find("TRIM_PITCH_CD");
+    ASSERT_GE(p, 0);
+    EXPECT_EQ(s.flight.trim_pitch_cd, 0);
+    EXPECT_FALSE(params::set(s, (uint16_t)p, 4501.0f));
+    EXPECT_FALSE(params::set(s, (uint16_t)p, -4501.0f));
+    EXPECT_FALSE(params::set(s, (uint16_t)p, 12.5f));
+    EXPECT_TRUE(params::set(s, (uint16_t)p, -140.0f));
+    EXPECT_EQ(s.flight.trim_pitch_cd, -140);
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("SERVO8_MAX"), 1900.0f));  // the last row before it
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("RC2_REVERSED"), 1.0f));
+    s.rate_hz = 20;
+    uint8_t rec[settings::kRecordSize];
+    settings::encode(s, rec);
+    settings::Settings out;
+    ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
+    EXPECT_EQ(out.flight.trim_pitch_cd, -140);
+
+    // The same settings as version 3 wrote them: its payload is this one's first part.
+    uint8_t v3[settings::kRecordSize];
+    std::memcpy(v3, rec, sizeof v3);
+    v3[2] = 3;
+    v3[3] = settings::kV3PayloadLength;
+    const uint16_t crc = settings::crc16(v3, 4 + settings::kV3PayloadLength);
+    v3[4 + settings::kV3PayloadLength] = (uint8_t)(crc & 0xFF);
+    v3[5 + settings::kV3PayloadLength] = (uint8_t)(crc >> 8);
+    settings::Settings up;
+    ASSERT_EQ(settings::decode(v3, up), settings::LoadResult::Ok);
+    EXPECT_EQ(up.flags & settings::kFlagUpgraded, 0);
+    EXPECT_EQ(up.flight.trim_pitch_cd, 0) << "not in version 3: its default";
+    for (uint16_t i = 0; i < params::count(); ++i)
+        if ((int16_t)i != p) EXPECT_EQ(params::get(up, i), params::get(s, i)) << i;
+    // Version 3's length with another version byte, or version 3's byte with this length: refused.
+    v3[2] = 4;
+    const uint16_t crc4 = settings::crc16(v3, 4 + settings::kV3PayloadLength);
+    v3[4 + settings::kV3PayloadLength] = (uint8_t)(crc4 & 0xFF);
+    v3[5 + settings::kV3PayloadLength] = (uint8_t)(crc4 >> 8);
+    EXPECT_EQ(settings::decode(v3, up), settings::LoadResult::OldVersion);
 }

@@ -32,6 +32,27 @@ GROUP is one of:
                   TRIM_ARSPD_CM set to the trim speed (18 m/s) on the console before it: the
                   board says it has no airspeed sensor and takes the set; the worst roll error
                   (DIR/turn_cruise_bank.csv) under 5 deg (issue 24) and every bank finite
+  turn45_default  DEFAULT settings and no pitot, light gusts: the stick held for a 45 deg bank for
+                  60 s, then centred for 15 s: the board says the cruise speed it assumes
+                  (TRIM_ARSPD_CM), the aeroplane stays above 50 m (of 100) throughout, the true
+                  bank is within 45 +- 12 deg from 10 s into the turn to its end, and within 8 deg
+                  of level from 10 s after the roll-out
+  rc_loss_turn    DEFAULT settings and no pitot, light gusts: 20 s into a 45 deg turn the receiver
+                  dies: from 15 s into the failsafe to 25 s the TRUE bank is within 5 deg of level
+                  (not only the estimate) and the aeroplane is in the air
+  pitch_trim      still air, hands off in STABILIZE for 60 s with TRIM_PITCH_CD set to the model's
+                  trim (1.4 deg, typed on the console): the true pitch holds within 0.5 deg of it
+                  and the height within 3 m of the start (at 0 the model sinks 0.3 m/s)
+  climb_pitch     with the pitot, light gusts: full throttle, the stick for a 30 deg bank and 10 deg
+                  of pitch (the airspeed doubles): from 10 s into the climb to 25 s the true pitch
+                  stays within 3 deg of 10 (the pitch integrator takes up the elevator the
+                  speed needs)
+  restart_air     the board powers up in the air (no launch stand: a brown-out in flight) at cruise
+                  in light gusts, the pitot fed: its start-up gyro calibration never sees it still,
+                  so it takes no pitot zero (which would read the flight's dynamic pressure as
+                  none) and says so; from 10 s to 20 s the roll within 3 deg of the truth and the
+                  pitch within 5 (the aim is 3: the pitch estimate reads the aeroplane's
+                  acceleration after the restart as nose up, and lags it by ~3 deg at 10 s)
   determinism     the same flight twice: the same bytes on the serial line and the servo log
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
@@ -62,6 +83,10 @@ GUST_NAMES = {0: "no", 1: "light", 2: "moderate"}
 # power setting flies faster, the honest mismatch of a configured speed).
 TURN_SENSOR_MAX_DEG, TURN_CRUISE_MAX_DEG = 2.0, 5.0
 TRIM_ARSPD_CM = 1800
+DEFAULT_TRIM_ARSPD_CM = 1500  # lib/Settings/Params.cpp: the cruise speed a board assumes unless set
+# The pitch the Rascal flies level at its trim speed (the backend's trim: alpha 1.40 deg),
+# what set-up step 6 reads in MANUAL and sets as TRIM_PITCH_CD.
+MODEL_TRIM_PITCH_CD = 140
 
 
 def row(t, roll=1500, pitch=1500, throttle=THROTTLE_US, yaw=1500, mode=STABILIZE):
@@ -84,7 +109,7 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=()):
+                 console=(), hold=HOLD_S):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
         board (apm25sim --input: from its first angle line)."""
         self.name, self.seconds = name, seconds
@@ -95,7 +120,7 @@ class Flight:
         cmd = [sys.executable, CLOSED_LOOP, "--rc", self.rc, "--seconds", "%g" % seconds, "--gust", str(gust),
                "--seed", str(seed), "--stamp", "--out", self.serial_path, "--log", self.log_path,
                "--servo-log", self.servo_path, "--sim", os.path.join(tools, "apm25sim"),
-               "--elf", os.path.join(tools, "firmware.elf"), "--timeout", "2300", "--hold", "%g" % HOLD_S]
+               "--elf", os.path.join(tools, "firmware.elf"), "--timeout", "2300", "--hold", "%g" % hold]
         for u in upsets:
             cmd += ["--upset", u]
         if not airspeed:
@@ -374,6 +399,116 @@ def check_turn_cruise(args):
                 "configured cruise speed only (under %g)" % (worst[1], TURN_CRUISE_MAX_DEG))
 
 
+def fly_default_turn(args, name, rows, seconds, seed):
+    """A flight on the default settings without a pitot in light gusts; the aeroplane's
+    lowest height from the release and whether the board said its cruise speed."""
+    f = Flight(args.work, name, rows, seconds, gust=1, tools=args.tools, seed=seed, airspeed=False)
+    said = f.said("# airspeed: no sensor on A0")
+    soft_assert(said is not None and said[1] == "# airspeed: no sensor on A0: cruise speed TRIM_ARSPD_CM %.2f m/s "
+                "assumed" % (DEFAULT_TRIM_ARSPD_CM / 100.0), "%s: the board did not say its cruise speed: %r" % (name, said))
+    flying = f.truth_between(HOLD_S, seconds)
+    lowest = min((-r["down_m"] for r in flying), default=float("nan"))
+    return f, lowest
+
+
+def check_turn45_default(args):
+    t_turn = HOLD_S + 2.0
+    t_out = t_turn + 60.0
+    seconds = t_out + 15.0
+    rows = [row(0.0), row(t_turn, stick_for_bank(45), throttle=THROTTLE_US + 40), row(t_out)]
+    f, lowest = fly_default_turn(args, "turn45_default", rows, seconds, seed=4401)
+    in_turn = [abs(r["roll_deg"]) for r in f.truth_between(t_turn + 10.0, t_out)]
+    after = [abs(r["roll_deg"]) for r in f.truth_between(t_out + 10.0, seconds)]
+    print("turn45_default: lowest %.1f m (from 100); true bank %.1f-%.1f deg from 10 s into the turn; |bank| <= %.1f "
+          "deg from 10 s after the roll-out" % (lowest, min(in_turn, default=float("nan")),
+                                                 max(in_turn, default=float("nan")), max(after, default=float("nan"))))
+    soft_assert(lowest > 50.0, "turn45_default: down to %.1f m (above 50)" % lowest)
+    soft_assert(in_turn and 33.0 <= min(in_turn) and max(in_turn) <= 57.0,
+                "turn45_default: the true bank left 45 +- 12 deg in the turn")
+    soft_assert(after and max(after) <= 8.0, "turn45_default: %.1f deg of true bank after the roll-out"
+                % max(after, default=float("nan")))
+
+
+def check_rc_loss_turn(args):
+    t_turn = HOLD_S + 2.0
+    t_lost = t_turn + 20.0
+    seconds = t_lost + 25.0
+    rows = [row(0.0), row(t_turn, stick_for_bank(45), throttle=THROTTLE_US + 40), (t_lost, None)]
+    f, lowest = fly_default_turn(args, "rc_loss_turn", rows, seconds, seed=4402)
+    said = f.said("# failsafe: receiver lost", t_lost)
+    soft_assert(said is not None, "rc_loss_turn: no failsafe")
+    bank_at_loss = f.truth_at(t_lost)["roll_deg"] if f.truth_at(t_lost) else float("nan")
+    t_fs = said[0] if said else t_lost
+    late = f.truth_between(t_fs + 15.0, t_lost + 25.0)
+    worst = max((abs(r["roll_deg"]) for r in late), default=float("nan"))
+    est = [abs(e[1]) for e in f.estimates() if t_fs + 15.0 <= e[0] < t_lost + 25.0]
+    print("rc_loss_turn: true bank %.1f deg at the loss; from 15 s into the failsafe: true |bank| <= %.1f deg, "
+          "estimated <= %.1f deg; lowest %.1f m" % (bank_at_loss, worst, max(est, default=float("nan")), lowest))
+    soft_assert(abs(bank_at_loss) > 35.0, "rc_loss_turn: only %.1f deg of bank at the loss" % bank_at_loss)
+    soft_assert(late and worst <= 5.0, "rc_loss_turn: true bank %.1f deg in the failsafe (within 5 of level)" % worst)
+    soft_assert(lowest > 5.0, "rc_loss_turn: down to %.1f m" % lowest)
+
+
+def check_pitch_trim(args):
+    seconds = HOLD_S + 60.0
+    f = Flight(args.work, "pitch_trim", [row(0.0)], seconds, tools=args.tools,
+               console=["set TRIM_PITCH_CD %d" % MODEL_TRIM_PITCH_CD])
+    said = f.said("# TRIM_PITCH_CD")
+    soft_assert(said is not None and said[1] == "# TRIM_PITCH_CD %d" % MODEL_TRIM_PITCH_CD,
+                "pitch_trim: TRIM_PITCH_CD not set: %r" % (said,))
+    start = f.truth_at(HOLD_S + 5.0)
+    hold = f.truth_between(HOLD_S + 5.0, seconds)
+    soft_assert(start is not None and len(hold) > 1000, "pitch_trim: no true state")
+    if start is None or len(hold) <= 1000:
+        return
+    pitch_err = max(abs(r["pitch_deg"] - MODEL_TRIM_PITCH_CD / 100.0) for r in hold)
+    drift = max(abs(-r["down_m"] + start["down_m"]) for r in hold)
+    print("pitch_trim: from 5 s after the release, true pitch within %.2f deg of %.2f, height within %.2f m"
+          % (pitch_err, MODEL_TRIM_PITCH_CD / 100.0, drift))
+    soft_assert(pitch_err <= 0.5, "pitch_trim: the true pitch %.2f deg off the trim" % pitch_err)
+    soft_assert(drift <= 3.0, "pitch_trim: the height moved %.1f m in still air" % drift)
+
+
+def check_climb_pitch(args):
+    t_climb = HOLD_S + 2.0
+    seconds = t_climb + 25.0
+    pitch_stick = round(1500 + 500 * 10.0 / 25.0)  # LIM_PITCH_MAX 2500: full stick is 25 deg
+    rows = [row(0.0), row(t_climb, stick_for_bank(30), pitch_stick, 2000)]
+    f = Flight(args.work, "climb_pitch", rows, seconds, gust=1, tools=args.tools, seed=4403)
+    held = f.truth_between(t_climb + 10.0, seconds)
+    soft_assert(len(held) > 1000, "climb_pitch: no true state")
+    if len(held) <= 1000:
+        return
+    lo, hi = min(r["pitch_deg"] for r in held), max(r["pitch_deg"] for r in held)
+    fast = max(r["airspeed_m_s"] for r in held)
+    print("climb_pitch: from 10 s into the climb, true pitch %.1f-%.1f deg (10 commanded), airspeed up to %.1f m/s"
+          % (lo, hi, fast))
+    soft_assert(fast > 27.0, "climb_pitch: only %.1f m/s: not the full-power climb" % fast)
+    soft_assert(lo >= 7.0 and hi <= 13.0, "climb_pitch: true pitch %.1f-%.1f deg, not within 3 of 10" % (lo, hi))
+
+
+def check_restart_air(args):
+    seconds = 20.0
+    f = Flight(args.work, "restart_air", [row(0.0)], seconds, gust=1, tools=args.tools, seed=4404, hold=0.0)
+    said = f.said("# airspeed:")
+    soft_assert(said is not None and said[1].startswith("# airspeed: the board was moving at start") and
+                "TRIM_ARSPD_CM" in said[1], "restart_air: the board did not refuse the pitot's zero: %r" % (said,))
+    worst_roll = worst_pitch = 0.0
+    n = 0
+    for t, roll, pitch, _ in f.estimates():
+        truth = f.truth_at(t)
+        if t < 10.0 or truth is None:
+            continue
+        n += 1
+        worst_roll = max(worst_roll, abs(angle_diff(roll, truth["roll_deg"])))
+        worst_pitch = max(worst_pitch, abs(pitch - truth["pitch_deg"]))
+    print("restart_air: the board said %r; from 10 s, roll within %.1f deg and pitch within %.1f deg of the truth"
+          % (said[1] if said else None, worst_roll, worst_pitch))
+    soft_assert(n > 400, "restart_air: only %d attitude lines from 10 s" % n)
+    soft_assert(worst_roll <= 3.0, "restart_air: roll %.1f deg off the truth (within 3)" % worst_roll)
+    soft_assert(worst_pitch <= 5.0, "restart_air: pitch %.1f deg off the truth (within 5)" % worst_pitch)
+
+
 def check_determinism(args):
     rows = [row(0.0), row(HOLD_S + 0.5, 1700), row(HOLD_S + 1.5)]
     a = Flight(args.work, "determinism_a", rows, HOLD_S + 2.5, gust=1, tools=args.tools)
@@ -389,7 +524,9 @@ def check_determinism(args):
 
 GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
-          "determinism": check_determinism}
+          "determinism": check_determinism, "turn45_default": check_turn45_default,
+          "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
+          "restart_air": check_restart_air}
 
 
 def main():
