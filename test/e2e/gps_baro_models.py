@@ -9,7 +9,7 @@ Checks (each prints 'ok NAME' or 'FAIL NAME: why'; the exit status is 1 if any f
   undisturbed    the firmware, which uses neither part yet, prints exactly the same bytes at
                  the same instants with the models attached (and faulted) as without them;
                  the MS5611 saw no transaction, the firmware sent nothing to the GPS
-  probe          a small AVR program (support/gps_baro_probe.cpp) talks to both parts through
+  probe          a small AVR program (support/avr/gps_baro_probe.cpp) talks to both parts through
                  simavr as a driver would: the PROM and its CRC-4, a read before the end of
                  a conversion (0), D1/D2 that the datasheet's arithmetic turns into the
                  standard atmosphere's pressure at the field, NMEA at 9600 (garbage at
@@ -127,7 +127,7 @@ def build_probe(work):
              '-fno-rtti', '-DDECIMAL_DIG=__DECIMAL_DIG__', '-I' + ARDUINO_AVR + '/cores/arduino',
              '-I' + ARDUINO_AVR + '/variants/mega', '-I' + ARDUINO_AVR + '/libraries/SPI/src']
     tmp = elf + '.tmp.%d' % os.getpid()
-    r = run(['avr-g++'] + flags + [os.path.join(HERE, 'support', 'gps_baro_probe.cpp'), os.path.join(core, 'avr', 'core.a'),
+    r = run(['avr-g++'] + flags + [os.path.join(HERE, 'support', 'avr', 'gps_baro_probe.cpp'), os.path.join(core, 'avr', 'core.a'),
                                    '-Wl,--gc-sections', '-fuse-linker-plugin', '-lm', '-o', tmp])
     if r.returncode != 0:
         raise Failure('the probe did not build: ' + r.stderr[-2000:])
