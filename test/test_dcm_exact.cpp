@@ -164,7 +164,7 @@ TEST(DcmExact, TheTurnTermTakesTheCalibratedBiasOffInRoundedCounts) {
         turn.configure(2048, 4096);  // about 18 m/s
         OneWindow w;
         for (uint8_t i = 0; i < n; ++i) w.gravity.add(gyro_counts, accel_counts);
-        w.gravity.take_off_turn(turn, Vector3l(0, 0, 1 << 30), sensor_bias_units, false);  // level
+        w.gravity.subtract_turn(turn, Vector3l(0, 0, 1 << 30), sensor_bias_units, false);  // level
         ASSERT_TRUE(w.gravity.low_pass_window(linalg::q30_from_matrix(Matrix3f::identity()), 0, Vector3l(),
                                               sensor_bias_units, false, 0.0f, w.k, w.gyro_mean, w.accel_mean, w.whole));
         EXPECT_EQ(w.accel_mean.x, 0) << (int)n;

@@ -321,7 +321,7 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     const bool hold_integrator = rotating_fast_ || start_holds_integrator();
     // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
     if (turn_ != nullptr && turn_->active())
-        gravity_.take_off_turn(*turn_, strapdown_.r().c, bias_.sensor_units(), starting);
+        gravity_.subtract_turn(*turn_, strapdown_.r().c, bias_.sensor_units(), starting);
     Vector3l gyro_mean, accel_mean;
     bool whole_window = false;
     if (gravity_.low_pass_window(strapdown_.r(), strapdown_.pending_steps(), offset_units_, bias_.sensor_units(), starting,

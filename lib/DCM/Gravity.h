@@ -36,15 +36,15 @@ public:
     }
     // The turn's centripetal acceleration off the window's accel sums (Centripetal.h),
     // from its gyro sums less the calibrated bias (units) and earth down in body axes
-    // (R's third row, Q30); start_tilt: the start-up's (TurnMean::take_off).
-    void take_off_turn(TurnMean& turn, const linalg::Vector3l& down_q30, const linalg::Vector3l& sensor_bias_units,
+    // (R's third row, Q30); start_tilt: the start-up's (TurnMean::subtract_from_window).
+    void subtract_turn(TurnMean& turn, const linalg::Vector3l& down_q30, const linalg::Vector3l& sensor_bias_units,
                        bool start_tilt) {
         const uint8_t n = window_samples_;
         if (n == 0) return;
         // The calibrated bias in counts, rounded (units are counts * 2^8).
         const int32_t bias_y = (sensor_bias_units.y + 128) >> 8, bias_z = (sensor_bias_units.z + 128) >> 8;
-        turn.take_off(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), down_q30, n, accel_sum_,
-                      accel_sum_of_sums_, start_tilt);
+        turn.subtract_from_window(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), down_q30, n,
+                                  accel_sum_, accel_sum_of_sums_, start_tilt);
     }
     // The window into the earth-frame low-pass (R body to earth, the steps not yet
     // integrated, what the step subtracts and the calibrated bias, in units); the window's
