@@ -37,7 +37,6 @@ int32_t row_times(const Vector3l& row, const linalg::Vector3i& v) {
 Dcm::Dcm(const DcmSettings& settings) : settings_(&settings) { k_.from_settings(settings); }
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
-    if (!bias.is_finite()) return;
     bias_.set_estimate_rad_s(bias, k_);
     update_offset();
 }
@@ -48,7 +47,6 @@ Vector3f Dcm::last_mag_field() const { return field_uT_of(last_field_q5_); }
 
 
 void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
-    if (!bias.is_finite()) return;
     bias_.set_sensor_rad_s(bias, k_);
     update_offset();
 }
@@ -220,10 +218,9 @@ void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok,
     if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
     if (!gyro_ok) {
         status_ |= kStatusGyroRejected;
-        rotating_fast_ = true;  // a broken gyro read: no bias learning on it (below, correct_gravity)
+        bias_.hold_for_broken_sample();  // no bias learning on a broken gyro read
     }
-    // Start-up (steps_ < k_.startup_steps): no bias learning but after a never-still start (correct_gravity).
-    if (rotating_fast_ || start_holds_integrator()) status_ |= kStatusBiasHeld;
+    if (bias_.integrator_held(steps_ < k_.startup_steps, start_from_mean_)) status_ |= kStatusBiasHeld;
 
     // Gravity. The specific force is low-passed in the (estimated) earth frame, as
     // VQF does: there a linear acceleration averages out over the filter's time,
@@ -275,21 +272,10 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
 #if DCM_TRACE
     const Vector3f before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif
-    bias_.follow_rest_mean(rest_.gyro_mean(), k_);
-    bias_.set_measured();
+    bias_.learn_at_rest(rest_.gyro_mean(), k_);
 #if DCM_TRACE
     if (trace_) trace_->bias_from_rest_rad_s += traced_bias_rad_s() - before;
 #endif
-}
-
-// The start's tilt error is not a gyro bias (a wrong first sample, a launch off the
-// stand): the integrator waits for the start-up to end. Except after a start that was
-// never still: its gravity is the window's mean, and the bias that nothing measured
-// (the saved calibration's, or none: the chip's +-20 deg/s) is what gravity has to
-// learn first; while it waits, the proportional loop holds b / kp of tilt (1.5 deg at
-// 1.5 deg/s) and the dip turns it into 2.5 times as much heading.
-bool Dcm::start_holds_integrator() const {
-    return steps_ < k_.startup_steps && !(start_from_mean_ && !bias_.measured());
 }
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
@@ -308,17 +294,11 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     // the loop a 3 s low-pass makes its answer slow and ringing (second order, damping
     // 1 / (2 sqrt(kp tau)): 0.29 at 3 s, 1 at 0.25 s).
     const float tilt_startup_left = start_from_mean_ ? 0.0f : startup_left;
-    // No bias learning while rotating fast: gyro scale errors look like bias there
-    // (ArduPilot's rule), and a vehicle's turn holds a centripetal acceleration the
-    // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is
-    // the turn that lasts, the 0.5 s mean rate of the rest test: a scale error on a
-    // vibration (an 8 Hz wobble at 50 deg/s) makes an error that averages out, while a
-    // hand's or a vehicle's turn does not: the instantaneous rate would hold the
-    // integrator through every wobble of a board that is never still, and its bias would
-    // go unlearned. A rejected gyro sample in the window holds it too (take_sample()).
+    // The bias integrator's holds (GyroBias): the turn that lasts, the rest test's mean
+    // rate less the estimate; a rejected gyro sample in the window; the start-up.
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
-    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
-    const bool hold_integrator = rotating_fast_ || start_holds_integrator();
+    bias_.judge_rotation(mean_off_bias, (status_ & kStatusGyroRejected) != 0, k_);
+    const bool hold_integrator = bias_.integrator_held(starting, start_from_mean_);
     // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
     if (turn_ != nullptr && turn_->active())
         gravity_.subtract_turn(*turn_, strapdown_.r().c, bias_.sensor_units(), starting);
@@ -522,14 +502,11 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     using linalg::q14_of;
     strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
                                  linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
-    // The compass teaches the bias only while nothing else has measured it (DcmSettings.h).
-    if (!rotating_fast_ && !starting && !bias_.measured() && settings_->ki_yaw_1_s2 != 0.0f) {
+    // The compass's integral, while nothing else has measured the bias (GyroBias).
 #if DCM_TRACE
-        const Vector3f bias_before = trace_ ? traced_bias_rad_s() : Vector3f();
+    const Vector3f bias_before = trace_ ? traced_bias_rad_s() : Vector3f();
 #endif
-        const Vector3f error = linalg::vector_from_q30(strapdown_.r().c) * -heading_error;
-        bias_.subtract_fine(linalg::fixed_from_vector(
-            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0), k_);
+    if (bias_.learn_from_heading(strapdown_.r().c, heading_error, steps, starting, *settings_, k_)) {
         update_offset();
 #if DCM_TRACE
         if (trace_) trace_->bias_from_heading_rad_s += traced_bias_rad_s() - bias_before;

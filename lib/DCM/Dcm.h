@@ -22,7 +22,7 @@
 //   Gravity.h        GravityCorrection      accel window, earth-frame low-pass, roll/pitch (VQF's updateAcc)
 //   Centripetal.h    TurnMean               the turn's centripetal acceleration off the window (AP's DCM, airspeed)
 //   Rest.h           RestDetector           rest detection (VQF's rest, Fusion's FusionOffset)
-//   GyroBias.h       GyroBias               the calibrated bias and the estimate
+//   GyroBias.h       GyroBias               the calibrated bias, the estimate and what may teach it when
 //   Heading.h        EarthFieldMean,        the heading's mean and the disturbance gate (VQF's updateMag)
 //                    MagneticGate
 //   Euler.h          euler_*                the output angles
@@ -236,8 +236,6 @@ private:
     linalg::Vector3f last_mag_field() const;
     void recover();
     bool accel_plausible(const linalg::Vector3f& a) const;
-    // The start-up holds the bias integrator (correct_gravity).
-    bool start_holds_integrator() const;
 
     // The settings (not a copy: 84 bytes of RAM; they must outlive the estimator, as
     // kDefaultDcmSettings and a tool's own set do) and what follows from them, once.
@@ -263,7 +261,6 @@ private:
     uint16_t heading_mean_from_ = 0;     // the step the start's heading mean began at
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
-    bool rotating_fast_ = false;
     bool start_from_mean_ = false;       // init's gravity_is_mean
 #if DCM_TRACE
     DcmTrace* trace_ = nullptr;          // set_trace (host only)
