@@ -269,13 +269,9 @@ void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, con
     const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
     if (!rest_.update(gyro_mean, accel_mean, mean_off_bias, whole_window, compass_watching, k_)) return;
     status_ |= kStatusAtRest;
-#if DCM_TRACE
-    const Vector3f before = trace_ ? traced_bias_rad_s() : Vector3f();
-#endif
+    trace().bias_before(bias_, k_);
     bias_.learn_at_rest(rest_.gyro_mean(), k_);
-#if DCM_TRACE
-    if (trace_) trace_->bias_from_rest_rad_s += traced_bias_rad_s() - before;
-#endif
+    trace().bias_after(BiasSource::kRest, bias_, k_);
 }
 
 // The gravity correction: the accel window low-passed in earth axes, the rest test,
@@ -307,25 +303,10 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     if (gravity_.low_pass_window(strapdown_.r(), strapdown_.pending_steps(), offset_units_, bias_.sensor_units(), starting,
                                  startup_left, k_, gyro_mean, accel_mean, whole_window))
         detect_rest(gyro_mean, accel_mean, mean_off_bias, whole_window);
-#if DCM_TRACE
-    Vector3f bias_before;
-    if (trace_) {
-        // The low-pass's direction against earth down, as correct_tilt sees it, in float.
-        const Vector3f lp = gravity_.low_pass_ef().scaled(k_.accel_m_s2_per_count * (1.0f / 256.0f));
-        const float lp_norm = sqrtf(lp.length_squared());
-        const bool direction = lp_norm > 0.5f * kGravity_m_s2;
-        trace_->gravity = direction ? GravityEvent::kRan : GravityEvent::kNoDirection;
-        trace_->integrator_held = hold_integrator;
-        trace_->gravity_kp_1_s = settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * tilt_startup_left;
-        trace_->tilt_error_n_rad = direction ? -lp.y / lp_norm : 0.0f;
-        trace_->tilt_error_e_rad = direction ? lp.x / lp_norm : 0.0f;
-        bias_before = traced_bias_rad_s();
-    }
-#endif
+    trace().gravity(gravity_.low_pass_ef(), hold_integrator, tilt_startup_left, *settings_, k_);
+    trace().bias_before(bias_, k_);
     gravity_.correct_tilt(strapdown_.r(), tilt_startup_left, hold_integrator, *settings_, k_, bias_);
-#if DCM_TRACE
-    if (trace_) trace_->bias_from_gravity_rad_s += traced_bias_rad_s() - bias_before;
-#endif
+    trace().bias_after(BiasSource::kGravity, bias_, k_);
     update_offset();
     profile::end(profile::kGravity);
 }
@@ -418,14 +399,7 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     field_mean_.take(field_ef, norm2);
     status_ |= kStatusMagIgnored;
     const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
-#if DCM_TRACE
-    if (trace_) {
-        trace_->heading = HeadingEvent::kTooVertical;
-        trace_->heading_error_deg = atan2f(field_ef.y, field_ef.x) * (1.0f / linalg::kRadPerDeg);
-        trace_->field_norm_uT = sqrtf(norm2);
-        trace_->field_dip_deg = asinf(fminf(1.0f, fmaxf(-1.0f, field_ef.z / sqrtf(norm2)))) * (1.0f / linalg::kRadPerDeg);
-    }
-#endif
+    trace().heading_mean(field_ef, norm2);
     if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
     // (The integer inverse square root, to 1e-4: no sqrtf and no division, the float
     // library's dearest calls on the AVR.)
@@ -445,15 +419,10 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     // board never looks the same twice, so it never gets in.
     const FieldVerdict verdict =
         gate_.judge(norm, down_component, interval_steps, sample_dt, last_rate_units(), *settings_, k_);
-#if DCM_TRACE
-    if (trace_) {
-        trace_->heading = verdict == FieldVerdict::kDisturbed ? HeadingEvent::kDisturbed
-                          : verdict == FieldVerdict::kNewField ? HeadingEvent::kNewField
-                                                               : HeadingEvent::kUsed;
-        trace_->ref_norm_uT = gate_.ref_norm();
-        trace_->ref_dip_deg = asinf(fminf(1.0f, fmaxf(-1.0f, gate_.ref_down()))) * (1.0f / linalg::kRadPerDeg);
-    }
-#endif
+    const HeadingEvent event = verdict == FieldVerdict::kDisturbed  ? HeadingEvent::kDisturbed
+                               : verdict == FieldVerdict::kNewField ? HeadingEvent::kNewField
+                                                                    : HeadingEvent::kUsed;
+    trace().heading(event, gate_.ref_norm(), gate_.ref_down());
     if (verdict == FieldVerdict::kDisturbed) return;
     status_ &= (uint8_t)~kStatusMagIgnored;
     if (verdict == FieldVerdict::kNewField) {
@@ -503,14 +472,10 @@ FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
     strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
                                  linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
     // The compass's integral, while nothing else has measured the bias (GyroBias).
-#if DCM_TRACE
-    const Vector3f bias_before = trace_ ? traced_bias_rad_s() : Vector3f();
-#endif
+    trace().bias_before(bias_, k_);
     if (bias_.learn_from_heading(strapdown_.r().c, heading_error, steps, starting, *settings_, k_)) {
+        trace().bias_after(BiasSource::kHeading, bias_, k_);
         update_offset();
-#if DCM_TRACE
-        if (trace_) trace_->bias_from_heading_rad_s += traced_bias_rad_s() - bias_before;
-#endif
     }
 }
 

@@ -180,7 +180,7 @@ public:
 #if DCM_TRACE
     // What the corrections do, step by step, into *trace (null: none): host tools only
     // (Trace.h); the firmware has no trace and the estimate does not depend on one.
-    void set_trace(DcmTrace* trace) { trace_ = trace; }
+    void set_trace(DcmTrace* trace) { trace_ = TraceHook(trace); }
 #endif
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const {
@@ -262,10 +262,13 @@ private:
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool start_from_mean_ = false;       // init's gravity_is_mean
+    // The trace's one hook (Trace.h), handed to the parts in their context: set_trace's
+    // on the host; on the AVR an empty one, which takes no byte of Dcm.
 #if DCM_TRACE
-    DcmTrace* trace_ = nullptr;          // set_trace (host only)
-    // The bias estimate now, for the trace's split of its changes by source.
-    linalg::Vector3f traced_bias_rad_s() const { return bias_.estimate_rad_s(k_); }
+    TraceHook trace() const { return trace_; }
+    TraceHook trace_;
+#else
+    static TraceHook trace() { return TraceHook(); }
 #endif
 };
 
