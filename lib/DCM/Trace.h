@@ -32,7 +32,7 @@ enum class GravityEvent : uint8_t {
     kNoDirection,   // the low-pass shorter than g/2: no correction (zero)
 };
 
-// Which way the heading correction went on a step (HeadingCorrection::add_sample).
+// Which way the heading correction went on a step.
 enum class HeadingEvent : uint8_t {
     kNotDue,        // no complete field mean this step
     kTooVertical,   // the mean field within ~6 deg of vertical: no heading from it
@@ -102,10 +102,14 @@ public:
         trace_->field_dip_deg =
             (float)asinf(fminf(1.0f, fmaxf(-1.0f, field_ef.z / (float)sqrtf(norm2)))) * (1.0f / linalg::kRadPerDeg);
     }
-    // The gate's verdict on it, and the learned field's strength (uT) and dip (its sine).
-    void heading(HeadingEvent event, float ref_norm_uT, float ref_down) const {
+    // The gate's verdict on it (MagneticGate's FieldVerdict: a template, as Heading.h
+    // includes this file), and the learned field's strength (uT) and dip (its sine).
+    template <class Verdict>
+    void heading(Verdict verdict, float ref_norm_uT, float ref_down) const {
         if (trace_ == nullptr) return;
-        trace_->heading = event;
+        trace_->heading = verdict == Verdict::kDisturbed  ? HeadingEvent::kDisturbed
+                          : verdict == Verdict::kNewField ? HeadingEvent::kNewField
+                                                          : HeadingEvent::kUsed;
         trace_->ref_norm_uT = ref_norm_uT;
         trace_->ref_dip_deg = (float)asinf(fminf(1.0f, fmaxf(-1.0f, ref_down))) * (1.0f / linalg::kRadPerDeg);
     }
