@@ -168,20 +168,19 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
 }
 
 
-// The step as ArduPilot's update() reads: the sample into the sums, then at most one
-// heavy part (HeavySchedule): the strapdown integration (matrix_update), the gravity
-// correction with the rest test and the bias (drift_correction), or the
-// renormalisation (normalize, with check_matrix's rebuild).
+// The step as ArduPilot's AP_AHRS_DCM::update() reads: the sample into the sums, then
+// at most one heavy part (HeavySchedule). The heading has its own call, when a field
+// sample arrives (correct_heading).
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
     const HeavyPart heavy = next_heavy_part(line_due);
-    take_sample(gyro, accel, gyro_ok, accel_ok);
+    take_sample(gyro, accel, gyro_ok, accel_ok);     // the checks; into the gravity window and the turn
     heavy_ = HeavySchedule::blocks(heavy);
     if (heavy == HeavyPart::kIntegration) {
-        strapdown_.integrate(k_);
+        strapdown_.integrate(k_);                    // matrix_update: R <- R exp([theta x])
     } else if (heavy == HeavyPart::kGravity) {
-        correct_gravity();
+        correct_gravity();                           // drift_correction's roll/pitch, the rest test, the bias
     } else if (heavy == HeavyPart::kRenormalisation) {
-        if (!strapdown_.renormalise()) recover();
+        if (!strapdown_.renormalise()) recover();    // normalize, check_matrix's rebuild
     }
     if (steps_ < 0xFFFFu) ++steps_;
 }
@@ -237,50 +236,53 @@ void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok,
 // Rest detection (RestDetector) and, at rest, the bias estimate from the rest mean.
 // A steady turn passes the deviation test too: the compass tells (correct_heading
 // watches the field) while one delivers.
-void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, const Vector3l& mean_off_bias,
-                      bool whole_window) {
+void Dcm::detect_rest(const WindowMeans& window, const Vector3l& mean_off_bias) {
     status_ &= (uint8_t)~kStatusAtRest;
     const bool compass_watching = heading_.sample_recent() && !(status_ & kStatusNoHeading);
-    if (!rest_.update(gyro_mean, accel_mean, mean_off_bias, whole_window, compass_watching, k_)) return;
+    if (!rest_.update(window.gyro, window.accel, mean_off_bias, window.whole, compass_watching, k_)) return;
     status_ |= kStatusAtRest;
     trace().bias_before(bias_, k_);
     bias_.learn_at_rest(rest_.gyro_mean(), k_);
     trace().bias_after(BiasSource::kRest, bias_, k_);
 }
 
-// The gravity correction: the accel window low-passed in earth axes, the rest test,
-// and the roll/pitch error (correct_tilt).
+// What the gravity correction reads: R, the turn not yet integrated, the offsets, and
+// where the start-up ramp is. The start-up's fast gain (kp_startup) pulls in a start
+// from one sample, whatever the moment's acceleration put in it. A start from a mean
+// (the still calibration's, a never-still window's: Pipeline) is as good as gravity
+// gets; a fast gain would only follow the accelerations since (a gust's 2-3 m/s^2 at
+// 5/s: degrees of tilt within 0.3 s, 2.5 times as much heading through the dip). The
+// low-pass's start-up ramp stays: a bias nothing measured turns the estimate from the
+// first step, and inside the loop a 3 s low-pass makes its answer slow and ringing
+// (second order, damping 1 / (2 sqrt(kp tau)): 0.29 at 3 s, 1 at 0.25 s).
+FIXED_INLINE GravityContext Dcm::gravity_context() {
+    const bool starting = steps_ < k_.startup_steps;
+    const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
+    const float tilt_startup_left = start_from_mean_ ? 0.0f : startup_left;
+    return GravityContext{*settings_, k_, strapdown_.r(), strapdown_.pending_steps(), offset_units_,
+                          bias_.sensor_units(), starting, startup_left, tilt_startup_left, trace()};
+}
+
+// The gravity correction (drift_correction's roll and pitch): the bias integrator's
+// holds, the turn's acceleration off the window, the window into the earth-frame
+// low-pass and the rest test, and the roll/pitch error (GravityCorrection).
 FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
     schedule_.gravity_done();
-    const bool starting = steps_ < k_.startup_steps;
-    const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
-    // The start-up's fast gain (kp_startup) pulls in a start from one sample, whatever the
-    // moment's acceleration put in it. A start from a mean (the still calibration's, a
-    // never-still window's: Pipeline) is as good as gravity gets; a fast gain would only
-    // follow the accelerations since (a gust's 2-3 m/s^2 at 5/s: degrees of tilt within
-    // 0.3 s, 2.5 times as much heading through the dip). The low-pass's start-up ramp
-    // stays: a bias nothing measured turns the estimate from the first step, and inside
-    // the loop a 3 s low-pass makes its answer slow and ringing (second order, damping
-    // 1 / (2 sqrt(kp tau)): 0.29 at 3 s, 1 at 0.25 s).
-    const float tilt_startup_left = start_from_mean_ ? 0.0f : startup_left;
+    const GravityContext context = gravity_context();
     // The bias integrator's holds (GyroBias): the turn that lasts, the rest test's mean
     // rate less the estimate; a rejected gyro sample in the window; the start-up.
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     bias_.judge_rotation(mean_off_bias, (status_ & kStatusGyroRejected) != 0, k_);
-    const bool hold_integrator = bias_.integrator_held(starting, start_from_mean_);
+    const bool hold_integrator = bias_.integrator_held(context.starting, start_from_mean_);
     // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
-    if (turn_ != nullptr && turn_->active())
-        gravity_.subtract_turn(*turn_, strapdown_.r().c, bias_.sensor_units(), starting);
-    Vector3l gyro_mean, accel_mean;
-    bool whole_window = false;
-    if (gravity_.low_pass_window(strapdown_.r(), strapdown_.pending_steps(), offset_units_, bias_.sensor_units(), starting,
-                                 startup_left, k_, gyro_mean, accel_mean, whole_window))
-        detect_rest(gyro_mean, accel_mean, mean_off_bias, whole_window);
-    trace().gravity(gravity_.low_pass_ef(), hold_integrator, tilt_startup_left, *settings_, k_);
-    trace().bias_before(bias_, k_);
-    gravity_.correct_tilt(strapdown_.r(), tilt_startup_left, hold_integrator, *settings_, k_, bias_);
-    trace().bias_after(BiasSource::kGravity, bias_, k_);
+    if (turn_ != nullptr && turn_->active()) gravity_.subtract_turn(*turn_, context);
+    // The window into the earth-frame low-pass, its means into the rest test.
+    WindowMeans window;
+    if (gravity_.low_pass_window(context, window)) detect_rest(window, mean_off_bias);
+    // The low-pass's direction against earth down: the roll/pitch correction, and its
+    // integral into the bias unless held.
+    gravity_.correct_tilt(context, hold_integrator, bias_);
     update_offset();
     profile::end(profile::kGravity);
 }

@@ -211,6 +211,8 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
+    // What the gravity correction reads (Gravity.h).
+    GravityContext gravity_context();
     void update_offset();
     // What the heading correction reads and turns (Heading.h).
     HeadingContext heading_context() {
@@ -228,8 +230,7 @@ private:
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
     linalg::Vector3f last_rate_rad_s() const;
     // mean_off_bias: the rest test's gyro mean less the bias estimate (the hold test's too).
-    void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean,
-                     const linalg::Vector3l& mean_off_bias, bool whole_window);
+    void detect_rest(const WindowMeans& window, const linalg::Vector3l& mean_off_bias);
     linalg::Vector3f last_mag_field() const;
     void recover();
     bool accel_plausible(const linalg::Vector3f& a) const;

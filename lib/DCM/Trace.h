@@ -74,7 +74,8 @@ struct DcmTrace {
 class TraceHook {
 public:
 #if DCM_TRACE
-    explicit TraceHook(DcmTrace* trace = nullptr) : trace_(trace) {}
+    TraceHook() : trace_(nullptr) {}
+    explicit TraceHook(DcmTrace* trace) : trace_(trace) {}
 #endif
 
     // A gravity correction about to turn the estimate: the low-pass (earth axes, accel
