@@ -16,8 +16,9 @@ replacement (never by line number: the files change; an inserted line's "origina
 left out of the sample and the score.
 
 Not mutated: lines the host does not compile (#ifdef __AVR__ blocks; the trace's
-#if DCM_TRACE blocks, host-only instrumentation for replay, built with DCM_TRACE=0), preprocessor
-lines, comment lines, mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
+#if DCM_TRACE blocks, host-only instrumentation for replay, built with DCM_TRACE=0), the calls
+of the trace's hook (one line each: `trace().NAME(...);`, `c.trace.NAME(...);`, which return at
+once with DCM_TRACE=0), preprocessor lines, comment lines, mutants that only rename an identifier (int32_t -> int(32+1)_t: they do
 not compile), mutants that only move blanks or swap the arguments of a commutative
 product (mul_q30, mul_s16, mul_u16: the same tokens), and lib/DCM/Trace.h (the trace's
 record). A mutant that does not compile is not counted either.
@@ -179,10 +180,15 @@ def link(out_bin, objs):
 # ---------------------------------------------------------------------------
 # Mutants: universalmutator's, less what the host never compiles.
 
+# A call of the trace's hook (lib/DCM/Trace.h, TraceHook), one statement on one line:
+# instrumentation, which returns at once in the build with -DDCM_TRACE=0.
+TRACE_HOOK_CALL = re.compile(r"^(\w+\.)?trace(\(\))?\.\w+\(.*\);$")
+
+
 def host_lines(path):
     """Line numbers (1-based) the host compiles: outside #ifdef __AVR__ ... #else/#endif
     and the trace's #if DCM_TRACE blocks (left out of the build: -DDCM_TRACE=0), and not
-    preprocessor lines."""
+    preprocessor lines nor the trace hook's calls."""
     keep = set()
     stack = []  # for each open #if: True when its current branch is AVR-only
     for n, line in enumerate(open(path), 1):
@@ -200,6 +206,8 @@ def host_lines(path):
             continue
         if s.startswith("//") or s.startswith("/*") or s.startswith("*"):
             continue  # a comment: a mutant of it is the same program
+        if TRACE_HOOK_CALL.match(s):
+            continue  # the trace's hook: instrumentation, not the estimator
         if not any(stack):
             keep.add(n)
     return keep

@@ -77,8 +77,8 @@ public:
     // they stand for (one window's rate, held, would alias a vibration at 25 Hz or its
     // multiples into a steady term); dV/dt every eighth window (6.25 Hz: a climb's pace).
     // Each is kept for the windows between.
-    void take_off(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
-                  linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums, bool start_tilt) {
+    void subtract_from_window(int32_t rate_y_sum, int32_t rate_z_sum, const linalg::Vector3l& down_q30, uint8_t n,
+                              linalg::Vector3l& accel_sum, linalg::Vector3l& accel_sum_of_sums, bool start_tilt) {
         const uint8_t window = windows_++;
         rate_y_means_ += per_sample(rate_y_sum, n);
         rate_z_means_ += per_sample(rate_z_sum, n);
@@ -87,30 +87,30 @@ public:
         // Sample j's weight in the running sums' sum is n - j + 1, n (n + 1) / 2 in all:
         // the window's term (n samples' worth) times (n + 1) / 2, 10 samples' worth for 4.
         if (n == 4) {
-            take_off_four(term_.x, accel_sum.x, accel_sum_of_sums.x);
-            take_off_four(term_.y, accel_sum.y, accel_sum_of_sums.y);
-            take_off_four(term_.z, accel_sum.z, accel_sum_of_sums.z);
+            subtract_four(term_.x, accel_sum.x, accel_sum_of_sums.x);
+            subtract_four(term_.y, accel_sum.y, accel_sum_of_sums.y);
+            subtract_four(term_.z, accel_sum.z, accel_sum_of_sums.z);
         } else {
-            take_off_late(term_.x, n, accel_sum.x, accel_sum_of_sums.x);
-            take_off_late(term_.y, n, accel_sum.y, accel_sum_of_sums.y);
-            take_off_late(term_.z, n, accel_sum.z, accel_sum_of_sums.z);
+            subtract_late(term_.x, n, accel_sum.x, accel_sum_of_sums.x);
+            subtract_late(term_.y, n, accel_sum.y, accel_sum_of_sums.y);
+            subtract_late(term_.z, n, accel_sum.z, accel_sum_of_sums.z);
         }
     }
 
 private:
-    static void take_off_term(int32_t term, int32_t term_weighted, int32_t& sum, int32_t& sum_of_sums) {
+    static void subtract_term(int32_t term, int32_t term_weighted, int32_t& sum, int32_t& sum_of_sums) {
         sum -= term;
         sum_of_sums -= term_weighted;
     }
     // The usual window's 4 samples (a sample's term, counts).
-    static void take_off_four(int16_t term, int32_t& sum, int32_t& sum_of_sums) {
+    static void subtract_four(int16_t term, int32_t& sum, int32_t& sum_of_sums) {
         const int32_t term4 = (int32_t)term * 4;
-        take_off_term(term4, term4 * 2 + (term4 >> 1), sum, sum_of_sums);
+        subtract_term(term4, term4 * 2 + (term4 >> 1), sum, sum_of_sums);
     }
     // A late window's n samples.
-    static void take_off_late(int16_t term, uint8_t n, int32_t& sum, int32_t& sum_of_sums) {
+    static void subtract_late(int16_t term, uint8_t n, int32_t& sum, int32_t& sum_of_sums) {
         const int32_t term_n = times_n(term, n);
-        take_off_term(term_n, (times_n(term_n, n) + term_n) >> 1, sum, sum_of_sums);
+        subtract_term(term_n, (times_n(term_n, n) + term_n) >> 1, sum, sum_of_sums);
     }
     // a = f + g down on one axis (f_sum the accelerometer's sum there, down_q30 earth
     // down's component) and the margin, each summed over the window's n samples.
@@ -122,7 +122,7 @@ private:
     int32_t lateral_sum(int32_t raw_sum, int32_t f_y_sum, int32_t down_y_q30, uint8_t n);
     // The lateral and normal terms from the means since the last update (four samples'
     // worth of them), dV/dt from this window's sums (f_sum: the accelerometer's) on every
-    // eighth window (window: the count of this one); start_tilt: take_off's.
+    // eighth window (window: the count of this one); start_tilt: subtract_from_window's.
     void update(const linalg::Vector3l& down_q30, uint8_t n, const linalg::Vector3l& f_sum, uint8_t window,
                 bool start_tilt);
     // dV/dt within its bound (f_x_sum: the accelerometer's x).

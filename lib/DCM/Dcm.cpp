@@ -10,34 +10,9 @@ using linalg::Matrix3f;
 using linalg::Vector3f;
 using linalg::Vector3l;
 
-namespace {
-
-// A mag correction stands for the time since the previous sample, but never more
-// than this many steps (after an outage the first sample must not make a jump).
-constexpr uint16_t kMaxMagIntervalSteps = 20;
-// A field sample's wait before it is used, counted in its latency up to this (steps).
-constexpr uint8_t kMaxMagAgeSteps = 2;
-// A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
-constexpr uint16_t kRestCompassSteps = 20;
-
-// Q26 radians in Q16 (2^-10, rounded), saturated at +-0.5 rad.
-int16_t q16_of(int32_t x_q26) {
-    const int32_t q16 = linalg::opaque((x_q26 + 512) >> 8) >> 2;  // a byte, then two bits
-    return (int16_t)(q16 > 32767 ? 32767 : (q16 < -32767 ? -32767 : q16));
-}
-// A Q21 change of a Q5 field in Q5 (rounded): the two high bytes.
-int16_t q5_of(int32_t x_q21) { return (int16_t)((x_q21 + 0x8000) >> 16); }
-int32_t row_times(const Vector3l& row, const linalg::Vector3i& v) {
-    using linalg::q14_of;
-    return linalg::mul_s16(q14_of(row.x), v.x) + linalg::mul_s16(q14_of(row.y), v.y) + linalg::mul_s16(q14_of(row.z), v.z);
-}
-
-}  // namespace
-
 Dcm::Dcm(const DcmSettings& settings) : settings_(&settings) { k_.from_settings(settings); }
 
 void Dcm::set_gyro_bias_rad_s(const Vector3f& bias) {
-    if (!bias.is_finite()) return;
     bias_.set_estimate_rad_s(bias, k_);
     update_offset();
 }
@@ -48,7 +23,6 @@ Vector3f Dcm::last_mag_field() const { return field_uT_of(last_field_q5_); }
 
 
 void Dcm::set_sensor_bias_rad_s(const Vector3f& bias) {
-    if (!bias.is_finite()) return;
     bias_.set_sensor_rad_s(bias, k_);
     update_offset();
 }
@@ -106,7 +80,7 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field, bool gravi
                                           (int16_t)linalg::fixed_from_float(kept.y, kFieldQ),
                                           (int16_t)linalg::fixed_from_float(kept.z, kFieldQ));
         const float norm = mag_field.length();
-        gate_.learn(norm, field_down / norm);
+        heading_.learn_field(norm, field_down / norm);
     }
     strapdown_.reset(linalg::q30_from_matrix(Matrix3f(north, down.cross(north), down)));
     // The integer factors of the scales, unless set_sample_scales set them (the float
@@ -115,11 +89,9 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field, bool gravi
     const float per_m_s2 = k_.accel_units_per_m_s2;
     gravity_.reset(linalg::fixed_from_float(-kGravity_m_s2 * per_m_s2, 0));
     update_offset();
-    gate_.restart_steady_count();
-    field_mean_.clear();
+    heading_.restart();
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
-    heading_mean_from_ = 0;
     start_from_mean_ = gravity_is_mean;
     status_ |= kStatusInitialised;
     return true;
@@ -196,20 +168,19 @@ void Dcm::update(const linalg::Vector3i& gyro_counts, const linalg::Vector3i& ac
 }
 
 
-// The step as ArduPilot's update() reads: the sample into the sums, then at most one
-// heavy part (HeavySchedule): the strapdown integration (matrix_update), the gravity
-// correction with the rest test and the bias (drift_correction), or the
-// renormalisation (normalize, with check_matrix's rebuild).
+// The step as ArduPilot's AP_AHRS_DCM::update() reads: the sample into the sums, then
+// at most one heavy part (HeavySchedule). The heading has its own call, when a field
+// sample arrives (correct_heading).
 void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due) {
     const HeavyPart heavy = next_heavy_part(line_due);
-    take_sample(gyro, accel, gyro_ok, accel_ok);
+    take_sample(gyro, accel, gyro_ok, accel_ok);     // the checks; into the gravity window and the turn
     heavy_ = HeavySchedule::blocks(heavy);
     if (heavy == HeavyPart::kIntegration) {
-        strapdown_.integrate(k_);
+        strapdown_.integrate(k_);                    // matrix_update: R <- R exp([theta x])
     } else if (heavy == HeavyPart::kGravity) {
-        correct_gravity();
+        correct_gravity();                           // drift_correction's roll/pitch, the rest test, the bias
     } else if (heavy == HeavyPart::kRenormalisation) {
-        if (!strapdown_.renormalise()) recover();
+        if (!strapdown_.renormalise()) recover();    // normalize, check_matrix's rebuild
     }
     if (steps_ < 0xFFFFu) ++steps_;
 }
@@ -217,13 +188,12 @@ void Dcm::step(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool a
 // The sample's checks (status), then into the gravity window and the strapdown's turn.
 void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok, bool accel_ok) {
     status_ &= (uint8_t)~(kStatusAccelIgnored | kStatusBiasHeld | kStatusGyroRejected);
-    if (steps_since_mag_ < 0xFFFF) ++steps_since_mag_;
+    heading_.count_step();
     if (!gyro_ok) {
         status_ |= kStatusGyroRejected;
-        rotating_fast_ = true;  // a broken gyro read: no bias learning on it (below, correct_gravity)
+        bias_.hold_for_broken_sample();  // no bias learning on a broken gyro read
     }
-    // Start-up (steps_ < k_.startup_steps): no bias learning but after a never-still start (correct_gravity).
-    if (rotating_fast_ || start_holds_integrator()) status_ |= kStatusBiasHeld;
+    if (bias_.integrator_held(steps_ < k_.startup_steps, start_from_mean_)) status_ |= kStatusBiasHeld;
 
     // Gravity. The specific force is low-passed in the (estimated) earth frame, as
     // VQF does: there a linear acceleration averages out over the filter's time,
@@ -266,86 +236,53 @@ void Dcm::take_sample(const Vector3l& gyro, const Vector3l& accel, bool gyro_ok,
 // Rest detection (RestDetector) and, at rest, the bias estimate from the rest mean.
 // A steady turn passes the deviation test too: the compass tells (correct_heading
 // watches the field) while one delivers.
-void Dcm::detect_rest(const Vector3l& gyro_mean, const Vector3l& accel_mean, const Vector3l& mean_off_bias,
-                      bool whole_window) {
+void Dcm::detect_rest(const WindowMeans& window, const Vector3l& mean_off_bias) {
     status_ &= (uint8_t)~kStatusAtRest;
-    const bool compass_watching = steps_since_mag_ < kRestCompassSteps && !(status_ & kStatusNoHeading);
-    if (!rest_.update(gyro_mean, accel_mean, mean_off_bias, whole_window, compass_watching, k_)) return;
+    const bool compass_watching = heading_.sample_recent() && !(status_ & kStatusNoHeading);
+    if (!rest_.update(window.gyro, window.accel, mean_off_bias, window.whole, compass_watching, k_)) return;
     status_ |= kStatusAtRest;
-#if DCM_TRACE
-    const Vector3f before = trace_ ? traced_bias_rad_s() : Vector3f();
-#endif
-    bias_.follow_rest_mean(rest_.gyro_mean(), k_);
-    bias_.set_measured();
-#if DCM_TRACE
-    if (trace_) trace_->bias_from_rest_rad_s += traced_bias_rad_s() - before;
-#endif
+    trace().bias_before(bias_, k_);
+    bias_.learn_at_rest(rest_.gyro_mean(), k_);
+    trace().bias_after(BiasSource::kRest, bias_, k_);
 }
 
-// The start's tilt error is not a gyro bias (a wrong first sample, a launch off the
-// stand): the integrator waits for the start-up to end. Except after a start that was
-// never still: its gravity is the window's mean, and the bias that nothing measured
-// (the saved calibration's, or none: the chip's +-20 deg/s) is what gravity has to
-// learn first; while it waits, the proportional loop holds b / kp of tilt (1.5 deg at
-// 1.5 deg/s) and the dip turns it into 2.5 times as much heading.
-bool Dcm::start_holds_integrator() const {
-    return steps_ < k_.startup_steps && !(start_from_mean_ && !bias_.measured());
+// What the gravity correction reads: R, the turn not yet integrated, the offsets, and
+// where the start-up ramp is. The start-up's fast gain (kp_startup) pulls in a start
+// from one sample, whatever the moment's acceleration put in it. A start from a mean
+// (the still calibration's, a never-still window's: Pipeline) is as good as gravity
+// gets; a fast gain would only follow the accelerations since (a gust's 2-3 m/s^2 at
+// 5/s: degrees of tilt within 0.3 s, 2.5 times as much heading through the dip). The
+// low-pass's start-up ramp stays: a bias nothing measured turns the estimate from the
+// first step, and inside the loop a 3 s low-pass makes its answer slow and ringing
+// (second order, damping 1 / (2 sqrt(kp tau)): 0.29 at 3 s, 1 at 0.25 s).
+FIXED_INLINE GravityContext Dcm::gravity_context() {
+    const bool starting = steps_ < k_.startup_steps;
+    const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
+    const float tilt_startup_left = start_from_mean_ ? 0.0f : startup_left;
+    return GravityContext{*settings_, k_, strapdown_.r(), strapdown_.pending_steps(), offset_units_,
+                          bias_.sensor_units(), starting, startup_left, tilt_startup_left, trace()};
 }
 
-// The gravity correction: the accel window low-passed in earth axes, the rest test,
-// and the roll/pitch error (correct_tilt).
+// The gravity correction (drift_correction's roll and pitch): the bias integrator's
+// holds, the turn's acceleration off the window, the window into the earth-frame
+// low-pass and the rest test, and the roll/pitch error (GravityCorrection).
 FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::begin(profile::kGravity);
     schedule_.gravity_done();
-    const bool starting = steps_ < k_.startup_steps;
-    const float startup_left = starting ? 1.0f - (float)steps_ * k_.inv_startup_steps : 0.0f;
-    // The start-up's fast gain (kp_startup) pulls in a start from one sample, whatever the
-    // moment's acceleration put in it. A start from a mean (the still calibration's, a
-    // never-still window's: Pipeline) is as good as gravity gets; a fast gain would only
-    // follow the accelerations since (a gust's 2-3 m/s^2 at 5/s: degrees of tilt within
-    // 0.3 s, 2.5 times as much heading through the dip). The low-pass's start-up ramp
-    // stays: a bias nothing measured turns the estimate from the first step, and inside
-    // the loop a 3 s low-pass makes its answer slow and ringing (second order, damping
-    // 1 / (2 sqrt(kp tau)): 0.29 at 3 s, 1 at 0.25 s).
-    const float tilt_startup_left = start_from_mean_ ? 0.0f : startup_left;
-    // No bias learning while rotating fast: gyro scale errors look like bias there
-    // (ArduPilot's rule), and a vehicle's turn holds a centripetal acceleration the
-    // accelerometer reads as tilt (DcmSettings.h, integrator_hold_rate). What counts is
-    // the turn that lasts, the 0.5 s mean rate of the rest test: a scale error on a
-    // vibration (an 8 Hz wobble at 50 deg/s) makes an error that averages out, while a
-    // hand's or a vehicle's turn does not: the instantaneous rate would hold the
-    // integrator through every wobble of a board that is never still, and its bias would
-    // go unlearned. A rejected gyro sample in the window holds it too (take_sample()).
+    const GravityContext context = gravity_context();
+    // The bias integrator's holds (GyroBias): the turn that lasts, the rest test's mean
+    // rate less the estimate; a rejected gyro sample in the window; the start-up.
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
-    rotating_fast_ = (status_ & kStatusGyroRejected) != 0 || exceeds(mean_off_bias, k_.hold_rate);
-    const bool hold_integrator = rotating_fast_ || start_holds_integrator();
+    bias_.judge_rotation(mean_off_bias, (status_ & kStatusGyroRejected) != 0, k_);
+    const bool hold_integrator = bias_.integrator_held(context.starting, start_from_mean_);
     // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
-    if (turn_ != nullptr && turn_->active())
-        gravity_.take_off_turn(*turn_, strapdown_.r().c, bias_.sensor_units(), starting);
-    Vector3l gyro_mean, accel_mean;
-    bool whole_window = false;
-    if (gravity_.low_pass_window(strapdown_.r(), strapdown_.pending_steps(), offset_units_, bias_.sensor_units(), starting,
-                                 startup_left, k_, gyro_mean, accel_mean, whole_window))
-        detect_rest(gyro_mean, accel_mean, mean_off_bias, whole_window);
-#if DCM_TRACE
-    Vector3f bias_before;
-    if (trace_) {
-        // The low-pass's direction against earth down, as correct_tilt sees it, in float.
-        const Vector3f lp = gravity_.low_pass_ef().scaled(k_.accel_m_s2_per_count * (1.0f / 256.0f));
-        const float lp_norm = sqrtf(lp.length_squared());
-        const bool direction = lp_norm > 0.5f * kGravity_m_s2;
-        trace_->gravity = direction ? GravityEvent::kRan : GravityEvent::kNoDirection;
-        trace_->integrator_held = hold_integrator;
-        trace_->gravity_kp_1_s = settings_->kp_rp_1_s + (settings_->kp_startup_1_s - settings_->kp_rp_1_s) * tilt_startup_left;
-        trace_->tilt_error_n_rad = direction ? -lp.y / lp_norm : 0.0f;
-        trace_->tilt_error_e_rad = direction ? lp.x / lp_norm : 0.0f;
-        bias_before = traced_bias_rad_s();
-    }
-#endif
-    gravity_.correct_tilt(strapdown_.r(), tilt_startup_left, hold_integrator, *settings_, k_, bias_);
-#if DCM_TRACE
-    if (trace_) trace_->bias_from_gravity_rad_s += traced_bias_rad_s() - bias_before;
-#endif
+    if (turn_ != nullptr && turn_->active()) gravity_.subtract_turn(*turn_, context);
+    // The window into the earth-frame low-pass, its means into the rest test.
+    WindowMeans window;
+    if (gravity_.low_pass_window(context, window)) detect_rest(window, mean_off_bias);
+    // The low-pass's direction against earth down: the roll/pitch correction, and its
+    // integral into the bias unless held.
+    gravity_.correct_tilt(context, hold_integrator, bias_);
     update_offset();
     profile::end(profile::kGravity);
 }
@@ -366,17 +303,17 @@ FIXED_COLD Vector3f Dcm::last_rate_rad_s() const { return last_rate_units().scal
 void Dcm::correct_heading(const Vector3f& mag_field, uint8_t age_steps) {
     linalg::Vector3i field;
     if (!field_q5_of(mag_field, field)) {  // beyond any compass: garbage
-        steps_since_mag_ = 0;
+        heading_.take_interval();
         status_ |= kStatusMagIgnored;
         return;
     }
     correct_heading(field, age_steps);
 }
 
-// In integers from here to the mean (~75 Hz): 16 bits, uT * 2^kFieldQ.
+// The sample's checks, the rest test's witness and the start's heading; then the
+// heading correction (HeadingCorrection).
 void Dcm::correct_heading(const linalg::Vector3i& field, uint8_t age_steps) {
-    const uint16_t since_last = steps_since_mag_;
-    steps_since_mag_ = 0;
+    const uint16_t since_last = heading_.take_interval();
     const uint32_t sample_norm2 = field_norm2(field);  // uT^2 * 2^(2 kFieldQ - kNorm2Shift)
     if (sample_norm2 == 0) {
         status_ |= kStatusMagIgnored;
@@ -392,149 +329,15 @@ void Dcm::correct_heading(const linalg::Vector3i& field, uint8_t age_steps) {
         init(last_accel_.scaled(k_.accel_m_s2_per_count), last_mag_field());
         return;
     }
-
-    // The sample is older than the gyro-propagated attitude (the chip's averaging
-    // and the wait for the next step): turn it forward by the rotation since, as a
-    // fixed earth vector seen from the body moves, dm/dt = m x w.
-    // The matrix itself is behind the last sample by the turn not yet integrated: the
-    // field is brought back by that much (a fixed earth vector seen from the body
-    // after a turn p reads v - p x v = v + v x p, so before it v x -p).
-    // Both in the turn sums' units (the rate per step times the latency in steps, Q12,
-    // less the pending turn), then in radians as the integration takes them.
-    const uint8_t age = age_steps < kMaxMagAgeSteps ? age_steps : kMaxMagAgeSteps;
-    const int16_t latency_q12 = (int16_t)(k_.mag_latency_steps_q12 + (int16_t)((uint16_t)age << 12));
-    const Vector3l rate = last_rate_units(), pending = pending_turn_units();
-    const Vector3l turn(linalg::hot::mul_q14(latency_q12, rate.x) * 4 - pending.x, linalg::hot::mul_q14(latency_q12, rate.y) * 4 - pending.y,
-                        linalg::hot::mul_q14(latency_q12, rate.z) * 4 - pending.z);
-    // field + field x turn, the turn in Q16 radians (saturated at 0.5): Q21, then Q5 again.
-    const Vector3l t = k_.theta_q26_coarse(turn);
-    const int16_t tx = q16_of(t.x), ty = q16_of(t.y), tz = q16_of(t.z);
-    using linalg::mul_s16;
-    // The change (Q21) in Q5, then added (a field within 1 000 uT and a turn within
-    // 0.5 rad stay within 16 bits).
-    const linalg::Vector3i field_now(
-        (int16_t)(field.x + q5_of(mul_s16(field.y, tz) - mul_s16(field.z, ty))),
-        (int16_t)(field.y + q5_of(mul_s16(field.z, tx) - mul_s16(field.x, tz))),
-        (int16_t)(field.z + q5_of(mul_s16(field.x, ty) - mul_s16(field.y, tx))));
-    // Tilt compensation: the field in earth axes; its horizontal part points to
-    // magnetic north when the heading is right (eq. 31-33 in vector form).
-    // The samples are averaged in earth axes over kHeadingSteps (a fixed earth field is
-    // the same vector there whatever the board did meanwhile), and the heading is
-    // corrected from their mean: each sample costs the rotation into earth axes, the
-    // correction (the rest of this function) runs at 12.5 Hz.
-    field_mean_.add(Vector3l(row_times(strapdown_.r().a, field_now) >> kEarthFieldShift,
-                             row_times(strapdown_.r().b, field_now) >> kEarthFieldShift,
-                             row_times(strapdown_.r().c, field_now) >> kEarthFieldShift),
-                    sample_norm2, since_last);
-    if (field_mean_.complete()) correct_heading_from_mean();
-}
-
-// The heading's correction from a complete mean (kHeadingSteps steps, 12.5 Hz): out of
-// line (FIXED_OWN_FRAME), so that its float locals stay out of the 75 Hz part's frame.
-FIXED_OWN_FRAME void Dcm::correct_heading_from_mean() {
-    uint16_t interval_steps = field_mean_.steps();
-    Vector3f field_ef;
-    float norm2;
-    field_mean_.take(field_ef, norm2);
-    status_ |= kStatusMagIgnored;
-    const float horizontal2 = field_ef.x * field_ef.x + field_ef.y * field_ef.y;
-#if DCM_TRACE
-    if (trace_) {
-        trace_->heading = HeadingEvent::kTooVertical;
-        trace_->heading_error_deg = atan2f(field_ef.y, field_ef.x) * (1.0f / linalg::kRadPerDeg);
-        trace_->field_norm_uT = sqrtf(norm2);
-        trace_->field_dip_deg = asinf(fminf(1.0f, fmaxf(-1.0f, field_ef.z / sqrtf(norm2)))) * (1.0f / linalg::kRadPerDeg);
-    }
-#endif
-    if (!(horizontal2 > 0.01f * norm2)) return;  // field within ~6 deg of vertical: no heading
-    // (The integer inverse square root, to 1e-4: no sqrtf and no division, the float
-    // library's dearest calls on the AVR.)
-    const float inv_norm = linalg::inverse_sqrt(norm2);
-    const float norm = norm2 * inv_norm;
-    const float down_component = field_ef.z * inv_norm;
-    const float inv_horizontal = linalg::inverse_sqrt(horizontal2);
-    const float sin_error = field_ef.y * inv_horizontal;
-    // The time this sample stands for (the low-passes below are in time, not samples).
-    const float sample_dt = settings_->step_s * (float)(interval_steps < kMaxMagIntervalSteps ? interval_steps : kMaxMagIntervalSteps);
-
-    // Disturbance rejection (as VQF does): a field whose strength or dip differs
-    // from the learned earth field is a magnet or iron nearby, not north, and is not
-    // used; the heading then runs on the gyro. A different field that stays the same
-    // for mag_recover_s is a new environment (the board was moved): it becomes the
-    // reference, and its heading is taken at once. A magnet fixed to a rotating
-    // board never looks the same twice, so it never gets in.
-    const FieldVerdict verdict =
-        gate_.judge(norm, down_component, interval_steps, sample_dt, last_rate_units(), *settings_, k_);
-#if DCM_TRACE
-    if (trace_) {
-        trace_->heading = verdict == FieldVerdict::kDisturbed ? HeadingEvent::kDisturbed
-                          : verdict == FieldVerdict::kNewField ? HeadingEvent::kNewField
-                                                               : HeadingEvent::kUsed;
-        trace_->ref_norm_uT = gate_.ref_norm();
-        trace_->ref_dip_deg = asinf(fminf(1.0f, fmaxf(-1.0f, gate_.ref_down()))) * (1.0f / linalg::kRadPerDeg);
-    }
-#endif
-    if (verdict == FieldVerdict::kDisturbed) return;
-    status_ &= (uint8_t)~kStatusMagIgnored;
-    if (verdict == FieldVerdict::kNewField) {
-        // Its heading at once: R <- Rz(-error) R (the rotation that puts the field's
-        // horizontal part on north).
-        const float cos_error = field_ef.x * inv_horizontal;
-        using linalg::mul_q30;
-        const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
-        const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
-        linalg::Matrix3q30& r = strapdown_.r();
-        const Vector3l north(mul_q30(c, r.a.x) + mul_q30(sn, r.b.x), mul_q30(c, r.a.y) + mul_q30(sn, r.b.y),
-                             mul_q30(c, r.a.z) + mul_q30(sn, r.b.z));
-        r.b = Vector3l(mul_q30(c, r.b.x) - mul_q30(sn, r.a.x), mul_q30(c, r.b.y) - mul_q30(sn, r.a.y),
-                       mul_q30(c, r.b.z) - mul_q30(sn, r.a.z));
-        r.a = north;
-        return;
-    }
-
-    // sin of the heading error, saturated to +-1 beyond 90 deg so it stays monotonic.
-    const float heading_error = field_ef.x >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
-    // The correction is a rotation about earth down by -error: in body axes that
-    // is the third row of R. It stands for the whole interval since the last
-    // correction, so its rate is scaled by interval / step.
-    if (interval_steps > kMaxMagIntervalSteps) interval_steps = kMaxMagIntervalSteps;
-    const float steps = (float)interval_steps;
-    const bool starting = steps_ < k_.startup_steps;
-    // At start, while the board moves, the heading is a constant to find from means that
-    // each carry their moment's tilt error through the dip: the mean of them all since the
-    // start (or since the compass's calibration last moved) is its least-squares estimate,
-    // the gain 1/t (VQF's kMagInit), within the start's kp_startup and the steady kp_yaw.
-    // At rest there is no motion's error to average out, and a gyro bias not yet learned
-    // would make a long mean lag: the start's gain.
-    float gain_1_s = settings_->kp_yaw_1_s;
-    if (starting && (status_ & kStatusAtRest)) {
-        gain_1_s = settings_->kp_startup_1_s;
-    } else if (starting) {
-        const float since_s = (float)(uint16_t)(steps_ - heading_mean_from_) * settings_->step_s;
-        float mean_gain_1_s = 1.0f / (since_s > sample_dt ? since_s : sample_dt);
-        if (mean_gain_1_s > settings_->kp_startup_1_s) mean_gain_1_s = settings_->kp_startup_1_s;
-        if (mean_gain_1_s > gain_1_s) gain_1_s = mean_gain_1_s;
-    }
-    // Into the turn not yet integrated (applied with the next integration): the row in
-    // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
-    // = 2.4e7 units: within 31 bits).
-    const int32_t size_units = linalg::fixed_from_float(-heading_error * gain_1_s * steps * k_.units_per_rad_s, 0);
-    using linalg::q14_of;
-    strapdown_.add_turn(Vector3l(linalg::mul_q14(q14_of(strapdown_.r().c.x), size_units), linalg::mul_q14(q14_of(strapdown_.r().c.y), size_units),
-                                 linalg::mul_q14(q14_of(strapdown_.r().c.z), size_units)));
-    // The compass teaches the bias only while nothing else has measured it (DcmSettings.h).
-    if (!rotating_fast_ && !starting && !bias_.measured() && settings_->ki_yaw_1_s2 != 0.0f) {
-#if DCM_TRACE
-        const Vector3f bias_before = trace_ ? traced_bias_rad_s() : Vector3f();
-#endif
-        const Vector3f error = linalg::vector_from_q30(strapdown_.r().c) * -heading_error;
-        bias_.subtract_fine(linalg::fixed_from_vector(
-            error * (settings_->ki_yaw_1_s2 * settings_->step_s * steps * k_.units_per_rad_s * (float)kTurnScale), 0), k_);
-        update_offset();
-#if DCM_TRACE
-        if (trace_) trace_->bias_from_heading_rad_s += traced_bias_rad_s() - bias_before;
-#endif
-    }
+    // The sample into the heading's mean; a complete mean corrects the heading. (Each call
+    // has its own context: the 75 Hz part's stays in registers.)
+    if (!heading_.add_sample(field, sample_norm2, since_last, age_steps, heading_context())) return;
+    const HeadingResult result = heading_.correct(heading_context());
+    if (result.field_used)
+        status_ &= (uint8_t)~kStatusMagIgnored;
+    else
+        status_ |= kStatusMagIgnored;
+    if (result.bias_learned) update_offset();
 }
 
 EulerQ24 Dcm::euler_now_q24() const {

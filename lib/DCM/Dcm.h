@@ -2,8 +2,8 @@
 // Fixed-step Direction Cosine Matrix attitude estimator with drift correction,
 // after W. Premerlani and P. Bizard, "Direction Cosine Matrix IMU: Theory" (2009): the
 // update (eq. 17, here as an exact rotation: Strapdown.h), the renormalisation (eqs.
-// 18-21), the roll/pitch error (eq. 27: Gravity.h), the heading error (eqs. 31-33,
-// Dcm::correct_heading) and the centripetal term (eq. 26: Centripetal.h).
+// 18-21), the roll/pitch error (eq. 27: Gravity.h), the heading error (eqs. 31-33:
+// Heading.h) and the centripetal term (eq. 26: Centripetal.h).
 //
 // Frames: body x forward, y right, z down; earth north-east-down, referenced to
 // MAGNETIC north (the declination is added only when a heading is reported, so
@@ -22,12 +22,14 @@
 //   Gravity.h        GravityCorrection      accel window, earth-frame low-pass, roll/pitch (VQF's updateAcc)
 //   Centripetal.h    TurnMean               the turn's centripetal acceleration off the window (AP's DCM, airspeed)
 //   Rest.h           RestDetector           rest detection (VQF's rest, Fusion's FusionOffset)
-//   GyroBias.h       GyroBias               the calibrated bias and the estimate
-//   Heading.h        EarthFieldMean,        the heading's mean and the disturbance gate (VQF's updateMag)
+//   GyroBias.h       GyroBias               the calibrated bias, the estimate and what may teach it when
+//   Heading.h        HeadingCorrection      the heading correction with its gate (VQF's updateMag): the
+//                    EarthFieldMean,        field's mean in earth axes, the magnetic disturbance gate
 //                    MagneticGate
+//   Trace.h          TraceHook              what the corrections did, for the host's replay --trace
 //   Euler.h          euler_*                the output angles
-// Dcm keeps the sample's checks, the field sample's latency turn and the heading error
-// (correct_heading), the start-up (TRIAD) and the rebuild.
+// Dcm keeps the samples' checks, the start-up (TRIAD), the rebuild, and the wiring
+// between the parts: what the step subtracts from the gyro, the status.
 //
 // Formats of the integer state (table in Coefficients.h): R Q30; rates and turns in
 // units (gyro counts * 2^8 per step); the bias in fine units (units * 2^8); accel in
@@ -128,8 +130,7 @@ public:
     // start without one (the costly parts): a caller with
     // deferrable work (the compass learner) puts it on another step.
     bool heading_due_next() const {
-        return initialised() && ((status_ & kStatusNoHeading) ||
-                                 field_mean_.complete_after(steps_since_mag_));
+        return initialised() && ((status_ & kStatusNoHeading) || heading_.due_after_next_step());
     }
 
     // The gyro's own turn over `steps` steps from its `counts` summed meanwhile, less the
@@ -143,18 +144,10 @@ public:
     // reference would reject as disturbed); false: the heading is corrected at the usual
     // rate (a learned offset that moved by a few uT: a small, uncertain change that
     // must not turn the heading in one step).
-    void reset_mag_reference(bool take_heading = true) {
-        gate_.forget(take_heading);
-        // The samples waiting for the heading's mean were calibrated the old way. The next
-        // sample closes the mean alone: the heading has run on the gyro meanwhile (the
-        // field was rejected, or the mean dropped), and one sample gives the new reference
-        // and the heading's error at once, a whole mean (40 ms) sooner.
-        field_mean_.restart_with_one_sample();
-        restart_heading_mean();
-    }
+    void reset_mag_reference(bool take_heading = true) { heading_.forget_field(take_heading, steps_); }
     // The compass's calibration moved (a learned offset): during the start the heading's
-    // mean begins again from the next sample (Dcm::correct_heading_from_mean).
-    void restart_heading_mean() { heading_mean_from_ = steps_; }
+    // mean begins again from the next sample (HeadingCorrection::restart_mean).
+    void restart_heading_mean() { heading_.restart_mean(steps_); }
 
     bool initialised() const { return (status_ & kStatusInitialised) != 0; }
     // The last update turned the matrix or worked out the gravity correction (the
@@ -180,7 +173,7 @@ public:
 #if DCM_TRACE
     // What the corrections do, step by step, into *trace (null: none): host tools only
     // (Trace.h); the firmware has no trace and the estimate does not depend on one.
-    void set_trace(DcmTrace* trace) { trace_ = trace; }
+    void set_trace(DcmTrace* trace) { trace_ = TraceHook(trace); }
 #endif
     // Euler angles of R (yaw relative to magnetic north); see Euler.h.
     EulerAngles euler() const {
@@ -218,8 +211,14 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
-    void correct_heading_from_mean();
+    // What the gravity correction reads (Gravity.h).
+    GravityContext gravity_context();
     void update_offset();
+    // What the heading correction reads and turns (Heading.h).
+    HeadingContext heading_context() {
+        return HeadingContext{*settings_, k_, strapdown_, bias_, last_rate_units(), steps_, (status_ & kStatusAtRest) != 0,
+                              trace()};
+    }
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
     // 32x32 routine).
     static int32_t in_turn_units(int32_t counts) {
@@ -231,13 +230,10 @@ private:
     linalg::Vector3l last_rate_units() const;     // the last sample, corrected (turn sums' units per step)
     linalg::Vector3f last_rate_rad_s() const;
     // mean_off_bias: the rest test's gyro mean less the bias estimate (the hold test's too).
-    void detect_rest(const linalg::Vector3l& gyro_mean, const linalg::Vector3l& accel_mean,
-                     const linalg::Vector3l& mean_off_bias, bool whole_window);
+    void detect_rest(const WindowMeans& window, const linalg::Vector3l& mean_off_bias);
     linalg::Vector3f last_mag_field() const;
     void recover();
     bool accel_plausible(const linalg::Vector3f& a) const;
-    // The start-up holds the bias integrator (correct_gravity).
-    bool start_holds_integrator() const;
 
     // The settings (not a copy: 84 bytes of RAM; they must outlive the estimator, as
     // kDefaultDcmSettings and a tool's own set do) and what follows from them, once.
@@ -250,8 +246,7 @@ private:
     GravityCorrection gravity_;          // the accel window, its low-pass and the roll/pitch correction
     TurnMean* turn_ = nullptr;           // the turn's centripetal correction, if flying (set_turn)
     RestDetector rest_;                  // rest, when the gyro reads its bias alone
-    EarthFieldMean field_mean_;          // the field samples in earth axes, for the heading
-    MagneticGate gate_;                  // the disturbance gate: which means are the earth field
+    HeadingCorrection heading_;          // the field's mean, the disturbance gate, the heading's correction
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
     linalg::Vector3l offset_units_;      // sensor bias + bias - correction: what the step subtracts
     linalg::Vector3l last_accel_;        // for a rebuild if the matrix degenerates (counts)
@@ -259,16 +254,16 @@ private:
     linalg::Vector3i last_field_q5_;     // for a rebuild if the matrix degenerates (uT * 2^5)
     bool heavy_ = false;                 // the last update integrated or corrected gravity
     uint16_t steps_ = 0;                 // since init, saturated (the start-up ramp's clock)
-    uint16_t steps_since_mag_ = 0;
-    uint16_t heading_mean_from_ = 0;     // the step the start's heading mean began at
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
-    bool rotating_fast_ = false;
     bool start_from_mean_ = false;       // init's gravity_is_mean
+    // The trace's one hook (Trace.h), handed to the parts in their context: set_trace's
+    // on the host; on the AVR an empty one, which takes no byte of Dcm.
 #if DCM_TRACE
-    DcmTrace* trace_ = nullptr;          // set_trace (host only)
-    // The bias estimate now, for the trace's split of its changes by source.
-    linalg::Vector3f traced_bias_rad_s() const { return bias_.estimate_rad_s(k_); }
+    TraceHook trace() const { return trace_; }
+    TraceHook trace_;
+#else
+    static TraceHook trace() { return TraceHook(); }
 #endif
 };
 

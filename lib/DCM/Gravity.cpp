@@ -53,11 +53,10 @@ void GravityCorrection::rescale(float gyro_ratio, float accel_ratio) {
     if (accel_ratio != 1.0f) lp_ef_ = rescaled(lp_ef_, accel_ratio);
 }
 
-bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pending_steps, const Vector3l& offset_units,
-                                        const Vector3l& sensor_bias_units, bool starting, float startup_left,
-                                        const DcmCoefficients& k, Vector3l& gyro_mean, Vector3l& accel_mean,
-                                        bool& whole_window) {
+bool GravityCorrection::low_pass_window(const GravityContext& c, WindowMeans& means) {
     if (window_samples_ == 0) return false;
+    const DcmCoefficients& k = c.k;
+    const linalg::Matrix3q30& r = c.r;
     using linalg::hot::mul_q14;
     using linalg::mul_q30;
     using linalg::q14_of;
@@ -67,8 +66,8 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     // calibrated bias.
     const Vector3l gyro_raw_mean = per(times_256(gyro_sum_), n, inv_n);
     const Vector3l accel_sum = times_256(accel_sum_);
-    gyro_mean = gyro_raw_mean - sensor_bias_units;
-    accel_mean = per(accel_sum, n, inv_n);
+    means.gyro = gyro_raw_mean - c.sensor_bias_units;
+    means.accel = per(accel_sum, n, inv_n);
     // Sample j of the window meets the matrix of the step before it, R_(j-1) =
     // R (I - [phi_j x]), phi_j = w dt (steps from j-1 to R's time). R is behind this
     // step's sample by the steps not yet integrated (this one among them), so the
@@ -82,20 +81,20 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     // (A subtraction per pending step, a step or two: opaque keeps avr-gcc from making
     // the loop three calls of its 32x32 multiply.)
     Vector3l weighted = accel_sum_of_sums_;
-    for (uint8_t i = pending_steps; i > 0; --i) {
+    for (uint8_t i = c.pending_steps; i > 0; --i) {
         weighted.x = linalg::opaque(weighted.x - accel_sum_.x);
         weighted.y = linalg::opaque(weighted.y - accel_sum_.y);
         weighted.z = linalg::opaque(weighted.z - accel_sum_.z);
     }
     weighted = times_256(weighted);  // |weighted| < 15 * 2^15 counts: within 2^31
-    const Vector3l turn = k.theta_q26_coarse(gyro_raw_mean - offset_units);
+    const Vector3l turn = k.theta_q26_coarse(gyro_raw_mean - c.offset_units);
     const int16_t tx = q14_of(turn.x * 16), ty = q14_of(turn.y * 16), tz = q14_of(turn.z * 16);
     const Vector3l body(accel_sum.x - mul_q14(ty, weighted.z) + mul_q14(tz, weighted.y),
                         accel_sum.y - mul_q14(tz, weighted.x) + mul_q14(tx, weighted.z),
                         accel_sum.z - mul_q14(tx, weighted.y) + mul_q14(ty, weighted.x));
-    const int32_t alpha = starting ? q30_of(k.startup_accel_alpha + (linalg::float_from_fixed(k.accel_alpha_q30, 30) -
-                                                                    k.startup_accel_alpha) * (1.0f - startup_left))
-                                   : k.accel_alpha_q30;
+    const int32_t alpha = c.starting ? q30_of(k.startup_accel_alpha + (linalg::float_from_fixed(k.accel_alpha_q30, 30) -
+                                                                      k.startup_accel_alpha) * (1.0f - c.startup_left))
+                                     : k.accel_alpha_q30;
     // Into earth axes by the matrix in 16 bits (its rounding turns the earth-frame
     // force by 6e-5 rad at most, 0.003 deg of tilt), the mean, and the low-pass.
     const Vector3l accel_ef = per(
@@ -106,13 +105,15 @@ bool GravityCorrection::low_pass_window(const linalg::Matrix3q30& r, uint8_t pen
     lp_ef_ += Vector3l(mul_q30(alpha, accel_ef.x - lp_ef_.x), mul_q30(alpha, accel_ef.y - lp_ef_.y),
                              mul_q30(alpha, accel_ef.z - lp_ef_.z));
 
-    whole_window = n >= kCorrectionDivider;
+    means.whole = n >= kCorrectionDivider;
     clear_window();
     return true;
 }
 
-FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
-                                     const DcmSettings& settings, const DcmCoefficients& k, GyroBias& bias) {
+FIXED_OWN_FRAME void GravityCorrection::tilt_correction(const linalg::Matrix3q30& r, float startup_left,
+                                                        bool hold_integrator, const DcmSettings& settings,
+                                                        const DcmCoefficients& k, GyroBias& bias, TraceHook trace) {
+    trace.gravity(lp_ef_, hold_integrator, startup_left, settings, k);
     using linalg::mul_q30;
     // Earth-frame error: measured down (-lp/|lp|) x earth down (0, 0, 1). |lp|^2 / 2^30
     // in integers (a 256th of its value at least: 1 g is 2^19 units at 16 g full
@@ -150,7 +151,9 @@ FIXED_OWN_FRAME void GravityCorrection::correct_tilt(const linalg::Matrix3q30& r
     const int16_t ex = q14_of(error.x), ey = q14_of(error.y), ez = q14_of(error.z);
     correction_units_ = Vector3l(mul_q14(ex, kp_units), mul_q14(ey, kp_units), mul_q14(ez, kp_units));
     if (!hold_integrator) {
+        trace.bias_before(bias, k);
         bias.integrate_tilt_error(ex, ey, ez, k);
+        trace.bias_after(BiasSource::kGravity, bias, k);
     }
     // The correction turns the estimated earth frame by kp dt error_ef over the
     // next kCorrectionDivider steps: the low-pass state, kept in that frame, turns

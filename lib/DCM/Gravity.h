@@ -20,8 +20,31 @@
 #include "Centripetal.h"
 #include "Coefficients.h"
 #include "GyroBias.h"
+#include "Trace.h"
 
 namespace dcm {
+
+// What the gravity correction reads of the estimator around it, for one correction
+// (built by Dcm; the part keeps no pointer to it).
+struct GravityContext {
+    const DcmSettings& settings;
+    const DcmCoefficients& k;
+    const linalg::Matrix3q30& r;           // R, body to earth
+    uint8_t pending_steps;                 // steps summed, not yet integrated into R
+    const linalg::Vector3l& offset_units;       // what the step subtracts from the gyro (units)
+    const linalg::Vector3l& sensor_bias_units;  // the calibrated bias (units)
+    bool starting;                         // within the start-up (startup_s)
+    float startup_left;                    // the start-up ramp's share still to run (1 at start, 0 after)
+    float tilt_startup_left;               // ... for the tilt's gain: 0 after a start from a mean (Dcm::init)
+    TraceHook trace;                       // what the correction did, for the host's trace
+};
+
+// One window's means, for the rest test.
+struct WindowMeans {
+    linalg::Vector3l gyro;   // the gyro's less the calibrated bias, units
+    linalg::Vector3l accel;  // accel units
+    bool whole;              // a whole window: kCorrectionDivider samples
+};
 
 class GravityCorrection {
 public:
@@ -36,35 +59,36 @@ public:
     }
     // The turn's centripetal acceleration off the window's accel sums (Centripetal.h),
     // from its gyro sums less the calibrated bias (units) and earth down in body axes
-    // (R's third row, Q30); start_tilt: the start-up's (TurnMean::take_off).
-    void take_off_turn(TurnMean& turn, const linalg::Vector3l& down_q30, const linalg::Vector3l& sensor_bias_units,
-                       bool start_tilt) {
+    // (R's third row, Q30); during the start-up a_y's bound leaves the tilt out
+    // (TurnMean::subtract_from_window).
+    void subtract_turn(TurnMean& turn, const GravityContext& c) {
         const uint8_t n = window_samples_;
         if (n == 0) return;
         // The calibrated bias in counts, rounded (units are counts * 2^8).
-        const int32_t bias_y = (sensor_bias_units.y + 128) >> 8, bias_z = (sensor_bias_units.z + 128) >> 8;
-        turn.take_off(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), down_q30, n, accel_sum_,
-                      accel_sum_of_sums_, start_tilt);
+        const int32_t bias_y = (c.sensor_bias_units.y + 128) >> 8, bias_z = (c.sensor_bias_units.z + 128) >> 8;
+        turn.subtract_from_window(gyro_sum_.y - times_n(bias_y, n), gyro_sum_.z - times_n(bias_z, n), c.r.c, n,
+                                  accel_sum_, accel_sum_of_sums_, c.starting);
     }
-    // The window into the earth-frame low-pass (R body to earth, the steps not yet
-    // integrated, what the step subtracts and the calibrated bias, in units); the window's
-    // gyro mean less the calibrated bias (units) and accel mean (accel units) for the rest
-    // test, whole_window when it holds kCorrectionDivider samples. False: no sample.
-    bool low_pass_window(const linalg::Matrix3q30& r, uint8_t pending_steps, const linalg::Vector3l& offset_units,
-                         const linalg::Vector3l& sensor_bias_units, bool starting, float startup_left,
-                         const DcmCoefficients& k, linalg::Vector3l& gyro_mean, linalg::Vector3l& accel_mean,
-                         bool& whole_window);
+    // The window into the earth-frame low-pass, each sample turned to R's time; its means
+    // for the rest test. False: no sample.
+    bool low_pass_window(const GravityContext& c, WindowMeans& means);
     // The low-pass's direction against earth down: the correction (units per step) and,
-    // unless held, the bias's integral; the low-pass turns with the correction.
-    // startup_left: the share of the start-up ramp still to run (1 at start, 0 after).
-    void correct_tilt(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator, const DcmSettings& settings,
-                      const DcmCoefficients& k, GyroBias& bias);
+    // unless held (GyroBias::integrator_held), the bias's integral; the low-pass turns
+    // with the correction.
+    void correct_tilt(const GravityContext& c, bool hold_integrator, GyroBias& bias) {
+        tilt_correction(c.r, c.tilt_startup_left, hold_integrator, c.settings, c.k, bias, c.trace);
+    }
     const linalg::Vector3l& correction_units() const { return correction_units_; }
     const linalg::Vector3l& low_pass_ef() const { return lp_ef_; }
     void rescale(float gyro_ratio, float accel_ratio);
 
 private:
     void clear_window();
+    // correct_tilt's work, out of line, with the context's fields as arguments (in
+    // registers): through the context itself, in memory, every use of a field would
+    // first load it through a pointer.
+    void tilt_correction(const linalg::Matrix3q30& r, float startup_left, bool hold_integrator,
+                         const DcmSettings& settings, const DcmCoefficients& k, GyroBias& bias, TraceHook trace);
 
     linalg::Vector3l gyro_sum_;           // gyro and accel counts summed over the window
     linalg::Vector3l accel_sum_;

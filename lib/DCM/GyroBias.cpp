@@ -17,12 +17,25 @@ Vector3f GyroBias::estimate_rad_s(const DcmCoefficients& k) const {
 }
 
 void GyroBias::set_estimate_rad_s(const Vector3f& bias, const DcmCoefficients& k) {
+    if (!bias.is_finite()) return;
     fine_ = linalg::fixed_from_vector(bias * (k.units_per_rad_s * (float)kTurnScale), 0);
     clamp(k);
 }
 
 void GyroBias::set_sensor_rad_s(const Vector3f& bias, const DcmCoefficients& k) {
+    if (!bias.is_finite()) return;
     sensor_units_ = linalg::fixed_from_vector(bias * k.units_per_rad_s, 0);
+}
+
+// The compass teaches the bias only while nothing else has measured it (DcmSettings.h):
+// its errors (a residual hard iron, a magnet nearby) turn with the heading.
+bool GyroBias::learn_from_heading(const linalg::Vector3l& down_q30, float heading_error, float steps, bool starting,
+                                  const DcmSettings& settings, const DcmCoefficients& k) {
+    if (rotating_fast_ || starting || measured() || settings.ki_yaw_1_s2 == 0.0f) return false;
+    const Vector3f error = linalg::vector_from_q30(down_q30) * -heading_error;
+    subtract_fine(linalg::fixed_from_vector(
+        error * (settings.ki_yaw_1_s2 * settings.step_s * steps * k.units_per_rad_s * (float)kTurnScale), 0), k);
+    return true;
 }
 
 // bias += alpha (mean - bias), in fine units (the difference within the bias limit and

@@ -1,8 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The gyro bias (Fusion's FusionOffset, with the DCM's integrator): the calibrated
-// sensor bias (the start-up calibration) and the estimator's own estimate, learned from
-// gravity (the tilt error's integral, ki_rp) and at rest (RestDetector: the gyro reads
-// its bias alone). What the step subtracts from every sample is offset_units().
+// The gyro bias (Fusion's FusionOffset, with the DCM's integrators): the calibrated
+// sensor bias (the start-up calibration) and the estimator's own estimate, with the rules
+// of what may teach it and when:
+//   gravity   the tilt error's integral (ki_rp, the two horizontal axes), held while the
+//             board turns lastingly or a broken gyro read is in the window, and through a
+//             still start's start-up;
+//   rest      the rest mean (RestDetector: the gyro reads its bias alone, every axis);
+//   compass   the heading error's integral (ki_yaw, the vertical axis), only until a rest
+//             or the calibration has measured the bias, and neither while turning nor
+//             starting (DcmSettings.h says why).
+// What the step subtracts from every sample is offset_units().
 //
 // Formats: units (gyro counts * 2^8, Coefficients.h); the estimate in fine units
 // (units * 2^8: the rest's slow steps are kept), bounded by bias_limit_rad_s (a quarter
@@ -40,6 +47,8 @@ public:
     }
 
     linalg::Vector3f estimate_rad_s(const DcmCoefficients& k) const;
+    // A start value for the estimate, and the calibrated bias (rad/s); a non-finite one is
+    // ignored.
     void set_estimate_rad_s(const linalg::Vector3f& bias, const DcmCoefficients& k);
     void set_sensor_rad_s(const linalg::Vector3f& bias, const DcmCoefficients& k);
     // New sensor scales: the state in the old units carried over (ratio old/new).
@@ -48,6 +57,39 @@ public:
         sensor_units_ = rescaled(sensor_units_, gyro_ratio);
     }
 
+    // The integrator's holds. No learning from gravity while rotating fast: gyro scale
+    // errors look like bias there (ArduPilot's rule), and a vehicle's turn holds a
+    // centripetal acceleration the accelerometer reads as tilt (integrator_hold_rate).
+    // What counts is the turn that lasts, the rest test's 0.5 s mean rate less the
+    // estimate (mean_off_bias, units): a vibration's rates average out, while a hand's or
+    // a vehicle's turn does not. Judged at each gravity correction; a broken gyro read in
+    // the window holds it too (gyro_rejected), and so does one before the next judgement.
+    void judge_rotation(const linalg::Vector3l& mean_off_bias, bool gyro_rejected, const DcmCoefficients& k) {
+        rotating_fast_ = gyro_rejected || exceeds(mean_off_bias, k.hold_rate);
+    }
+    void hold_for_broken_sample() { rotating_fast_ = true; }
+    // The gravity integrator is held: rotating fast, or within the start-up (starting),
+    // whose tilt error is not a gyro bias (a wrong first sample, a launch off the stand).
+    // Except after a start from a mean that was never still (start_from_mean, with no
+    // bias measured): the bias nothing measured (the saved calibration's, or none: the
+    // chip's +-20 deg/s) is what gravity has to learn first; while it waits, the
+    // proportional loop holds b / kp of tilt and the dip turns it into 2.5 times as much
+    // heading.
+    bool integrator_held(bool starting, bool start_from_mean) const {
+        return rotating_fast_ || (starting && !(start_from_mean && !measured()));
+    }
+
+    // At rest: the estimate follows the rest mean (follow_rest_mean), and the bias counts
+    // as measured.
+    void learn_at_rest(const linalg::Vector3l& rest_mean_units, const DcmCoefficients& k) {
+        follow_rest_mean(rest_mean_units, k);
+        set_measured();
+    }
+    // The compass's integral (ki_yaw): the heading error (the sine, saturated) about earth
+    // down (R's third row, Q30), over `steps` steps; only while nothing else has measured
+    // the bias, neither rotating fast nor starting. True when it learned.
+    bool learn_from_heading(const linalg::Vector3l& down_q30, float heading_error, float steps, bool starting,
+                            const DcmSettings& settings, const DcmCoefficients& k);
     // At rest: estimate += alpha (rest mean - estimate), alpha = rest_bias_alpha_q30.
     void follow_rest_mean(const linalg::Vector3l& rest_mean_units, const DcmCoefficients& k);
     // The bias was measured on a still board: from now the gravity integrator uses
@@ -72,6 +114,7 @@ private:
     linalg::Vector3l fine_;          // the estimate, fine units
     linalg::Vector3l sensor_units_;  // the calibrated bias (set_sensor_rad_s), units
     uint8_t measured_ = 0;           // kByRest, kByCalibration: what measured the bias
+    bool rotating_fast_ = false;     // judge_rotation: the integrator held
 };
 
 }  // namespace dcm

@@ -43,7 +43,7 @@ Turn coordinated_turn(float bank_deg, float airspeed_m_s) {
 int32_t down_y_q30_at(float bank_deg) { return (int32_t)std::lround(std::sin(bank_deg * kDeg) * 1073741824.0); }
 
 // One gravity window of n equal samples through a TurnMean: the accel sums after
-// take_off, per sample in m/s^2, and the running sums' sum per unit weight.
+// subtract_from_window, per sample in m/s^2, and the running sums' sum per unit weight.
 struct Window {
     Vector3f accel_m_s2, weighted_m_s2;
 };
@@ -53,8 +53,8 @@ Window take_off(dcm::TurnMean& turn, const mpu6000::Sample& s, float bank_deg, u
     const int32_t weight = n * (n + 1) / 2;  // sum over j of n - j + 1
     linalg::Vector3l sum_of_sums(s.accel.x * weight, s.accel.y * weight, s.accel.z * weight);
     // Earth down in body axes at the bank, pitch 0 (z is not read).
-    turn.take_off(s.gyro.y * n, s.gyro.z * n, linalg::Vector3l(0, down_y_q30_at(bank_deg), 0), n, sum, sum_of_sums,
-                  start_tilt);
+    turn.subtract_from_window(s.gyro.y * n, s.gyro.z * n, linalg::Vector3l(0, down_y_q30_at(bank_deg), 0), n, sum,
+                              sum_of_sums, start_tilt);
     const float per_count = s.accel_m_s2_per_count;
     return {Vector3f((float)sum.x, (float)sum.y, (float)sum.z) * (per_count / (float)n),
             Vector3f((float)sum_of_sums.x, (float)sum_of_sums.y, (float)sum_of_sums.z) * (per_count / (float)weight)};
@@ -372,7 +372,7 @@ TEST(Centripetal, ExtremesHeldWithoutOverflow) {
         turn.configure(top, kGravityCounts);
         const int32_t full = 5L * 32767L;
         linalg::Vector3l sum(0, sign * full, -full), sum_of_sums(0, sign * 3 * full, -3 * full);
-        turn.take_off(-sign * full, sign * full, linalg::Vector3l(), 5, sum, sum_of_sums, false);
+        turn.subtract_from_window(-sign * full, sign * full, linalg::Vector3l(), 5, sum, sum_of_sums, false);
         EXPECT_EQ(sum.y, 0) << sign;  // held at a_y (+ the margin): then at full scale
         EXPECT_EQ(sum.z, -full - sign * full) << sign;
         EXPECT_EQ(sum_of_sums.y, 0) << sign;

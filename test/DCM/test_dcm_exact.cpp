@@ -144,8 +144,14 @@ struct OneWindow {
     void run(const linalg::Matrix3q30& r, const Vector3l& gyro_counts, const Vector3l& accel_counts, uint8_t n,
              const Vector3l& sensor_bias_units = Vector3l(), bool starting = false, float startup_left = 0.0f) {
         for (uint8_t i = 0; i < n; ++i) gravity.add(gyro_counts, accel_counts);
-        ASSERT_TRUE(gravity.low_pass_window(r, 0, Vector3l(), sensor_bias_units, starting, startup_left, k, gyro_mean,
-                                            accel_mean, whole));
+        const Vector3l offset = Vector3l();
+        dcm::WindowMeans means;
+        const dcm::GravityContext c = {dcm::kDefaultDcmSettings, k, r, 0, offset, sensor_bias_units, starting,
+                                       startup_left, startup_left};
+        ASSERT_TRUE(gravity.low_pass_window(c, means));
+        gyro_mean = means.gyro;
+        accel_mean = means.accel;
+        whole = means.whole;
     }
 };
 
@@ -164,9 +170,14 @@ TEST(DcmExact, TheTurnTermTakesTheCalibratedBiasOffInRoundedCounts) {
         turn.configure(2048, 4096);  // about 18 m/s
         OneWindow w;
         for (uint8_t i = 0; i < n; ++i) w.gravity.add(gyro_counts, accel_counts);
-        w.gravity.take_off_turn(turn, Vector3l(0, 0, 1 << 30), sensor_bias_units, false);  // level
-        ASSERT_TRUE(w.gravity.low_pass_window(linalg::q30_from_matrix(Matrix3f::identity()), 0, Vector3l(),
-                                              sensor_bias_units, false, 0.0f, w.k, w.gyro_mean, w.accel_mean, w.whole));
+        const linalg::Matrix3q30 level = linalg::q30_from_matrix(Matrix3f::identity());
+        const Vector3l offset = Vector3l();
+        const dcm::GravityContext c = {dcm::kDefaultDcmSettings, w.k, level, 0, offset, sensor_bias_units, false,
+                                       0.0f, 0.0f};
+        w.gravity.subtract_turn(turn, c);  // level
+        dcm::WindowMeans means;
+        ASSERT_TRUE(w.gravity.low_pass_window(c, means));
+        w.accel_mean = means.accel;
         EXPECT_EQ(w.accel_mean.x, 0) << (int)n;
         EXPECT_EQ(w.accel_mean.y, 0) << (int)n;
         EXPECT_NEAR(w.accel_mean.z, -4096 * 256, 1) << (int)n;
@@ -179,7 +190,9 @@ TEST(DcmExact, AResetClearsTheCorrection) {
     // About 0.25 g and 0.12 g of tilt at the float form's scale (4096 counts per m/s^2).
     w.run(linalg::q30_from_matrix(Matrix3f::identity()), Vector3l(), Vector3l(10000, -5000, -38000), 4);
     dcm::GyroBias bias;
-    w.gravity.correct_tilt(linalg::q30_from_matrix(Matrix3f::identity()), 0.0f, true, dcm::kDefaultDcmSettings, w.k, bias);
+    const linalg::Matrix3q30 level = linalg::q30_from_matrix(Matrix3f::identity());
+    const Vector3l zero = Vector3l();
+    w.gravity.correct_tilt({dcm::kDefaultDcmSettings, w.k, level, 0, zero, zero, false, 0.0f, 0.0f}, true, bias);
     const Vector3l before = w.gravity.correction_units();
     ASSERT_TRUE(before.x != 0 && before.y != 0);
     w.gravity.reset(-4096 * 256);
@@ -386,7 +399,8 @@ TEST(DcmExact, NoTiltCorrectionFromALowPassAtTheLimit) {
         dcm::DcmCoefficients k = w.k;
         k.min_lp2 = lp2 - below;
         dcm::GyroBias bias;
-        gravity.correct_tilt(level, 0.0f, true, dcm::kDefaultDcmSettings, k, bias);
+        const Vector3l zero = Vector3l();
+        gravity.correct_tilt({dcm::kDefaultDcmSettings, k, level, 0, zero, zero, false, 0.0f, 0.0f}, true, bias);
         if (below)
             EXPECT_NE(gravity.correction_units().y, 0);
         else

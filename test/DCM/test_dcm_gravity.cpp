@@ -36,13 +36,13 @@ struct Loop {
                 strapdown.end_step();
                 if (strapdown.pending_steps() == dcm::kIntegrationSteps) strapdown.integrate(k);
             }
-            Vector3l gyro_mean, accel_mean;
-            bool whole = false;
-            ASSERT_TRUE(gravity.low_pass_window(strapdown.r(), strapdown.pending_steps(),
-                                                bias.offset_units(gravity.correction_units()), bias.sensor_units(), false,
-                                                0.0f, k, gyro_mean, accel_mean, whole));
-            EXPECT_TRUE(whole);
-            gravity.correct_tilt(strapdown.r(), 0.0f, hold_integrator, dcm::kDefaultDcmSettings, k, bias);
+            const Vector3l offset = bias.offset_units(gravity.correction_units());
+            const dcm::GravityContext c = {dcm::kDefaultDcmSettings, k, strapdown.r(), strapdown.pending_steps(),
+                                           offset, bias.sensor_units(), false, 0.0f, 0.0f};
+            dcm::WindowMeans means;
+            ASSERT_TRUE(gravity.low_pass_window(c, means));
+            EXPECT_TRUE(means.whole);
+            gravity.correct_tilt(c, hold_integrator, bias);
         }
     }
     Matrix3f estimate() const { return linalg::matrix_from_q30(strapdown.r()); }
@@ -104,9 +104,11 @@ TEST(DcmGravity, TheIntegratorLearnsOnTheErrorsAxis) {
 
 TEST(DcmGravity, AnEmptyWindowIsNoWindow) {
     Loop loop(Matrix3f::identity());
-    Vector3l g, a;
-    bool whole = true;
-    EXPECT_FALSE(loop.gravity.low_pass_window(loop.strapdown.r(), 0, Vector3l(), Vector3l(), false, 0.0f, loop.k, g, a, whole));
+    const Vector3l zero = Vector3l();
+    const dcm::GravityContext c = {dcm::kDefaultDcmSettings, loop.k, loop.strapdown.r(), 0, zero, zero, false, 0.0f,
+                                   0.0f};
+    dcm::WindowMeans means;
+    EXPECT_FALSE(loop.gravity.low_pass_window(c, means));
 }
 
 // A reset puts the low-pass exactly at gravity (earth down) with no correction.
@@ -143,10 +145,13 @@ TEST(DcmGravity, TheWindowsMeansAreTheSumsOverTheirLength) {
         dcm::GravityCorrection gravity;
         gravity.reset(-4096 * 256);
         for (uint8_t i = 0; i < n; ++i) gravity.add(gyro_counts, accel_counts);
-        Vector3l gyro_mean, accel_mean;
-        bool whole = false;
-        ASSERT_TRUE(gravity.low_pass_window(linalg::q30_from_matrix(Matrix3f::identity()), 0, Vector3l(), Vector3l(),
-                                            false, 0.0f, k, gyro_mean, accel_mean, whole));
+        const linalg::Matrix3q30 level = linalg::q30_from_matrix(Matrix3f::identity());
+        const Vector3l zero = Vector3l();
+        dcm::WindowMeans means;
+        const dcm::GravityContext c = {dcm::kDefaultDcmSettings, k, level, 0, zero, zero, false, 0.0f, 0.0f};
+        ASSERT_TRUE(gravity.low_pass_window(c, means));
+        const Vector3l &gyro_mean = means.gyro, &accel_mean = means.accel;
+        const bool whole = means.whole;
         EXPECT_NEAR(gyro_mean.x, 10 * 256, 1) << (int)n;
         EXPECT_NEAR(gyro_mean.y, -20 * 256, 1) << (int)n;
         EXPECT_NEAR(gyro_mean.z, 30 * 256, 1) << (int)n;
