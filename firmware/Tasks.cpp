@@ -66,7 +66,7 @@ static void once_a_second() {
 #define SAMPLE_TASKS(X)                                                                                          \
     X(compass,      nullptr,                         compass_service,                  1, 1400, kSecCompassTask)  \
     X(estimator,    nullptr,                         estimator_step,                   1, 2300, kSecEstimator)    \
-    X(airspeed,     nullptr,                         airspeed_input::step,             1,  300, kSecAirspeed)     \
+    X(airspeed,     nullptr,                         airspeed_input::step,             1,  800, kSecAirspeed)     \
     X(input_step,   nullptr,                         console_link::take_input_in_step, 1, 1000, kSecInputInStep)  \
     X(user,         estimator_running,               user_step,                        1,  200, kSecUser)         \
     X(output,       output_line::due,                output_line::run,                 1, 1800, kSecOutput)       \
