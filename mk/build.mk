@@ -235,16 +235,20 @@ sim: firmware tools
 # (STAMP=1: after its simulated time); VIEW=1 (or make view FLIGHT=...) draws it on the
 # live horizon. SERIAL=tcp:5760 (or GCS=tcp:5760) attaches a ground station: the board's
 # UART0 also on TCP 127.0.0.1:5760, as make sim SERIAL=... and ArduPilot's SITL, flown in
-# real time (SPEED=x: x times real time). Both processes end by themselves, or after
-# FLY_TIMEOUT wall seconds.
+# real time (SPEED=x: x times real time). MODE=mavlink (plot, csv, quat, raw, quiet) types
+# `mode NAME` into the board as it starts, as make view MODE=... does: in MAVLink from then
+# on, a ground station that only listens hears it. Both processes end by themselves, or
+# after FLY_TIMEOUT wall seconds.
 FLY_TIMEOUT ?= 1800
 FLY_SERIAL = $(or $(GCS),$(SERIAL))
 fly: firmware tools venv
 	@echo "# flight '$(or $(FLIGHT),cruise)': build/firmware.elf in simavr flies the JSBSim Rascal 110 (FLIGHT=name, GUST=0-2, SECONDS=s, SERIAL=tcp:5760 for a ground station; flights: fly.py --list)"
+	$(if $(MODE),@mkdir -p $(BUILD)/flight && printf 'mode $(MODE)\n' > $(BUILD)/flight/fly-input.txt)
 	@$(VENV_PY) sim/flight/closed_loop.py --flight $(or $(FLIGHT),cruise) $(if $(GUST),--gust $(GUST)) \
 	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(STAMP),--stamp) --sim $(BUILD)/apm25sim \
 	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) \
 	  $(if $(FLY_SERIAL),--serial $(FLY_SERIAL)) $(if $(SPEED),--speed $(SPEED)) \
+	  $(if $(MODE),--input $(BUILD)/flight/fly-input.txt) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
 
 test: firmware attitude-only big tools venv

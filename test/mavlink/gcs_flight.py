@@ -20,6 +20,11 @@ while it flies. Checks:
     launched (pacing never runs ahead; a loaded host only runs behind);
   - the flight ran to its end (time_boot_ms past 19 s), the flight's exit status 0 and
     apm25sim's link summary on stderr.
+Then 6 s of cruise with `mode mavlink` typed into the board as it starts (closed_loop.py
+--input, as `make fly MODE=mavlink`): a client that sends nothing, pymavlink's plain
+wait_heartbeat(), hears the board's HEARTBEAT and ATTITUDE. (Without a HEARTBEAT from the
+ground station or `mode mavlink`, the port stays in its text mode: the first phase's
+client must send one.)
 Exit 1 with every failure listed. The wall clock bounds only the pacing's invariant and
 the guard against a hang.
 """
@@ -68,6 +73,99 @@ def interpolate(ts, values, t):
     return values[i - 1] + w * (values[i] - values[i - 1])
 
 
+class Flight:
+    """closed_loop.py with --serial tcp:0, its stderr read on a thread (the port it serves)."""
+
+    def __init__(self, tools, work, flight, seconds, extra):
+        self.work = work
+        cmd = [sys.executable, os.path.join(ROOT, "sim", "flight", "closed_loop.py"), "--flight", flight,
+               "--seconds", "%g" % seconds, "--sim", os.path.join(tools, "apm25sim"),
+               "--elf", os.path.join(tools, "firmware.elf"), "--serial", "tcp:0",
+               "--timeout", "%d" % WALL_GUARD_S] + extra
+        self.launched = time.monotonic()
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        self.stderr_lines = []
+        self.port = None
+        self.port_found = threading.Event()
+        self.reader = threading.Thread(target=self.read_stderr, daemon=True)
+        self.reader.start()
+
+    def read_stderr(self):
+        for line in self.proc.stderr:
+            self.stderr_lines.append(line)
+            m = re.search(r"serving UART0 on tcp:127\.0\.0\.1:(\d+)", line)
+            if m and self.port is None:
+                self.port = int(m.group(1))
+                self.port_found.set()
+        self.port_found.set()  # the flight ended without serving
+
+    def connect(self):
+        """A pymavlink connection to the board as system 255, or None (a failure printed)."""
+        self.port_found.wait(WALL_GUARD_S)
+        if self.port is None:
+            print("FAIL: the flight did not serve UART0 on TCP:\n" + "".join(self.stderr_lines)[-3000:])
+            return None
+        conn = mavutil.mavlink_connection("tcp:127.0.0.1:%d" % self.port, source_system=255, source_component=190,
+                                          autoreconnect=False)
+        conn.closed = []  # the board's end closes the connection: no more to read
+        conn.handle_eof = lambda: conn.closed.append("eof")
+        conn.handle_disconnect = lambda: conn.closed.append("reset")
+        return conn
+
+    def end(self):
+        """The flight's exit status and stderr (killed after the guard)."""
+        try:
+            status = self.proc.wait(timeout=120)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            status = self.proc.wait()
+        self.reader.join(timeout=10)
+        return status, "".join(self.stderr_lines)
+
+    def kill(self):
+        """SIGTERM (closed_loop.py then stops the backend and apm25sim), SIGKILL after 30 s."""
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+def listen_only(tools, work):
+    """The board told `mode mavlink` as it starts: a client that sends nothing hears it."""
+    input_path = os.path.join(work, "mode_mavlink.txt")
+    with open(input_path, "w") as f:
+        f.write("mode mavlink\n")
+    flight = Flight(tools, work, "cruise", 6.0, ["--input", input_path])
+    try:
+        conn = flight.connect()
+        if conn is None:
+            soft_assert(False, "listen-only: the flight did not serve")
+            return
+        # Until the flight ends (the guard only against a hang).
+        def live():
+            return not conn.closed and flight.proc.poll() is None and \
+                time.monotonic() - flight.launched < WALL_GUARD_S
+        hb = att = None
+        while hb is None and live():
+            hb = conn.wait_heartbeat(timeout=1.0)
+        soft_assert(hb is not None and hb.get_srcSystem() == 1 and hb.type == mavlink2.MAV_TYPE_FIXED_WING,
+                    "listen-only: wait_heartbeat() heard %r in the flight" % hb)
+        while att is None and live():
+            att = conn.recv_match(type="ATTITUDE", blocking=True, timeout=1.0)
+        soft_assert(att is not None, "listen-only: no ATTITUDE in the flight")
+        if hb is not None and att is not None:
+            print("# listen-only client: HEARTBEAT and ATTITUDE at %.2f s without sending a byte"
+                  % (att.time_boot_ms / 1000.0))
+        conn.close()
+        status, err = flight.end()  # the 6 s flight ends by itself
+        soft_assert(status == 0, "listen-only: the flight exited %s:\n%s" % (status, err[-3000:]))
+    finally:
+        flight.kill()
+
+
 def main():
     args = tools_and_work()
     for need in ("apm25sim", "firmware.elf"):
@@ -76,38 +174,15 @@ def main():
             return 1
     truth_path = os.path.join(args.work, "truth.csv")
     serial_path = os.path.join(args.work, "serial.bin")
-    cmd = [sys.executable, os.path.join(ROOT, "sim", "flight", "closed_loop.py"), "--flight", "turn",
-           "--seconds", "%g" % SECONDS, "--sim", os.path.join(args.tools, "apm25sim"),
-           "--elf", os.path.join(args.tools, "firmware.elf"), "--serial", "tcp:0", "--log", truth_path,
-           "--out", serial_path, "--timeout", "%d" % WALL_GUARD_S]
-    launched = time.monotonic()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    stderr_lines = []
-    port_found = threading.Event()
-    port = []
-
-    def read_stderr():
-        for line in proc.stderr:
-            stderr_lines.append(line)
-            m = re.search(r"serving UART0 on tcp:127\.0\.0\.1:(\d+)", line)
-            if m and not port:
-                port.append(int(m.group(1)))
-                port_found.set()
-        port_found.set()  # the flight ended without serving
-
-    reader = threading.Thread(target=read_stderr, daemon=True)
-    reader.start()
+    flight = Flight(args.tools, args.work, "turn", SECONDS, ["--log", truth_path, "--out", serial_path])
+    launched = flight.launched
+    proc = flight.proc
     msgs = []  # (wall s since launch, message)
     try:
-        port_found.wait(WALL_GUARD_S)
-        if not port:
-            print("FAIL: the flight did not serve UART0 on TCP:\n" + "".join(stderr_lines)[-3000:])
+        conn = flight.connect()
+        if conn is None:
             return 1
-        conn = mavutil.mavlink_connection("tcp:127.0.0.1:%d" % port[0], source_system=255, source_component=190,
-                                          autoreconnect=False)
-        closed = []  # the board's end closes the connection: no more to read
-        conn.handle_eof = lambda: closed.append("eof")
-        conn.handle_disconnect = lambda: closed.append("reset")
+        closed = conn.closed
         last_hb = 0.0
         while time.monotonic() - launched < WALL_GUARD_S:
             now = time.monotonic()
@@ -125,13 +200,9 @@ def main():
             if m.get_srcSystem() == 1:
                 msgs.append((time.monotonic() - launched, m))
         conn.close()
-        status = proc.wait(timeout=120)
+        status, err = flight.end()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        reader.join(timeout=10)
-    err = "".join(stderr_lines)
+        flight.kill()
     soft_assert(status == 0, "the flight exited %s:\n%s" % (status, err[-3000:]))
     summary = re.search(r"physics backend at \S+: (\d+) frames, (\d+) sent again, (\d+) late or duplicate", err)
     soft_assert(summary is not None, "no link summary from apm25sim:\n" + err[-3000:])
@@ -187,6 +258,7 @@ def main():
                     % (worst[1], worst[2], worst[0]))
         soft_assert(rms_roll < 1.5 and rms_pitch < 1.5, "RMS roll %.2f pitch %.2f deg" % (rms_roll, rms_pitch))
         soft_assert(bank_seen > 20.0, "the ground station saw at most %.1f deg of bank in the turn" % bank_seen)
+    listen_only(args.tools, args.work)
     return finish("gcs_flight", "gcs_flight: a ground station watched the board fly in real time")
 
 
