@@ -221,12 +221,15 @@ docs: tools
 
 # SERIAL=tcp:5760: a live board, UART0 served on TCP 127.0.0.1:5760 in real time (as
 # ArduPilot's SITL) until Ctrl-C, the scenario's last state held after its end.
+# MODE=mavlink (any output mode) types `mode NAME` into the board as it starts.
 sim: firmware tools
 	@mkdir -p $(BUILD)/scenarios
 	@$(BUILD)/scenario $(SCENARIO) > $(BUILD)/scenarios/$(SCENARIO).csv
+	$(if $(MODE),@printf 'mode $(MODE)\n' > $(BUILD)/scenarios/sim-input.txt)
 	@echo "# simavr: $(FW_BUILD)/firmware.elf on scenario '$(SCENARIO)' (SCENARIO=name, SECONDS=s, SERIAL=tcp:5760 to change)"
 	@$(BUILD)/apm25sim --elf $(FW_BUILD)/firmware.elf --trajectory $(BUILD)/scenarios/$(SCENARIO).csv \
-	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL))
+	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL)) \
+	  $(if $(MODE),--input $(BUILD)/scenarios/sim-input.txt)
 
 # make fly [FLIGHT=cruise|gusty|upset|turn|figure8|climb] [GUST=0|1|2] [SECONDS=s] [STAMP=1]
 # [VIEW=1] [SERIAL=tcp:5760] [SPEED=x]: the firmware flies the JSBSim Rascal
