@@ -226,9 +226,12 @@ TEST(HarnessPhysics, ALateOrDuplicateReplyIsDroppedAndCounted) {
         const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, seconds);
         ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
         clean = run.result.out;
+        // Every frame once; a frame sent again on a loaded machine (none when idle) is
+        // answered twice, and one of the two answers dropped.
         EXPECT_EQ(summary_count(run.result.err, "frames"), 2501) << run.result.err;
-        EXPECT_EQ(summary_count(run.result.err, "sent again"), 0) << run.result.err;
-        EXPECT_EQ(summary_count(run.result.err, "dropped"), 0) << run.result.err;
+        EXPECT_GE(summary_count(run.result.err, "sent again"), 0) << run.result.err;
+        EXPECT_EQ(summary_count(run.result.err, "dropped"), summary_count(run.result.err, "sent again"))
+            << run.result.err;
     }
     EXPECT_GT(clean.size(), 500u);
     {
@@ -239,14 +242,14 @@ TEST(HarnessPhysics, ALateOrDuplicateReplyIsDroppedAndCounted) {
         EXPECT_NE(run.result.err.find("has not answered frame 1500"), std::string::npos) << run.result.err;
         EXPECT_EQ(run.result.err.find("is not after"), std::string::npos) << run.result.err;
         EXPECT_EQ(summary_count(run.result.err, "frames"), 2501) << run.result.err;
-        EXPECT_EQ(summary_count(run.result.err, "sent again"), 1) << run.result.err;
-        EXPECT_EQ(summary_count(run.result.err, "dropped"), 1) << run.result.err;
+        EXPECT_GE(summary_count(run.result.err, "sent again"), 1) << run.result.err;  // 1 on an idle machine
+        EXPECT_EQ(summary_count(run.result.err, "dropped"), summary_count(run.result.err, "sent again"))
+            << run.result.err;
         EXPECT_TRUE(run.result.out == clean) << "the serial output differs from the undisturbed run's";
         const std::vector<std::vector<long>> sent = packets(backend.log);
-        ASSERT_EQ(sent.size(), 2502u);  // frame 1500 twice
+        ASSERT_GE(sent.size(), 2502u);  // frame 1500 twice
         EXPECT_EQ(sent[1500][1], 1500);
         EXPECT_EQ(sent[1501][1], 1500);
-        EXPECT_EQ(sent[1502][1], 1501);
     }
     {
         Backend backend;
@@ -254,9 +257,10 @@ TEST(HarnessPhysics, ALateOrDuplicateReplyIsDroppedAndCounted) {
         const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, seconds);
         EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
         EXPECT_EQ(summary_count(run.result.err, "frames"), 2501) << run.result.err;
-        EXPECT_EQ(summary_count(run.result.err, "sent again"), 0) << run.result.err;
-        // Every frame's second answer but the last frame's, read before the run ended.
-        EXPECT_EQ(summary_count(run.result.err, "dropped"), 2500) << run.result.err;
+        // Every frame's second answer but the last frame's, read before the run ended (and
+        // both answers to a frame sent again on a loaded machine).
+        EXPECT_EQ(summary_count(run.result.err, "dropped"), 2500 + 2 * summary_count(run.result.err, "sent again"))
+            << run.result.err;
         EXPECT_TRUE(run.result.out == clean) << "the serial output differs from the undisturbed run's";
     }
 }
