@@ -41,8 +41,12 @@ TEST(Mixer, PlainElevonAndVtail) {
     s.flight.vtail_output = 1;
     flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{900, 900, 0, 900}, nullptr, out);
     EXPECT_EQ(out[0], 1600);  // the aileron stays on OUT1
-    EXPECT_EQ(out[1], 1500);  // left ruddervator: (900 - 900) / 2
-    EXPECT_EQ(out[3], 1600);  // right: (900 + 900) / 2
+    EXPECT_EQ(out[1], 1600);  // left ruddervator: (900 + 900) / 2, trailing edge up
+    EXPECT_EQ(out[3], 1500);  // right: (900 - 900) / 2
+    // Yaw right alone: the left trailing edge up, the right down (docs/flight.md).
+    flight::mix(s.flight, flight::scales_of(s.flight), flight::Surfaces{0, 0, 0, 900}, nullptr, out);
+    EXPECT_EQ(out[1], 1550);
+    EXPECT_EQ(out[3], 1450);
     // Reverse and limits.
     s.flight.vtail_output = 0;
     s.flight.servo_reversed = 0x01;
@@ -118,8 +122,9 @@ TEST(Mixer, ElevonsCarryTheElevatorInTheirSumAndTheAileronInTheirDifference) {
 }
 
 TEST(Mixer, VtailCarriesTheElevatorInItsSumAndTheRudderInItsDifference) {
-    // Left = (elevator - rudder) / 2 on OUT2, right = (elevator + rudder) / 2 on OUT4; the
-    // aileron stays on OUT1.
+    // Left = (elevator + rudder) / 2 on OUT2, right = (elevator - rudder) / 2 on OUT4 (as
+    // ArduPlane's vtail_left and vtail_right): right + left is the elevator, left - right the
+    // rudder (to the halving's rounding toward zero); the aileron stays on OUT1.
     settings::Settings s = odd_outputs();
     s.flight.vtail_output = 1;
     s.flight.servo_reversed = 0x02;  // the left ruddervator's servo mounted the other way
@@ -128,7 +133,9 @@ TEST(Mixer, VtailCarriesTheElevatorInItsSumAndTheRudderInItsDifference) {
     for (int16_t r : kCommands)
         for (int16_t e : kCommands) {
             flight::mix(s.flight, sc, flight::Surfaces{-700, e, 250, r}, nullptr, out);
-            const int left = (e - r) / 2, right = (e + r) / 2;
+            const int left = (e + r) / 2, right = (e - r) / 2;
+            ASSERT_LE(std::abs(right + left - e), 1);
+            ASSERT_LE(std::abs(left - right - r), 1);
             EXPECT_EQ(out[0], flight::angle_to_width(-700, s.flight.servo[0], false));
             EXPECT_EQ(out[1], flight::angle_to_width((int16_t)left, s.flight.servo[1], true)) << r << " " << e;
             EXPECT_EQ(out[3], flight::angle_to_width((int16_t)right, s.flight.servo[3], false)) << r << " " << e;
