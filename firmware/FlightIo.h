@@ -80,6 +80,6 @@ private:
     uint32_t last_control_us_ = 0;
     // The gyro bias in the control's rate units, worked out again once a second.
     int16_t bias_cds_[2] = {0, 0};
-    uint8_t bias_age_ = 0xFF;
+    uint8_t bias_age_ = 49;  // the first step with an attitude works it out (0xFF wrapped to 0: a second late)
 #endif
 };
