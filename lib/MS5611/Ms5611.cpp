@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Ms5611.h"
 
+#include "Profile.h"
+
 namespace ms5611 {
 
 bool Sequencer::due(uint32_t now_us) const {
@@ -85,7 +87,9 @@ Event Sequencer::reject() {
 }
 
 Event Sequencer::take_d2(uint32_t d2) {
+    profile::begin(profile::kBaroCompensation);
     const Terms t = terms(prom_, d2);
+    profile::end(profile::kBaroCompensation);
     if (t.temp_c100 < kMinTempC100 || t.temp_c100 > kMaxTempC100) return reject();
     terms_ = t;
     have_terms_ = true;
@@ -108,7 +112,9 @@ Event Sequencer::take_d1(uint32_t d1) {
     }
     last_d1_ = d1;
     if (!have_terms_) return said;
+    profile::begin(profile::kBaroCompensation);
     const int32_t p = pressure_pa(terms_, d1);
+    profile::end(profile::kBaroCompensation);
     const bool absurd = p < kMinPressurePa || p > kMaxPressurePa;
     const bool jump = have_pa_ && (p > last_pa_ + kSpikePa || p < last_pa_ - kSpikePa);
     if (absurd || (jump && spike_run_ < kSpikeRun)) {
