@@ -142,20 +142,28 @@ text::Flash state_word() {
     return healthy() ? TXT("ok") : TXT("starting");
 }
 
+// Three short lines, not one long one: a reply part's cost grows with its numbers, and each
+// part must fit the `reply` task's budget.
 bool print_line(uint8_t part, const text::Sink* out) {
     Writer w(out);
+    char buf[14];
     if (part == 0) {
         w.str(TXT("# baro ")).str(state_word());
         if (found)
-            w.str(TXT(": ")).u32((uint32_t)(mean_pa + 0.5f)).str(TXT(" Pa, ")).fixed2(temperature_c())
-                .str(TXT(" C, height ")).fixed2(height.height_m()).str(TXT(" m, climb "))
-                .fixed2(height.climb_m_s()).str(TXT(" m/s"));
+            w.str(TXT(": ")).u32((uint32_t)(mean_pa + 0.5f)).str(TXT(" Pa, "))
+                .str(buf, text::format_centi(buf, chip.temperature_c100())).str(TXT(" C, height "))
+                .fixed2(height.height_m()).str(TXT(" m"));
         w.end();
         return true;
     }
-    if (part > 1 || !found) return false;
-    w.str(TXT("# baro: ")).u32(chip.conversions()).str(TXT(" read, ")).u32(chip.missed()).str(TXT(" missed, "))
-        .u32(chip.rejected()).str(TXT(" rejected, ground ")).u32((uint32_t)(ground_pa + 0.5f)).str(TXT(" Pa")).end();
+    if (part > 2 || !found) return false;
+    if (part == 1)
+        w.str(TXT("# baro: climb ")).fixed2(height.climb_m_s()).str(TXT(" m/s, ground "))
+            .u32((uint32_t)(ground_pa + 0.5f)).str(TXT(" Pa"));
+    else
+        w.str(TXT("# baro: ")).u32(chip.conversions()).str(TXT(" read, ")).u32(chip.missed())
+            .str(TXT(" missed, ")).u32(chip.rejected()).str(TXT(" rejected"));
+    w.end();
     return true;
 }
 

@@ -33,8 +33,8 @@ bool due();
 void service();
 
 // `baro`, a part (a line within console::kPartReply) at a time, false past the last:
-//   "# baro ok: P Pa, T C, height H m, climb V m/s" (`status` shows this one),
-//   "# baro: N read, M missed, R rejected, ground P0 Pa".
+//   "# baro ok: P Pa, T C, height H m" (`status` shows this one),
+//   "# baro: climb V m/s, ground P0 Pa", "# baro: N read, M missed, R rejected".
 bool print_line(uint8_t part, const text::Sink* out);
 // `status`'s word for it: "ok", "absent", "lost", "stuck", "starting".
 text::Flash state_word();
