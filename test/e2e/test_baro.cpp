@@ -6,7 +6,7 @@
 // (apm25sim's exit status 3).
 //
 // The height is read as a user would: `baro` typed at the console, its reply's
-// "height H m" compared with the trajectory's -d at the instant the reply left the UART.
+// height compared with the trajectory's -d at the instant the reply left the UART.
 // The commands are spaced by empty lines (each '\n' one character time, 87 us at 115200
 // baud, which the console ignores).
 #include <cmath>
@@ -27,14 +27,14 @@ std::string spaced_commands(const std::string& command, double period_s, int cou
     return all;
 }
 
-// The heights of the "# baro ok: ... height H m" replies: (stamp, H).
+// The heights of the "# baro ok: P Pa, T C, H m, V m/s, ..." replies: (stamp, H).
 std::vector<std::pair<double, double>> baro_heights(const std::vector<e2e::Line>& lines) {
     std::vector<std::pair<double, double>> out;
     for (const e2e::Line& l : lines) {
         if (l.text.rfind("# baro ok: ", 0) != 0) continue;
-        const size_t at = l.text.find("height ");
-        if (at == std::string::npos) continue;
-        out.emplace_back(l.t_s, std::atof(l.text.c_str() + at + 7));
+        const size_t at = l.text.find(" C, ");
+        if (at == std::string::npos || l.text.find(" m, ", at) == std::string::npos) continue;
+        out.emplace_back(l.t_s, std::atof(l.text.c_str() + at + 4));
     }
     return out;
 }
