@@ -3,6 +3,7 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "Console.h"
 #include "GcsLink.h"
 #include "LoopLoad.h"
@@ -100,8 +101,9 @@ static bool print_status(uint8_t part) {
         case 2: pipeline_text::write_bias_status(out, pipe); return true;
         case 3: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
-        case 5: tasks::print_status_line(out); return true;
-        case 6: return flight_io.print_status_line();
+        case 5: baro::print_line(out); return true;
+        case 6: tasks::print_status_line(out); return true;
+        case 7: return flight_io.print_status_line();
         default: return false;
     }
 }
@@ -124,6 +126,11 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Status: return print_status(part);
         case console::CommandId::Show:
             if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            if (c.arg == console::kShowBaro) {
+                if (part > 0) return false;
+                baro::print_line(out);
+                return true;
+            }
             break;
         default: break;
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include "Baro.h"
 #include "Board.h"
 #include "Console.h"
 #include "ConsoleLink.h"
@@ -21,7 +22,7 @@ static mav::Parser input;
 static mav::ParamReplies param_replies;
 static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
 static bool defaults_said_pending = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
-constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
+constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
 
 mav::Parser& parser() { return input; }
@@ -133,14 +134,19 @@ void send_param_value() {
 }
 
 bool streams_due() {
-    return FlightIo::kEnabled && millis() - last_stream_ms >= kStreamPeriodMs && room_for(2u * mav::kRcChannelsFrame);
+    return (FlightIo::kEnabled || baro::present()) && millis() - last_stream_ms >= kStreamPeriodMs &&
+           room_for(2u * mav::kRcChannelsFrame + mav::kScaledPressureFrame);
 }
 void send_streams() {
     const uint32_t now_ms = millis();
     last_stream_ms = now_ms;
     uint8_t frame[mav::kMaxFrame];
-    port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
-    port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    if (FlightIo::kEnabled) {
+        port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
+        port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    }
+    if (baro::present())
+        port::send_frame(frame, port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c()));
 }
 
 void send_heartbeat_and_status() {
@@ -156,7 +162,9 @@ void send_heartbeat_and_status() {
                                         flight_io.plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
-    n = port::mavlink.sys_status(frame, mav::health(true, imu.ok(), true, compass.ok()),
+    mav::Health sensors = mav::health(true, imu.ok(), true, compass.ok());
+    mav::add_sensor(sensors, mav::kAbsolutePressure, baro::present(), baro::healthy());
+    n = port::mavlink.sys_status(frame, sensors,
                                  (uint16_t)(loop_load::percent() * 10u),
                                  (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu));
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);

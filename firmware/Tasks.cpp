@@ -14,6 +14,7 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "Board.h"
 #include "ConsoleLink.h"
 #include "GcsLink.h"
@@ -88,6 +89,7 @@ static void once_a_second() {
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(store,        nullptr,                         store_service,                    1500, kSecStore,        kAlways) \
+    X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
     X(flight,       nullptr,                         flight_poll,                       800, kSecFlightPoll,   kAlways) \
