@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "Navigator.h"
+
+namespace nav {
+
+namespace {
+
+int32_t centimetres(float m) { return round_to_int32(m * 100.0f); }
+
+}  // namespace
+
+uint8_t Navigator::on_fix(const gps::Fix& fix, const BaroReading& baro, uint8_t min_sats) {
+    if (fix.fix != gps::FixType::k3D) return 0;  // a 2D or no fix: the position moves on from the last
+    uint8_t events = 0;
+    Location pos;
+    pos.lat_e7 = fix.lat_e7;
+    pos.lon_e7 = fix.lon_e7;
+    pos.alt_cm = fix.alt_msl_mm / 10;
+    float vel[3];
+    for (uint8_t i = 0; i < 3; ++i) vel[i] = (float)fix.vel_ned_cm_s[i] * 0.01f;
+    if (!fix.have_vertical_velocity) vel[2] = 0.0f;
+    const NorthEast vel_ne = {vel[0], vel[1]};
+    if (!map_.valid()) map_.set_origin(pos);
+
+    const bool was_glitching = glitch_.glitching();
+    const bool good = glitch_.check(pos, vel_ne, fix.received_ms, map_);
+    if (good) {
+        base_ = pos;
+        if (was_glitching) events |= kGlitchOver;
+    } else {
+        // Dead reckoning over the rejected fix: the mean of the two fixes' velocities.
+        const float dt_s = (float)(fix.received_ms - base_ms_) * 0.001f;
+        const float half_dt_s = 0.5f * dt_s;
+        base_ = map_.moved(base_, (vel_ned_m_s_[0] + vel[0]) * half_dt_s, (vel_ned_m_s_[1] + vel[1]) * half_dt_s);
+        base_.alt_cm -= centimetres((vel_ned_m_s_[2] + vel[2]) * half_dt_s);
+        if (!was_glitching) events |= kGlitch;
+    }
+    base_ms_ = fix.received_ms;
+    for (uint8_t i = 0; i < 3; ++i) vel_ned_m_s_[i] = vel[i];
+    have_position_ = true;
+
+    if (good && !home_set() && fix.sats >= min_sats && fix.hdop_cm <= kMaxHdopCm) {
+        take_home(pos, baro, HomeSource::kGps);
+        events |= kHomeSet;
+    }
+    // The barometer's datum from the GPS when home could not give it (no barometer then).
+    if (good && baro.healthy && !have_datum_) {
+        baro_datum_cm_ = pos.alt_cm - centimetres(baro.height_m);
+        have_datum_ = true;
+    }
+    update(fix.received_ms, baro);
+    return events;
+}
+
+void Navigator::update(uint32_t now_ms, const BaroReading& baro) {
+    if (!have_position_) return;
+    now_ms_ = now_ms;
+    uint32_t age_ms = now_ms - base_ms_;
+    if (age_ms > kMaxExtrapolation_ms) age_ms = kMaxExtrapolation_ms;
+    const float t_s = kGpsLag_s + (float)age_ms * 0.001f;
+    position_ = map_.moved(base_, vel_ned_m_s_[0] * t_s, vel_ned_m_s_[1] * t_s);
+    height_from_baro_ = baro.healthy && have_datum_;
+    position_.alt_cm = height_from_baro_ ? baro_datum_cm_ + centimetres(baro.height_m)
+                                         : base_.alt_cm - centimetres(vel_ned_m_s_[2] * t_s);
+    if (!home_set()) return;
+    const NorthEast ne = map_.offset_m(home_, position_);
+    north_m_ = ne.north_m;
+    east_m_ = ne.east_m;
+    height_above_home_m_ = (float)(position_.alt_cm - home_.alt_cm) * 0.01f;
+}
+
+void Navigator::take_home(const Location& home, const BaroReading& baro, HomeSource source) {
+    home_ = home;
+    home_source_ = source;
+    ++home_changes_;
+    map_.set_origin(home);
+    // Home from the GPS ties the barometer to it: the height above home is then the
+    // barometer's change since this moment.
+    if (source == HomeSource::kGps && baro.healthy) {
+        baro_datum_cm_ = home.alt_cm - centimetres(baro.height_m);
+        have_datum_ = true;
+    }
+}
+
+bool Navigator::set_home_here(const BaroReading& baro) {
+    if (!have_position_) return false;
+    take_home(position_, baro, HomeSource::kGroundStation);
+    update(now_ms_, baro);
+    return true;
+}
+
+bool Navigator::set_home(const Location& home, const BaroReading& baro) {
+    if (home.lat_e7 < -900000000 || home.lat_e7 > 900000000 || home.lon_e7 < -1800000000 ||
+        home.lon_e7 > 1800000000 || home.alt_cm < -100000 || home.alt_cm > 2000000)
+        return false;
+    take_home(home, baro, HomeSource::kGroundStation);
+    if (have_position_) update(now_ms_, baro);
+    return true;
+}
+
+}  // namespace nav

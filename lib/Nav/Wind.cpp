@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "Wind.h"
+
+#include <math.h>
+
+#include "Constants.h"
+
+namespace nav {
+
+void WindEstimator::update(const NorthEast& ground_m_s, float tas_m_s, float heading_rad, float pitch_rad,
+                           float dt_s) {
+    if (!(tas_m_s >= kMinAirspeed_m_s) || !(dt_s > 0.0f)) return;
+    const float horizontal_m_s = tas_m_s * cosf(pitch_rad);
+    const NorthEast now = {ground_m_s.north_m - horizontal_m_s * cosf(heading_rad),
+                           ground_m_s.east_m - horizontal_m_s * sinf(heading_rad)};
+    if (!(now.north_m == now.north_m) || !(now.east_m == now.east_m)) return;  // NaN in: nothing learnt
+    if (!valid_) {
+        wind_ = now;  // the first estimate as it is: nothing to average with yet
+        valid_ = true;
+        return;
+    }
+    // First order low-pass, alpha = dt / (tau + dt) (a step in dt never overshoots).
+    const float alpha = dt_s / (kTimeConstant_s + dt_s);
+    wind_.north_m += alpha * (now.north_m - wind_.north_m);
+    wind_.east_m += alpha * (now.east_m - wind_.east_m);
+}
+
+float WindEstimator::speed_m_s() const { return sqrtf(wind_.north_m * wind_.north_m + wind_.east_m * wind_.east_m); }
+
+float WindEstimator::from_deg() const {
+    // The wind blows from the opposite of where the air goes.
+    float deg = atan2f(-wind_.east_m, -wind_.north_m) * linalg::kDegPerRad;
+    if (deg < 0.0f) deg += 360.0f;
+    return deg;
+}
+
+float eas_to_tas(float pressure_pa, float temperature_c) {
+    constexpr float kDryAirGasConstant = 287.05f;  // J/(kg K)
+    if (!(pressure_pa > 1000.0f) || !(temperature_c > -100.0f) || !(temperature_c < 100.0f)) return 1.0f;
+    const float density_kg_m3 = pressure_pa / (kDryAirGasConstant * (temperature_c + 273.15f));
+    return sqrtf(linalg::kAirDensity_kg_m3 / density_kg_m3);
+}
+
+}  // namespace nav
