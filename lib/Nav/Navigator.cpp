@@ -9,47 +9,41 @@ int32_t centimetres(float m) { return round_to_int32(m * 100.0f); }
 
 }  // namespace
 
-uint8_t Navigator::on_fix(const gps::Fix& fix, const BaroReading& baro, uint8_t min_sats) {
-    if (fix.fix != gps::FixType::k3D) return 0;  // a 2D or no fix: the position moves on from the last
-    uint8_t events = 0;
-    Location pos;
-    pos.lat_e7 = fix.lat_e7;
-    pos.lon_e7 = fix.lon_e7;
-    pos.alt_cm = fix.alt_msl_mm / 10;
+bool Navigator::on_fix(const gps::Fix& fix, const BaroReading& baro, uint8_t min_sats) {
+    if (fix.fix != gps::FixType::k3D) return false;  // a 2D or no fix: the position moves on from the last
     float vel[3];
     for (uint8_t i = 0; i < 3; ++i) vel[i] = (float)fix.vel_ned_cm_s[i] * 0.01f;
     if (!fix.have_vertical_velocity) vel[2] = 0.0f;
-    const NorthEast vel_ne = {vel[0], vel[1]};
-    if (!map_.valid()) map_.set_origin(pos);
-
-    const bool was_glitching = glitch_.glitching();
-    const bool good = glitch_.check(pos, vel_ne, fix.received_ms, map_);
+    // A glitch before any good fix has nothing to be dead-reckoned from.
+    const bool good = !fix.glitching || !have_position_;
     if (good) {
-        base_ = pos;
-        if (was_glitching) events |= kGlitchOver;
+        base_.lat_e7 = fix.lat_e7;
+        base_.lon_e7 = fix.lon_e7;
+        base_.alt_cm = fix.alt_msl_mm / 10;
+        if (!map_.valid()) map_.set_origin(base_);
     } else {
         // Dead reckoning over the rejected fix: the mean of the two fixes' velocities.
-        const float dt_s = (float)(fix.received_ms - base_ms_) * 0.001f;
-        const float half_dt_s = 0.5f * dt_s;
+        const float half_dt_s = 0.5f * (float)(fix.received_ms - base_ms_) * 0.001f;
         base_ = map_.moved(base_, (vel_ned_m_s_[0] + vel[0]) * half_dt_s, (vel_ned_m_s_[1] + vel[1]) * half_dt_s);
         base_.alt_cm -= centimetres((vel_ned_m_s_[2] + vel[2]) * half_dt_s);
-        if (!was_glitching) events |= kGlitch;
+        if (glitched_fixes_ != UINT16_MAX) ++glitched_fixes_;
     }
     base_ms_ = fix.received_ms;
     for (uint8_t i = 0; i < 3; ++i) vel_ned_m_s_[i] = vel[i];
     have_position_ = true;
 
+    bool home_now = false;
     if (good && !home_set() && fix.sats >= min_sats && fix.hdop_cm <= kMaxHdopCm) {
-        take_home(pos, baro, HomeSource::kGps);
-        events |= kHomeSet;
+        take_home(base_, baro, HomeSource::kGps);
+        home_now = true;
     }
     // The barometer's datum from the GPS when home could not give it (no barometer then).
     if (good && baro.healthy && !have_datum_) {
-        baro_datum_cm_ = pos.alt_cm - centimetres(baro.height_m);
+        baro_datum_cm_ = base_.alt_cm - centimetres(baro.height_m);
         have_datum_ = true;
     }
     update(fix.received_ms, baro);
-    return events;
+    return home_now;
 }
 
 void Navigator::update(uint32_t now_ms, const BaroReading& baro) {

@@ -13,9 +13,10 @@
 // - the position now: the last good fix moved on by its velocity for the fix's age plus
 //   the u-blox's lag, kGpsLag_s 0.2 s (ArduPilot's: the solution leaves the receiver that
 //   long after its time), for at most kMaxExtrapolation_ms past the fix (a GPS that went
-//   quiet is not extrapolated for ever). A fix the glitch rule rejects (GlitchFilter.h)
-//   moves the position on by its velocity only: the last good position dead-reckoned with
-//   the GPS's fresh velocities.
+//   quiet is not extrapolated for ever). A fix the driver's glitch rule rejects
+//   (gps::Fix::glitching: AP_GPS_Glitch's test, lib/GPS/GpsReceiver.h, which also says
+//   it) moves the position on by its velocity only: the last good position dead-reckoned
+//   with the GPS's fresh velocities.
 //
 // Frames: positions as Location (1e-7 deg, cm above mean sea level); north, east, down
 // metres from home on the local map at home (Location.h); velocities NED m/s. Times are
@@ -24,7 +25,6 @@
 
 #include <stdint.h>
 
-#include "GlitchFilter.h"
 #include "GpsFix.h"
 #include "Location.h"
 
@@ -44,15 +44,9 @@ public:
     static constexpr uint16_t kMaxHdopCm = 250;  // hDOP 2.5
     static constexpr uint16_t kMaxExtrapolation_ms = 1000;
 
-    // What on_fix() saw, as bits.
-    enum Event : uint8_t {
-        kHomeSet = 1,      // home was set from this fix (home(), home_source())
-        kGlitch = 2,       // the first fix of a glitch was rejected (glitch().distance_m())
-        kGlitchOver = 4,   // a good fix again after a glitch
-    };
-
-    // A new fix (the driver's fix count moved on). min_sats: AHRS_GPS_MINSATS.
-    uint8_t on_fix(const gps::Fix& fix, const BaroReading& baro, uint8_t min_sats);
+    // A new fix (the driver's fix count moved on). min_sats: AHRS_GPS_MINSATS. True when
+    // home was set from it (home(), home_source()).
+    bool on_fix(const gps::Fix& fix, const BaroReading& baro, uint8_t min_sats);
     // The position moved on to now_ms and the height from the barometer (10 Hz between fixes).
     void update(uint32_t now_ms, const BaroReading& baro);
 
@@ -81,14 +75,14 @@ public:
     const float* velocity_ned_m_s() const { return vel_ned_m_s_; }
     NorthEast ground_velocity_m_s() const { return NorthEast{vel_ned_m_s_[0], vel_ned_m_s_[1]}; }
 
-    const GlitchFilter& glitch() const { return glitch_; }
+    // Fixes dead-reckoned over (the driver said they glitched), since power-up.
+    uint16_t glitched_fixes() const { return glitched_fixes_; }
     const LocalMap& map() const { return map_; }
 
 private:
     void take_home(const Location& home, const BaroReading& baro, HomeSource source);
 
     LocalMap map_;             // at home, else at the first fix
-    GlitchFilter glitch_;
     Location home_;
     Location base_;            // the last good fix, dead-reckoned over rejected ones
     Location position_;
@@ -99,6 +93,7 @@ private:
     int32_t baro_datum_cm_ = 0;  // mean sea level height of the barometer's zero
     HomeSource home_source_ = HomeSource::kNone;
     uint8_t home_changes_ = 0;
+    uint16_t glitched_fixes_ = 0;
     bool have_position_ = false;
     bool have_datum_ = false;
     bool height_from_baro_ = false;
