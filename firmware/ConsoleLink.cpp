@@ -8,6 +8,7 @@
 #include "LoopLoad.h"
 #include "Port.h"
 #include "PipelineText.h"
+#include "Position.h"
 #include "SerialText.h"
 #include "Tasks.h"
 #include "Vehicle.h"
@@ -101,7 +102,8 @@ static bool print_status(uint8_t part) {
         case 3: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
         case 5: tasks::print_status_line(out); return true;
-        case 6: return flight_io.print_status_line();
+        case 6: position::print_status_line(out); return true;
+        case 7: return flight_io.print_status_line();
         default: return false;
     }
 }
