@@ -3,6 +3,7 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "Console.h"
 #include "GcsLink.h"
 #include "LoopLoad.h"
@@ -101,9 +102,10 @@ static bool print_status(uint8_t part) {
         case 2: pipeline_text::write_bias_status(out, pipe); return true;
         case 3: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
-        case 5: tasks::print_status_line(out); return true;
-        case 6: position::print_status_line(out); return true;
-        case 7: return flight_io.print_status_line();
+        case 5: return baro::print_line(0, out);
+        case 6: tasks::print_status_line(out); return true;
+        case 7: position::print_status_line(out); return true;
+        case 8: return flight_io.print_status_line();
         default: return false;
     }
 }
@@ -126,6 +128,7 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Status: return print_status(part);
         case console::CommandId::Show:
             if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            if (c.arg == console::kShowBaro) return baro::print_line(part, out);
             break;
         default: break;
     }

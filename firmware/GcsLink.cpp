@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include "Baro.h"
 #include "Board.h"
 #include "Console.h"
 #include "ConsoleLink.h"
@@ -23,7 +24,7 @@ static mav::Parser input;
 static mav::ParamReplies param_replies;
 static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
 static bool defaults_said_pending = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
-constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
+constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
 
@@ -160,14 +161,19 @@ void send_param_value() {
 }
 
 bool streams_due() {
-    return FlightIo::kEnabled && millis() - last_stream_ms >= kStreamPeriodMs && room_for(2u * mav::kRcChannelsFrame);
+    return (FlightIo::kEnabled || baro::present()) && millis() - last_stream_ms >= kStreamPeriodMs &&
+           room_for(2u * mav::kRcChannelsFrame + mav::kScaledPressureFrame);
 }
 void send_streams() {
     const uint32_t now_ms = millis();
     last_stream_ms = now_ms;
     uint8_t frame[mav::kMaxFrame];
-    port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
-    port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    if (FlightIo::kEnabled) {
+        port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
+        port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    }
+    if (baro::present())
+        port::send_frame(frame, port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c()));
 }
 
 void send_heartbeat_and_status() {
@@ -183,6 +189,7 @@ void send_heartbeat_and_status() {
     const gps::Fix& fix = gps_port::fix();
     mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
                     fix.fix == gps::FixType::k3D && !fix.glitching);
+    mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
     uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
                                         flight_io.plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);

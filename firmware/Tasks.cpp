@@ -14,6 +14,7 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "Board.h"
 #include "ConsoleLink.h"
 #include "GcsLink.h"
@@ -88,6 +89,7 @@ static void once_a_second() {
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
+    X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(nav,          position::due,                   position::run,                    2000, kSecNav,          0)       \
     X(store,        nullptr,                         store_service,                    1500, kSecStore,        kAlways) \

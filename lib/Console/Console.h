@@ -16,6 +16,7 @@
 //   rc                   the receiver's eight channel widths, us (radio set-up)
 //   servo                the eight output widths, us
 //   params               every parameter (lib/Settings/Params.h) and its value, one a line
+//   baro                 the barometer: pressure, temperature, height, climb, counters
 //   get NAME             one parameter
 //   set NAME VALUE       set one (range-checked; `save` keeps it)
 //
@@ -57,7 +58,7 @@ enum class CommandId : uint8_t {
     Get,       // arg = parameter index
 };
 
-enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2 };
+enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowBaro = 3 };
 // `set` values are parsed with four decimals (parse_fixed) and carried as integers.
 constexpr int32_t kParamScale = 10000;
 

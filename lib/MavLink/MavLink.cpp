@@ -43,7 +43,8 @@ static_assert((uint8_t)Severity::Error == MAV_SEVERITY_ERROR && (uint8_t)Severit
                   (uint8_t)Severity::Notice == MAV_SEVERITY_NOTICE && (uint8_t)Severity::Info == MAV_SEVERITY_INFO,
               "Severity values are MAV_SEVERITY's");
 static_assert(kGyro3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_GYRO && kAccel3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_ACCEL &&
-                  kMag3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_MAG,
+                  kMag3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_MAG &&
+                  kAbsolutePressure == (uint32_t)MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE,
               "SensorBits are MAV_SYS_STATUS_SENSOR's");
 static_assert(kComponentId == (uint8_t)MAV_COMP_ID_AUTOPILOT1, "QGroundControl makes vehicles of AUTOPILOT1 only");
 static_assert(kParamTypeInt8 == MAV_PARAM_TYPE_INT8 && kParamTypeInt16 == MAV_PARAM_TYPE_INT16 &&
@@ -52,6 +53,7 @@ static_assert(kParamTypeInt8 == MAV_PARAM_TYPE_INT8 && kParamTypeInt16 == MAV_PA
 static_assert(kParamIdLen == MAVLINK_MSG_PARAM_VALUE_FIELD_PARAM_ID_LEN, "param_id length");
 static_assert(kParamValueFrame == kFrameOverhead + MAVLINK_MSG_ID_PARAM_VALUE_LEN, "PARAM_VALUE size");
 static_assert(kRcChannelsFrame == kFrameOverhead + MAVLINK_MSG_ID_RC_CHANNELS_LEN, "RC_CHANNELS size");
+static_assert(kScaledPressureFrame == kFrameOverhead + MAVLINK_MSG_ID_SCALED_PRESSURE_LEN, "SCALED_PRESSURE size");
 static_assert(kMaxFrame >= kRcChannelsFrame && kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_SERVO_OUTPUT_RAW_LEN &&
                   kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_COMMAND_ACK_LEN,
               "the replies and streams fit kMaxFrame");
@@ -119,6 +121,12 @@ Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok) {
     if (mag_present) h.present |= kMag3d;
     if (mag_present && mag_ok) h.healthy |= kMag3d;
     return h;
+}
+
+void add_sensor(Health& h, uint32_t bits, bool present, bool ok) {
+    if (!present) return;
+    h.present |= bits;
+    if (ok) h.healthy |= bits;
 }
 
 uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode) {
@@ -195,11 +203,6 @@ uint8_t Packer::servo_output_raw(uint8_t out[kMaxFrame], uint32_t time_boot_us, 
                                              w[1], w[2], w[3], w[4], w[5], w[6], w[7], 0u, 0u, 0u, 0u, 0u, 0u, 0u,
                                              0u);
     return f.finish(out, seq_);
-}
-
-void add_sensor(Health& h, uint32_t bit, bool present, bool healthy) {
-    if (present) h.present |= bit;
-    if (present && healthy) h.healthy |= bit;
 }
 
 namespace {
@@ -479,6 +482,16 @@ bool decode_command_long(const Received& rx, CommandLong& out) {
     out.param[5] = m.param6;
     out.param[6] = m.param7;
     return true;
+}
+
+uint8_t Packer::scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c) {
+    Frame f(seq_);
+    // The temperature within int16's 0.01 degC (the chip's -40..85 degC is well inside).
+    const float c100 = temperature_c * 100.0f;
+    const int16_t temp = c100 > 32767.0f ? (int16_t)32767 : c100 < -32767.0f ? (int16_t)-32767 : (int16_t)c100;
+    mavlink_msg_scaled_pressure_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_boot_ms,
+                                            pressure_pa * 0.01f, 0.0f, temp, 0);
+    return f.finish(out, seq_);
 }
 
 }  // namespace mav

@@ -9,6 +9,7 @@
 //   STATUSTEXT       per "# "  15..66     every "# " console line, severity from its first word
 //   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us
 //   SERVO_OUTPUT_RAW 5 Hz      33 bytes   the eight outputs' widths, us
+//   SCALED_PRESSURE  5 Hz      ~28 bytes  the barometer's pressure (hPa) and temperature
 //   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
 //   COMMAND_ACK      replies   ~15 bytes
 //   GPS_RAW_INT      2 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
@@ -56,6 +57,7 @@ constexpr uint8_t kAttitudeFrame = kFrameOverhead + 28;  // trimmed only if yaws
 constexpr uint8_t kParamIdLen = 16;  // PARAM_* param_id, characters
 constexpr uint8_t kParamValueFrame = kFrameOverhead + 25;
 constexpr uint8_t kRcChannelsFrame = kFrameOverhead + 42;
+constexpr uint8_t kScaledPressureFrame = kFrameOverhead + 16;  // at most (zeros trimmed)
 
 // PARAM_VALUE param_type (MAV_PARAM_TYPE): the ones ArduPilot uses.
 constexpr uint8_t kParamTypeInt8 = 2;
@@ -81,10 +83,14 @@ enum class PlaneMode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
 // STATUSTEXT severity (MAV_SEVERITY).
 enum class Severity : uint8_t { Error = 3, Warning = 4, Notice = 5, Info = 6 };
 
-// SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR_3D_GYRO, _3D_ACCEL, _3D_MAG).
+// SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR_3D_GYRO, _3D_ACCEL, _3D_MAG,
+// _ABSOLUTE_PRESSURE, _GPS: present once a receiver has been heard, healthy with a 3D
+// fix the driver does not call a glitch).
 constexpr uint32_t kGyro3d = 1u;
 constexpr uint32_t kAccel3d = 2u;
 constexpr uint32_t kMag3d = 4u;
+constexpr uint32_t kAbsolutePressure = 8u;
+constexpr uint32_t kGps = 32u;
 
 struct Health {
     uint32_t present;  // sensor bits found at start-up (also reported as enabled)
@@ -92,10 +98,8 @@ struct Health {
 };
 // The MPU6000 is both the 3D gyro and the 3D accelerometer.
 Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok);
-
-// MAV_SYS_STATUS_SENSOR_GPS: present once a receiver has been heard, healthy with a 3D fix.
-constexpr uint32_t kGps = 32u;
-void add_sensor(Health& h, uint32_t bit, bool present, bool healthy);
+// Another sensor's bits: present (and enabled) when present, healthy when also ok.
+void add_sensor(Health& h, uint32_t bits, bool present, bool ok);
 
 // GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
 struct PositionReport {
@@ -146,6 +150,9 @@ public:
     // HOME_POSITION: home (alt above mean sea level, mm); its local position x, y, z 0
     // (there is no local frame but home's), q level, no approach vector: as ArduPilot.
     uint8_t home_position(uint8_t out[kMaxFrame], int32_t lat_e7, int32_t lon_e7, int32_t alt_msl_mm);
+    // SCALED_PRESSURE: the barometer's absolute pressure (Pa, sent in hPa) and its
+    // temperature (degC, sent in 0.01 degC); no differential pressure (0).
+    uint8_t scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c);
     uint8_t next_sequence() const { return seq_; }
 
 private:

@@ -957,3 +957,46 @@ TEST(MavLink, ParameterReferenceTableIsTheCodes) {
 }
 
 }  // namespace
+
+namespace {
+
+constexpr uint8_t kExtraScaledPressure = 115;  // common.xml's SCALED_PRESSURE
+
+TEST(MavLink, SysStatusAddsTheBarometersBits) {
+    mav::Health h = mav::health(true, true, true, true);
+    mav::add_sensor(h, mav::kAbsolutePressure, false, false);  // absent: no bit
+    EXPECT_EQ(h.present, 7u);
+    mav::add_sensor(h, mav::kAbsolutePressure, true, false);   // present, not healthy
+    EXPECT_EQ(h.present, 15u);
+    EXPECT_EQ(h.healthy, 7u);
+    mav::add_sensor(h, mav::kAbsolutePressure, true, true);
+    EXPECT_EQ(h.healthy, 15u);
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const Frame f = parse(buf, p.sys_status(buf, h, 100u, 0u), kExtraSysStatus);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(u32(f.payload, 0), 15u);  // present: gyro, accel, mag, absolute pressure (8)
+    EXPECT_EQ(u32(f.payload, 4), 15u);
+    EXPECT_EQ(u32(f.payload, 8), 15u);
+}
+
+TEST(MavLink, ScaledPressureInHectopascalAndCentidegrees) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const uint8_t n = p.scaled_pressure(buf, 123456u, 89569.0f, 8.32f);
+    const Frame f = parse(buf, n, kExtraScaledPressure);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 29u);
+    EXPECT_LE(n, mav::kScaledPressureFrame);
+    EXPECT_EQ(u32(f.payload, 0), 123456u);
+    EXPECT_FLOAT_EQ(f32(f.payload, 4), 895.69f);  // hPa
+    EXPECT_EQ(f32(f.payload, 8), 0.0f);           // no differential pressure
+    EXPECT_EQ((int16_t)u16(f.payload, 12), 832);  // 0.01 degC
+    // Out of int16's range: held at its end, never wrapped.
+    const Frame hot = parse(buf, p.scaled_pressure(buf, 0u, 1000.0f, 1e6f), kExtraScaledPressure);
+    EXPECT_EQ((int16_t)u16(hot.payload, 12), 32767);
+    const Frame cold = parse(buf, p.scaled_pressure(buf, 0u, 1000.0f, -1e6f), kExtraScaledPressure);
+    EXPECT_EQ((int16_t)u16(cold.payload, 12), -32767);
+}
+
+}  // namespace
