@@ -5,7 +5,9 @@
 #include "ArduinoCore.h"
 #include "Baro.h"
 #include "Constants.h"
+#include "GcsLink.h"
 #include "GpsPort.h"
+#include "SerialText.h"
 #include "Vehicle.h"
 
 namespace position {
@@ -18,6 +20,12 @@ static nav::WindEstimator wind_;
 static uint16_t last_fix_count = 0;
 static uint32_t last_run_ms = 0;
 static uint32_t last_wind_fix_ms = 0;
+// Home's line waits for room in the output queue (a write into a full queue would wait
+// for the UART, past the next sample): the satellites and hDOP of the fix that set it.
+static bool home_line_pending = false;
+static bool home_from_gps = false;
+static uint8_t home_sats = 0;
+static uint16_t home_hdop_cm = 0;
 
 const nav::Navigator& navigator() { return nav_; }
 const nav::WindEstimator& wind() { return wind_; }
@@ -25,15 +33,23 @@ uint8_t home_changes() { return nav_.home_changes(); }
 
 static nav::BaroReading baro_now() { return nav::BaroReading{baro::healthy(), baro::height_m()}; }
 
-bool due() { return gps_port::fix_count() != last_fix_count || millis() - last_run_ms >= kPeriodMs; }
+// Room for the line (two STATUSTEXT frames in MAVLink, 90 characters as text) and an
+// output line after it.
+static bool room_for_line() { return serial_text::room() >= 2u * mav::kMaxFrame + gcs_link::output_line_bytes(); }
 
-static void say_home(const gps::Fix* fix) {
+bool due() {
+    return gps_port::fix_count() != last_fix_count || millis() - last_run_ms >= kPeriodMs ||
+           (home_line_pending && room_for_line());
+}
+
+static void say_home() {
+    home_line_pending = false;
     const nav::Location& h = nav_.home();
     Writer w(vehicle::out);
     w.str(TXT("# home: set at ")).degrees_e7(h.lat_e7).chr(' ').degrees_e7(h.lon_e7).str(TXT(", "))
         .fixed2((float)h.alt_cm * 0.01f).str(TXT(" m ("));
-    if (fix != nullptr) {
-        w.u32(fix->sats).str(TXT(" satellites, hdop ")).fixed2((float)fix->hdop_cm * 0.01f);
+    if (home_from_gps) {
+        w.u32(home_sats).str(TXT(" satellites, hdop ")).fixed2((float)home_hdop_cm * 0.01f);
     } else {
         w.str(TXT("ground station"));
     }
@@ -65,30 +81,37 @@ void run() {
     const uint16_t count = gps_port::fix_count();
     if (count == last_fix_count) {
         nav_.update(now_ms, baro);
+        if (home_line_pending && room_for_line()) say_home();
         return;
     }
     last_fix_count = count;
     const gps::Fix& fix = gps_port::fix();
-    if (nav_.on_fix(fix, baro, pipe.settings().flight.ahrs_gps_minsats)) say_home(&fix);
+    if (nav_.on_fix(fix, baro, pipe.settings().flight.ahrs_gps_minsats)) {
+        home_line_pending = home_from_gps = true;
+        home_sats = fix.sats;
+        home_hdop_cm = fix.hdop_cm;
+    }
     learn_wind(fix);
     nav_.update(now_ms, baro);
 }
 
-bool set_home_here() {
-    if (!nav_.set_home_here(baro_now())) return false;
-    say_home(nullptr);
+// The ground station's request (its task checked the room for an ACK and two frames).
+static bool ground_station_home(bool ok) {
+    if (!ok) return false;
+    home_from_gps = false;
+    say_home();
     return true;
 }
 
-bool set_home(const nav::Location& home) {
-    if (!nav_.set_home(home, baro_now())) return false;
-    say_home(nullptr);
-    return true;
-}
+bool set_home_here() { return ground_station_home(nav_.set_home_here(baro_now())); }
+bool set_home(const nav::Location& home) { return ground_station_home(nav_.set_home(home, baro_now())); }
 
 void report(mav::PositionReport& r) {
+    // Moved on to this instant: at 18 m/s the 10 Hz position is up to 1.8 m old.
+    const uint32_t now_ms = millis();
+    nav_.update(now_ms, baro_now());
     const nav::Location& p = nav_.position();
-    r.time_boot_ms = millis();
+    r.time_boot_ms = now_ms;
     r.lat_e7 = p.lat_e7;
     r.lon_e7 = p.lon_e7;
     r.alt_msl_mm = p.alt_cm * 10;
