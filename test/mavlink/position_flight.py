@@ -17,8 +17,16 @@ MAV_CMD_GET_HOME_POSITION and MAV_CMD_DO_SET_HOME "here", both before any fix. C
     the glitch included; relative_alt within 1.5 m RMS of the truth's height;
   - the glitch said and its end said (the GPS driver's lines);
   - GPS_RAW_INT 3D with 10 satellites, SYS_STATUS's GPS bit present and healthy after the fix;
-  - VFR_HUD's ground speed within 0.5 m/s of the truth's in steady flight;
+  - GLOBAL_POSITION_INT's ground speed within 0.5 m/s of the truth's in steady flight, and
+    VFR_HUD at 4 Hz;
   - no sample missed (no "overrun" STATUSTEXT).
+Then a second run, 22 s of the same path, with the ground station's bytes at 8 s (home set
+from the GPS at ~7 s): MAV_CMD_DO_SET_HOME at a place 100 m south and 28 m below the origin,
+then MAV_CMD_REQUEST_MESSAGE 242 (a third command in the same burst would overflow the
+core's 64-byte receive ring while the first waits; a ground station waits for each ACK):
+both ACCEPTED, the new home said ("ground station"), the last HOME_POSITION that place, the
+position 100 m further north of it and the height above it 28 m more than the truth's
+(within 3 m: the barometer's datum is the GPS's height at the first fix).
 Exit 1 with every failure listed.
 """
 import math
@@ -94,33 +102,70 @@ def metres_per_degree():
     return math.radians(north), math.radians(east)
 
 
-def ground_station_bytes():
+def ground_station_bytes(work, name, commands):
+    """A file of a ground station's HEARTBEAT and COMMAND_LONGs (command, params 1-7)."""
     gcs = mavlink2.MAVLink(None, srcSystem=255, srcComponent=190)
-    frames = [gcs.heartbeat_encode(mavlink2.MAV_TYPE_GCS, mavlink2.MAV_AUTOPILOT_INVALID, 0, 0, 0),
-              gcs.command_long_encode(1, 1, mavlink2.MAV_CMD_GET_HOME_POSITION, 0, 0, 0, 0, 0, 0, 0, 0),
-              gcs.command_long_encode(1, 1, mavlink2.MAV_CMD_DO_SET_HOME, 0, 1, 0, 0, 0, 0, 0, 0)]
-    return b"".join(f.pack(gcs) for f in frames)
+    frames = [gcs.heartbeat_encode(mavlink2.MAV_TYPE_GCS, mavlink2.MAV_AUTOPILOT_INVALID, 0, 0, 0)]
+    frames += [gcs.command_long_encode(1, 1, c, 0, *p) for c, p in commands]
+    path = os.path.join(work, name)
+    with open(path, "wb") as f:
+        f.write(b"".join(m.pack(gcs) for m in frames))
+    return path
+
+
+def fly(args, flight, seconds, gcs_path, input_at, *extra):
+    """The board on the path; its MAVLink messages by type."""
+    r = subprocess.run([os.path.join(args.tools, "apm25sim"), "--elf", os.path.join(args.tools, "firmware.elf"),
+                        "--trajectory", flight, "--seconds", str(seconds), "--input", gcs_path, "--input-at",
+                        str(input_at)] + list(extra), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    soft_assert(r.returncode == 0, "apm25sim exited %d: %s" % (r.returncode, r.stderr.decode(errors="replace")[-500:]))
+    start = r.stdout.find(b"\xfd")  # the text before the switch to MAVLink
+    mav = mavlink2.MAVLink(None)
+    mav.robust_parsing = True
+    by_type = {}
+    for m in (mav.parse_buffer(r.stdout[start:]) or []):
+        by_type.setdefault(m.get_type(), []).append(m)
+    return by_type
+
+
+def check_ground_station_home(args, flight):
+    south_m, below_m = 100.0, 28.0
+    north_m_per_deg, _ = metres_per_degree()
+    lat, lon, alt = HOME[0] - south_m / north_m_per_deg, HOME[1], HOME[2] - below_m
+    gcs_path = ground_station_bytes(args.work, "gcs_home.bin", [
+        (mavlink2.MAV_CMD_DO_SET_HOME, (0, 0, 0, 0, lat, lon, alt)),
+        (mavlink2.MAV_CMD_REQUEST_MESSAGE, (242, 0, 0, 0, 0, 0, 0))])
+    by_type = fly(args, flight, 22.0, gcs_path, 8.0)
+    acks = [(a.command, a.result) for a in by_type.get("COMMAND_ACK", [])]
+    accepted = mavlink2.MAV_RESULT_ACCEPTED
+    soft_assert(acks == [(mavlink2.MAV_CMD_DO_SET_HOME, accepted), (mavlink2.MAV_CMD_REQUEST_MESSAGE, accepted)],
+                "the ground station's home: ACKs %r" % acks)
+    texts = [m.text for m in by_type.get("STATUSTEXT", [])]
+    soft_assert(any(t.startswith("home: set at") for t in texts) and "ground station)" in "".join(texts),
+                "the ground station's home not said: %r" % texts)
+    homes = by_type.get("HOME_POSITION", [])
+    # COMMAND_LONG carries degrees as a float: 24 bits, 5e-7 deg at 7 deg, 7e-6 deg at 73 deg.
+    soft_assert(homes and abs(homes[-1].latitude - lat * 1e7) <= 10 and abs(homes[-1].longitude - lon * 1e7) <= 80
+                and abs(homes[-1].altitude - alt * 1e3) <= 10,
+                "the last HOME_POSITION %r, expected %.7f %.7f %.2f" % (homes[-1:] and homes[-1], lat, lon, alt))
+    late = [p for p in by_type.get("GLOBAL_POSITION_INT", []) if p.time_boot_ms > 9000]
+    errs = [abs(p.relative_alt * 1e-3 - (-path(p.time_boot_ms * 1e-3)[2] + below_m)) for p in late]
+    soft_assert(late and max(errs) < 3.0, "height above the ground station's home off by up to %.2f m" %
+                (max(errs) if errs else -1))
+    north_errs = [abs((p.lat * 1e-7 - lat) * north_m_per_deg - (path(p.time_boot_ms * 1e-3)[0] + south_m))
+                  for p in late]
+    print("ground station's home: height above it within %.2f m, %d HOME_POSITION" % (max(errs) if errs else -1,
+                                                                                      len(homes)))
+    soft_assert(north_errs and max(north_errs) < 3.0, "north of the new home off by %.2f m" % max(north_errs))
 
 
 def main():
     args = tools_and_work()
     flight = write_flight(args.tools, args.work)
-    gcs_path = os.path.join(args.work, "gcs.bin")
-    with open(gcs_path, "wb") as f:
-        f.write(ground_station_bytes())
-    r = subprocess.run([os.path.join(args.tools, "apm25sim"), "--elf", os.path.join(args.tools, "firmware.elf"),
-                        "--trajectory", flight, "--seconds", str(SECONDS), "--input", gcs_path, "--input-at", "2",
-                        "--fault", GLITCH], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    soft_assert(r.returncode == 0, "apm25sim exited %d: %s" % (r.returncode, r.stderr.decode(errors="replace")[-500:]))
-    with open(os.path.join(args.work, "stream.bin"), "wb") as f:
-        f.write(r.stdout)
-    start = r.stdout.find(b"\xfd")  # the text before the switch to MAVLink
-    mav = mavlink2.MAVLink(None)
-    mav.robust_parsing = True
-    msgs = [m for m in (mav.parse_buffer(r.stdout[start:]) or []) if m.get_type() != "BAD_DATA"]
-    by_type = {}
-    for m in msgs:
-        by_type.setdefault(m.get_type(), []).append(m)
+    gcs_path = ground_station_bytes(args.work, "gcs.bin", [
+        (mavlink2.MAV_CMD_GET_HOME_POSITION, (0, 0, 0, 0, 0, 0, 0)),
+        (mavlink2.MAV_CMD_DO_SET_HOME, (1, 0, 0, 0, 0, 0, 0))])
+    by_type = fly(args, flight, SECONDS, gcs_path, 2.0, "--fault", GLITCH)
     texts = [m.text for m in by_type.get("STATUSTEXT", [])]
 
     acks = {a.command: a.result for a in by_type.get("COMMAND_ACK", [])}
@@ -181,6 +226,7 @@ def main():
     soft_assert(len(huds) > 4 * 40, "%d VFR_HUD in %g s" % (len(huds), SECONDS))
 
     soft_assert(not any("overrun" in t for t in texts), "samples missed: %r" % [t for t in texts if "overrun" in t])
+    check_ground_station_home(args, flight)
     sys.exit(finish("position flight", "position and home as a ground station sees them"))
 
 
