@@ -231,13 +231,20 @@ void Receiver::new_solution(const Fix& f, uint32_t now_ms) {
     const uint32_t previous_itow = last_itow_ms_;
     fix_ = f;
     fix_.received_ms = now_ms;
+    // A position off the earth or a speed beyond any aircraft's is no fix, whatever the
+    // receiver says (a frame with a valid checksum can still carry nonsense).
+    if (fix_.fix >= FixType::k2D &&
+        (fix_.lat_e7 > 900000000 || fix_.lat_e7 < -900000000 || fix_.lon_e7 > 1800000000 ||
+         fix_.lon_e7 < -1800000000 || fix_.ground_speed_cm_s > kMaxSpeedCmS || fix_.course_e5 < 0 ||
+         fix_.course_e5 > 36000000))
+        fix_.fix = FixType::kNoFix;
     last_itow_ms_ = f.itow_ms;
     if (protocol_ == Protocol::kUbx && f.itow_ms - previous_itow <= kRateGapMs) rate_ok_ms_ = now_ms;
     check_glitch(now_ms);
     ++fix_count_;
     Quality q = Quality::kNoFix;
-    if (f.fix == FixType::k3D) q = f.sats < config_.min_sats ? Quality::k3DFewSats : Quality::k3D;
-    else if (f.fix == FixType::k2D) q = Quality::k2D;
+    if (fix_.fix == FixType::k3D) q = fix_.sats < config_.min_sats ? Quality::k3DFewSats : Quality::k3D;
+    else if (fix_.fix == FixType::k2D) q = Quality::k2D;
     if (q != quality_) events_ |= kEventQuality;
     quality_ = q;
 }

@@ -24,7 +24,9 @@
 // receiver the probes are sent again every kRateLostMs: a u-blox that missed them (a cut
 // RX wire mended) then switches to UBX, is lost to NMEA, and is found again.
 //
-// Faults: nothing valid heard for kDataTimeoutMs: the receiver is lost (fix kNoGps) and
+// Faults: a position off the earth (|lat| > 90 deg, |lon| > 180 deg), a ground speed over
+// kMaxSpeedCmS or a course outside 0..360 deg is no fix. Nothing valid heard for
+// kDataTimeoutMs: the receiver is lost (fix kNoGps) and
 // detection starts again at the same baud. A 2D/3D position further from the last good
 // one moved on by its velocity than kGlitchRadiusM + kGlitchAccelMss * dt^2 / 2 is a
 // glitch (AP_GPS_Glitch's test with its defaults): the fix carries `glitching` and the
@@ -83,6 +85,7 @@ public:
     static constexpr uint16_t kMeasRateMs = 200;
     static constexpr float kGlitchRadiusM = 2.0f;   // AP_GPS_Glitch GPSGLITCH_RADIUS 200 cm
     static constexpr float kGlitchAccelMss = 10.0f;  // GPSGLITCH_ACCEL 1000 cm/s/s
+    static constexpr uint32_t kMaxSpeedCmS = 50000;  // 500 m/s: a faster "fix" is no fix
     static uint32_t baud_at(uint8_t index);  // kBauds[index]: 38400, 57600, 9600, 115200, 4800
 
     // The port is kept by reference: it outlives the receiver.

@@ -342,6 +342,21 @@ TEST(GpsReceiver, GlitchRejectedThenAccepted) {
     EXPECT_FALSE(r.rx.fix().glitching);
 }
 
+// A valid frame with a position off the earth is no fix.
+TEST(GpsReceiver, AbsurdPositionIsNoFix) {
+    Rig r;
+    configured(r);
+    uint32_t itow = 0;
+    stream(r, 400, itow, 71350450);
+    EXPECT_EQ(r.rx.quality(), Quality::k3D);
+    stream(r, 400, itow, 910000000);  // 91 deg north
+    EXPECT_EQ(r.rx.fix().fix, gps::FixType::kNoFix);
+    EXPECT_EQ(r.rx.quality(), Quality::kNoFix);
+    EXPECT_TRUE(r.take(gps::kEventQuality));
+    stream(r, 400, itow, -900000000);  // the south pole is on the earth
+    EXPECT_EQ(r.rx.fix().fix, gps::FixType::k3D);
+}
+
 // Moving at 20 m/s north is no glitch: the velocity explains the distance.
 TEST(GpsReceiver, MotionIsNoGlitch) {
     Rig r;
