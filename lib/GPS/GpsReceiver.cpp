@@ -21,15 +21,11 @@ using namespace ubx;
 const char kPubx41[] GPS_FLASH = "$PUBX,41,1,0003,0001,38400,0*26\r\n";
 static constexpr uint8_t kPubx41Len = sizeof("$PUBX,41,1,0003,0001,38400,0*26\r\n") - 1;
 
-// The order ArduPilot tried on APM2's GPS port (the 3DR u-blox is set to 38400).
+// The order ArduPilot tried on APM2's GPS port (the 3DR u-blox is set to 38400), as
+// multiples of 4800 in flash (a switch would be a table in the AVR's RAM).
+static const char kBaudIn4800s[] GPS_FLASH = {8, 12, 2, 24, 1};
 uint32_t Receiver::baud_at(uint8_t index) {
-    switch (index) {
-        case 0: return 38400;
-        case 1: return 57600;
-        case 2: return 9600;
-        case 3: return 115200;
-        default: return 4800;
-    }
+    return 4800u * (uint32_t)flash_byte(kBaudIn4800s + (index < kBaudCount ? index : kBaudCount - 1u));
 }
 
 // Metres of a 1e-7 degree of latitude (WGS-84 equatorial radius, a sphere: AP_GPS_Glitch's scale).
@@ -58,13 +54,13 @@ void Receiver::start_baud(uint8_t index, uint32_t now_ms) {
     probes_ms_ = now_ms;
     ubx_.reset();
     nmea_.reset();
-    port_.set_baud(port_.ctx, baud_at(index));
+    port_->set_baud(port_->ctx, baud_at(index));
 }
 
 bool Receiver::send_frame(uint8_t cls, uint8_t id, const uint8_t* payload, uint8_t len) {
-    if (port_.room(port_.ctx) < len + kFrameOverhead) return false;
+    if (port_->room(port_->ctx) < len + kFrameOverhead) return false;
     uint8_t frame[kLenCfgNav5 + kFrameOverhead];
-    port_.write(port_.ctx, frame, write_frame(frame, cls, id, payload, len));
+    port_->write(port_->ctx, frame, write_frame(frame, cls, id, payload, len));
     return true;
 }
 
@@ -74,14 +70,17 @@ bool Receiver::send_frame(uint8_t cls, uint8_t id, const uint8_t* payload, uint8
 // it stays at.
 bool Receiver::send_probes() {
     if (probe_step_ == 0) {
-        if (port_.room(port_.ctx) < kPubx41Len) return false;
+        if (port_->room(port_->ctx) < kPubx41Len) return false;
         uint8_t text[kPubx41Len];
         for (uint8_t i = 0; i < kPubx41Len; ++i) text[i] = flash_byte(kPubx41 + i);
-        port_.write(port_.ctx, text, kPubx41Len);
+        port_->write(port_->ctx, text, kPubx41Len);
         probe_step_ = 1;
     }
     if (probe_step_ == 1) {
-        const uint8_t sol_on[kLenCfgMsg] = {kClassNav, kNavSol, 1};
+        uint8_t sol_on[kLenCfgMsg];  // (filled here: an initialiser would be a copy in RAM)
+        sol_on[0] = kClassNav;
+        sol_on[1] = kNavSol;
+        sol_on[2] = 1;
         if (!send_frame(kClassCfg, kCfgMsg, sol_on, kLenCfgMsg)) return false;
         probe_step_ = 2;
     }
@@ -104,9 +103,8 @@ bool Receiver::send_step() {
         case kStepStatus:
         case kStepSol:
         case kStepVelned: {
-            static const uint8_t kIds[] = {kNavPosllh, kNavStatus, kNavSol, kNavVelned};
             p[0] = kClassNav;
-            p[1] = kIds[step_ - kStepPosllh];
+            p[1] = step_ == kStepPosllh ? kNavPosllh : step_ == kStepStatus ? kNavStatus : step_ == kStepSol ? kNavSol : kNavVelned;
             p[2] = 1;  // every solution
             return send_frame(kClassCfg, kCfgMsg, p, kLenCfgMsg);
         }
@@ -178,9 +176,11 @@ void Receiver::update(uint32_t now_ms) {
         case State::kOff: return;
         case State::kDetecting:
             if (now_ms - state_ms_ >= kBaudDwellMs) {
-                if (++bauds_tried_ >= kBaudCount) {
-                    bauds_tried_ = 0;
-                    if (!no_gps_said_) events_ |= kEventNoGpsFound;
+                // A round and the first baud again: a u-blox that took the probes during
+                // the round (at its factory 9600) is found at 38400 before it is missed.
+                if (bauds_tried_ <= kBaudCount) ++bauds_tried_;
+                if (bauds_tried_ == kBaudCount + 1u && !no_gps_said_) {
+                    events_ |= kEventNoGpsFound;
                     no_gps_said_ = true;
                 }
                 start_baud((uint8_t)((baud_index_ + 1u) % kBaudCount), now_ms);
@@ -231,13 +231,20 @@ void Receiver::new_solution(const Fix& f, uint32_t now_ms) {
     const uint32_t previous_itow = last_itow_ms_;
     fix_ = f;
     fix_.received_ms = now_ms;
+    // A position off the earth or a speed beyond any aircraft's is no fix, whatever the
+    // receiver says (a frame with a valid checksum can still carry nonsense).
+    if (fix_.fix >= FixType::k2D &&
+        (fix_.lat_e7 > 900000000 || fix_.lat_e7 < -900000000 || fix_.lon_e7 > 1800000000 ||
+         fix_.lon_e7 < -1800000000 || fix_.ground_speed_cm_s > kMaxSpeedCmS || fix_.course_e5 < 0 ||
+         fix_.course_e5 > 36000000))
+        fix_.fix = FixType::kNoFix;
     last_itow_ms_ = f.itow_ms;
     if (protocol_ == Protocol::kUbx && f.itow_ms - previous_itow <= kRateGapMs) rate_ok_ms_ = now_ms;
     check_glitch(now_ms);
     ++fix_count_;
     Quality q = Quality::kNoFix;
-    if (f.fix == FixType::k3D) q = f.sats < config_.min_sats ? Quality::k3DFewSats : Quality::k3D;
-    else if (f.fix == FixType::k2D) q = Quality::k2D;
+    if (fix_.fix == FixType::k3D) q = fix_.sats < config_.min_sats ? Quality::k3DFewSats : Quality::k3D;
+    else if (fix_.fix == FixType::k2D) q = Quality::k2D;
     if (q != quality_) events_ |= kEventQuality;
     quality_ = q;
 }

@@ -12,8 +12,8 @@
 // CFG-MSG that turns NAV-SOL on are sent. The first valid UBX frame means a u-blox at this baud
 // (auto, u-blox); a valid NMEA sentence means an NMEA receiver (NMEA; in auto only once
 // kNmeaSettleMs have passed since the probes left, time enough for a u-blox that heard
-// them to have left NMEA and this baud). A round with nothing heard is said once
-// (Event::kNoGpsFound) and detection goes on.
+// them to have left NMEA and this baud). A round and its first baud again with nothing
+// heard is said once (Event::kNoGpsFound) and detection goes on.
 //
 // Configuration of a u-blox, one message per update() when the port has room for it:
 // CFG-RATE 200 ms (5 Hz), CFG-MSG rate 1 for NAV-POSLLH, NAV-STATUS, NAV-SOL, NAV-VELNED,
@@ -24,7 +24,9 @@
 // receiver the probes are sent again every kRateLostMs: a u-blox that missed them (a cut
 // RX wire mended) then switches to UBX, is lost to NMEA, and is found again.
 //
-// Faults: nothing valid heard for kDataTimeoutMs: the receiver is lost (fix kNoGps) and
+// Faults: a position off the earth (|lat| > 90 deg, |lon| > 180 deg), a ground speed over
+// kMaxSpeedCmS or a course outside 0..360 deg is no fix. Nothing valid heard for
+// kDataTimeoutMs: the receiver is lost (fix kNoGps) and
 // detection starts again at the same baud. A 2D/3D position further from the last good
 // one moved on by its velocity than kGlitchRadiusM + kGlitchAccelMss * dt^2 / 2 is a
 // glitch (AP_GPS_Glitch's test with its defaults): the fix carries `glitching` and the
@@ -55,7 +57,7 @@ struct Port {
 enum Event : uint8_t {
     kEventFound = 0x01,       // a receiver at baud() speaking protocol()
     kEventConfigured = 0x02,  // the u-blox took every setting
-    kEventNoGpsFound = 0x04,  // a whole round of bauds without one (said once until one is found)
+    kEventNoGpsFound = 0x04,  // six bauds (a round and 38400 again) without one (said once)
     kEventLost = 0x08,        // nothing valid for kDataTimeoutMs: detection again
     kEventQuality = 0x10,     // quality() changed
     kEventGlitch = 0x20,      // a glitch began (glitch_m()) ...
@@ -83,9 +85,11 @@ public:
     static constexpr uint16_t kMeasRateMs = 200;
     static constexpr float kGlitchRadiusM = 2.0f;   // AP_GPS_Glitch GPSGLITCH_RADIUS 200 cm
     static constexpr float kGlitchAccelMss = 10.0f;  // GPSGLITCH_ACCEL 1000 cm/s/s
+    static constexpr uint32_t kMaxSpeedCmS = 50000;  // 500 m/s: a faster "fix" is no fix
     static uint32_t baud_at(uint8_t index);  // kBauds[index]: 38400, 57600, 9600, 115200, 4800
 
-    explicit Receiver(const Port& port) : port_(port) {}
+    // The port is kept by reference: it outlives the receiver.
+    explicit Receiver(const Port& port) : port_(&port), ubx_(work_), nmea_(work_) {}
 
     // Starts (or restarts with new settings) detection; Type::kNone: stays silent.
     void begin(const Config& config, uint32_t now_ms);
@@ -127,8 +131,9 @@ private:
     void check_glitch(uint32_t now_ms);
     bool send_frame(uint8_t cls, uint8_t id, const uint8_t* payload, uint8_t len);
 
-    Port port_;
+    const Port* port_;
     Config config_;
+    Fix work_;  // the parsers' solution being assembled (only one parser runs once found)
     UbxParser ubx_;
     NmeaParser nmea_;
     Fix fix_;
@@ -136,7 +141,7 @@ private:
     Protocol protocol_ = Protocol::kNone;
     Quality quality_ = Quality::kNoFix;
     uint8_t baud_index_ = 0;
-    uint8_t bauds_tried_ = 0;      // in this round
+    uint8_t bauds_tried_ = 0;      // since detection started (saturates past kBaudCount + 1)
     uint8_t probe_step_ = 0;       // probes sent at this baud (2: both)
     uint8_t step_ = 0;             // Step
     uint8_t events_ = 0;

@@ -76,7 +76,7 @@ NmeaParser::Message NmeaParser::feed(uint8_t byte) {
         length_ = field_index_ = field_len_ = 0;
         xor_ = 0;
         field_overflow_ = false;
-        v_ = Values();
+        v_ = Values{0, 0, 0, 0, 0, 0, 9999, 0, 0, 0, false, false, false, false, false, false};
         return Message::kNone;
     }
     switch (state_) {
@@ -141,10 +141,15 @@ void NmeaParser::field_end() {
     const uint8_t i = field_index_++;
     field_len_ = 0;
     if (i == 0) {  // the address: a two-letter talker and the sentence
-        if (f[0] == '\0' || f[1] == '\0' || f[2] == '\0') return;
-        const char* type = f + 2;
-        const auto is = [type](const char* name) { return type[0] == name[0] && type[1] == name[1] && type[2] == name[2] && type[3] == '\0'; };
-        kind_ = is("GGA") ? kGga : is("RMC") ? kRmc : is("VTG") ? kVtg : is("GSA") ? kGsa : kUnknown;
+        if (f[0] == '\0' || f[1] == '\0' || f[2] == '\0' || f[3] == '\0' || f[4] == '\0') return;
+        // (characters, not string literals: those would take the AVR's RAM)
+        const char a = f[2], b = f[3], c = f[4];
+        kind_ = f[5] != '\0'                          ? kUnknown
+                : (a == 'G' && b == 'G' && c == 'A') ? kGga
+                : (a == 'R' && b == 'M' && c == 'C') ? kRmc
+                : (a == 'V' && b == 'T' && c == 'G') ? kVtg
+                : (a == 'G' && b == 'S' && c == 'A') ? kGsa
+                                                     : kUnknown;
         return;
     }
     int32_t x;
@@ -231,8 +236,9 @@ NmeaParser::Message NmeaParser::sentence_end() {
     // North and east from speed and course (NMEA has no vertical velocity).
     const float course_rad = (float)fix_.course_e5 * 1e-5f * linalg::kRadPerDeg;
     const float speed = (float)fix_.ground_speed_cm_s;
-    fix_.vel_ned_cm_s[0] = (int32_t)lroundf(speed * cosf(course_rad));
-    fix_.vel_ned_cm_s[1] = (int32_t)lroundf(speed * sinf(course_rad));
+    const float c = cosf(course_rad), s = sinf(course_rad);  // (avr-libc's are double = float)
+    fix_.vel_ned_cm_s[0] = (int32_t)lroundf(speed * c);
+    fix_.vel_ned_cm_s[1] = (int32_t)lroundf(speed * s);
     fix_.vel_ned_cm_s[2] = 0;
     fix_.have_vertical_velocity = false;
     fix_.h_acc_mm = 0;

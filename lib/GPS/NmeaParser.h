@@ -36,9 +36,11 @@ public:
     };
     struct Counters {
         uint32_t sentences = 0;     // valid (checksum good)
-        uint32_t bad_checksum = 0;
-        uint32_t malformed = 0;     // too long, a field too long, no "*hh"
+        uint16_t bad_checksum = 0;
+        uint16_t malformed = 0;     // too long, a field too long, no "*hh"
     };
+
+    explicit NmeaParser(Fix& work) : fix_(work) {}  // the working solution (see UbxParser)
 
     Message feed(uint8_t byte);
     const Fix& fix() const { return fix_; }
@@ -61,17 +63,17 @@ private:
     char field_[kMaxField + 1];
     // The values of the sentence being read, committed at a good checksum.
     struct Values {
-        uint32_t time_cs = 0;      // UTC hhmmss.ss as centiseconds of the day
-        int32_t lat_e7 = 0, lon_e7 = 0, alt_mm = 0;
-        uint32_t speed_cm_s = 0;
-        int32_t course_e5 = 0;
-        uint16_t hdop_cm = 9999;
-        uint8_t sats = 0, quality = 0, mode = 0;  // GSA mode: 1 none, 2 2D, 3 3D
-        bool valid = false;        // RMC 'A'
-        bool have_time = false, have_pos = false, have_alt = false, have_course = false, have_speed = false;
+        uint32_t time_cs;          // UTC hhmmss.ss as centiseconds of the day
+        int32_t lat_e7, lon_e7, alt_mm;
+        uint32_t speed_cm_s;
+        int32_t course_e5;
+        uint16_t hdop_cm;
+        uint8_t sats, quality, mode;  // GSA mode: 1 none, 2 2D, 3 3D
+        bool valid : 1;            // RMC 'A'
+        bool have_time : 1, have_pos : 1, have_alt : 1, have_course : 1, have_speed : 1;
     } v_;
-    // The solution between sentences.
-    Fix fix_;
+    // The working solution, complete at kFix results.
+    Fix& fix_;
     uint32_t gga_time_cs_ = 0xFFFFFFFFu, rmc_time_cs_ = 0xFFFFFFFEu;
     uint8_t quality_ = 0;
     uint8_t mode_ = 3;  // the last GSA's

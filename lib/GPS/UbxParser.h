@@ -25,6 +25,10 @@ namespace gps {
 
 class UbxParser {
 public:
+    // The working solution is the caller's (the NMEA parser may share it: only one of
+    // them runs once a receiver is found).
+    explicit UbxParser(Fix& work) : fix_(work) {}
+
     static constexpr uint8_t kMaxPayload = ubx::kLenNavSol;
     static constexpr uint16_t kMaxSkip = 512;  // u-blox 6's longest output (NAV-SVINFO, 16 channels) fits
 
@@ -38,8 +42,8 @@ public:
     };
     struct Counters {
         uint32_t frames = 0;        // valid frames (checksum good)
-        uint32_t bad_checksum = 0;
-        uint32_t too_long = 0;      // longer than kMaxPayload (skipped) or than kMaxSkip (noise)
+        uint16_t bad_checksum = 0;
+        uint16_t too_long = 0;      // longer than kMaxPayload (skipped) or than kMaxSkip (noise)
     };
 
     Message feed(uint8_t byte);
@@ -61,8 +65,8 @@ private:
     ubx::Checksum ck_;
     uint8_t ck_a_ = 0;
     uint8_t payload_[kMaxPayload];
-    // The working solution: fix_ between kFix results; which of this epoch's halves came.
-    Fix fix_;
+    // The working solution: complete at kFix results; which of this epoch's halves came.
+    Fix& fix_;
     uint32_t pos_itow_ = 0, vel_itow_ = 0;
     uint8_t gps_fix_ = 0;        // the last NAV-STATUS/SOL gpsFix ...
     bool fix_ok_ = false;        // ... and gpsFixOk

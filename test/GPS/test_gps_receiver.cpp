@@ -29,7 +29,8 @@ void write(void* ctx, const uint8_t* data, uint8_t len) {
 
 struct Rig {
     FakePort port;
-    Receiver rx{gps::Port{&port, set_baud, room, write}};
+    const gps::Port seam{&port, set_baud, room, write};
+    Receiver rx{seam};
     uint32_t now_ms = 0;
     uint8_t events = 0;  // accumulated
 
@@ -97,16 +98,17 @@ TEST(GpsReceiver, TypeNoneIsSilent) {
     EXPECT_EQ(r.rx.fix_count(), 0u);
 }
 
-// Each baud in ArduPilot's order for 1.2 s, the probes at each; "no GPS" once a round.
+// Each baud in ArduPilot's order for 1.2 s, the probes at each; "no GPS" once, after a
+// round and 38400 again.
 TEST(GpsReceiver, DetectionSequence) {
     Rig r;
     r.begin(gps::Type::kAuto);
-    r.run(1200 * 5 - 10);
+    r.run(1200 * 6 - 10);
     EXPECT_FALSE(r.take(gps::kEventNoGpsFound));
+    EXPECT_EQ(r.port.bauds, (std::vector<uint32_t>{38400, 57600, 9600, 115200, 4800, 38400}));
     r.run(20);
     EXPECT_TRUE(r.take(gps::kEventNoGpsFound));
-    EXPECT_EQ(r.port.bauds, (std::vector<uint32_t>{38400, 57600, 9600, 115200, 4800, 38400}));
-    ASSERT_EQ(r.port.writes.size(), 12u);
+    ASSERT_EQ(r.port.writes.size(), 14u);
     for (size_t i = 0; i < 12; i += 2) {
         EXPECT_EQ(text(r.port.writes[i]), "$PUBX,41,1,0003,0001,38400,0*26\r\n");
         EXPECT_EQ(r.port.writes[i + 1], (Bytes{0xB5, 0x62, 0x06, 0x01, 0x03, 0x00, 0x01, 0x06, 0x01, 0x12, 0x4F}));
@@ -338,6 +340,21 @@ TEST(GpsReceiver, GlitchRejectedThenAccepted) {
     stream(r, 600, itow, 71350450 + jump_e7);
     EXPECT_TRUE(r.take(gps::kEventGlitchOver));
     EXPECT_FALSE(r.rx.fix().glitching);
+}
+
+// A valid frame with a position off the earth is no fix.
+TEST(GpsReceiver, AbsurdPositionIsNoFix) {
+    Rig r;
+    configured(r);
+    uint32_t itow = 0;
+    stream(r, 400, itow, 71350450);
+    EXPECT_EQ(r.rx.quality(), Quality::k3D);
+    stream(r, 400, itow, 910000000);  // 91 deg north
+    EXPECT_EQ(r.rx.fix().fix, gps::FixType::kNoFix);
+    EXPECT_EQ(r.rx.quality(), Quality::kNoFix);
+    EXPECT_TRUE(r.take(gps::kEventQuality));
+    stream(r, 400, itow, -900000000);  // the south pole is on the earth
+    EXPECT_EQ(r.rx.fix().fix, gps::FixType::k3D);
 }
 
 // Moving at 20 m/s north is no glitch: the velocity explains the distance.

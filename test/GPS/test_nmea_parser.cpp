@@ -35,7 +35,8 @@ TEST(NmeaChecksum, Pubx41) {
 }
 
 TEST(NmeaParser, SouthWestFix) {
-    NmeaParser p;
+    gps::Fix work;
+    NmeaParser p(work);
     EXPECT_EQ(feed(p, gpstest::sentence(kGgaSw)), std::vector<Msg>{Msg::kOther});  // RMC not yet
     EXPECT_EQ(feed(p, gpstest::sentence(kRmcSw)), std::vector<Msg>{Msg::kFix});
     const gps::Fix& f = p.fix();
@@ -55,7 +56,8 @@ TEST(NmeaParser, SouthWestFix) {
 }
 
 TEST(NmeaParser, NorthEastAnyTalkerLowerCaseChecksumEitherOrder) {
-    NmeaParser p;
+    gps::Fix work;
+    NmeaParser p(work);
     feed(p, gpstest::sentence("GNRMC,010203.00,A,4807.038,N,01131.000,E,0.000,,230394,,,A", true));
     EXPECT_EQ(feed(p, gpstest::sentence("GNGGA,010203.00,4807.038,N,01131.000,E,2,12,1.5,-12.5,M,47.0,M,,")),
               std::vector<Msg>{Msg::kFix});
@@ -67,7 +69,8 @@ TEST(NmeaParser, NorthEastAnyTalkerLowerCaseChecksumEitherOrder) {
 
 // No fix: quality 0 and empty fields; the last position is kept, nothing reads garbage.
 TEST(NmeaParser, EmptyFieldsNoFix) {
-    NmeaParser p;
+    gps::Fix work;
+    NmeaParser p(work);
     feed(p, gpstest::sentence(kGgaSw));
     feed(p, gpstest::sentence(kRmcSw));
     feed(p, gpstest::sentence("GPGGA,150001.00,,,,,0,02,99.99,,,,,,"));
@@ -79,7 +82,8 @@ TEST(NmeaParser, EmptyFieldsNoFix) {
 
 // GSA's mode 2: a 2D fix; a fix needs RMC's 'A'.
 TEST(NmeaParser, GsaModeAndRmcStatus) {
-    NmeaParser p;
+    gps::Fix work;
+    NmeaParser p(work);
     feed(p, gpstest::sentence("GPGSA,A,2,01,02,03,,,,,,,,,,2.0,1.5,1.3"));
     feed(p, gpstest::sentence(kGgaSw));
     feed(p, gpstest::sentence(kRmcSw));
@@ -91,7 +95,8 @@ TEST(NmeaParser, GsaModeAndRmcStatus) {
 }
 
 TEST(NmeaParser, VtgUpdatesSpeedAndCourse) {
-    NmeaParser p;
+    gps::Fix work;
+    NmeaParser p(work);
     feed(p, gpstest::sentence(kRmcSw));
     EXPECT_EQ(feed(p, gpstest::sentence("GPVTG,180.00,T,,M,1.944,N,3.600,K,A")), std::vector<Msg>{Msg::kOther});
     EXPECT_EQ(feed(p, gpstest::sentence(kGgaSw)), std::vector<Msg>{Msg::kFix});
@@ -101,7 +106,8 @@ TEST(NmeaParser, VtgUpdatesSpeedAndCourse) {
 }
 
 TEST(NmeaParser, BadChecksumAndMalformed) {
-    NmeaParser p;
+    gps::Fix work;
+    NmeaParser p(work);
     std::string bad = gpstest::sentence(kGgaSw);
     bad[10] = '9';
     EXPECT_TRUE(feed(p, bad).empty());
@@ -125,7 +131,8 @@ TEST(NmeaParser, BadChecksumAndMalformed) {
 TEST(NmeaParser, SplitAtEveryByte) {
     const std::string text = gpstest::sentence(kGgaSw) + gpstest::sentence(kRmcSw);
     for (size_t cut = 0; cut <= text.size(); ++cut) {
-        NmeaParser p;
+        gps::Fix work;
+        NmeaParser p(work);
         std::vector<Msg> a = feed(p, text.substr(0, cut)), b = feed(p, text.substr(cut));
         a.insert(a.end(), b.begin(), b.end());
         ASSERT_EQ(a.size(), 2u) << cut;

@@ -48,7 +48,8 @@ TEST(UbxChecksum, KnownFrame) {
 }
 
 TEST(UbxParser, DecodesAnEpoch) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     const Bytes bytes = cat({gpstest::posllh(1000, -71350450, -731194210, 1028300, 1200),
                              gpstest::sol(1000, 3, 0x0D, 9, 180),
                              gpstest::velned(1000, -150, 250, -30, 292, 12103000)});
@@ -80,7 +81,8 @@ TEST(UbxParser, DecodesAnEpoch) {
 TEST(UbxParser, FramesSplitAtEveryByte) {
     const Bytes bytes = gpstest::epoch(5000, 71350450, -731194210, 1500);
     for (size_t cut = 0; cut <= bytes.size(); ++cut) {
-        UbxParser p;
+        gps::Fix work;
+        UbxParser p(work);
         const std::vector<Msg> first = feed(p, Bytes(bytes.begin(), bytes.begin() + (long)cut));
         const std::vector<Msg> second = feed(p, Bytes(bytes.begin() + (long)cut, bytes.end()));
         ASSERT_EQ(first.size() + second.size(), 4u) << cut;
@@ -93,7 +95,8 @@ TEST(UbxParser, FramesSplitAtEveryByte) {
 // Random bytes between frames (sync bytes among them) lose no frame.
 TEST(UbxParser, GarbageBetweenFrames) {
     std::mt19937 rng(7);
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     int fixes = 0;
     for (uint32_t k = 0; k < 200; ++k) {
         Bytes junk(rng() % 40);
@@ -110,7 +113,8 @@ TEST(UbxParser, GarbageBetweenFrames) {
 }
 
 TEST(UbxParser, BadChecksumCountedAndDropped) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     Bytes bad = gpstest::posllh(1000, 1, 2, 3);
     bad[10] ^= 0x40;  // a payload bit flipped on the line
     EXPECT_TRUE(feed(p, bad).empty());
@@ -128,7 +132,8 @@ TEST(UbxParser, BadChecksumCountedAndDropped) {
 // Longer than the buffer: skipped while summed (a valid frame, not decoded); beyond
 // kMaxSkip: noise, and the very next frame is found.
 TEST(UbxParser, OversizedLengths) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     const Bytes long_frame = gpstest::frame(0x01, 0x30, Bytes(300, 0xB5));  // NAV-SVINFO-sized, sync bytes inside
     EXPECT_EQ(feed(p, long_frame), std::vector<Msg>{Msg::kOther});
     EXPECT_EQ(p.counters().too_long, 1u);
@@ -146,7 +151,8 @@ TEST(UbxParser, OversizedLengths) {
 
 // A known message with the wrong length is not decoded.
 TEST(UbxParser, WrongLengthNotDecoded) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     Bytes short_pos = gpstest::frame(0x01, 0x02, Bytes(20, 0x22));
     feed(p, short_pos);
     feed(p, gpstest::velned(0x22222222u, 1, 2, 3, 4, 5));
@@ -155,7 +161,8 @@ TEST(UbxParser, WrongLengthNotDecoded) {
 
 // A fix only when POSLLH and VELNED carry the same iTOW.
 TEST(UbxParser, ItowPairing) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     EXPECT_EQ(feed(p, gpstest::posllh(1000, 10, 20, 30)).back(), Msg::kOther);
     EXPECT_EQ(feed(p, gpstest::velned(1200, 1, 2, 3, 4, 5)).back(), Msg::kOther);  // another epoch
     EXPECT_EQ(feed(p, gpstest::posllh(1200, 11, 21, 31)).back(), Msg::kFix);       // pairs with it
@@ -179,12 +186,14 @@ TEST(UbxParser, FixTypeNeedsTheValidFlag) {
                  {2, 0x00, FixType::kNoFix}, {0, 0x00, FixType::kNoFix}, {4, 0x01, FixType::k3D},
                  {1, 0x01, FixType::kNoFix}, {5, 0x01, FixType::kNoFix}};
     for (const Case& c : cases) {
-        UbxParser p;
+        gps::Fix work;
+        UbxParser p(work);
         feed(p, gpstest::epoch(1000, 1, 2, 0, 8, c.gps_fix, c.flags));
         EXPECT_EQ(p.fix().fix, c.want) << (int)c.gps_fix << " " << (int)c.flags;
     }
     // NAV-STATUS alone (no SOL) decides too.
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     feed(p, cat({gpstest::status(1000, 3, 0x01), gpstest::posllh(1000, 1, 2, 3), gpstest::velned(1000, 0, 0, 0, 0, 0)}));
     EXPECT_EQ(p.fix().fix, FixType::k3D);
     feed(p, cat({gpstest::status(1200, 3, 0x00), gpstest::posllh(1200, 1, 2, 3), gpstest::velned(1200, 0, 0, 0, 0, 0)}));
@@ -192,7 +201,8 @@ TEST(UbxParser, FixTypeNeedsTheValidFlag) {
 }
 
 TEST(UbxParser, AcksAndNav5) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     EXPECT_EQ(feed(p, gpstest::ack(true, 0x06, 0x08)).back(), Msg::kAck);
     EXPECT_EQ(p.acked_class(), 0x06);
     EXPECT_EQ(p.acked_id(), 0x08);
@@ -204,6 +214,7 @@ TEST(UbxParser, AcksAndNav5) {
 
 // A repeated first sync byte (0xB5 0xB5 0x62) still starts the frame.
 TEST(UbxParser, RepeatedSync) {
-    UbxParser p;
+    gps::Fix work;
+    UbxParser p(work);
     EXPECT_EQ(feed(p, cat({Bytes{0xB5}, gpstest::ack(true, 6, 1)})).back(), Msg::kAck);
 }
