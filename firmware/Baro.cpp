@@ -6,6 +6,7 @@
 #include "ArduinoCore.h"
 #include "Board.h"
 #include "BaroHeight.h"
+#include "LinAlg.h"
 #include "Ms5611.h"
 #include "Vehicle.h"
 
@@ -142,21 +143,22 @@ text::Flash state_word() {
     return healthy() ? TXT("ok") : TXT("starting");
 }
 
-bool print_line(uint8_t part, const text::Sink* out) {
+// Within console::kPartReply (96) whatever the numbers: at most "# baro starting: " (17),
+// "120000 Pa, " (11), "-40.00 C, " (10), "-99999.99 m, " (13), "-99999.99 m/s, " (15),
+// "65535 missed, " (14), "65535 rejected" (14): 94 characters.
+void print_line(const text::Sink* out) {
+    constexpr float kShownMax = 99999.99f;  // the height and climb printed within +-kShownMax
     Writer w(out);
-    if (part == 0) {
-        w.str(TXT("# baro ")).str(state_word());
-        if (found)
-            w.str(TXT(": ")).u32((uint32_t)(mean_pa + 0.5f)).str(TXT(" Pa, ")).fixed2(temperature_c())
-                .str(TXT(" C, height ")).fixed2(height.height_m()).str(TXT(" m, climb "))
-                .fixed2(height.climb_m_s()).str(TXT(" m/s"));
-        w.end();
-        return true;
+    w.str(TXT("# baro ")).str(state_word());
+    if (found) {
+        char buf[14];
+        w.str(TXT(": ")).u32((uint32_t)(mean_pa + 0.5f)).str(TXT(" Pa, "))
+            .str(buf, text::format_centi(buf, chip.temperature_c100())).str(TXT(" C, "))
+            .fixed2(linalg::constrain(height.height_m(), -kShownMax, kShownMax)).str(TXT(" m, "))
+            .fixed2(linalg::constrain(height.climb_m_s(), -kShownMax, kShownMax)).str(TXT(" m/s, "))
+            .u32(chip.missed()).str(TXT(" missed, ")).u32(chip.rejected()).str(TXT(" rejected"));
     }
-    if (part > 1 || !found) return false;
-    w.str(TXT("# baro: ")).u32(chip.conversions()).str(TXT(" read, ")).u32(chip.missed()).str(TXT(" missed, "))
-        .u32(chip.rejected()).str(TXT(" rejected, ground ")).u32((uint32_t)(ground_pa + 0.5f)).str(TXT(" Pa")).end();
-    return true;
+    w.end();
 }
 
 }  // namespace baro

@@ -32,10 +32,10 @@ bool present();
 bool due();
 void service();
 
-// `baro`, a part (a line within console::kPartReply) at a time, false past the last:
-//   "# baro ok: P Pa, T C, height H m, climb V m/s" (`status` shows this one),
-//   "# baro: N read, M missed, R rejected, ground P0 Pa".
-bool print_line(uint8_t part, const text::Sink* out);
+// `baro` and `status`'s barometer line, within console::kPartReply:
+//   "# baro ok: P Pa, T C, H m, V m/s, M missed, R rejected" (height above the ground,
+//   climb; the state word "absent", "lost", "stuck" or "starting" instead of "ok").
+void print_line(const text::Sink* out);
 // `status`'s word for it: "ok", "absent", "lost", "stuck", "starting".
 text::Flash state_word();
 
