@@ -136,7 +136,8 @@ void print_status_line(const text::Sink* out) {
         w.str(nav_.have_position() ? TXT("not set (waiting for a good fix)") : TXT("not set (no GPS fix)")).end();
         return;
     }
-    w.fixed2(nav_.north_m()).str(TXT(" m N, ")).fixed2(nav_.east_m()).str(TXT(" m E, "))
+    const nav::NorthEast ne = nav_.from_home_m();
+    w.fixed2(ne.north_m).str(TXT(" m N, ")).fixed2(ne.east_m).str(TXT(" m E, "))
         .fixed2(nav_.height_above_home_m()).str(nav_.height_from_baro() ? TXT(" m up (baro)") : TXT(" m up (gps)"));
     if (wind_.valid())
         w.str(TXT(", wind ")).fixed2(wind_.speed_m_s()).str(TXT(" m/s from ")).u32((uint32_t)(wind_.from_deg() + 0.5f));

@@ -56,11 +56,15 @@ void Navigator::update(uint32_t now_ms, const BaroReading& baro) {
     height_from_baro_ = baro.healthy && have_datum_;
     position_.alt_cm = height_from_baro_ ? baro_datum_cm_ + centimetres(baro.height_m)
                                          : base_.alt_cm - centimetres(vel_ned_m_s_[2] * t_s);
-    if (!home_set()) return;
-    const NorthEast ne = map_.offset_m(home_, position_);
-    north_m_ = ne.north_m;
-    east_m_ = ne.east_m;
-    height_above_home_m_ = (float)(position_.alt_cm - home_.alt_cm) * 0.01f;
+}
+
+NorthEast Navigator::from_home_m() const {
+    if (!home_set()) return NorthEast{0.0f, 0.0f};
+    return map_.offset_m(home_, position_);
+}
+
+float Navigator::height_above_home_m() const {
+    return home_set() ? (float)(position_.alt_cm - home_.alt_cm) * 0.01f : 0.0f;
 }
 
 void Navigator::take_home(const Location& home, const BaroReading& baro, HomeSource source) {

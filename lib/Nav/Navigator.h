@@ -65,10 +65,12 @@ public:
     bool have_position() const { return have_position_; }
     // Now, moved on (update()); alt_cm above mean sea level.
     const Location& position() const { return position_; }
-    // Metres north, east and up from home (0 until home is set).
-    float north_m() const { return north_m_; }
-    float east_m() const { return east_m_; }
-    float height_above_home_m() const { return height_above_home_m_; }
+    // Metres north and east, and up, from home (0 until home is set): worked out on each
+    // call (a few float operations) rather than kept.
+    NorthEast from_home_m() const;
+    float north_m() const { return from_home_m().north_m; }
+    float east_m() const { return from_home_m().east_m; }
+    float height_above_home_m() const;
     // The barometer gives the height (else the GPS).
     bool height_from_baro() const { return height_from_baro_; }
     // The last fix's velocity, m/s north, east, down.
@@ -89,7 +91,6 @@ private:
     uint32_t base_ms_ = 0;     // the board's time of base_'s fix
     uint32_t now_ms_ = 0;      // of the last update()
     float vel_ned_m_s_[3] = {0.0f, 0.0f, 0.0f};
-    float north_m_ = 0.0f, east_m_ = 0.0f, height_above_home_m_ = 0.0f;
     int32_t baro_datum_cm_ = 0;  // mean sea level height of the barometer's zero
     HomeSource home_source_ = HomeSource::kNone;
     uint8_t home_changes_ = 0;
