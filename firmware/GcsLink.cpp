@@ -56,6 +56,8 @@ static mav::Result set_home(const float* p) {
     bool ok;
     if (p[0] == 1.0f || (p[4] == 0.0f && p[5] == 0.0f && p[6] == 0.0f)) {
         ok = position::set_home_here();
+    } else if (!(p[4] == p[4] && p[5] == p[5] && p[6] == p[6])) {
+        ok = false;  // NaN (MAVLink's "unset") in a place: no place
     } else {
         nav::Location home;
         // A float has 24 bits: 7.135045 deg arrives to 5e-7 deg (5 cm); COMMAND_INT would be exact.
