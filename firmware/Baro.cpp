@@ -40,6 +40,7 @@ static ms5611::BaroHeight height;
 static float mean_pa = 0.0f;
 static float ground_sum_pa = 0.0f;
 static float ground_pa = 0.0f, ground_c = 0.0f;  // as set in `height`
+static float ground_chip_c = 0.0f;  // the chip's temperature when the ground was taken
 static uint32_t period_start_us = 0, last_pressure_ms = 0, last_reject_said_ms = 0;
 static uint8_t periods = 0;  // 10 Hz periods since found (saturates)
 static bool found = false, lost = false, absent = false;
@@ -107,16 +108,17 @@ static void new_period(uint32_t now_us) {
         ground_sum_pa += p;
         if (periods < kGroundFirst + kGroundPeriods) return;
         s.gnd_abs_press_pa = ground_sum_pa / (float)kGroundPeriods;
+        // The ground air's temperature is the chip's now: later it warms in the fuselage
+        // and cools aloft, neither of which is the ground air's.
+        ground_chip_c = temperature_c();
         Writer(vehicle::out).str(TXT("# baro: MS5611, ground ")).u32((uint32_t)(s.gnd_abs_press_pa + 0.5f))
-            .str(TXT(" Pa (GND_ABS_PRESS), ")).fixed2(temperature_c()).str(TXT(" C")).end();
+            .str(TXT(" Pa (GND_ABS_PRESS), ")).fixed2(ground_chip_c).str(TXT(" C")).end();
     }
-    const float t_c = s.flight.gnd_temp_c != 0.0f ? s.flight.gnd_temp_c : temperature_c();
+    const float t_c = s.flight.gnd_temp_c != 0.0f ? s.flight.gnd_temp_c : ground_chip_c;
     if (!height.have_ground() || s.gnd_abs_press_pa != ground_pa || t_c != ground_c) {
         if (!(s.gnd_abs_press_pa > 0.0f)) return;  // GND_ABS_PRESS 0: none to measure from
-        // The temperature is the ground's as at start-up: later the chip's own warms in
-        // the fuselage and cools aloft, neither of which is the ground air's.
         ground_pa = s.gnd_abs_press_pa;
-        ground_c = height.have_ground() && s.flight.gnd_temp_c == 0.0f ? ground_c : t_c;
+        ground_c = t_c;
         height.set_ground(ground_pa, ground_c);
     }
     board::mark_begin(board::kSecBaroHeight);

@@ -67,25 +67,28 @@ double true_height_m(double t) {
     return h;
 }
 
-TEST(Baro, HeightAboveHomeWithinOneAndAHalfMetresRms) {
-    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
-    const double seconds = 50.0;
-    // The board at rest (the scenario's IMU columns) with the n,e,d columns of the profile.
+// The rest scenario's IMU columns with n,e,d columns from height(t), as a trajectory file.
+std::string with_heights(const std::string& name, double seconds, double (*height_m)(double)) {
     const std::string rest = e2e::scenario_csv("rest", seconds);
-    ASSERT_FALSE(rest.empty());
     std::ifstream in(rest);
-    const std::string path = e2e::work_dir() + "/baro_heights." + std::to_string(getpid()) + ".csv";
+    const std::string path = e2e::work_dir() + "/" + name + "." + std::to_string(getpid()) + ".csv";
     std::ofstream out(path);
     std::string line;
     std::getline(in, line);
     out << line << ",n,e,d\n";
     while (std::getline(in, line)) {
-        const double t = std::atof(line.c_str());
         char ned[64];
-        std::snprintf(ned, sizeof ned, ",0,0,%.4f\n", -true_height_m(t));
+        std::snprintf(ned, sizeof ned, ",0,0,%.4f\n", -height_m(std::atof(line.c_str())));
         out << line << ned;
     }
-    out.close();
+    return path;
+}
+
+TEST(Baro, HeightAboveHomeWithinOneAndAHalfMetresRms) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    const double seconds = 50.0;
+    // The board at rest (the scenario's IMU columns) with the n,e,d columns of the profile.
+    const std::string path = with_heights("baro_heights", seconds, true_height_m);
     const std::string input = e2e::input_file("baro_heights", spaced_commands("baro", 0.25, 180));
     const e2e::SimRun run = e2e::run_sim_file(e2e::firmware_elf(), path, seconds, "--input " + input + " --input-at 3");
     unlink(input.c_str());
@@ -105,6 +108,47 @@ TEST(Baro, HeightAboveHomeWithinOneAndAHalfMetresRms) {
     std::printf("height above home: RMS %.2f m, worst %.2f m over %zu readings\n", rms, worst, heights.size());
     EXPECT_LT(rms, 1.5);
     EXPECT_LT(worst, 4.0);
+}
+
+// The climb of a "# baro ok: P Pa, T C, H m, V m/s, ..." line.
+double climb_of(const std::string& text) {
+    const size_t at = text.find(" m, ");
+    return at == std::string::npos ? NAN : std::atof(text.c_str() + at + 4);
+}
+
+double climbing_4_m_s(double t) { return t < 1.5 ? 0.0 : 4.0 * (t - 1.5); }
+
+// GND_TEMP stands for the ground's temperature while it is not 0: the height scales with
+// it (T0 in kelvin: 40 degC against the chip's 8.32 is 313.15 / 281.47 = 1.113); back at 0,
+// the chip's own again, and the height and climb track the truth.
+TEST(Baro, GndTempScalesTheHeightAndZeroGivesTheChipsBack) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    const double seconds = 11.0;
+    const std::string path = with_heights("baro_gnd_temp", seconds, climbing_4_m_s);
+    const double char_s = 10.0 / 115200.0;
+    auto pad = [&](double s) { return std::string((size_t)(s / char_s), '\n'); };
+    const std::string input = e2e::input_file(
+        "baro_gnd_temp", "set GND_TEMP 40\r\n" + pad(2.5) + "baro\r\n" + pad(0.5) + "set GND_TEMP 0\r\n" + pad(3.0) +
+                             "baro\r\n");
+    const e2e::SimRun run = e2e::run_sim_file(e2e::firmware_elf(), path, seconds, "--input " + input + " --input-at 3");
+    unlink(input.c_str());
+    unlink(path.c_str());
+    expect_undisturbed(run, seconds);
+    const auto heights = baro_heights(run.lines);
+    ASSERT_EQ(heights.size(), 2u) << e2e::dump(run, 100);
+    // The height is the 10 Hz update's before the reply (~0.1 s), its climb state restarted
+    // when GND_TEMP moved the reference 2.5 s before: against the truth 0.1 s back, within 5 %
+    // (without GND_TEMP the ratio would be 1.00).
+    const double warm = heights[0].second / climbing_4_m_s(heights[0].first - 0.1);
+    std::printf("GND_TEMP 40: %.2f m at %.2f s, %.3f of the truth; then %.2f m against %.2f m\n", heights[0].second,
+                heights[0].first, warm, heights[1].second, climbing_4_m_s(heights[1].first));
+    EXPECT_NEAR(warm, 313.15 / 281.47, 0.05);
+    EXPECT_NEAR(heights[1].second, climbing_4_m_s(heights[1].first), 1.0);
+    const e2e::Line* last = nullptr;
+    for (const e2e::Line& l : run.lines)
+        if (l.text.rfind("# baro ok: ", 0) == 0) last = &l;
+    ASSERT_TRUE(last);
+    EXPECT_NEAR(climb_of(last->text), 4.0, 1.0) << last->text;
 }
 
 TEST(Baro, AbsentIsSaidOnceAndTheRestRuns) {
