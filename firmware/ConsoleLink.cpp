@@ -6,9 +6,11 @@
 #include "Baro.h"
 #include "Console.h"
 #include "GcsLink.h"
+#include "GpsPort.h"
 #include "LoopLoad.h"
 #include "Port.h"
 #include "PipelineText.h"
+#include "Position.h"
 #include "SerialText.h"
 #include "Tasks.h"
 #include "Vehicle.h"
@@ -103,7 +105,9 @@ static bool print_status(uint8_t part) {
         case 4: print_settings_line(); return true;
         case 5: baro::print_line(out); return true;
         case 6: tasks::print_status_line(out); return true;
-        case 7: return flight_io.print_status_line();
+        case 7: gps_port::print_status_line(out); return true;
+        case 8: position::print_status_line(out); return true;
+        case 9: return flight_io.print_status_line();
         default: return false;
     }
 }
@@ -126,6 +130,7 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Status: return print_status(part);
         case console::CommandId::Show:
             if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            if (c.arg == console::kShowGps) return gps_port::print(part, out);
             if (c.arg == console::kShowBaro) {
                 if (part > 0) return false;
                 baro::print_line(out);

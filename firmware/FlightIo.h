@@ -52,6 +52,8 @@ public:
 
     // The receiver's throttle above idle: the aeroplane flies at its cruise speed.
     bool powered() const;
+    // The throttle output (OUT3) between its SERVO3_MIN and _MAX, percent (VFR_HUD).
+    uint8_t throttle_percent() const;
     // The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode), and whether it
     // is the failsafe (HEARTBEAT's state CRITICAL).
     mav::PlaneMode plane_mode() const;

@@ -328,7 +328,12 @@ TIMING_TEXT = [(re.compile(r"load \d+%"), "load N%"), (re.compile(r"uptime [0-9.
                (re.compile(r"^# GND_ABS_PRESS [0-9.]+"), "# GND_ABS_PRESS P")]
 # MAVLink fields that are measured time: (message id, payload offset, length).
 TIMING_FIELDS = {1: [(12, 2)],   # SYS_STATUS.load
-                 36: [(0, 4)]}   # SERVO_OUTPUT_RAW.time_usec
+                 36: [(0, 4)],   # SERVO_OUTPUT_RAW.time_usec
+                 24: [(0, 8)],   # GPS_RAW_INT.time_usec: the fix's arrival on the board's clock
+                 # GLOBAL_POSITION_INT: its instant, the position moved on to it (lat, lon, alt,
+                 # relative_alt) and the attitude's heading then; the fix's velocity is compared
+                 33: [(0, 20), (26, 2)],
+                 74: [(8, 10)]}  # VFR_HUD: the barometer's height and climb, the heading, at its instant
 # Receiver widths, in us, and what follows from them. simavr applies a pin edge at the end of
 # the instruction running when it is due, so Timer5's capture (0.5 us a count) of the same
 # edge may read one count apart when other instructions run (on the chip it is cycle-exact):
