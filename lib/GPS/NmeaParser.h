@@ -4,8 +4,8 @@
 // Protocol"), fed a byte at a time. Nothing is stored but the field being read and the
 // values decoded so far: a sentence's values count only once its checksum (the XOR of
 // the characters between '$' and '*') is right. A sentence longer than kMaxSentence
-// (NMEA 0183's 82 characters with "$" and CR LF), a field longer than kMaxField, or a
-// sentence without "*hh" is dropped.
+// (NMEA 0183 allows 82 characters with "$", "*hh" and CR LF: 76 between; 3 more are
+// tolerated), a field longer than kMaxField, or a sentence without "*hh" is dropped.
 //
 // Integer arithmetic throughout: latitude "ddmm.mmmmm" and longitude "dddmm.mmmmm" to
 // 1e-7 degree (minutes to 7 decimals, divided by 60 with rounding), height to mm, speed
@@ -26,7 +26,7 @@ namespace gps {
 
 class NmeaParser {
 public:
-    static constexpr uint8_t kMaxSentence = 79;  // characters between '$' and '*' (82 with "$*hh\r\n" less 3)
+    static constexpr uint8_t kMaxSentence = 79;  // characters between '$' and '*' (NMEA 0183: 76)
     static constexpr uint8_t kMaxField = 15;
 
     enum class Message : uint8_t {
