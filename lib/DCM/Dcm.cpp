@@ -4,6 +4,8 @@
 #include "Fixed.h"
 #include "Profile.h"
 
+#include <math.h>
+
 namespace dcm {
 
 using linalg::Matrix3f;
@@ -93,6 +95,8 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field, bool gravi
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     start_from_mean_ = gravity_is_mean;
+    gps_.stop();  // no pair across a start
+    course_taken_ = false;
     status_ |= kStatusInitialised;
     return true;
 }
@@ -275,11 +279,17 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     bias_.judge_rotation(mean_off_bias, (status_ & kStatusGyroRejected) != 0, k_);
     const bool hold_integrator = bias_.integrator_held(context.starting, start_from_mean_);
-    // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
-    if (turn_ != nullptr && turn_->active()) gravity_.subtract_turn(*turn_, context);
-    // The window into the earth-frame low-pass, its means into the rest test.
+    // In flight, the turn's centripetal acceleration off the window first (Centripetal.h),
+    // unless the GPS's acceleration comes off it (GpsAid.h: the turn's is in it).
+    const bool gps_aiding = gps_.aiding();
+    if (turn_ != nullptr && turn_->active() && !gps_aiding) gravity_.subtract_turn(*turn_, context);
+    // The window into the earth-frame low-pass (or, GPS-aided, into the GPS's sums: its
+    // observations feed the low-pass), its means into the rest test.
     WindowMeans window;
-    if (gravity_.low_pass_window(context, window)) detect_rest(window, mean_off_bias);
+    if (gravity_.low_pass_window(context, window, !gps_aiding)) {
+        detect_rest(window, mean_off_bias);
+        gps_.add_window(window.accel_ef);
+    }
     // The low-pass's direction against earth down: the roll/pitch correction, and its
     // integral into the bias unless held.
     gravity_.correct_tilt(context, hold_integrator, bias_);
@@ -287,6 +297,46 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::end(profile::kGravity);
 }
 
+
+// A GPS velocity (GpsAid.h): a completed pair's observation into the low-pass, with the
+// factor of its interval against accel_lowpass_s (5 Hz: float and one exp).
+void Dcm::on_gps_velocity(const Vector3f& vel_ned_m_s, float interval_s, float gain) {
+    if (!initialised() || steps_ < k_.startup_steps) {
+        gps_.stop();
+        return;
+    }
+    Vector3l observation;
+    if (!gps_.on_velocity(vel_ned_m_s, interval_s, gain, k_.accel_units_per_m_s2,
+                          observation))
+        return;
+    const float alpha = 1.0f - expf(-interval_s / settings_->accel_lowpass_s);
+    gravity_.low_pass_observation(observation, linalg::fixed_from_float(alpha, linalg::kQ30));
+}
+
+// The GPS course as the heading reference (AP_AHRS_DCM without a compass): the error
+// sin(yaw - course), yaw's cosine and sine from R's first column (cos(pitch) cos(yaw),
+// cos(pitch) sin(yaw)), corrected at kp_yaw as a compass's mean is (Heading.h); the
+// first one after a start without a heading at once.
+void Dcm::correct_heading_from_course(float course_rad, uint16_t interval_steps) {
+    if (!initialised()) return;
+    const float north = linalg::float_from_fixed(strapdown_.r().a.x, linalg::kQ30);
+    const float east = linalg::float_from_fixed(strapdown_.r().b.x, linalg::kQ30);
+    const float horizontal2 = north * north + east * east;
+    if (!(horizontal2 > 0.01f)) return;  // the nose within ~6 deg of vertical: no yaw to correct
+    const float inv = linalg::inverse_sqrt(horizontal2);
+    const float cos_course = cosf(course_rad), sin_course = sinf(course_rad);
+    const float cos_error = (north * cos_course + east * sin_course) * inv;
+    const float sin_error = (east * cos_course - north * sin_course) * inv;
+    if ((status_ & kStatusNoHeading) && !course_taken_) {
+        course_taken_ = true;
+        turn_heading_at_once(strapdown_.r(), cos_error, sin_error);
+        return;
+    }
+    // Saturated at +-1 beyond 90 deg, so it stays monotonic (as the compass's).
+    const float heading_error = cos_error >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
+    const uint16_t steps = interval_steps < kGpsMaxCourseSteps ? interval_steps : kGpsMaxCourseSteps;
+    turn_heading(strapdown_, heading_error, settings_->kp_yaw_1_s, (float)steps, k_);
+}
 
 Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
 

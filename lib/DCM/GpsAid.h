@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The GPS-aided gravity reference (ArduPilot's AP_AHRS_DCM::drift_correction on the APM 2,
+// after Premerlani & Bizard's "Direction Cosine Matrix IMU: Theory" eq. 26 with the GPS
+// velocity for v). The accelerometer reads the specific force f = a - g; in earth axes,
+// summed over an interval, it is the velocity change less gravity's:
+//   sum(R f) dt = dv - g dt     so     mean(R f) - dv/dt = -g (0, 0, 1)
+// with dv from two GPS velocities. What is left of the estimated earth-frame mean after
+// the GPS's acceleration is taken off is gravity alone, whatever the aeroplane does: a
+// turn's centripetal acceleration, a climb's speed change, a gust's push are all in dv.
+// That difference is the gravity correction's input (Gravity.h: its earth-frame low-pass,
+// then the roll/pitch error of eq. 27) in place of the accelerometer's window alone.
+//
+// Timing: a u-blox reports the velocity of a measurement kGpsLag_s before its message is
+// complete (ArduPilot assumed 0.2 s for the u-blox on the APM 2). The accelerometer's sums
+// are taken between the fixes' arrivals; the sum paired with a velocity change is the one
+// whose interval is nearest in time to the GPS's interval: one fix late (ArduPilot's
+// _ra_delay_buffer) when the lag is at least half the interval (5 Hz), else the current
+// one (1 Hz NMEA: a lag of a fifth of the interval).
+//
+// Formats: the windows' earth-frame means in accel units (counts * 2^8, Coefficients.h),
+// summed over at most kGpsMaxWindows (within 31 bits at 16 g); the velocity and the
+// observation's arithmetic in float (5 Hz).
+#pragma once
+
+#include <stdint.h>
+
+#include "LinAlg.h"
+
+namespace dcm {
+
+// The u-blox's latency from measurement to message (ArduPilot's assumption on the APM 2).
+constexpr float kGpsLag_s = 0.2f;
+// Fixes further apart than this are no derivative: a lost fix (1 Hz NMEA is 1 s apart).
+constexpr float kGpsMaxInterval_s = 1.5f;
+// A course stands for at most this many steps (kGpsMaxInterval_s at 200 Hz).
+constexpr uint16_t kGpsMaxCourseSteps = 300;
+// The windows (50 Hz) a sum holds at most: kGpsMaxInterval_s and a late arrival (at 16 g
+// full scale a window's mean is 2^23 accel units at most: 80 of them within 2^31).
+constexpr uint8_t kGpsMaxWindows = 80;
+// Without a usable fix for this many windows (1 s: five 5 Hz fixes, a 1 Hz fix late by
+// its serial transfer), the window's own low-pass (and the turn's term) takes over again.
+constexpr uint8_t kGpsTimeoutWindows = 75;
+
+class GpsAccel {
+public:
+    // One gravity window's earth-frame mean specific force (accel units).
+    void add_window(const linalg::Vector3l& accel_ef) {
+        if (since_fix_ < 255u) ++since_fix_;
+        if (windows_ >= kGpsMaxWindows) return;  // too long for a derivative: the pair is refused
+        sum_ += accel_ef;
+        ++windows_;
+    }
+    // A usable fix's velocity (m/s, the estimator's earth axes: north the magnetic one) and
+    // the time since the fix before (s, from the receiver's time of week; 0: none). True
+    // when it completes a pair: `observation` is then the earth-frame mean specific force
+    // less gain times the GPS's acceleration (accel units; accel_units_per_m_s2 their
+    // scale), gravity's reading: (0, 0, -g) when the attitude is right.
+    bool on_velocity(const linalg::Vector3f& vel_m_s, float interval_s, float gain, float accel_units_per_m_s2,
+                     linalg::Vector3l& observation);
+    // No usable fix (none, 2D, too few satellites, the estimator restarting): no pair
+    // across it, and the window's own low-pass at once.
+    void stop() {
+        fixes_ = 0;
+        aiding_ = false;
+    }
+    // The GPS's observations feed the low-pass (the last within kGpsTimeoutWindows).
+    bool aiding() const { return aiding_ && since_fix_ <= kGpsTimeoutWindows; }
+
+private:
+    linalg::Vector3l sum_;       // the windows since the last fix (accel units)
+    linalg::Vector3l prev_sum_;  // ... between the two fixes before
+    linalg::Vector3f prev_vel_m_s_;
+    uint8_t windows_ = 0, prev_windows_ = 0;
+    uint8_t since_fix_ = 255;    // windows since the last usable fix (saturated)
+    uint8_t fixes_ = 0;          // usable fixes in a row (up to 2: a velocity and a sum before it)
+    bool aiding_ = false;
+};
+
+}  // namespace dcm
