@@ -14,7 +14,9 @@
 // any consistent unit (uT), time in seconds. Gains are per second and scaled by the
 // step, so the step rate can change without retuning.
 //
-// Dcm is the facade; each mechanism is a part with its own file and tests:
+// Dcm is the facade; each mechanism is a part with its own file and tests, which owns its
+// state and is handed what it reads of the estimator around it in a small context
+// (GravityContext, HeadingContext) built for the call:
 //   DcmSettings.h    DcmSettings            the tuning values with units (VQF's params)
 //   Coefficients.h   DcmCoefficients        what follows from them and the scales (VQF's coefficients)
 //   Strapdown.h      Strapdown              integration and renormalisation (AP's matrix_update, normalize)
@@ -235,8 +237,8 @@ private:
     void update_offset();
     // What the heading correction reads and turns (Heading.h).
     HeadingContext heading_context() {
-        return HeadingContext{*settings_, k_, strapdown_, bias_, last_rate_units(), steps_, (status_ & kStatusAtRest) != 0,
-                              trace()};
+        return HeadingContext{*settings_, k_, strapdown_, bias_, last_rate_units(), steps_,
+                              (status_ & kStatusAtRest) != 0, trace()};
     }
     // Counts to the turn sums' units: a byte shift (a multiply by 256 may become avr-gcc's
     // 32x32 routine).

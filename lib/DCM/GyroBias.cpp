@@ -29,9 +29,10 @@ void GyroBias::set_sensor_rad_s(const Vector3f& bias, const DcmCoefficients& k) 
 
 // The compass teaches the bias only while nothing else has measured it (DcmSettings.h):
 // its errors (a residual hard iron, a magnet nearby) turn with the heading.
-bool GyroBias::learn_from_heading(const linalg::Vector3l& down_q30, float heading_error, float steps, bool starting,
-                                  const DcmSettings& settings, const DcmCoefficients& k) {
+bool GyroBias::learn_from_heading(const linalg::Vector3l& down_q30, float heading_error, uint16_t interval_steps,
+                                  bool starting, const DcmSettings& settings, const DcmCoefficients& k) {
     if (rotating_fast_ || starting || measured() || settings.ki_yaw_1_s2 == 0.0f) return false;
+    const float steps = (float)interval_steps;
     const Vector3f error = linalg::vector_from_q30(down_q30) * -heading_error;
     subtract_fine(linalg::fixed_from_vector(
         error * (settings.ki_yaw_1_s2 * settings.step_s * steps * k.units_per_rad_s * (float)kTurnScale), 0), k);

@@ -86,10 +86,10 @@ public:
         set_measured();
     }
     // The compass's integral (ki_yaw): the heading error (the sine, saturated) about earth
-    // down (R's third row, Q30), over `steps` steps; only while nothing else has measured
-    // the bias, neither rotating fast nor starting. True when it learned.
-    bool learn_from_heading(const linalg::Vector3l& down_q30, float heading_error, float steps, bool starting,
-                            const DcmSettings& settings, const DcmCoefficients& k);
+    // down (R's third row, Q30), over interval_steps steps; only while nothing else has
+    // measured the bias, neither rotating fast nor starting. True when it learned.
+    bool learn_from_heading(const linalg::Vector3l& down_q30, float heading_error, uint16_t interval_steps,
+                            bool starting, const DcmSettings& settings, const DcmCoefficients& k);
     // At rest: estimate += alpha (rest mean - estimate), alpha = rest_bias_alpha_q30.
     void follow_rest_mean(const linalg::Vector3l& rest_mean_units, const DcmCoefficients& k);
     // The bias was measured on a still board: from now the gravity integrator uses

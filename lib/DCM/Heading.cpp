@@ -267,10 +267,9 @@ FIXED_OWN_FRAME HeadingResult HeadingCorrection::correct(const HeadingContext& c
     const Vector3l& down = ctx.strapdown.r().c;
     // The compass's integral, while nothing else has measured the bias (GyroBias).
     ctx.trace.bias_before(ctx.bias, ctx.k);
-    if (!ctx.bias.learn_from_heading(down, heading_error, steps, starting, settings, ctx.k))
-        return HeadingResult{true, false};
+    const bool learned = ctx.bias.learn_from_heading(down, heading_error, interval_steps, starting, settings, ctx.k);
     ctx.trace.bias_after(BiasSource::kHeading, ctx.bias, ctx.k);
-    return HeadingResult{true, true};
+    return HeadingResult{true, learned};
 }
 
 }  // namespace dcm

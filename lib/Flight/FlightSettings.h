@@ -59,6 +59,14 @@ struct FlightSettings {
     uint8_t servo_reversed;     // SERVOn_REVERSED: bit n-1
     EndPoints rc[kChannels];    // RCn_MIN, _MAX, _TRIM
     EndPoints servo[kChannels]; // SERVOn_MIN, _MAX, _TRIM
+    // The GPS and the estimator's use of it, the barometer's datum (ArduPilot's AP_GPS,
+    // AP_AHRS and AP_Baro names).
+    uint8_t gps_type;           // GPS_TYPE: 0 none, 1 auto, 2 u-blox, 5 NMEA
+    uint8_t gps_navfilter;      // GPS_NAVFILTER: the u-blox's dynamic model (CFG-NAV5 dynModel)
+    float ahrs_gps_gain;        // AHRS_GPS_GAIN: weight of the GPS acceleration in the gravity reference
+    uint8_t ahrs_gps_use;       // AHRS_GPS_USE: 0 = the estimator ignores the GPS
+    uint8_t ahrs_gps_minsats;   // AHRS_GPS_MINSATS: satellites a fix needs to be used
+    float gnd_temp_c;           // GND_TEMP: the ground's air temperature, degC (0: the barometer's own)
 };
 
 // The channel map's roles (index into rcmap).

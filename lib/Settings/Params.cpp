@@ -229,6 +229,38 @@ const Row kRows[] PARAM_TABLE = {
                "the failsafe glide (FS_GLIDE_PITCH is added to it), as ArduPlane adds it to every pitch it asks "
                "for. Find it in the set-up: trim the model for level cruise in MANUAL, read the pitch the board "
                "shows, set it here. 0 holds the board level, and a model whose trim is nose up then sinks.")},
+    // Version 5: the GPS, the estimator's use of it, the barometer's datum.
+    {"GPS_TYPE", Type::UInt8, 0, 1, 0, AT(flight.gps_type), 0.0f, 5.0f, 1.0f,
+     PARAM_DOC("GPS type", "",
+               "The receiver on the GPS port: 0 none (the port is left silent), 1 auto (a u-blox is looked for at "
+               "38400, 57600, 9600, 115200 and 4800 baud and set to binary UBX at 5 Hz; a module that only "
+               "speaks NMEA is taken as it is), 2 u-blox only, 5 NMEA only. 3 and 4 (ArduPilot's MediaTek "
+               "receivers) are taken as 1.")},
+    {"GPS_NAVFILTER", Type::UInt8, 0, 1, 0, AT(flight.gps_navfilter), 0.0f, 8.0f, 8.0f,
+     PARAM_DOC("GPS navigation filter", "",
+               "The u-blox's dynamic platform model (CFG-NAV5 dynModel), written to the module when it differs: "
+               "8 airborne below 4 g (an aeroplane), 0 portable, 2 stationary, 3 pedestrian, 4 automotive, 5 "
+               "sea, 6 airborne below 1 g, 7 airborne below 2 g.")},
+    {"AHRS_GPS_GAIN", Type::Float, 0, 1, 0, AT(flight.ahrs_gps_gain), 0.0f, 10.0f, 1.0f,
+     PARAM_DOC("AHRS GPS gain", "",
+               "How strongly the estimator takes the acceleration measured by the GPS (the change of its "
+               "velocity) out of the accelerometer's gravity reference: 1 wholly, 0 not at all.")},
+    {"AHRS_GPS_USE", Type::UInt8, 0, 1, 0, AT(flight.ahrs_gps_use), 0.0f, 1.0f, 1.0f,
+     PARAM_DOC("AHRS use GPS", "",
+               "1: the estimator uses the GPS velocity (and its course when there is no compass); 0: it never "
+               "does, as without a GPS.")},
+    {"AHRS_GPS_MINSATS", Type::UInt8, 0, 1, 0, AT(flight.ahrs_gps_minsats), 0.0f, 10.0f, 6.0f,
+     PARAM_DOC("AHRS GPS minimum satellites", "",
+               "A 3D fix is used by the estimator, and may set home, only with at least this many satellites.")},
+    {"GND_TEMP", Type::Float, 0, 1, 0, AT(flight.gnd_temp_c), -40.0f, 80.0f, 0.0f,
+     PARAM_DOC("Ground temperature", "degC",
+               "The air's temperature on the ground, for the height from the pressure: 0 takes the barometer's "
+               "own at start-up (a chip inside a warm fuselage reads high: about 0.35 % of the height per "
+               "degree).")},
+    {"GND_ABS_PRESS", Type::Float, 0, 1, 0, AT(gnd_abs_press_pa), 0.0f, 120000.0f, 0.0f,
+     PARAM_DOC("Ground pressure", "Pa",
+               "The pressure at home, measured at each start while the gyro calibrates (0 until then): the "
+               "height above home is taken from it. Not saved.")},
     {"COMPASS_DEC", Type::DeclRad, 0, 1, 0, AT(declination_centideg), -3.1416f, 3.1416f, 0.0f,
      PARAM_DOC("Compass declination", "rad",
                "The angle from true north to magnetic north, east positive, added to the heading the board "

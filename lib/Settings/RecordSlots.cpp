@@ -53,9 +53,10 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     out.newest_cut = p.newest_cut;
     out.write = p.write;
     out.next_sequence = p.next_sequence;
-    // This firmware's record, or version 3's (Settings.h: it loads, the newer rows at defaults).
+    // This firmware's record, or version 3's or 4's (Settings.h: they load, the newer rows at defaults).
     if (p.load >= 0 && info[(uint8_t)p.load].record_length != settings::kRecordSize &&
-        info[(uint8_t)p.load].record_length != settings::kV3RecordSize) {
+        info[(uint8_t)p.load].record_length != settings::kV3RecordSize &&
+        info[(uint8_t)p.load].record_length != settings::kV4RecordSize) {
         s = settings::defaults();
         out.result = settings::LoadResult::OldVersion;  // another firmware's record layout
         return out;

@@ -87,10 +87,11 @@ FIXED_COLD LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     if (blank) return LoadResult::Blank;
     if (in[0] != kMagic0 || in[1] != kMagic1) return LoadResult::BadMagic;
     // Version 2's payload is this version's first part: read it, flight settings at
-    // defaults. Version 3's lacks only the rows added since: they keep their defaults.
+    // defaults. Versions 3 and 4 lack only the rows added since: they keep their defaults.
     const bool v2 = in[2] == 2u && in[3] == kV2PayloadLength;
     const bool v3 = in[2] == 3u && in[3] == kV3PayloadLength;
-    if (!v2 && !v3 && (in[2] != kSettingsVersion || in[3] != kPayloadLength)) return LoadResult::OldVersion;
+    const bool v4 = in[2] == 4u && in[3] == kV4PayloadLength;
+    if (!v2 && !v3 && !v4 && (in[2] != kSettingsVersion || in[3] != kPayloadLength)) return LoadResult::OldVersion;
     const uint8_t len = in[3];
     const uint16_t crc = (uint16_t)(in[4 + len] | (uint16_t)((uint16_t)in[5 + len] << 8));
     if (crc != crc16(in, (uint16_t)(4u + len))) return LoadResult::BadCrc;

@@ -12,14 +12,15 @@
 //          4+len  CRC-16/CCITT-FALSE of bytes 0 .. 3+len, little-endian
 //
 // encode/decode are explicit byte by byte, so the layout is the same on the AVR and
-// the host (no struct padding or endianness in the record). No EEPROM access here:
+// the host (no struct padding or endianness in the record). GND_ABS_PRESS is measured at
+// each start and lives before `flight`: not in the record. No EEPROM access here:
 // the firmware copies kRecordSize bytes to and from EEPROM.
 //
 // A version 2 record (a 65-byte payload, no flight settings) still loads: its rate,
 // declination, mode and calibration are kept, the flight settings are the defaults and
 // kFlagUpgraded says so (the firmware tells the user, `save` writes this version).
-// A version 3 record is this version's first kV3FlightBytes of flight settings: it loads
-// whole, and the rows added since (at the table's end) take their defaults, as ArduPilot
+// A version 3 or 4 record is this version's first kV3FlightBytes or kV4FlightBytes of flight
+// settings: it loads whole, and the rows added since (at the table's end) take their defaults, as ArduPilot
 // gives a new parameter its default.
 #pragma once
 
@@ -36,14 +37,18 @@ constexpr uint8_t kMagic1 = 'T';
 // 2: the compass calibration gained the soft-iron cross terms and the learned offset.
 // 3: the flight settings (ArduPlane's parameters, the parameter table: Params.h).
 // 4: TRIM_PITCH_CD after the version 3 rows.
-constexpr uint8_t kSettingsVersion = 4;
+// 5: the GPS's and the barometer's rows (GPS_TYPE .. GND_TEMP) after version 4's.
+constexpr uint8_t kSettingsVersion = 5;
 constexpr uint8_t kV2PayloadLength = 65;  // rate(1) + decl(2) + mode(1) + flags(1) + 15 floats(60)
-constexpr uint8_t kFlightBytes = 168;     // params::encode_flight (checked by params' tests)
+constexpr uint8_t kFlightBytes = 180;     // params::encode_flight (checked by params' tests)
+constexpr uint8_t kV4FlightBytes = 168;   // version 4's flight settings: the rows before GPS_TYPE
 constexpr uint8_t kV3FlightBytes = 166;   // version 3's flight settings: the rows before TRIM_PITCH_CD
 constexpr uint8_t kPayloadLength = kV2PayloadLength + kFlightBytes;
 constexpr uint8_t kRecordSize = 4 + kPayloadLength + 2;
 constexpr uint8_t kV3PayloadLength = kV2PayloadLength + kV3FlightBytes;
 constexpr uint8_t kV3RecordSize = 4 + kV3PayloadLength + 2;
+constexpr uint8_t kV4PayloadLength = kV2PayloadLength + kV4FlightBytes;
+constexpr uint8_t kV4RecordSize = 4 + kV4PayloadLength + 2;
 constexpr uint16_t kEepromAddress = 0;
 
 constexpr uint8_t kRateMinHz = 1;
@@ -64,6 +69,7 @@ struct Settings {
     fmt::OutputMode mode;
     uint8_t flags;                 // Flags
     calib::Calibration cal;
+    float gnd_abs_press_pa;        // GND_ABS_PRESS: the ground's pressure, measured at each start (not stored)
     flight::FlightSettings flight;  // Params.h has their names, ranges and defaults
 
     float declination_deg() const { return (float)declination_centideg * 0.01f; }

@@ -61,7 +61,7 @@ TEST(FlightParams, SetChecksRangeWholenessAndEndPointOrder) {
     EXPECT_NEAR(params::get(s, dec), 0.1f, 1e-4f);
 }
 
-TEST(FlightParams, RecordVersion4RoundTripsAndVersion2StillLoads) {
+TEST(FlightParams, RecordVersion5RoundTripsAndVersion2StillLoads) {
     EXPECT_EQ(params::flight_bytes(), settings::kFlightBytes);
     settings::Settings in = settings::defaults();
     in.rate_hz = 20;
@@ -70,7 +70,7 @@ TEST(FlightParams, RecordVersion4RoundTripsAndVersion2StillLoads) {
     ASSERT_TRUE(params::set(in, (uint16_t)params::find("RC3_MIN"), 1050.0f));
     uint8_t rec[settings::kRecordSize];
     settings::encode(in, rec);
-    EXPECT_EQ(rec[2], 4);
+    EXPECT_EQ(rec[2], 5);
     settings::Settings out;
     ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
     for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(params::get(out, i), params::get(in, i)) << i;
@@ -151,4 +151,46 @@ TEST(FlightParams, TrimPitchIsNewInVersion4AndVersion3StillLoads) {
     v3[4 + settings::kV3PayloadLength] = (uint8_t)(crc4 & 0xFF);
     v3[5 + settings::kV3PayloadLength] = (uint8_t)(crc4 >> 8);
     EXPECT_EQ(settings::decode(v3, up), settings::LoadResult::OldVersion);
+}
+
+// Version 5: the GPS's and the barometer's rows after version 4's. A version 4 record loads
+// whole with them at their defaults; GND_ABS_PRESS, measured at each start, is in no record.
+TEST(FlightParams, GpsRowsAreNewInVersion5AndVersion4StillLoads) {
+    settings::Settings s = settings::defaults();
+    EXPECT_EQ(s.flight.gps_type, 1);
+    EXPECT_EQ(s.flight.gps_navfilter, 8);
+    EXPECT_FLOAT_EQ(s.flight.ahrs_gps_gain, 1.0f);
+    EXPECT_EQ(s.flight.ahrs_gps_use, 1);
+    EXPECT_EQ(s.flight.ahrs_gps_minsats, 6);
+    EXPECT_FLOAT_EQ(s.flight.gnd_temp_c, 0.0f);
+    EXPECT_FLOAT_EQ(s.gnd_abs_press_pa, 0.0f);
+    EXPECT_FALSE(params::set(s, (uint16_t)params::find("GPS_NAVFILTER"), 9.0f));
+    EXPECT_FALSE(params::set(s, (uint16_t)params::find("AHRS_GPS_GAIN"), 10.5f));
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("TRIM_PITCH_CD"), -140.0f));  // version 4's last row
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("GPS_TYPE"), 5.0f));
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("AHRS_GPS_GAIN"), 0.5f));
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("GND_TEMP"), 31.5f));
+    ASSERT_TRUE(params::set(s, (uint16_t)params::find("GND_ABS_PRESS"), 89876.0f));
+    uint8_t rec[settings::kRecordSize];
+    settings::encode(s, rec);
+    settings::Settings out;
+    ASSERT_EQ(settings::decode(rec, out), settings::LoadResult::Ok);
+    EXPECT_EQ(out.flight.gps_type, 5);
+    EXPECT_FLOAT_EQ(out.flight.ahrs_gps_gain, 0.5f);
+    EXPECT_FLOAT_EQ(out.flight.gnd_temp_c, 31.5f);
+    EXPECT_FLOAT_EQ(out.gnd_abs_press_pa, 0.0f) << "measured at each start, not stored";
+
+    uint8_t v4[settings::kRecordSize];
+    std::memcpy(v4, rec, sizeof v4);
+    v4[2] = 4;
+    v4[3] = settings::kV4PayloadLength;
+    const uint16_t crc = settings::crc16(v4, 4 + settings::kV4PayloadLength);
+    v4[4 + settings::kV4PayloadLength] = (uint8_t)(crc & 0xFF);
+    v4[5 + settings::kV4PayloadLength] = (uint8_t)(crc >> 8);
+    settings::Settings up;
+    ASSERT_EQ(settings::decode(v4, up), settings::LoadResult::Ok);
+    EXPECT_EQ(up.flight.trim_pitch_cd, -140) << "version 4's rows kept";
+    EXPECT_EQ(up.flight.gps_type, 1) << "not in version 4: its default";
+    EXPECT_FLOAT_EQ(up.flight.ahrs_gps_gain, 1.0f);
+    EXPECT_FLOAT_EQ(up.flight.gnd_temp_c, 0.0f);
 }

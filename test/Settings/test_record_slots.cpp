@@ -269,31 +269,39 @@ TEST(RecordSlots, Crc16IsCcittFalse) {
     }
 }
 
-// A slot that version 3 of the firmware wrote (its record is this one's first part, Settings.h):
-// loaded, the rows added since at their defaults; the next save writes the other slot.
-TEST(RecordSlots, SlotOfVersion3Loads) {
+// A slot that version 3 or 4 of the firmware wrote (its record is this one's first part,
+// Settings.h): loaded, the rows added since at their defaults; the next save writes the other slot.
+void expect_older_slot_loads(uint8_t version, uint8_t payload_length, uint8_t record_size) {
     g_chip.assign(kChipSize, 0xFF);
-    Settings v3_settings = numbered(5);
-    v3_settings.flight.trim_arspd_cm = 1800;
-    std::vector<uint8_t> rec = record_of(v3_settings);
-    rec[2] = 3;
-    rec[3] = settings::kV3PayloadLength;
-    const uint16_t rcrc = settings::crc16(rec.data(), (uint16_t)(4u + settings::kV3PayloadLength));
-    rec[4 + settings::kV3PayloadLength] = (uint8_t)(rcrc & 0xFFu);
-    rec[5 + settings::kV3PayloadLength] = (uint8_t)(rcrc >> 8);
+    Settings older = numbered(5);
+    older.flight.trim_arspd_cm = 1800;
+    std::vector<uint8_t> rec = record_of(older);
+    rec[2] = version;
+    rec[3] = payload_length;
+    const uint16_t rcrc = settings::crc16(rec.data(), (uint16_t)(4u + payload_length));
+    rec[4 + payload_length] = (uint8_t)(rcrc & 0xFFu);
+    rec[5 + payload_length] = (uint8_t)(rcrc >> 8);
     uint8_t* slot = g_chip.data() + slots::slot_address(0);
     slot[0] = 4;
     slot[1] = 0;
-    slot[2] = settings::kV3RecordSize;
-    std::copy(rec.begin(), rec.begin() + settings::kV3RecordSize, slot + 3);
-    const uint16_t crc = settings::crc16(slot, (uint16_t)(3u + settings::kV3RecordSize));
-    slot[3 + settings::kV3RecordSize] = (uint8_t)(crc & 0xFFu);
-    slot[4 + settings::kV3RecordSize] = (uint8_t)(crc >> 8);
+    slot[2] = record_size;
+    std::copy(rec.begin(), rec.begin() + record_size, slot + 3);
+    const uint16_t crc = settings::crc16(slot, (uint16_t)(3u + record_size));
+    slot[3 + record_size] = (uint8_t)(crc & 0xFFu);
+    slot[4 + record_size] = (uint8_t)(crc >> 8);
     Settings s;
     const slots::Loaded l = load(s);
-    EXPECT_EQ(l.result, LoadResult::Ok);
+    EXPECT_EQ(l.result, LoadResult::Ok) << "version " << (int)version;
     EXPECT_EQ(s.flight.trim_arspd_cm, 1800);
-    EXPECT_TRUE(same(s, v3_settings));  // TRIM_PITCH_CD: numbered() has its default
+    EXPECT_TRUE(same(s, older));  // the newer rows: numbered() has their defaults
     EXPECT_EQ(l.write, 1);
     EXPECT_EQ(l.next_sequence, 5);
+}
+
+TEST(RecordSlots, SlotOfVersion3Loads) {
+    expect_older_slot_loads(3, settings::kV3PayloadLength, settings::kV3RecordSize);
+}
+
+TEST(RecordSlots, SlotOfVersion4Loads) {
+    expect_older_slot_loads(4, settings::kV4PayloadLength, settings::kV4RecordSize);
 }
