@@ -45,6 +45,7 @@
 
 #include "Calibration.h"
 #include "Dcm.h"
+#include "GpsFix.h"
 #include "LinAlg.h"
 #include "Mpu6000.h"
 #include "Settings.h"
@@ -106,6 +107,12 @@ constexpr float kMagReferenceShift_uT = 2.5f;
 // velocity is not along x (on the ground, a launch, a stall): no correction. ArduPlane's
 // ARSPD_FBW_MIN default, about two thirds of a small aeroplane's stall.
 constexpr float kCentripetalMinAirspeed_m_s = 9.0f;
+// The GPS course is the heading only above this ground speed (AP_AHRS_DCM's GPS_SPEED_MIN:
+// at a walk the course's noise, 0.1 m/s of velocity noise across the track, is degrees).
+constexpr float kCourseMinSpeed_m_s = 3.0f;
+// A compass sample at most this old (steps: 0.5 s; it delivers at 75 Hz) is a working
+// compass: older, the GPS course takes the heading.
+constexpr uint16_t kCompassStaleSteps = 100;
 // Above the MPXV7002DP's full scale (2 kPa: 57 m/s) an airspeed is a fault: clamped.
 constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
 
@@ -228,6 +235,13 @@ public:
     void set_cruise_airspeed_m_s(float trim_m_s);
     float airspeed_m_s() const { return airspeed_m_s_; }
 
+    // A new GPS solution (call once per fix: the driver's fix_count() moved): its velocity
+    // aids the gravity correction (dcm::GpsAccel: the accelerometer less the GPS's
+    // acceleration, in place of the airspeed's or cruise speed's turn term) while the fix
+    // is 3D with AHRS_GPS_MINSATS satellites and AHRS_GPS_USE is 1; AHRS_GPS_GAIN weighs
+    // it. Without a compass (or with one that stopped), its course above
+    // kCourseMinSpeed_m_s is the heading reference.
+    void on_gps_fix(const gps::Fix& fix);
     // One MPU6000 sample at the fixed 200 Hz step.
     void on_imu_sample(const mpu6000::Sample& s);
     // One magnetometer sample (body frame, uT, self-test scale applied, before the
@@ -321,6 +335,8 @@ private:
     linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
+    uint32_t gps_itow_ms_ = 0;        // the last usable fix's time of week (0: none)
+    uint32_t gps_course_step_ = 0;    // st_.steps at the last course given to the estimator
     float airspeed_m_s_ = 0.0f;
     uint16_t airspeed_step_ = 0;  // st_.steps's low half at the last measured airspeed
     linalg::Vector3i mag_cal_q5_;     // latest calibrated field (uT * 2^dcm::kFieldQ: dcm::field_q5_of)
