@@ -60,6 +60,7 @@ SECTIONS = [
     (10, "compass", "step part: heading correction", ()),
     (11, "learner", "step part: compass offset learner", ()),
     (14, "magfit", "one part of the cal mag fit (outside the step)", ()),
+    (40, "gpsaid", "a GPS fix into the estimator (5 Hz, inside the step when the firmware calls it there)", ()),
     (16, "gcsrequest", "a ground station's MAVLink request handled", ()),
     (17, "gcsreply", "one PARAM_VALUE, or RC_CHANNELS + SERVO_OUTPUT_RAW, packed", ()),
 ]

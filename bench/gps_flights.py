@@ -4,7 +4,7 @@
 ours without it and against VQF, per flight.
 
     build/venv/bin/python bench/gps_flights.py --seeds 52001-52005
-        [--flights turn:1,figure8:1,climb:1,upset:1,cruise:2,gusty] [--out DIR] [--jobs N]
+        [--flights turn:1,turn:2,figure8:1,...,cruise:1,gusty] [--out DIR] [--jobs N]
 
 Each flight (NAME or NAME:GUST, `fly.py --list`) is flown on each seed by sim/flight/fly.py
 (cached as bench/flights.py caches them). Ours runs through build/replay in the three
@@ -18,7 +18,6 @@ without an airspeed sensor. This is replay on the flights' IMU (open loop: the f
 own pilot flew it), not the firmware flying them.
 """
 import argparse
-import json
 import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -29,9 +28,9 @@ sys.path.insert(0, BENCH_DIR)
 
 import bench  # noqa: E402
 import flights  # noqa: E402
-from fresh_flights import flight_list, seed_list, vqf_late  # noqa: E402
+from fresh_flights import flight_list, seed_list, vqf_totals  # noqa: E402
 
-DEFAULT_FLIGHTS = "turn:1,figure8:1,climb:1,upset:1,cruise:2,gusty"
+DEFAULT_FLIGHTS = "turn:1,turn:2,figure8:1,figure8:2,climb:1,climb:2,upset:1,upset:2,cruise:1,gusty"
 
 
 def seed_of(stem):
@@ -53,9 +52,6 @@ def main():
         log("no flights")
         return 1
     replay, score = os.path.join(a.build, "replay"), os.path.join(a.build, "score")
-    cache_path = os.path.join(a.out, "vqf_from_loop_start.json")
-    cache = json.load(open(cache_path)) if os.path.exists(cache_path) else {}
-    key = lambda traj: "%s@%d" % (os.path.basename(traj), os.path.getmtime(traj))
     tasks, runs = [], []
     for stem, (kind, traj, state) in sorted(files.items()):
         for suffix, _, extra in flights.airspeed_variants(state):
@@ -65,10 +61,7 @@ def main():
                 tasks.append((stem, suffix, gps))
                 runs.append(("%s %s" % (stem, suffix), traj, est, replay, score, (), more))
     with ProcessPoolExecutor(a.jobs) as pool:
-        need = [traj for _, traj, _ in files.values() if key(traj) not in cache]
-        for traj, total in zip(need, pool.map(vqf_late, need)):
-            cache[key(traj)] = total
-        json.dump(cache, open(cache_path, "w"))
+        cache, key = vqf_totals(files, a.out, pool)
         results = {}
         for t, r in zip(tasks, pool.map(bench.task_replay, runs)):
             if r[3]:

@@ -108,6 +108,7 @@ const SettingName kSettingNames[] = {
     {"rest_min_s", &dcm::DcmSettings::rest_min_s, 1.0f},
     {"rest_bias_s", &dcm::DcmSettings::rest_bias_s, 1.0f},
     {"output_lead_s", &dcm::DcmSettings::output_lead_s, 1.0f},
+    {"gps_lowpass_s", &dcm::DcmSettings::gps_lowpass_s, 1.0f},
     {"mag_new_min_rate_deg_s", &dcm::DcmSettings::mag_new_min_rate_rad_s, linalg::kRadPerDeg},
 };
 

@@ -299,8 +299,8 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
 
 
 // A GPS velocity (GpsAid.h): a completed pair's observation into the low-pass, with the
-// factor of its interval against accel_lowpass_s (5 Hz, in float): 1 - exp(-I / tau) as
-// I / (tau + I / 2) (the bilinear form: within 1e-4 of it at I / tau = 0.07, no exp).
+// factor of its interval against gps_lowpass_s (5 Hz, in float): 1 - exp(-I / tau) as
+// I / (tau + I / 2) (the bilinear form: within 1e-3 of it at I / tau = 0.2, no exp).
 void Dcm::on_gps_velocity(const Vector3f& vel_ned_m_s, float interval_s, float gain) {
     if (!initialised() || steps_ < k_.startup_steps) {
         gps_.stop();
@@ -310,7 +310,7 @@ void Dcm::on_gps_velocity(const Vector3f& vel_ned_m_s, float interval_s, float g
     if (!gps_.on_velocity(vel_ned_m_s, interval_s, gain, k_.accel_units_per_m_s2,
                           observation))
         return;
-    const float alpha = interval_s / (settings_->accel_lowpass_s + 0.5f * interval_s);
+    const float alpha = interval_s / (settings_->gps_lowpass_s + 0.5f * interval_s);
     gravity_.low_pass_observation(observation, linalg::fixed_from_float(alpha, linalg::kQ30));
 }
 

@@ -73,6 +73,12 @@ void AttitudePipeline::configure_turn(int16_t dv_dt_counts) {
 }
 
 void AttitudePipeline::on_gps_fix(const gps::Fix& fix) {
+    profile::begin(profile::kGpsAid);
+    take_gps_fix(fix);
+    profile::end(profile::kGpsAid);
+}
+
+void AttitudePipeline::take_gps_fix(const gps::Fix& fix) {
     const flight::FlightSettings& fs = settings_.flight;
     const bool usable = fs.ahrs_gps_use != 0u && fix.fix == gps::FixType::k3D && fix.sats >= fs.ahrs_gps_minsats &&
                         st_.phase == Phase::Running;
@@ -96,10 +102,9 @@ void AttitudePipeline::on_gps_fix(const gps::Fix& fix) {
     // The course for the heading without a working compass (AP_AHRS_DCM: above 3 m/s).
     const bool compass_working = st_.mag_present && st_.steps_since_mag < kCompassStaleSteps;
     if (compass_working || (float)fix.ground_speed_cm_s < kCourseMinSpeed_m_s * 100.0f) return;
-    const uint32_t since = st_.steps - gps_course_step_;
-    gps_course_step_ = st_.steps;
-    dcm_.correct_heading_from_course((float)fix.course_e5 * (linalg::kRadPerDeg * 1e-5f) - decl_rad,
-                                     since < 0xFFFFu ? (uint16_t)since : 0xFFFFu);
+    const uint16_t since = (uint16_t)((uint16_t)st_.steps - gps_course_step_);
+    gps_course_step_ = (uint16_t)st_.steps;
+    dcm_.correct_heading_from_course((float)fix.course_e5 * (linalg::kRadPerDeg * 1e-5f) - decl_rad, since);
 }
 
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {

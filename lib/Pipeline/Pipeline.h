@@ -309,6 +309,7 @@ private:
     // The estimator's turn correction from the airspeed (once running: TurnMean's space).
     void configure_turn(int16_t dv_dt_counts = 0);
     void step_mag_fit();
+    void take_gps_fix(const gps::Fix& fix);
     void finish_mag_calibration();
     void report_deferred();
     // An event to the sink; the short forms keep each call site small (flash).
@@ -336,7 +337,7 @@ private:
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
     uint32_t gps_itow_ms_ = 0;        // the last usable fix's time of week (0: none)
-    uint32_t gps_course_step_ = 0;    // st_.steps at the last course given to the estimator
+    uint16_t gps_course_step_ = 0;    // st_.steps's low half at the last course given to the estimator
     float airspeed_m_s_ = 0.0f;
     uint16_t airspeed_step_ = 0;  // st_.steps's low half at the last measured airspeed
     linalg::Vector3i mag_cal_q5_;     // latest calibrated field (uT * 2^dcm::kFieldQ: dcm::field_q5_of)
