@@ -10,12 +10,17 @@
 // That difference is the gravity correction's input (Gravity.h: its earth-frame low-pass,
 // then the roll/pitch error of eq. 27) in place of the accelerometer's window alone.
 //
-// Timing: a u-blox reports the velocity of a measurement kGpsLag_s before its message is
-// complete (ArduPilot assumed 0.2 s for the u-blox on the APM 2). The accelerometer's sums
-// are taken between the fixes' arrivals; the sum paired with a velocity change is the one
-// whose interval is nearest in time to the GPS's interval: one fix late (ArduPilot's
-// _ra_delay_buffer) when the lag is at least half the interval (5 Hz), else the current
-// one (1 Hz NMEA: a lag of a fifth of the interval).
+// Timing: a u-blox reports the velocity of a measurement kGpsFixLatency_s before the fix
+// is complete on the board: the receiver's own latency (ArduPilot assumed 0.2 s for the
+// u-blox on the APM 2) and the epoch's messages on the line. The accelerometer's sums are
+// taken between the fixes' arrivals (a sum a fix interval); the GPS's velocity change
+// covers the interval that ended kGpsFixLatency_s before this arrival, s = latency /
+// interval sums back: at 5 Hz 1.2 (ArduPilot's _ra_delay_buffer takes the sum one fix
+// late, 1), at 1 Hz (NMEA) 0.24. Its mean is interpolated between the two sums it spans,
+// (1 - f) M_j + f M_(j+1) with j, f the whole and fractional parts of s: exact for an
+// acceleration that changes linearly (a turn's entry), where the nearest sum alone would
+// read the ramp over the 43 ms as a tilt (a roll into 30 deg of bank in 1.5 s: 0.2 m/s^2,
+// 1.2 deg).
 //
 // Formats: the windows' earth-frame means in accel units (counts * 2^8, Coefficients.h),
 // summed over at most kGpsMaxWindows (within 31 bits at 16 g); the velocity and the
@@ -28,8 +33,12 @@
 
 namespace dcm {
 
-// The u-blox's latency from measurement to message (ArduPilot's assumption on the APM 2).
-constexpr float kGpsLag_s = 0.2f;
+// From a u-blox's measurement to its fix complete on the board: the receiver's latency
+// (ArduPilot's assumption on the APM 2, 0.2 s) and the epoch's messages the firmware asks
+// for (NAV-POSLLH, -STATUS, -SOL, -VELNED: 164 bytes with their frames) at 38400 baud,
+// 0.043 s. (A 1 Hz NMEA module's sentences at 9600 baud take longer: not modelled.)
+constexpr float kGpsReceiverLag_s = 0.2f;
+constexpr float kGpsFixLatency_s = kGpsReceiverLag_s + 0.043f;
 // Fixes further apart than this are no derivative: a lost fix (1 Hz NMEA is 1 s apart).
 constexpr float kGpsMaxInterval_s = 1.5f;
 // A course stands for at most this many steps (kGpsMaxInterval_s at 200 Hz).
@@ -46,9 +55,9 @@ public:
     // One gravity window's earth-frame mean specific force (accel units).
     void add_window(const linalg::Vector3l& accel_ef) {
         if (since_fix_ < 255u) ++since_fix_;
-        if (windows_ >= kGpsMaxWindows) return;  // too long for a derivative: the pair is refused
-        sum_ += accel_ef;
-        ++windows_;
+        if (windows_[0] >= kGpsMaxWindows) return;  // too long for a derivative: the pair is refused
+        sums_[0] += accel_ef;
+        ++windows_[0];
     }
     // A usable fix's velocity (m/s, the estimator's earth axes: north the magnetic one) and
     // the time since the fix before (s, from the receiver's time of week; 0: none). True
@@ -67,12 +76,13 @@ public:
     bool aiding() const { return aiding_ && since_fix_ <= kGpsTimeoutWindows; }
 
 private:
-    linalg::Vector3l sum_;       // the windows since the last fix (accel units)
-    linalg::Vector3l prev_sum_;  // ... between the two fixes before
+    // The sums of the windows between arrivals: [0] since the last fix, [1] and [2] the
+    // two intervals before it (accel units), and their windows.
+    linalg::Vector3l sums_[3];
+    uint8_t windows_[3] = {0, 0, 0};
     linalg::Vector3f prev_vel_m_s_;
-    uint8_t windows_ = 0, prev_windows_ = 0;
     uint8_t since_fix_ = 255;    // windows since the last usable fix (saturated)
-    uint8_t fixes_ = 0;          // usable fixes in a row (up to 2: a velocity and a sum before it)
+    uint8_t fixes_ = 0;          // usable fixes in a row (up to 3: a velocity and the sums before it)
     bool aiding_ = false;
 };
 

@@ -7,7 +7,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
     closed_loop.py --rc STICKS.csv [--upset T,SECONDS,NM ...] [--seconds S]
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
-        [--no-airspeed]
+        [--no-airspeed] [--gps ublox|nmea|none]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -16,7 +16,8 @@ The backend listens on a free UDP port, apm25sim flies it; --log is the backend'
 state, --servo-log apm25sim's measured pulses. Both processes always end: when apm25sim
 ends the backend is stopped, when the backend dies apm25sim is stopped, and after
 --timeout s of wall time (default 900) both are. --no-airspeed flies an aeroplane without
-a pitot (the backend sends no airspeed: the board's A0 reads 0 V, no sensor). Exit status: apm25sim's, or 4 when the
+a pitot (the backend sends no airspeed: the board's A0 reads 0 V, no sensor). --gps KIND is
+apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS). Exit status: apm25sim's, or 4 when the
 backend failed, 5 on the timeout.
 """
 import argparse
@@ -67,6 +68,7 @@ def parse_args(argv):
     p.add_argument("--no-airspeed", action="store_true",
                    help="the backend sends no airspeed: no pitot, the board's A0 at 0 V")
     p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
+    p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
@@ -148,6 +150,8 @@ def run(args):
             sim_cmd += ["--input", args.input]
         if args.servo_log:
             sim_cmd += ["--servo-log", args.servo_log]
+        if args.gps:
+            sim_cmd += ["--gps", args.gps]
         sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)
 
         def watchdog():

@@ -25,7 +25,8 @@ bool UbloxFeed::poll(double t_s, gps::Fix& fix) {
         const char* pubx = "$PUBX,41,1,0003,0001,38400,0*26\r\n";
         send(kConfigure_s, std::vector<uint8_t>(pubx, pubx + std::strlen(pubx)), 9600);
         std::vector<uint8_t> config;
-        for (uint8_t id : {ubx::kNavSol, ubx::kNavVelned}) {
+        // The firmware's four (lib/DCM/GpsAid.h's latency counts their bytes on the line).
+        for (uint8_t id : {ubx::kNavPosllh, ubx::kNavStatus, ubx::kNavSol, ubx::kNavVelned}) {
             const std::vector<uint8_t> m = ubx::frame(ubx::kClassCfg, ubx::kCfgMsg, {ubx::kClassNav, id, 1});
             config.insert(config.end(), m.begin(), m.end());
         }

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The u-blox model (UbloxModel.h) as the host replay tool's GPS: configured as ArduPilot
-// configured the module on the APM 2 (PUBX,41 at 9600 baud for UBX at 38400, then NAV-SOL
-// and NAV-VELNED at rate 1 and a 200 ms measurement period), its bytes decoded when their
+// configured the module on the APM 2 and the firmware does (PUBX,41 at 9600 baud for UBX at
+// 38400, then NAV-POSLLH, -STATUS, -SOL and -VELNED at rate 1 and a 200 ms measurement
+// period), its bytes decoded when their
 // stop bit has left the line, and each solution (NAV-SOL and NAV-VELNED of one iTOW) given
 // as the gps::Fix the firmware's driver delivers: the model's noise, latency, fix and
 // satellites, and the line's time, without simavr.
