@@ -282,12 +282,16 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     // In flight, the turn's centripetal acceleration off the window first (Centripetal.h),
     // unless the GPS's acceleration comes off it (GpsAid.h: the turn's is in it).
     const bool gps_aiding = gps_.aiding();
-    if (turn_ != nullptr && turn_->active() && !gps_aiding) gravity_.subtract_turn(*turn_, context);
+    const bool turn = turn_ != nullptr && turn_->active() && !gps_aiding;
+    if (turn) gravity_.subtract_turn(*turn_, context);
     // The window into the earth-frame low-pass (or, GPS-aided, into the GPS's sums: its
     // observations feed the low-pass), its means into the rest test.
     WindowMeans window;
     if (gravity_.low_pass_window(context, window, !gps_aiding)) {
         detect_rest(window, mean_off_bias);
+        // The GPS's sums take the specific force as measured (its acceleration comes off
+        // at the pair): before its aiding starts, the turn's term goes back, in earth axes.
+        if (turn && gps_.receiving()) window.accel_ef += earth_of_counts(turn_->term());
         gps_.add_window(window.accel_ef);
     }
     // The low-pass's direction against earth down: the roll/pitch correction, and its
@@ -297,6 +301,18 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::end(profile::kGravity);
 }
 
+
+// A vector in accel counts in body axes, in earth axes and accel units (counts * 2^8),
+// by R in 16 bits (Q14: 6e-5 of it).
+Vector3l Dcm::earth_of_counts(const linalg::Vector3i& counts) const {
+    using linalg::mul_q14;
+    using linalg::q14_of;
+    const linalg::Matrix3q30& r = strapdown_.r();
+    const Vector3l u((int32_t)counts.x * 256, (int32_t)counts.y * 256, (int32_t)counts.z * 256);
+    return Vector3l(mul_q14(q14_of(r.a.x), u.x) + mul_q14(q14_of(r.a.y), u.y) + mul_q14(q14_of(r.a.z), u.z),
+                    mul_q14(q14_of(r.b.x), u.x) + mul_q14(q14_of(r.b.y), u.y) + mul_q14(q14_of(r.b.z), u.z),
+                    mul_q14(q14_of(r.c.x), u.x) + mul_q14(q14_of(r.c.y), u.y) + mul_q14(q14_of(r.c.z), u.z));
+}
 
 // A GPS velocity (GpsAid.h): a completed pair's observation into the low-pass, with the
 // factor of its interval against gps_lowpass_s (5 Hz, in float): 1 - exp(-I / tau) as

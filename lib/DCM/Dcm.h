@@ -232,6 +232,7 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
+    linalg::Vector3l earth_of_counts(const linalg::Vector3i& counts) const;
     // What the gravity correction reads (Gravity.h).
     GravityContext gravity_context();
     void update_offset();

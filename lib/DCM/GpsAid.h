@@ -72,6 +72,9 @@ public:
         fixes_ = 0;
         aiding_ = false;
     }
+    // A usable fix came within kGpsTimeoutWindows: the sums will be paired (the turn's term
+    // a window had taken off goes back into them: Dcm::correct_gravity).
+    bool receiving() const { return since_fix_ <= kGpsTimeoutWindows; }
     // The GPS's observations feed the low-pass (the last within kGpsTimeoutWindows).
     bool aiding() const { return aiding_ && since_fix_ <= kGpsTimeoutWindows; }
 

@@ -4,8 +4,11 @@
 // magnetic-north axes by the declination, the course as the heading without a compass.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "Euler.h"
+#include "GpsAid.h"
 #include "GpsFix.h"
 #include "Pipeline.h"
 #include "pipeline_test_support.h"
@@ -40,6 +43,7 @@ struct GpsRun {
         const float decl = p.settings().declination_deg() * kDeg;
         const float h = b - decl;  // the heading from magnetic north
         const Vector3f body_field(20.0f * std::cos(h), -20.0f * std::sin(h), 45.0f);
+        p.set_mag_present(field);
         for (uint32_t i = 0; i < (uint32_t)(seconds * 200.0f); ++i) {
             const float t = (float)p.steps() * 0.005f;
             const float a = t > 5.0f ? 2.0f : 0.0f;
@@ -109,6 +113,59 @@ TEST(PipelineGps, WithoutACompassTheCourseIsTheHeading) {
     r.p.set_mag_present(false);
     r.go(10.0f);
     EXPECT_NEAR(r.p.angles().heading_deg, 120.0f, 0.5f);
+}
+
+}  // namespace
+
+namespace {
+
+// A level coordinated turn at 30 deg of bank from t = 5 s (rolled into at 15 deg/s) with
+// the cruise speed set (TRIM_ARSPD_CM, grown in the bank as the firmware grows it: the
+// speed here is that one, so the turn's term is right), the GPS's first fix at 15 s, in
+// the turn. Its sums are paired with velocity changes: the turn's term the windows had
+// taken off before the aiding began must go back into them, or the first observations
+// take the centripetal acceleration off twice (30 deg of tilt, at the low-pass's pace).
+TEST(PipelineGps, AidingThatStartsInATurnTakesOverWithoutAJump) {
+    pipeline::AttitudePipeline p;
+    p.set_mag_present(true);
+    const float bank = 30.0f * kDeg, trim_m_s = 18.0f;
+    const float speed = trim_m_s / std::sqrt(std::cos(bank));
+    const float k = kG / speed, roll_rate = 15.0f * kDeg, ramp_s = bank / roll_rate;
+    const auto bank_at = [&](float t) { return t <= 5.0f ? 0.0f : std::min(roll_rate * (t - 5.0f), bank); };
+    const auto heading_at = [&](float t) {
+        const float in_s = t - 5.0f;
+        float h = in_s > 0.0f ? k * -std::log(std::cos(bank_at(t))) / roll_rate : 0.0f;
+        if (in_s > ramp_s) h += k * std::tan(bank) * (in_s - ramp_s);
+        return h;
+    };
+    gps::Fix fix;
+    fix.fix = gps::FixType::k3D;
+    fix.sats = 10;
+    fix.have_vertical_velocity = true;
+    float worst_before = 0.0f, worst_after = 0.0f;
+    for (int i = 0; i < 60 * 200; ++i) {
+        const float t = (float)p.steps() * 0.005f;
+        const float b = bank_at(t), h = heading_at(t), rate = k * std::tan(b);
+        const float p_rate = t > 5.0f && t - 5.0f < ramp_s ? roll_rate : 0.0f;
+        const linalg::Matrix3f r = dcm::dcm_from_euler(b, 0.0f, h);
+        if (i % 3 == 0) p.on_mag_sample(r.mul_transpose(Vector3f(20.0f, 0.0f, 45.0f)));
+        if (p.steps() % 8 == 0) p.set_cruise_airspeed_m_s(trim_m_s);
+        p.on_imu_sample(imu(Vector3f(p_rate, rate * std::sin(b), rate * std::cos(b)), Vector3f(0.0f, 0.0f, -kG / std::cos(b))));
+        if (p.steps() % 40 == 0 && t >= 15.0f) {
+            const float then = t - dcm::kGpsFixLatency_s, h_then = heading_at(then);
+            fix.itow_ms += 200;
+            fix.vel_ned_cm_s[0] = (int32_t)std::lround(100.0f * speed * std::cos(h_then));
+            fix.vel_ned_cm_s[1] = (int32_t)std::lround(100.0f * speed * std::sin(h_then));
+            fix.ground_speed_cm_s = (uint32_t)std::lround(100.0f * speed);
+            p.on_gps_fix(fix);
+        }
+        if (t < 10.0f || !p.output_due()) continue;
+        const float err = std::fabs(p.angles().roll_deg - b / kDeg);
+        (t < 15.0f ? worst_before : worst_after) = std::max(t < 15.0f ? worst_before : worst_after, err);
+    }
+    EXPECT_TRUE(p.estimator().gps_aiding());
+    EXPECT_LT(worst_before, 1.0f);  // the cruise speed's term
+    EXPECT_LT(worst_after, 1.0f);   // the GPS's, from its first fix on
 }
 
 }  // namespace
