@@ -5,6 +5,7 @@
 #include "ArduinoCore.h"
 #include "Console.h"
 #include "GcsLink.h"
+#include "GpsPort.h"
 #include "LoopLoad.h"
 #include "Port.h"
 #include "PipelineText.h"
@@ -101,7 +102,8 @@ static bool print_status(uint8_t part) {
         case 3: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
         case 5: tasks::print_status_line(out); return true;
-        case 6: return flight_io.print_status_line();
+        case 6: gps_port::print_status_line(out); return true;
+        case 7: return flight_io.print_status_line();
         default: return false;
     }
 }
@@ -124,6 +126,7 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Status: return print_status(part);
         case console::CommandId::Show:
             if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
+            if (c.arg == console::kShowGps) return gps_port::print(part, out);
             break;
         default: break;
     }

@@ -17,6 +17,7 @@
 #include "Board.h"
 #include "ConsoleLink.h"
 #include "GcsLink.h"
+#include "GpsPort.h"
 #include "LoopLoad.h"
 #include "OutputLine.h"
 #include "Scheduler.h"
@@ -91,6 +92,7 @@ static void once_a_second() {
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
     X(flight,       nullptr,                         flight_poll,                       800, kSecFlightPoll,   kAlways) \
+    X(gps,          nullptr,                         gps_port::service,                1500, kSecGps,          0)       \
     X(second,       loop_load::second_due,           once_a_second,                    1000, kSecSecond,       kAlways)
 
 // The rows' ids (stats[]), names (`status`) and the periodic rows' counters.

@@ -6,7 +6,8 @@
 
 #include "Pipeline.h"
 
-// Once, at the end of setup(): start your own devices (Serial1 for a GPS, servos, ...).
+// Once, at the end of setup(): start your own devices (Serial2 for a radio, servos, ...;
+// UART1, the GPS port, is the firmware's: GpsPort.h).
 void user_setup();
 // Every loop() iteration: after each interrupt (a sample, a serial byte, a receiver
 // edge), and at least every 1.024 ms (timer0's tick) while the loop idles between samples.

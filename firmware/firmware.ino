@@ -19,6 +19,7 @@
 #include "Board.h"
 #include "Console.h"
 #include "ConsoleLink.h"
+#include "GpsPort.h"
 #include "SerialText.h"
 #include "Tasks.h"
 #include "UserCode.h"
@@ -61,6 +62,7 @@ void setup() {
     serial_text::flush();  // the banner out before the 200 Hz loop starts: no missed sample
     user_setup();
     wait_until_ms(pipeline::kLoopStartMs);
+    gps_port::begin();  // from here the loop task parses what arrives
     tasks::loop_starts();
 }
 

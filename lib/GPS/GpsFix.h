@@ -33,6 +33,8 @@ struct Fix {
     uint8_t sats = 0;                // satellites used in the solution
     FixType fix = FixType::kNoGps;
     bool have_vertical_velocity = false;  // NMEA carries no vel_ned_cm_s[2]
+    bool glitching = false;  // the position jumped further than the last good one, its velocity and
+                             // 10 m/s/s explain (AP_GPS_Glitch): do not use lat/lon/alt
 };
 
 }  // namespace gps

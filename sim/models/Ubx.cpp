@@ -6,23 +6,14 @@
 namespace sim {
 namespace ubx {
 
-void checksum(const uint8_t* data, size_t n, uint8_t& ck_a, uint8_t& ck_b) {
-    ck_a = 0;
-    ck_b = 0;
-    for (size_t i = 0; i < n; ++i) {
-        ck_a = (uint8_t)(ck_a + data[i]);
-        ck_b = (uint8_t)(ck_b + ck_a);
-    }
-}
-
 std::vector<uint8_t> frame(uint8_t cls, uint8_t id, const std::vector<uint8_t>& payload) {
     std::vector<uint8_t> f = {kSync1, kSync2, cls, id};
     put_u2(f, (uint32_t)payload.size());
     f.insert(f.end(), payload.begin(), payload.end());
-    uint8_t a, b;
-    checksum(f.data() + 2, f.size() - 2, a, b);
-    f.push_back(a);
-    f.push_back(b);
+    Checksum ck;
+    ck.add(f.data() + 2, f.size() - 2);
+    f.push_back(ck.a);
+    f.push_back(ck.b);
     return f;
 }
 
@@ -34,29 +25,14 @@ void put_u2(std::vector<uint8_t>& p, uint32_t v) {
 void put_u4(std::vector<uint8_t>& p, uint32_t v) {
     for (int i = 0; i < 4; ++i) p.push_back((uint8_t)(v >> (8 * i)));
 }
-uint16_t get_u2(const uint8_t* p) { return (uint16_t)(p[0] | (p[1] << 8)); }
-uint32_t get_u4(const uint8_t* p) {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
 
 std::string nmea_sentence(const std::string& body) {
-    uint8_t x = 0;
-    for (char c : body) x = (uint8_t)(x ^ (uint8_t)c);
     char tail[8];
-    std::snprintf(tail, sizeof tail, "*%02X\r\n", x);
+    std::snprintf(tail, sizeof tail, "*%02X\r\n", gps::nmea::checksum(body.data(), body.size()));
     return "$" + body + tail;
 }
 
-namespace {
-
-int hex_value(uint8_t c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    return -1;
-}
-
-}  // namespace
+using gps::nmea::hex_value;
 
 bool StreamParser::start(uint8_t byte) {
     if (byte == kSync1) {
@@ -117,10 +93,11 @@ bool StreamParser::feed(uint8_t byte, Message& out) {
         return false;
     case kCkB: {
         state_ = kIdle;
-        std::vector<uint8_t> body = {msg_.cls, msg_.id, (uint8_t)length_, (uint8_t)(length_ >> 8)};
-        body.insert(body.end(), msg_.payload.begin(), msg_.payload.end());
-        checksum(body.data(), body.size(), ck_a_, ck_b_);
-        if (ck_a_ != got_ck_a_ || ck_b_ != byte) {
+        const uint8_t head[4] = {msg_.cls, msg_.id, (uint8_t)length_, (uint8_t)(length_ >> 8)};
+        Checksum ck;
+        ck.add(head, sizeof head);
+        ck.add(msg_.payload.data(), msg_.payload.size());
+        if (ck.a != got_ck_a_ || ck.b != byte) {
             ++counters_.ubx_bad_checksum;
             return false;
         }
@@ -139,8 +116,7 @@ bool StreamParser::feed(uint8_t byte, Message& out) {
                 ++counters_.nmea_malformed;
                 return false;
             }
-            uint8_t x = 0;
-            for (size_t i = 0; i < star; ++i) x = (uint8_t)(x ^ (uint8_t)s[i]);
+            const uint8_t x = gps::nmea::checksum(s.data(), star);
             const int given = hex_value((uint8_t)s[star + 1]) * 16 + hex_value((uint8_t)s[star + 2]);
             if (given != x) {
                 ++counters_.nmea_bad_checksum;

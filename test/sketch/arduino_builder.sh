@@ -50,14 +50,14 @@ if [ -f "$out/sketch/firmware.ino.elf" ] && run sketch && [ "$(grep -c '^roll:' 
   pass "the arduino-builder ELF prints angles in apm25sim"
 else fail "no angle lines from the arduino-builder ELF"; head -20 "$out/sketch.out" "$out/sketch.err" 2>/dev/null; fi
 
-# 2. A user's second sketch file using Serial1, Serial, Wire and SPI beside the firmware.
+# 2. A user's second sketch file using Serial2, Serial, Wire and SPI beside the firmware.
 ext="$out/extended/firmware"
 rm -rf "$out/extended" && mkdir -p "$ext" && cp "$project"/firmware/* "$ext"/
 cp "$project/test/sketch/user_extension.ino" "$ext/user.ino"
-if build extended-build "$ext"; then pass "the sketch with a user file calling Serial1.begin, Serial.print, Wire.setClock, SPI.usingInterrupt links"
+if build extended-build "$ext"; then pass "the sketch with a user file calling Serial2.begin, Serial.print, Wire.setClock, SPI.usingInterrupt links"
 else fail "the sketch with the user file:"; tail -30 "$out/extended-build.log"; fi
 if [ -f "$out/extended-build/firmware.ino.elf" ] && run extended-build &&
-   grep -q '^# user code: Serial1 at 38400 baud' "$out/extended-build.out" &&
+   grep -q '^# user code: Serial2 at 57600 baud' "$out/extended-build.out" &&
    [ "$(grep -c '^roll:' "$out/extended-build.out")" -ge 50 ]; then
   pass "with the user's code the angles still flow, and its message is printed"
 else fail "the extended sketch in apm25sim"; head -20 "$out/extended-build.out" "$out/extended-build.err" 2>/dev/null; fi
