@@ -80,8 +80,11 @@ void AttitudePipeline::on_gps_fix(const gps::Fix& fix) {
 
 void AttitudePipeline::take_gps_fix(const gps::Fix& fix) {
     const flight::FlightSettings& fs = settings_.flight;
+    const float speed_cm_s = (float)fix.ground_speed_cm_s;
+    if (speed_cm_s >= kCourseMinSpeed_m_s * 100.0f) st_.gps_moving = true;
+    if (speed_cm_s < kGpsStillSpeed_m_s * 100.0f) st_.gps_moving = false;
     const bool usable = fs.ahrs_gps_use != 0u && fix.fix == gps::FixType::k3D && fix.sats >= fs.ahrs_gps_minsats &&
-                        st_.phase == Phase::Running;
+                        st_.phase == Phase::Running && st_.gps_moving;
     if (!usable) {
         dcm_.gps_unusable();
         gps_itow_ms_ = 0;
@@ -101,7 +104,7 @@ void AttitudePipeline::take_gps_fix(const gps::Fix& fix) {
     dcm_.on_gps_velocity(Vector3f(n * c + e * s, e * c - n * s, d), interval_s, fs.ahrs_gps_gain);
     // The course for the heading without a working compass (AP_AHRS_DCM: above 3 m/s).
     const bool compass_working = st_.mag_present && st_.steps_since_mag < kCompassStaleSteps;
-    if (compass_working || (float)fix.ground_speed_cm_s < kCourseMinSpeed_m_s * 100.0f) return;
+    if (compass_working || speed_cm_s < kCourseMinSpeed_m_s * 100.0f) return;
     const uint16_t since = (uint16_t)((uint16_t)st_.steps - gps_course_step_);
     gps_course_step_ = (uint16_t)st_.steps;
     dcm_.correct_heading_from_course((float)fix.course_e5 * (linalg::kRadPerDeg * 1e-5f) - decl_rad, since);

@@ -107,9 +107,15 @@ constexpr float kMagReferenceShift_uT = 2.5f;
 // velocity is not along x (on the ground, a launch, a stall): no correction. ArduPlane's
 // ARSPD_FBW_MIN default, about two thirds of a small aeroplane's stall.
 constexpr float kCentripetalMinAirspeed_m_s = 9.0f;
-// The GPS course is the heading only above this ground speed (AP_AHRS_DCM's GPS_SPEED_MIN:
-// at a walk the course's noise, 0.1 m/s of velocity noise across the track, is degrees).
+// The GPS aids the estimator only in motion: from this ground speed on (AP_AHRS_DCM's
+// GPS_SPEED_MIN, where it takes the course as the heading: at a walk the course's noise,
+// 0.1 m/s of velocity noise across the track, is degrees) until it falls below
+// kGpsStillSpeed_m_s (its GPS_SPEED_RESET). Still or at a walk, the accelerations the GPS
+// could take off are below its own noise (0.1 m/s differentiated over a fix: 0.7 m/s^2),
+// and the accelerometer's low-pass averages a board's bounded motions without any: the
+// GPS-aided tilt would only be noisier (~0.1 deg RMS, 0.25 deg of heading through the dip).
 constexpr float kCourseMinSpeed_m_s = 3.0f;
+constexpr float kGpsStillSpeed_m_s = 1.0f;
 // A compass sample at most this old (steps: 0.5 s; it delivers at 75 Hz) is a working
 // compass: older, the GPS course takes the heading.
 constexpr uint16_t kCompassStaleSteps = 100;
@@ -238,8 +244,8 @@ public:
     // A new GPS solution (call once per fix: the driver's fix_count() moved): its velocity
     // aids the gravity correction (dcm::GpsAccel: the accelerometer less the GPS's
     // acceleration, in place of the airspeed's or cruise speed's turn term) while the fix
-    // is 3D with AHRS_GPS_MINSATS satellites and AHRS_GPS_USE is 1; AHRS_GPS_GAIN weighs
-    // it. Without a compass (or with one that stopped), its course above
+    // is 3D with AHRS_GPS_MINSATS satellites, AHRS_GPS_USE is 1 and the board moves
+    // (kCourseMinSpeed_m_s); AHRS_GPS_GAIN weighs it. Without a compass (or with one that stopped), its course above
     // kCourseMinSpeed_m_s is the heading reference.
     void on_gps_fix(const gps::Fix& fix);
     // One MPU6000 sample at the fixed 200 Hz step.
@@ -371,6 +377,7 @@ private:
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
         bool start_moved;               // the start was never still: the calibration measuring on may see a turn
+        bool gps_moving;                // the GPS's ground speed passed kCourseMinSpeed_m_s (and not below kGpsStillSpeed_m_s since)
     };
     State st_;
     // One space for two phases (RAM): before the estimator runs the start's gravity if

@@ -169,3 +169,39 @@ TEST(PipelineGps, AidingThatStartsInATurnTakesOverWithoutAJump) {
 }
 
 }  // namespace
+
+namespace {
+
+// A still board (or one carried at a walk) gets nothing from the GPS but its noise: the
+// GPS aids only from 3 m/s of ground speed on, and stops below 1 m/s.
+TEST(PipelineGps, AStillBoardIsNotAided) {
+    pipeline::AttitudePipeline p;
+    p.set_mag_present(true);
+    gps::Fix fix;
+    fix.fix = gps::FixType::k3D;
+    fix.sats = 10;
+    // Level, heading north at a steady speed for some seconds, a fix every 40 steps.
+    const auto fly = [&](float speed_m_s, float seconds) {
+        for (int i = 0; i < (int)(seconds * 200.0f); ++i) {
+            if (i % 3 == 0) p.on_mag_sample(Vector3f(20.0f, 0.0f, 45.0f));
+            p.on_imu_sample(imu(Vector3f(), kLevel));
+            if (p.steps() % 40 != 0) continue;
+            fix.itow_ms += 200;
+            fix.vel_ned_cm_s[0] = (int32_t)std::lround(100.0f * speed_m_s);
+            fix.ground_speed_cm_s = (uint32_t)std::lround(100.0f * speed_m_s);
+            p.on_gps_fix(fix);
+        }
+    };
+    fly(0.0f, 6.0f);
+    EXPECT_FALSE(p.estimator().gps_aiding());  // still
+    fly(2.0f, 2.0f);
+    EXPECT_FALSE(p.estimator().gps_aiding());  // a walk
+    fly(3.5f, 2.0f);
+    EXPECT_TRUE(p.estimator().gps_aiding());   // moving
+    fly(2.0f, 2.0f);
+    EXPECT_TRUE(p.estimator().gps_aiding());   // slower, still moving
+    fly(0.5f, 2.0f);
+    EXPECT_FALSE(p.estimator().gps_aiding());  // stopped
+}
+
+}  // namespace

@@ -62,14 +62,11 @@ Agreement compare(const std::vector<e2e::Line>& sim_lines, const std::vector<Row
 
 // A scenario through build/replay and through the firmware in simavr, each simavr line
 // against its replay row from from_s on (fatal failures inside: ASSERT_NO_FATAL_FAILURE).
-// Both without a GPS: replay has none unless given a path (--gps-log), and apm25sim's
-// u-blox would report a scenario without positions as still at the origin, which the
-// firmware's estimator takes in (issue 45).
 void replay_against_simavr(const char* scenario, double seconds, double from_s, Agreement& a) {
     const std::string csv = e2e::scenario_csv(scenario, seconds);
     const e2e::CommandResult replay = e2e::run_command(e2e::tool("replay") + " --trajectory " + csv);
     ASSERT_EQ(replay.exit_code, 0) << replay.err;
-    const e2e::SimRun sim = e2e::run_sim(e2e::firmware_elf(), scenario, seconds, "--gps none");
+    const e2e::SimRun sim = e2e::run_sim(e2e::firmware_elf(), scenario, seconds);
     ASSERT_EQ(sim.result.exit_code, 0) << e2e::dump(sim);
     a = compare(sim.lines, parse_replay(replay.out), from_s);
 }
@@ -137,15 +134,13 @@ TEST(Broad, ReplayOnEveryRecording) {
 }
 
 // The first 30 s of a recording in simavr: mostly at rest, with the start of the
-// motion in 07. Scored over every row with a truth (--all), and against replay. No GPS:
-// a hand-held recording has no position, and a u-blox still at the origin would tell the
-// estimator the hand does not accelerate.
+// motion in 07. Scored over every row with a truth (--all), and against replay.
 void simavr_on_recording(const std::string& name, double bound_deg) {
     const std::string f = recording(name);
     if (!e2e::file_exists(f)) GTEST_SKIP() << f << " is absent: skipped";
     const double seconds = 30.0;
     const e2e::CommandResult run = e2e::run_command(e2e::tool("apm25sim") + " --elf " + e2e::firmware_elf() +
-                                                    " --trajectory " + f + " --seconds 30 --stamp --gps none");
+                                                    " --trajectory " + f + " --seconds 30 --stamp");
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const std::vector<e2e::Line> lines = e2e::parse_stamped(run.out);
     EXPECT_FALSE(e2e::has_non_finite(lines));
