@@ -8,7 +8,8 @@
 #   make big        the firmware padded past 128 KB to the 200 KB budget (build/big/firmware.elf:
 #                   the test e2e.Beyond128K runs it beside the firmware)
 #   make sim        the firmware in simavr on a default scenario, shown as a serial monitor would
-#   make fly        the firmware in simavr flies a JSBSim aeroplane (FLIGHT=turn GUST=1 SECONDS=30)
+#   make fly        the firmware in simavr flies a JSBSim aeroplane (FLIGHT=turn GUST=1 SECONDS=30;
+#                   SERIAL=tcp:5760: a ground station watches it, in real time)
 #   make test       every test: host GoogleTest units, the simavr end-to-end suite, the
 #                   sketch built by arduino-builder
 #   make unit       the host unit tests alone (test/<Library>/, test/sim/): built and run in

@@ -41,7 +41,7 @@ BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
 REQUIREMENTS = open(os.path.join(REPO, "requirements.txt")).read().split()
 
 FIGURE_KEYS = ["step_cycles_avg", "step_cycles_avg_running", "euler_cycles_avg", "line_cycles_avg", "loop_load_pct",
-               "flash_bytes", "ram_bytes", "flash_attitude_only_bytes", "broad_total_deg", "broad_incl_deg", "broad_heading_deg"]
+               "flash_bytes", "ram_bytes", "stack_used_bytes", "stack_free_bytes", "flash_attitude_only_bytes", "broad_total_deg", "broad_incl_deg", "broad_heading_deg"]
 
 # Profile sections written by apm25sim --profile (numbers, or names matched by keyword).
 SECTIONS = [
@@ -62,6 +62,9 @@ SECTIONS = [
     (14, "magfit", "one part of the cal mag fit (outside the step)", ()),
     (40, "gpsaid", "a GPS fix into the estimator (5 Hz, inside the step when the firmware calls it there)", ()),
     (16, "gcsrequest", "a ground station's MAVLink request handled", ()),
+    (37, "baro", "the barometer task: a conversion read, the next started (PROM at start)", ()),
+    (46, "barocomp", "the MS5611 compensation: a D2's temperature terms or a D1's pressure", ()),
+    (47, "baroheight", "the barometer's height and climb (10 Hz)", ()),
     (17, "gcsreply", "one PARAM_VALUE, or RC_CHANNELS + SERVO_OUTPUT_RAW, packed", ()),
 ]
 
@@ -88,6 +91,9 @@ CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 10000, ""),
                  ("ram_bytes", "static RAM", 3584, " B"),
                  ("flash_bytes", "flash", 204800, " B"),
                  ("flash_attitude_only_bytes", "flash, attitude-only build (APM25_FLIGHT=0)", 204800, " B")]
+# The stack's high-water mark: the painted RAM (firmware/StackPaint.cpp) no profiled run
+# reached must be at least this (issue 45: 512 B to spare).
+STACK_SPARE_MIN = 512
 # The estimator's running step is measured from here on: past the gyro calibration (~1.5 s)
 # and the start-up ramp's first second.
 RUNNING_FROM_S = 3.0
@@ -294,7 +300,19 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour", console=None, 
             running = (rows[1]["total"] - start["total"]) / (rows[1]["count"] - start["count"])
         else:
             log("cycles: the run to %g s failed: no running step figure" % RUNNING_FROM_S)
-    return dict(sections=rows, window=run_window, load=load, seconds=seconds, running_step_avg=running)
+    return dict(sections=rows, window=run_window, load=load, seconds=seconds, running_step_avg=running,
+                stack=read_stack(prof))
+
+
+def read_stack(path):
+    """apm25sim --profile's stack rows: {'used': B, 'free': B} at the run's end, or None."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            p = line.strip().split(",")
+            if p[0] in ("stack_used", "stack_free") and len(p) >= 3:
+                out[p[0][len("stack_"):]] = int(p[2])
+    return out if len(out) == 2 else None
 
 
 def read_profile(path):
@@ -757,6 +775,9 @@ def main():
     loop_max_of = lambda c: c["sections"][6]["max"] if c and 6 in c["sections"] else None
     ours_broad = results[OURS]
     have_all = trials and all(t in ours_broad for t in trials)
+    # The deepest stack over every profiled run (the MAVLink session's frames are the deepest).
+    stacks = [c["stack"] for c in (cycles, cycles_shake, cycles_flight["tilt_tour"], cycles_flight["shake"],
+                                   cycles_console, cycles_gcs) if c and c.get("stack")]
     figures = {
         "step_cycles_avg": sec[1]["avg"] if 1 in sec else None,
         "step_cycles_max": sec[1]["max"] if 1 in sec else None,
@@ -774,6 +795,8 @@ def main():
         "euler_cycles_avg": sec[2]["avg"] if 2 in sec else None,
         "line_cycles_avg": sec[3]["avg"] if 3 in sec else None,
         "loop_load_pct": cycles["load"] if cycles else None,
+        "stack_used_bytes": max(stacks, key=lambda x: x["used"])["used"] if stacks else None,
+        "stack_free_bytes": min(stacks, key=lambda x: x["free"])["free"] if stacks else None,
         "flash_bytes": size["flash"] if size else None,
         "ram_bytes": size["ram"] if size else None,
         "flash_attitude_only_bytes": size_attitude_only["flash"] if size_attitude_only else None,
@@ -850,6 +873,12 @@ def main():
     if size:
         rep.append("Flash %s bytes (.text + .data), static RAM %s bytes (.data + .bss)." % (
             fmt(size["flash"]), fmt(size["ram"])))
+        rep.append("")
+    if figures["stack_used_bytes"] is not None:
+        rep.append("stack high-water mark: %s B used, %s B free (the deepest of the profiled runs: the RAM "
+                   "above the static data is painted at start-up, firmware/StackPaint.cpp, and apm25sim "
+                   "--profile counts what the stack left of it)." % (
+                       fmt(figures["stack_used_bytes"]), fmt(figures["stack_free_bytes"])))
         rep.append("")
     if size_attitude_only:
         rep.append("Attitude-only build (`make APM25_FLIGHT=0`: no receiver, servo outputs or flight modes): "
@@ -989,6 +1018,10 @@ def main():
         rows.append([label, "≤ %s%s" % (fmt(limit) if isinstance(limit, int) else fmt(limit, 1), unit),
                      (fmt(v, 1) if unit == "%" else fmt(int(round(v)))) if v is not None else "–",
                      verdict(v, limit)])
+    spare = figures["stack_free_bytes"]
+    rows.append(["stack never reached (high-water mark)", "≥ %d B" % STACK_SPARE_MIN,
+                 fmt(spare) if spare is not None else "–",
+                 "N/A" if spare is None else ("PASS" if spare >= STACK_SPARE_MIN else "MISS")])
     w, wt = worst_of(results[OURS], trials) if trials else (None, None)
     rows.append(["BROAD mean total RMSE (15 trials)", "≤ %.1f°" % TARGET_BROAD_TOTAL,
                  fmt(figures["broad_total_deg"]), verdict(figures["broad_total_deg"], TARGET_BROAD_TOTAL)])

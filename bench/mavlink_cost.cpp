@@ -13,6 +13,7 @@
 //   section 7  Parser over one 21-byte HEARTBEAT frame from a GCS (CRC-checked)
 //   section 8  RC_CHANNELS and SERVO_OUTPUT_RAW (the 5 Hz pair)
 //   section 9  Parser over one 35-byte PARAM_SET frame from a GCS (CRC-checked), decoded
+//   section 10 GPS_RAW_INT, 11 GLOBAL_POSITION_INT, 12 VFR_HUD (the position streams), 13 HOME_POSITION
 //   section 6  the whole run
 #include <avr/io.h>
 #include <stdint.h>
@@ -58,6 +59,21 @@ int main() {
     const uint16_t widths[8] = {1500, 1500, 1100, 1500, 1520, 1480, 1500, 1900};
     static const char kShort[] = "# mode mavlink: MAVLink 2 now\n";
     static const char kLong[] = "# error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68), retrying each s\n";
+    gps::Fix fix;
+    fix.lat_e7 = 71350450;
+    fix.lon_e7 = -731194210;
+    fix.alt_msl_mm = 1028000;
+    fix.ground_speed_cm_s = 1800u;
+    fix.course_e5 = 9000000;
+    fix.hdop_cm = 90u;
+    fix.sats = 10u;
+    fix.fix = gps::FixType::k3D;
+    mav::PositionReport report{};
+    report.lat_e7 = fix.lat_e7;
+    report.lon_e7 = fix.lon_e7;
+    report.alt_msl_mm = fix.alt_msl_mm;
+    report.heading_deg = 90.0f;
+    report.airspeed_m_s = 18.0f;
 #endif
     for (uint8_t k = 0; k < 20; ++k) {
 #ifndef MAV_COST_EMPTY
@@ -96,6 +112,25 @@ int main() {
         g_sink = filter.ready() && mav::decode_param_set(filter.frame(), ps);
         filter.release();
         end(9);
+        fix.received_ms = 200u * k;
+        report.time_boot_ms = 200u * k;
+        report.vel_ned_m_s[1] = g_angle;
+        begin(10);
+        n = packer.gps_raw_int(frame, fix);
+        end(10);
+        sink(nullptr, frame, n);
+        begin(11);
+        n = packer.global_position_int(frame, report);
+        end(11);
+        sink(nullptr, frame, n);
+        begin(12);
+        n = packer.vfr_hud(frame, report);
+        end(12);
+        sink(nullptr, frame, n);
+        begin(13);
+        n = packer.home_position(frame, fix.lat_e7, fix.lon_e7, fix.alt_msl_mm);
+        end(13);
+        sink(nullptr, frame, n);
 #else
         begin(1);
         g_sink = (uint8_t)(g_sink + (uint8_t)g_angle);

@@ -107,8 +107,9 @@ def section(runs, md_table, fmt):
 
 
 # What the console session types: replies of every kind (help, status's float lines, the
-# parameter list, a set that reconfigures the flight, the receiver's widths, a save).
-CONSOLE_SESSION = "help\r\nstatus\r\nparams\r\nset RLL2SRV_P 0.5\r\nrc\r\nservo\r\nget RLL2SRV_P\r\nsave"
+# parameter list, a set that reconfigures the flight, the receiver's widths, the barometer's
+# lines, a save).
+CONSOLE_SESSION = "help\r\nstatus\r\nparams\r\nset RLL2SRV_P 0.5\r\nrc\r\nservo\r\nbaro\r\nget RLL2SRV_P\r\nsave"
 
 
 def gcs_session_bytes():

@@ -4,7 +4,7 @@
 // Everything here is a small named piece; the sketch (firmware.ino) composes them.
 //
 // Pins (../shared/APM25.md): MPU6000 CS = pin 53 (PB0, also the AVR's SS: an output keeps
-// SPI master), barometer CS = pin 40 (PG1, high forever), SDA/SCL = pins 20/21,
+// SPI master), barometer CS = pin 40 (PG1, high but in the barometer's transactions: Baro.cpp), SDA/SCL = pins 20/21,
 // HMC5883L DRDY = pin 31 (PC6, no interrupt: polled), MPU6000 INT = PE6 (INT6, not an
 // Arduino pin number: read from its port), LEDs A/B/C = pins 27/26/25, active low
 // (calibrating / running / fault).
@@ -67,6 +67,8 @@ enum Section : uint8_t {
     kSecBaro = 37,         // the barometer task: a conversion read and the next one started
     kSecNav = 38,          // position and home from a new fix, the position moved on between fixes
     kSecGcsPosition = 39,  // GPS_RAW_INT, GLOBAL_POSITION_INT, VFR_HUD ... packed and queued
+    // 46 is lib/MS5611's compensation (lib/LinAlg/Profile.h), inside 37.
+    kSecBaroHeight = 47,   // the barometer's 10 Hz height and climb (inside 37)
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

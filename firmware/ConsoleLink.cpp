@@ -3,12 +3,14 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "Console.h"
 #include "GcsLink.h"
 #include "GpsPort.h"
 #include "LoopLoad.h"
 #include "Port.h"
 #include "PipelineText.h"
+#include "Position.h"
 #include "SerialText.h"
 #include "Tasks.h"
 #include "Vehicle.h"
@@ -101,9 +103,11 @@ static bool print_status(uint8_t part) {
         case 2: pipeline_text::write_bias_status(out, pipe); return true;
         case 3: pipeline_text::write_compass_status(out, pipe); return true;
         case 4: print_settings_line(); return true;
-        case 5: tasks::print_status_line(out); return true;
-        case 6: gps_port::print_status_line(out); return true;
-        case 7: return flight_io.print_status_line();
+        case 5: baro::print_line(out); return true;
+        case 6: tasks::print_status_line(out); return true;
+        case 7: gps_port::print_status_line(out); return true;
+        case 8: position::print_status_line(out); return true;
+        case 9: return flight_io.print_status_line();
         default: return false;
     }
 }
@@ -127,6 +131,11 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Show:
             if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
             if (c.arg == console::kShowGps) return gps_port::print(part, out);
+            if (c.arg == console::kShowBaro) {
+                if (part > 0) return false;
+                baro::print_line(out);
+                return true;
+            }
             break;
         default: break;
     }

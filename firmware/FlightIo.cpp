@@ -114,6 +114,14 @@ bool FlightIo::powered() const {
            flight::width_to_throttle(control_.rc_us()[ch], fs.rc[ch], (fs.rc_reversed >> ch) & 1u) > kIdleThrottle;
 }
 
+uint8_t FlightIo::throttle_percent() const {
+    constexpr uint8_t kOut = 2;  // the mixer's throttle output, OUT3
+    const flight::FlightSettings& fs = pipe.settings().flight;
+    const int16_t t = flight::width_to_throttle(servo_outputs::width_us(kOut), fs.servo[kOut],
+                                                (fs.servo_reversed >> kOut) & 1u);
+    return (uint8_t)((t + 5) / 10);
+}
+
 // The failsafe's wings-level glide is ArduPlane's FBWA glide (MavLink.h), STABILIZE
 // without an attitude flies as MANUAL.
 mav::PlaneMode FlightIo::plane_mode() const {
@@ -206,6 +214,7 @@ void FlightIo::poll(uint32_t, uint32_t) {}
 bool FlightIo::control_due(bool) { return false; }
 void FlightIo::control_run(uint32_t, uint32_t, const mpu6000::Sample&, const pipeline::AnglesCentideg*) {}
 bool FlightIo::powered() const { return false; }
+uint8_t FlightIo::throttle_percent() const { return 0; }
 mav::PlaneMode FlightIo::plane_mode() const { return mav::PlaneMode::Manual; }
 bool FlightIo::failsafe() const { return false; }
 bool FlightIo::print_status_line() { return false; }

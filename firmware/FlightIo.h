@@ -52,6 +52,8 @@ public:
 
     // The receiver's throttle above idle: the aeroplane flies at its cruise speed.
     bool powered() const;
+    // The throttle output (OUT3) between its SERVO3_MIN and _MAX, percent (VFR_HUD).
+    uint8_t throttle_percent() const;
     // The mode flying now as ArduPlane numbers it (HEARTBEAT custom_mode), and whether it
     // is the failsafe (HEARTBEAT's state CRITICAL).
     mav::PlaneMode plane_mode() const;
@@ -80,6 +82,6 @@ private:
     uint32_t last_control_us_ = 0;
     // The gyro bias in the control's rate units, worked out again once a second.
     int16_t bias_cds_[2] = {0, 0};
-    uint8_t bias_age_ = 0xFF;
+    uint8_t bias_age_ = 49;  // the first step with an attitude works it out (0xFF wrapped to 0: a second late)
 #endif
 };

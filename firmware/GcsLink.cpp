@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include "Baro.h"
 #include "Board.h"
 #include "Console.h"
 #include "ConsoleLink.h"
+#include "GpsPort.h"
 #include "LoopLoad.h"
 #include "ParamLink.h"
 #include "Port.h"
+#include "Position.h"
 #include "SerialText.h"
 #include "Vehicle.h"
 
@@ -21,8 +24,9 @@ static mav::Parser input;
 static mav::ParamReplies param_replies;
 static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
 static bool defaults_said_pending = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
-constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz
+constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
+static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
 
 mav::Parser& parser() { return input; }
 
@@ -44,6 +48,25 @@ uint16_t output_line_bytes() { return port::mavlink_mode() ? mav::kAttitudeFrame
 
 static bool room_for(uint16_t frame_bytes) {
     return port::mavlink_mode() && serial_text::room() >= frame_bytes + output_line_bytes();
+}
+
+// MAV_CMD_DO_SET_HOME: param1 1 (or a place of all zeros, as ArduPilot) here, else
+// param5 latitude, param6 longitude (degrees), param7 height above mean sea level (m).
+static mav::Result set_home(const float* p) {
+    bool ok;
+    if (p[0] == 1.0f || (p[4] == 0.0f && p[5] == 0.0f && p[6] == 0.0f)) {
+        ok = position::set_home_here();
+    } else if (!(p[4] == p[4] && p[5] == p[5] && p[6] == p[6])) {
+        ok = false;  // NaN (MAVLink's "unset") in a place: no place
+    } else {
+        nav::Location home;
+        // A float has 24 bits: 7.135045 deg arrives to 5e-7 deg (5 cm); COMMAND_INT would be exact.
+        home.lat_e7 = nav::round_to_int32(p[4] * 1e7f);
+        home.lon_e7 = nav::round_to_int32(p[5] * 1e7f);
+        home.alt_cm = nav::round_to_int32(p[6] * 100.0f);
+        ok = position::set_home(home);
+    }
+    return ok ? mav::Result::Accepted : mav::Result::Failed;
 }
 
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
@@ -74,6 +97,13 @@ static mav::Result run_command(const mav::CommandLong& c) {
         } else {
             return mav::Result::Unsupported;
         }
+        return mav::Result::Accepted;
+    }
+    if (c.command == mav::kCmdDoSetHome) return set_home(p);
+    if (c.command == mav::kCmdGetHomePosition ||
+        (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
+        if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
+        home_requested = true;
         return mav::Result::Accepted;
     }
     return mav::Result::Unsupported;
@@ -133,14 +163,19 @@ void send_param_value() {
 }
 
 bool streams_due() {
-    return FlightIo::kEnabled && millis() - last_stream_ms >= kStreamPeriodMs && room_for(2u * mav::kRcChannelsFrame);
+    return (FlightIo::kEnabled || baro::present()) && millis() - last_stream_ms >= kStreamPeriodMs &&
+           room_for(2u * mav::kRcChannelsFrame + mav::kScaledPressureFrame);
 }
 void send_streams() {
     const uint32_t now_ms = millis();
     last_stream_ms = now_ms;
     uint8_t frame[mav::kMaxFrame];
-    port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
-    port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    if (FlightIo::kEnabled) {
+        port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
+        port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    }
+    if (baro::present())
+        port::send_frame(frame, port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c()));
 }
 
 void send_heartbeat_and_status() {
@@ -152,14 +187,69 @@ void send_heartbeat_and_status() {
                                  ? mav::State::Calibrating
                                  : mav::State::Active;
     uint8_t frame[mav::kMaxFrame];
+    mav::Health health = mav::health(true, imu.ok(), true, compass.ok());
+    const gps::Fix& fix = gps_port::fix();
+    mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
+                    fix.fix == gps::FixType::k3D && !fix.glitching);
+    mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
     uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
                                         flight_io.plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
-    n = port::mavlink.sys_status(frame, mav::health(true, imu.ok(), true, compass.ok()),
+    n = port::mavlink.sys_status(frame, health,
                                  (uint16_t)(loop_load::percent() * 10u),
                                  (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu));
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
+}
+
+// The position messages: each round (kPositionPeriodMs) GLOBAL_POSITION_INT and VFR_HUD,
+// every other round GPS_RAW_INT first; HOME_POSITION before them when due. One frame a run.
+constexpr uint16_t kPositionPeriodMs = 250;
+enum PositionFrame : uint8_t { kGpsRaw, kGlobalPosition, kVfrHud, kRoundDone };
+static uint8_t next_position_frame = kRoundDone;
+static uint8_t position_rounds = 0;
+static uint32_t position_round_ms = 0;
+static uint8_t home_changes_sent = 0;
+
+static bool home_due() {
+    return position::navigator().home_set() && (home_requested || home_changes_sent != position::home_changes());
+}
+
+bool position_due() {
+    if (!port::mavlink_mode() || !room_for(mav::kMaxFrame)) return false;
+    if (home_due() || next_position_frame != kRoundDone) return true;
+    return millis() - position_round_ms >= kPositionPeriodMs;
+}
+
+void send_position() {
+    uint8_t frame[mav::kMaxFrame];
+    uint8_t n = 0;
+    if (home_due()) {
+        home_requested = false;
+        home_changes_sent = position::home_changes();
+        const nav::Location& h = position::navigator().home();
+        n = port::mavlink.home_position(frame, h.lat_e7, h.lon_e7, h.alt_cm * 10);
+    } else {
+        if (next_position_frame == kRoundDone) {
+            position_round_ms = millis();
+            next_position_frame = (position_rounds++ & 1u) == 0u ? kGpsRaw : kGlobalPosition;
+        }
+        // No GLOBAL_POSITION_INT before the first fix: a map would put the plane at 0, 0.
+        if (next_position_frame == kGlobalPosition && !position::navigator().have_position()) ++next_position_frame;
+        mav::PositionReport r;
+        switch (next_position_frame++) {
+            case kGpsRaw: n = port::mavlink.gps_raw_int(frame, gps_port::fix()); break;
+            case kGlobalPosition:
+                position::report(r);
+                n = port::mavlink.global_position_int(frame, r);
+                break;
+            default:
+                position::report(r);
+                n = port::mavlink.vfr_hud(frame, r);
+                break;
+        }
+    }
+    if (n > 0) port::send_frame(frame, n);
 }
 
 }  // namespace gcs_link

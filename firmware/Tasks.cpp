@@ -14,12 +14,14 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "Board.h"
 #include "ConsoleLink.h"
 #include "GcsLink.h"
 #include "GpsPort.h"
 #include "LoopLoad.h"
 #include "OutputLine.h"
+#include "Position.h"
 #include "Scheduler.h"
 #include "SerialText.h"
 #include "UserCode.h"
@@ -96,7 +98,10 @@ static void once_a_second() {
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
+    X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
+    X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
     X(store,        nullptr,                         store_service,                    1500, kSecStore,        kAlways) \
+    X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
     X(flight,       nullptr,                         flight_poll,                       800, kSecFlightPoll,   kAlways) \

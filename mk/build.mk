@@ -221,25 +221,37 @@ docs: tools
 
 # SERIAL=tcp:5760: a live board, UART0 served on TCP 127.0.0.1:5760 in real time (as
 # ArduPilot's SITL) until Ctrl-C, the scenario's last state held after its end.
+# MODE=mavlink (any output mode) types `mode NAME` into the board as it starts.
 sim: firmware tools
 	@mkdir -p $(BUILD)/scenarios
 	@$(BUILD)/scenario $(SCENARIO) > $(BUILD)/scenarios/$(SCENARIO).csv
+	$(if $(MODE),@printf 'mode $(MODE)\n' > $(BUILD)/scenarios/sim-input.txt)
 	@echo "# simavr: $(FW_BUILD)/firmware.elf on scenario '$(SCENARIO)' (SCENARIO=name, SECONDS=s, SERIAL=tcp:5760 to change)"
 	@$(BUILD)/apm25sim --elf $(FW_BUILD)/firmware.elf --trajectory $(BUILD)/scenarios/$(SCENARIO).csv \
-	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL))
+	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL)) \
+	  $(if $(MODE),--input $(BUILD)/scenarios/sim-input.txt)
 
 # make fly [FLIGHT=cruise|gusty|upset|turn|figure8|climb] [GUST=0|1|2] [SECONDS=s] [STAMP=1]
-# [VIEW=1]: the firmware flies the JSBSim Rascal (sim/flight/closed_loop.py: the backend with
-# the flight's stick script, apm25sim --physics json in lock-step), the board's serial
-# output shown as a serial monitor would (STAMP=1: after its simulated time); VIEW=1 (or
-# make view FLIGHT=...) draws it on the live horizon. Both processes end by themselves,
-# or after FLY_TIMEOUT wall seconds.
+# [VIEW=1] [SERIAL=tcp:5760] [SPEED=x]: the firmware flies the JSBSim Rascal
+# (sim/flight/closed_loop.py: the backend with the flight's stick script, apm25sim
+# --physics json in lock-step), the board's serial output shown as a serial monitor would
+# (STAMP=1: after its simulated time); VIEW=1 (or make view FLIGHT=...) draws it on the
+# live horizon. SERIAL=tcp:5760 (or GCS=tcp:5760) attaches a ground station: the board's
+# UART0 also on TCP 127.0.0.1:5760, as make sim SERIAL=... and ArduPilot's SITL, flown in
+# real time (SPEED=x: x times real time). MODE=mavlink (plot, csv, quat, raw, quiet) types
+# `mode NAME` into the board as it starts, as make view MODE=... does: in MAVLink from then
+# on, a ground station that only listens hears it. Both processes end by themselves, or
+# after FLY_TIMEOUT wall seconds.
 FLY_TIMEOUT ?= 1800
+FLY_SERIAL = $(or $(GCS),$(SERIAL))
 fly: firmware tools venv
-	@echo "# flight '$(or $(FLIGHT),cruise)': build/firmware.elf in simavr flies the JSBSim Rascal 110 (FLIGHT=name, GUST=0-2, SECONDS=s; flights: fly.py --list)"
+	@echo "# flight '$(or $(FLIGHT),cruise)': build/firmware.elf in simavr flies the JSBSim Rascal 110 (FLIGHT=name, GUST=0-2, SECONDS=s, SERIAL=tcp:5760 for a ground station; flights: fly.py --list)"
+	$(if $(MODE),@mkdir -p $(BUILD)/flight && printf 'mode $(MODE)\n' > $(BUILD)/flight/fly-input.txt)
 	@$(VENV_PY) sim/flight/closed_loop.py --flight $(or $(FLIGHT),cruise) $(if $(GUST),--gust $(GUST)) \
 	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(STAMP),--stamp) --sim $(BUILD)/apm25sim \
 	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) \
+	  $(if $(FLY_SERIAL),--serial $(FLY_SERIAL)) $(if $(SPEED),--speed $(SPEED)) \
+	  $(if $(MODE),--input $(BUILD)/flight/fly-input.txt) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
 
 test: firmware attitude-only big tools venv

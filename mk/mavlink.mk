@@ -66,7 +66,7 @@ endif
 MAVCOST_DIR   := $(BUILD)/mavlink-cost
 MAVCOST_FLAGS := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -Os -flto -std=gnu++11 -fno-exceptions -fno-rtti \
                  -fno-threadsafe-statics -ffunction-sections -fdata-sections -mcall-prologues -mrelax \
-                 -Wall -Wextra -Werror -Wdouble-promotion -Ilib/MavLink -Ilib/LinAlg -Ilib/Console \
+                 -Wall -Wextra -Werror -Wdouble-promotion -Ilib/MavLink -Ilib/LinAlg -Ilib/Console -Ilib/GPS \
                  -I$(MAVLINK_DIR) -Wl,--gc-sections
 MAVCOST_SRC   := bench/mavlink_cost.cpp lib/MavLink/MavLink.cpp lib/LinAlg/LinAlg.cpp lib/Console/Text.cpp
 
@@ -85,5 +85,6 @@ mavlink-cost: $(MAVLINK_STAMP) tools
 	  --profile $(MAVCOST_DIR)/profile.csv > /dev/null
 	@awk -F, 'BEGIN { n[1]="HEARTBEAT"; n[2]="ATTITUDE"; n[3]="SYS_STATUS"; n[4]="STATUSTEXT, 30-char line"; \
 	  n[5]="STATUSTEXT, 70-char line (2 chunks)"; n[7]="Parser, 21-byte HEARTBEAT frame"; \
-	  n[8]="RC_CHANNELS + SERVO_OUTPUT_RAW"; n[9]="Parser, 35-byte PARAM_SET (bad CRC)" } \
+	  n[8]="RC_CHANNELS + SERVO_OUTPUT_RAW"; n[9]="Parser, 35-byte PARAM_SET (bad CRC)"; \
+	  n[10]="GPS_RAW_INT"; n[11]="GLOBAL_POSITION_INT"; n[12]="VFR_HUD"; n[13]="HOME_POSITION" } \
 	  ($$1 in n) { printf "# %-38s %6d cycles avg (min %d, max %d)\n", n[$$1], $$3, $$4, $$5 }' $(MAVCOST_DIR)/profile.csv

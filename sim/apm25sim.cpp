@@ -65,7 +65,10 @@ const char* const kUsage =
     "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..63 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
-    "                   run,1,C,C,C,C with C = cycles from the first start to the last end of section 6\n"
+    "                   run,1,C,C,C,C with C = cycles from the first start to the last end of section 6;\n"
+    "                   then stack_used,1,U,U,U,U and stack_free,1,F,F,F,F: of the RAM above .data\n"
+    "                   and .bss, the bytes still holding the firmware's start-up paint (0xC5, from\n"
+    "                   the bottom up: F) and the rest (U, the stack at its deepest)\n"
     "  --rc FILE        the receiver: CSV header t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8 (s, us), rows\n"
     "                   in increasing time, widths 500-3000 us; a row holds from its time until\n"
     "                   the next; a row with every channel empty (12.0,,,,,,,,) is a dead\n"
@@ -115,12 +118,18 @@ const char* const kUsage =
     "                   frames, so a run is deterministic. rc_1..rc_8 drive the PPM on ICP5 (an\n"
     "                   rc with none of them, or all 0, is a dead receiver; --rc, if given,\n"
     "                   drives it instead). A frame unanswered for 1 s is sent again (same\n"
-    "                   frame_count, said on stderr); airspeed, when sent, is the pitot's: the\n"
-    "                   APM 2.5's MPXV7002DP on A0 (ADC0), 2.5 V + 1 V/kPa of 1/2 1.225 v^2,\n"
-    "                   held within 0.5..4.5 V; position and velocity (NED metres and m/s from\n"
+    "                   frame_count, said on stderr); a reply whose timestamp is not after the\n"
+    "                   last state taken, or one waiting before a frame is sent, answers an\n"
+    "                   earlier send (a frame sent again and answered twice, late): dropped\n"
+    "                   and counted (the summary on stderr at the end: frames, sent again,\n"
+    "                   replies dropped). airspeed, when sent, is the pitot's: the APM 2.5's\n"
+    "                   MPXV7002DP on A0 (ADC0), 2.5 V + 1 V/kPa of 1/2 1.225 v^2, held\n"
+    "                   within 0.5..4.5 V; position and velocity (NED metres and m/s from\n"
     "                   --home) drive the GPS and the barometer; wind is read, not used. Runs\n"
     "                   until SIGINT/SIGTERM unless --seconds. Exit status 4 when the backend\n"
-    "                   stops answering or answers something that is not a state. With --serial\n"
+    "                   stops answering, answers something that is not a state, or gives no\n"
+    "                   state newer than the last for --physics-timeout s (its time stands\n"
+    "                   still or went back). With --serial\n"
     "                   a ground station watches the flying board, in real time by default\n"
     "                   (lock-step and --speed pacing together: the slower of the two sets it)\n"
     "  --physics-rate HZ  the frame_rate asked of the backend, 400..10000 (default 1000)\n"
@@ -128,7 +137,8 @@ const char* const kUsage =
     "                   t,gx,...,qz,movement,n,e,d; the backend's true attitude and position):\n"
     "                   replay, score and the peers run on a flight as on any recording, and\n"
     "                   apm25sim --trajectory flies it again with the GPS and the barometer\n"
-    "  --physics-timeout S  give up on a silent backend after S s (default 30)\n"
+    "  --physics-timeout S  give up on a silent backend, or one whose replies are all stale,\n"
+    "                   after S s (default 30)\n"
     "  --earth-field N,E,D  the earth field for --physics, uT NED (default 20,0,45)\n"
     "  --verbose        print the sensor models' protocol counters on stderr at the end\n"
     "  --gps KIND       the module on the GPS port (UART1): ublox (default), a u-blox 6 (NEO-6M)\n"
@@ -546,6 +556,10 @@ int main(int argc, char** argv) {
                 break;
             }
         }
+        // The link's summary: a loaded machine shows here as frames sent again and their
+        // late answers dropped.
+        std::fprintf(stderr, "apm25sim: physics backend at %s:%d: %s\n", physics.host.c_str(), physics.port,
+                     link.summary().c_str());
     }
     board.finish_output();
     if (physics_log && std::fclose(physics_log) != 0) {

@@ -17,6 +17,7 @@
 //   servo                the eight output widths, us
 //   gps                  the GPS: fix, satellites, hDOP, position, speed, course, age, counters
 //   params               every parameter (lib/Settings/Params.h) and its value, one a line
+//   baro                 the barometer: pressure, temperature, height, climb, counters
 //   get NAME             one parameter
 //   set NAME VALUE       set one (range-checked; `save` keeps it)
 //
@@ -58,7 +59,7 @@ enum class CommandId : uint8_t {
     Get,       // arg = parameter index
 };
 
-enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowGps = 3 };
+enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowGps = 3, kShowBaro = 4 };
 // `set` values are parsed with four decimals (parse_fixed) and carried as integers.
 constexpr int32_t kParamScale = 10000;
 

@@ -129,6 +129,19 @@ Writer& Writer::vec(const linalg::Vector3f& v, float scale) {
     return fixed2(v.x * scale).chr(' ').fixed2(v.y * scale).chr(' ').fixed2(v.z * scale);
 }
 
+Writer& Writer::degrees_e7(int32_t v) {
+    if (v < 0) chr('-');
+    const uint32_t a = v < 0 ? (uint32_t)0 - (uint32_t)v : (uint32_t)v;
+    u32(a / 10000000u).chr('.');
+    char digits[7];
+    uint32_t frac = a % 10000000u;
+    for (uint8_t i = 7; i-- > 0;) {
+        digits[i] = (char)('0' + frac % 10u);
+        frac /= 10u;
+    }
+    return str(digits, 7);
+}
+
 Writer& Writer::hex8(uint8_t v) {
     const uint8_t hi = (uint8_t)(v >> 4), lo = (uint8_t)(v & 0x0Fu);
     const char buf[2] = {(char)(hi < 10u ? '0' + hi : 'A' + hi - 10u),

@@ -88,6 +88,8 @@ public:
     // "x y z", each times `scale` with two decimals (fixed2).
     Writer& vec(const linalg::Vector3f& v, float scale = 1.0f);
     Writer& hex8(uint8_t v);  // two upper-case hex digits, no prefix
+    // Degrees x 1e7 (a GPS latitude or longitude) with seven decimals: "-73.1194210".
+    Writer& degrees_e7(int32_t v);
     Writer& end() { return chr('\n'); }
 
 private:

@@ -215,12 +215,16 @@ namespace {
 
 int16_t clamp_throw(int32_t v) { return (int16_t)clamp32(v, -kFullThrow_cd, kFullThrow_cd); }
 
-// Two surfaces that share two commands (elevons: elevator and aileron; V-tail: elevator
-// and rudder), each half of both as ArduPlane's default MIXING_GAIN 0.5: the left
-// surface's command is (a - b) / 2, the right one's (a + b) / 2.
-void mix_pair(int16_t a, int16_t b, int16_t& left, int16_t& right) {
-    left = clamp_throw(((int32_t)a - b) / 2);
-    right = clamp_throw(((int32_t)a + b) / 2);
+// Two surfaces that share two commands, each half of both as ArduPlane's default
+// MIXING_GAIN 0.5 (its channel_function_mixer): `minus` takes (a - b) / 2, `plus`
+// (a + b) / 2. A positive command is trailing edge up. Elevons (a the elevator, b the
+// aileron): the left is `minus`, so that a right roll lowers the left trailing edge and
+// raises the right. V-tail (a the elevator, b the rudder): the right is `minus`, so that
+// a yaw to the right raises the left trailing edge and lowers the right: each
+// ruddervator's force is normal to it, and the two push the tail to the left.
+void mix_pair(int16_t a, int16_t b, int16_t& minus, int16_t& plus) {
+    minus = clamp_throw(((int32_t)a - b) / 2);
+    plus = clamp_throw(((int32_t)a + b) / 2);
 }
 
 }  // namespace
@@ -229,7 +233,7 @@ void mix(const FlightSettings& s, const Scales& sc, const Surfaces& in, const ui
          uint16_t out_us[kChannels]) {
     int16_t cmd[4] = {in.aileron_cd, in.elevator_cd, 0, in.rudder_cd};
     if (s.elevon_output != 0u) mix_pair(in.elevator_cd, in.aileron_cd, cmd[0], cmd[1]);
-    if (s.vtail_output != 0u) mix_pair(in.elevator_cd, in.rudder_cd, cmd[1], cmd[3]);
+    if (s.vtail_output != 0u) mix_pair(in.elevator_cd, in.rudder_cd, cmd[3], cmd[1]);
     for (uint8_t i = 0; i < 4; ++i) {
         const bool rev = bit(s.servo_reversed, i);
         out_us[i] = i == 2 ? throttle_to_width(in.throttle, s.servo[i], sc.out[i], rev)

@@ -22,7 +22,12 @@ enum Part : uint8_t {
     kMagFit = 14,         // one part of the `cal mag` fit (Pipeline), outside the estimator step
     // 15..39 are the firmware's (firmware/Board.h).
     kGpsAid = 40,         // a GPS fix into the estimator (Pipeline::on_gps_fix, 5 Hz)
+    kBaroCompensation = 46,  // lib/MS5611: a D2's temperature terms or a D1's pressure (in the baro task)
 };
+
+// The byte the firmware paints its free RAM with at start-up (firmware/StackPaint.cpp):
+// apm25sim --profile reports how much of it the stack overwrote (its high-water mark).
+constexpr uint8_t kStackPaint = 0xC5;
 
 #if defined(__AVR__)
 // GPIOR0 and GPIOR1 are I/O registers 0x1E and 0x2A on the ATmega2560 (datasheet 31).

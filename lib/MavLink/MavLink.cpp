@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MavLink.h"
 
+#include <math.h>
 #include <string.h>
 
 // The generated headers (build/mavlink): one channel, no signing (the SHA-256 code and
@@ -42,7 +43,8 @@ static_assert((uint8_t)Severity::Error == MAV_SEVERITY_ERROR && (uint8_t)Severit
                   (uint8_t)Severity::Notice == MAV_SEVERITY_NOTICE && (uint8_t)Severity::Info == MAV_SEVERITY_INFO,
               "Severity values are MAV_SEVERITY's");
 static_assert(kGyro3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_GYRO && kAccel3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_ACCEL &&
-                  kMag3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_MAG,
+                  kMag3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_MAG &&
+                  kAbsolutePressure == (uint32_t)MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE,
               "SensorBits are MAV_SYS_STATUS_SENSOR's");
 static_assert(kComponentId == (uint8_t)MAV_COMP_ID_AUTOPILOT1, "QGroundControl makes vehicles of AUTOPILOT1 only");
 static_assert(kParamTypeInt8 == MAV_PARAM_TYPE_INT8 && kParamTypeInt16 == MAV_PARAM_TYPE_INT16 &&
@@ -51,6 +53,7 @@ static_assert(kParamTypeInt8 == MAV_PARAM_TYPE_INT8 && kParamTypeInt16 == MAV_PA
 static_assert(kParamIdLen == MAVLINK_MSG_PARAM_VALUE_FIELD_PARAM_ID_LEN, "param_id length");
 static_assert(kParamValueFrame == kFrameOverhead + MAVLINK_MSG_ID_PARAM_VALUE_LEN, "PARAM_VALUE size");
 static_assert(kRcChannelsFrame == kFrameOverhead + MAVLINK_MSG_ID_RC_CHANNELS_LEN, "RC_CHANNELS size");
+static_assert(kScaledPressureFrame == kFrameOverhead + MAVLINK_MSG_ID_SCALED_PRESSURE_LEN, "SCALED_PRESSURE size");
 static_assert(kMaxFrame >= kRcChannelsFrame && kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_SERVO_OUTPUT_RAW_LEN &&
                   kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_COMMAND_ACK_LEN,
               "the replies and streams fit kMaxFrame");
@@ -63,6 +66,22 @@ static_assert(kMsgHeartbeat == MAVLINK_MSG_ID_HEARTBEAT && kMsgParamRequestRead 
               "MsgId values are the message ids");
 static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE,
               "MAV_CMD values");
+static_assert(kGps == (uint32_t)MAV_SYS_STATUS_SENSOR_GPS, "MAV_SYS_STATUS_SENSOR_GPS");
+static_assert(kCmdDoSetHome == MAV_CMD_DO_SET_HOME && kCmdGetHomePosition == MAV_CMD_GET_HOME_POSITION &&
+                  kCmdRequestMessage == MAV_CMD_REQUEST_MESSAGE && kMsgHomePosition == MAVLINK_MSG_ID_HOME_POSITION,
+              "the position commands' values");
+// Whole frames fit kMaxFrame: GPS_RAW_INT with its extensions (64), GLOBAL_POSITION_INT
+// (40), VFR_HUD (32); HOME_POSITION without its time_usec extension, which is sent 0
+// and so trimmed (MAVLink 2 drops trailing zero bytes).
+static_assert(kFrameOverhead + MAVLINK_MSG_ID_GPS_RAW_INT_LEN <= kMaxFrame &&
+                  kFrameOverhead + MAVLINK_MSG_ID_GLOBAL_POSITION_INT_LEN <= kMaxFrame &&
+                  kFrameOverhead + MAVLINK_MSG_ID_VFR_HUD_LEN <= kMaxFrame &&
+                  kFrameOverhead + MAVLINK_MSG_ID_HOME_POSITION_MIN_LEN <= kMaxFrame,
+              "the position messages fit kMaxFrame");
+static_assert((uint8_t)gps::FixType::kNoGps == GPS_FIX_TYPE_NO_GPS && (uint8_t)gps::FixType::kNoFix ==
+                  GPS_FIX_TYPE_NO_FIX && (uint8_t)gps::FixType::k2D == GPS_FIX_TYPE_2D_FIX &&
+                  (uint8_t)gps::FixType::k3D == GPS_FIX_TYPE_3D_FIX,
+              "FixType values are GPS_FIX_TYPE's");
 static_assert((uint8_t)Result::Accepted == MAV_RESULT_ACCEPTED && (uint8_t)Result::TemporarilyRejected ==
                   MAV_RESULT_TEMPORARILY_REJECTED && (uint8_t)Result::Denied == MAV_RESULT_DENIED &&
                   (uint8_t)Result::Unsupported == MAV_RESULT_UNSUPPORTED && (uint8_t)Result::Failed == MAV_RESULT_FAILED,
@@ -102,6 +121,12 @@ Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok) {
     if (mag_present) h.present |= kMag3d;
     if (mag_present && mag_ok) h.healthy |= kMag3d;
     return h;
+}
+
+void add_sensor(Health& h, uint32_t bits, bool present, bool ok) {
+    if (!present) return;
+    h.present |= bits;
+    if (ok) h.healthy |= bits;
 }
 
 uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode) {
@@ -177,6 +202,65 @@ uint8_t Packer::servo_output_raw(uint8_t out[kMaxFrame], uint32_t time_boot_us, 
     mavlink_msg_servo_output_raw_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_boot_us, 0u, w[0],
                                              w[1], w[2], w[3], w[4], w[5], w[6], w[7], 0u, 0u, 0u, 0u, 0u, 0u, 0u,
                                              0u);
+    return f.finish(out, seq_);
+}
+
+namespace {
+// A float m/s as MAVLink's int16 cm/s, held within its range.
+int16_t cm_s(float m_s) {
+    const float cm = m_s * 100.0f;
+    if (!(cm > -32767.0f)) return cm != cm ? 0 : -32767;
+    if (cm > 32767.0f) return 32767;
+    return (int16_t)cm;
+}
+// A heading in degrees as centi-degrees 0..35999, UINT16_MAX when unknown (< 0 or NaN).
+uint16_t heading_cd(float deg) {
+    if (!(deg >= 0.0f) || !(deg < 360.0f)) return UINT16_MAX;
+    const uint16_t cd = (uint16_t)(deg * 100.0f + 0.5f);
+    return cd >= 36000u ? 0u : cd;
+}
+}  // namespace
+
+uint8_t Packer::gps_raw_int(uint8_t out[kMaxFrame], const gps::Fix& fix) {
+    Frame f(seq_);
+    const bool moving = fix.fix >= gps::FixType::k2D;
+    const uint32_t speed = fix.ground_speed_cm_s < UINT16_MAX ? fix.ground_speed_cm_s : UINT16_MAX - 1u;
+    const uint16_t vel = moving ? (uint16_t)speed : UINT16_MAX;
+    const uint16_t cog = moving ? (uint16_t)((uint32_t)fix.course_e5 / 1000u % 36000u) : UINT16_MAX;
+    const uint8_t sats = fix.fix == gps::FixType::kNoGps ? UINT8_MAX : fix.sats;
+    mavlink_msg_gps_raw_int_pack_status(kSystemId, kComponentId, &f.status, &f.msg, (uint64_t)fix.received_ms * 1000u,
+                                        (uint8_t)fix.fix, fix.lat_e7, fix.lon_e7, fix.alt_msl_mm, fix.hdop_cm,
+                                        UINT16_MAX, vel, cog, sats, 0, fix.h_acc_mm, 0u,
+                                        fix.speed_acc_cm_s * 10u, 0u, 0u);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::global_position_int(uint8_t out[kMaxFrame], const PositionReport& p) {
+    Frame f(seq_);
+    mavlink_msg_global_position_int_pack_status(kSystemId, kComponentId, &f.status, &f.msg, p.time_boot_ms, p.lat_e7,
+                                                p.lon_e7, p.alt_msl_mm, p.relative_alt_mm, cm_s(p.vel_ned_m_s[0]),
+                                                cm_s(p.vel_ned_m_s[1]), cm_s(p.vel_ned_m_s[2]),
+                                                heading_cd(p.heading_deg));
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::vfr_hud(uint8_t out[kMaxFrame], const PositionReport& p) {
+    Frame f(seq_);
+    const float* v = p.vel_ned_m_s;
+    const float ground_m_s = sqrtf(v[0] * v[0] + v[1] * v[1]);
+    const uint16_t hdg = heading_cd(p.heading_deg);
+    const int16_t heading_deg = hdg == UINT16_MAX ? 0 : (int16_t)((hdg + 50u) / 100u % 360u);
+    mavlink_msg_vfr_hud_pack_status(kSystemId, kComponentId, &f.status, &f.msg, p.airspeed_m_s, ground_m_s,
+                                    heading_deg, p.throttle_pct, (float)p.alt_msl_mm * 0.001f, p.climb_m_s);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::home_position(uint8_t out[kMaxFrame], int32_t lat_e7, int32_t lon_e7, int32_t alt_msl_mm) {
+    Frame f(seq_);
+    const float q[4] = {1.0f, 0.0f, 0.0f, 0.0f};
+    mavlink_msg_home_position_pack_status(kSystemId, kComponentId, &f.status, &f.msg, lat_e7, lon_e7, alt_msl_mm,
+                                          0.0f, 0.0f, 0.0f, q, 0.0f, 0.0f, 0.0f, 0u);
+    if (kFrameOverhead + f.msg.len > kMaxFrame) return 0;  // never: the trimmed payload ends at q[0]
     return f.finish(out, seq_);
 }
 
@@ -398,6 +482,16 @@ bool decode_command_long(const Received& rx, CommandLong& out) {
     out.param[5] = m.param6;
     out.param[6] = m.param7;
     return true;
+}
+
+uint8_t Packer::scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c) {
+    Frame f(seq_);
+    // The temperature within int16's 0.01 degC (the chip's -40..85 degC is well inside).
+    const float c100 = temperature_c * 100.0f;
+    const int16_t temp = c100 > 32767.0f ? (int16_t)32767 : c100 < -32767.0f ? (int16_t)-32767 : (int16_t)c100;
+    mavlink_msg_scaled_pressure_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_boot_ms,
+                                            pressure_pa * 0.01f, 0.0f, temp, 0);
+    return f.finish(out, seq_);
 }
 
 }  // namespace mav

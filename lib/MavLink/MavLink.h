@@ -9,8 +9,13 @@
 //   STATUSTEXT       per "# "  15..66     every "# " console line, severity from its first word
 //   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us
 //   SERVO_OUTPUT_RAW 5 Hz      33 bytes   the eight outputs' widths, us
+//   SCALED_PRESSURE  5 Hz      ~28 bytes  the barometer's pressure (hPa) and temperature
 //   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
 //   COMMAND_ACK      replies   ~15 bytes
+//   GPS_RAW_INT      2 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
+//   GLOBAL_POSITION_INT 2 Hz   <= 40      the position now, the height above home, velocity
+//   VFR_HUD          2 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
+//   HOME_POSITION    on request and when home changes, <= 40
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -32,6 +37,7 @@
 
 #include <stdint.h>
 
+#include "GpsFix.h"
 #include "LinAlg.h"
 #include "Text.h"
 
@@ -51,6 +57,7 @@ constexpr uint8_t kAttitudeFrame = kFrameOverhead + 28;  // trimmed only if yaws
 constexpr uint8_t kParamIdLen = 16;  // PARAM_* param_id, characters
 constexpr uint8_t kParamValueFrame = kFrameOverhead + 25;
 constexpr uint8_t kRcChannelsFrame = kFrameOverhead + 42;
+constexpr uint8_t kScaledPressureFrame = kFrameOverhead + 16;  // at most (zeros trimmed)
 
 // PARAM_VALUE param_type (MAV_PARAM_TYPE): the ones ArduPilot uses.
 constexpr uint8_t kParamTypeInt8 = 2;
@@ -76,10 +83,14 @@ enum class PlaneMode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
 // STATUSTEXT severity (MAV_SEVERITY).
 enum class Severity : uint8_t { Error = 3, Warning = 4, Notice = 5, Info = 6 };
 
-// SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR_3D_GYRO, _3D_ACCEL, _3D_MAG).
+// SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR_3D_GYRO, _3D_ACCEL, _3D_MAG,
+// _ABSOLUTE_PRESSURE, _GPS: present once a receiver has been heard, healthy with a 3D
+// fix the driver does not call a glitch).
 constexpr uint32_t kGyro3d = 1u;
 constexpr uint32_t kAccel3d = 2u;
 constexpr uint32_t kMag3d = 4u;
+constexpr uint32_t kAbsolutePressure = 8u;
+constexpr uint32_t kGps = 32u;
 
 struct Health {
     uint32_t present;  // sensor bits found at start-up (also reported as enabled)
@@ -87,6 +98,21 @@ struct Health {
 };
 // The MPU6000 is both the 3D gyro and the 3D accelerometer.
 Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok);
+// Another sensor's bits: present (and enabled) when present, healthy when also ok.
+void add_sensor(Health& h, uint32_t bits, bool present, bool ok);
+
+// GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
+struct PositionReport {
+    uint32_t time_boot_ms;
+    int32_t lat_e7, lon_e7;      // now (moved on from the fix)
+    int32_t alt_msl_mm;          // above mean sea level
+    int32_t relative_alt_mm;     // above home (0 without one)
+    float vel_ned_m_s[3];        // ground velocity
+    float heading_deg;           // the attitude's, 0..360 (declination applied); < 0: unknown
+    float airspeed_m_s;          // the pitot's, else the ground speed (VFR_HUD)
+    float climb_m_s;             // up positive
+    uint8_t throttle_pct;
+};
 
 // Packs messages; one sequence counter across all of them (a GCS counts gaps as loss).
 // Each call writes one frame into `out` and returns its length (0 only on bad input).
@@ -116,6 +142,17 @@ public:
     uint8_t rc_channels(uint8_t out[kMaxFrame], uint32_t time_boot_ms, const uint16_t width_us[8], uint8_t count);
     // SERVO_OUTPUT_RAW: the eight outputs' widths in us, port 0.
     uint8_t servo_output_raw(uint8_t out[kMaxFrame], uint32_t time_boot_us, const uint16_t width_us[8]);
+    // GPS_RAW_INT: the fix as the receiver gave it (time_usec its arrival on the board's
+    // clock; eph its hDOP x 100, epv unknown; vel and cog unknown without a fix).
+    uint8_t gps_raw_int(uint8_t out[kMaxFrame], const gps::Fix& fix);
+    uint8_t global_position_int(uint8_t out[kMaxFrame], const PositionReport& p);
+    uint8_t vfr_hud(uint8_t out[kMaxFrame], const PositionReport& p);
+    // HOME_POSITION: home (alt above mean sea level, mm); its local position x, y, z 0
+    // (there is no local frame but home's), q level, no approach vector: as ArduPilot.
+    uint8_t home_position(uint8_t out[kMaxFrame], int32_t lat_e7, int32_t lon_e7, int32_t alt_msl_mm);
+    // SCALED_PRESSURE: the barometer's absolute pressure (Pa, sent in hPa) and its
+    // temperature (degC, sent in 0.01 degC); no differential pressure (0).
+    uint8_t scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c);
     uint8_t next_sequence() const { return seq_; }
 
 private:
@@ -242,5 +279,9 @@ bool decode_command_long(const Received& rx, CommandLong& out);
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;
 constexpr uint16_t kCmdPreflightStorage = 245;
+constexpr uint16_t kCmdDoSetHome = 179;          // param1 1: here; else param5 lat, param6 lon (deg), param7 alt (m MSL)
+constexpr uint16_t kCmdGetHomePosition = 410;    // answered with HOME_POSITION (and the ACK)
+constexpr uint16_t kCmdRequestMessage = 512;     // param1 the message id: 242 HOME_POSITION here
+constexpr uint8_t kMsgHomePosition = 242;
 
 }  // namespace mav

@@ -191,7 +191,7 @@ const Row kRows[] PARAM_TABLE = {
     {"VTAIL_OUTPUT", Type::UInt8, 0, 1, 0, AT(flight.vtail_output), 0.0f, 1.0f, 0.0f,
      PARAM_DOC("V-tail output", "",
                "1: a V-tail, the left ruddervator on OUT2 and the right on OUT4, each half of the elevator and "
-               "half of the rudder command: left (elevator - rudder) / 2, right (elevator + rudder) / 2.")},
+               "half of the rudder command: left (elevator + rudder) / 2, right (elevator - rudder) / 2 (ArduPlane's: a right rudder raises the left trailing edge and lowers the right, and the nose yaws right).")},
     {"RC#_MIN", Type::UInt16, 1, kN, kEp, AT(flight.rc[0].min_us), 800.0f, 2200.0f, 1000.0f,
      PARAM_DOC("RC minimum", "us",
                "Receiver channel n's width at the stick's low end (what `rc` shows there). With RCn_TRIM and "

@@ -7,7 +7,8 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
     closed_loop.py --rc STICKS.csv [--upset T,SECONDS,NM ...] [--seconds S]
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
-        [--no-airspeed] [--gps ublox|nmea|none]
+        [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
+        [--gps ublox|nmea|none]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -16,9 +17,14 @@ The backend listens on a free UDP port, apm25sim flies it; --log is the backend'
 state, --servo-log apm25sim's measured pulses. Both processes always end: when apm25sim
 ends the backend is stopped, when the backend dies apm25sim is stopped, and after
 --timeout s of wall time (default 900) both are. --no-airspeed flies an aeroplane without
-a pitot (the backend sends no airspeed: the board's A0 reads 0 V, no sensor). --gps KIND is
-apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS). Exit status: apm25sim's, or 4 when the
-backend failed, 5 on the timeout.
+a pitot (the backend sends no airspeed: the board's A0 reads 0 V, no sensor); --airframe
+elevons or vtail flies the outputs as an elevon or V-tail aeroplane's (the backend's
+--airframe: the board is to be set to mix for it, ELEVON_OUTPUT or VTAIL_OUTPUT 1). --serial
+tcp:PORT attaches a ground station: apm25sim also serves the board's UART0 on TCP
+127.0.0.1:PORT (MAVProxy, QGroundControl, Mission Planner connect as to SITL's 5760) and
+flies in real time (--speed X for X times real time; 0 as fast as the host goes). --gps
+KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS).
+Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
 import os
@@ -67,11 +73,17 @@ def parse_args(argv):
     p.add_argument("--log", help="the backend's true state, one row a frame")
     p.add_argument("--no-airspeed", action="store_true",
                    help="the backend sends no airspeed: no pitot, the board's A0 at 0 V")
+    p.add_argument("--airframe", default="plain", choices=("plain", "elevons", "vtail"),
+                   help="the backend reads the outputs as this airframe's surfaces (default plain)")
     p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
     p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
+    p.add_argument("--serial", metavar="tcp:PORT",
+                   help="apm25sim --serial: the board's UART0 on TCP for a ground station, in real time")
+    p.add_argument("--speed", type=float, metavar="X",
+                   help="apm25sim --speed: X simulated seconds a wall second (default 1 with --serial, else 0)")
     return p.parse_args(argv)
 
 
@@ -124,6 +136,8 @@ def run(args):
         backend_cmd += ["--trajectory", args.trajectory]
     if args.no_airspeed:
         backend_cmd.append("--no-airspeed")
+    if args.airframe != "plain":
+        backend_cmd += ["--airframe", args.airframe]
     deadline = time.monotonic() + args.timeout
     backend = subprocess.Popen(backend_cmd)
     sim = None
@@ -150,6 +164,10 @@ def run(args):
             sim_cmd += ["--input", args.input]
         if args.servo_log:
             sim_cmd += ["--servo-log", args.servo_log]
+        if args.serial:
+            sim_cmd += ["--serial", args.serial]
+        if args.speed is not None:
+            sim_cmd += ["--speed", "%g" % args.speed]
         if args.gps:
             sim_cmd += ["--gps", args.gps]
         sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)

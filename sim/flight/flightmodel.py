@@ -66,6 +66,46 @@ def valid_width(width_us):
     return 800 <= width_us <= 2200
 
 
+# The airframes an autopilot may mix for (its ELEVON_OUTPUT / VTAIL_OUTPUT), flown on the
+# plain-tailed model by their geometry: each surface of a pair moves by its width's offset
+# from 1500 us, above it trailing edge up (the firmware's convention, docs/flight.md).
+#   elevons   OUT1 the left, OUT2 the right elevon. Both up pitch the nose up; the right
+#             up and the left down take lift from the right wing and give it to the left:
+#             the aeroplane rolls right. Aileron = right - left, elevator = left + right.
+#   vtail     OUT2 the left, OUT4 the right ruddervator. Both up pitch the nose up; the left
+#             up and the right down push the tail left (each surface's force is normal to
+#             it, and the V's two normals lean inward): the nose yaws right, as a rudder's
+#             trailing edge to the right does. Elevator = left + right, rudder = left - right.
+# A surface so worked out is held within full throw (+-500 us about 1500); a pair with
+# either width absent (0 or implausible) holds both surfaces it drives.
+AIRFRAMES = ("plain", "elevons", "vtail")
+
+
+def unmix(airframe, widths_us):
+    """OUT1..OUT4 of an `airframe` as the plain aeroplane's aileron, elevator, throttle and
+    rudder widths (the conventions above; more outputs are dropped)."""
+    w = list(widths_us)[:4] + [0] * max(0, 4 - len(widths_us))
+    if airframe == "plain":
+        return w
+    if airframe == "elevons":
+        pair, into = (0, 1), (0, 1)
+    elif airframe == "vtail":
+        pair, into = (1, 3), (3, 1)
+    else:
+        raise ValueError("airframe %r: one of %s" % (airframe, ", ".join(AIRFRAMES)))
+    left, right = w[pair[0]], w[pair[1]]
+    if not (valid_width(left) and valid_width(right)):
+        w[pair[0]] = w[pair[1]] = 0
+        return w
+    dl, dr = left - 1500.0, right - 1500.0
+    # into[0] takes the difference (elevons: the aileron, right - left; V-tail: the rudder,
+    # left - right), into[1] the sum (the elevator).
+    difference = dr - dl if airframe == "elevons" else dl - dr
+    w[into[0]] = 1500.0 + max(-SURFACE_THROW_US, min(SURFACE_THROW_US, difference))
+    w[into[1]] = 1500.0 + max(-SURFACE_THROW_US, min(SURFACE_THROW_US, dl + dr))
+    return w
+
+
 class Dryden:
     """Dryden gusts in body axes, driven by a seeded generator (Beard & McLain eq. 4.15-4.17)."""
 

@@ -7,7 +7,7 @@ autopilot speaks the protocol (build/apm25sim --physics json, ArduPilot SITL wit
     build/venv/bin/python sim/flight/jsbsim_backend.py [--port 9002] [--rc FILE|none]
         [--gust 0|1|2] [--seed N] [--trajectory FILE.csv[.gz]] [--log FILE.csv[.gz]]
         [--seconds S] [--airspeed 18] [--altitude 100] [--heading 0] [--upset T,SECONDS,NM ...]
-        [--vibration M_S2] [--no-airspeed]
+        [--vibration M_S2] [--no-airspeed] [--airframe plain|elevons|vtail]
 
 Lock-step: one physics frame (1 / frame_rate of the packet, in JSBSim steps of at most
 2.5 ms) per servo packet received, no wall clock, so a flight is the same every time.
@@ -17,7 +17,10 @@ wings level); outputs without pulses (width 0) hold the trim. The pilot's sticks
 hands off, sticks centred, throttle at the trim, ch5-ch8 1500; `--rc none` sends no rc
 field). --no-airspeed leaves the replies' optional airspeed out: an aeroplane without a
 pitot (apm25sim then leaves the MPXV7002DP's input A0 at 0 V, which the board reads as no
-sensor).
+sensor). --airframe elevons or vtail reads OUT1-OUT4 as an autopilot's ELEVON_OUTPUT or
+VTAIL_OUTPUT mixes them (elevons on OUT1 left and OUT2 right; ruddervators on OUT2 left and
+OUT4 right; above 1500 us trailing edge up) and flies the plain-tailed model with the
+aileron, elevator and rudder those surfaces make (flightmodel.unmix).
 The files hold --seconds of simulated time; after it the backend still answers (an
 autopilot may run a frame longer) and exits once no packet came for --linger s (default 1);
 --idle-timeout s without a packet before that stops it too.
@@ -54,6 +57,9 @@ def parse_args(argv):
                         "board starts at rest), then release it into the trimmed flight")
     p.add_argument("--no-airspeed", action="store_true",
                    help="send no airspeed in the replies (no pitot on the aeroplane; the log keeps the truth)")
+    p.add_argument("--airframe", default="plain", choices=flightmodel.AIRFRAMES,
+                   help="how the outputs drive the surfaces: plain (OUT1-4 aileron, elevator, throttle, "
+                        "rudder), elevons (OUT1 left, OUT2 right) or vtail (OUT2 left, OUT4 right ruddervator)")
     p.add_argument("--trajectory", help="write the flight as a trajectory (../shared/SIM.md)")
     p.add_argument("--log", help="write the true state, one row a frame")
     p.add_argument("--seconds", type=float, default=0.0,
@@ -135,7 +141,7 @@ class Backend:
             self.model.reset()
             self.frames = 0
             self.open_outputs()
-        self.model.set_widths(pwm[:4])
+        self.model.set_widths(flightmodel.unmix(self.args.airframe, pwm[:4]))
         crashed_before = self.model.crashed_at is not None
         self.model.step(1.0 / frame_rate)
         if self.model.crashed_at is not None and not crashed_before:

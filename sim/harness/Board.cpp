@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Board.h"
+
 #include "Hmc5883Registers.h"
+#include "Profile.h"
 
 #include <unistd.h>
 
@@ -54,6 +56,7 @@ constexpr uint16_t kGpior0 = 0x3E;  // profiling: section start
 constexpr uint16_t kGpior1 = 0x4A;  // profiling: section end
 constexpr uint8_t kMpuCsBit = 0;    // PB0, Arduino pin 53
 constexpr uint8_t kBaroCsBit = 1;   // PG1, Arduino pin 40
+constexpr uint32_t kSramStart = 0x200;  // ATmega2560: SRAM after the 512 register and I/O addresses
 constexpr int kMaxViolationsPrinted = 10;
 
 // The servo outputs as the APM 2.5 wires them (APM25.md "Flying", ArduPilot's APM2 HAL):
@@ -224,6 +227,9 @@ bool Board::init() {
     }
     // Arduino ELFs carry no .mmcu section (SIM.md): the board is fixed.
     std::strcpy(firmware.mmcu, "atmega2560");
+    // Static data (.data then .bss) from the start of SRAM: above it, the free RAM the
+    // firmware paints at start-up (lib/LinAlg/Profile.h kStackPaint), then the stack.
+    static_end_ = kSramStart + firmware.datasize + firmware.bsssize;
     firmware.frequency = kCpuHz;
 
     // simavr 1.6 prints part-init chatter on stdout: keep stdout for the firmware's bytes.
@@ -961,6 +967,17 @@ bool Board::write_profile(const std::string& path) const {
                                           ? (unsigned long long)(run_last_end_ - run_first_start_)
                                           : 0ull;
     std::fprintf(f, "run,1,%llu,%llu,%llu,%llu\n", window, window, window, window);
+    // The stack's high-water mark: the painted bytes above the static data that nothing
+    // overwrote (free), the rest of the RAM above it (used by the stack at its deepest).
+    unsigned long long free_bytes = 0, used_bytes = 0;
+    if (avr_ && static_end_ <= avr_->ramend) {
+        uint32_t a = static_end_;
+        while (a <= avr_->ramend && avr_->data[a] == profile::kStackPaint) ++a;
+        free_bytes = a - static_end_;
+        used_bytes = (unsigned long long)avr_->ramend + 1u - a;
+    }
+    std::fprintf(f, "stack_used,1,%llu,%llu,%llu,%llu\n", used_bytes, used_bytes, used_bytes, used_bytes);
+    std::fprintf(f, "stack_free,1,%llu,%llu,%llu,%llu\n", free_bytes, free_bytes, free_bytes, free_bytes);
     return std::fclose(f) == 0;
 }
 

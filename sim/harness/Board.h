@@ -242,6 +242,7 @@ private:
     uint64_t run_first_start_ = 0, run_last_end_ = 0;
     bool run_started_ = false;
     uint32_t profile_errors_ = 0;
+    uint32_t static_end_ = 0;  // the first SRAM address above .data and .bss
 };
 
 }  // namespace sim

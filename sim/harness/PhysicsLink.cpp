@@ -80,14 +80,16 @@ bool PhysicsLink::open() {
 }
 
 bool PhysicsLink::exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServoChannels], PhysicsState& state) {
-    // Whatever is waiting answers an earlier frame (a resent one answered twice): dropped,
-    // so that the answer taken is this frame's.
+    // Whatever is waiting answers an earlier send (a resent frame answered twice, or a
+    // backend that steps on every packet): dropped, so that the answer taken is this
+    // frame's. What comes later is told by its timestamp (ReplyClock).
     char buffer[65536];
-    while (recv(fd_, buffer, sizeof buffer, MSG_DONTWAIT) > 0) {
-    }
+    while (recv(fd_, buffer, sizeof buffer, MSG_DONTWAIT) > 0) ++drained_;
     const std::string packet = encode_servo_packet((uint16_t)options_.frame_rate_hz, frame_count, pwm_us);
     const double start_s = wall_clock_s();
     double sent_s = -1e9;
+    uint32_t stale = 0;  // stale replies in this wait
+    double stale_last_s = 0.0;
     for (;;) {
         if (stop_ && stop_()) {  // SIGINT/SIGTERM while the backend is silent
             stopped_ = true;
@@ -95,6 +97,22 @@ bool PhysicsLink::exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServ
             return false;
         }
         const double now_s = wall_clock_s();
+        if (now_s - start_s >= options_.give_up_s) {
+            char why[320];
+            if (stale == 0) {
+                std::snprintf(why, sizeof why, "no answer from the physics backend at %s:%d to frame %u for %.0f s",
+                              options_.host.c_str(), options_.port, (unsigned)frame_count, options_.give_up_s);
+            } else {
+                std::snprintf(why, sizeof why,
+                              "no new state from the physics backend at %s:%d for frame %u in %.0f s: %u "
+                              "replies, none after %.6f s (the last at %.6f s): its time stands still or went "
+                              "back",
+                              options_.host.c_str(), options_.port, (unsigned)frame_count, options_.give_up_s,
+                              (unsigned)stale, clock_.last_s(), stale_last_s);
+            }
+            error_ = why;
+            return false;
+        }
         if (now_s - sent_s >= options_.resend_s) {
             if (sent_s > -1e9) {
                 ++resends_;
@@ -107,13 +125,6 @@ bool PhysicsLink::exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServ
             sendto(fd_, packet.data(), packet.size(), 0, reinterpret_cast<const sockaddr*>(&address_), sizeof address_);
             sent_s = now_s;
         }
-        if (now_s - start_s >= options_.give_up_s) {
-            char why[160];
-            std::snprintf(why, sizeof why, "no answer from the physics backend at %s:%d to frame %u for %.0f s",
-                          options_.host.c_str(), options_.port, (unsigned)frame_count, options_.give_up_s);
-            error_ = why;
-            return false;
-        }
         double wait_s = sent_s + options_.resend_s - now_s;
         if (start_s + options_.give_up_s - now_s < wait_s) wait_s = start_s + options_.give_up_s - now_s;
         pollfd p{fd_, POLLIN, 0};
@@ -122,12 +133,26 @@ bool PhysicsLink::exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServ
         const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
         if (n <= 0) continue;  // e.g. ECONNREFUSED reported for an earlier send
         std::string why;
-        if (!parse_physics_state(std::string(buffer, (size_t)n), state, why)) {
+        PhysicsState reply;
+        if (!parse_physics_state(std::string(buffer, (size_t)n), reply, why)) {
             error_ = "the physics backend's answer to frame " + std::to_string(frame_count) + ": " + why;
             return false;
         }
+        if (!clock_.take(reply.timestamp_s)) {  // an earlier send's answer: wait on
+            ++stale;
+            stale_last_s = reply.timestamp_s;
+            continue;
+        }
+        state = reply;
         return true;
     }
+}
+
+std::string PhysicsLink::summary() const {
+    char text[160];
+    std::snprintf(text, sizeof text, "%u frames, %u sent again, %u late or duplicate replies dropped",
+                  (unsigned)clock_.taken(), (unsigned)resends_, (unsigned)dropped_replies());
+    return text;
 }
 
 }  // namespace sim

@@ -33,10 +33,18 @@ public:
     const std::string& error() const { return error_; }
 
     // Sends frame `frame_count` with the widths and waits for the backend's state: resends
-    // the same frame every resend_s and says so on stderr; false with error() set when no
-    // answer came within give_up_s, or the answer is not a state.
+    // the same frame every resend_s and says so on stderr. A reply that answers an earlier
+    // send (waiting before this frame is sent, or a timestamp not after the last state
+    // taken: ReplyClock) is dropped and counted, and the wait goes on. False with error()
+    // set when no new state came within give_up_s (a silent backend, or one whose time
+    // does not move or went back), or an answer is not a state.
     bool exchange(uint32_t frame_count, const uint16_t pwm_us[kSitlServoChannels], PhysicsState& state);
     uint32_t resends() const { return resends_; }
+    uint32_t frames_taken() const { return clock_.taken(); }
+    // Replies dropped: late or duplicate answers to earlier sends.
+    uint32_t dropped_replies() const { return drained_ + clock_.stale(); }
+    // "FRAMES frames, R sent again, D late or duplicate replies dropped" for the summary.
+    std::string summary() const;
     // Checked while waiting: when it says so, exchange returns false with stopped() true.
     void set_stop_check(bool (*stop)()) { stop_ = stop; }
     bool stopped() const { return stopped_; }
@@ -47,6 +55,8 @@ private:
     sockaddr_in address_{};  // the backend
     std::string error_;
     uint32_t resends_ = 0;
+    uint32_t drained_ = 0;  // replies waiting before a frame was sent
+    ReplyClock clock_;
     bool (*stop_)() = nullptr;
     bool stopped_ = false;
 };

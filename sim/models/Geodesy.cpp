@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "Wgs84.h"
+
 namespace sim {
 
 namespace {
@@ -17,13 +19,9 @@ constexpr double kIsaExponent = 5.25588;
 }  // namespace
 
 LocalFrame::LocalFrame(const GeodeticPoint& home) : home_(home) {
-    const double s = std::sin(home.lat_deg * kDegToRad);
-    const double w = 1.0 - kWgs84E2 * s * s;
-    const double r_meridian = kWgs84A_m * (1.0 - kWgs84E2) / (w * std::sqrt(w));
-    const double r_normal = kWgs84A_m / std::sqrt(w);
-    const double h = home.alt_m + kGeoidSeparation_m;
-    m_per_rad_lat_ = r_meridian + h;
-    m_per_rad_lon_ = (r_normal + h) * std::cos(home.lat_deg * kDegToRad);
+    // The board's own map (lib/Nav/Wgs84.h), in double.
+    nav::wgs84::metres_per_radian(home.lat_deg * kDegToRad, home.alt_m + kGeoidSeparation_m, m_per_rad_lat_,
+                                  m_per_rad_lon_);
 }
 
 GeodeticPoint LocalFrame::to_geodetic(const double ned_m[3]) const {

@@ -8,10 +8,11 @@
 // origin:
 //   lat = lat0 + n / (R_M + h0),  lon = lon0 + e / ((R_N + h0) cos lat0),  alt = alt0 - d
 //   R_M = a (1 - e^2) / (1 - e^2 sin^2 lat0)^1.5,  R_N = a / sqrt(1 - e^2 sin^2 lat0)
-// Within a few kilometres of the origin this is the local-level frame to millimetres in
-// latitude and longitude (the map's own error grows as distance^2 / R: 0.08 m at 1 km,
-// a property of the flat frame, which the backend shares); ECEF (NAV-SOL) from the WGS-84
-// ellipsoid exactly.
+// (the radii are lib/Nav/Wgs84.h's: the firmware's navigation uses the same map). Within
+// a few kilometres of the origin this is the local-level frame to millimetres in latitude
+// and longitude (the map's own error grows as distance^2 / R: 0.08 m at 1 km, a property
+// of the flat frame, which the backend shares); ECEF (NAV-SOL) from the WGS-84 ellipsoid
+// exactly.
 //
 // Heights: ALT_M and the backend's -d are above mean sea level (hMSL). The ellipsoid
 // height is hMSL + kGeoidSeparation_m, a constant of this model (not EGM96's value at the
@@ -22,11 +23,12 @@
 //   p = 101325 Pa (1 - 2.25577e-5 h)^5.25588,  T = 15 degC - 0.0065 h
 #pragma once
 
+#include "Wgs84.h"
+
 namespace sim {
 
-constexpr double kWgs84A_m = 6378137.0;                 // semi-major axis
-constexpr double kWgs84F = 1.0 / 298.257223563;         // flattening
-constexpr double kWgs84E2 = kWgs84F * (2.0 - kWgs84F);  // first eccentricity squared
+constexpr double kWgs84A_m = nav::wgs84::kA_m;   // semi-major axis
+constexpr double kWgs84E2 = nav::wgs84::kE2;     // first eccentricity squared
 constexpr double kGeoidSeparation_m = 10.0;             // ellipsoid height - hMSL (this model's)
 
 struct GeodeticPoint {

@@ -3,45 +3,18 @@
 
 #include <cmath>
 
+#include "Ms5611.h"
+
 namespace sim {
 
 namespace {
 
-constexpr uint8_t kCmdReset = 0x1E;
-constexpr uint8_t kCmdAdcRead = 0x00;
-constexpr uint8_t kCmdConvertD1 = 0x40;  // + 2 * OSR index
+using ms5611::kCmdAdcRead;
+using ms5611::kCmdPromRead;  // + 2 * word
+using ms5611::kCmdReset;
+constexpr uint8_t kCmdConvertD1 = 0x40;  // + 2 * OSR index (the firmware uses OSR 4096's)
 constexpr uint8_t kCmdConvertD2 = 0x50;
-constexpr uint8_t kCmdPromRead = 0xA0;   // + 2 * word
 constexpr uint32_t kMaxCode = 0xFFFFFF;  // 24-bit ADC
-
-// The compensation's intermediate values (datasheet "Pressure and temperature
-// calculation", "Second order temperature compensation"), integer arithmetic as printed.
-struct Compensation {
-    int64_t dt, temp, off, sens;
-};
-
-Compensation compensation(const uint16_t prom[8], uint32_t d2) {
-    Compensation c;
-    c.dt = (int64_t)d2 - (int64_t)prom[5] * 256;
-    c.temp = 2000 + c.dt * prom[6] / 8388608;
-    c.off = (int64_t)prom[2] * 65536 + (int64_t)prom[4] * c.dt / 128;
-    c.sens = (int64_t)prom[1] * 32768 + (int64_t)prom[3] * c.dt / 256;
-    if (c.temp < 2000) {
-        const int64_t t2 = c.dt * c.dt / 2147483648LL;
-        const int64_t low = (c.temp - 2000) * (c.temp - 2000);
-        int64_t off2 = 5 * low / 2;
-        int64_t sens2 = 5 * low / 4;
-        if (c.temp < -1500) {
-            const int64_t very_low = (c.temp + 1500) * (c.temp + 1500);
-            off2 += 7 * very_low;
-            sens2 += 11 * very_low / 2;
-        }
-        c.temp -= t2;
-        c.off -= off2;
-        c.sens -= sens2;
-    }
-    return c;
-}
 
 // The temperature the chip means by D2, in 0.01 degC without the integer rounding (the
 // inverse is searched on it, so that D2 is the code nearest the temperature).
@@ -63,24 +36,6 @@ const uint16_t Ms5611Model::kProm[8] = {0x0C4D, 40127, 36924, 23317, 23282, 3346
 Ms5611Model::Ms5611Model(const Trajectory& trajectory, const Ms5611Options& options)
     : trajectory_(trajectory), options_(options), noise_(options.seed ^ 0xBB67AE8584CAA73Bull) {}
 
-uint8_t Ms5611Model::crc4(const uint16_t prom[8]) {
-    uint16_t words[8];
-    for (int i = 0; i < 8; ++i) words[i] = prom[i];
-    words[7] = (uint16_t)(words[7] & 0xFF00);  // AN520: the CRC byte taken as 0
-    uint32_t rem = 0;
-    for (int cnt = 0; cnt < 16; ++cnt) {
-        rem ^= (cnt % 2 == 1) ? (uint32_t)(words[cnt >> 1] & 0x00FF) : (uint32_t)(words[cnt >> 1] >> 8);
-        for (int bit = 8; bit > 0; --bit) rem = (rem & 0x8000) ? (rem << 1) ^ 0x3000 : (rem << 1);
-    }
-    return (uint8_t)((rem >> 12) & 0x000F);
-}
-
-void Ms5611Model::compensate(const uint16_t prom[8], uint32_t d1, uint32_t d2, int32_t& p_pa, int32_t& temp_c100) {
-    const Compensation c = compensation(prom, d2);
-    temp_c100 = (int32_t)c.temp;
-    p_pa = (int32_t)(((int64_t)d1 * c.sens / 2097152 - c.off) / 32768);
-}
-
 void Ms5611Model::codes_for(const uint16_t prom[8], double pressure_pa, double temperature_c, uint32_t& d1,
                             uint32_t& d2) {
     // D2: TEMP grows with D2 (dT C6 / 2^23 - dT^2 / 2^31 rises for dT < 0): bisection.
@@ -94,7 +49,7 @@ void Ms5611Model::codes_for(const uint16_t prom[8], double pressure_pa, double t
     }
     d2 = (std::fabs(temperature_c100(prom, lo) - target) < std::fabs(temperature_c100(prom, hi) - target)) ? lo : hi;
     // D1: P = (D1 SENS / 2^21 - OFF) / 2^15 with the OFF and SENS this D2 gives.
-    const Compensation c = compensation(prom, d2);
+    const ms5611::Terms c = ms5611::terms(prom, d2);
     const double code = (pressure_pa * 32768.0 + (double)c.off) * 2097152.0 / (double)c.sens;
     d1 = code <= 0.0 ? 0 : code >= (double)kMaxCode ? kMaxCode : (uint32_t)std::llround(code);
 }

@@ -91,12 +91,8 @@ public:
     // One SPI byte while selected; spi_mode 0..3 (CPOL << 1 | CPHA).
     uint8_t transfer(uint8_t mosi, int spi_mode = 0);
 
-    // AN520's CRC-4 of the 8 PROM words (word 7's low 4 bits taken as 0).
-    static uint8_t crc4(const uint16_t prom[8]);
-    // The datasheet's compensation, integer arithmetic as printed: pressure in Pa and
-    // temperature in 0.01 degC from D1 and D2 with the PROM coefficients C1..C6.
-    static void compensate(const uint16_t prom[8], uint32_t d1, uint32_t d2, int32_t& p_pa, int32_t& temp_c100);
-    // The codes the chip reports for a pressure and temperature (noise-free).
+    // The codes the chip reports for a pressure and temperature (noise-free): the
+    // inverse of lib/MS5611's compensation (Ms5611Math.h), which the firmware runs.
     static void codes_for(const uint16_t prom[8], double pressure_pa, double temperature_c, uint32_t& d1, uint32_t& d2);
 
     // The truth now: pressure (Pa) and temperature (degC) at the board's height.

@@ -277,6 +277,17 @@ bool parse_physics_state(const std::string& datagram, PhysicsState& state, std::
     return true;
 }
 
+bool ReplyClock::take(double timestamp_s) {
+    if (started_ && !(timestamp_s > last_s_)) {
+        ++stale_;
+        return false;
+    }
+    started_ = true;
+    last_s_ = timestamp_s;
+    ++taken_;
+    return true;
+}
+
 TrajectorySample physics_sample(const PhysicsState& state, double t_s, const double earth_field_ned_uT[3]) {
     TrajectorySample sample;
     sample.t_s = t_s;

@@ -52,6 +52,30 @@ struct PhysicsState {
 // missing or malformed (a mandatory one, or an optional one present but wrong).
 bool parse_physics_state(const std::string& datagram, PhysicsState& state, std::string& error);
 
+// Which replies answer the frame waited for. Lock-step: frame N is sent only after a reply
+// to N - 1 was taken, so a reply whose timestamp is not after the last one taken answers
+// an earlier send: a frame sent again after a time-out and then answered twice (the
+// backend's late first answer and its answer to the resend), or a backend that answers
+// each packet twice. Such a reply is stale: dropped, counted, never taken as the next
+// frame's state. A backend whose time went back answers every send with stale replies and
+// never with a new one: the link's time-out reports it (PhysicsLink).
+class ReplyClock {
+public:
+    // True when `timestamp_s` is after the last one taken (or is the first): it becomes
+    // the last. False for a stale reply, counted.
+    bool take(double timestamp_s);
+    bool started() const { return started_; }
+    double last_s() const { return last_s_; }
+    uint32_t taken() const { return taken_; }
+    uint32_t stale() const { return stale_; }
+
+private:
+    bool started_ = false;
+    double last_s_ = 0.0;
+    uint32_t taken_ = 0;
+    uint32_t stale_ = 0;
+};
+
 // The sensor models' sample at simulated time t_s: the backend's body rates and specific
 // force, its attitude, the earth field (NED, uT) seen in the body frame, and its position
 // and velocity (NED from the origin, for the GPS and the barometer).

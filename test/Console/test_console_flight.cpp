@@ -32,13 +32,16 @@ TEST(FlightConsole, SetGetFlightShowParse) {
     EXPECT_EQ(console::parse_line("GPS").id, console::CommandId::Show);
     EXPECT_EQ(console::parse_line("gps").arg, console::kShowGps);
     EXPECT_EQ(console::parse_line("gps now").error, console::Error::ExtraArgument);
-    EXPECT_EQ(console::parse_line("rate 5").value, 5);  // the words after gps still theirs
+    EXPECT_EQ(console::parse_line("baro").id, console::CommandId::Show);
+    EXPECT_EQ(console::parse_line("BARO").arg, console::kShowBaro);
+    EXPECT_EQ(console::parse_line("baro 1").error, console::Error::ExtraArgument);
+    EXPECT_EQ(console::parse_line("rate 5").value, 5);  // the words after gps and baro keep their ids
     EXPECT_EQ(console::parse_line("rc 1").error, console::Error::ExtraArgument);
     // Through the queue, across the ring's wrap.
     console::CommandQueue q;
     for (int round = 0; round < 30; ++round) {
         for (const char* line : {"set RLL2SRV_D -0.0", "set LIM_PITCH_MIN -2000", "get RC8_TRIM", "flight stabilize",
-                                 "servo", "set RC1_MIN 3000", "params", "gps"}) {
+                                 "servo", "set RC1_MIN 3000", "params", "gps", "baro"}) {
             const console::Command in = console::parse_line(line);
             ASSERT_TRUE(q.push(in));
             const console::Command back = q.pop();

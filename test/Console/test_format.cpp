@@ -102,6 +102,14 @@ TEST(Format, WriterChains) {
     text::Writer(nullptr).str(TXT("silent")).i32(3).end();  // a null sink is a no-op
 }
 
+TEST(Format, DegreesWithSevenDecimals) {
+    std::string s;
+    const text::Sink sink{&s, sink_write};
+    text::Writer(&sink).degrees_e7(71350450).chr(' ').degrees_e7(-731194210).chr(' ').degrees_e7(-5).chr(' ')
+        .degrees_e7(1800000000).chr(' ').degrees_e7(INT32_MIN);
+    EXPECT_EQ(s, "7.1350450 -73.1194210 -0.0000005 180.0000000 -214.7483648");
+}
+
 namespace {
 
 std::string quat(float w, float x, float y, float z) {

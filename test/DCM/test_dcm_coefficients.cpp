@@ -55,6 +55,26 @@ TEST(DcmCoefficients, TheLimitsAreInTheBoardsUnits) {
     EXPECT_FALSE(float_form.hold_rate.limit2 == hold.limit2 && float_form.hold_rate.shift == hold.shift);
 }
 
+// The float form (from_settings alone: the host's float scales until set_scales) compares
+// its sums with the same limits set_scales would give at those scales: the hold rate and
+// the rest test's gyro and accelerometer deviations.
+TEST(DcmCoefficients, TheFloatFormsLimitsAreSetScalesAtTheFloatScales) {
+    const dcm::DcmSettings& s = dcm::kDefaultDcmSettings;
+    dcm::DcmCoefficients float_form;
+    float_form.from_settings(s);
+    dcm::DcmCoefficients scaled;
+    scaled.from_settings(s);
+    scaled.set_scales(s, dcm::kFloatGyroScale, dcm::kFloatAccelScale);
+    ASSERT_EQ(scaled.units_per_rad_s, float_form.units_per_rad_s);
+    ASSERT_EQ(scaled.accel_units_per_m_s2, float_form.accel_units_per_m_s2);
+    EXPECT_EQ(float_form.hold_rate.limit2, scaled.hold_rate.limit2);
+    EXPECT_EQ(float_form.hold_rate.shift, scaled.hold_rate.shift);
+    EXPECT_EQ(float_form.rest_gyro_dev.limit2, scaled.rest_gyro_dev.limit2);
+    EXPECT_EQ(float_form.rest_gyro_dev.shift, scaled.rest_gyro_dev.shift);
+    EXPECT_EQ(float_form.rest_accel_dev.limit2, scaled.rest_accel_dev.limit2);
+    EXPECT_EQ(float_form.rest_accel_dev.shift, scaled.rest_accel_dev.shift);
+}
+
 // The compass latency in steps, Q12, held within 0..5.9 steps (the wait for the next
 // step and the 16-bit turn's range).
 TEST(DcmCoefficients, MagLatencyHeldWithinItsSteps) {

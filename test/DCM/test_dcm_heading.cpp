@@ -139,7 +139,20 @@ TEST(DcmHeading, TheLearnedFieldPassesAndADisturbanceDoesNot) {
     EXPECT_EQ(g.judge(kEarthNorm * 1.05f, kEarthDown + 0.05f), dcm::FieldVerdict::kEarthField);  // within 10 %
     EXPECT_EQ(g.judge(kEarthNorm * 1.2f, kEarthDown), dcm::FieldVerdict::kDisturbed);            // strength
     EXPECT_EQ(g.judge(kEarthNorm, kEarthDown - 0.2f), dcm::FieldVerdict::kDisturbed);           // dip
+    EXPECT_EQ(g.judge(kEarthNorm * 0.8f, kEarthDown), dcm::FieldVerdict::kDisturbed);            // weaker
     EXPECT_EQ(g.judge(kEarthNorm, kEarthDown), dcm::FieldVerdict::kEarthField);
+}
+
+// The dip's test both ways. At 66 deg (down 0.914) no real field is steeper by the
+// tolerance (0.1 of the sine): a gate learned at 30 deg (down 0.5), as nearer the equator.
+TEST(DcmHeading, AFieldSteeperOrShallowerByTheDipToleranceIsADisturbance) {
+    Gate g;
+    g.gate.learn(kEarthNorm, 0.5f);
+    EXPECT_EQ(g.judge(kEarthNorm, 0.55f), dcm::FieldVerdict::kEarthField);
+    EXPECT_EQ(g.judge(kEarthNorm, 0.45f), dcm::FieldVerdict::kEarthField);
+    EXPECT_EQ(g.judge(kEarthNorm, 0.65f), dcm::FieldVerdict::kDisturbed);  // steeper
+    EXPECT_EQ(g.judge(kEarthNorm, 0.35f), dcm::FieldVerdict::kDisturbed);  // shallower
+    EXPECT_EQ(g.judge(kEarthNorm, 0.5f), dcm::FieldVerdict::kEarthField);
 }
 
 // A different field that stays the same becomes the reference after mag_recover_s,

@@ -24,8 +24,10 @@ enum class Airframe { Plain, Elevons, Vtail };
 // The surfaces' effect, degrees of an equivalent aileron and elevator, from the widths: a
 // surface command in degrees is (width - 1500) x 45 / 500 (the default end points). An
 // elevon or a ruddervator's positive command is trailing edge up: the right elevon up and
-// the left down roll right, both up pitch up; both ruddervators up pitch up, the right one
-// up and the left down yaw right.
+// the left down roll right, both up pitch up; both ruddervators up pitch up, the left one
+// up and the right down yaw right (each surface's force is normal to it: the left one's
+// up pushes the tail down and left, the right one's down pushes it up and left; the tail
+// goes left, the nose right, as under a rudder deflected right).
 struct Effect {
     float aileron_deg, elevator_deg, rudder_deg;
 };
@@ -34,7 +36,7 @@ Effect effect(Airframe a, const uint16_t out[8]) {
     switch (a) {
     case Airframe::Plain: return Effect{deg(out[0]), deg(out[1]), deg(out[3])};
     case Airframe::Elevons: return Effect{deg(out[1]) - deg(out[0]), deg(out[0]) + deg(out[1]), deg(out[3])};
-    case Airframe::Vtail: return Effect{deg(out[0]), deg(out[1]) + deg(out[3]), deg(out[3]) - deg(out[1])};
+    case Airframe::Vtail: return Effect{deg(out[0]), deg(out[1]) + deg(out[3]), deg(out[1]) - deg(out[3])};
     }
     return Effect{0, 0, 0};
 }

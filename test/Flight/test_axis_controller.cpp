@@ -387,3 +387,41 @@ TEST(AxisController, TurnGainIsGOverVInCentiDegreesHeldInRange) {
     EXPECT_EQ(flight::turn_gain_cds(1.0f, 1.0f), 32767) << "held at 16 bits";
     EXPECT_EQ(flight::turn_gain_cds(15.5f, -1.0f), 0) << "never negative";
 }
+
+TEST(AxisController, IntegratorSumsTheRateErrorSoAMatchedRateLeavesIt) {
+    // The integrator sums I TCONST dt x (demanded - measured rate), not the angle error
+    // (docs/flight.md): I 0.5, TCONST 0.5, dt 0.02 s is 0.005 a step, 328 in Q16 per cd/s.
+    // 10 deg of error demands 20 deg/s (2000 cd/s); P' = (1 - 0.25) 0.5 = 0.375, D 0.
+    const flight::AxisTerms t = flight::axis_terms(flight::AxisGains{0.5f, 1.0f, 0.5f, 0.0f, 4500}, 0.02f);
+    ASSERT_EQ(t.ki_dt_q16, 328);
+    ASSERT_EQ(t.kp_ff_q12, 1536);
+    // Already rolling at the demanded rate: no rate error, the integrator stays at 0 and the
+    // surface is the feed-forward alone, 0.375 x 20 = 7.5 deg, however long.
+    flight::AxisController matched;
+    for (int i = 0; i < 200; ++i) ASSERT_EQ(matched.step(t, 1000, 0, 2000), 750) << i;
+    EXPECT_EQ(matched.integrator_deg(), 0.0f);
+    // Faster than demanded (30 deg/s): -10 deg/s of rate error, -1000 x 328 a step; the
+    // surface has the integrator's whole centi-degrees (rounded down): -5.005 -> -6.
+    flight::AxisController fast;
+    EXPECT_EQ(fast.step(t, 1000, 0, 3000), 750 - 6);
+    for (int i = 1; i < 10; ++i) fast.step(t, 1000, 0, 3000);
+    EXPECT_EQ(fast.integrator_deg(), deg_of_q16(-10 * 1000 * 328));
+    EXPECT_EQ(fast.step(t, 1000, 0, 3000), 750 - 56) << "-55.06 cd";
+    // Rolling away at 10 deg/s: +30 deg/s of rate error, 3 x as fast the other way.
+    flight::AxisController away;
+    for (int i = 0; i < 10; ++i) away.step(t, 1000, 0, -1000);
+    EXPECT_EQ(away.integrator_deg(), deg_of_q16(10 * 3000 * 328));
+    // No angle error and no motion: nothing to sum, whatever the integrator held.
+    const float held = away.integrator_deg();
+    for (int i = 0; i < 10; ++i) EXPECT_EQ(away.step(t, 0, 0, 0), (int16_t)(10 * 3000 * 328 >> 16));
+    EXPECT_EQ(away.integrator_deg(), held);
+    // A rate offset (the turn's pitch rate) flown as measured is no error either; not
+    // flown (the nose not following the turn), it is summed as the error's own would be.
+    flight::AxisController turning, lagging;
+    for (int i = 0; i < 10; ++i) {
+        EXPECT_EQ(turning.step(t, 0, 1000, 1000), 375);
+        lagging.step(t, 0, 1000, 0);
+    }
+    EXPECT_EQ(turning.integrator_deg(), 0.0f);
+    EXPECT_EQ(lagging.integrator_deg(), deg_of_q16(10 * 1000 * 328));
+}

@@ -601,6 +601,154 @@ TEST(MavLink, ParamValueCommandAckRcChannelsServoOutputRawOnTheWire) {
     EXPECT_EQ(u8(f.payload, 20), 0u);
 }
 
+// --- The position messages (GPS_RAW_INT, GLOBAL_POSITION_INT, VFR_HUD, HOME_POSITION) ---
+
+constexpr uint8_t kExtraGpsRawInt = 24, kExtraGlobalPositionInt = 104, kExtraVfrHud = 20, kExtraHomePosition = 104;
+
+gps::Fix field_fix() {
+    gps::Fix f;
+    f.received_ms = 61234u;
+    f.lat_e7 = 71350450;
+    f.lon_e7 = -731194210;
+    f.alt_msl_mm = 1028123;
+    f.ground_speed_cm_s = 1834u;
+    f.course_e5 = 27012345;  // 270.12345 deg
+    f.h_acc_mm = 2100u;
+    f.speed_acc_cm_s = 15u;
+    f.hdop_cm = 90u;
+    f.sats = 10u;
+    f.fix = gps::FixType::k3D;
+    return f;
+}
+
+TEST(MavLinkPosition, GpsRawIntCarriesTheFix) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const uint8_t n = p.gps_raw_int(buf, field_fix());
+    const Frame f = parse(buf, n, kExtraGpsRawInt);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 24u);
+    // time_usec (u64), lat, lon, alt (i32), eph, epv, vel, cog (u16), fix_type, satellites_visible;
+    // extensions: alt_ellipsoid (i32), h_acc, v_acc, vel_acc, hdg_acc (u32), yaw (u16).
+    EXPECT_EQ(u32(f.payload, 0), 61234000u);
+    EXPECT_EQ(u32(f.payload, 4), 0u);
+    EXPECT_EQ((int32_t)u32(f.payload, 8), 71350450);
+    EXPECT_EQ((int32_t)u32(f.payload, 12), -731194210);
+    EXPECT_EQ((int32_t)u32(f.payload, 16), 1028123);
+    EXPECT_EQ(u16(f.payload, 20), 90u);
+    EXPECT_EQ(u16(f.payload, 22), 0xFFFFu) << "epv unknown";
+    EXPECT_EQ(u16(f.payload, 24), 1834u);
+    EXPECT_EQ(u16(f.payload, 26), 27012u) << "course in centi-degrees";
+    EXPECT_EQ(u8(f.payload, 28), 3u);
+    EXPECT_EQ(u8(f.payload, 29), 10u);
+    EXPECT_EQ(u32(f.payload, 34), 2100u);
+    EXPECT_EQ(u32(f.payload, 42), 150u) << "vel_acc in mm/s";
+    EXPECT_LE(n, mav::kMaxFrame);
+    // No receiver at all: fix type 0, speed, course and satellites unknown.
+    const uint8_t n0 = p.gps_raw_int(buf, gps::Fix{});
+    const Frame none = parse(buf, n0, kExtraGpsRawInt);
+    EXPECT_TRUE(none.crc_ok);
+    EXPECT_EQ(u8(none.payload, 28), 0u);
+    EXPECT_EQ(u16(none.payload, 24), 0xFFFFu);
+    EXPECT_EQ(u16(none.payload, 26), 0xFFFFu);
+    EXPECT_EQ(u8(none.payload, 29), 255u);
+}
+
+mav::PositionReport report() {
+    mav::PositionReport r{};
+    r.time_boot_ms = 61300u;
+    r.lat_e7 = 71351450;
+    r.lon_e7 = -731193210;
+    r.alt_msl_mm = 1078500;
+    r.relative_alt_mm = 50500;
+    r.vel_ned_m_s[0] = 12.0f;
+    r.vel_ned_m_s[1] = -16.0f;
+    r.vel_ned_m_s[2] = -1.5f;
+    r.heading_deg = 306.87f;
+    r.airspeed_m_s = 19.5f;
+    r.climb_m_s = 1.5f;
+    r.throttle_pct = 65u;
+    return r;
+}
+
+TEST(MavLinkPosition, GlobalPositionIntAndVfrHud) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    uint8_t n = p.global_position_int(buf, report());
+    Frame f = parse(buf, n, kExtraGlobalPositionInt);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 33u);
+    EXPECT_EQ(n, mav::kFrameOverhead + 28u);
+    // time_boot_ms, lat, lon, alt, relative_alt (i32), vx, vy, vz (i16 cm/s), hdg (u16 cdeg).
+    EXPECT_EQ(u32(f.payload, 0), 61300u);
+    EXPECT_EQ((int32_t)u32(f.payload, 4), 71351450);
+    EXPECT_EQ((int32_t)u32(f.payload, 8), -731193210);
+    EXPECT_EQ((int32_t)u32(f.payload, 12), 1078500);
+    EXPECT_EQ((int32_t)u32(f.payload, 16), 50500);
+    EXPECT_EQ((int16_t)u16(f.payload, 20), 1200);
+    EXPECT_EQ((int16_t)u16(f.payload, 22), -1600);
+    EXPECT_EQ((int16_t)u16(f.payload, 24), -150);
+    EXPECT_EQ(u16(f.payload, 26), 30687u);
+
+    n = p.vfr_hud(buf, report());
+    f = parse(buf, n, kExtraVfrHud);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 74u);
+    // airspeed, groundspeed, alt, climb (f32), heading (i16 deg), throttle (u16 %).
+    EXPECT_FLOAT_EQ(f32(f.payload, 0), 19.5f);
+    EXPECT_FLOAT_EQ(f32(f.payload, 4), 20.0f);
+    EXPECT_NEAR(f32(f.payload, 8), 1078.5f, 1e-3f);
+    EXPECT_FLOAT_EQ(f32(f.payload, 12), 1.5f);
+    EXPECT_EQ((int16_t)u16(f.payload, 16), 307);
+    EXPECT_EQ(u16(f.payload, 18), 65u);
+
+    // Out of range and unknown: velocities held at int16's limits, no NaN, heading unknown.
+    mav::PositionReport bad = report();
+    bad.vel_ned_m_s[0] = 400.0f;
+    bad.vel_ned_m_s[1] = NAN;
+    bad.vel_ned_m_s[2] = -400.0f;
+    bad.heading_deg = -1.0f;
+    n = p.global_position_int(buf, bad);
+    f = parse(buf, n, kExtraGlobalPositionInt);
+    EXPECT_EQ((int16_t)u16(f.payload, 20), 32767);
+    EXPECT_EQ((int16_t)u16(f.payload, 22), 0);
+    EXPECT_EQ((int16_t)u16(f.payload, 24), -32767);
+    EXPECT_EQ(u16(f.payload, 26), 0xFFFFu);
+    bad.heading_deg = 359.999f;  // rounds to 360.00: 0
+    n = p.global_position_int(buf, bad);
+    EXPECT_EQ(u16(parse(buf, n, kExtraGlobalPositionInt).payload, 26), 0u);
+}
+
+TEST(MavLinkPosition, HomePositionIsTrimmedToFit) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const uint8_t n = p.home_position(buf, 71350450, -731194210, 1028000);
+    const Frame f = parse(buf, n, kExtraHomePosition);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 242u);
+    // latitude, longitude, altitude (i32), x, y, z, q[4], approach x, y, z (f32), time_usec
+    // (u64): q = (1, 0, 0, 0) ends the payload after q[0].
+    EXPECT_EQ(n, mav::kFrameOverhead + 28u);
+    EXPECT_EQ((int32_t)u32(f.payload, 0), 71350450);
+    EXPECT_EQ((int32_t)u32(f.payload, 4), -731194210);
+    EXPECT_EQ((int32_t)u32(f.payload, 8), 1028000);
+    EXPECT_EQ(f32(f.payload, 24), 1.0f);
+    EXPECT_EQ(p.next_sequence(), 1u);
+}
+
+TEST(MavLinkPosition, GpsBitInSysStatus) {
+    mav::Health h = mav::health(true, true, true, true);
+    mav::add_sensor(h, mav::kGps, true, false);
+    EXPECT_EQ(h.present, 7u | 32u);
+    EXPECT_EQ(h.healthy, 7u);
+    mav::add_sensor(h, mav::kGps, true, true);
+    EXPECT_EQ(h.healthy, 7u | 32u);
+    mav::Health none = mav::health(true, true, true, true);
+    mav::add_sensor(none, mav::kGps, false, true);
+    EXPECT_EQ(none.present, 7u);
+    EXPECT_EQ(none.healthy, 7u);
+}
+
 // --- The parameter protocol over lib/Params ---------------------------------------------
 
 TEST(ParamLink, EveryIndexPacksItsNameValueTypeAndCount) {
@@ -806,6 +954,49 @@ TEST(MavLink, ParameterReferenceTableIsTheCodes) {
         params::info(i, in);
         EXPECT_EQ(covered[i], 1) << in.name << " in the reference's table " << covered[i] << " times";
     }
+}
+
+}  // namespace
+
+namespace {
+
+constexpr uint8_t kExtraScaledPressure = 115;  // common.xml's SCALED_PRESSURE
+
+TEST(MavLink, SysStatusAddsTheBarometersBits) {
+    mav::Health h = mav::health(true, true, true, true);
+    mav::add_sensor(h, mav::kAbsolutePressure, false, false);  // absent: no bit
+    EXPECT_EQ(h.present, 7u);
+    mav::add_sensor(h, mav::kAbsolutePressure, true, false);   // present, not healthy
+    EXPECT_EQ(h.present, 15u);
+    EXPECT_EQ(h.healthy, 7u);
+    mav::add_sensor(h, mav::kAbsolutePressure, true, true);
+    EXPECT_EQ(h.healthy, 15u);
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const Frame f = parse(buf, p.sys_status(buf, h, 100u, 0u), kExtraSysStatus);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(u32(f.payload, 0), 15u);  // present: gyro, accel, mag, absolute pressure (8)
+    EXPECT_EQ(u32(f.payload, 4), 15u);
+    EXPECT_EQ(u32(f.payload, 8), 15u);
+}
+
+TEST(MavLink, ScaledPressureInHectopascalAndCentidegrees) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const uint8_t n = p.scaled_pressure(buf, 123456u, 89569.0f, 8.32f);
+    const Frame f = parse(buf, n, kExtraScaledPressure);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 29u);
+    EXPECT_LE(n, mav::kScaledPressureFrame);
+    EXPECT_EQ(u32(f.payload, 0), 123456u);
+    EXPECT_FLOAT_EQ(f32(f.payload, 4), 895.69f);  // hPa
+    EXPECT_EQ(f32(f.payload, 8), 0.0f);           // no differential pressure
+    EXPECT_EQ((int16_t)u16(f.payload, 12), 832);  // 0.01 degC
+    // Out of int16's range: held at its end, never wrapped.
+    const Frame hot = parse(buf, p.scaled_pressure(buf, 0u, 1000.0f, 1e6f), kExtraScaledPressure);
+    EXPECT_EQ((int16_t)u16(hot.payload, 12), 32767);
+    const Frame cold = parse(buf, p.scaled_pressure(buf, 0u, 1000.0f, -1e6f), kExtraScaledPressure);
+    EXPECT_EQ((int16_t)u16(cold.payload, 12), -32767);
 }
 
 }  // namespace

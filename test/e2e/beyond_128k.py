@@ -319,10 +319,21 @@ def check_placement(elf, checks):
 # uptime a reply is formatted at.
 TIMING_TEXT = [(re.compile(r"load \d+%"), "load N%"), (re.compile(r"uptime [0-9.]+ s"), "uptime T s"),
                # the task table's overrun counts and longest runs (status)
-               (re.compile(r"# tasks: .*"), "# tasks: T")]
+               (re.compile(r"# tasks: .*"), "# tasks: T"),
+               # The barometer's readings: a loop task starts its conversions when the loop
+               # gets to it, so the instant each is taken (the pressure on a moving trajectory,
+               # the noise a 10 Hz mean draws) is timing; its state word is not.
+               (re.compile(r"^(# baro \w+: ).*"), r"\1readings"),
+               (re.compile(r"ground \d+ Pa \(GND_ABS_PRESS\), -?[0-9.]+ C"), "ground P Pa (GND_ABS_PRESS), T C"),
+               (re.compile(r"^# GND_ABS_PRESS [0-9.]+"), "# GND_ABS_PRESS P")]
 # MAVLink fields that are measured time: (message id, payload offset, length).
 TIMING_FIELDS = {1: [(12, 2)],   # SYS_STATUS.load
-                 36: [(0, 4)]}   # SERVO_OUTPUT_RAW.time_usec
+                 36: [(0, 4)],   # SERVO_OUTPUT_RAW.time_usec
+                 24: [(0, 8)],   # GPS_RAW_INT.time_usec: the fix's arrival on the board's clock
+                 # GLOBAL_POSITION_INT: its instant, the position moved on to it (lat, lon, alt,
+                 # relative_alt) and the attitude's heading then; the fix's velocity is compared
+                 33: [(0, 20), (26, 2)],
+                 74: [(8, 10)]}  # VFR_HUD: the barometer's height and climb, the heading, at its instant
 # Receiver widths, in us, and what follows from them. simavr applies a pin edge at the end of
 # the instruction running when it is due, so Timer5's capture (0.5 us a count) of the same
 # edge may read one count apart when other instructions run (on the chip it is cycle-exact):
@@ -340,7 +351,23 @@ WIDTH_FIELDS = {65: (4, 18, RC_TOLERANCE_US),       # RC_CHANNELS chan1..18_raw
 KEYED_MESSAGES = (30,)  # ATTITUDE
 # Messages sent when a loop pass finds their period over: the millisecond they are stamped
 # with is timing; matched in order, their stamps within this many ms.
-ORDERED_MESSAGES = {65: 5}  # RC_CHANNELS (5 Hz)
+ORDERED_MESSAGES = {65: 5,  # RC_CHANNELS (5 Hz)
+                    29: 5}  # SCALED_PRESSURE (with them)
+# The barometer's pressure and temperature are timing too (TIMING_TEXT): SCALED_PRESSURE's
+# within 0.1 hPa (a conversion's noise) and 0.02 degC.
+BARO_TOLERANCE_HPA = 0.1
+BARO_TOLERANCE_CDEG = 2
+
+
+def scaled_pressure_close(p, q):
+    full = lambda b: bytes(b) + bytes(16 - len(b))  # trailing zeros trimmed
+    a, b = struct.unpack("<Iffhh", full(p)), struct.unpack("<Iffhh", full(q))
+    return a[0] == b[0] and abs(a[1] - b[1]) <= BARO_TOLERANCE_HPA and a[2] == b[2] and \
+        abs(a[3] - b[3]) <= BARO_TOLERANCE_CDEG and a[4] == b[4]
+
+
+# Payload comparisons other than equality, for ORDERED_MESSAGES (their stamps zeroed).
+CLOSE = {29: scaled_pressure_close}
 
 
 def split_stream(data):
@@ -385,6 +412,8 @@ def streams(data):
             p = bytearray(payload)
             for off, n in TIMING_FIELDS.get(msgid, []):
                 p[off:off + n] = b"\0" * min(n, max(0, len(p) - off))
+            if msgid == 22 and bytes(p[8:21]) == b"GND_ABS_PRESS":  # PARAM_VALUE: the barometer's reading
+                p[0:4] = b"\0" * 4
             kinds.setdefault("MAVLink %d" % msgid, []).append(bytes(p))
     return kinds
 
@@ -431,8 +460,8 @@ def compare_kind(kind, x, y):
             return "%d vs %d frames" % (len(x), len(y))
         stamp = lambda p: struct.unpack_from("<I", p, 0)[0]
         for i, (p, q) in enumerate(zip(x, y)):
-            if abs(stamp(p) - stamp(q)) > ORDERED_MESSAGES[msgid] or \
-                    not widths_close(msgid, bytes(4) + p[4:], bytes(4) + q[4:]):
+            close = CLOSE.get(msgid) or (lambda a, b: widths_close(msgid, a, b))
+            if abs(stamp(p) - stamp(q)) > ORDERED_MESSAGES[msgid] or not close(bytes(4) + p[4:], bytes(4) + q[4:]):
                 return "frame %d differs: %r vs %r" % (i, p, q)
         return None
     if kind == "plot lines":  # from the start to the switch to another mode: one more or less

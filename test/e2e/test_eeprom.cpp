@@ -384,7 +384,7 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfASettingsSave) {
         sweep("sweep_settings", e2e::scenario_csv("rest", 2.0), 2.0, "rate 40\r\ndecl -3\r\nmode csv\r\nsave\r\n", 1.4,
               {{slots::slot_address(0), slot_of(encoded(numbered_settings(1, false)), 7)},
                {slots::slot_address(1), slot_of(encoded(numbered_settings(2, true)), 8)}},
-              1.35, 1.8);
+              1.35, 1.85);
     // The slot's changed bytes at 3.4 ms each.
     EXPECT_GE(r.cuts_during_save, 100);
     EXPECT_GT(r.old_boots, 0);

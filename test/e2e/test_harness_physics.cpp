@@ -5,6 +5,7 @@
 // the measured servo widths go out in the packets, the backend's `rc` comes in as PPM, a
 // silent backend is said and given up on, and two runs are the same bytes.
 #include <map>
+#include <regex>
 
 #include "harness_live.h"
 
@@ -196,6 +197,94 @@ TEST(HarnessPhysics, ASilentOrConfusedBackendStopsTheRunWithAReason) {
         EXPECT_EQ(run.result.exit_code, 4) << e2e::dump(run);
         EXPECT_NE(run.result.err.find("answer to frame 11: not a JSON object"), std::string::npos) << run.result.err;
     }
+}
+
+// The count in the summary line "apm25sim: physics backend at ...: F frames, R sent again,
+// D late or duplicate replies dropped" (-1 when there is none).
+long summary_count(const std::string& err, const std::string& what) {
+    const std::regex re("physics backend at [^:]+:[0-9]+: ([0-9]+) frames, ([0-9]+) sent again, ([0-9]+) late or "
+                        "duplicate replies dropped");
+    std::smatch m;
+    if (!std::regex_search(err, m, re)) return -1;
+    const int group = what == "frames" ? 1 : what == "sent again" ? 2 : 3;
+    return std::atol(m[group].str().c_str());
+}
+
+// Issue 46's race on a loaded machine, made deterministic by the backend: frame 1500 is
+// answered only after apm25sim's 1 s time-out sent it again, and the answer to that resend
+// (the same state) arrives while apm25sim waits for frame 1501. A backend answering every
+// packet twice is the same race at every frame. Neither stops the run: the stale replies
+// are dropped and counted, and the board sees exactly the states of an undisturbed run
+// (lock-step: the same bytes, stamped).
+TEST(HarnessPhysics, ALateOrDuplicateReplyIsDroppedAndCounted) {
+    E2E_REQUIRE_TOOLS("apm25sim", "firmware.elf");
+    const double seconds = 2.5;
+    std::string clean;
+    {
+        Backend backend;
+        ASSERT_TRUE(backend.start({"--attitude", "5,3,200"})) << backend.process.text;
+        const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, seconds);
+        ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+        clean = run.result.out;
+        // Every frame once; a frame sent again on a loaded machine (none when idle) is
+        // answered twice, and one of the two answers dropped.
+        EXPECT_EQ(summary_count(run.result.err, "frames"), 2501) << run.result.err;
+        EXPECT_GE(summary_count(run.result.err, "sent again"), 0) << run.result.err;
+        EXPECT_EQ(summary_count(run.result.err, "dropped"), summary_count(run.result.err, "sent again"))
+            << run.result.err;
+    }
+    EXPECT_GT(clean.size(), 500u);
+    {
+        Backend backend;
+        ASSERT_TRUE(backend.start({"--attitude", "5,3,200", "--late", "1500"})) << backend.process.text;
+        const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, seconds);
+        EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+        EXPECT_NE(run.result.err.find("has not answered frame 1500"), std::string::npos) << run.result.err;
+        EXPECT_EQ(run.result.err.find("is not after"), std::string::npos) << run.result.err;
+        EXPECT_EQ(summary_count(run.result.err, "frames"), 2501) << run.result.err;
+        EXPECT_GE(summary_count(run.result.err, "sent again"), 1) << run.result.err;  // 1 on an idle machine
+        EXPECT_EQ(summary_count(run.result.err, "dropped"), summary_count(run.result.err, "sent again"))
+            << run.result.err;
+        EXPECT_TRUE(run.result.out == clean) << "the serial output differs from the undisturbed run's";
+        const std::vector<std::vector<long>> sent = packets(backend.log);
+        ASSERT_GE(sent.size(), 2502u);  // frame 1500 twice
+        EXPECT_EQ(sent[1500][1], 1500);
+        EXPECT_EQ(sent[1501][1], 1500);
+    }
+    {
+        Backend backend;
+        ASSERT_TRUE(backend.start({"--attitude", "5,3,200", "--twice"})) << backend.process.text;
+        const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, seconds);
+        EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+        EXPECT_EQ(summary_count(run.result.err, "frames"), 2501) << run.result.err;
+        // Every frame's second answer but the last frame's, read before the run ended (and
+        // both answers to a frame sent again on a loaded machine).
+        EXPECT_EQ(summary_count(run.result.err, "dropped"), 2500 + 2 * summary_count(run.result.err, "sent again"))
+            << run.result.err;
+        EXPECT_TRUE(run.result.out == clean) << "the serial output differs from the undisturbed run's";
+    }
+}
+
+// A backend whose time went back (restarted under the same port) answers every send, but
+// never with a state after the last one: a genuine failure, not a late reply. The frame is
+// sent again every second, and after --physics-timeout the run stops with exit status 4,
+// saying so.
+TEST(HarnessPhysics, ABackendWhoseTimeWentBackStopsTheRun) {
+    E2E_REQUIRE_TOOLS("apm25sim", "firmware.elf");
+    Backend backend;
+    ASSERT_TRUE(backend.start({"--time-back-after", "200"})) << backend.process.text;
+    const e2e::SimRun run = run_physics(e2e::firmware_elf(), backend, 5.0, "--physics-timeout 3");
+    EXPECT_EQ(run.result.exit_code, 4) << e2e::dump(run);
+    EXPECT_NE(run.result.err.find("has not answered frame 201"), std::string::npos) << run.result.err;
+    EXPECT_NE(run.result.err.find("no new state from the physics backend at 127.0.0.1:" + backend.port +
+                                  " for frame 201"),
+              std::string::npos)
+        << run.result.err;
+    EXPECT_NE(run.result.err.find("its time stands still or went back"), std::string::npos) << run.result.err;
+    EXPECT_EQ(summary_count(run.result.err, "frames"), 201) << run.result.err;
+    EXPECT_GE(summary_count(run.result.err, "dropped"), 3) << run.result.err;  // the send and its resends
+    // The board stopped at the last new state (frame 200, 0.2 s), never ran on a stale one.
+    EXPECT_NE(run.result.err.find("stopping at t=0.200000 s"), std::string::npos) << run.result.err;
 }
 
 // Lock-step: the same backend twice gives the same bytes on the serial line.

@@ -3,9 +3,13 @@
 // from a stick script (--rc) and every servo pulse is measured from OUT1-OUT8's pin edges
 // (--servo-log). Defaults: MANUAL with the mode switch (channel 8) low, STABILIZE high;
 // end points 1000-2000 us around 1500; THR_FS_OUT 0 (OUT3 at 1000 us in failsafe).
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
+#include <vector>
 
 #include "e2e_support.h"
 
@@ -295,4 +299,126 @@ TEST(Flight, SixtySecondsOfChangingCommandsWithoutAGlitch) {
     }
     EXPECT_GT(checked, 7u * 2900u);
     EXPECT_EQ(glitches, 0u);
+}
+
+// --- The body rates reach the controllers (firmware/FlightIo: gyro counts less the bias) --
+
+namespace {
+
+// A level, north-facing board that rolls or pitches (never both at once) through the
+// piecewise-linear (t, roll, pitch) points, degrees, at 100 Hz for `seconds`: body rates
+// p = roll rate (pitch 0), q = pitch rate (roll 0), read by a gyro with a constant bias
+// (deg/s, x and y); specific force and field rotated by R = Ry(pitch) Rx(roll).
+std::string roll_pitch_trajectory(const std::string& name, double seconds,
+                                  const std::vector<std::array<double, 3>>& points, double bias_x_deg_s,
+                                  double bias_y_deg_s) {
+    const double g = 9.80665, d2r = M_PI / 180.0;
+    std::string s = "t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz\n";
+    char buf[320];
+    for (int i = 0; i <= (int)(seconds * 100.0); ++i) {
+        const double t = i * 0.01;
+        double roll = points.back()[1], pitch = points.back()[2], p = 0.0, q = 0.0;
+        for (size_t k = 0; k + 1 < points.size(); ++k) {
+            const auto& a = points[k];
+            const auto& b = points[k + 1];
+            if (t >= a[0] && t < b[0]) {
+                const double f = (t - a[0]) / (b[0] - a[0]);
+                roll = a[1] + f * (b[1] - a[1]);
+                pitch = a[2] + f * (b[2] - a[2]);
+                p = (b[1] - a[1]) / (b[0] - a[0]);
+                q = (b[2] - a[2]) / (b[0] - a[0]);
+                break;
+            }
+        }
+        if (t < points.front()[0]) roll = points.front()[1], pitch = points.front()[2], p = q = 0.0;
+        const double cr = std::cos(roll * d2r), sr = std::sin(roll * d2r), cp = std::cos(pitch * d2r),
+                     sp = std::sin(pitch * d2r);
+        const double mx = 20.0 * cp - 45.0 * sp, mz0 = 20.0 * sp + 45.0 * cp;
+        const double hr = roll * d2r / 2.0, hp = pitch * d2r / 2.0;
+        std::snprintf(buf, sizeof buf, "%.2f,%.6f,%.6f,0,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.7f,%.7f,%.7f,%.7f\n", t,
+                      (p + bias_x_deg_s) * d2r, (q + bias_y_deg_s) * d2r, g * sp, -g * cp * sr, -g * cp * cr, mx, sr * mz0, cr * mz0,
+                      std::cos(hp) * std::cos(hr), std::cos(hp) * std::sin(hr), std::sin(hp) * std::cos(hr),
+                      -std::sin(hp) * std::sin(hr));
+        s += buf;
+    }
+    return e2e::write_work_file(name + "_" + std::to_string(getpid()) + ".csv", s);
+}
+
+}  // namespace
+
+// STABILIZE, wings level and nose level asked, no integrator (RLL2SRV_I and PTCH2SRV_I 0),
+// D at 0.2 on both axes (its maximum: the rate's part large beside the angle's): the board
+// rolls right to 20 deg at 40 deg/s and back, then pitches up to 20 deg and back, its gyro
+// biased by 2 and -1.5 deg/s on x and y (the start's calibration learns them). Every
+// aileron and elevator pulse in the motion is the controller's equation (docs/flight.md)
+// on the board's own angle and the motion's body rate, the bias taken out:
+//   surface = P' w_d + D (w_d - w),  w_d = -angle / TCONST,  P' = P TCONST - D = 0.3,
+// at 100 cd of surface per 1.11 us (500 us for 4500 cd). The rate's part is D x 40 deg/s =
+// 8 deg of surface, 89 us: a rate with the wrong sign, scale or axis is 89 us or more off,
+// a bias left in or added twice 3 to 9 us. The angle is the board's angle line in the 20 ms
+// before the pulse (at 50 Hz the step takes the angles the line has just printed, and the
+// pulse starts at the period after it). Within 2 us: the width's rounding to 1 us, the
+// line's 0.01 deg, the servo log's 0.3 us.
+TEST(Flight, StabilizeDampsTheBodyRatesItMeasures) {
+    E2E_REQUIRE_TOOLS("apm25sim");
+    const double seconds = 10.0;
+    // (t, roll, pitch): still 4 s (the gyro calibration, the estimator's start), then each
+    // leg 0.5 s at 40 deg/s, 0.7 s of hold between.
+    const std::vector<std::array<double, 3>> points = {{4.0, 0, 0},  {4.5, 20, 0}, {5.2, 20, 0}, {5.7, 0, 0},
+                                                       {6.5, 0, 0},  {7.0, 0, 20}, {7.7, 0, 20}, {8.2, 0, 0}};
+    const std::string traj = roll_pitch_trajectory("rates", seconds, points, 2.0, -1.5);
+    ASSERT_FALSE(traj.empty());
+    const std::string input = e2e::input_file("rates", "set RLL2SRV_I 0\nset PTCH2SRV_I 0\nset RLL2SRV_D 0.2\n"
+                                                       "set PTCH2SRV_D 0.2\n");
+    RcScript rc;
+    rc.add(0.5, {1500, 1500, 1100, 1500, 1500, 1500, 1500, 1000});  // MANUAL
+    rc.add(2.5, {1500, 1500, 1100, 1500, 1500, 1500, 1500, 2000});  // STABILIZE
+    const FlightRun r = fly("rates", traj, seconds, rc, "--input " + input + " --input-at 2");
+    ASSERT_EQ(r.sim.result.exit_code, 0) << e2e::dump(r.sim);
+    for (const char* said : {"# RLL2SRV_I 0", "# PTCH2SRV_I 0", "# RLL2SRV_D 0.2", "# PTCH2SRV_D 0.2"})
+        ASSERT_NE(first_line(r.sim.lines, said), nullptr) << said << "\n" << e2e::dump(r.sim);
+    ASSERT_NE(first_line(r.sim.lines, "# flight STABILIZE", 2.5), nullptr) << e2e::dump(r.sim);
+    const e2e::Line* bias = first_line(r.sim.lines, "# gyro bias: ");
+    ASSERT_NE(bias, nullptr) << e2e::dump(r.sim);
+    double bx = NAN, by = NAN;
+    ASSERT_EQ(std::sscanf(bias->text.c_str(), "# gyro bias: %lf %lf", &bx, &by), 2) << bias->text;
+    EXPECT_NEAR(bx, 2.0, 0.05) << bias->text;  // to the gyro's counts (16.4 a deg/s)
+    EXPECT_NEAR(by, -1.5, 0.05) << bias->text;
+    expect_steady_and_within_limits(r.pulses, seconds);
+    // One leg: output `out`, the angle (roll or pitch) of the board's lines, the rate.
+    struct Leg {
+        double t0, t1;
+        int out;
+        bool roll;
+        double rate_deg_s;
+    };
+    const Leg legs[4] = {{4.0, 4.5, 1, true, 40.0}, {5.2, 5.7, 1, true, -40.0}, {6.5, 7.0, 2, false, 40.0},
+                         {7.7, 8.2, 2, false, -40.0}};
+    const double tau = 0.5, p_ff = 0.3, d = 0.2, us_per_deg = 500.0 / 45.0, kEquation_us = 2.0;
+    auto expected_us = [&](double angle_deg, double rate_deg_s) {
+        const double w_d = -angle_deg / tau;
+        return 1500.0 + us_per_deg * (p_ff * w_d + d * (w_d - rate_deg_s));
+    };
+    for (const Leg& leg : legs) {
+        int checked = 0;
+        double worst = 0.0;
+        // From 0.06 s into the leg (the gyro's low-pass settled) to its end.
+        for (const Pulse& p : r.pulses) {
+            if (p.out != leg.out || p.t_s < leg.t0 + 0.06 || p.t_s > leg.t1) continue;
+            const e2e::Line* line = nullptr;
+            int lines = 0;
+            for (const e2e::Line& l : r.sim.lines)
+                if (l.is_angle && l.t_s >= p.t_s - 0.020 && l.t_s < p.t_s) line = &l, ++lines;
+            ASSERT_EQ(lines, 1) << "angle lines in the 20 ms before the pulse at " << p.t_s;
+            const double want = expected_us(leg.roll ? line->roll : line->pitch, leg.rate_deg_s);
+            const double off = std::fabs(p.width_us - want);
+            worst = std::max(worst, off);
+            EXPECT_LE(off, kEquation_us) << "OUT" << leg.out << " at " << p.t_s << ": " << p.width_us
+                                         << " us, the equation " << want << " (" << line->text << ")";
+            ++checked;
+        }
+        EXPECT_GE(checked, 20) << "leg from " << leg.t0;
+        std::printf("rates: OUT%d, %+.0f deg/s from %.1f s: %d pulses, at most %.2f us from the equation\n", leg.out,
+                    leg.rate_deg_s, leg.t0, checked, worst);
+    }
 }

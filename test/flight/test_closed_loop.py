@@ -59,6 +59,17 @@ GROUP is one of:
                   the worst roll error in flight under 1 deg (DIR/turn_gps_bank.csv), against the
                   same flight with `--gps none` (printed)
   determinism     the same flight twice: the same bytes on the serial line and the servo log
+  elevons         ELEVON_OUTPUT 1 (typed on the console), the backend's --airframe elevons
+                  (the aeroplane flown by the elevons' geometry, not by the firmware's
+                  formulas), light gusts: on the launcher in MANUAL, OUT1-OUT4 are the sticks'
+                  mix within 1.3 us; then STABILIZE: the upset within 10 deg of level in
+                  <= 3 s and within 5 deg after, a 30 deg bank held within 8 deg, level within
+                  8 deg 5 s after the roll-out, |pitch| <= 10 deg, under 20 m of height lost
+  vtail           VTAIL_OUTPUT 1, the backend's --airframe vtail, light gusts: the MANUAL
+                  outputs as for elevons; in STABILIZE 30 % of right rudder for 3 s yaws the
+                  nose right (> 2 deg/s on average, the heading > 5 deg right), 10 deg of
+                  pitch held within 3 deg from 5 s into it, the bank within 15 deg, level
+                  again within 5 deg of pitch, above 80 m
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
 import argparse
@@ -115,10 +126,11 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=(), hold=HOLD_S, gps=None):
+                 console=(), hold=HOLD_S, airframe="plain", gps=None):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
-        board (apm25sim --input: from its first angle line); gps: apm25sim --gps (None: its
-        default)."""
+        board (apm25sim --input: from its first angle line); airframe: how the backend reads
+        the outputs (closed_loop.py --airframe: plain, elevons, vtail); gps: apm25sim --gps
+        (None: its default)."""
         self.name, self.seconds = name, seconds
         base = os.path.join(work, name)
         self.rc = write_rc(base + "_rc.csv", rows)
@@ -132,6 +144,8 @@ class Flight:
             cmd += ["--upset", u]
         if not airspeed:
             cmd.append("--no-airspeed")
+        if airframe != "plain":
+            cmd += ["--airframe", airframe]
         if gps:
             cmd += ["--gps", gps]
         if console:
@@ -546,11 +560,151 @@ def check_determinism(args):
     soft_assert(servo[0] == servo[1], "determinism: the same flight gave different servo pulses")
 
 
+def check_mixed_outputs(f, name, rows, start, end, outputs):
+    """MANUAL through a mixer: every pulse of `outputs` (OUT numbers) from 0.1 s after a
+    stick row (a PPM frame and an output period) to the next row, within [start, end), is the
+    row's `expect(widths)[out]` within FOLLOW_US. Returns the worst difference."""
+    worst, n = 0.0, 0
+    for i, (t0, widths, expect) in enumerate(rows):
+        t1 = rows[i + 1][0] if i + 1 < len(rows) else end
+        want = expect(widths)
+        lo, hi = max(t0, start) + 0.1, min(t1, end)
+        for t, out, w in f.pulses:
+            if out in outputs and lo <= t < hi:
+                worst = max(worst, abs(w - want[out]))
+                n += 1
+        soft_assert(n > 0 and hi > lo, "%s: no pulses on OUT%s in %.1f-%.1f s" % (name, outputs, lo, hi))
+    soft_assert(worst <= FOLLOW_US, "%s: a mixed output %.2f us from the sticks' mix (at most %.1f)"
+                % (name, worst, FOLLOW_US))
+    return worst
+
+
+def said_set(f, name, setting):
+    """The board took `set SETTING 1` before MIX_CHECK_S (its echo '# SETTING 1')."""
+    said = f.said("# %s" % setting)
+    soft_assert(said is not None and said[1] == "# %s 1" % setting and said[0] < MIX_CHECK_S,
+                "%s: %s 1 not set before %.1f s: %r" % (name, setting, MIX_CHECK_S, said))
+
+
+# The mixers' stick checks run while the aeroplane stands on the launcher (closed_loop.py
+# --hold), after the console's `set` (from the first angle line, ~1.4 s): MANUAL, two stick
+# positions, each its own mix of the commands; the default end points make a command of
+# 4500 cd 500 us, so each ruddervator or elevon moves half of each stick's offset.
+MIX_CHECK_S = 1.6
+
+
+def check_elevons(args):
+    """ELEVON_OUTPUT 1 on the backend's elevon airframe (OUT1 left, OUT2 right elevon,
+    above trim trailing edge up: aileron = right - left, elevator = left + right)."""
+    name, h = "elevons", HOLD_S
+    t_turn, t_out = h + 8.0, h + 20.0
+    seconds = h + 26.0
+
+    def mix(w):  # docs/flight.md: left (elevator - aileron) / 2, right (elevator + aileron) / 2
+        a, e = w[0] - 1500, w[1] - 1500
+        return {1: 1500 + (e - a) / 2.0, 2: 1500 + (e + a) / 2.0, 3: w[2], 4: w[3]}
+
+    checks = [(MIX_CHECK_S, (1700, 1400, 1000, 1560, 1500, 1500, 1500, MANUAL), mix),
+              (MIX_CHECK_S + 0.6, (1250, 1650, 1000, 1440, 1500, 1500, 1500, MANUAL), mix)]
+    rows = [row(0.0, mode=MANUAL, throttle=1000)] + [(t, w) for t, w, _ in checks] + [
+        row(h - 0.1), row(t_turn, stick_for_bank(30), throttle=THROTTLE_US + 40), row(t_out)]
+    f = Flight(args.work, name, rows, seconds, gust=1, upsets=[UPSET], tools=args.tools, seed=4405,
+               console=["set ELEVON_OUTPUT 1"], airframe="elevons")
+    said_set(f, name, "ELEVON_OUTPUT")
+    worst_us = check_mixed_outputs(f, name, checks, MIX_CHECK_S, h - 0.1, (1, 2, 3, 4))
+    fly_stabilized(f, name, t_turn, t_out, seconds, worst_us, bank=30.0)
+
+
+def check_vtail(args):
+    """VTAIL_OUTPUT 1 on the backend's V-tail airframe (OUT2 left, OUT4 right ruddervator,
+    above trim trailing edge up: elevator = left + right, rudder = left - right)."""
+    name, h = "vtail", HOLD_S
+    t_rudder, t_pitch, t_level = h + 2.0, h + 5.0, h + 17.0
+    seconds = h + 22.0
+
+    def mix(w):  # docs/flight.md: left (elevator + rudder) / 2, right (elevator - rudder) / 2
+        e, r = w[1] - 1500, w[3] - 1500
+        return {1: w[0], 2: 1500 + (e + r) / 2.0, 3: w[2], 4: 1500 + (e - r) / 2.0}
+
+    checks = [(MIX_CHECK_S, (1600, 1400, 1000, 1700, 1500, 1500, 1500, MANUAL), mix),
+              (MIX_CHECK_S + 0.6, (1450, 1650, 1000, 1250, 1500, 1500, 1500, MANUAL), mix)]
+    pitch_stick = round(1500 + 500 * 10.0 / 25.0)  # LIM_PITCH_MAX 2500: full stick is 25 deg
+    rows = [row(0.0, mode=MANUAL, throttle=1000)] + [(t, w) for t, w, _ in checks] + [
+        row(h - 0.1), row(t_rudder, yaw=1650), row(t_pitch, pitch=pitch_stick, throttle=1300), row(t_level)]
+    f = Flight(args.work, name, rows, seconds, gust=1, tools=args.tools, seed=4406,
+               console=["set VTAIL_OUTPUT 1"], airframe="vtail")
+    said_set(f, name, "VTAIL_OUTPUT")
+    worst_us = check_mixed_outputs(f, name, checks, MIX_CHECK_S, h - 0.1, (1, 2, 3, 4))
+    # 30 % of the rudder stick for 3 s in STABILIZE (the rudder passes through, the ailerons
+    # hold the wings level): the nose yaws right, and the heading follows.
+    start, yawing = f.truth_at(t_rudder), f.truth_between(t_rudder + 0.5, t_pitch)
+    end = f.truth_at(t_pitch)
+    soft_assert(start is not None and end is not None and len(yawing) > 1000, "vtail: no true state")
+    if start is None or end is None or len(yawing) <= 1000:
+        return
+    r_mean = sum(r["r_deg_s"] for r in yawing) / len(yawing)
+    turned = angle_diff(end["yaw_deg"], start["yaw_deg"])
+    # 10 deg of pitch for 12 s (the elevator through both ruddervators): held within 3 deg
+    # from 5 s on; then level, and the aeroplane high all along.
+    held = f.truth_between(t_pitch + 5.0, t_level)
+    lo = min((r["pitch_deg"] for r in held), default=float("nan"))
+    hi = max((r["pitch_deg"] for r in held), default=float("nan"))
+    roll = max((abs(r["roll_deg"]) for r in f.truth_between(t_rudder, seconds)), default=float("nan"))
+    level = f.truth_between(t_level + 3.0, seconds)
+    level_pitch = max((abs(r["pitch_deg"]) for r in level), default=float("nan"))
+    height = [-r["down_m"] for r in f.truth_between(h, seconds)]
+    print("vtail: MANUAL outputs within %.2f us of the mix; rudder stick 1650 us for 3 s in STABILIZE: yaw rate "
+          "%+.1f deg/s on average, heading %+.1f deg; 10 deg of pitch asked: true %.1f-%.1f deg from 5 s; "
+          "|bank| <= %.1f deg; |pitch| <= %.1f deg level again; height %.0f-%.0f m"
+          % (worst_us, r_mean, turned, lo, hi, roll, level_pitch, min(height), max(height)))
+    soft_assert(r_mean > 2.0 and turned > 5.0, "vtail: the rudder stick right yawed %+.1f deg/s, heading %+.1f deg "
+                "(want right)" % (r_mean, turned))
+    soft_assert(held and lo >= 7.0 and hi <= 13.0, "vtail: pitch %.1f-%.1f deg, not within 3 of 10" % (lo, hi))
+    soft_assert(roll <= 15.0, "vtail: the bank reached %.1f deg (at most 15)" % roll)
+    soft_assert(level and level_pitch <= 5.0, "vtail: pitch %.1f deg after levelling (at most 5)" % level_pitch)
+    soft_assert(min(height) > 80.0, "vtail: down to %.0f m" % min(height))
+
+
+def fly_stabilized(f, name, t_turn, t_out, seconds, worst_us, bank):
+    """STABILIZE through the mixer: the upset (UPSET) recovered to within 10 deg of level
+    in 3 s, the wings and the nose within 5 deg of level until the turn, the turn's bank
+    within 8 deg of `bank` from 5 s into it, level again (within 8 deg) 5 s after the roll-out,
+    the pitch within 10 deg throughout and the height lost under 20 m."""
+    t_up = upset_start()
+    after = f.truth_between(t_up, seconds)
+    soft_assert(len(after) > 1000, "%s: no true state after the upset" % name)
+    if len(after) <= 1000:
+        return
+    peak = max(abs(r["roll_deg"]) for r in f.truth_between(t_up, t_turn))
+    last_out = max((r["t"] for r in f.truth_between(t_up, t_turn) if abs(r["roll_deg"]) >= 10.0), default=t_up)
+    calm = f.truth_between(t_up + 3.0, t_turn)
+    calm_roll = max((abs(r["roll_deg"]) for r in calm), default=float("nan"))
+    turn = [r["roll_deg"] for r in f.truth_between(t_turn + 5.0, t_out)]
+    out = [abs(r["roll_deg"]) for r in f.truth_between(t_out + 5.0, seconds)]
+    pitch = max(abs(r["pitch_deg"]) for r in f.truth_between(HOLD_S, seconds))
+    h0 = -f.truth_at(HOLD_S)["down_m"]
+    lost = h0 - min(-r["down_m"] for r in f.truth_between(HOLD_S, seconds))
+    print("%s: MANUAL outputs within %.2f us of the mix; the upset peaks at %.1f deg of bank, within 10 deg for "
+          "good %.2f s after it began, then |bank| <= %.1f deg; %g deg asked: %.1f-%.1f deg from 5 s; |bank| <= %.1f "
+          "deg 5 s after the roll-out; |pitch| <= %.1f deg; height lost %.1f m"
+          % (name, worst_us, peak, last_out - t_up, calm_roll, bank, min(turn, default=float("nan")),
+             max(turn, default=float("nan")), max(out, default=float("nan")), pitch, lost))
+    soft_assert(peak > 15.0, "%s: the upset banked only %.1f deg" % (name, peak))
+    soft_assert(last_out - t_up <= 3.0, "%s: %.2f s to stay within 10 deg of level (at most 3)" % (name, last_out - t_up))
+    soft_assert(calm and calm_roll <= 5.0, "%s: bank %.1f deg after the upset (at most 5)" % (name, calm_roll))
+    soft_assert(turn and bank - 8.0 <= min(turn) and max(turn) <= bank + 8.0,
+                "%s: the bank left %g +- 8 deg in the turn" % (name, bank))
+    soft_assert(out and max(out) <= 8.0, "%s: %.1f deg of bank after the roll-out" % (name, max(out, default=0.0)))
+    soft_assert(pitch <= 10.0, "%s: the pitch reached %.1f deg (at most 10)" % (name, pitch))
+    soft_assert(lost < 20.0, "%s: lost %.1f m of height (less than 20)" % (name, lost))
+
+
 GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
-          "restart_air": check_restart_air, "turn_gps": check_turn_gps}
+          "restart_air": check_restart_air, "elevons": check_elevons, "vtail": check_vtail,
+          "turn_gps": check_turn_gps}
 
 
 def main():

@@ -14,7 +14,9 @@ GROUP is one of:
                 aircraft's lift and drag tables are make_aero_tables.py's
   signs         OUT1 above 1500 rolls right, below rolls left; OUT2 above its trim pitches the
                 nose up; OUT4 above 1500 yaws the nose right; more OUT3 is more speed; a
-                positive upset moment rolls right, and only from its start time
+                positive upset moment rolls right, and only from its start time; the mixed
+                airframes (--airframe): the right elevon up and the left down roll right,
+                the left ruddervator up and the right down yaw right, each pair up pitches up
   trajectory    a flown turn as a trajectory file: integrating its gyro reproduces its truth
                 quaternion, its specific force rotated to earth plus g is the velocity's
                 derivative in the true-state log, level flight reads -g on z, the turn holds 30 deg of bank with
@@ -263,6 +265,39 @@ def check_signs(work):
     soft_assert(abs(math.degrees(calm["euler"][0])) < 0.5 and math.degrees(after["euler"][0]) > 30,
                 "--upset 0.5,0.5,20: bank %.1f deg before, %.1f deg 1.5 s after (want calm, then > 30 right)"
                 % (math.degrees(calm["euler"][0]), math.degrees(after["euler"][0])))
+    # The mixed airframes (--airframe) by their geometry: the right elevon up and the left
+    # down roll right, both up pitch up; the left ruddervator up and the right down yaw the
+    # nose right, both up pitch up; a pair with a width missing holds its surfaces.
+    def mixed(airframe, changes, seconds):
+        model.reset()
+        widths = [1500, 1500, trim[2], 1500]
+        for i, w in changes.items():
+            widths[i] = w
+        for _ in range(int(round(seconds * 400))):
+            model.set_widths(flightmodel.unmix(airframe, widths))
+            model.step(1 / 400)
+        return model.state()
+
+    soft_assert(flightmodel.unmix("elevons", [1250, 1750, 1100, 1600]) == [2000, 1500, 1100, 1600] and
+                flightmodel.unmix("elevons", [1400, 1700, 1100, 1600]) == [1800, 1600, 1100, 1600] and
+                flightmodel.unmix("vtail", [1300, 1700, 1100, 1450]) == [1300, 1650, 1100, 1750] and
+                flightmodel.unmix("vtail", [1300, 1000, 1100, 2000]) == [1300, 1500, 1100, 1000] and
+                flightmodel.unmix("vtail", [1300, 1700, 1100, 0]) == [1300, 0, 1100, 0] and
+                flightmodel.unmix("elevons", [0, 1700, 1100]) == [0, 0, 1100, 0] and
+                flightmodel.unmix("plain", [1300, 1700, 1100, 1450, 1900]) == [1300, 1700, 1100, 1450],
+                "unmix: a pair's sum and difference, within full throw, held without a pulse")
+    roll_right = mixed("elevons", {0: 1300, 1: 1700}, 1.0)
+    elevons_up = mixed("elevons", {0: 1600, 1: 1600}, 0.5)
+    yaw_right = mixed("vtail", {1: 1750, 3: 1250}, 0.5)
+    vtail_up = mixed("vtail", {1: 1600, 3: 1600}, 0.5)
+    soft_assert(math.degrees(roll_right["euler"][0]) > 20 and roll_right["gyro"][0] > 0,
+                "elevons: left 1300, right 1700 us for 1 s: bank %.1f deg (want right)" % math.degrees(roll_right["euler"][0]))
+    soft_assert(math.degrees(elevons_up["euler"][1]) > pitch0 + 3, "elevons: both 1600 us: pitch %.1f deg (want up)"
+                % math.degrees(elevons_up["euler"][1]))
+    soft_assert(yaw_right["gyro"][2] > 0.05, "vtail: left 1750, right 1250 us: yaw rate %.3f rad/s (want nose right)"
+                % yaw_right["gyro"][2])
+    soft_assert(math.degrees(vtail_up["euler"][1]) > pitch0 + 3, "vtail: both 1600 us: pitch %.1f deg (want up)"
+                % math.degrees(vtail_up["euler"][1]))
     fast = pulse(2, 1600, 5.0)
     soft_assert(fast["airspeed"] > 19.0, "OUT3 1600 us for 5 s: airspeed %.2f m/s" % fast["airspeed"])
     print("signs: OUT1 2000 us 1 s -> bank %+.1f deg; 1000 us -> %+.1f deg; OUT2 +200 us 0.5 s -> pitch %+.1f deg;"

@@ -28,7 +28,8 @@ def main():
     soft_assert(mav.total_receive_errors == 0, "receive errors: %d" % mav.total_receive_errors)
     types = [m.get_type() for m in msgs]
     want = ["HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT",
-            "HEARTBEAT", "PARAM_VALUE", "COMMAND_ACK", "RC_CHANNELS", "SERVO_OUTPUT_RAW"]
+            "HEARTBEAT", "PARAM_VALUE", "COMMAND_ACK", "RC_CHANNELS", "SERVO_OUTPUT_RAW",
+            "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION"]
     soft_assert(types == want, "message order %r, expected %r" % (types, want))
     if types != want:
         return
@@ -68,6 +69,20 @@ def main():
                 [getattr(servo, "servo%d_raw" % i) for i in range(1, 9)] == [1000, 1100, 1200, 1300, 1400, 1500, 1600,
                                                                             2000],
                 "SERVO_OUTPUT_RAW %r" % servo)
+
+    gps, pos, hud, home = msgs[12:16]
+    soft_assert(gps.time_usec == 61234000 and gps.fix_type == mavlink2.GPS_FIX_TYPE_3D_FIX and gps.lat == 71350450
+                and gps.lon == -731194210 and gps.alt == 1028123 and gps.eph == 90 and gps.epv == 65535
+                and gps.vel == 1834 and gps.cog == 27012 and gps.satellites_visible == 10 and gps.h_acc == 2100,
+                "GPS_RAW_INT %r" % gps)
+    soft_assert(pos.time_boot_ms == 61300 and pos.lat == 71351450 and pos.lon == -731193210 and pos.alt == 1078500
+                and pos.relative_alt == 50500 and (pos.vx, pos.vy, pos.vz) == (1200, -1600, -150)
+                and pos.hdg == 30687, "GLOBAL_POSITION_INT %r" % pos)
+    soft_assert(abs(hud.airspeed - 19.5) < 1e-6 and abs(hud.groundspeed - 20.0) < 1e-5 and hud.heading == 307
+                and hud.throttle == 65 and abs(hud.alt - 1078.5) < 1e-3 and abs(hud.climb - 1.5) < 1e-6,
+                "VFR_HUD %r" % hud)
+    soft_assert(home.latitude == 71350450 and home.longitude == -731194210 and home.altitude == 1028000
+                and list(home.q) == [1.0, 0.0, 0.0, 0.0] and home.time_usec == 0, "HOME_POSITION %r" % home)
 
     att = msgs[1]
     soft_assert(att.time_boot_ms == 123456, "time_boot_ms %d" % att.time_boot_ms)

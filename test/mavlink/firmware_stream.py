@@ -10,9 +10,11 @@ time-stamped), once with `mode mavlink` typed at 3 s. Checks, for the MAVLink ru
   - everything after the reply to `mode mavlink` decodes: no bad CRC, no stray byte;
   - HEARTBEAT about once a second (every ~50 ATTITUDE), a fixed wing ArduPilot in MANUAL (no receiver);
   - RC_CHANNELS and SERVO_OUTPUT_RAW at 5 Hz (no receiver: no channels, outputs at trim);
+  - SCALED_PRESSURE with them: the standard atmosphere's pressure and temperature at the field;
   - ATTITUDE at the output rate (50 Hz: time_boot_ms 20 +- 6 ms apart, 20 on average, none missing), its
     roll, pitch and yaw equal to the csv run's at the same time_boot_ms within 0.01 rad;
-  - SYS_STATUS each second, the compass' health bit cleared while it is unplugged;
+  - SYS_STATUS each second, the compass' health bit cleared while it is unplugged, the
+    barometer present, enabled and healthy;
   - STATUSTEXT for the fault ("HMC5883L", severity error) and its recovery.
 Exit 1 with every failure listed.
 """
@@ -83,7 +85,8 @@ def main():
     soft_assert(not bad and mav.total_receive_errors == 0,
           "%d bad frames, %d receive errors: %r" % (len(bad), mav.total_receive_errors, bad[:3]))
     types = [m.get_type() for m in msgs]
-    soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "RC_CHANNELS", "SERVO_OUTPUT_RAW"},
+    soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "RC_CHANNELS", "SERVO_OUTPUT_RAW",
+                               "SCALED_PRESSURE", "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION"},
                 "unexpected: %r" % set(types))
     soft_assert(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
           "first frame: the reply to the command, got %r" % (msgs[:1],))
@@ -134,13 +137,23 @@ def main():
     soft_assert(all([m.servo1_raw, m.servo2_raw, m.servo3_raw, m.servo4_raw] == [1500, 1500, 1000, 1500] for m in servo),
                 "SERVO_OUTPUT_RAW not at trim: %r" % servo[:1])
 
-    # SYS_STATUS: the compass bit follows the fault.
+    # SCALED_PRESSURE with them: the MS5611 model at the field (1028 m: 895.7 hPa, 8.32 degC).
+    baro = [m for m in msgs if m.get_type() == "SCALED_PRESSURE"]
+    soft_assert(len(baro) == len(rc), "%d SCALED_PRESSURE for %d RC_CHANNELS" % (len(baro), len(rc)))
+    soft_assert(all(abs(m.press_abs - 895.7) < 0.5 and abs(m.temperature - 832) <= 2 and m.press_diff == 0
+                    for m in baro), "SCALED_PRESSURE %r" % baro[:1])
+
+    # SYS_STATUS: the compass bit follows the fault; the barometer's bits are set throughout.
     status = [m for m in msgs if m.get_type() == "SYS_STATUS"]
     soft_assert(len(status) == len(hb_at), "%d SYS_STATUS for %d HEARTBEAT" % (len(status), len(hb_at)))
     mag = mavlink2.MAV_SYS_STATUS_SENSOR_3D_MAG
     soft_assert(any(not (s.onboard_control_sensors_health & mag) for s in status), "compass never unhealthy")
     soft_assert(status and status[-1].onboard_control_sensors_health & mag, "compass not healthy again at the end")
     soft_assert(all(0 < s.load <= 1000 for s in status), "load %r" % [s.load for s in status])
+    pressure = mavlink2.MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE
+    soft_assert(all(s.onboard_control_sensors_present & s.onboard_control_sensors_enabled &
+                    s.onboard_control_sensors_health & pressure for s in status), "barometer bits %r" % [
+                        (s.onboard_control_sensors_present, s.onboard_control_sensors_health) for s in status])
 
     # STATUSTEXT for the fault and its recovery.
     texts = [m for m in msgs if m.get_type() == "STATUSTEXT"]

@@ -177,4 +177,28 @@ TEST(SitlJson, TrajectoryHistoryIsTrimmedKeepingWhatInterpolationNeeds) {
     EXPECT_EQ(t.size(), 5u);
 }
 
+// The race of issue 46 on a loaded machine: frame 47172 is sent again after a time-out and
+// answered twice; the second answer (timestamp 47.173 s) arrives while frame 47173 is
+// awaited. It is not after the last state taken: stale, dropped and counted; the next
+// frame's own answer is taken. Any timestamp not after the last is stale (an older late
+// answer too), and the first reply is taken whatever its time.
+TEST(SitlJson, AReplyNotAfterTheLastTakenIsStale) {
+    sim::ReplyClock clock;
+    EXPECT_FALSE(clock.started());
+    EXPECT_TRUE(clock.take(47.172));  // frame 0: any time starts the clock
+    EXPECT_TRUE(clock.take(47.173));  // frame 47172's first answer
+    EXPECT_FALSE(clock.take(47.173)); // its late duplicate, while 47173 is awaited
+    EXPECT_FALSE(clock.take(47.170)); // an older late answer
+    EXPECT_TRUE(clock.take(47.174));  // frame 47173's answer
+    EXPECT_EQ(clock.taken(), 3u);
+    EXPECT_EQ(clock.stale(), 2u);
+    EXPECT_DOUBLE_EQ(clock.last_s(), 47.174);
+    // A backend whose time went back: every answer stale, the last taken kept.
+    for (int i = 0; i < 5; ++i) EXPECT_FALSE(clock.take(0.001 * (i + 1)));
+    EXPECT_EQ(clock.stale(), 7u);
+    EXPECT_DOUBLE_EQ(clock.last_s(), 47.174);
+    // Only strictly later counts: the smallest step after is taken.
+    EXPECT_TRUE(clock.take(std::nextafter(47.174, 100.0)));
+}
+
 }  // namespace

@@ -16,6 +16,14 @@ readme's resend). Prints 'port N' on stdout once listening.
   --log FILE            one CSV row per packet: frame_count,frame_rate,pwm1..pwm16
   --silent-after N      stop answering after frame N (the link's timeout test)
   --garbage-after N     answer frames after N with text that is not a state
+  --late N              a loaded machine's race (issue 46), deterministically: frame N is
+                        answered only once it came again (apm25sim sent it again after its
+                        1 s time-out); the answer to that resend, the same state, is held
+                        and sent just before the next frame's answer, when apm25sim already
+                        waits for that frame
+  --twice               answer every packet twice
+  --time-back-after N   from frame N + 1 on, the timestamps are 1 s earlier (the backend's
+                        time went back, e.g. a physics restarted under the same port)
 """
 import argparse
 import json
@@ -49,6 +57,9 @@ def main():
     ap.add_argument('--log')
     ap.add_argument('--silent-after', type=int)
     ap.add_argument('--garbage-after', type=int)
+    ap.add_argument('--late', type=int)
+    ap.add_argument('--twice', action='store_true')
+    ap.add_argument('--time-back-after', type=int)
     args = ap.parse_args()
     roll, pitch, yaw = (math.radians(float(v)) for v in args.attitude.split(','))
     # Specific force at rest: R^T (0, 0, -g).
@@ -62,6 +73,8 @@ def main():
     log = open(args.log, 'w') if args.log else None
     last_frame = None
     t = 0.0
+    late_waiting = False  # --late: frame N received once, not answered yet
+    held = None           # --late: the resend's answer, sent before the next frame's
     while True:
         data, sender = sock.recvfrom(1024)
         if len(data) != PACKET.size:
@@ -75,11 +88,13 @@ def main():
             log.flush()
         if args.silent_after is not None and frame > args.silent_after:
             continue
-        if frame != last_frame:
+        new_frame = frame != last_frame
+        if new_frame:
             if last_frame is not None:
                 t += 1.0 / rate
             last_frame = frame
-        state = {'timestamp': 1.5 + t, 'imu': {'gyro': [0, 0, 0], 'accel_body': accel},
+        back = 1.0 if args.time_back_after is not None and frame > args.time_back_after else 0.0
+        state = {'timestamp': 1.5 + t - back, 'imu': {'gyro': [0, 0, 0], 'accel_body': accel},
                  'position': [0, 0, -10], 'velocity': [0, 0, 0]}
         if args.quaternion:
             state['quaternion'] = quaternion(roll, pitch, yaw)
@@ -93,7 +108,21 @@ def main():
         text = '\n' + json.dumps(state) + '\n'
         if args.garbage_after is not None and frame > args.garbage_after:
             text = 'hello\n'
+        if args.late is not None and frame == args.late:
+            if new_frame:
+                late_waiting = True  # the first send: no answer until it comes again
+                continue
+            if late_waiting:
+                late_waiting = False
+                sock.sendto(text.encode(), sender)  # the first send's late answer
+                held = text                         # the resend's, held
+                continue
+        if held is not None and new_frame:
+            sock.sendto(held.encode(), sender)
+            held = None
         sock.sendto(text.encode(), sender)
+        if args.twice:
+            sock.sendto(text.encode(), sender)
 
 
 if __name__ == '__main__':
