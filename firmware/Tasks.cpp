@@ -9,7 +9,9 @@
 // after the previous one, so a loop task must end by kDeadlineUs after the last sample,
 // and it starts only when its budget says it will. Each budget is what the task takes at
 // most (apm25sim --profile: make bench) with a margin; the MAVLink rows' include packing
-// the "# " lines into STATUSTEXT frames.
+// the "# " lines into STATUSTEXT frames. The gps row's is for a slice of at most
+// gps_port::kSliceBytes received bytes parsed, the receiver's step (a fix, its glitch test)
+// and a "# gps:" line: a pass is bounded whatever arrives, the rest waits in the ring.
 #include "Tasks.h"
 
 #include "AirspeedInput.h"

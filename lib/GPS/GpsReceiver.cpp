@@ -108,7 +108,7 @@ bool Receiver::send_step() {
             p[2] = 1;  // every solution
             return send_frame(kClassCfg, kCfgMsg, p, kLenCfgMsg);
         }
-        case kStepPollNav5: return send_frame(kClassCfg, kCfgNav5, p, 0);
+        case kStepPollNav5: return send_frame(kClassCfg, kCfgNav5, nullptr, 0);  // a poll: no payload
         case kStepWriteNav5:
             for (uint8_t i = 0; i < kLenCfgNav5; ++i) p[i] = 0;  // only the masked field applies
             p[kNav5Mask] = (uint8_t)kNav5MaskDyn;
