@@ -60,6 +60,7 @@ SECTIONS = [
     (10, "compass", "step part: heading correction", ()),
     (11, "learner", "step part: compass offset learner", ()),
     (14, "magfit", "one part of the cal mag fit (outside the step)", ()),
+    (40, "gpsaid", "a GPS fix into the estimator (5 Hz, inside the step when the firmware calls it there)", ()),
     (16, "gcsrequest", "a ground station's MAVLink request handled", ()),
     (37, "baro", "the barometer task: a conversion read, the next started (PROM at start)", ()),
     (46, "barocomp", "the MS5611 compensation: a D2's temperature terms or a D1's pressure", ()),

@@ -54,6 +54,19 @@ def vqf_late(traj):
     return flights.vqf_from_loop_start(peers.load_trajectory(traj))["total"]
 
 
+def vqf_totals(files, out_dir, pool):
+    """VQF's total RMSE on each flight of files ({stem: (kind, trajectory, log)}), cached in
+    out_dir while the trajectory is unchanged: (cache, its key function)."""
+    cache_path = os.path.join(out_dir, "vqf_from_loop_start.json")
+    cache = json.load(open(cache_path)) if os.path.exists(cache_path) else {}
+    key = lambda traj: "%s@%d" % (os.path.basename(traj), os.path.getmtime(traj))
+    need = [traj for _, traj, _ in files.values() if key(traj) not in cache]
+    for traj, total in zip(need, pool.map(vqf_late, need)):
+        cache[key(traj)] = total
+    json.dump(cache, open(cache_path, "w"))
+    return cache, key
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--seeds", required=True, type=seed_list)
@@ -80,9 +93,6 @@ def main():
         log("no flights")
         return 1
 
-    cache_path = os.path.join(a.out, "vqf_from_loop_start.json")
-    cache = json.load(open(cache_path)) if os.path.exists(cache_path) else {}
-    key = lambda traj: "%s@%d" % (os.path.basename(traj), os.path.getmtime(traj))
     tasks, runs = [], []
     for stem, (kind, traj, state) in sorted(files.items()):
         for b, build in enumerate(builds):
@@ -93,10 +103,7 @@ def main():
                 runs.append(("%s %s" % (stem, suffix), traj, est, os.path.join(build, "replay"),
                              os.path.join(build, "score"), sets, extra))
     with ProcessPoolExecutor(a.jobs) as pool:
-        need = [traj for _, traj, _ in files.values() if key(traj) not in cache]
-        for traj, total in zip(need, pool.map(vqf_late, need)):
-            cache[key(traj)] = total
-        json.dump(cache, open(cache_path, "w"))
+        cache, key = vqf_totals(files, a.out, pool)
         results = {}
         for (stem, b, suffix), r in zip(tasks, pool.map(bench.task_replay, runs)):
             if r[3]:

@@ -2,7 +2,7 @@
 // build/replay: the firmware's estimator on the host (contract: ../shared/SIM.md).
 //
 //   build/replay --trajectory FILE.csv[.gz] [--seconds S] [--log] [--set NAME=VALUE ...]
-//                [--airspeed M_S | --airspeed-log LOG.csv] [--trace FILE.csv] [--samples FILE.csv]
+//                [--airspeed M_S | --airspeed-log LOG.csv] [--gps-log LOG.csv [--gps-seed N]] [--trace FILE.csv] [--samples FILE.csv]
 //
 // The same pipeline as the board, minus the AVR: the simulator's register models
 // (sim/models) answer the very drivers the firmware runs (lib/MPU6000, lib/HMC5883)
@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,6 +35,7 @@
 #include "ScoreMetric.h"
 #include "Text.h"
 #include "Trajectory.h"
+#include "UbloxFeed.h"
 
 namespace {
 
@@ -54,6 +56,12 @@ void usage(FILE* out) {
             "  --airspeed-log LOG.csv  the airspeed over time from a flight's state log\n"
             "               (sim/flight: columns t and airspeed_m_s), given every\n"
             "               8 steps as the firmware reads its sensor\n"
+            "  --gps-log LOG.csv  a GPS on the flight's path: the state log's t, north_m,\n"
+            "               east_m, down_m, vn_m_s, ve_m_s, vd_m_s (sim/flight) drive the\n"
+            "               simulator's u-blox model (0.2 s latency, 0.1 m/s velocity\n"
+            "               noise, first fix at 3 s), configured for UBX at 5 Hz; each\n"
+            "               fix goes to the pipeline (AttitudePipeline::on_gps_fix)\n"
+            "  --gps-seed N  the GPS model's noise seed (default 1)\n"
             "  --trace FILE.csv  per estimator step (200 Hz, from the estimator's start):\n"
             "               the error against the trajectory's truth (signed, deg; the tilt\n"
             "               error split about magnetic north and east; the heading error a\n"
@@ -100,6 +108,7 @@ const SettingName kSettingNames[] = {
     {"rest_min_s", &dcm::DcmSettings::rest_min_s, 1.0f},
     {"rest_bias_s", &dcm::DcmSettings::rest_bias_s, 1.0f},
     {"output_lead_s", &dcm::DcmSettings::output_lead_s, 1.0f},
+    {"gps_lowpass_s", &dcm::DcmSettings::gps_lowpass_s, 1.0f},
     {"mag_new_min_rate_deg_s", &dcm::DcmSettings::mag_new_min_rate_rad_s, linalg::kRadPerDeg},
 };
 
@@ -317,43 +326,71 @@ void write_sample_row(FILE* out, double t_s, const mpu6000::Sample& sample, cons
 
 // The state log's airspeed (sim/flight/flightio.py LOG_HEADER: t and airspeed_m_s
 // columns), as (t, airspeed) pairs; false with a message when unreadable.
-bool load_airspeed_log(const std::string& path, std::vector<std::pair<double, double>>& out) {
+// The named columns of a flight's state log (sim/flight: a CSV with a header), one row of
+// them per line, each finite; false (with a message) when a column is missing or a value
+// is not finite.
+bool load_log_columns(const std::string& path, const std::vector<const char*>& names,
+                      std::vector<std::vector<double>>& rows) {
     FILE* f = fopen(path.c_str(), "r");
     if (!f) {
         fprintf(stderr, "replay: cannot open %s\n", path.c_str());
         return false;
     }
     char line[1024];
-    int t_col = -1, v_col = -1;
+    std::vector<int> cols(names.size(), -1);
     if (fgets(line, sizeof line, f)) {
         int col = 0;
-        for (char* tok = strtok(line, ",\r\n"); tok; tok = strtok(nullptr, ",\r\n"), ++col) {
-            if (strcmp(tok, "t") == 0) t_col = col;
-            if (strcmp(tok, "airspeed_m_s") == 0) v_col = col;
-        }
+        for (char* tok = strtok(line, ",\r\n"); tok; tok = strtok(nullptr, ",\r\n"), ++col)
+            for (size_t k = 0; k < names.size(); ++k)
+                if (strcmp(tok, names[k]) == 0) cols[k] = col;
     }
-    if (t_col < 0 || v_col < 0) {
-        fprintf(stderr, "replay: %s has no t and airspeed_m_s columns\n", path.c_str());
+    for (size_t k = 0; k < names.size(); ++k) {
+        if (cols[k] >= 0) continue;
+        fprintf(stderr, "replay: %s has no %s column\n", path.c_str(), names[k]);
         fclose(f);
         return false;
     }
     int line_no = 1;
     while (fgets(line, sizeof line, f)) {
         ++line_no;
-        double t = NAN, v = NAN;
+        std::vector<double> row(names.size(), NAN);
         int col = 0;
-        for (char* tok = strtok(line, ",\r\n"); tok; tok = strtok(nullptr, ",\r\n"), ++col) {
-            if (col == t_col) t = strtod(tok, nullptr);
-            if (col == v_col) v = strtod(tok, nullptr);
-        }
-        if (!std::isfinite(t) || !std::isfinite(v)) {
-            fprintf(stderr, "replay: %s line %d: no finite t and airspeed_m_s\n", path.c_str(), line_no);
+        for (char* tok = strtok(line, ",\r\n"); tok; tok = strtok(nullptr, ",\r\n"), ++col)
+            for (size_t k = 0; k < names.size(); ++k)
+                if (col == cols[k]) row[k] = strtod(tok, nullptr);
+        for (size_t k = 0; k < names.size(); ++k) {
+            if (std::isfinite(row[k])) continue;
+            fprintf(stderr, "replay: %s line %d: no finite %s\n", path.c_str(), line_no, names[k]);
             fclose(f);
             return false;
         }
-        out.emplace_back(t, v);
+        rows.push_back(row);
     }
     fclose(f);
+    return true;
+}
+
+bool load_airspeed_log(const std::string& path, std::vector<std::pair<double, double>>& out) {
+    std::vector<std::vector<double>> rows;
+    if (!load_log_columns(path, {"t", "airspeed_m_s"}, rows)) return false;
+    for (const std::vector<double>& r : rows) out.emplace_back(r[0], r[1]);
+    return true;
+}
+
+// The flight's path from its state log (t, position and velocity NED), for the GPS model.
+bool load_gps_path(const std::string& path, sim::Trajectory& out) {
+    std::vector<std::vector<double>> rows;
+    if (!load_log_columns(path, {"t", "north_m", "east_m", "down_m", "vn_m_s", "ve_m_s", "vd_m_s"}, rows)) return false;
+    for (const std::vector<double>& r : rows) {
+        sim::TrajectorySample s{};
+        s.t_s = r[0];
+        for (int k = 0; k < 3; ++k) {
+            s.ned_m[k] = r[1 + k];
+            s.vel_ned_m_s[k] = r[4 + k];
+        }
+        s.quat[0] = 1.0;
+        out.append(s);
+    }
     return true;
 }
 
@@ -365,6 +402,8 @@ int main(int argc, char** argv) {
     std::vector<std::pair<double, double>> airspeed_log;
     std::string trace_path;
     std::string samples_path;
+    std::string gps_log_path;
+    uint64_t gps_seed = 1;
     dcm::DcmSettings dcm_settings = dcm::kDefaultDcmSettings;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -386,6 +425,10 @@ int main(int argc, char** argv) {
             }
         } else if (a == "--airspeed-log" && i + 1 < argc) {
             if (!load_airspeed_log(argv[++i], airspeed_log)) return 1;
+        } else if (a == "--gps-log" && i + 1 < argc) {
+            gps_log_path = argv[++i];
+        } else if (a == "--gps-seed" && i + 1 < argc) {
+            gps_seed = strtoull(argv[++i], nullptr, 10);
         } else if (a == "--trace" && i + 1 < argc) {
             trace_path = argv[++i];
         } else if (a == "--samples" && i + 1 < argc) {
@@ -434,6 +477,14 @@ int main(int argc, char** argv) {
     FILE* samples_file = open_output(samples_path);
     if (unwritable) return 1;
     if (samples_file) fputs(sim::kTrajectoryHeader, samples_file);
+
+    // The GPS: the u-blox model on the flight's path, its fixes into the pipeline.
+    sim::Trajectory gps_path;
+    if (!gps_log_path.empty() && !load_gps_path(gps_log_path, gps_path)) return 1;
+    sim::UbloxOptions gps_options;
+    gps_options.seed = gps_seed;
+    std::unique_ptr<sim::UbloxFeed> gps;
+    if (!gps_log_path.empty()) gps.reset(new sim::UbloxFeed(gps_path, gps_options));
 
     sim::Mpu6000Model mpu_model(trajectory);
     sim::Hmc5883Model mag_model(trajectory);
@@ -497,6 +548,8 @@ int main(int argc, char** argv) {
                 pipe.set_cruise_airspeed_m_s((float)airspeed_m_s);  // as the firmware does with TRIM_ARSPD_CM
             }
         }
+        gps::Fix fix;
+        if (gps && gps->poll(board.t_s, fix)) pipe.on_gps_fix(fix);
         pipe.on_imu_sample(sample);
         if (trace_file && pipe.estimator().initialised()) trace_writer.row(board.t_s, trajectory.at(board.t_s), pipe, trace);
         if (pipe.output_due()) {

@@ -69,6 +69,9 @@ public:
     // and dV/dt in accel counts; the means go on.
     void configure(int16_t gain_q8, int16_t gravity_counts, int16_t dv_dt_counts = 0);
     bool active() const { return gain_q8_ != 0; }
+    // The terms the last window had taken off, a sample's (accel counts; x dV/dt, y omega_z
+    // V, z -omega_y V): what a GPS's sums give back (Dcm::correct_gravity).
+    const linalg::Vector3i& term() const { return term_; }
     // The window's sums less (dV/dt, omega_z V, -omega_y V), the first two within their
     // bounds: accel_sum and the running sums' sum, from the gyro's sums less the
     // calibrated bias (counts) and earth down in body axes (R's third row, Q30;

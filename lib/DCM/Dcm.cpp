@@ -4,6 +4,8 @@
 #include "Fixed.h"
 #include "Profile.h"
 
+#include <math.h>
+
 namespace dcm {
 
 using linalg::Matrix3f;
@@ -93,6 +95,8 @@ bool Dcm::init(const Vector3f& accel_m_s2, const Vector3f& mag_field, bool gravi
     rest_.reset(linalg::fixed_from_vector(accel_m_s2 * per_m_s2, 0));
     steps_ = 0;
     start_from_mean_ = gravity_is_mean;
+    gps_.stop();  // no pair across a start
+    course_taken_ = false;
     status_ |= kStatusInitialised;
     return true;
 }
@@ -275,11 +279,21 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     const Vector3l mean_off_bias = rest_.gyro_mean() - bias_.units();  // the rest mean's turn (units)
     bias_.judge_rotation(mean_off_bias, (status_ & kStatusGyroRejected) != 0, k_);
     const bool hold_integrator = bias_.integrator_held(context.starting, start_from_mean_);
-    // In flight, the turn's centripetal acceleration off the window first (Centripetal.h).
-    if (turn_ != nullptr && turn_->active()) gravity_.subtract_turn(*turn_, context);
-    // The window into the earth-frame low-pass, its means into the rest test.
+    // In flight, the turn's centripetal acceleration off the window first (Centripetal.h),
+    // unless the GPS's acceleration comes off it (GpsAid.h: the turn's is in it).
+    const bool gps_aiding = gps_.aiding();
+    const bool turn = turn_ != nullptr && turn_->active() && !gps_aiding;
+    if (turn) gravity_.subtract_turn(*turn_, context);
+    // The window into the earth-frame low-pass (or, GPS-aided, into the GPS's sums: its
+    // observations feed the low-pass), its means into the rest test.
     WindowMeans window;
-    if (gravity_.low_pass_window(context, window)) detect_rest(window, mean_off_bias);
+    if (gravity_.low_pass_window(context, window, !gps_aiding)) {
+        detect_rest(window, mean_off_bias);
+        // The GPS's sums take the specific force as measured (its acceleration comes off
+        // at the pair): before its aiding starts, the turn's term goes back, in earth axes.
+        if (turn && gps_.receiving()) window.accel_ef += earth_of_counts(turn_->term());
+        gps_.add_window(window.accel_ef);
+    }
     // The low-pass's direction against earth down: the roll/pitch correction, and its
     // integral into the bias unless held.
     gravity_.correct_tilt(context, hold_integrator, bias_);
@@ -287,6 +301,59 @@ FIXED_OWN_FRAME void Dcm::correct_gravity() {
     profile::end(profile::kGravity);
 }
 
+
+// A vector in accel counts in body axes, in earth axes and accel units (counts * 2^8),
+// by R in 16 bits (Q14: 6e-5 of it).
+Vector3l Dcm::earth_of_counts(const linalg::Vector3i& counts) const {
+    using linalg::mul_q14;
+    using linalg::q14_of;
+    const linalg::Matrix3q30& r = strapdown_.r();
+    const Vector3l u((int32_t)counts.x * 256, (int32_t)counts.y * 256, (int32_t)counts.z * 256);
+    return Vector3l(mul_q14(q14_of(r.a.x), u.x) + mul_q14(q14_of(r.a.y), u.y) + mul_q14(q14_of(r.a.z), u.z),
+                    mul_q14(q14_of(r.b.x), u.x) + mul_q14(q14_of(r.b.y), u.y) + mul_q14(q14_of(r.b.z), u.z),
+                    mul_q14(q14_of(r.c.x), u.x) + mul_q14(q14_of(r.c.y), u.y) + mul_q14(q14_of(r.c.z), u.z));
+}
+
+// A GPS velocity (GpsAid.h): a completed pair's observation into the low-pass, with the
+// factor of its interval against gps_lowpass_s (5 Hz, in float): 1 - exp(-I / tau) as
+// I / (tau + I / 2) (the bilinear form: within 1e-3 of it at I / tau = 0.2, no exp).
+void Dcm::on_gps_velocity(const Vector3f& vel_ned_m_s, float interval_s, float gain) {
+    if (!initialised() || steps_ < k_.startup_steps) {
+        gps_.stop();
+        return;
+    }
+    Vector3l observation;
+    if (!gps_.on_velocity(vel_ned_m_s, interval_s, gain, k_.accel_units_per_m_s2,
+                          observation))
+        return;
+    const float alpha = interval_s / (settings_->gps_lowpass_s + 0.5f * interval_s);
+    gravity_.low_pass_observation(observation, linalg::fixed_from_float(alpha, linalg::kQ30));
+}
+
+// The GPS course as the heading reference (AP_AHRS_DCM without a compass): the error
+// sin(yaw - course), yaw's cosine and sine from R's first column (cos(pitch) cos(yaw),
+// cos(pitch) sin(yaw)), corrected at kp_yaw as a compass's mean is (Heading.h); the
+// first one after a start without a heading at once.
+void Dcm::correct_heading_from_course(float course_rad, uint16_t interval_steps) {
+    if (!initialised()) return;
+    const float north = linalg::float_from_fixed(strapdown_.r().a.x, linalg::kQ30);
+    const float east = linalg::float_from_fixed(strapdown_.r().b.x, linalg::kQ30);
+    const float horizontal2 = north * north + east * east;
+    if (!(horizontal2 > 0.01f)) return;  // the nose within ~6 deg of vertical: no yaw to correct
+    const float inv = linalg::inverse_sqrt(horizontal2);
+    const float cos_course = cosf(course_rad), sin_course = sinf(course_rad);
+    const float cos_error = (north * cos_course + east * sin_course) * inv;
+    const float sin_error = (east * cos_course - north * sin_course) * inv;
+    if ((status_ & kStatusNoHeading) && !course_taken_) {
+        course_taken_ = true;
+        turn_heading_at_once(strapdown_.r(), cos_error, sin_error);
+        return;
+    }
+    // Saturated at +-1 beyond 90 deg, so it stays monotonic (as the compass's).
+    const float heading_error = cos_error >= 0.0f ? sin_error : (sin_error >= 0.0f ? 1.0f : -1.0f);
+    const uint16_t steps = interval_steps < kGpsMaxCourseSteps ? interval_steps : kGpsMaxCourseSteps;
+    turn_heading(strapdown_, heading_error, settings_->kp_yaw_1_s, (float)steps, k_);
+}
 
 Vector3l Dcm::pending_turn_units() const { return strapdown_.pending_units(); }
 

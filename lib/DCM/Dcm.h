@@ -23,6 +23,7 @@
 //   Schedule.h       HeavySchedule          one heavy part a step
 //   Gravity.h        GravityCorrection      accel window, earth-frame low-pass, roll/pitch (VQF's updateAcc)
 //   Centripetal.h    TurnMean               the turn's centripetal acceleration off the window (AP's DCM, airspeed)
+//   GpsAid.h         GpsAccel               gravity from the accelerometer less the GPS's acceleration (AP's DCM, GPS)
 //   Rest.h           RestDetector           rest detection (VQF's rest, Fusion's FusionOffset)
 //   GyroBias.h       GyroBias               the calibrated bias, the estimate and what may teach it when
 //   Heading.h        HeadingCorrection      the heading correction with its gate (VQF's updateMag): the
@@ -46,6 +47,7 @@
 #include "Coefficients.h"
 #include "DcmSettings.h"
 #include "Euler.h"
+#include "GpsAid.h"
 #include "Gravity.h"
 #include "GyroBias.h"
 #include "Heading.h"
@@ -167,6 +169,23 @@ public:
     // The turn's centripetal correction (Centripetal.h): its gain and means, kept by the
     // caller (the pipeline: it knows the airspeed); nullptr: none.
     void set_turn(TurnMean* turn) { turn_ = turn; }
+    // A usable GPS fix's velocity (m/s, north-east-down with north the MAGNETIC one, as
+    // the estimator's earth axes), interval_s after the one before (s, the receiver's
+    // time; 0: none), gain AHRS_GPS_GAIN: the accelerometer's earth-frame sums less the
+    // GPS's acceleration become the gravity correction's reference (GpsAid.h) in place of
+    // the accelerometer alone and the turn's term, until kGpsTimeoutWindows pass without
+    // one or gps_unusable(). Not during the start-up (its low-pass ramps on its own).
+    void on_gps_velocity(const linalg::Vector3f& vel_ned_m_s, float interval_s, float gain);
+    // A fix that cannot be used (no 3D fix, too few satellites, AHRS_GPS_USE 0): the
+    // accelerometer's own reference at once.
+    void gps_unusable() { gps_.stop(); }
+    bool gps_aiding() const { return gps_.aiding(); }
+    // The GPS course over ground as the heading reference, for a board without a compass
+    // or with a failed one (AP_AHRS_DCM: yaw error sin(course - yaw), above 3 m/s: the
+    // caller's test): course_rad from the MAGNETIC north, interval_steps since the last
+    // course given (the correction's rate stands for it). The first one after a start
+    // without a heading is taken at once, as a compass's first field is.
+    void correct_heading_from_course(float course_rad, uint16_t interval_steps);
     // Current gyro-bias estimate, rad/s (what the integrator has learned).
     linalg::Vector3f gyro_bias_rad_s() const;
     // A start value for the bias estimate, e.g. from a start-up calibration at rest.
@@ -213,6 +232,7 @@ private:
     void step(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok, bool line_due);
     void take_sample(const linalg::Vector3l& gyro, const linalg::Vector3l& accel, bool gyro_ok, bool accel_ok);
     void correct_gravity();
+    linalg::Vector3l earth_of_counts(const linalg::Vector3i& counts) const;
     // What the gravity correction reads (Gravity.h).
     GravityContext gravity_context();
     void update_offset();
@@ -247,6 +267,7 @@ private:
     GyroBias bias_;                      // the calibrated bias and the estimate
     GravityCorrection gravity_;          // the accel window, its low-pass and the roll/pitch correction
     TurnMean* turn_ = nullptr;           // the turn's centripetal correction, if flying (set_turn)
+    GpsAccel gps_;                       // the GPS-aided gravity reference
     RestDetector rest_;                  // rest, when the gyro reads its bias alone
     HeadingCorrection heading_;          // the field's mean, the disturbance gate, the heading's correction
     // The rates in the turn sums' units per step ("units": gyro counts * 2^8).
@@ -259,6 +280,7 @@ private:
     uint16_t recoveries_ = 0;
     uint8_t status_ = kStatusNoHeading;
     bool start_from_mean_ = false;       // init's gravity_is_mean
+    bool course_taken_ = false;          // a GPS course gave the heading since the start
     // The trace's one hook (Trace.h), handed to the parts in their context: set_trace's
     // on the host; on the AVR an empty one, which takes no byte of Dcm.
 #if DCM_TRACE

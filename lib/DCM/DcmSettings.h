@@ -35,6 +35,7 @@ struct DcmSettings {
     float rest_min_s;                // rest must last this long before the bias is taken from it, s
     float rest_bias_s;               // time constant of the bias estimate at rest (0: none), s
     float output_lead_s;             // the output is R carried forward by this, s
+    float gps_lowpass_s;             // the earth-frame low-pass's time constant while a GPS aids it (GpsAid.h), s
 };
 
 // One set for everything, each value with its physical reason beside it; `make tune`
@@ -88,6 +89,12 @@ constexpr DcmSettings kDefaultDcmSettings = {
     // The MPU6000's 42 Hz DLPF delays the gyro by 4.8 ms (Register Map 4.3), of which the
     // step's end-point integration takes back 2.5 ms: the output leads by 3 ms.
     0.003f,                         // output_lead_s
+    // With the GPS's acceleration taken off, no linear acceleration is left for the
+    // low-pass to average out: only the GPS's velocity noise, differentiated (0.1 m/s at
+    // 5 Hz), which reaches the attitude through the low-pass and kp's loop as about
+    // 0.1 deg RMS at 1 s (0.05 at 3 s, 0.2 at 0.5 s). The loop's damping is
+    // 1 / (2 sqrt(kp tau)): 0.29 at 3 s rings; 0.5 at 1 s.
+    1.0f,                           // gps_lowpass_s
 };
 
 using linalg::kGravity_m_s2;

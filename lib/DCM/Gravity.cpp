@@ -53,7 +53,7 @@ void GravityCorrection::rescale(float gyro_ratio, float accel_ratio) {
     if (accel_ratio != 1.0f) lp_ef_ = rescaled(lp_ef_, accel_ratio);
 }
 
-bool GravityCorrection::low_pass_window(const GravityContext& c, WindowMeans& means) {
+bool GravityCorrection::low_pass_window(const GravityContext& c, WindowMeans& means, bool feed_low_pass) {
     if (window_samples_ == 0) return false;
     const DcmCoefficients& k = c.k;
     const linalg::Matrix3q30& r = c.r;
@@ -102,12 +102,17 @@ bool GravityCorrection::low_pass_window(const GravityContext& c, WindowMeans& me
                  mul_q14(q14_of(r.b.x), body.x) + mul_q14(q14_of(r.b.y), body.y) + mul_q14(q14_of(r.b.z), body.z),
                  mul_q14(q14_of(r.c.x), body.x) + mul_q14(q14_of(r.c.y), body.y) + mul_q14(q14_of(r.c.z), body.z)),
         n, inv_n);
-    lp_ef_ += Vector3l(mul_q30(alpha, accel_ef.x - lp_ef_.x), mul_q30(alpha, accel_ef.y - lp_ef_.y),
-                             mul_q30(alpha, accel_ef.z - lp_ef_.z));
-
+    if (feed_low_pass) low_pass_observation(accel_ef, alpha);
+    means.accel_ef = accel_ef;
     means.whole = n >= kCorrectionDivider;
     clear_window();
     return true;
+}
+
+void GravityCorrection::low_pass_observation(const Vector3l& observation, int32_t alpha_q30) {
+    using linalg::mul_q30;
+    lp_ef_ += Vector3l(mul_q30(alpha_q30, observation.x - lp_ef_.x), mul_q30(alpha_q30, observation.y - lp_ef_.y),
+                       mul_q30(alpha_q30, observation.z - lp_ef_.z));
 }
 
 FIXED_OWN_FRAME void GravityCorrection::tilt_correction(const linalg::Matrix3q30& r, float startup_left,

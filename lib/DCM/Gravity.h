@@ -43,6 +43,7 @@ struct GravityContext {
 struct WindowMeans {
     linalg::Vector3l gyro;   // the gyro's less the calibrated bias, units
     linalg::Vector3l accel;  // accel units
+    linalg::Vector3l accel_ef;  // the mean in earth axes, each sample turned to R's time (accel units)
     bool whole;              // a whole window: kCorrectionDivider samples
 };
 
@@ -70,8 +71,12 @@ public:
                                   accel_sum_, accel_sum_of_sums_, c.starting);
     }
     // The window into the earth-frame low-pass, each sample turned to R's time; its means
-    // for the rest test. False: no sample.
-    bool low_pass_window(const GravityContext& c, WindowMeans& means);
+    // for the rest test and the GPS's sums. False: no sample. feed_low_pass false: the
+    // means only (the GPS's observations feed the low-pass: low_pass_observation).
+    bool low_pass_window(const GravityContext& c, WindowMeans& means, bool feed_low_pass = true);
+    // The GPS-aided gravity reading (GpsAid.h: earth axes, accel units) into the low-pass
+    // with the factor alpha_q30 (its interval against accel_lowpass_s).
+    void low_pass_observation(const linalg::Vector3l& observation, int32_t alpha_q30);
     // The low-pass's direction against earth down: the correction (units per step) and,
     // unless held (GyroBias::integrator_held), the bias's integral; the low-pass turns
     // with the correction.

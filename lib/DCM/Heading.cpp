@@ -180,6 +180,28 @@ bool HeadingCorrection::add_sample(const linalg::Vector3i& field, uint32_t norm2
     return mean_.complete();
 }
 
+void turn_heading_at_once(linalg::Matrix3q30& r, float cos_error, float sin_error) {
+    using linalg::mul_q30;
+    const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
+    const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
+    const Vector3l north(mul_q30(c, r.a.x) + mul_q30(sn, r.b.x), mul_q30(c, r.a.y) + mul_q30(sn, r.b.y),
+                         mul_q30(c, r.a.z) + mul_q30(sn, r.b.z));
+    r.b = Vector3l(mul_q30(c, r.b.x) - mul_q30(sn, r.a.x), mul_q30(c, r.b.y) - mul_q30(sn, r.a.y),
+                   mul_q30(c, r.b.z) - mul_q30(sn, r.a.z));
+    r.a = north;
+}
+
+void turn_heading(Strapdown& strapdown, float heading_error, float gain_1_s, float steps, const DcmCoefficients& k) {
+    // Into the turn not yet integrated (applied with the next integration): the row in
+    // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
+    // = 2.4e7 units: within 31 bits).
+    const int32_t size_units = linalg::fixed_from_float(-heading_error * gain_1_s * steps * k.units_per_rad_s, 0);
+    using linalg::q14_of;
+    const Vector3l& down = strapdown.r().c;
+    strapdown.add_turn(Vector3l(linalg::mul_q14(q14_of(down.x), size_units), linalg::mul_q14(q14_of(down.y), size_units),
+                                linalg::mul_q14(q14_of(down.z), size_units)));
+}
+
 // The heading's correction from a complete mean (kHeadingSteps steps, 12.5 Hz): out of
 // line (FIXED_OWN_FRAME), so that its float locals stay out of the 75 Hz part's frame.
 FIXED_OWN_FRAME HeadingResult HeadingCorrection::correct(const HeadingContext& ctx) {
@@ -213,18 +235,8 @@ FIXED_OWN_FRAME HeadingResult HeadingCorrection::correct(const HeadingContext& c
     ctx.trace.heading(verdict, gate_.ref_norm(), gate_.ref_down());
     if (verdict == FieldVerdict::kDisturbed) return HeadingResult{false, false};
     if (verdict == FieldVerdict::kNewField) {
-        // Its heading at once: R <- Rz(-error) R (the rotation that puts the field's
-        // horizontal part on north).
-        const float cos_error = field_ef.x * inv_horizontal;
-        using linalg::mul_q30;
-        const int32_t c = linalg::fixed_from_float(cos_error, linalg::kQ30);
-        const int32_t sn = linalg::fixed_from_float(sin_error, linalg::kQ30);
-        linalg::Matrix3q30& r = ctx.strapdown.r();
-        const Vector3l north(mul_q30(c, r.a.x) + mul_q30(sn, r.b.x), mul_q30(c, r.a.y) + mul_q30(sn, r.b.y),
-                             mul_q30(c, r.a.z) + mul_q30(sn, r.b.z));
-        r.b = Vector3l(mul_q30(c, r.b.x) - mul_q30(sn, r.a.x), mul_q30(c, r.b.y) - mul_q30(sn, r.a.y),
-                       mul_q30(c, r.b.z) - mul_q30(sn, r.a.z));
-        r.a = north;
+        // Its heading at once (the rotation that puts the field's horizontal part on north).
+        turn_heading_at_once(ctx.strapdown.r(), field_ef.x * inv_horizontal, sin_error);
         return HeadingResult{true, false};
     }
 
@@ -251,15 +263,8 @@ FIXED_OWN_FRAME HeadingResult HeadingCorrection::correct(const HeadingContext& c
         if (mean_gain_1_s > settings.kp_startup_1_s) mean_gain_1_s = settings.kp_startup_1_s;
         if (mean_gain_1_s > gain_1_s) gain_1_s = mean_gain_1_s;
     }
-    // Into the turn not yet integrated (applied with the next integration): the row in
-    // 16 bits times the turn's size in units (kp error steps, at most 5 * 20 rad/s steps
-    // = 2.4e7 units: within 31 bits).
-    const int32_t size_units = linalg::fixed_from_float(-heading_error * gain_1_s * steps * ctx.k.units_per_rad_s, 0);
-    using linalg::q14_of;
+    turn_heading(ctx.strapdown, heading_error, gain_1_s, steps, ctx.k);
     const Vector3l& down = ctx.strapdown.r().c;
-    ctx.strapdown.add_turn(Vector3l(linalg::mul_q14(q14_of(down.x), size_units),
-                                    linalg::mul_q14(q14_of(down.y), size_units),
-                                    linalg::mul_q14(q14_of(down.z), size_units)));
     // The compass's integral, while nothing else has measured the bias (GyroBias).
     ctx.trace.bias_before(ctx.bias, ctx.k);
     const bool learned = ctx.bias.learn_from_heading(down, heading_error, interval_steps, starting, settings, ctx.k);

@@ -138,6 +138,14 @@ struct HeadingResult {
     bool bias_learned;  // the compass's integral changed the bias estimate
 };
 
+// The heading turned at once by an error (the estimate's heading less the reference's,
+// by its cosine and sine): R <- Rz(-error) R (a new field's, the first GPS course).
+void turn_heading_at_once(linalg::Matrix3q30& r, float cos_error, float sin_error);
+// A heading error (its sine, saturated at +-1 beyond 90 deg) corrected at gain_1_s over
+// `steps` steps: the rotation about earth down by -error gain steps dt, into the turn not
+// yet integrated (in body axes earth down is R's third row).
+void turn_heading(Strapdown& strapdown, float heading_error, float gain_1_s, float steps, const DcmCoefficients& k);
+
 // A compass sample at least this recent (steps) watches the rest (75 Hz: 2-3 steps).
 constexpr uint16_t kRestCompassSteps = 20;
 

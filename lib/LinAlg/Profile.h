@@ -20,6 +20,8 @@ enum Part : uint8_t {
     kChecks = 12,         // the pipeline's sample checks and calibration before the DCM
     // 13 is the firmware's flight control step (firmware/Board.h).
     kMagFit = 14,         // one part of the `cal mag` fit (Pipeline), outside the estimator step
+    // 15..39 are the firmware's (firmware/Board.h).
+    kGpsAid = 40,         // a GPS fix into the estimator (Pipeline::on_gps_fix, 5 Hz)
     kBaroCompensation = 46,  // lib/MS5611: a D2's temperature terms or a D1's pressure (in the baro task)
 };
 

@@ -72,6 +72,44 @@ void AttitudePipeline::configure_turn(int16_t dv_dt_counts) {
     dcm_.set_turn(gain_q8 != 0 ? &turn_mean_ : nullptr);
 }
 
+void AttitudePipeline::on_gps_fix(const gps::Fix& fix) {
+    profile::begin(profile::kGpsAid);
+    take_gps_fix(fix);
+    profile::end(profile::kGpsAid);
+}
+
+void AttitudePipeline::take_gps_fix(const gps::Fix& fix) {
+    const flight::FlightSettings& fs = settings_.flight;
+    const float speed_cm_s = (float)fix.ground_speed_cm_s;
+    if (speed_cm_s >= kCourseMinSpeed_m_s * 100.0f) st_.gps_moving = true;
+    if (speed_cm_s < kGpsStillSpeed_m_s * 100.0f) st_.gps_moving = false;
+    const bool usable = fs.ahrs_gps_use != 0u && fix.fix == gps::FixType::k3D && fix.sats >= fs.ahrs_gps_minsats &&
+                        st_.phase == Phase::Running && st_.gps_moving;
+    if (!usable) {
+        dcm_.gps_unusable();
+        gps_itow_ms_ = 0;
+        return;
+    }
+    // The interval from the receiver's own clock (a fix's arrival jitters with the serial
+    // line and the loop); across the week's end it wraps within uint32.
+    const float interval_s = gps_itow_ms_ != 0u ? (float)(fix.itow_ms - gps_itow_ms_) * 0.001f : 0.0f;
+    gps_itow_ms_ = fix.itow_ms != 0u ? fix.itow_ms : 1u;
+    // Into the estimator's earth axes, whose north is the magnetic one: turned about down
+    // by the declination (a vector at true bearing b is at magnetic bearing b - decl).
+    const float decl_rad = settings_.declination_deg() * linalg::kRadPerDeg;
+    const float c = cosf(decl_rad), s = sinf(decl_rad);
+    const float n = (float)fix.vel_ned_cm_s[0] * 0.01f, e = (float)fix.vel_ned_cm_s[1] * 0.01f;
+    // NMEA carries no vertical speed: level, its change unseen (a climb's start, small).
+    const float d = fix.have_vertical_velocity ? (float)fix.vel_ned_cm_s[2] * 0.01f : 0.0f;
+    dcm_.on_gps_velocity(Vector3f(n * c + e * s, e * c - n * s, d), interval_s, fs.ahrs_gps_gain);
+    // The course for the heading without a working compass (AP_AHRS_DCM: above 3 m/s).
+    const bool compass_working = st_.mag_present && st_.steps_since_mag < kCompassStaleSteps;
+    if (compass_working || speed_cm_s < kCourseMinSpeed_m_s * 100.0f) return;
+    const uint16_t since = (uint16_t)((uint16_t)st_.steps - gps_course_step_);
+    gps_course_step_ = (uint16_t)st_.steps;
+    dcm_.correct_heading_from_course((float)fix.course_e5 * (linalg::kRadPerDeg * 1e-5f) - decl_rad, since);
+}
+
 bool RateLimiter::allow(uint32_t now, uint16_t interval) {
     // Events held back go out first, in deferred()'s line, which counts this one too.
     if (ever && (now - last < interval || held != 0)) {

@@ -45,6 +45,7 @@
 
 #include "Calibration.h"
 #include "Dcm.h"
+#include "GpsFix.h"
 #include "LinAlg.h"
 #include "Mpu6000.h"
 #include "Settings.h"
@@ -106,6 +107,18 @@ constexpr float kMagReferenceShift_uT = 2.5f;
 // velocity is not along x (on the ground, a launch, a stall): no correction. ArduPlane's
 // ARSPD_FBW_MIN default, about two thirds of a small aeroplane's stall.
 constexpr float kCentripetalMinAirspeed_m_s = 9.0f;
+// The GPS aids the estimator only in motion: from this ground speed on (AP_AHRS_DCM's
+// GPS_SPEED_MIN, where it takes the course as the heading: at a walk the course's noise,
+// 0.1 m/s of velocity noise across the track, is degrees) until it falls below
+// kGpsStillSpeed_m_s (its GPS_SPEED_RESET). Still or at a walk, the accelerations the GPS
+// could take off are below its own noise (0.1 m/s differentiated over a fix: 0.7 m/s^2),
+// and the accelerometer's low-pass averages a board's bounded motions without any: the
+// GPS-aided tilt would only be noisier (~0.1 deg RMS, 0.25 deg of heading through the dip).
+constexpr float kCourseMinSpeed_m_s = 3.0f;
+constexpr float kGpsStillSpeed_m_s = 1.0f;
+// A compass sample at most this old (steps: 0.5 s; it delivers at 75 Hz) is a working
+// compass: older, the GPS course takes the heading.
+constexpr uint16_t kCompassStaleSteps = 100;
 // Above the MPXV7002DP's full scale (2 kPa: 57 m/s) an airspeed is a fault: clamped.
 constexpr float kCentripetalMaxAirspeed_m_s = 60.0f;
 
@@ -228,6 +241,13 @@ public:
     void set_cruise_airspeed_m_s(float trim_m_s);
     float airspeed_m_s() const { return airspeed_m_s_; }
 
+    // A new GPS solution (call once per fix: the driver's fix_count() moved): its velocity
+    // aids the gravity correction (dcm::GpsAccel: the accelerometer less the GPS's
+    // acceleration, in place of the airspeed's or cruise speed's turn term) while the fix
+    // is 3D with AHRS_GPS_MINSATS satellites, AHRS_GPS_USE is 1 and the board moves
+    // (kCourseMinSpeed_m_s); AHRS_GPS_GAIN weighs it. Without a compass (or with one that stopped), its course above
+    // kCourseMinSpeed_m_s is the heading reference.
+    void on_gps_fix(const gps::Fix& fix);
     // One MPU6000 sample at the fixed 200 Hz step.
     void on_imu_sample(const mpu6000::Sample& s);
     // One magnetometer sample (body frame, uT, self-test scale applied, before the
@@ -295,6 +315,7 @@ private:
     // The estimator's turn correction from the airspeed (once running: TurnMean's space).
     void configure_turn(int16_t dv_dt_counts = 0);
     void step_mag_fit();
+    void take_gps_fix(const gps::Fix& fix);
     void finish_mag_calibration();
     void report_deferred();
     // An event to the sink; the short forms keep each call site small (flash).
@@ -321,6 +342,8 @@ private:
     linalg::Vector3l learn_turn_counts_;        // (counts summed over st_.learn_steps)
     linalg::Vector3f cal_field_uT_;             // the latest raw sample (for the `cal mag` sums)
     mpu6000::Sample last_;            // previous accepted sample (spike substitute)
+    uint32_t gps_itow_ms_ = 0;        // the last usable fix's time of week (0: none)
+    uint16_t gps_course_step_ = 0;    // st_.steps's low half at the last course given to the estimator
     float airspeed_m_s_ = 0.0f;
     uint16_t airspeed_step_ = 0;  // st_.steps's low half at the last measured airspeed
     linalg::Vector3i mag_cal_q5_;     // latest calibrated field (uT * 2^dcm::kFieldQ: dcm::field_q5_of)
@@ -354,6 +377,7 @@ private:
         bool cal_pending;               // cal_field_uT_ likewise
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
         bool start_moved;               // the start was never still: the calibration measuring on may see a turn
+        bool gps_moving;                // the GPS's ground speed passed kCourseMinSpeed_m_s (and not below kGpsStillSpeed_m_s since)
     };
     State st_;
     // One space for two phases (RAM): before the estimator runs the start's gravity if

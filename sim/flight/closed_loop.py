@@ -8,6 +8,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
+        [--gps ublox|nmea|none]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -21,8 +22,9 @@ elevons or vtail flies the outputs as an elevon or V-tail aeroplane's (the backe
 --airframe: the board is to be set to mix for it, ELEVON_OUTPUT or VTAIL_OUTPUT 1). --serial
 tcp:PORT attaches a ground station: apm25sim also serves the board's UART0 on TCP
 127.0.0.1:PORT (MAVProxy, QGroundControl, Mission Planner connect as to SITL's 5760) and
-flies in real time (--speed X for X times real time; 0 as fast as the host goes). Exit
-status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
+flies in real time (--speed X for X times real time; 0 as fast as the host goes). --gps
+KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS).
+Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
 import os
@@ -74,6 +76,7 @@ def parse_args(argv):
     p.add_argument("--airframe", default="plain", choices=("plain", "elevons", "vtail"),
                    help="the backend reads the outputs as this airframe's surfaces (default plain)")
     p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
+    p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
@@ -165,6 +168,8 @@ def run(args):
             sim_cmd += ["--serial", args.serial]
         if args.speed is not None:
             sim_cmd += ["--speed", "%g" % args.speed]
+        if args.gps:
+            sim_cmd += ["--gps", args.gps]
         sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)
 
         def watchdog():

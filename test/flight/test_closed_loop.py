@@ -53,6 +53,11 @@ GROUP is one of:
                   none) and says so; from 10 s to 20 s the roll within 3 deg of the truth and the
                   pitch within 5 (the aim is 3: the pitch estimate reads the aeroplane's
                   acceleration after the restart as nose up, and lags it by ~3 deg at 10 s)
+  turn_gps        the 60 s, 30 deg turn in light gusts on the DEFAULT settings without a pitot, with
+                  the simulator's u-blox on the GPS port (issue 45), from 10 s (the board says its
+                  3D fix before): the GPS's acceleration takes the turn's out of the accelerometer;
+                  the worst roll error in flight under 1 deg (DIR/turn_gps_bank.csv), against the
+                  same flight with `--gps none` (printed)
   determinism     the same flight twice: the same bytes on the serial line and the servo log
   elevons         ELEVON_OUTPUT 1 (typed on the console), the backend's --airframe elevons
                   (the aeroplane flown by the elevons' geometry, not by the firmware's
@@ -93,6 +98,7 @@ GUST_NAMES = {0: "no", 1: "light", 2: "moderate"}
 # the configured cruise speed only (TRIM_ARSPD_CM, the backend's trim speed: the turn's
 # power setting flies faster, the honest mismatch of a configured speed).
 TURN_SENSOR_MAX_DEG, TURN_CRUISE_MAX_DEG = 2.0, 5.0
+TURN_GPS_MAX_DEG = 1.0  # issue 45: with the GPS, without the airspeed sensor
 TRIM_ARSPD_CM = 1800
 DEFAULT_TRIM_ARSPD_CM = 1500  # lib/Settings/Params.cpp: the cruise speed a board assumes unless set
 # The pitch the Rascal flies level at its trim speed (the backend's trim: alpha 1.40 deg),
@@ -120,10 +126,11 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=(), hold=HOLD_S, airframe="plain"):
+                 console=(), hold=HOLD_S, airframe="plain", gps=None):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
         board (apm25sim --input: from its first angle line); airframe: how the backend reads
-        the outputs (closed_loop.py --airframe: plain, elevons, vtail)."""
+        the outputs (closed_loop.py --airframe: plain, elevons, vtail); gps: apm25sim --gps
+        (None: its default)."""
         self.name, self.seconds = name, seconds
         base = os.path.join(work, name)
         self.rc = write_rc(base + "_rc.csv", rows)
@@ -139,6 +146,8 @@ class Flight:
             cmd.append("--no-airspeed")
         if airframe != "plain":
             cmd += ["--airframe", airframe]
+        if gps:
+            cmd += ["--gps", gps]
         if console:
             with open(base + "_console.txt", "w") as f:
                 f.write("".join(line + "\n" for line in console))
@@ -351,10 +360,10 @@ def check_rc_loss(args):
     soft_assert(thr and all(abs(w - THROTTLE_US) <= FOLLOW_US for w in thr), "rc_loss: throttle not back on the stick")
 
 
-def fly_turn(args, name, **flight_options):
-    """The 60 s, 30 deg turn: (the Flight, the worst roll error in flight (t, error, true,
-    estimate), all banks finite), the banks logged to DIR/NAME_bank.csv and printed."""
-    t_turn = HOLD_S + 2.0
+def fly_turn(args, name, t_turn=HOLD_S + 2.0, **flight_options):
+    """The 60 s, 30 deg turn from t_turn: (the Flight, the worst roll error in flight (t,
+    error, true, estimate), all banks finite), the banks logged to DIR/NAME_bank.csv and
+    printed."""
     seconds = t_turn + 60.0
     rows = [row(0.0), row(t_turn, stick_for_bank(30), throttle=THROTTLE_US + 40)]
     f = Flight(args.work, name, rows, seconds, tools=args.tools, **flight_options)
@@ -411,6 +420,21 @@ def check_turn_cruise(args):
                 "turn_cruise: TRIM_ARSPD_CM not set before the turn: %r" % (said,))
     soft_assert(finite and abs(worst[1]) < TURN_CRUISE_MAX_DEG, "turn_cruise: worst roll error %.1f deg with the "
                 "configured cruise speed only (under %g)" % (worst[1], TURN_CRUISE_MAX_DEG))
+
+
+def check_turn_gps(args):
+    """Seed 45001; the same flight without the GPS for comparison. The turn begins once the
+    GPS has a 3D fix, as a flight leaves the ground with one (the board finds and configures
+    the module and the model has its first fix ~6.7 s after power-up)."""
+    t_turn = HOLD_S + 7.0
+    _, without, _ = fly_turn(args, "turn_gps_none", t_turn, airspeed=False, gust=1, seed=45001, gps="none")
+    f, worst, finite = fly_turn(args, "turn_gps", t_turn, airspeed=False, gust=1, seed=45001, gps="ublox")
+    print("turn_gps: worst roll error %.2f deg with the GPS, %.2f without" % (worst[1], without[1]))
+    fix = f.said("# gps: 3D fix")
+    soft_assert(fix is not None and fix[0] < t_turn, "turn_gps: no 3D fix said before the turn: %r" % (fix,))
+    soft_assert(f.said("# airspeed: no sensor") is not None, "turn_gps: the board found an airspeed sensor")
+    soft_assert(finite and abs(worst[1]) < TURN_GPS_MAX_DEG, "turn_gps: worst roll error %.2f deg with the GPS and no "
+                "airspeed sensor (under %g)" % (worst[1], TURN_GPS_MAX_DEG))
 
 
 def fly_default_turn(args, name, rows, seconds, seed):
@@ -679,7 +703,8 @@ GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_u
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
-          "restart_air": check_restart_air, "elevons": check_elevons, "vtail": check_vtail}
+          "restart_air": check_restart_air, "elevons": check_elevons, "vtail": check_vtail,
+          "turn_gps": check_turn_gps}
 
 
 def main():
