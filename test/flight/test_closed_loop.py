@@ -28,16 +28,16 @@ GROUP is one of:
                   the backend's airspeed: the true and the estimated bank, logged
                   (DIR/turn_bank.csv) and printed every 5 s; the worst roll error while the
                   aeroplane flies is under 2 deg (issue 24) and every bank finite
-  turn_cruise     the same turn without a pitot (the backend sends no airspeed: A0 at 0 V),
-                  TRIM_ARSPD_CM set to the trim speed (18 m/s) on the console before it: the
+  turn_cruise     the same turn without a pitot (the backend sends no airspeed: A0 at 0 V) and
+                  without a GPS (--gps none: the fallback a fix replaces), TRIM_ARSPD_CM set to the trim speed (18 m/s) on the console before it: the
                   board says it has no airspeed sensor and takes the set; the worst roll error
                   (DIR/turn_cruise_bank.csv) under 5 deg (issue 24) and every bank finite
-  turn45_default  DEFAULT settings and no pitot, light gusts: the stick held for a 45 deg bank for
+  turn45_default  DEFAULT settings, no pitot and no GPS, light gusts: the stick held for a 45 deg bank for
                   60 s, then centred for 15 s: the board says the cruise speed it assumes
                   (TRIM_ARSPD_CM), the aeroplane stays above 50 m (of 100) throughout, the true
                   bank is within 45 +- 12 deg from 10 s into the turn to its end, and within 8 deg
                   of level from 10 s after the roll-out
-  rc_loss_turn    DEFAULT settings and no pitot, light gusts: 20 s into a 45 deg turn the receiver
+  rc_loss_turn    DEFAULT settings, no pitot and no GPS, light gusts: 20 s into a 45 deg turn the receiver
                   dies: from 15 s into the failsafe to 25 s the TRUE bank is within 5 deg of level
                   (not only the estimate) and the aeroplane is in the air
   pitch_trim      still air, hands off in STABILIZE for 60 s with TRIM_PITCH_CD set to the model's
@@ -411,7 +411,8 @@ def check_turn(args):
 
 
 def check_turn_cruise(args):
-    f, worst, finite = fly_turn(args, "turn_cruise", airspeed=False, console=["set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    f, worst, finite = fly_turn(args, "turn_cruise", airspeed=False, gps="none",
+                                console=["set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
     said = f.said("# TRIM_ARSPD_CM")
     print("turn_cruise: the board said %r and %r" % (f.said("# airspeed:"), said))
     soft_assert(f.said("# airspeed: no sensor") is not None, "turn_cruise: the board did not say it has no "
@@ -438,9 +439,10 @@ def check_turn_gps(args):
 
 
 def fly_default_turn(args, name, rows, seconds, seed):
-    """A flight on the default settings without a pitot in light gusts; the aeroplane's
-    lowest height from the release and whether the board said its cruise speed."""
-    f = Flight(args.work, name, rows, seconds, gust=1, tools=args.tools, seed=seed, airspeed=False)
+    """A flight on the default settings without a pitot and without a GPS (the cruise
+    speed's fallback, which a GPS fix would replace) in light gusts; the aeroplane's lowest
+    height from the release and whether the board said its cruise speed."""
+    f = Flight(args.work, name, rows, seconds, gust=1, tools=args.tools, seed=seed, airspeed=False, gps="none")
     said = f.said("# airspeed: no sensor on A0")
     soft_assert(said is not None and said[1] == "# airspeed: no sensor on A0: cruise speed TRIM_ARSPD_CM %.2f m/s "
                 "assumed" % (DEFAULT_TRIM_ARSPD_CM / 100.0), "%s: the board did not say its cruise speed: %r" % (name, said))
