@@ -37,6 +37,8 @@ public:
     uint32_t missed_samples() const { return missed_; }
     // Time since the last sample was read (0 before the first).
     uint32_t us_since_sample(uint32_t now_us) const { return have_sample_time_ ? now_us - last_sample_us_ : 0u; }
+    // No sample time yet (the first sample, or the first after pacing changed): one may come any moment.
+    bool awaiting_sample() const { return !have_sample_time_; }
 
 private:
     mpu6000::Mpu6000 chip_;

@@ -135,7 +135,13 @@ struct Clock {
         return (uint16_t)((uint16_t)overflows << 8 | count);
     }
     // No sample can be late while the MPU6000 is down: nothing waits then.
-    static uint32_t us_since_sample() { return vehicle::imu.ok() ? vehicle::imu.us_since_sample(micros()) : 0u; }
+    // Before the first sample (or the first after pacing changed) only the kAlways rows run:
+    // the sample may come any moment, and a late first read would take a later sample and
+    // start the estimator off the fixed timeline (pipeline::kLoopStartMs).
+    static uint32_t us_since_sample() {
+        if (!vehicle::imu.ok()) return 0u;
+        return vehicle::imu.awaiting_sample() ? kDeadlineUs : vehicle::imu.us_since_sample(micros());
+    }
 };
 using Timing = sched::Timing<Clock>;
 
