@@ -288,7 +288,7 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour", console=None, 
     # The running estimator's step: the same run cut at RUNNING_FROM_S (simavr is exact, so
     # the first seconds are the same cycles) taken off, which leaves out the gyro
     # calibration's cheap steps and the start.
-    running = None
+    running_avg = None
     if running and 1 in rows and seconds > RUNNING_FROM_S:
         head = prof[:-len(".csv")] + "_start.csv"
         cut = list(cmd)
@@ -297,10 +297,10 @@ def measure_cycles(build, out_dir, seconds, scenario="tilt_tour", console=None, 
         r = subprocess.run(cut, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=1800)
         start = read_profile(head)[0].get(1) if r.returncode == 0 and os.path.exists(head) else None
         if start and rows[1]["count"] > start["count"]:
-            running = (rows[1]["total"] - start["total"]) / (rows[1]["count"] - start["count"])
+            running_avg = (rows[1]["total"] - start["total"]) / (rows[1]["count"] - start["count"])
         else:
             log("cycles: the run to %g s failed: no running step figure" % RUNNING_FROM_S)
-    return dict(sections=rows, window=run_window, load=load, seconds=seconds, running_step_avg=running,
+    return dict(sections=rows, window=run_window, load=load, seconds=seconds, running_step_avg=running_avg,
                 stack=read_stack(prof))
 
 
