@@ -94,7 +94,7 @@ static void once_a_second() {
     X(pump,         nullptr,                         serial_text::pump,                 800, kSecPump,         kAlways) \
     X(input,        nullptr,                         console_link::take_input,         2000, kSecInput,        kAlways) \
     X(command,      console_link::command_due,       console_link::reply,              5800, kSecCommand,      0)       \
-    X(reply,        console_link::reply_due_text,    console_link::reply,              2300, kSecConsoleReply, 0)       \
+    X(reply,        console_link::reply_due_text,    console_link::reply,              3200, kSecConsoleReply, 0)       \
     X(statustext,   console_link::reply_due_mavlink, console_link::reply,              3000, kSecStatusText,   0)       \
     X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           5800, kSecGcsRequest,   0)       \
     X(gcs_defaults, gcs_link::defaults_line_due,     gcs_link::say_defaults,           2300, kSecGcsDefaults,  0)       \
@@ -103,7 +103,7 @@ static void once_a_second() {
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
-    X(store,        nullptr,                         store_service,                    1500, kSecStore,        kAlways) \
+    X(store,        nullptr,                         store_service,                    1800, kSecStore,        kAlways) \
     X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
