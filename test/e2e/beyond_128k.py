@@ -337,10 +337,13 @@ TIMING_FIELDS = {1: [(12, 2)],   # SYS_STATUS.load
 # Receiver widths, in us, and what follows from them. simavr applies a pin edge at the end of
 # the instruction running when it is due, so Timer5's capture (0.5 us a count) of the same
 # edge may read one count apart when other instructions run (on the chip it is cycle-exact):
-# a width read 1 us apart, the outputs of the controllers fed with it 1 us apart. The servo
+# a width read 1 us apart. In MANUAL the outputs follow it 1 us apart; in STABILIZE the
+# stick's bank demand goes through the roll controller's P and its integrator, which sums
+# a read's difference over the steps until the next frame: up to 2.25 us apart on OUT1 (3
+# of 1000 pulses, STABILIZE from 10 s; a misplaced call is off by tens of us). The servo
 # log stamps each edge at an instruction boundary too (within 0.3 us, apm25sim --help).
 RC_TOLERANCE_US = 1
-SERVO_TOLERANCE_US = 2
+SERVO_TOLERANCE_US = 3
 SERVO_LOG_STAMP_US = 0.6
 # MAVLink messages whose fields are receiver or servo widths: (message id, first uint16
 # field's offset, count, tolerance in us).
