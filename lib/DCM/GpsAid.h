@@ -23,7 +23,7 @@
 // 1.2 deg).
 //
 // Formats: the windows' earth-frame means in accel units (counts * 2^8, Coefficients.h),
-// summed over at most kGpsMaxWindows (within 31 bits at 16 g); the velocity and the
+// clipped and summed over at most kGpsMaxWindows (within 31 bits); the velocity and the
 // observation's arithmetic in float (5 Hz).
 #pragma once
 
@@ -46,6 +46,9 @@ constexpr uint16_t kGpsMaxCourseSteps = 300;
 // The windows (50 Hz) a sum holds at most: kGpsMaxInterval_s and a late arrival (at 16 g
 // full scale a window's mean is 2^23 accel units at most: 80 of them within 2^31).
 constexpr uint8_t kGpsMaxWindows = 80;
+// A window's earth-frame mean is clipped to this (32 g): a body-axis 16 g on every axis is
+// sqrt(3) 2^23 in earth axes, and a sample no accelerometer gives must not wrap the sums.
+constexpr int32_t kGpsWindowLimit = (int32_t)1 << 24;
 // Without a usable fix for this many windows (1 s: five 5 Hz fixes, a 1 Hz fix late by
 // its serial transfer), the window's own low-pass (and the turn's term) takes over again.
 constexpr uint8_t kGpsTimeoutWindows = 75;
@@ -56,7 +59,7 @@ public:
     void add_window(const linalg::Vector3l& accel_ef) {
         if (since_fix_ < 255u) ++since_fix_;
         if (windows_[0] >= kGpsMaxWindows) return;  // too long for a derivative: the pair is refused
-        sums_[0] += accel_ef;
+        sums_[0] += linalg::Vector3l(clip(accel_ef.x), clip(accel_ef.y), clip(accel_ef.z));
         ++windows_[0];
     }
     // A usable fix's velocity (m/s, the estimator's earth axes: north the magnetic one) and
@@ -79,6 +82,7 @@ public:
     bool aiding() const { return aiding_ && since_fix_ <= kGpsTimeoutWindows; }
 
 private:
+    static int32_t clip(int32_t v) { return v > kGpsWindowLimit ? kGpsWindowLimit : v < -kGpsWindowLimit ? -kGpsWindowLimit : v; }
     // The sums of the windows between arrivals: [0] since the last fix, [1] and [2] the
     // two intervals before it (accel units), and their windows.
     linalg::Vector3l sums_[3];
