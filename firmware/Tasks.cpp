@@ -44,7 +44,7 @@ constexpr uint16_t kDeadlineUs = 7300;
 static void compass_service() { vehicle::compass.service(tick.now_ms); }
 static void estimator_step() {
     if (vehicle::imu.pacing_on_timer()) pipe.imu_doubtful();
-    // A new GPS solution goes into the estimator before the sample (issue 45: its velocity
+    // A new GPS solution goes into the estimator before the sample (its velocity
     // aids the gravity correction, its course the heading without a compass); its ~13k
     // cycles come five times a second (`make bench` section 40).
     static uint16_t gps_fixes_seen = 0;
