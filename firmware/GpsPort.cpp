@@ -209,20 +209,6 @@ void service() {
     }
 }
 
-// Degrees * 1e7 as "-73.1194210".
-static void degrees_e7(Writer& w, int32_t v) {
-    if (v < 0) w.chr('-');
-    const uint32_t a = v < 0 ? (uint32_t)(-v) : (uint32_t)v;
-    w.u32(a / 10000000u).chr('.');
-    char digits[7];
-    uint32_t frac = a % 10000000u;
-    for (int8_t i = 6; i >= 0; --i) {
-        digits[i] = (char)('0' + frac % 10u);
-        frac /= 10u;
-    }
-    w.str(digits, 7);
-}
-
 static void centi(Writer& w, int32_t v) {
     char buf[14];
     w.str(buf, text::format_centi(buf, v));
@@ -240,10 +226,7 @@ bool print(uint8_t part, const text::Sink* out) {
         quality(w).str(TXT(", hdop "));
         centi(w, f.hdop_cm);
         w.str(TXT(", "));
-        degrees_e7(w, f.lat_e7);
-        w.chr(' ');
-        degrees_e7(w, f.lon_e7);
-        w.str(TXT(", "));
+        w.degrees_e7(f.lat_e7).chr(' ').degrees_e7(f.lon_e7).str(TXT(", "));
         centi(w, f.alt_msl_mm / 10);
         w.str(TXT(" m")).end();
         return true;
