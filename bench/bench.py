@@ -70,8 +70,9 @@ SECTIONS = [
 
 # The budgets each figure is held to: (key, label, limit, unit). Flash is budgeted at
 # 200 KB with every feature (the 2560 has 256 KB, its bootloader 8 KB: cycles and RAM are
-# the scarce resources); static RAM at 3.5 KB with the GPS, barometer and navigation to
-# come, which leaves the stack (8 KB in all) its room.
+# the scarce resources); static RAM at 4.5 KB with arming, calibration, battery, missions
+# and navigation: the stack's high-water mark was 1.7 KB with the GPS, barometer and
+# position (issue 45), so 4.5 + 1.7 leaves more than STACK_SPARE_MIN of the 8 KB.
 CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 10000, ""),
                  ("step_cycles_max", "estimator step, max cycles", 30000, ""),
                  ("step_cycles_avg_shake", "estimator step on `shake`, avg cycles", 10000, ""),
@@ -88,7 +89,7 @@ CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 10000, ""),
                  ("euler_cycles_avg", "Euler extraction, avg cycles", 4000, ""),
                  ("loop_load_pct", "loop CPU load at 200 Hz", 25.0, "%"),
                  ("loop_cycles_max", "loop iteration, max cycles (`tilt_tour`, `shake`, each also in flight)", 40000, ""),
-                 ("ram_bytes", "static RAM", 3584, " B"),
+                 ("ram_bytes", "static RAM", 4608, " B"),
                  ("flash_bytes", "flash", 204800, " B"),
                  ("flash_attitude_only_bytes", "flash, attitude-only build (APM25_FLIGHT=0)", 204800, " B")]
 # The stack's high-water mark: the painted RAM (firmware/StackPaint.cpp) no profiled run

@@ -265,6 +265,21 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Compass declination", "rad",
                "The angle from true north to magnetic north, east positive, added to the heading the board "
                "reports: `decl` sets the same in degrees. Kept to a hundredth of a degree.")},
+    // The second record's rows (settings::VehicleSettings), each feature under its heading.
+    // Arming.
+    {"ARMING_REQUIRE", Type::UInt8, 0, 1, 0, AT(vehicle.arming_require), 0.0f, 1.0f, 1.0f,
+     PARAM_DOC("Require arming", "",
+               "1: the throttle output holds its minimum until the board is armed (the surfaces stay live); 0: "
+               "the throttle follows the stick from power-up and the board always reports armed.")},
+
+    // Board orientation, level, the accelerometer's calibration.
+
+    // Compass.
+
+    // Battery monitor and its failsafe.
+
+    // Telemetry rates.
+
 };
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
@@ -458,7 +473,7 @@ void each_flight_value(const Settings& s, F f) {
     Row row;
     for (uint8_t r = 0; r < kRowCount; ++r) {
         COPY_ROW(&row, &kRows[r]);
-        if (row.offset < offsetof(Settings, flight)) continue;
+        if (row.offset < offsetof(Settings, flight) || row.offset >= offsetof(Settings, vehicle)) continue;
         const uint8_t n = row.type == Type::Bit ? 1 : row.count;
         for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
     }
@@ -490,6 +505,50 @@ void flight_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out) {
         }
         at = (uint16_t)(at + len);
     });
+}
+
+namespace {
+
+// Calls f(pointer to the value's bytes, their count) for every stored value of the
+// second record (Settings::vehicle), in the record's order.
+template <typename F>
+void each_vehicle_value(const Settings& s, F f) {
+    Row row;
+    for (uint8_t r = 0; r < kRowCount; ++r) {
+        COPY_ROW(&row, &kRows[r]);
+        if (row.offset < offsetof(Settings, vehicle)) continue;
+        const uint8_t n = row.type == Type::Bit ? 1 : row.count;
+        for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
+    }
+}
+
+}  // namespace
+
+void vehicle_part(const Settings& s, uint8_t from, uint8_t n, uint8_t* out) {
+    uint16_t at = 0;
+    const uint16_t to = (uint16_t)(from + n);
+    each_vehicle_value(s, [&](uint8_t* p, uint8_t len) {
+        for (uint8_t j = 0; j < len; ++j) {
+            const uint16_t k = (uint16_t)(at + j);
+            if (k >= from && k < to) out[k - from] = p[j];
+        }
+        at = (uint16_t)(at + len);
+    });
+}
+
+void decode_vehicle(const uint8_t* in, uint8_t len, Settings& s) {
+    uint16_t at = 0;
+    each_vehicle_value(s, [&](uint8_t* p, uint8_t n) {
+        if (at + n <= len) memcpy(p, in + at, n);
+        at = (uint16_t)(at + n);
+    });
+}
+
+uint16_t vehicle_bytes() {
+    uint16_t at = 0;
+    const Settings s{};
+    each_vehicle_value(s, [&](uint8_t*, uint8_t n) { at = (uint16_t)(at + n); });
+    return at;
 }
 
 uint16_t flight_bytes() {

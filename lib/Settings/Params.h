@@ -64,6 +64,13 @@ void flight_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* 
 void decode_flight(const uint8_t* in, uint8_t n, settings::Settings& s);
 // What encode_flight writes (a test holds it to settings::kFlightBytes).
 uint16_t flight_bytes();
+// The second record's values (Settings::vehicle: the rows after COMPASS_DEC), in table
+// order as encode_flight's: vehicle_bytes() of them. A record with fewer (an older
+// firmware's) is this one's first part: decode_vehicle reads the values it holds whole
+// and leaves the others as they are (their defaults).
+void vehicle_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* out);
+void decode_vehicle(const uint8_t* in, uint8_t n, settings::Settings& s);
+uint16_t vehicle_bytes();
 // Every parameter within its range and the end points in order (settings::is_valid).
 bool all_valid(const settings::Settings& s);
 

@@ -29,6 +29,7 @@
 #include "SensorCalibration.h"
 #include "FlightSettings.h"
 #include "OutputMode.h"
+#include "VehicleSettings.h"
 
 namespace settings {
 
@@ -71,6 +72,7 @@ struct Settings {
     calib::Calibration cal;
     float gnd_abs_press_pa;        // GND_ABS_PRESS: the ground's pressure, measured at each start (not stored)
     flight::FlightSettings flight;  // Params.h has their names, ranges and defaults
+    VehicleSettings vehicle;        // the second record's (VehicleSettings.h)
 
     float declination_deg() const { return (float)declination_centideg * 0.01f; }
 };

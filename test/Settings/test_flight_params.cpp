@@ -194,3 +194,27 @@ TEST(FlightParams, GpsRowsAreNewInVersion5AndVersion4StillLoads) {
     EXPECT_FLOAT_EQ(up.flight.ahrs_gps_gain, 1.0f);
     EXPECT_FLOAT_EQ(up.flight.gnd_temp_c, 0.0f);
 }
+
+// The second record's rows (Settings::vehicle) are not in the first record's flight
+// bytes, and vehicle_part / decode_vehicle carry them whole; a shorter (older) second
+// record leaves the values it lacks at their defaults.
+TEST(FlightParams, VehicleRowsGoInTheSecondRecordOnly) {
+    EXPECT_EQ(params::flight_bytes(), settings::kFlightBytes);
+    const uint16_t n = params::vehicle_bytes();
+    ASSERT_GE(n, 1u);
+    ASSERT_LE(n, 240u);
+    settings::Settings in = settings::defaults();
+    ASSERT_TRUE(params::set(in, (uint16_t)params::find("ARMING_REQUIRE"), 0.0f));
+    uint8_t flight_in[settings::kFlightBytes], flight_def[settings::kFlightBytes];
+    params::encode_flight(in, flight_in);
+    params::encode_flight(settings::defaults(), flight_def);
+    EXPECT_EQ(0, memcmp(flight_in, flight_def, sizeof flight_in));
+    uint8_t bytes[240];
+    params::vehicle_part(in, 0, (uint8_t)n, bytes);
+    settings::Settings out = settings::defaults();
+    params::decode_vehicle(bytes, (uint8_t)n, out);
+    EXPECT_EQ(out.vehicle.arming_require, 0);
+    settings::Settings older = settings::defaults();
+    params::decode_vehicle(bytes, 0, older);
+    EXPECT_EQ(older.vehicle.arming_require, 1);
+}
