@@ -17,22 +17,18 @@ constexpr float kMinGroundSpeed_m_s = 0.1f;    // update_waypoint's floor
 constexpr float kMinLoiterSpeed_m_s = 1.0f;    // update_loiter's floor for the gains
 constexpr float kPassedB_s = 3.0f;             // past next by this long: back to next
 
-// v / |v|, or `fallback` when |v| is below min_len.
-NorthEast unit_or(const NorthEast& v, float min_len, const NorthEast& fallback, float& len) {
-    len = length(v);
-    if (len < min_len) return fallback;
-    return v * (1.0f / len);
-}
-
 }  // namespace
 
-float L1Control::limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel_unit) {
+float L1Control::limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel, float speed) {
     const int8_t side = eta_positive ? 1 : -1;
     // Beyond 162 deg on the other side than last step, the target behind (more than 120 deg
-    // off the course): keep turning the way it was (ArduPilot's _prevent_indecision).
+    // off the course: v.t < -|v||t|/2, squared): keep turning the way it was (ArduPilot's
+    // _prevent_indecision).
     int8_t used = side;
     if (cos_eta < kCos162) {
-        if (behind_side_ != 0 && behind_side_ != side && dot(vel_unit, target_dir_) < kCos120) used = behind_side_;
+        const float d = dot(vel, to_target_m_);
+        const bool behind = d < 0.0f && d * d > kCos120 * kCos120 * speed * speed * length_squared(to_target_m_);
+        if (behind_side_ != 0 && behind_side_ != side && behind) used = behind_side_;
         behind_side_ = used;
     } else {
         behind_side_ = 0;
@@ -45,101 +41,101 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
                                 const NorthEast& next_m) {
     const float k_l1 = 4.0f * params_.damping * params_.damping;
     circling_ = false;
+    to_target_m_ = next_m - pos_m;
 
     // The track's direction: prev to next, else here to next, else the way it flies.
-    NorthEast ab = next_m - prev_m;
-    float ab_len = length(ab);
-    float vg;
-    NorthEast vel_unit = unit_or(vel_m_s, kMinGroundSpeed_m_s, nav_dir_, vg);
+    float vg = length(vel_m_s);
+    const NorthEast ab = next_m - prev_m;
+    const float ab_len = length(ab);
     NorthEast ab_unit;
     if (ab_len > 1e-3f) {
         ab_unit = ab * (1.0f / ab_len);
     } else {
-        float to_next_len;
-        ab_unit = unit_or(next_m - pos_m, 1e-3f, vel_unit, to_next_len);
+        const float to_next_len = length(to_target_m_);
+        if (to_next_len > 1e-3f) {
+            ab_unit = to_target_m_ * (1.0f / to_next_len);
+        } else {
+            ab_unit = vg > kMinGroundSpeed_m_s ? vel_m_s * (1.0f / vg) : nav_dir_;
+        }
     }
     // Below 0.1 m/s the velocity's direction means nothing: the track's at 0.1 m/s
     // (ArduPilot takes the compass heading there).
     NorthEast vel = vel_m_s;
     if (vg < kMinGroundSpeed_m_s) {
         vg = kMinGroundSpeed_m_s;
-        vel_unit = ab_unit;
         vel = ab_unit * vg;
     }
+    const float inv_vg = 1.0f / vg;
     l1_m_ = kInvPi * params_.damping * params_.period_s * vg;
     const float inv_l1 = 1.0f / l1_m_;
-    const float inv_vg = 1.0f / vg;
 
     const NorthEast a_air = pos_m - prev_m;
     crosstrack_m_ = cross(a_air, ab_unit);
     const float along_m = dot(a_air, ab_unit);
-    const float a_dist_m = length(a_air);
+    // Behind prev by more than L1, beyond +-135 deg of the track: along < -0.7071 max(|a|, 1),
+    // squared to spare a square root.
+    const float a_dist2 = length_squared(a_air);
+    const bool behind_prev = along_m < 0.0f && a_dist2 > l1_m_ * l1_m_ &&
+                             (a_dist2 >= 1.0f ? along_m * along_m > 0.5f * a_dist2 : along_m < -kSin45);
 
-    float sin_eta, cos_eta;
-    bool eta_positive;
-    if (a_dist_m > l1_m_ && along_m < -kSin45 * (a_dist_m > 1.0f ? a_dist_m : 1.0f)) {
-        // Behind prev, beyond +-135 deg of the track: fly to prev.
-        nav_dir_ = a_air * (-1.0f / a_dist_m);
-        target_dir_ = nav_dir_;
-        const float xvel = cross(vel, nav_dir_);
+    float sin_eta, cos_eta, xvel;
+    if (behind_prev || along_m > ab_len + vg * kPassedB_s) {
+        // Fly to prev; or, 3 s past next, back to next.
+        const NorthEast to = behind_prev ? a_air * -1.0f : to_target_m_;
+        const float len = length(to);
+        nav_dir_ = len > 1e-3f ? to * (1.0f / len) : ab_unit;
+        if (behind_prev) to_target_m_ = to;
+        xvel = cross(vel, nav_dir_);
         sin_eta = xvel * inv_vg;
         cos_eta = dot(vel, nav_dir_) * inv_vg;
-        eta_positive = xvel >= 0.0f;
-    } else if (along_m > ab_len + vg * kPassedB_s) {
-        // 3 s past next: back to next.
-        float len;
-        nav_dir_ = unit_or(next_m - pos_m, 1e-3f, ab_unit, len);
-        target_dir_ = nav_dir_;
-        const float xvel = cross(vel, nav_dir_);
-        sin_eta = xvel * inv_vg;
-        cos_eta = dot(vel, nav_dir_) * inv_vg;
-        eta_positive = xvel >= 0.0f;
     } else {
         // eta2: the velocity's angle to the track; eta1: the angle to the L1 point.
-        const float xvel = cross(vel, ab_unit);
+        xvel = cross(vel, ab_unit);
         const float sin2 = xvel * inv_vg;
         const float cos2 = dot(vel, ab_unit) * inv_vg;
         const float sin1 = linalg::constrain(crosstrack_m_ * inv_l1, -kSin45, kSin45);
         const float cos1 = linalg::safe_sqrt(1.0f - sin1 * sin1);
         sin_eta = sin1 * cos2 + cos1 * sin2;
         cos_eta = cos1 * cos2 - sin1 * sin2;
-        // |eta1| <= 45 deg, so beyond 90 deg eta has eta2's sign.
-        eta_positive = xvel >= 0.0f;
         nav_dir_ = rotated(ab_unit, cos1, sin1);
-        float len;
-        target_dir_ = unit_or(next_m - pos_m, 1e-3f, ab_unit, len);
     }
-    const float s = limited_sin_eta(sin_eta, cos_eta, eta_positive, vel_unit);
+    // Beyond 90 deg eta has eta2's sign (|eta1| <= 45 deg), the sign of the cross product.
+    const float s = limited_sin_eta(sin_eta, cos_eta, xvel >= 0.0f, vel, vg);
     lat_acc_m_s2_ = k_l1 * vg * vg * inv_l1 * s;
 }
 
 void L1Control::update_loiter(const NorthEast& pos_m, const NorthEast& vel_m_s, const NorthEast& centre_m,
                               float radius_m, int8_t direction) {
-    const float omega = 2.0f * linalg::kPi / params_.period_s;
+    // omega = 2 pi / T; and K_L1 Vg^2 / L1 = 4 pi damping Vg / T: one divide for both.
+    const float inv_period = 1.0f / params_.period_s;
+    const float omega = 2.0f * linalg::kPi * inv_period;
     const float kx = omega * omega;
     const float kv = 2.0f * params_.damping * omega;
-    const float k_l1 = 4.0f * params_.damping * params_.damping;
     const float dir = direction < 0 ? -1.0f : 1.0f;
 
-    float speed;
-    const NorthEast vel_unit = unit_or(vel_m_s, 0.1f, nav_dir_ * -1.0f, speed);
+    const float speed = length(vel_m_s);
+    const float inv_speed = speed > 1e-3f ? 1.0f / speed : 0.0f;
     const float vg = speed > kMinLoiterSpeed_m_s ? speed : kMinLoiterSpeed_m_s;
     l1_m_ = kInvPi * params_.damping * params_.period_s * vg;
 
-    // From the centre to the plane; on the centre itself, along the velocity.
+    // From the centre to the plane; on the centre itself, along the velocity (or north).
     const NorthEast a_air = pos_m - centre_m;
-    float dist_m;
-    const NorthEast out_unit = unit_or(a_air, 0.1f, vel_unit, dist_m);
+    const float dist_m = length(a_air);
+    NorthEast out_unit;
+    if (dist_m > 0.1f) {
+        out_unit = a_air * (1.0f / dist_m);
+    } else {
+        out_unit = speed > 0.1f ? vel_m_s * inv_speed : ne(1.0f, 0.0f);
+    }
+    to_target_m_ = a_air * -1.0f;
 
     // Capture: the L1 law steering at the centre.
     const float xvel_cap = cross(out_unit, vel_m_s);  // across the radial
     const float lvel_cap = -dot(vel_m_s, out_unit);   // inbound along the radial
-    const float inv_speed = speed > 1e-3f ? 1.0f / speed : 0.0f;
-    target_dir_ = out_unit * -1.0f;
-    nav_dir_ = target_dir_;
+    nav_dir_ = out_unit * -1.0f;
     const float s = limited_sin_eta(xvel_cap * inv_speed, speed > 1e-3f ? lvel_cap * inv_speed : 1.0f,
-                                    xvel_cap >= 0.0f, vel_unit);
-    const float acc_capture = k_l1 * vg * vg / l1_m_ * s;
+                                    xvel_cap >= 0.0f, vel_m_s, speed);
+    const float acc_capture = 4.0f * linalg::kPi * params_.damping * vg * inv_period * s;
 
     // On the circle: PD on the radius error plus the centripetal acceleration.
     const float radial_vel = -lvel_cap;
@@ -170,7 +166,7 @@ int16_t L1Control::nav_roll_cd(int16_t lim_roll_cd, float cos_pitch) const {
 }
 
 float L1Control::nav_bearing_rad() const { return bearing_rad(nav_dir_); }
-float L1Control::target_bearing_rad() const { return bearing_rad(target_dir_); }
+float L1Control::target_bearing_rad() const { return bearing_rad(to_target_m_); }
 
 float L1Control::turn_distance_m(float wp_radius_m) const { return wp_radius_m < l1_m_ ? wp_radius_m : l1_m_; }
 

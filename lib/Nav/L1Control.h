@@ -20,7 +20,7 @@
 // Angles as sines and cosines: sin(eta1 + eta2) by the sum formula, eta2's sine and cosine
 // from the cross and dot products of the velocity and the track, the bearings kept as unit
 // vectors (bearing_rad() turns one into an angle for telemetry). Per step one atan (the
-// bank), two or three square roots and three or four divides; no sin, cos or asin.
+// bank, fast_atan2), two or three square roots and three or four divides; no sin, cos or asin.
 // Signs: cross-track error positive left of the track (ArduPilot's A_air % AB), lateral
 // acceleration and bank positive to the right.
 #pragma once
@@ -59,10 +59,10 @@ public:
     int16_t nav_roll_cd(int16_t lim_roll_cd, float cos_pitch = 1.0f) const;
     // Metres off the track (positive left of it); on a loiter, the distance outside the circle.
     float crosstrack_error_m() const { return crosstrack_m_; }
-    // Unit vectors: towards the L1 point (nav_bearing) and towards the waypoint or the
-    // loiter's centre (target_bearing).
+    // Towards the L1 point (nav_bearing; a unit vector), and the metres to the waypoint or
+    // the loiter's centre (target_bearing).
     const NorthEast& nav_direction() const { return nav_dir_; }
-    const NorthEast& target_direction() const { return target_dir_; }
+    const NorthEast& to_target_m() const { return to_target_m_; }
     float nav_bearing_rad() const;
     float target_bearing_rad() const;
     float l1_distance_m() const { return l1_m_; }
@@ -77,14 +77,14 @@ private:
     // sin(eta) limited to +-90 deg, from eta's sine and cosine and the sign of eta when
     // beyond 90 deg; holds the last side when the target is behind (ArduPilot's
     // _prevent_indecision).
-    float limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel_unit);
+    float limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel, float speed);
 
     const L1Params& params_;
     float lat_acc_m_s2_ = 0.0f;
     float crosstrack_m_ = 0.0f;
     float l1_m_ = 0.0f;
     NorthEast nav_dir_ = {1.0f, 0.0f};
-    NorthEast target_dir_ = {1.0f, 0.0f};
+    NorthEast to_target_m_ = {1.0f, 0.0f};
     int8_t behind_side_ = 0;  // the sign of eta when it was beyond 162 deg last step, else 0
     bool circling_ = false;
 };

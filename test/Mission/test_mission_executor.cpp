@@ -35,6 +35,12 @@ struct Flight {
         exec.update(s, l1);
         return exec.current_seq();
     }
+    // One step at pos_m (L1 as it was); the seq current after.
+    uint16_t at(float north_m, float east_m) {
+        s.pos_m = ne(north_m, east_m);
+        exec.update(s, l1);
+        return exec.current_seq();
+    }
 };
 
 TEST(MissionExecutor, WaypointsInOrderThenLoiterAtHome) {
@@ -70,19 +76,11 @@ TEST(MissionExecutor, ReachedWithinTheTurnDistanceOrOncePast) {
     r.exec.start(r.s);
     r.l1.update_waypoint(r.s.pos_m, ne(15.0f, 0.0f), ne(0.0f, 0.0f), ne(500.0f, 0.0f));
     // A 90-degree turn next: WP_RADIUS 30 (L1 is 71.6 m).
-    r.s.pos_m = ne(469.0f, 0.0f);
-    r.exec.update(r.s, r.l1);
-    EXPECT_EQ(r.exec.current_seq(), 1u);
-    r.s.pos_m = ne(471.0f, 0.0f);
-    r.exec.update(r.s, r.l1);
-    EXPECT_EQ(r.exec.current_seq(), 2u);
+    EXPECT_EQ(r.at(469.0f, 0.0f), 1u);
+    EXPECT_EQ(r.at(471.0f, 0.0f), 2u);
     // 100 m off the waypoint but past the line through it across the leg: passed.
-    r.s.pos_m = ne(400.0f, 499.0f);
-    r.exec.update(r.s, r.l1);
-    EXPECT_EQ(r.exec.current_seq(), 2u);
-    r.s.pos_m = ne(400.0f, 501.0f);
-    r.exec.update(r.s, r.l1);
-    EXPECT_EQ(r.exec.current_seq(), 3u);
+    EXPECT_EQ(r.at(400.0f, 499.0f), 2u);
+    EXPECT_EQ(r.at(400.0f, 501.0f), 3u);
 }
 
 TEST(MissionExecutor, GentleTurnSwitchesLater) {
@@ -91,12 +89,8 @@ TEST(MissionExecutor, GentleTurnSwitchesLater) {
     r.f.upload({r.f.wp(500.0f, 0.0f, 50.0f), r.f.wp(1000.0f, 500.0f, 50.0f)});
     r.exec.start(r.s);
     r.l1.update_waypoint(r.s.pos_m, ne(15.0f, 0.0f), ne(0.0f, 0.0f), ne(500.0f, 0.0f));
-    r.s.pos_m = ne(484.0f, 0.0f);
-    r.exec.update(r.s, r.l1);
-    EXPECT_EQ(r.exec.current_seq(), 1u);
-    r.s.pos_m = ne(486.0f, 0.0f);
-    r.exec.update(r.s, r.l1);
-    EXPECT_EQ(r.exec.current_seq(), 2u);
+    EXPECT_EQ(r.at(484.0f, 0.0f), 1u);
+    EXPECT_EQ(r.at(486.0f, 0.0f), 2u);
 }
 
 TEST(MissionExecutor, DoJumpCountsAndForever) {

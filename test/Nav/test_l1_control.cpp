@@ -202,7 +202,8 @@ TEST(L1Control, LoiterCaptureOnlyOnTheCircle) {
     EXPECT_FALSE(l1.loiter_captured());
     EXPECT_NEAR(l1.lateral_accel_m_s2(), 0.0f, 1e-4f);
     EXPECT_NEAR(l1.crosstrack_error_m(), 440.0f, 1e-3f);
-    EXPECT_NEAR(l1.target_direction().north_m, 1.0f, 1e-6f);
+    EXPECT_NEAR(l1.to_target_m().north_m, 500.0f, 1e-3f);
+    EXPECT_NEAR(l1.target_bearing_rad(), 0.0f, 1e-5f);
     // On the circle, flying clockwise along it: the centripetal V^2 / R to the right.
     l1.update_loiter(ne(0.0f, -60.0f), ne(15.0f, 0.0f), ne(0.0f, 0.0f), 60.0f, 1);
     EXPECT_TRUE(l1.loiter_captured());

@@ -14,17 +14,7 @@
 namespace {
 
 nav::TecsInput cruise_input(float height_dem_m, float eas_dem_m_s, const testplane::PointMass& m, bool airspeed) {
-    nav::TecsInput in;
-    in.height_dem_m = height_dem_m;
-    in.eas_dem_m_s = eas_dem_m_s;
-    in.eas_m_s = m.tas_m_s;
-    in.have_airspeed = airspeed;
-    in.eas2tas = 1.0f;
-    in.cos_bank_sq = m.cos_bank_sq();
-    in.pitch_rad = m.pitch_rad;
-    in.stage = nav::TecsStage::kNormal;
-    in.takeoff_pitch_cd = 0;
-    return in;
+    return testplane::tecs_input(m, height_dem_m, eas_dem_m_s, airspeed);
 }
 
 struct Flight {
