@@ -219,6 +219,12 @@ TEST(MissionExecutor, ChangeSpeedActsWhenThePrecedingWaypointStarts) {
     r.arrive();  // seq 2 starts: the DO_CHANGE_SPEED after it acts
     EXPECT_EQ(r.exec.airspeed_cm_s(), 1800u);
     EXPECT_EQ(r.exec.throttle_pct(), 60);
+    // Before the first navigation command: at the start.
+    Flight first;
+    first.f.upload({speed, first.f.wp(300.0f, 0.0f, 50.0f)});
+    first.exec.start(first.s);
+    EXPECT_EQ(first.exec.current_seq(), 2u);
+    EXPECT_EQ(first.exec.airspeed_cm_s(), 1800u);
 }
 
 TEST(MissionExecutor, GlideSlopeSpreadsBigChangesOnly) {

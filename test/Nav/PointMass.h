@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A point-mass aeroplane for the navigation's host tests (L1, TECS, the route): the bank
 // and the pitch follow their demands through first-order lags (the attitude controllers),
-// the pitch is the flight path angle (the angle of attack taken as constant), the turn
+// the flight path is the pitch less a constant angle of attack (0 unless set), the turn
 // is coordinated (heading rate g tan(bank) / V), and the airspeed follows thrust, drag
 // and gravity. The airframe: kThrust_m_s2 at full throttle, level at 15 m/s on 45 %
 // (drag 0.012 V^2), induced drag kInduced_m_s2 (1/cos^2 bank - 1); so at 15 m/s it climbs
@@ -28,27 +28,29 @@ struct PointMass {
     float pitch_rad = 0.0f;
     float bank_rad = 0.0f;
     nav::NorthEast wind_m_s = {0.0f, 0.0f};
+    float alpha_rad = 0.0f;  // angle of attack: the flight path is the pitch less this
     float pitch_tau_s = 0.3f;
     float bank_tau_s = 0.5f;
     // The last step's accelerations, as TECS's 50 Hz filters take them.
     float accel_fwd_m_s2 = 0.0f;
     float accel_up_m_s2 = 0.0f;
 
-    nav::NorthEast ground_velocity() const { return heading * (tas_m_s * cosf(pitch_rad)) + wind_m_s; }
+    float path_rad() const { return pitch_rad - alpha_rad; }
+    nav::NorthEast ground_velocity() const { return heading * (tas_m_s * cosf(path_rad())) + wind_m_s; }
     float cos_bank_sq() const { return cosf(bank_rad) * cosf(bank_rad); }
 
     void step(float pitch_dem_rad, float bank_dem_rad, float throttle, float dt_s) {
-        const float climb_before = tas_m_s * sinf(pitch_rad);
+        const float climb_before = tas_m_s * sinf(path_rad());
         pitch_rad += (pitch_dem_rad - pitch_rad) * dt_s / pitch_tau_s;
         bank_rad += (bank_dem_rad - bank_rad) * dt_s / bank_tau_s;
         const float c2 = cosf(bank_rad) * cosf(bank_rad);
         accel_fwd_m_s2 = kThrust_m_s2 * throttle - kDragPerV2 * tas_m_s * tas_m_s -
-                         kInduced_m_s2 * (1.0f / c2 - 1.0f) - kG * sinf(pitch_rad);
+                         kInduced_m_s2 * (1.0f / c2 - 1.0f) - kG * sinf(path_rad());
         tas_m_s += accel_fwd_m_s2 * dt_s;
         if (tas_m_s < 5.0f) tas_m_s = 5.0f;
         pos_m = pos_m + ground_velocity() * dt_s;
-        height_m += tas_m_s * sinf(pitch_rad) * dt_s;
-        accel_up_m_s2 = (tas_m_s * sinf(pitch_rad) - climb_before) / dt_s;
+        height_m += tas_m_s * sinf(path_rad()) * dt_s;
+        accel_up_m_s2 = (tas_m_s * sinf(path_rad()) - climb_before) / dt_s;
         const float turn = kG * tanf(bank_rad) / tas_m_s * dt_s;
         heading = nav::rotated(heading, cosf(turn), sinf(turn));
         heading = heading * (1.0f / nav::length(heading));

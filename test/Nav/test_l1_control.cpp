@@ -195,6 +195,16 @@ TEST(L1Control, LoiterHoldsTheRadiusEitherWayRound) {
     EXPECT_TRUE(captured);
 }
 
+TEST(L1Control, LoiterTheWrongWayRoundTurnsBack) {
+    // Inside a clockwise circle (50 m of 60), flying it counter-clockwise and drifting out:
+    // the radius PD would turn it further the wrong way; it is held at 0, so only the
+    // centripetal term is left, to the right: Vt^2 / 50.
+    nav::L1Control l1(nav::kL1Defaults);
+    l1.update_loiter(ne(0.0f, -50.0f), ne(-15.0f, -1.0f), ne(0.0f, 0.0f), 60.0f, 1);
+    EXPECT_TRUE(l1.loiter_captured());
+    EXPECT_NEAR(l1.lateral_accel_m_s2(), 225.0f / 50.0f, 1e-3f);
+}
+
 TEST(L1Control, LoiterCaptureOnlyOnTheCircle) {
     nav::L1Control l1(nav::kL1Defaults);
     // 500 m out, flying at the centre: the capture law, steering at the centre.

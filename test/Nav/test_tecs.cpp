@@ -50,6 +50,37 @@ TEST(Tecs, HeightFilterFollowsASteadyClimbWithoutLag) {
     EXPECT_NEAR(tecs.height_m(), 20.04f, 0.005f);
 }
 
+TEST(Tecs, HeightFilterPolesAtHgtOmega) {
+    // A 1 m step of the barometer at rest: with all three poles at w the estimate is
+    // 1 - exp(-w t) (1 - 2 w t + (w t)^2 / 2): 1.184 at w t = 1 (an overshoot), 0.983 at 6.
+    nav::Tecs tecs(nav::kTecsDefaults);  // TECS_HGT_OMEGA 3
+    tecs.update_50hz(0.0f, 0.0f, 0.0f, 0.02f);
+    float at_third = 0.0f;
+    for (int i = 1; i <= 100; ++i) {
+        tecs.update_50hz(1.0f, 0.0f, 0.0f, 0.02f);
+        if (i == 17) at_third = tecs.height_m();  // t = 0.34 s
+    }
+    EXPECT_NEAR(at_third, 1.0f + 0.184f, 0.03f);
+    EXPECT_NEAR(tecs.height_m(), 0.983f, 0.01f);
+}
+
+TEST(Tecs, IntegratorsTakeOutATrimError) {
+    // The airframe needs 45 % to cruise level, TRIM_THROTTLE says 35, and it flies 3 deg
+    // nose up at zero flight path: the throttle and pitch integrators find both.
+    Flight f;
+    f.params.trim_throttle_pct = 35;
+    f.tecs.set_params();
+    f.plane.alpha_rad = 0.0524f;
+    f.fly(150.0f, 100.0f, 15.0f, true);
+    float worst_h = 0.0f, worst_v = 0.0f;
+    f.fly(30.0f, 100.0f, 15.0f, true, [&] {
+        worst_h = fmaxf(worst_h, fabsf(f.plane.height_m - 100.0f));
+        worst_v = fmaxf(worst_v, fabsf(f.plane.tas_m_s - 15.0f));
+    });
+    EXPECT_LT(worst_h, 0.3f);
+    EXPECT_LT(worst_v, 0.2f);
+}
+
 TEST(Tecs, EnergyBalanceSigns) {
     // Trimmed level at 100 m and 15 m/s, then one demand changed at a time.
     Flight base;
@@ -145,6 +176,28 @@ TEST(Tecs, NewHeightHeldWithoutAirspeed) {
     });
     EXPECT_NEAR((h6 - h12) / 6.0f, 5.0f, 0.3f);
     EXPECT_NEAR(f.plane.height_m, 50.0f, 1.0f);
+}
+
+TEST(Tecs, UnderspeedAsksForTheLeastAirspeedAndSpeedFirst) {
+    // 7 m/s on the pitot (below 0.9 ARSPD_FBW_MIN) while asked for 15 and 50 m up: full
+    // throttle, then underspeed: the speed demand goes to ARSPD_FBW_MIN 9 m/s and the pitch
+    // puts the speed first (nose down, the height demand above notwithstanding).
+    nav::Tecs tecs(nav::kTecsDefaults);
+    testplane::PointMass m;
+    nav::TecsInput in = cruise_input(150.0f, 15.0f, m, true);
+    in.eas_m_s = 7.0f;
+    for (int i = 0; i < 5; ++i) tecs.update_50hz(100.0f, 0.0f, 0.0f, 0.02f);
+    bool seen = false;
+    for (int i = 0; i < 100; ++i) {
+        tecs.update_50hz(100.0f, 0.0f, 0.0f, 0.02f);
+        tecs.update_pitch_throttle(in, 0.1f);
+        seen = seen || tecs.underspeed();
+    }
+    EXPECT_TRUE(seen);
+    EXPECT_TRUE(tecs.underspeed());
+    EXPECT_NEAR(tecs.tas_dem_adj_m_s(), 9.0f, 0.01f);
+    EXPECT_EQ(tecs.throttle_pct(), 75u);
+    EXPECT_LT(tecs.pitch_dem_rad(), 0.0f);
 }
 
 TEST(Tecs, TakeoffFullThrottleAndTheTakeoffPitch) {
