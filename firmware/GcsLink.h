@@ -32,6 +32,8 @@ bool defaults_line_due();
 void say_defaults();
 bool save_due();
 void save();
+// A save in a pass of its own, as after a PARAM_SET (the compass calibration accepted).
+void save_soon();
 bool param_value_due();
 void send_param_value();
 bool streams_due();

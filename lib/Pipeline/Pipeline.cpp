@@ -533,11 +533,13 @@ void AttitudePipeline::restart_estimator() {
     st_.spike_run = 0;
 }
 
-void AttitudePipeline::start_mag_calibration() {
+void AttitudePipeline::start_mag_calibration(bool hold) {
     if (!st_.mag_present) {
         tell(EventKind::kMagCalNoCompass);
         return;
     }
+    st_.mag_cal_hold = hold;
+    st_.mag_cal_end = MagCalState::kNone;
     // The centre in use (the fit's offset plus the learned one, which W ~ I barely
     // changes) centres the fit's sums.
     mag_cal_.restart(settings_.cal.mag_offset_uT + settings_.cal.mag_learned_uT);
@@ -561,17 +563,52 @@ void AttitudePipeline::step_mag_fit() {
 
 void AttitudePipeline::finish_mag_calibration() {
     const calib::MagCalibrator::Quality q = mag_cal_.quality();
-    if (q == calib::MagCalibrator::Quality::Ok) {
-        calib::Calibration& c = settings_.cal;
-        mag_cal_.result(c);
-        // The DCM takes the heading from the new calibration.
-        recalibrate_latest_field(calib::apply_mag(c, cal_field_uT_));
-        settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
+    const bool ok = q == calib::MagCalibrator::Quality::Ok;
+    st_.mag_cal_end = !ok ? MagCalState::kFailed : st_.mag_cal_hold ? MagCalState::kWaiting : MagCalState::kApplied;
+    if (st_.mag_cal_end == MagCalState::kApplied) {
+        mag_cal_.result(settings_.cal);
+        use_mag_calibration();
     }
     tell(EventKind::kMagCalDone, mag_cal_.coverage_pct(), mag_cal_.count(),
          q == calib::MagCalibrator::Quality::NotEarthField ? mag_cal_.radius_uT() : mag_cal_.residual_uT(),
          (uint8_t)q);
-    if (q != calib::MagCalibrator::Quality::Ok) return;
+}
+
+bool AttitudePipeline::accept_mag_calibration() {
+    if (st_.mag_cal_end != MagCalState::kWaiting) return false;
+    mag_cal_.result(settings_.cal);
+    use_mag_calibration();
+    st_.mag_cal_end = MagCalState::kApplied;
+    return true;
+}
+
+void AttitudePipeline::cancel_mag_calibration() {
+    st_.mag_cal_active = st_.mag_fit_active = st_.cal_pending = false;
+    st_.mag_cal_end = MagCalState::kNone;
+}
+
+void AttitudePipeline::take_mag_calibration() {
+    settings_.cal.mag_learned_uT = Vector3f();
+    use_mag_calibration();
+}
+
+MagCalState AttitudePipeline::mag_cal_state() const {
+    return st_.mag_cal_active ? MagCalState::kCollecting : st_.mag_fit_active ? MagCalState::kFitting : st_.mag_cal_end;
+}
+
+uint8_t AttitudePipeline::mag_cal_progress_pct() const {
+    const MagCalState m = mag_cal_state();
+    if (m == MagCalState::kCollecting)
+        return (uint8_t)((uint32_t)st_.mag_cal_steps * 100u / ((uint32_t)calib::kMagCalSeconds * kRateHz));
+    return m == MagCalState::kFitting ? 99u : m == MagCalState::kNone ? 0u : 100u;
+}
+
+// settings_.cal holds a new compass calibration (learned offset zero): in use from the
+// next sample, the compass flagged calibrated.
+void AttitudePipeline::use_mag_calibration() {
+    // The DCM takes the heading from the new calibration.
+    recalibrate_latest_field(calib::apply_mag(settings_.cal, cal_field_uT_));
+    settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
     // Applied from the next sample: the estimator learns the calibrated field afresh.
     learner_.restart(calib::kLearnPriorCalibrated_uT, Vector3f());
     if (st_.phase == Phase::Running) {

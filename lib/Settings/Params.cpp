@@ -52,6 +52,8 @@ struct Row {
 #define AT(member) ((uint16_t)offsetof(Settings, member))
 constexpr uint8_t kEp = (uint8_t)sizeof(flight::EndPoints);
 constexpr uint8_t kN = flight::kChannels;
+// A row numbered X, Y, Z ("COMPASS_OFS_#"): the number's character is '0' + first + instance.
+constexpr uint8_t kLetterX = (uint8_t)('X' - '0');
 
 // The ranges are ArduPilot's where it documents one, the widths' the PPM decoder's
 // plausible ones. The defaults are ArduPlane's but for the integrator gains. Roll: ArduPlane
@@ -274,7 +276,26 @@ const Row kRows[] PARAM_TABLE = {
 
     // Board orientation, level, the accelerometer's calibration.
 
-    // Compass.
+    // Compass. The `cal mag` result as ArduPilot's AP_Compass names it: rows into Settings::cal
+    // (saved in the first record with the calibration, not in `flight` or `vehicle`). Both
+    // correct a field as M (m + COMPASS_OFS), M the symmetric matrix of COMPASS_DIA_* and
+    // COMPASS_ODI_*. The ranges are calib::is_plausible's: a saved calibration stays valid.
+    {"COMPASS_OFS_#", Type::MagOfs, kLetterX, 3, 4, AT(cal.mag_offset_uT), -2000.0f, 2000.0f, 0.0f,
+     PARAM_DOC("Compass offsets", "mGauss",
+               "The hard iron along the board's x (forward), y (right) or z (down) axis, n X, Y or Z, as "
+               "ArduPilot's: added to the field before COMPASS_DIA_* and COMPASS_ODI_* (the `cal mag` offset in uT "
+               "with its sign turned, times 10). Set by `cal mag` and by the ground station's compass calibration; "
+               "a value set here is in use at once, marks the compass calibrated and clears the offset learned in "
+               "motion, which otherwise comes on top of it (`status`).")},
+    {"COMPASS_DIA_#", Type::Float, kLetterX, 3, 4, AT(cal.mag_scale), 0.5f, 2.0f, 1.0f,
+     PARAM_DOC("Compass soft-iron diagonal", "",
+               "The soft-iron matrix's diagonal, n X, Y or Z, as ArduPilot's: the field's x, y or z component, "
+               "offset corrected, is scaled by it (with COMPASS_ODI_* a symmetric matrix; after `cal mag` its "
+               "determinant is 1). 1 and COMPASS_ODI_* 0: no soft iron.")},
+    {"COMPASS_ODI_#", Type::Float, kLetterX, 3, 4, AT(cal.mag_cross), -0.5f, 0.5f, 0.0f,
+     PARAM_DOC("Compass soft-iron off-diagonal", "",
+               "The soft-iron matrix's off-diagonal terms, as ArduPilot's: X the xy and yx term, Y xz and zx, Z yz "
+               "and zy.")},
 
     // Battery monitor and its failsafe.
 
@@ -312,6 +333,7 @@ float read(const Settings& s, const Row& row, uint8_t instance) {
         case Type::UInt8: return (float)*p;
         case Type::Bit: return (float)((*p >> instance) & 1u);
         case Type::DeclRad: { int16_t v; memcpy(&v, p, sizeof v); return (float)v * kRadPerCentideg; }
+        case Type::MagOfs: { float v; memcpy(&v, p, sizeof v); return compass_ofs_mgauss(v); }
     }
     return 0.0f;
 }
@@ -336,6 +358,11 @@ void write(Settings& s, const Row& row, uint8_t instance, float value) {
             memcpy(p, &v, sizeof v);
             break;
         }
+        case Type::MagOfs: {
+            const float uT = value / -kMilliGaussPerMicroTesla;
+            memcpy(p, &uT, sizeof uT);
+            break;
+        }
     }
 }
 
@@ -354,7 +381,21 @@ char upper(char c) { return (c >= 'a' && c <= 'z') ? (char)(c - 'a' + 'A') : c; 
 
 }  // namespace
 
-bool is_integer(Type t) { return t != Type::Float && t != Type::DeclRad; }
+float compass_ofs_mgauss(float offset_uT) {
+    const float centi = offset_uT * (-100.0f * kMilliGaussPerMicroTesla);
+    // Divided, not multiplied by 0.01f: the nearest float to the decimal.
+    if (!(centi > -1e7f && centi < 1e7f)) return centi / 100.0f;  // NaN or absurd: as it is
+    return (float)(int32_t)(centi >= 0.0f ? centi + 0.5f : centi - 0.5f) / 100.0f;
+}
+
+bool is_integer(Type t) { return t != Type::Float && t != Type::DeclRad && t != Type::MagOfs; }
+
+bool is_compass_calibration(uint16_t index) {
+    Row row;
+    uint8_t instance;
+    return locate(index, row, instance) && row.offset >= offsetof(Settings, cal.mag_offset_uT) &&
+           row.offset < offsetof(Settings, cal.mag_learned_uT);
+}
 
 uint16_t count() {
     uint16_t n = 0;
@@ -394,9 +435,10 @@ int16_t find(const char* name) {
         bool match = true;
         while (match && row.name[i] != '\0') {
             if (row.name[i] == '#') {
-                const char c = name[j++];
+                // A digit, or a letter (X, Y, Z): '0' + first + instance, whatever its case.
+                const char c = upper(name[j++]);
                 instance = (int16_t)(c - '0' - (char)row.first);
-                match = c >= '0' && c <= '9' && instance >= 0 && instance < row.count;
+                match = instance >= 0 && instance < row.count;
             } else {
                 match = upper(name[j++]) == row.name[i];
             }
@@ -458,7 +500,8 @@ namespace {
 
 uint8_t stored_bytes(Type t) {
     switch (t) {
-        case Type::Float: return 4;
+        case Type::Float:
+        case Type::MagOfs: return 4;
         case Type::Int16:
         case Type::UInt16:
         case Type::DeclRad: return 2;
