@@ -84,8 +84,8 @@ static mav::Result run_command(const mav::CommandLong& c) {
         if (!gyro && !mag) return mav::Result::Unsupported;
         if (pipe.gyro_calibrating() || pipe.mag_calibrating() || pipe.phase() != pipeline::Phase::Running)
             return mav::Result::TemporarilyRejected;
+        if (mag) mag_cal_link::start(true);  // first: it refuses while the gyro calibrates
         if (gyro) pipe.start_gyro_calibration();
-        if (mag) mag_cal_link::start(true);
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdPreflightStorage) {

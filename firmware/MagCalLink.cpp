@@ -14,6 +14,7 @@ using pipeline::MagCalState;
 using vehicle::pipe;
 
 constexpr uint16_t kProgressPeriodMs = 500;  // MAG_CAL_PROGRESS at 2 Hz
+static bool start_pending = false;           // START acknowledged: the run starts in this task's next pass
 static bool reporting = false;               // a run the ground station started: PROGRESS, then REPORT
 static bool autosave = false;
 static uint16_t progress_ms = 0;             // millis()'s low half at the last PROGRESS
@@ -23,13 +24,14 @@ bool handles(uint16_t command) {
            command == mav::kCmdDoCancelMagCal;
 }
 
+// The run itself starts in the task, not in the request: its "# cal mag: ..." line (a
+// STATUSTEXT packed) and the ACK would not fit one request's budget together.
 mav::Result start(bool save) {
     if (pipe.phase() != pipeline::Phase::Running || pipe.gyro_calibrating()) return mav::Result::TemporarilyRejected;
-    pipe.start_mag_calibration(!save);
-    if (pipe.mag_cal_state() != MagCalState::kCollecting) return mav::Result::Failed;  // no compass (said)
+    if (!vehicle::compass.ok()) return mav::Result::Failed;
+    start_pending = true;
     reporting = true;
     autosave = save;
-    progress_ms = (uint16_t)(millis() - kProgressPeriodMs);  // the first PROGRESS at once
     return mav::Result::Accepted;
 }
 
@@ -47,7 +49,7 @@ mav::Result command(const mav::CommandLong& c) {
         return pipe.mag_cal_state() == MagCalState::kApplied ? mav::Result::Accepted : mav::Result::Failed;
     }
     pipe.cancel_mag_calibration();
-    reporting = false;
+    start_pending = reporting = false;
     return mav::Result::Accepted;
 }
 
@@ -57,10 +59,17 @@ bool due() {
         return false;
     const MagCalState m = pipe.mag_cal_state();
     const bool running = m == MagCalState::kCollecting || m == MagCalState::kFitting;
-    return !running || (uint16_t)((uint16_t)millis() - progress_ms) >= kProgressPeriodMs;
+    return start_pending || !running || (uint16_t)((uint16_t)millis() - progress_ms) >= kProgressPeriodMs;
 }
 
 void send() {
+    if (start_pending) {
+        start_pending = false;
+        pipe.start_mag_calibration(!autosave);
+        reporting = pipe.mag_cal_state() == MagCalState::kCollecting;  // else the compass went (said)
+        progress_ms = (uint16_t)(millis() - kProgressPeriodMs);     // the first PROGRESS in the next pass
+        return;
+    }
     uint8_t frame[mav::kMaxFrame];
     const MagCalState m = pipe.mag_cal_state();
     const calib::MagCalibrator& cal = pipe.mag_calibrator();

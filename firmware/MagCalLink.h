@@ -25,12 +25,13 @@ namespace mag_cal_link {
 bool handles(uint16_t command);
 // Its COMMAND_ACK result.
 mav::Result command(const mav::CommandLong& c);
-// Starts a calibration that the ground station hears of (PROGRESS, REPORT); autosave:
-// the result used and saved when good. Accepted, or TemporarilyRejected while the
-// estimator starts or the gyro calibrates, Failed without a compass.
+// Starts a calibration that the ground station hears of (PROGRESS, REPORT), in the task's
+// next pass; autosave: the result used and saved when good. Accepted, or
+// TemporarilyRejected while the estimator starts or the gyro calibrates, Failed without a
+// compass.
 mav::Result start(bool autosave);
-// The loop task: one MAG_CAL_PROGRESS every 500 ms while a run the ground station started
-// goes on, then its MAG_CAL_REPORT (and the save, with autosave).
+// The loop task: the run started, then one MAG_CAL_PROGRESS every 500 ms while it goes
+// on, then its MAG_CAL_REPORT (and the save, with autosave).
 bool due();
 void send();
 // A parameter changed (PARAM_SET, `set`): a compass calibration row's new value is the

@@ -155,6 +155,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     // The fit's sums wait for a step free of heavy work, as the learner does.
     cal_field_uT_ = field_uT;
     if (st_.mag_cal_active) st_.cal_pending = true;
+    // COMPASS_USE 0: `cal mag` takes the samples, the heading none (as without a compass).
+    if (settings_.vehicle.compass_use == 0u) return;
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     // The DCM's integer form, made once here (the range check takes its strength).
     linalg::Vector3i f_q5;
@@ -175,7 +177,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         learner_.forget_pair();
         st_.learn_pending = false;
         st_.turn_doubtful = false;
-    } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
+    } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present &&
+               settings_.vehicle.compass_learn != 0u) {  // COMPASS_LEARN
         // A sample every kLearnMinSteps at most; the turn goes on summing until then.
         turn_restarts = st_.steps_since_mag >= kLearnMinSteps;
         if (turn_restarts) take_learner_sample(f);

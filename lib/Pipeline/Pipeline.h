@@ -29,7 +29,8 @@
 // Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
 // the offset learned in motion) before the DCM sees it; while running, the learner
 // (calib::OffsetLearner) estimates the hard iron from the field's change against the
-// gyro's rotation, and puts it in use once it is significant. A new calibration, or a
+// gyro's rotation, and puts it in use once it is significant (settings' COMPASS_LEARN;
+// COMPASS_USE 0 keeps the field from the heading, not from `cal mag`). A new calibration, or a
 // learned offset that has moved by kMagReferenceShift_uT since the estimator learned the
 // earth field, makes the estimator forget that field (Dcm::reset_mag_reference): its
 // strength and dip are those of the calibrated field from then on.

@@ -10,9 +10,11 @@
 #include <avr/pgmspace.h>
 #define PARAM_TABLE PROGMEM
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
+#define ROW_BYTE(r, member) ((uint8_t)pgm_read_byte(&kRows[(r)].member))
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
+#define ROW_BYTE(r, member) ((uint8_t)kRows[(r)].member)
 #endif
 
 // What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
@@ -296,6 +298,15 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Compass soft-iron off-diagonal", "",
                "The soft-iron matrix's off-diagonal terms, as ArduPilot's: X the xy and yx term, Y xz and zx, Z yz "
                "and zy.")},
+    {"COMPASS_USE", Type::UInt8, 0, 1, 0, AT(vehicle.compass_use), 0.0f, 1.0f, 1.0f,
+     PARAM_DOC("Use compass for yaw", "",
+               "1: the heading is corrected by the compass; 0: the compass is read (and `cal mag` works) but the "
+               "heading is the gyro's, or the GPS course when moving, as without a compass.")},
+    {"COMPASS_LEARN", Type::UInt8, 0, 1, 0, AT(vehicle.compass_learn), 0.0f, 1.0f, 1.0f,
+     PARAM_DOC("Learn compass offsets", "",
+               "1: the hard iron is learned in motion, from the field's change against the gyro's turn, and used on "
+               "top of COMPASS_OFS_* once it clearly differs (`status` shows it); 0: not learned (the offset "
+               "learned so far is kept until `cal mag` or a COMPASS_OFS_* change clears it).")},
 
     // Battery monitor and its failsafe.
 
@@ -307,15 +318,18 @@ constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
 
 constexpr float kRadPerCentideg = linalg::kPi / 18000.0f;
 
-// The row holding index, and the instance within it; false past the end.
+// The row holding index, and the instance within it; false past the end. Only the counts
+// are read on the way and the one row copied: a walk copying every row (35 bytes from
+// flash each) took a PARAM_SET of a row near the table's end past its task's budget.
 bool locate(uint16_t index, Row& row, uint8_t& instance) {
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (index < row.count) {
+        const uint8_t n = ROW_BYTE(r, count);
+        if (index < n) {
+            COPY_ROW(&row, &kRows[r]);
             instance = (uint8_t)index;
             return true;
         }
-        index = (uint16_t)(index - row.count);
+        index = (uint16_t)(index - n);
     }
     return false;
 }
@@ -399,11 +413,7 @@ bool is_compass_calibration(uint16_t index) {
 
 uint16_t count() {
     uint16_t n = 0;
-    Row row;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        n = (uint16_t)(n + row.count);
-    }
+    for (uint8_t r = 0; r < kRowCount; ++r) n = (uint16_t)(n + ROW_BYTE(r, count));
     return n;
 }
 
@@ -426,26 +436,24 @@ bool info(uint16_t index, Info& out) {
 // not info() for every index: MAVLink's PARAM_SET and PARAM_REQUEST_READ look names up
 // between samples.
 int16_t find(const char* name) {
-    Row row;
     uint16_t index = 0;
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        uint8_t i = 0, j = 0;  // row.name, name
+        const uint8_t count = ROW_BYTE(r, count);
+        uint8_t i = 0, j = 0;  // the row's name (read from flash a character at a time), name
         int16_t instance = 0;
         bool match = true;
-        while (match && row.name[i] != '\0') {
-            if (row.name[i] == '#') {
+        for (char rc = (char)ROW_BYTE(r, name[0]); match && rc != '\0'; rc = (char)ROW_BYTE(r, name[++i])) {
+            if (rc == '#') {
                 // A digit, or a letter (X, Y, Z): '0' + first + instance, whatever its case.
                 const char c = upper(name[j++]);
-                instance = (int16_t)(c - '0' - (char)row.first);
-                match = instance >= 0 && instance < row.count;
+                instance = (int16_t)(c - '0' - (char)ROW_BYTE(r, first));
+                match = instance >= 0 && instance < count;
             } else {
-                match = upper(name[j++]) == row.name[i];
+                match = upper(name[j++]) == rc;
             }
-            ++i;
         }
         if (match && name[j] == '\0') return (int16_t)(index + instance);
-        index = (uint16_t)(index + row.count);
+        index = (uint16_t)(index + count);
     }
     return -1;
 }

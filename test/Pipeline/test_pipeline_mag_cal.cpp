@@ -130,3 +130,45 @@ TEST(PipelineMagCal, CalibrationTakenFromOutside) {
 }
 
 }  // namespace
+
+namespace {
+
+// COMPASS_USE 0: the field does not turn the heading (the gyro's alone), `cal mag` still
+// collects; COMPASS_LEARN 0: a board turning with hard iron learns no offset.
+TEST(PipelineMagCal, CompassUseAndLearnSwitches) {
+    for (const int use : {1, 0}) {
+        LoggedPipeline logged;
+        pipeline::AttitudePipeline& p = logged.p;
+        p.settings().vehicle.compass_use = (uint8_t)use;
+        start(p);
+        // The field says north is 90 deg away: with the compass the heading goes there.
+        for (int i = 0; i < 2000; ++i) {
+            if (i % 3 == 0) p.on_mag_sample(Vector3f(0.0f, -20.0f, 40.0f));
+            p.on_imu_sample(imu(kGyro, kLevel));
+        }
+        const float h = p.angles().heading_deg;
+        if (use == 1) EXPECT_NEAR(h, 90.0f, 2.0f);
+        else EXPECT_LT(std::fabs(h > 180.0f ? h - 360.0f : h), 1.0f) << "the gyro's heading from the start";
+        p.start_mag_calibration();
+        tumble(p, 300);
+        EXPECT_GT(p.mag_calibrator().count(), 50u) << "cal mag collects with COMPASS_USE " << use;
+    }
+    for (const int learn : {1, 0}) {
+        LoggedPipeline logged;
+        pipeline::AttitudePipeline& p = logged.p;
+        p.settings().vehicle.compass_learn = (uint8_t)learn;
+        start(p);
+        // Turning about down at 1 rad/s (the gyro says so), the field turning with it, hard iron on top.
+        const Vector3f rate(0.0f, 0.0f, 1.0f);
+        for (int i = 0; i < 20 * 200; ++i) {
+            const float a = -(float)i * 0.005f;
+            if (i % 3 == 0) p.on_mag_sample(Vector3f(20.0f * std::cos(a), 20.0f * std::sin(a), 40.0f) + kHardIron_uT);
+            p.on_imu_sample(imu(kGyro + rate, kLevel));
+        }
+        const float learned = p.settings().cal.mag_learned_uT.length();
+        if (learn == 1) EXPECT_GT(learned, 5.0f) << "the hard iron learned";
+        else EXPECT_EQ(learned, 0.0f);
+    }
+}
+
+}  // namespace
