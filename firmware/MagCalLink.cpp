@@ -14,10 +14,13 @@ using pipeline::MagCalState;
 using vehicle::pipe;
 
 constexpr uint16_t kProgressPeriodMs = 500;  // MAG_CAL_PROGRESS at 2 Hz
-static bool start_pending = false;           // START acknowledged: the run starts in this task's next pass
-static bool reporting = false;               // a run the ground station started: PROGRESS, then REPORT
-static bool autosave = false;
-static uint16_t progress_ms = 0;             // millis()'s low half at the last PROGRESS
+// One byte for the three flags (RAM).
+static struct {
+    bool start_pending : 1;  // START acknowledged: the run starts in this task's next pass
+    bool reporting : 1;      // a run the ground station started: PROGRESS, then REPORT
+    bool autosave : 1;
+} link = {false, false, false};
+static uint16_t progress_ms = 0;  // millis()'s low half at the last PROGRESS
 
 bool handles(uint16_t command) {
     return command == mav::kCmdDoStartMagCal || command == mav::kCmdDoAcceptMagCal ||
@@ -29,9 +32,9 @@ bool handles(uint16_t command) {
 mav::Result start(bool save) {
     if (pipe.phase() != pipeline::Phase::Running || pipe.gyro_calibrating()) return mav::Result::TemporarilyRejected;
     if (!vehicle::compass.ok()) return mav::Result::Failed;
-    start_pending = true;
-    reporting = true;
-    autosave = save;
+    link.start_pending = true;
+    link.reporting = true;
+    link.autosave = save;
     return mav::Result::Accepted;
 }
 
@@ -49,24 +52,24 @@ mav::Result command(const mav::CommandLong& c) {
         return pipe.mag_cal_state() == MagCalState::kApplied ? mav::Result::Accepted : mav::Result::Failed;
     }
     pipe.cancel_mag_calibration();
-    start_pending = reporting = false;
+    link.start_pending = link.reporting = false;
     return mav::Result::Accepted;
 }
 
 bool due() {
-    if (!reporting || !port::mavlink_mode() ||
+    if (!link.reporting || !port::mavlink_mode() ||
         serial_text::room() < mav::kMaxFrame + gcs_link::output_line_bytes())
         return false;
     const MagCalState m = pipe.mag_cal_state();
     const bool running = m == MagCalState::kCollecting || m == MagCalState::kFitting;
-    return start_pending || !running || (uint16_t)((uint16_t)millis() - progress_ms) >= kProgressPeriodMs;
+    return link.start_pending || !running || (uint16_t)((uint16_t)millis() - progress_ms) >= kProgressPeriodMs;
 }
 
 void send() {
-    if (start_pending) {
-        start_pending = false;
-        pipe.start_mag_calibration(!autosave);
-        reporting = pipe.mag_cal_state() == MagCalState::kCollecting;  // else the compass went (said)
+    if (link.start_pending) {
+        link.start_pending = false;
+        pipe.start_mag_calibration(!link.autosave);
+        link.reporting = pipe.mag_cal_state() == MagCalState::kCollecting;  // else the compass went (said)
         progress_ms = (uint16_t)(millis() - kProgressPeriodMs);     // the first PROGRESS in the next pass
         return;
     }
@@ -83,14 +86,14 @@ void send() {
                                                                                 : mav::MagCalStatus::RunningStepTwo,
                                            1u, pipe.mag_cal_progress_pct(), cal.cells_seen(), dir);
     } else {
-        reporting = false;
+        link.reporting = false;
         if (m == MagCalState::kNone) return;  // stopped by other means: nothing to report
         const bool good = m != MagCalState::kFailed;
         // A good fit's terms (waiting or in use); after a failure the calibration in use, which stays.
         const calib::Calibration& now = pipe.settings().cal;
         mav::MagCalReport r;
         r.status = good ? mav::MagCalStatus::Success : mav::MagCalStatus::Failed;
-        r.autosaved = good && autosave;
+        r.autosaved = good && link.autosave;
         r.fitness_mgauss = cal.residual_uT() * params::kMilliGaussPerMicroTesla;
         const linalg::Vector3f ofs_uT = good ? cal.offset_uT() : now.mag_offset_uT;
         r.ofs_mgauss = linalg::Vector3f(params::compass_ofs_mgauss(ofs_uT.x), params::compass_ofs_mgauss(ofs_uT.y),

@@ -11,10 +11,12 @@
 #define PARAM_TABLE PROGMEM
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)pgm_read_byte(&kRows[(r)].member))
+#define ROW_WORD(r, member) ((uint16_t)pgm_read_word(&kRows[(r)].member))
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)kRows[(r)].member)
+#define ROW_WORD(r, member) ((uint16_t)kRows[(r)].member)
 #endif
 
 // What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
@@ -519,15 +521,26 @@ uint8_t stored_bytes(Type t) {
 
 // Calls f(pointer to the value's bytes, their count) for every stored value of the
 // flight settings, in the record's order.
+// ... of the rows whose values lie at offsets from .. to-1 of Settings. The settings store
+// calls this for every part of a record it writes, between samples: only the bytes it needs
+// are read from each row (copying each whole row from flash took the store's task past its
+// budget as rows were added).
+template <typename F>
+void each_value_at(const Settings& s, uint16_t from, uint16_t to, F f) {
+    for (uint8_t r = 0; r < kRowCount; ++r) {
+        const uint16_t offset = ROW_WORD(r, offset);
+        if (offset < from || offset >= to) continue;
+        const Type type = (Type)ROW_BYTE(r, type);
+        const uint8_t n = type == Type::Bit ? 1 : ROW_BYTE(r, count);
+        const uint8_t stride = ROW_BYTE(r, stride);
+        uint8_t* p = reinterpret_cast<uint8_t*>(&const_cast<Settings&>(s)) + offset;
+        for (uint8_t i = 0; i < n; ++i) f(p + (uint16_t)stride * i, stored_bytes(type));
+    }
+}
+
 template <typename F>
 void each_flight_value(const Settings& s, F f) {
-    Row row;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (row.offset < offsetof(Settings, flight) || row.offset >= offsetof(Settings, vehicle)) continue;
-        const uint8_t n = row.type == Type::Bit ? 1 : row.count;
-        for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
-    }
+    each_value_at(s, offsetof(Settings, flight), offsetof(Settings, vehicle), f);
 }
 
 }  // namespace
@@ -564,13 +577,7 @@ namespace {
 // second record (Settings::vehicle), in the record's order.
 template <typename F>
 void each_vehicle_value(const Settings& s, F f) {
-    Row row;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (row.offset < offsetof(Settings, vehicle)) continue;
-        const uint8_t n = row.type == Type::Bit ? 1 : row.count;
-        for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
-    }
+    each_value_at(s, offsetof(Settings, vehicle), 0xFFFFu, f);
 }
 
 }  // namespace
