@@ -67,7 +67,6 @@ enum Section : uint8_t {
     kSecBaro = 37,         // the barometer task: a conversion read and the next one started
     kSecNav = 38,          // position and home from a new fix, the position moved on between fixes
     kSecGcsPosition = 39,  // GPS_RAW_INT, GLOBAL_POSITION_INT, VFR_HUD ... packed and queued
-    kSecGcsMagCal = 52,    // MAG_CAL_PROGRESS or MAG_CAL_REPORT packed and queued
     // 46 is lib/MS5611's compensation (lib/LinAlg/Profile.h), inside 37.
     kSecBaroHeight = 47,   // the barometer's 10 Hz height and climb (inside 37)
 };

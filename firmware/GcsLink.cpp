@@ -222,13 +222,17 @@ static bool home_due() {
     return position::navigator().home_set() && (home_requested || home_changes_sent != position::home_changes());
 }
 
+// The compass calibration's frames (MagCalLink) take this task's runs while due: a row of
+// their own in the task table would cost every loop pass a call in the text modes too, and
+// move the firmware's timeline (the compass's DRDY read falls on another step).
 bool position_due() {
     if (!port::mavlink_mode() || !room_for(mav::kMaxFrame)) return false;
-    if (home_due() || next_position_frame != kRoundDone) return true;
+    if (mag_cal_link::due() || home_due() || next_position_frame != kRoundDone) return true;
     return millis() - position_round_ms >= kPositionPeriodMs;
 }
 
 void send_position() {
+    if (mag_cal_link::due()) return mag_cal_link::send();
     uint8_t frame[mav::kMaxFrame];
     uint8_t n = 0;
     if (home_due()) {

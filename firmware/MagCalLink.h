@@ -30,8 +30,8 @@ mav::Result command(const mav::CommandLong& c);
 // TemporarilyRejected while the estimator starts or the gyro calibrates, Failed without a
 // compass.
 mav::Result start(bool autosave);
-// The loop task: the run started, then one MAG_CAL_PROGRESS every 500 ms while it goes
-// on, then its MAG_CAL_REPORT (and the save, with autosave).
+// In the gcs_position task's runs (GcsLink): the run started, then one MAG_CAL_PROGRESS
+// every 500 ms while it goes on, then its MAG_CAL_REPORT (and the save, with autosave).
 bool due();
 void send();
 // A parameter changed (PARAM_SET, `set`): a compass calibration row's new value is the

@@ -23,7 +23,6 @@
 #include "GcsLink.h"
 #include "GpsPort.h"
 #include "LoopLoad.h"
-#include "MagCalLink.h"
 #include "OutputLine.h"
 #include "Position.h"
 #include "Scheduler.h"
@@ -103,7 +102,6 @@ static void once_a_second() {
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
-    X(gcs_magcal,   mag_cal_link::due,               mag_cal_link::send,               3300, kSecGcsMagCal,    0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
     X(store,        nullptr,                         store_service,                    1800, kSecStore,        kAlways) \
     X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
