@@ -84,7 +84,10 @@ static mav::Result run_command(const mav::CommandLong& c) {
         if (!gyro && !mag) return mav::Result::Unsupported;
         if (pipe.gyro_calibrating() || pipe.mag_calibrating() || pipe.phase() != pipeline::Phase::Running)
             return mav::Result::TemporarilyRejected;
-        if (mag) mag_cal_link::start(true);  // first: it refuses while the gyro calibrates
+        if (mag) {  // first: it refuses while the gyro calibrates
+            const mav::Result r = mag_cal_link::start(true);
+            if (r != mav::Result::Accepted) return r;
+        }
         if (gyro) pipe.start_gyro_calibration();
         return mav::Result::Accepted;
     }

@@ -16,7 +16,7 @@ using vehicle::pipe;
 constexpr uint16_t kProgressPeriodMs = 500;  // MAG_CAL_PROGRESS at 2 Hz
 // One byte for the three flags (RAM).
 static struct {
-    bool start_pending : 1;  // START acknowledged: the run starts in this task's next pass
+    bool start_pending : 1;  // START acknowledged: the run starts in the task's next run
     bool reporting : 1;      // a run the ground station started: PROGRESS, then REPORT
     bool autosave : 1;
 } link = {false, false, false};
@@ -27,7 +27,7 @@ bool handles(uint16_t command) {
            command == mav::kCmdDoCancelMagCal;
 }
 
-// The run itself starts in the task, not in the request: its "# cal mag: ..." line (a
+// The run itself starts in the gcs_position task, not in the request: its "# cal mag: ..." line (a
 // STATUSTEXT packed) and the ACK would not fit one request's budget together.
 mav::Result start(bool save) {
     if (pipe.phase() != pipeline::Phase::Running || pipe.gyro_calibrating()) return mav::Result::TemporarilyRejected;

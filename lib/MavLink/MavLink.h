@@ -103,7 +103,6 @@ Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok);
 // Another sensor's bits: present (and enabled) when present, healthy when also ok.
 void add_sensor(Health& h, uint32_t bits, bool present, bool ok);
 
-// GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
 // MAG_CAL_STATUS (common.xml): where a compass calibration stands.
 enum class MagCalStatus : uint8_t {
     NotStarted = 0,
@@ -123,6 +122,7 @@ struct MagCalReport {
     linalg::Vector3f diag, offdiag;  // the soft-iron matrix: diagonal; xy, xz, yz
 };
 
+// GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
 struct PositionReport {
     uint32_t time_boot_ms;
     int32_t lat_e7, lon_e7;      // now (moved on from the fix)

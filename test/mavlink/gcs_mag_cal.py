@@ -29,7 +29,6 @@ Exit 1 with every failure listed. Timing assertions are on simulated time only.
 import csv
 import math
 import os
-import subprocess
 import sys
 
 from pymavlink import mavutil
@@ -37,7 +36,7 @@ from pymavlink import mavutil
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from gcs_link import Board  # noqa: E402
-from sim_run import tools_and_work  # noqa: E402
+from sim_run import scenario_file, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 mav = mavutil.mavlink  # the ArduPilot dialect: MAG_CAL_PROGRESS, DO_*_MAG_CAL
@@ -215,13 +214,9 @@ def offset_moves_the_heading(b, trajectory, report):
 
 def main():
     args = tools_and_work()
-    trajectory = os.path.join(args.work, "tumble_hard_soft_iron.csv")
-    with open(trajectory, "wb") as f:
-        subprocess.run([os.path.join(args.tools, "scenario"), "tumble", "--hard-iron", "8,-5,3",
-                        "--soft-iron", "1.03,1,1"], stdout=f, check=True)
-    plain = os.path.join(args.work, "tumble.csv")  # the same motion, its true field
-    with open(plain, "wb") as f:
-        subprocess.run([os.path.join(args.tools, "scenario"), "tumble"], stdout=f, check=True)
+    trajectory = scenario_file(args.tools, args.work, "tumble", ["--hard-iron", "8,-5,3", "--soft-iron", "1.03,1,1"],
+                               "tumble_hard_soft_iron.csv")
+    plain = scenario_file(args.tools, args.work, "tumble")  # the same motion, its true field
     eeprom = os.path.join(args.work, "eeprom.bin")
     if os.path.exists(eeprom):
         os.remove(eeprom)

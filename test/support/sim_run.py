@@ -17,9 +17,9 @@ def tools_and_work():
     return args
 
 
-def scenario_file(tools, work, name):
-    """build/scenario NAME written to WORK/NAME.csv; its path."""
-    path = os.path.join(work, name + ".csv")
+def scenario_file(tools, work, name, options=(), file_name=None):
+    """build/scenario NAME [OPTIONS] written to WORK/FILE_NAME (default NAME.csv); its path."""
+    path = os.path.join(work, file_name or name + ".csv")
     with open(path, "wb") as f:
-        subprocess.run([os.path.join(tools, "scenario"), name], stdout=f, check=True)
+        subprocess.run([os.path.join(tools, "scenario"), name] + list(options), stdout=f, check=True)
     return path
