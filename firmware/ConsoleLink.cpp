@@ -8,6 +8,8 @@
 #include "GcsLink.h"
 #include "GpsPort.h"
 #include "LoopLoad.h"
+#include "MagCalLink.h"
+#include "Params.h"
 #include "Port.h"
 #include "PipelineText.h"
 #include "Position.h"
@@ -145,7 +147,9 @@ static bool answer(const console::Command& c, uint8_t part) {
         if (c.id == console::CommandId::Save) {
             vehicle::store.start_save(pipe.settings());
         } else if (c.id == console::CommandId::Set) {
+            const float before = params::get(pipe.settings(), c.arg);
             console::apply_setting(c, pipe.settings(), out);
+            if (params::get(pipe.settings(), c.arg) != before) mag_cal_link::parameter_changed(c.arg);
             flight_io.configure();
         } else {
             pipe.restore_defaults();

@@ -7,6 +7,7 @@
 #include "ConsoleLink.h"
 #include "GpsPort.h"
 #include "LoopLoad.h"
+#include "MagCalLink.h"
 #include "ParamLink.h"
 #include "Port.h"
 #include "Position.h"
@@ -70,7 +71,8 @@ static mav::Result set_home(const float* p) {
 }
 
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
-// (`cal mag`); the others (baro, accel, airspeed ...) the board does not have.
+// (`cal mag`, saved when good: MagCalLink's START with autosave); the others (baro, accel,
+// airspeed ...) the board does not have.
 // MAV_CMD_PREFLIGHT_STORAGE: param1 1 write (`save`), 2 defaults (`defaults`, not
 // saved); 0 (read) UNSUPPORTED. The result comes as "# " lines.
 static mav::Result run_command(const mav::CommandLong& c) {
@@ -82,8 +84,11 @@ static mav::Result run_command(const mav::CommandLong& c) {
         if (!gyro && !mag) return mav::Result::Unsupported;
         if (pipe.gyro_calibrating() || pipe.mag_calibrating() || pipe.phase() != pipeline::Phase::Running)
             return mav::Result::TemporarilyRejected;
+        if (mag) {  // first: it refuses while the gyro calibrates
+            const mav::Result r = mag_cal_link::start(true);
+            if (r != mav::Result::Accepted) return r;
+        }
         if (gyro) pipe.start_gyro_calibration();
-        if (mag) pipe.start_mag_calibration();
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdPreflightStorage) {
@@ -100,6 +105,7 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdDoSetHome) return set_home(p);
+    if (mag_cal_link::handles(c.command)) return mag_cal_link::command(c);
     if (c.command == mav::kCmdGetHomePosition ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
         if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
@@ -128,7 +134,10 @@ void take_request() {
         if (index >= 0) param_replies.request_one((uint16_t)index);
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
         // settings before it whole until the new ones are), in a pass of its own.
-        if (changed) save_pending = true;
+        if (changed) {
+            save_pending = true;
+            mag_cal_link::parameter_changed((uint16_t)index);
+        }
     } else if (mav::decode_command_long(rx, cmd)) {
         const mav::Result r = run_command(cmd);
         uint8_t frame[mav::kMaxFrame];
@@ -148,6 +157,7 @@ void save() {
     save_pending = false;
     vehicle::store.start_save(pipe.settings());
 }
+void save_soon() { save_pending = true; }
 
 bool param_value_due() {
     uint16_t index;
@@ -215,13 +225,17 @@ static bool home_due() {
     return position::navigator().home_set() && (home_requested || home_changes_sent != position::home_changes());
 }
 
+// The compass calibration's frames (MagCalLink) take this task's runs while due: a row of
+// their own in the task table would cost every loop pass a call in the text modes too, and
+// move the firmware's timeline (the compass's DRDY read falls on another step).
 bool position_due() {
     if (!port::mavlink_mode() || !room_for(mav::kMaxFrame)) return false;
-    if (home_due() || next_position_frame != kRoundDone) return true;
+    if (mag_cal_link::due() || home_due() || next_position_frame != kRoundDone) return true;
     return millis() - position_round_ms >= kPositionPeriodMs;
 }
 
 void send_position() {
+    if (mag_cal_link::due()) return mag_cal_link::send();
     uint8_t frame[mav::kMaxFrame];
     uint8_t n = 0;
     if (home_due()) {

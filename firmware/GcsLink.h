@@ -32,6 +32,8 @@ bool defaults_line_due();
 void say_defaults();
 bool save_due();
 void save();
+// A save in a pass of its own, as after a PARAM_SET (the compass calibration accepted).
+void save_soon();
 bool param_value_due();
 void send_param_value();
 bool streams_due();
@@ -39,7 +41,8 @@ void send_streams();
 // The position messages (Position.h), one frame a run: GPS_RAW_INT at 2 Hz,
 // GLOBAL_POSITION_INT and VFR_HUD at 4 Hz (ArduPlane's usual rates for a ground
 // station's map and HUD); HOME_POSITION when home changes and when asked for
-// (MAV_CMD_GET_HOME_POSITION, MAV_CMD_REQUEST_MESSAGE 242).
+// (MAV_CMD_GET_HOME_POSITION, MAV_CMD_REQUEST_MESSAGE 242). The compass calibration's
+// MAG_CAL_PROGRESS and REPORT (MagCalLink) go first when due.
 bool position_due();
 void send_position();
 // Once a second in MAVLink: HEARTBEAT and SYS_STATUS (a ground station drops a link

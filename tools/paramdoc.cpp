@@ -55,7 +55,11 @@ int main() {
         printf("| `");
         print_name(r);
         putchar('`');
-        if (r.count > 1) printf(" (n %u-%u)", (unsigned)r.first, (unsigned)(r.first + r.count - 1));
+        // The numbers as the names spell them: digits, or letters ("COMPASS_OFS_n" (n X-Z)).
+        if (r.count > 1 && r.first + r.count - 1 <= 9)
+            printf(" (n %u-%u)", (unsigned)r.first, (unsigned)(r.first + r.count - 1));
+        else if (r.count > 1)
+            printf(" (n %c-%c)", (char)('0' + r.first), (char)('0' + r.first + r.count - 1));
         // ", whole": as the console says when `set` is given a fraction.
         printf(" | %s | %g to %g%s | %g | **%s.** %s |\n", r.units, (double)r.min, (double)r.max,
                params::is_integer(r.type) ? ", whole" : "", (double)r.def, r.display_name, r.description);

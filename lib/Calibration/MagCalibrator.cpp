@@ -167,6 +167,13 @@ uint8_t MagCalibrator::cell_samples(uint8_t cell) const {
     return (uint8_t)((cell_samples_[cell >> 2] >> ((cell & 3u) * 2u)) & 3u);
 }
 
+uint32_t MagCalibrator::cells_seen() const {
+    uint32_t bits = 0;
+    for (uint8_t i = 0; i < kCells; ++i)
+        if (cell_samples(i) >= kMagCellMinSamples) bits |= (uint32_t)1u << i;
+    return bits;
+}
+
 uint8_t MagCalibrator::coverage_pct() const {
     uint8_t seen = 0;
     for (uint8_t i = 0; i < kCells; ++i) seen = (uint8_t)(seen + (cell_samples(i) >= kMagCellMinSamples));
@@ -350,11 +357,17 @@ FIXED_COLD MagCalibrator::Quality MagCalibrator::final_checks() {
     return Quality::Ok;
 }
 
-void MagCalibrator::result(Calibration& cal) const {
+Vector3f MagCalibrator::offset_uT() const {
     const Work::Root& r = work_.root;
-    cal.mag_offset_uT = pivot_uT_ + Vector3f(r.centre[0], r.centre[1], r.centre[2]) * kFitScale_uT;
-    cal.mag_scale = Vector3f(r.y[0], r.y[4], r.y[8]);
-    cal.mag_cross = Vector3f(r.y[1], r.y[2], r.y[5]);
+    return pivot_uT_ + Vector3f(r.centre[0], r.centre[1], r.centre[2]) * kFitScale_uT;
+}
+Vector3f MagCalibrator::scale() const { return Vector3f(work_.root.y[0], work_.root.y[4], work_.root.y[8]); }
+Vector3f MagCalibrator::cross() const { return Vector3f(work_.root.y[1], work_.root.y[2], work_.root.y[5]); }
+
+void MagCalibrator::result(Calibration& cal) const {
+    cal.mag_offset_uT = offset_uT();
+    cal.mag_scale = scale();
+    cal.mag_cross = cross();
     cal.mag_learned_uT = Vector3f();
 }
 

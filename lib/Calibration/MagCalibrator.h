@@ -66,6 +66,9 @@ public:
     uint16_t count() const { return count_; }
     // Share of the 26 direction cells seen at least kMagCellMinSamples times, percent.
     uint8_t coverage_pct() const;
+    // The same cells as bits (bit i: cell i seen kMagCellMinSamples times): the ground
+    // station's MAG_CAL_PROGRESS completion_mask.
+    uint32_t cells_seen() const;
     // Fits all at once (tools, tests: the parts below, one after the other); on Ok writes
     // result() into cal. The figures below are valid after any fit that got as far as
     // the ellipsoid (Ok, NotEarthField, SoftIronTooLarge, PoorFit).
@@ -79,8 +82,13 @@ public:
     bool fitting() const { return stage_ < kStageDone; }
     Quality quality() const { return quality_; }
     // The offset, the soft-iron terms and a zero learned offset into cal (gyro bias
-    // untouched); valid when quality() is Ok.
+    // untouched); valid when quality() is Ok, until restart(): a result may wait there
+    // for a ground station's accept without a copy.
     void result(Calibration& cal) const;
+    // The same terms one at a time (Calibration's mag_offset_uT, mag_scale, mag_cross).
+    linalg::Vector3f offset_uT() const;
+    linalg::Vector3f scale() const;
+    linalg::Vector3f cross() const;
     float residual_uT() const { return residual_uT_; }
     float radius_uT() const { return radius_uT_; }
     // The sphere fit's offset and residual (the first stage).

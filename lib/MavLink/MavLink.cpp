@@ -82,6 +82,12 @@ static_assert((uint8_t)gps::FixType::kNoGps == GPS_FIX_TYPE_NO_GPS && (uint8_t)g
                   GPS_FIX_TYPE_NO_FIX && (uint8_t)gps::FixType::k2D == GPS_FIX_TYPE_2D_FIX &&
                   (uint8_t)gps::FixType::k3D == GPS_FIX_TYPE_3D_FIX,
               "FixType values are GPS_FIX_TYPE's");
+static_assert((uint8_t)MagCalStatus::NotStarted == MAG_CAL_NOT_STARTED &&
+                  (uint8_t)MagCalStatus::RunningStepOne == MAG_CAL_RUNNING_STEP_ONE &&
+                  (uint8_t)MagCalStatus::RunningStepTwo == MAG_CAL_RUNNING_STEP_TWO &&
+                  (uint8_t)MagCalStatus::Success == MAG_CAL_SUCCESS && (uint8_t)MagCalStatus::Failed == MAG_CAL_FAILED,
+              "MagCalStatus values are MAG_CAL_STATUS's");
+static_assert(kFrameOverhead + MAVLINK_MSG_ID_MAG_CAL_REPORT_LEN <= kMaxFrame, "MAG_CAL_REPORT fits kMaxFrame");
 static_assert((uint8_t)Result::Accepted == MAV_RESULT_ACCEPTED && (uint8_t)Result::TemporarilyRejected ==
                   MAV_RESULT_TEMPORARILY_REJECTED && (uint8_t)Result::Denied == MAV_RESULT_DENIED &&
                   (uint8_t)Result::Unsupported == MAV_RESULT_UNSUPPORTED && (uint8_t)Result::Failed == MAV_RESULT_FAILED,
@@ -185,6 +191,42 @@ uint8_t Packer::command_ack(uint8_t out[kMaxFrame], uint16_t command, Result res
     Frame f(seq_);
     mavlink_msg_command_ack_pack_status(kSystemId, kComponentId, &f.status, &f.msg, command, (uint8_t)result, 0u, 0,
                                         target_system, target_component);
+    return f.finish(out, seq_);
+}
+
+// ardupilotmega.xml's MAG_CAL_PROGRESS, not in the common.xml the headers are made from:
+// packed here in its wire order (the floats first, then the bytes, as mavgen orders
+// fields by size) and finished by the generated helpers with its CRC_EXTRA.
+constexpr uint32_t kMsgMagCalProgress = 191;
+constexpr uint8_t kMagCalProgressLen = kMagCalProgressFrame - kFrameOverhead;
+constexpr uint8_t kMagCalProgressCrcExtra = 92;
+
+uint8_t Packer::mag_cal_progress(uint8_t out[kMaxFrame], MagCalStatus status, uint8_t attempt,
+                                 uint8_t completion_pct, uint32_t completion_bits, const linalg::Vector3f& direction) {
+    Frame f(seq_);
+    char* p = _MAV_PAYLOAD_NON_CONST(&f.msg);
+    memset(p, 0, kMagCalProgressLen);
+    _mav_put_float(p, 0, direction.x);
+    _mav_put_float(p, 4, direction.y);
+    _mav_put_float(p, 8, direction.z);
+    _mav_put_uint8_t(p, 12, 0);  // compass_id
+    _mav_put_uint8_t(p, 13, 1);  // cal_mask
+    _mav_put_uint8_t(p, 14, (uint8_t)status);
+    _mav_put_uint8_t(p, 15, attempt);
+    _mav_put_uint8_t(p, 16, completion_pct);
+    for (uint8_t i = 0; i < 4; ++i) _mav_put_uint8_t(p, 17 + i, (uint8_t)(completion_bits >> (8u * i)));
+    f.msg.msgid = kMsgMagCalProgress;
+    mavlink_finalize_message_buffer(&f.msg, kSystemId, kComponentId, &f.status, kMagCalProgressLen,
+                                    kMagCalProgressLen, kMagCalProgressCrcExtra);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::mag_cal_report(uint8_t out[kMaxFrame], const MagCalReport& r) {
+    Frame f(seq_);
+    mavlink_msg_mag_cal_report_pack_status(kSystemId, kComponentId, &f.status, &f.msg, 0u, 1u, (uint8_t)r.status,
+                                           r.autosaved ? 1u : 0u, r.fitness_mgauss, r.ofs_mgauss.x, r.ofs_mgauss.y,
+                                           r.ofs_mgauss.z, r.diag.x, r.diag.y, r.diag.z, r.offdiag.x, r.offdiag.y,
+                                           r.offdiag.z, 0.0f, 0u, 0u, 0.0f);
     return f.finish(out, seq_);
 }
 

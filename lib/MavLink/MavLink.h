@@ -16,6 +16,8 @@
 //   GLOBAL_POSITION_INT 2 Hz   <= 40      the position now, the height above home, velocity
 //   VFR_HUD          2 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
 //   HOME_POSITION    on request and when home changes, <= 40
+//   MAG_CAL_PROGRESS 2 Hz      39 bytes   while a ground station's compass calibration runs
+//   MAG_CAL_REPORT   once      <= 66      its end: offsets, soft iron, fitness
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -101,6 +103,25 @@ Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok);
 // Another sensor's bits: present (and enabled) when present, healthy when also ok.
 void add_sensor(Health& h, uint32_t bits, bool present, bool ok);
 
+// MAG_CAL_STATUS (common.xml): where a compass calibration stands.
+enum class MagCalStatus : uint8_t {
+    NotStarted = 0,
+    RunningStepOne = 2,  // collecting samples
+    RunningStepTwo = 3,  // fitting
+    Success = 4,
+    Failed = 5,
+};
+constexpr uint8_t kMagCalProgressFrame = kFrameOverhead + 27;  // ardupilotmega.xml's 191: 3 floats, 15 bytes
+
+// MAG_CAL_REPORT's figures in ArduPilot's units (AP_Compass's COMPASS_OFS_*, _DIA_*, _ODI_*).
+struct MagCalReport {
+    MagCalStatus status;         // Success or Failed
+    bool autosaved;              // the result is in use and being saved
+    float fitness_mgauss;        // the fit's RMS residual (ArduPilot's COMPASS_CAL_FIT unit)
+    linalg::Vector3f ofs_mgauss;  // added to the field
+    linalg::Vector3f diag, offdiag;  // the soft-iron matrix: diagonal; xy, xz, yz
+};
+
 // GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
 struct PositionReport {
     uint32_t time_boot_ms;
@@ -153,6 +174,15 @@ public:
     // SCALED_PRESSURE: the barometer's absolute pressure (Pa, sent in hPa) and its
     // temperature (degC, sent in 0.01 degC); no differential pressure (0).
     uint8_t scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c);
+    // MAG_CAL_PROGRESS (ArduPilot's dialect: ardupilotmega.xml, CRC_EXTRA 92), compass 0
+    // alone (cal_mask 1): completion_mask's bits the direction cells seen (the first
+    // 26 of its 80: this calibrator's cells, not ArduPilot's geodesic sections); direction
+    // the field now, a unit vector in the body frame.
+    uint8_t mag_cal_progress(uint8_t out[kMaxFrame], MagCalStatus status, uint8_t attempt, uint8_t completion_pct,
+                             uint32_t completion_bits, const linalg::Vector3f& direction);
+    // MAG_CAL_REPORT, compass 0: orientation unchanged (ROTATION_NONE, confidence 0), no
+    // scale factor (0).
+    uint8_t mag_cal_report(uint8_t out[kMaxFrame], const MagCalReport& r);
     uint8_t next_sequence() const { return seq_; }
 
 private:
@@ -283,5 +313,10 @@ constexpr uint16_t kCmdDoSetHome = 179;          // param1 1: here; else param5 
 constexpr uint16_t kCmdGetHomePosition = 410;    // answered with HOME_POSITION (and the ACK)
 constexpr uint16_t kCmdRequestMessage = 512;     // param1 the message id: 242 HOME_POSITION here
 constexpr uint8_t kMsgHomePosition = 242;
+// ArduPilot's compass calibrator (ardupilotmega.xml): param1 the compasses (0 all), START's
+// param2 retry, param3 autosave, param4 delay (s), param5 reboot.
+constexpr uint16_t kCmdDoStartMagCal = 42424;
+constexpr uint16_t kCmdDoAcceptMagCal = 42425;
+constexpr uint16_t kCmdDoCancelMagCal = 42426;
 
 }  // namespace mav

@@ -155,6 +155,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
     // The fit's sums wait for a step free of heavy work, as the learner does.
     cal_field_uT_ = field_uT;
     if (st_.mag_cal_active) st_.cal_pending = true;
+    // COMPASS_USE 0: `cal mag` takes the samples, the heading none (as without a compass).
+    if (settings_.vehicle.compass_use == 0u) return;
     Vector3f f = calib::apply_mag(settings_.cal, field_uT);
     // The DCM's integer form, made once here (the range check takes its strength).
     linalg::Vector3i f_q5;
@@ -175,7 +177,8 @@ void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
         learner_.forget_pair();
         st_.learn_pending = false;
         st_.turn_doubtful = false;
-    } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present) {
+    } else if (st_.phase == Phase::Running && dcm_.initialised() && st_.mag_present &&
+               settings_.vehicle.compass_learn != 0u) {  // COMPASS_LEARN
         // A sample every kLearnMinSteps at most; the turn goes on summing until then.
         turn_restarts = st_.steps_since_mag >= kLearnMinSteps;
         if (turn_restarts) take_learner_sample(f);
@@ -533,11 +536,13 @@ void AttitudePipeline::restart_estimator() {
     st_.spike_run = 0;
 }
 
-void AttitudePipeline::start_mag_calibration() {
+void AttitudePipeline::start_mag_calibration(bool hold) {
     if (!st_.mag_present) {
         tell(EventKind::kMagCalNoCompass);
         return;
     }
+    st_.mag_cal_hold = hold;
+    st_.mag_cal_end = MagCalState::kNone;
     // The centre in use (the fit's offset plus the learned one, which W ~ I barely
     // changes) centres the fit's sums.
     mag_cal_.restart(settings_.cal.mag_offset_uT + settings_.cal.mag_learned_uT);
@@ -561,17 +566,52 @@ void AttitudePipeline::step_mag_fit() {
 
 void AttitudePipeline::finish_mag_calibration() {
     const calib::MagCalibrator::Quality q = mag_cal_.quality();
-    if (q == calib::MagCalibrator::Quality::Ok) {
-        calib::Calibration& c = settings_.cal;
-        mag_cal_.result(c);
-        // The DCM takes the heading from the new calibration.
-        recalibrate_latest_field(calib::apply_mag(c, cal_field_uT_));
-        settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
+    const bool ok = q == calib::MagCalibrator::Quality::Ok;
+    st_.mag_cal_end = !ok ? MagCalState::kFailed : st_.mag_cal_hold ? MagCalState::kWaiting : MagCalState::kApplied;
+    if (st_.mag_cal_end == MagCalState::kApplied) {
+        mag_cal_.result(settings_.cal);
+        use_mag_calibration();
     }
     tell(EventKind::kMagCalDone, mag_cal_.coverage_pct(), mag_cal_.count(),
          q == calib::MagCalibrator::Quality::NotEarthField ? mag_cal_.radius_uT() : mag_cal_.residual_uT(),
          (uint8_t)q);
-    if (q != calib::MagCalibrator::Quality::Ok) return;
+}
+
+bool AttitudePipeline::accept_mag_calibration() {
+    if (st_.mag_cal_end != MagCalState::kWaiting) return false;
+    mag_cal_.result(settings_.cal);
+    use_mag_calibration();
+    st_.mag_cal_end = MagCalState::kApplied;
+    return true;
+}
+
+void AttitudePipeline::cancel_mag_calibration() {
+    st_.mag_cal_active = st_.mag_fit_active = st_.cal_pending = false;
+    st_.mag_cal_end = MagCalState::kNone;
+}
+
+void AttitudePipeline::take_mag_calibration() {
+    settings_.cal.mag_learned_uT = Vector3f();
+    use_mag_calibration();
+}
+
+MagCalState AttitudePipeline::mag_cal_state() const {
+    return st_.mag_cal_active ? MagCalState::kCollecting : st_.mag_fit_active ? MagCalState::kFitting : st_.mag_cal_end;
+}
+
+uint8_t AttitudePipeline::mag_cal_progress_pct() const {
+    const MagCalState m = mag_cal_state();
+    if (m == MagCalState::kCollecting)
+        return (uint8_t)((uint32_t)st_.mag_cal_steps * 100u / ((uint32_t)calib::kMagCalSeconds * kRateHz));
+    return m == MagCalState::kFitting ? 99u : m == MagCalState::kNone ? 0u : 100u;
+}
+
+// settings_.cal holds a new compass calibration (learned offset zero): in use from the
+// next sample, the compass flagged calibrated.
+void AttitudePipeline::use_mag_calibration() {
+    // The DCM takes the heading from the new calibration.
+    recalibrate_latest_field(calib::apply_mag(settings_.cal, cal_field_uT_));
+    settings_.flags = (uint8_t)(settings_.flags | settings::kFlagMagCalibrated);
     // Applied from the next sample: the estimator learns the calibrated field afresh.
     learner_.restart(calib::kLearnPriorCalibrated_uT, Vector3f());
     if (st_.phase == Phase::Running) {

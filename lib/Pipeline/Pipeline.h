@@ -29,7 +29,8 @@
 // Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
 // the offset learned in motion) before the DCM sees it; while running, the learner
 // (calib::OffsetLearner) estimates the hard iron from the field's change against the
-// gyro's rotation, and puts it in use once it is significant. A new calibration, or a
+// gyro's rotation, and puts it in use once it is significant (settings' COMPASS_LEARN;
+// COMPASS_USE 0 keeps the field from the heading, not from `cal mag`). A new calibration, or a
 // learned offset that has moved by kMagReferenceShift_uT since the estimator learned the
 // earth field, makes the estimator forget that field (Dcm::reset_mag_reference): its
 // strength and dip are those of the calibrated field from then on.
@@ -203,6 +204,16 @@ struct Event {
     float value;
 };
 
+// Where the latest `cal mag` run stands (a ground station's MAG_CAL_PROGRESS and REPORT).
+enum class MagCalState : uint8_t {
+    kNone,        // none since the start, or cancelled
+    kCollecting,  // the board is being turned: the sums grow
+    kFitting,     // the fit, a part a step
+    kWaiting,     // a good result waits for accept_mag_calibration() (a run started with hold)
+    kApplied,     // a good result is in use (settings().cal)
+    kFailed,      // the fit was refused: mag_calibrator().quality() says why
+};
+
 class AttitudePipeline;
 // Where the events go: a function and its context (no virtual call: avr-gcc keeps
 // vtables in SRAM). The function may read the pipeline's state (settings, bias).
@@ -280,7 +291,22 @@ public:
     // this start (a measurement, not a setting). Not saved until the caller saves.
     void restore_defaults();
     void start_gyro_calibration();
-    void start_mag_calibration();
+    // `cal mag`: collect for calib::kMagCalSeconds, then fit. A good result is used at once,
+    // or with hold (a ground station's DO_START_MAG_CAL without autosave) kept in the
+    // calibrator until accept_mag_calibration(); a new start drops a result not accepted.
+    void start_mag_calibration(bool hold = false);
+    // A result waiting (kWaiting) into settings().cal and used, as `cal mag` uses one: true;
+    // false when none waits.
+    bool accept_mag_calibration();
+    // The run stopped, or the result waiting dropped: the calibration in use stays.
+    void cancel_mag_calibration();
+    // settings().cal's compass terms were set from outside (a parameter): the compass is
+    // calibrated, the learned offset goes, the estimator learns the field afresh, as
+    // after `cal mag`.
+    void take_mag_calibration();
+    MagCalState mag_cal_state() const;
+    // The run's progress, percent: the collection's time, 100 once the fit is over.
+    uint8_t mag_cal_progress_pct() const;
     // After a sensor outage: the next sample restarts the DCM from gravity and the latest
     // field, keeping the gyro bias (before the first start it just goes on calibrating).
     void restart_estimator();
@@ -317,6 +343,7 @@ private:
     void step_mag_fit();
     void take_gps_fix(const gps::Fix& fix);
     void finish_mag_calibration();
+    void use_mag_calibration();
     void report_deferred();
     // An event to the sink; the short forms keep each call site small (flash).
     void tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const;
@@ -378,6 +405,8 @@ private:
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
         bool start_moved;               // the start was never still: the calibration measuring on may see a turn
         bool gps_moving;                // the GPS's ground speed passed kCourseMinSpeed_m_s (and not below kGpsStillSpeed_m_s since)
+        bool mag_cal_hold;              // the run's good result waits for accept_mag_calibration()
+        MagCalState mag_cal_end;        // how the last run ended (kNone, kWaiting, kApplied, kFailed)
     };
     State st_;
     // One space for two phases (RAM): before the estimator runs the start's gravity if

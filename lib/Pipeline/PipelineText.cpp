@@ -13,10 +13,13 @@ void write_cal_mag_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, co
     using Quality = calib::MagCalibrator::Quality;
     const Quality q = (Quality)e.code;
     if (q == Quality::Ok) {
-        const calib::Calibration& c = pipe.settings().cal;
-        w.str(TXT("# cal mag: offset ")).vec(c.mag_offset_uT).str(TXT(" uT, scale ")).vec(c.mag_scale)
-            .str(TXT(", cross ")).vec(c.mag_cross).str(TXT(", residual ")).fixed2(e.value)
-            .str(TXT(" uT, coverage ")).u32(e.count).str(TXT("% (save to keep)")).end();
+        // From the calibrator: a result waiting for a ground station's accept is not in use yet.
+        const calib::MagCalibrator& m = pipe.mag_calibrator();
+        w.str(TXT("# cal mag: offset ")).vec(m.offset_uT()).str(TXT(" uT, scale ")).vec(m.scale())
+            .str(TXT(", cross ")).vec(m.cross()).str(TXT(", residual ")).fixed2(e.value)
+            .str(TXT(" uT, coverage ")).u32(e.count)
+            .str(pipe.mag_cal_state() == pipeline::MagCalState::kWaiting ? TXT("% (accept to use)")
+                                                                          : TXT("% (save to keep)")).end();
         return;
     }
     w.str(TXT(TXT_ERROR "cal mag failed: "));

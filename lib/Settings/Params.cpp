@@ -10,9 +10,13 @@
 #include <avr/pgmspace.h>
 #define PARAM_TABLE PROGMEM
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
+#define ROW_BYTE(r, member) ((uint8_t)pgm_read_byte(&kRows[(r)].member))
+#define ROW_WORD(r, member) ((uint16_t)pgm_read_word(&kRows[(r)].member))
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
+#define ROW_BYTE(r, member) ((uint8_t)kRows[(r)].member)
+#define ROW_WORD(r, member) ((uint16_t)kRows[(r)].member)
 #endif
 
 // What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
@@ -52,6 +56,8 @@ struct Row {
 #define AT(member) ((uint16_t)offsetof(Settings, member))
 constexpr uint8_t kEp = (uint8_t)sizeof(flight::EndPoints);
 constexpr uint8_t kN = flight::kChannels;
+// A row numbered X, Y, Z ("COMPASS_OFS_#"): the number's character is '0' + first + instance.
+constexpr uint8_t kLetterX = (uint8_t)('X' - '0');
 
 // The ranges are ArduPilot's where it documents one, the widths' the PPM decoder's
 // plausible ones. The defaults are ArduPlane's but for the integrator gains. Roll: ArduPlane
@@ -274,7 +280,35 @@ const Row kRows[] PARAM_TABLE = {
 
     // Board orientation, level, the accelerometer's calibration.
 
-    // Compass.
+    // Compass. The `cal mag` result as ArduPilot's AP_Compass names it: rows into Settings::cal
+    // (saved in the first record with the calibration, not in `flight` or `vehicle`). Both
+    // correct a field as M (m + COMPASS_OFS), M the symmetric matrix of COMPASS_DIA_* and
+    // COMPASS_ODI_*. The ranges are calib::is_plausible's: a saved calibration stays valid.
+    {"COMPASS_OFS_#", Type::MagOfs, kLetterX, 3, 4, AT(cal.mag_offset_uT), -2000.0f, 2000.0f, 0.0f,
+     PARAM_DOC("Compass offsets", "mGauss",
+               "The hard iron along the board's x (forward), y (right) or z (down) axis, n X, Y or Z, as "
+               "ArduPilot's: added to the field before COMPASS_DIA_* and COMPASS_ODI_* (the `cal mag` offset in uT "
+               "with its sign turned, times 10). Set by `cal mag` and by the ground station's compass calibration; "
+               "a value set here is in use at once, marks the compass calibrated and clears the offset learned in "
+               "motion, which otherwise comes on top of it (`status`).")},
+    {"COMPASS_DIA_#", Type::Float, kLetterX, 3, 4, AT(cal.mag_scale), 0.5f, 2.0f, 1.0f,
+     PARAM_DOC("Compass soft-iron diagonal", "",
+               "The soft-iron matrix's diagonal, n X, Y or Z, as ArduPilot's: the field's x, y or z component, "
+               "offset corrected, is scaled by it (with COMPASS_ODI_* a symmetric matrix; after `cal mag` its "
+               "determinant is 1). 1 and COMPASS_ODI_* 0: no soft iron.")},
+    {"COMPASS_ODI_#", Type::Float, kLetterX, 3, 4, AT(cal.mag_cross), -0.5f, 0.5f, 0.0f,
+     PARAM_DOC("Compass soft-iron off-diagonal", "",
+               "The soft-iron matrix's off-diagonal terms, as ArduPilot's: X the xy and yx term, Y xz and zx, Z yz "
+               "and zy.")},
+    {"COMPASS_USE", Type::UInt8, 0, 1, 0, AT(vehicle.compass_use), 0.0f, 1.0f, 1.0f,
+     PARAM_DOC("Use compass for yaw", "",
+               "1: the heading is corrected by the compass; 0: the compass is read (and `cal mag` works) but the "
+               "heading is the gyro's, or the GPS course when moving, as without a compass.")},
+    {"COMPASS_LEARN", Type::UInt8, 0, 1, 0, AT(vehicle.compass_learn), 0.0f, 1.0f, 1.0f,
+     PARAM_DOC("Learn compass offsets", "",
+               "1: the hard iron is learned in motion, from the field's change against the gyro's turn, and used on "
+               "top of COMPASS_OFS_* once it clearly differs (`status` shows it); 0: not learned (the offset "
+               "learned so far is kept until `cal mag` or a COMPASS_OFS_* change clears it).")},
 
     // Battery monitor and its failsafe.
 
@@ -286,15 +320,18 @@ constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
 
 constexpr float kRadPerCentideg = linalg::kPi / 18000.0f;
 
-// The row holding index, and the instance within it; false past the end.
+// The row holding index, and the instance within it; false past the end. Only the counts
+// are read on the way and the one row copied: a walk copying every row (35 bytes from
+// flash each) took a PARAM_SET of a row near the table's end past its task's budget.
 bool locate(uint16_t index, Row& row, uint8_t& instance) {
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (index < row.count) {
+        const uint8_t n = ROW_BYTE(r, count);
+        if (index < n) {
+            COPY_ROW(&row, &kRows[r]);
             instance = (uint8_t)index;
             return true;
         }
-        index = (uint16_t)(index - row.count);
+        index = (uint16_t)(index - n);
     }
     return false;
 }
@@ -312,6 +349,7 @@ float read(const Settings& s, const Row& row, uint8_t instance) {
         case Type::UInt8: return (float)*p;
         case Type::Bit: return (float)((*p >> instance) & 1u);
         case Type::DeclRad: { int16_t v; memcpy(&v, p, sizeof v); return (float)v * kRadPerCentideg; }
+        case Type::MagOfs: { float v; memcpy(&v, p, sizeof v); return compass_ofs_mgauss(v); }
     }
     return 0.0f;
 }
@@ -336,6 +374,11 @@ void write(Settings& s, const Row& row, uint8_t instance, float value) {
             memcpy(p, &v, sizeof v);
             break;
         }
+        case Type::MagOfs: {
+            const float uT = value / -kMilliGaussPerMicroTesla;
+            memcpy(p, &uT, sizeof uT);
+            break;
+        }
     }
 }
 
@@ -354,15 +397,25 @@ char upper(char c) { return (c >= 'a' && c <= 'z') ? (char)(c - 'a' + 'A') : c; 
 
 }  // namespace
 
-bool is_integer(Type t) { return t != Type::Float && t != Type::DeclRad; }
+float compass_ofs_mgauss(float offset_uT) {
+    const float centi = offset_uT * (-100.0f * kMilliGaussPerMicroTesla);
+    // Divided, not multiplied by 0.01f: the nearest float to the decimal.
+    if (!(centi > -1e7f && centi < 1e7f)) return centi / 100.0f;  // NaN or absurd: as it is
+    return (float)(int32_t)(centi >= 0.0f ? centi + 0.5f : centi - 0.5f) / 100.0f;
+}
+
+bool is_integer(Type t) { return t != Type::Float && t != Type::DeclRad && t != Type::MagOfs; }
+
+bool is_compass_calibration(uint16_t index) {
+    Row row;
+    uint8_t instance;
+    return locate(index, row, instance) && row.offset >= offsetof(Settings, cal.mag_offset_uT) &&
+           row.offset < offsetof(Settings, cal.mag_learned_uT);
+}
 
 uint16_t count() {
     uint16_t n = 0;
-    Row row;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        n = (uint16_t)(n + row.count);
-    }
+    for (uint8_t r = 0; r < kRowCount; ++r) n = (uint16_t)(n + ROW_BYTE(r, count));
     return n;
 }
 
@@ -385,25 +438,24 @@ bool info(uint16_t index, Info& out) {
 // not info() for every index: MAVLink's PARAM_SET and PARAM_REQUEST_READ look names up
 // between samples.
 int16_t find(const char* name) {
-    Row row;
     uint16_t index = 0;
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        uint8_t i = 0, j = 0;  // row.name, name
+        const uint8_t count = ROW_BYTE(r, count);
+        uint8_t i = 0, j = 0;  // the row's name (read from flash a character at a time), name
         int16_t instance = 0;
         bool match = true;
-        while (match && row.name[i] != '\0') {
-            if (row.name[i] == '#') {
-                const char c = name[j++];
-                instance = (int16_t)(c - '0' - (char)row.first);
-                match = c >= '0' && c <= '9' && instance >= 0 && instance < row.count;
+        for (char rc = (char)ROW_BYTE(r, name[0]); match && rc != '\0'; rc = (char)ROW_BYTE(r, name[++i])) {
+            if (rc == '#') {
+                // A digit, or a letter (X, Y, Z): '0' + first + instance, whatever its case.
+                const char c = upper(name[j++]);
+                instance = (int16_t)(c - '0' - (char)ROW_BYTE(r, first));
+                match = instance >= 0 && instance < count;
             } else {
-                match = upper(name[j++]) == row.name[i];
+                match = upper(name[j++]) == rc;
             }
-            ++i;
         }
         if (match && name[j] == '\0') return (int16_t)(index + instance);
-        index = (uint16_t)(index + row.count);
+        index = (uint16_t)(index + count);
     }
     return -1;
 }
@@ -458,7 +510,8 @@ namespace {
 
 uint8_t stored_bytes(Type t) {
     switch (t) {
-        case Type::Float: return 4;
+        case Type::Float:
+        case Type::MagOfs: return 4;
         case Type::Int16:
         case Type::UInt16:
         case Type::DeclRad: return 2;
@@ -468,15 +521,26 @@ uint8_t stored_bytes(Type t) {
 
 // Calls f(pointer to the value's bytes, their count) for every stored value of the
 // flight settings, in the record's order.
+// ... of the rows whose values lie at offsets from .. to-1 of Settings. The settings store
+// calls this for every part of a record it writes, between samples: only the bytes it needs
+// are read from each row (copying each whole row from flash took the store's task past its
+// budget as rows were added).
+template <typename F>
+void each_value_at(const Settings& s, uint16_t from, uint16_t to, F f) {
+    for (uint8_t r = 0; r < kRowCount; ++r) {
+        const uint16_t offset = ROW_WORD(r, offset);
+        if (offset < from || offset >= to) continue;
+        const Type type = (Type)ROW_BYTE(r, type);
+        const uint8_t n = type == Type::Bit ? 1 : ROW_BYTE(r, count);
+        const uint8_t stride = ROW_BYTE(r, stride);
+        uint8_t* p = reinterpret_cast<uint8_t*>(&const_cast<Settings&>(s)) + offset;
+        for (uint8_t i = 0; i < n; ++i) f(p + (uint16_t)stride * i, stored_bytes(type));
+    }
+}
+
 template <typename F>
 void each_flight_value(const Settings& s, F f) {
-    Row row;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (row.offset < offsetof(Settings, flight) || row.offset >= offsetof(Settings, vehicle)) continue;
-        const uint8_t n = row.type == Type::Bit ? 1 : row.count;
-        for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
-    }
+    each_value_at(s, offsetof(Settings, flight), offsetof(Settings, vehicle), f);
 }
 
 }  // namespace
@@ -513,13 +577,7 @@ namespace {
 // second record (Settings::vehicle), in the record's order.
 template <typename F>
 void each_vehicle_value(const Settings& s, F f) {
-    Row row;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (row.offset < offsetof(Settings, vehicle)) continue;
-        const uint8_t n = row.type == Type::Bit ? 1 : row.count;
-        for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
-    }
+    each_value_at(s, offsetof(Settings, vehicle), 0xFFFFu, f);
 }
 
 }  // namespace

@@ -26,6 +26,11 @@ enum class Type : uint8_t {
     UInt8,    // uint8_t
     Bit,      // bit n of a uint8_t (n = the instance), 0 or 1
     DeclRad,  // the declination: int16_t centi-degrees, shown in radians (ArduPilot's COMPASS_DEC)
+    // The compass's hard-iron offset: a float in uT that calib::apply_mag subtracts from the
+    // field, shown as ArduPilot's COMPASS_OFS_*, which AP_Compass adds to the field, in
+    // milligauss: its negation times 10 (1 uT = 10 mGauss), rounded to 0.01 mGauss so that
+    // a value sent comes back as sent.
+    MagOfs,
 };
 
 constexpr uint8_t kNameMax = 16;  // MAVLink's param_id length
@@ -49,6 +54,14 @@ float get(const settings::Settings& s, uint16_t index);
 // out of range, not whole for an integer type, or leaves an end point pair out of order
 // (RCn/SERVOn: MIN <= TRIM <= MAX).
 bool set(settings::Settings& s, uint16_t index, float value);
+// ArduPilot's COMPASS_OFS (mGauss, added to the field) of a `cal mag` offset (uT, subtracted
+// from the field): 1 uT = 10 mGauss, rounded to 0.01 mGauss (the nearest float to that
+// decimal, so that the value a ground station sets comes back as sent).
+constexpr float kMilliGaussPerMicroTesla = 10.0f;
+float compass_ofs_mgauss(float offset_uT);
+// True for the rows of the compass calibration (COMPASS_OFS_*, _DIA_*, _ODI_*: Settings::cal's
+// offset and soft iron): a change is a new calibration (the pipeline takes it as `cal mag`'s).
+bool is_compass_calibration(uint16_t index);
 // Every parameter to its default.
 void apply_defaults(settings::Settings& s);
 // The flight settings in the EEPROM record (settings::encode): the rows that live in

@@ -19,7 +19,10 @@ struct VehicleSettings {
 
     // Board orientation, level, the accelerometer's calibration (AP_AHRS, AP_InertialSensor).
 
-    // Compass (AP_Compass).
+    // Compass (AP_Compass). Its calibration's rows (COMPASS_OFS_*, _DIA_*, _ODI_*) point into
+    // Settings::cal: saved with it in the first record.
+    uint8_t compass_use;        // COMPASS_USE: 1 the heading from the compass, 0 the gyro's (or the GPS course)
+    uint8_t compass_learn;      // COMPASS_LEARN: 1 the hard iron learned in motion (OffsetLearner), 0 not
 
     // Battery monitor and its failsafe (AP_BattMonitor, ArduPlane's FS_BATT_*).
 

@@ -930,8 +930,12 @@ TEST(MavLink, ParameterReferenceTableIsTheCodes) {
         const std::string name = c[0].substr(1, tick - 1);
         int first = 0, last = 0;
         const size_t n_at = name.find('n');
-        if (n_at != std::string::npos)
-            ASSERT_EQ(sscanf(c[0].c_str() + tick + 1, " (n %d-%d)", &first, &last), 2) << lines[at];
+        char first_c = 0, last_c = 0;  // or letters ("COMPASS_OFS_n" (n X-Z))
+        if (n_at != std::string::npos && sscanf(c[0].c_str() + tick + 1, " (n %d-%d)", &first, &last) != 2) {
+            ASSERT_EQ(sscanf(c[0].c_str() + tick + 1, " (n %c-%c)", &first_c, &last_c), 2) << lines[at];
+            first = first_c - '0';
+            last = last_c - '0';
+        }
         float lo = 0, hi = 0, def = 0;
         ASSERT_EQ(sscanf(c[2].c_str(), "%f to %f", &lo, &hi), 2) << lines[at];
         ASSERT_EQ(sscanf(c[3].c_str(), "%f", &def), 1) << lines[at];
@@ -997,6 +1001,62 @@ TEST(MavLink, ScaledPressureInHectopascalAndCentidegrees) {
     EXPECT_EQ((int16_t)u16(hot.payload, 12), 32767);
     const Frame cold = parse(buf, p.scaled_pressure(buf, 0u, 1000.0f, -1e6f), kExtraScaledPressure);
     EXPECT_EQ((int16_t)u16(cold.payload, 12), -32767);
+}
+
+// MAG_CAL_PROGRESS (ardupilotmega.xml 191, CRC_EXTRA 92: not in the common.xml the headers
+// are made from, packed by hand) and MAG_CAL_REPORT (common.xml 192, CRC_EXTRA 36), in
+// their wire order; pymavlink decodes both in test/mavlink/gcs_mag_cal.py.
+TEST(MavLinkMagCal, ProgressFieldsInWireOrder) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const uint8_t n = p.mag_cal_progress(buf, mav::MagCalStatus::RunningStepOne, 1u, 42u, 0x02ABCDEFu,
+                                         linalg::Vector3f(0.6f, -0.8f, 0.0f));
+    const Frame f = parse(buf, n, 92u);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 191u);
+    EXPECT_LE(n, mav::kMagCalProgressFrame);
+    EXPECT_EQ(f.payload.size(), 21u) << "the mask's six zero bytes trimmed";
+    EXPECT_FLOAT_EQ(f32(f.payload, 0), 0.6f);
+    EXPECT_FLOAT_EQ(f32(f.payload, 4), -0.8f);
+    EXPECT_FLOAT_EQ(f32(f.payload, 8), 0.0f);
+    EXPECT_EQ(u8(f.payload, 12), 0u);  // compass_id
+    EXPECT_EQ(u8(f.payload, 13), 1u);  // cal_mask
+    EXPECT_EQ(u8(f.payload, 14), 2u);  // MAG_CAL_RUNNING_STEP_ONE
+    EXPECT_EQ(u8(f.payload, 15), 1u);  // attempt
+    EXPECT_EQ(u8(f.payload, 16), 42u);  // completion_pct
+    EXPECT_EQ(u32(f.payload, 17), 0x02ABCDEFu);  // completion_mask[0..3], little-endian bits
+    for (size_t i = 21; i < 27; ++i) EXPECT_EQ(u8(f.payload, i), 0u);
+    const Frame next = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Manual), kExtraHeartbeat);
+    EXPECT_EQ(next.seq, (uint8_t)(f.seq + 1u)) << "one sequence with the others";
+}
+
+TEST(MavLinkMagCal, ReportCarriesArduPilotsUnits) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    mav::MagCalReport r;
+    r.status = mav::MagCalStatus::Success;
+    r.autosaved = true;
+    r.fitness_mgauss = 2.3f;
+    r.ofs_mgauss = linalg::Vector3f(-80.1f, 50.2f, -30.0f);
+    r.diag = linalg::Vector3f(0.99f, 1.0f, 1.02f);
+    r.offdiag = linalg::Vector3f(0.01f, -0.02f, 0.0f);
+    const uint8_t n = p.mag_cal_report(buf, r);
+    const Frame f = parse(buf, n, 36u);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 192u);
+    EXPECT_LE(n, mav::kMaxFrame);
+    const float want[10] = {2.3f, -80.1f, 50.2f, -30.0f, 0.99f, 1.0f, 1.02f, 0.01f, -0.02f, 0.0f};
+    for (size_t i = 0; i < 10; ++i) EXPECT_FLOAT_EQ(f32(f.payload, 4 * i), want[i]) << "field " << i;
+    EXPECT_EQ(u8(f.payload, 40), 0u);  // compass_id
+    EXPECT_EQ(u8(f.payload, 41), 1u);  // cal_mask
+    EXPECT_EQ(u8(f.payload, 42), 4u);  // MAG_CAL_SUCCESS
+    EXPECT_EQ(u8(f.payload, 43), 1u);  // autosaved
+    r.status = mav::MagCalStatus::Failed;
+    r.autosaved = false;
+    const Frame failed = parse(buf, p.mag_cal_report(buf, r), 36u);
+    EXPECT_TRUE(failed.crc_ok);
+    EXPECT_EQ(u8(failed.payload, 42), 5u);  // MAG_CAL_FAILED
+    EXPECT_EQ(u8(failed.payload, 43), 0u);
 }
 
 }  // namespace

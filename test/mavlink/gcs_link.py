@@ -30,7 +30,6 @@ Exit 1 with every failure listed. Timing assertions are on simulated time only.
 import bisect
 import csv
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -40,7 +39,7 @@ from pymavlink import mavutil
 from pymavlink.dialects.v20 import common as mavlink2
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from sim_run import scenario_file, tools_and_work  # noqa: E402
+from sim_run import scenario_file, serve, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 WALL_TIMEOUT_S = 600  # a loaded machine runs simavr many times slower than the board
@@ -88,16 +87,8 @@ class Board:
         # The sections' cycles (loop 6, request 16, reply 17), printed at the end: where a
         # missed sample would come from.
         self.profile = os.path.join(work, name + ".profile.csv")
-        cmd = [os.path.join(tools, "apm25sim"), "--elf", os.path.join(tools, "firmware.elf"),
-               "--serial", "tcp:0", "--speed", "1", "--profile", self.profile] + extra
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        line = self.proc.stderr.readline()
-        self.log.write(line)
-        m = re.search(r"tcp:127\.0\.0\.1:(\d+)", line)
-        if not m:
-            self.proc.kill()
-            sys.exit("apm25sim did not serve: %r" % line)
-        self.conn = mavutil.mavlink_connection("tcp:127.0.0.1:%s" % m.group(1), source_system=255,
+        self.proc, port = serve(tools, ["--profile", self.profile] + extra, self.log)
+        self.conn = mavutil.mavlink_connection("tcp:127.0.0.1:%s" % port, source_system=255,
                                                source_component=190, autoreconnect=False)
         self.msgs = []      # (sim time s, message)
         self.t_s = 0.0      # the latest simulated time a message carried

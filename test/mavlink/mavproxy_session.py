@@ -28,7 +28,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from sim_run import tools_and_work  # noqa: E402
+from sim_run import serve, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 WALL_TIMEOUT_S = 600
@@ -85,32 +85,43 @@ def write_banked(path):
             f.write(",".join("%.6f" % v for v in [t, 0, 0, 0] + accel + mag + list(q)) + "\n")
 
 
+class Session:
+    """apm25sim serving the board on TCP in real time, and MAVProxy's console on it (its output
+    in `out`, typed into with type_line); stop() ends both."""
+
+    def __init__(self, args, sim_args, modules):
+        self.sim_log = open(os.path.join(args.work, "apm25sim.stderr"), "w")
+        self.sim, port = serve(args.tools, sim_args, self.sim_log)
+        mavproxy = os.path.join(os.path.dirname(sys.executable), "mavproxy.py")
+        self.mp_log = open(os.path.join(args.work, "mavproxy.out"), "w")
+        self.mp = subprocess.Popen([sys.executable, mavproxy, "--master", "tcp:127.0.0.1:" + port,
+                                    "--no-state", "--default-modules", modules, "--target-system", "1"],
+                                   stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                   bufsize=1, cwd=args.work)
+        self.out = Lines(self.mp.stdout, self.mp_log)
+
+    def type_line(self, cmd):
+        self.mp.stdin.write(cmd + "\n")
+        self.mp.stdin.flush()
+
+    def stop(self):
+        self.type_line("exit")
+        try:
+            self.mp.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.mp.kill()
+        self.mp_log.close()
+        self.sim.terminate()
+        self.sim.wait()
+        self.sim_log.write(self.sim.stderr.read())
+
+
 def main():
     args = tools_and_work()
     trajectory = os.path.join(args.work, "banked.csv")
     write_banked(trajectory)
-    sim_log = open(os.path.join(args.work, "apm25sim.stderr"), "w")
-    sim = subprocess.Popen([os.path.join(args.tools, "apm25sim"), "--elf", os.path.join(args.tools, "firmware.elf"),
-                            "--trajectory", trajectory, "--serial", "tcp:0", "--speed", "1"],
-                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    first = sim.stderr.readline()
-    sim_log.write(first)
-    port = re.search(r"tcp:127\.0\.0\.1:(\d+)", first)
-    if not port:
-        sim.kill()
-        sys.exit("apm25sim did not serve: %r" % first)
-    mavproxy = os.path.join(os.path.dirname(sys.executable), "mavproxy.py")
-    mp_log = open(os.path.join(args.work, "mavproxy.out"), "w")
-    mp = subprocess.Popen([sys.executable, mavproxy, "--master", "tcp:127.0.0.1:" + port.group(1), "--no-state",
-                           "--default-modules", "param,mode", "--target-system", "1"],
-                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1,
-                          cwd=args.work)
-    out = Lines(mp.stdout, mp_log)
-
-    def type_line(cmd):
-        mp.stdin.write(cmd + "\n")
-        mp.stdin.flush()
-
+    session = Session(args, ["--trajectory", trajectory], "param,mode")
+    out, type_line = session.out, session.type_line
     try:
         m = out.wait(r"Received (\d+) parameters", "the parameter list")
         soft_assert(m and int(m.group(1)) > 90, "parameters received: %s" % (m and m.group(1)))
@@ -147,15 +158,7 @@ def main():
         soft_assert(checked == 5, "%d ATTITUDE shown" % checked)
         print("# MAVProxy: parameters fetched, RLL2SRV_P set and saved, MANUAL> shown, %d ATTITUDE checked" % checked)
     finally:
-        type_line("exit")
-        try:
-            mp.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            mp.kill()
-        mp_log.close()
-        sim.terminate()
-        sim.wait()
-        sim_log.write(sim.stderr.read())
+        session.stop()
 
 
 if __name__ == "__main__":

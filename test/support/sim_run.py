@@ -4,7 +4,9 @@
 of their own) and a scenario's trajectory written there."""
 import argparse
 import os
+import re
 import subprocess
+import sys
 
 
 def tools_and_work():
@@ -17,9 +19,25 @@ def tools_and_work():
     return args
 
 
-def scenario_file(tools, work, name):
-    """build/scenario NAME written to WORK/NAME.csv; its path."""
-    path = os.path.join(work, name + ".csv")
+def scenario_file(tools, work, name, options=(), file_name=None):
+    """build/scenario NAME [OPTIONS] written to WORK/FILE_NAME (default NAME.csv); its path."""
+    path = os.path.join(work, file_name or name + ".csv")
     with open(path, "wb") as f:
-        subprocess.run([os.path.join(tools, "scenario"), name], stdout=f, check=True)
+        subprocess.run([os.path.join(tools, "scenario"), name] + list(options), stdout=f, check=True)
     return path
+
+
+def serve(tools, extra, log):
+    """apm25sim serving the board's UART0 on TCP in real time (--serial tcp:0 --speed 1, then
+    EXTRA), its first stderr line written to LOG: (the process, the port). Exits when it does
+    not serve."""
+    proc = subprocess.Popen([os.path.join(tools, "apm25sim"), "--elf", os.path.join(tools, "firmware.elf"),
+                             "--serial", "tcp:0", "--speed", "1"] + list(extra),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    line = proc.stderr.readline()
+    log.write(line)
+    m = re.search(r"tcp:127\.0\.0\.1:(\d+)", line)
+    if not m:
+        proc.kill()
+        sys.exit("apm25sim did not serve: %r" % line)
+    return proc, m.group(1)
