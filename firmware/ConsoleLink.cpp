@@ -157,6 +157,10 @@ static bool answer(const console::Command& c, uint8_t part) {
     switch (c.id) {
         case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
+        case console::CommandId::CalLevel:
+            if (!pipe.start_level_calibration())
+                text::Writer(out).str(TXT(TXT_ERROR "cal level: not now (starting, or a calibration runs); nothing changed")).end();
+            break;
         case console::CommandId::Flight:
         case console::CommandId::Show: flight_io.answer(c); break;  // flight manual|stabilize, rc, servo
         case console::CommandId::Mode:

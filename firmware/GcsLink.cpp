@@ -70,11 +70,19 @@ static mav::Result set_home(const float* p) {
 }
 
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
-// (`cal mag`); the others (baro, accel, airspeed ...) the board does not have.
+// (`cal mag`), param5 2 the level (`cal level`); the others (baro, the accelerometer's
+// six positions, airspeed ...) the board does not have.
 // MAV_CMD_PREFLIGHT_STORAGE: param1 1 write (`save`), 2 defaults (`defaults`, not
 // saved); 0 (read) UNSUPPORTED. The result comes as "# " lines.
 static mav::Result run_command(const mav::CommandLong& c) {
     const float* p = c.param;
+    if (c.command == mav::kCmdPreflightCalibration && p[4] == 2.0f) {
+        // param5 2: the level (Mission Planner's "Calibrate Level", MAVProxy's ahrstrim):
+        // accepted as it starts, the verdict a "# cal level" line (STATUSTEXT).
+        for (uint8_t i = 0; i < 7; ++i)
+            if (i != 4 && p[i] != 0.0f) return mav::Result::Unsupported;
+        return pipe.start_level_calibration() ? mav::Result::Accepted : mav::Result::TemporarilyRejected;
+    }
     if (c.command == mav::kCmdPreflightCalibration) {
         const bool gyro = p[0] == 1.0f, mag = p[1] == 1.0f;
         for (uint8_t i = 2; i < 7; ++i)

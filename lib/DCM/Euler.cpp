@@ -159,6 +159,30 @@ EulerQ24 euler_carried_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int
     return e;
 }
 
+// One carried row (r + r x theta), all three entries.
+static linalg::Vector3l carried_row(const Theta& t, const linalg::Vector3l& p) {
+    return linalg::Vector3l(carried_entry(t, p.x, p.y, t.z, p.z, t.y), carried_entry(t, p.y, p.z, t.x, p.x, t.z),
+                            carried_entry(t, p.z, p.x, t.y, p.y, t.x));
+}
+// Row p of R' times row j of T (Q14): entry (., j) of R' T^T, Q30.
+static int32_t times_trim_row(const linalg::Vector3l& p, const int16_t* tj) {
+    return linalg::mul_q14(tj[0], p.x) + linalg::mul_q14(tj[1], p.y) + linalg::mul_q14(tj[2], p.z);
+}
+
+EulerQ24 euler_carried_trimmed_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                                   int32_t theta_z_q26, const int16_t trim_q14[3][3]) {
+    const Theta t = theta_for(theta_x_q26, theta_y_q26, theta_z_q26);
+    const linalg::Vector3l a = carried_row(t, r.a), b = carried_row(t, r.b), c = carried_row(t, r.c);
+    EulerQ24 e;
+    const bool away_from_lock = roll_pitch(times_trim_row(c, trim_q14[0]), times_trim_row(c, trim_q14[1]),
+                                           times_trim_row(c, trim_q14[2]), e);
+    // Column 1 of the first two rows, or at the lock column 2.
+    const int16_t* tj = trim_q14[away_from_lock ? 0 : 1];
+    const int32_t r_1 = times_trim_row(a, tj), r_2 = times_trim_row(b, tj);
+    e.yaw_q24 = yaw(away_from_lock, r_1, r_1, r_2, r_2);
+    return e;
+}
+
 EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {
     return euler_carried_q24(linalg::q30_from_matrix(r), theta_x_q26, theta_y_q26, theta_z_q26);
 }

@@ -135,7 +135,7 @@ AttitudePipeline::AttitudePipeline(const EventSink* events, const dcm::DcmSettin
 }
 
 AttitudePipeline::AttitudePipeline(const EventSink* events, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
-    : events_(events), settings_(), dcm_(dcm_settings), st_(), start_gravity_() {
+    : events_(events), settings_(), dcm_(dcm_settings), st_(), frame_(), trim_(), start_gravity_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f, mpu6000::kGyroRange, mpu6000::kAccelRange);
 }
 
@@ -150,8 +150,12 @@ void AttitudePipeline::set_mag_present(bool present) {
     if (!present) st_.mag_pending = false;
 }
 
-void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
-    if (!field_uT.is_finite()) return;
+void AttitudePipeline::on_mag_sample(const Vector3f& board_field_uT) {
+    if (!board_field_uT.is_finite()) return;
+    // The compass is on the board (the APM 2.5's HMC5883L): it turns with it. Everything
+    // after this, the calibration too, is in the airframe's axes, as ArduPilot's.
+    Vector3f field_uT = board_field_uT;
+    calib::rotate(frame_.rotation, field_uT);
     // The fit's sums wait for a step free of heavy work, as the learner does.
     cal_field_uT_ = field_uT;
     if (st_.mag_cal_active) st_.cal_pending = true;
@@ -324,6 +328,23 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
             return;
         }
     }
+    if (st_.level_cal_active && r == calib::GyroCalibrator::Result::Moved) {
+        st_.gyro_cal_active = false;
+        finish_level_calibration(LevelResult::kMoved);
+        return;
+    }
+    if (r == calib::GyroCalibrator::Result::Done && st_.level_cal_active) {
+        // The still second's mean specific force, in the airframe's axes less the trim.
+        float tx, ty;
+        const bool ok = calib::level_trim(gyro_cal_.mean_accel_m_s2(), tx, ty);
+        if (ok) {
+            settings_.vehicle.ahrs_trim_x_rad = tx;
+            settings_.vehicle.ahrs_trim_y_rad = ty;
+            trim_ = calib::trim_q14(tx, ty);
+        }
+        finish_level_calibration(ok ? LevelResult::kOk : LevelResult::kTooFar);
+        // and the bias of the same still second, as `cal gyro`'s (below)
+    }
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
@@ -356,7 +377,8 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
         st_.gyro_cal_active = false;
-        tell(EventKind::kGyroCalTimeout);
+        if (st_.level_cal_active) finish_level_calibration(LevelResult::kTimeout);
+        else tell(EventKind::kGyroCalTimeout);
     }
 }
 
@@ -365,9 +387,19 @@ static uint8_t clipped_axes(const linalg::Vector3i& a) {
     return (uint8_t)((a.x >= 32767 || a.x <= -32767) + (a.y >= 32767 || a.y <= -32767) + (a.z >= 32767 || a.z <= -32767));
 }
 
-void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
+void AttitudePipeline::on_imu_sample(const mpu6000::Sample& board_sample) {
     st_.output_due = false;
     ++st_.steps;
+    if (st_.phase == Phase::WaitImu) refresh_board_frame();  // the settings as loaded
+    // Once a second the frame follows the settings (a parameter set meanwhile).
+    if ((uint8_t)st_.steps == 0u) st_.frame_due = true;
+    // The accelerometer's calibration and the board's orientation, on the counts: the
+    // vehicle's axes from here on.
+    profile::begin(profile::kBoardFrame);
+    mpu6000::Sample raw = board_sample;
+    calib::apply_gyro(frame_, raw.gyro);
+    calib::apply_accel(frame_, raw.accel);
+    profile::end(profile::kBoardFrame);
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);
     if (st_.start_message == StartMessage::kBias) tell(EventKind::kGyroBias);
@@ -474,6 +506,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         fit_step = st_.mag_fit_active;
         if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
         else if (fit_step) step_mag_fit();
+        else if (st_.frame_due) refresh_board_frame();
         else report_deferred();
         st_.cal_pending = false;
     }
@@ -497,13 +530,13 @@ void AttitudePipeline::report_deferred() {
 }
 
 Angles AttitudePipeline::angles() const {
-    const dcm::EulerAngles e = dcm_.euler_now();
+    const dcm::EulerAngles e = dcm::euler_in_rad(dcm_.euler_now_q24(trim_rows()));
     const float h = dcm::heading_deg(e.yaw_rad, settings_.declination_deg());
     return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad, h};
 }
 
 AnglesCentideg AttitudePipeline::angles_centideg() const {
-    return dcm::angles_centideg(dcm_.euler_now_q24(), settings_.declination_centideg);
+    return dcm::angles_centideg(dcm_.euler_now_q24(trim_rows()), settings_.declination_centideg);
 }
 
 linalg::Quaternion AttitudePipeline::quaternion() const {
@@ -518,13 +551,50 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
     return settings_.cal.gyro_bias_rad_s + dcm_.gyro_bias_rad_s();
 }
 
+bool AttitudePipeline::start_level_calibration() {
+    if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating()) return false;
+    begin_gyro_window();
+    st_.level_cal_active = true;
+    tell(EventKind::kLevelStart);
+    return true;
+}
+
+void AttitudePipeline::finish_level_calibration(LevelResult r) {
+    st_.level_cal_active = false;
+    tell(EventKind::kLevelDone, 0, 0, 0.0f, (uint8_t)r);
+}
+
+// The settings' frame and trim in the sample path's forms (a few thousand cycles, on a
+// step with room). A new orientation makes the gyro bias and the estimator's attitude
+// those of another frame: both start again (the user is setting the board up: it is
+// still, as a start).
+void AttitudePipeline::refresh_board_frame() {
+    st_.frame_due = false;
+    const settings::VehicleSettings& v = settings_.vehicle;
+    const uint8_t before = frame_.rotation;
+    frame_ = calib::make_board_frame(Vector3f(v.ins_accoffs_m_s2[0], v.ins_accoffs_m_s2[1], v.ins_accoffs_m_s2[2]),
+                                     Vector3f(v.ins_accscal[0], v.ins_accscal[1], v.ins_accscal[2]),
+                                     v.ahrs_orientation, kAccelCount_m_s2);
+    const bool trims_ok = fabsf(v.ahrs_trim_x_rad) <= calib::kTrimMax_rad && fabsf(v.ahrs_trim_y_rad) <= calib::kTrimMax_rad;
+    trim_ = calib::trim_q14(trims_ok ? v.ahrs_trim_x_rad : 0.0f, trims_ok ? v.ahrs_trim_y_rad : 0.0f);
+    if (frame_.rotation == before || st_.phase != Phase::Running) return;
+    tell(EventKind::kOrientation, 0, 0, 0.0f, frame_.rotation);
+    restart_estimator();
+    if (!st_.gyro_cal_active) start_gyro_calibration();
+}
+
 void AttitudePipeline::start_gyro_calibration() {
+    begin_gyro_window();
+    if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);
+}
+
+void AttitudePipeline::begin_gyro_window() {
     gyro_cal_.restart();
     if (st_.phase != Phase::Running) start_gravity_.restart();  // running: the space is the turn's
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
     st_.start_moved = false;  // asked for (`cal gyro`): the user says the board is still
-    if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);
+    st_.level_cal_active = false;
 }
 
 void AttitudePipeline::restart_estimator() {

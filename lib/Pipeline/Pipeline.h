@@ -43,6 +43,7 @@
 
 #include <stdint.h>
 
+#include "BoardFrame.h"
 #include "Calibration.h"
 #include "Dcm.h"
 #include "GpsFix.h"
@@ -189,6 +190,17 @@ enum class EventKind : uint8_t {
     kMagCalNoCompass,  // `cal mag` refused: no magnetometer
     kMagCalProgress,   // `cal mag` collecting: count seconds left, total samples
     kMagCalDone,       // the verdict: code a calib::MagCalibrator::Quality (Ok: in settings().cal)
+    kLevelStart,       // the level calibration begins
+    kLevelDone,        // its verdict: code a LevelResult (Ok: the trims in settings().vehicle)
+    kOrientation,      // AHRS_ORIENTATION changed to code: the estimator and the gyro start again
+};
+
+// The level calibration's verdict (kLevelDone's code).
+enum class LevelResult : uint8_t {
+    kOk,
+    kMoved,     // the board moved: nothing changed
+    kTooFar,    // the board is more than AHRS_TRIM's 10 deg from level: nothing changed
+    kTimeout,   // never still for 1 s within 10 s
 };
 
 // One event. count, for the rate-limited kinds (kGyroCalMoved, kSpike, kGyroSaturated,
@@ -281,6 +293,16 @@ public:
     void restore_defaults();
     void start_gyro_calibration();
     void start_mag_calibration();
+    // The level calibration (ArduPilot's "Calibrate Level", MAV_CMD_PREFLIGHT_CALIBRATION
+    // param5 2): a still second's mean specific force sets AHRS_TRIM_X/Y so that the
+    // airframe, level and at rest, reads level (calib::level_trim); the gyro bias is
+    // measured again in the same second. False (nothing started) while not running or
+    // while another calibration runs. The verdict is kLevelDone.
+    bool start_level_calibration();
+    bool level_calibrating() const { return st_.level_cal_active; }
+    // The board's frame and trim from the settings now (AHRS_ORIENTATION, AHRS_TRIM_*,
+    // INS_ACC*): the pipeline takes them up by itself within a second of a change.
+    void refresh_board_frame();
     // After a sensor outage: the next sample restarts the DCM from gravity and the latest
     // field, keeping the gyro bias (before the first start it just goes on calibrating).
     void restart_estimator();
@@ -318,6 +340,10 @@ private:
     void take_gps_fix(const gps::Fix& fix);
     void finish_mag_calibration();
     void report_deferred();
+    void finish_level_calibration(LevelResult r);
+    void begin_gyro_window();  // start_gyro_calibration without its line
+    // The trim's rotation for the angles (null: none).
+    const int16_t (*trim_rows() const)[3] { return trim_.active ? trim_.t : nullptr; }
     // An event to the sink; the short forms keep each call site small (flash).
     void tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const;
     __attribute__((noinline)) void tell(EventKind kind, uint16_t count) const;
@@ -378,8 +404,12 @@ private:
         bool turn_doubtful;             // since the last field sample the gyro was not the board's turn
         bool start_moved;               // the start was never still: the calibration measuring on may see a turn
         bool gps_moving;                // the GPS's ground speed passed kCourseMinSpeed_m_s (and not below kGpsStillSpeed_m_s since)
+        bool level_cal_active;          // the gyro calibration under way is the level calibration
+        bool frame_due;                 // refresh_board_frame on the next step with room
     };
     State st_;
+    calib::BoardFrame frame_;  // the accelerometer's calibration and the board's orientation, in counts
+    calib::TrimQ14 trim_;      // the level trim for the angles
     // One space for two phases (RAM): before the estimator runs the start's gravity if
     // never still (StartGravity.h), then the turn's mean (TurnMean: a plain struct, taken
     // up by assignment in start_estimator; the phase never goes back).

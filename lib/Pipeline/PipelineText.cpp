@@ -39,6 +39,23 @@ void write_cal_mag_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, co
     w.str(TXT("; calibration unchanged")).end();
 }
 
+// The level calibration's verdict (kLevelDone).
+void write_level_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
+    using pipeline::LevelResult;
+    const LevelResult r = (LevelResult)e.code;
+    if (r == LevelResult::kOk) {
+        const settings::VehicleSettings& v = pipe.settings().vehicle;
+        w.str(TXT("# cal level: trim roll ")).fixed2(v.ahrs_trim_x_rad * linalg::kDegPerRad).str(TXT(" pitch "))
+            .fixed2(v.ahrs_trim_y_rad * linalg::kDegPerRad).str(TXT(" deg (AHRS_TRIM_X/Y; save to keep)")).end();
+        return;
+    }
+    w.str(TXT(TXT_ERROR "cal level failed: "));
+    if (r == LevelResult::kMoved) w.str(TXT("the board moved; keep it still"));
+    else if (r == LevelResult::kTooFar) w.str(TXT("more than 10 deg from level"));
+    else w.str(TXT("never still for 1 s"));
+    w.str(TXT("; trim unchanged")).end();
+}
+
 }  // namespace
 
 void write_event(void* out, const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
@@ -92,6 +109,11 @@ void write_event(void* out, const pipeline::AttitudePipeline& pipe, const pipeli
                 .str(TXT(" samples)"));
             break;
         case EventKind::kMagCalDone: write_cal_mag_verdict(w, pipe, e); return;
+        case EventKind::kLevelStart: w.str(TXT("# cal level: keep the airframe level and still for 1 s")); break;
+        case EventKind::kLevelDone: write_level_verdict(w, pipe, e); return;
+        case EventKind::kOrientation:
+            w.str(TXT("# AHRS_ORIENTATION ")).u32(e.code).str(TXT(": estimator restarted, calibrating gyro: keep the board still"));
+            break;
         default: return;
     }
     w.end();
