@@ -73,6 +73,8 @@ const uint16_t kRotations[kRotationCount] ROTATION_TABLE = {
 constexpr uint16_t kYaw45 = 1u << 9;
 constexpr int16_t kHalfSqrt2Q15 = 23170;  // round(2^15 / sqrt(2))
 
+// |x| <= limit (avr-libc's fabsf is a double function: no promotion here; NaN fails).
+bool within(float x, float limit) { return x <= limit && x >= -limit; }
 int16_t saturate(int32_t v) { return v > 32767 ? 32767 : (v < -32767 ? -32767 : (int16_t)v); }
 int16_t negate(int16_t v) { return v == -32768 ? 32767 : (int16_t)-v; }
 template <typename T>
@@ -141,7 +143,7 @@ bool level_trim(const Vector3f& a, float& trim_x_rad, float& trim_y_rad) {
     const float yz = sqrtf(a.y * a.y + a.z * a.z);
     if (!(yz > 0.5f * linalg::kGravity_m_s2)) return false;  // NaN too; a level board reads -9.8 on z
     const float pitch = atan2f(a.x, yz), roll = atan2f(-a.y, -a.z);
-    if (!(fabsf(pitch) <= kTrimMax_rad && fabsf(roll) <= kTrimMax_rad)) return false;
+    if (!(within(pitch, kTrimMax_rad) && within(roll, kTrimMax_rad))) return false;
     trim_x_rad = roll;
     trim_y_rad = pitch;
     return true;
@@ -154,7 +156,7 @@ BoardFrame make_board_frame(const Vector3f& offset_m_s2, const Vector3f& scale, 
     f.accel_corrected = false;
     for (uint8_t i = 0; i < 3; ++i) {
         // Out of range (a corrupt setting): none of it.
-        const bool ok = fabsf(o[i]) <= kAccelOffsetMax_m_s2 && s[i] >= kAccelScaleMin && s[i] <= kAccelScaleMax;
+        const bool ok = within(o[i], kAccelOffsetMax_m_s2) && s[i] >= kAccelScaleMin && s[i] <= kAccelScaleMax;
         f.accel_offset_counts[i] = ok ? (int16_t)lroundf(o[i] / accel_m_s2_per_count) : 0;
         f.accel_scale_q14[i] = ok ? (int16_t)lroundf(s[i] * 16384.0f) : 16384;
         f.accel_corrected = f.accel_corrected || f.accel_offset_counts[i] != 0 || f.accel_scale_q14[i] != 16384;

@@ -173,14 +173,14 @@ EulerQ24 euler_carried_trimmed_q24(const linalg::Matrix3q30& r, int32_t theta_x_
                                    int32_t theta_z_q26, const int16_t trim_q14[3][3]) {
     const Theta t = theta_for(theta_x_q26, theta_y_q26, theta_z_q26);
     const linalg::Vector3l a = carried_row(t, r.a), b = carried_row(t, r.b), c = carried_row(t, r.c);
-    EulerQ24 e;
-    const bool away_from_lock = roll_pitch(times_trim_row(c, trim_q14[0]), times_trim_row(c, trim_q14[1]),
-                                           times_trim_row(c, trim_q14[2]), e);
-    // Column 1 of the first two rows, or at the lock column 2.
-    const int16_t* tj = trim_q14[away_from_lock ? 0 : 1];
-    const int32_t r_1 = times_trim_row(a, tj), r_2 = times_trim_row(b, tj);
-    e.yaw_q24 = yaw(away_from_lock, r_1, r_1, r_2, r_2);
-    return e;
+    // R' T^T: the entries the angles read (the third row, the first two columns of the
+    // first two rows), then the one extraction with no further turn (one copy of it in
+    // flash: this path adds 21 products, not another atan2).
+    linalg::Matrix3q30 v;
+    v.a = linalg::Vector3l(times_trim_row(a, trim_q14[0]), times_trim_row(a, trim_q14[1]), 0);
+    v.b = linalg::Vector3l(times_trim_row(b, trim_q14[0]), times_trim_row(b, trim_q14[1]), 0);
+    v.c = linalg::Vector3l(times_trim_row(c, trim_q14[0]), times_trim_row(c, trim_q14[1]), times_trim_row(c, trim_q14[2]));
+    return euler_carried_q24(v, 0, 0, 0);
 }
 
 EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {

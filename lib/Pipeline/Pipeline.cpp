@@ -575,7 +575,8 @@ void AttitudePipeline::refresh_board_frame() {
     frame_ = calib::make_board_frame(Vector3f(v.ins_accoffs_m_s2[0], v.ins_accoffs_m_s2[1], v.ins_accoffs_m_s2[2]),
                                      Vector3f(v.ins_accscal[0], v.ins_accscal[1], v.ins_accscal[2]),
                                      v.ahrs_orientation, kAccelCount_m_s2);
-    const bool trims_ok = fabsf(v.ahrs_trim_x_rad) <= calib::kTrimMax_rad && fabsf(v.ahrs_trim_y_rad) <= calib::kTrimMax_rad;
+    const bool trims_ok = v.ahrs_trim_x_rad <= calib::kTrimMax_rad && v.ahrs_trim_x_rad >= -calib::kTrimMax_rad &&
+                          v.ahrs_trim_y_rad <= calib::kTrimMax_rad && v.ahrs_trim_y_rad >= -calib::kTrimMax_rad;
     trim_ = calib::trim_q14(trims_ok ? v.ahrs_trim_x_rad : 0.0f, trims_ok ? v.ahrs_trim_y_rad : 0.0f);
     if (frame_.rotation == before || st_.phase != Phase::Running) return;
     tell(EventKind::kOrientation, 0, 0, 0.0f, frame_.rotation);
