@@ -146,6 +146,7 @@ static bool answer(const console::Command& c, uint8_t part) {
             vehicle::store.start_save(pipe.settings());
         } else if (c.id == console::CommandId::Set) {
             console::apply_setting(c, pipe.settings(), out);
+            pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
             flight_io.configure();
         } else {
             pipe.restore_defaults();

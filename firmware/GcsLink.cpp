@@ -137,6 +137,7 @@ void take_request() {
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) save_pending = true;
+        if (changed) pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
     } else if (mav::decode_command_long(rx, cmd)) {
         const mav::Result r = run_command(cmd);
         uint8_t frame[mav::kMaxFrame];

@@ -82,17 +82,21 @@ T pick(const T* in, uint16_t code, uint8_t axis) {
     return in[(code >> (2 * axis)) & 3u];
 }
 
-}  // namespace
+// The row's fields (no variable shift per sample: a loop of single shifts on the AVR).
+void decode(uint16_t code, uint8_t src[3], uint8_t& signs) {
+    src[0] = (uint8_t)(code & 3u);
+    src[1] = (uint8_t)((code >> 2) & 3u);
+    src[2] = (uint8_t)((code >> 4) & 3u);
+    signs = (uint8_t)((code >> 6) & 15u);
+}
 
-void rotate(uint8_t r, Vector3i& v) {
-    if (r == 0 || r >= kRotationCount) return;
-    const uint16_t code = READ_ROTATION(&kRotations[r]);
+void turn(const uint8_t src[3], uint8_t signs, Vector3i& v) {
     const int16_t in[3] = {v.x, v.y, v.z};
-    int16_t x = pick(in, code, 0), y = pick(in, code, 1), z = pick(in, code, 2);
-    if (code & (1u << 6)) x = negate(x);
-    if (code & (1u << 7)) y = negate(y);
-    if (code & (1u << 8)) z = negate(z);
-    if (code & kYaw45) {
+    int16_t x = in[src[0]], y = in[src[1]], z = in[src[2]];
+    if (signs & 1u) x = negate(x);
+    if (signs & 2u) y = negate(y);
+    if (signs & 4u) z = negate(z);
+    if (signs & 8u) {
         // Q15 products, rounded (16x16 multiplies: four MULs each on the AVR).
         const int32_t xh = linalg::mul_s16(x, kHalfSqrt2Q15), yh = linalg::mul_s16(y, kHalfSqrt2Q15);
         const int16_t x2 = saturate((xh - yh + 16384) >> 15);
@@ -100,6 +104,19 @@ void rotate(uint8_t r, Vector3i& v) {
         x = x2;
     }
     v = Vector3i(x, y, z);
+}
+
+}  // namespace
+
+void rotate(uint8_t r, Vector3i& v) {
+    if (r == 0 || r >= kRotationCount) return;
+    uint8_t src[3], signs;
+    decode(READ_ROTATION(&kRotations[r]), src, signs);
+    turn(src, signs, v);
+}
+
+void apply_gyro(const BoardFrame& f, Vector3i& g) {
+    if (f.rotation != 0) turn(f.src, f.signs, g);
 }
 
 void rotate(uint8_t r, Vector3f& v) {
@@ -162,6 +179,7 @@ BoardFrame make_board_frame(const Vector3f& offset_m_s2, const Vector3f& scale, 
         f.accel_corrected = f.accel_corrected || f.accel_offset_counts[i] != 0 || f.accel_scale_q14[i] != 16384;
     }
     f.rotation = rotation < kRotationCount ? rotation : 0;
+    decode(READ_ROTATION(&kRotations[f.rotation]), f.src, f.signs);
     return f;
 }
 
@@ -174,7 +192,7 @@ void apply_accel(const BoardFrame& f, Vector3i& a) {
             *axes[i] = saturate((linalg::mul_s16(d, f.accel_scale_q14[i]) + 8192) >> 14);
         }
     }
-    rotate(f.rotation, a);
+    if (f.rotation != 0) turn(f.src, f.signs, a);
 }
 
 }  // namespace calib

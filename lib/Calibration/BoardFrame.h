@@ -59,12 +59,14 @@ struct BoardFrame {
     int16_t accel_offset_counts[3];  // INS_ACCOFFS in counts
     int16_t accel_scale_q14[3];      // INS_ACCSCAL in Q14
     uint8_t rotation;                // AHRS_ORIENTATION
+    uint8_t src[3];                  // its table row decoded: out[i] = +-in[src[i]] ...
+    uint8_t signs;                   // ... negated where bit i is set; bit 3: then a 45 deg yaw
     bool accel_corrected;            // offsets or scales not the identity's
 };
 BoardFrame make_board_frame(const linalg::Vector3f& accel_offset_m_s2, const linalg::Vector3f& accel_scale,
                             uint8_t rotation, float accel_m_s2_per_count);
 // The accelerometer's counts corrected (offset, scale) and turned; the gyro's turned.
 void apply_accel(const BoardFrame& f, linalg::Vector3i& accel_counts);
-inline void apply_gyro(const BoardFrame& f, linalg::Vector3i& gyro_counts) { rotate(f.rotation, gyro_counts); }
+void apply_gyro(const BoardFrame& f, linalg::Vector3i& gyro_counts);
 
 }  // namespace calib

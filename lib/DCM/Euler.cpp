@@ -166,7 +166,7 @@ static linalg::Vector3l carried_row(const Theta& t, const linalg::Vector3l& p) {
 }
 // Row p of R' times row j of T (Q14): entry (., j) of R' T^T, Q30.
 static int32_t times_trim_row(const linalg::Vector3l& p, const int16_t* tj) {
-    return linalg::mul_q14(tj[0], p.x) + linalg::mul_q14(tj[1], p.y) + linalg::mul_q14(tj[2], p.z);
+    return linalg::hot::mul_q14(tj[0], p.x) + linalg::hot::mul_q14(tj[1], p.y) + linalg::hot::mul_q14(tj[2], p.z);
 }
 
 EulerQ24 euler_carried_trimmed_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,

@@ -396,9 +396,14 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& board_sample) {
     // The accelerometer's calibration and the board's orientation, on the counts: the
     // vehicle's axes from here on.
     profile::begin(profile::kBoardFrame);
-    mpu6000::Sample raw = board_sample;
-    calib::apply_gyro(frame_, raw.gyro);
-    calib::apply_accel(frame_, raw.accel);
+    mpu6000::Sample turned;
+    const bool identity = frame_.rotation == 0 && !frame_.accel_corrected;
+    if (!identity) {
+        turned = board_sample;
+        calib::apply_gyro(frame_, turned.gyro);
+        calib::apply_accel(frame_, turned.accel);
+    }
+    const mpu6000::Sample& raw = identity ? board_sample : turned;
     profile::end(profile::kBoardFrame);
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);

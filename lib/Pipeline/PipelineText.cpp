@@ -46,13 +46,14 @@ void write_level_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, cons
     if (r == LevelResult::kOk) {
         const settings::VehicleSettings& v = pipe.settings().vehicle;
         w.str(TXT("# cal level: trim roll ")).fixed2(v.ahrs_trim_x_rad * linalg::kDegPerRad).str(TXT(" pitch "))
-            .fixed2(v.ahrs_trim_y_rad * linalg::kDegPerRad).str(TXT(" deg (AHRS_TRIM_X/Y; save to keep)")).end();
+            .fixed2(v.ahrs_trim_y_rad * linalg::kDegPerRad).str(TXT(" deg")).end();
         return;
     }
-    w.str(TXT(TXT_ERROR "cal level failed: "));
-    if (r == LevelResult::kMoved) w.str(TXT("the board moved; keep it still"));
-    else if (r == LevelResult::kTooFar) w.str(TXT("more than 10 deg from level"));
-    else w.str(TXT("never still for 1 s"));
+    // Short enough for one STATUSTEXT (50 characters).
+    w.str(TXT(TXT_ERROR "cal level: "));
+    if (r == LevelResult::kMoved) w.str(TXT("board moved"));
+    else if (r == LevelResult::kTooFar) w.str(TXT("over 10 deg off level"));
+    else w.str(TXT("never still"));
     w.str(TXT("; trim unchanged")).end();
 }
 
