@@ -158,6 +158,12 @@ static bool answer(const console::Command& c, uint8_t part) {
     switch (c.id) {
         case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
+        case console::CommandId::CalAccel:
+            // The first starts it; each next one says the airframe is in the position asked.
+            if (pipe.accel_calibrating() ? !pipe.confirm_accel_position(pipe.accel_position_asked())
+                                         : !pipe.start_accel_calibration())
+                text::Writer(out).str(TXT(TXT_ERROR "cal accel: not now (busy, or measuring a position)")).end();
+            break;
         case console::CommandId::CalLevel:
             if (!pipe.start_level_calibration())
                 text::Writer(out).str(TXT(TXT_ERROR "cal level: not now (starting, or a calibration runs); nothing changed")).end();

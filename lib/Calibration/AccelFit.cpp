@@ -28,14 +28,21 @@ bool in_position(AccelPosition p, const Vector3f& m) {
     return expected_direction(p).dot(m) >= cos_tol * n;
 }
 
+void AccelFit::set_mean(uint8_t k, const Vector3f& m) {
+    if (k >= kAccelPositions) return;
+    m_[k][0] = m.x;
+    m_[k][1] = m.y;
+    m_[k][2] = m.z;
+}
+
 void AccelFit::begin(const Vector3f means[kAccelPositions], float g) {
+    for (uint8_t k = 0; k < kAccelPositions; ++k) set_mean(k, means[k]);
+    begin(g);
+}
+
+void AccelFit::begin(float g) {
     Vector3f c;
-    for (uint8_t k = 0; k < kAccelPositions; ++k) {
-        m_[k][0] = means[k].x;
-        m_[k][1] = means[k].y;
-        m_[k][2] = means[k].z;
-        c += means[k];
-    }
+    for (uint8_t k = 0; k < kAccelPositions; ++k) c += Vector3f(m_[k][0], m_[k][1], m_[k][2]);
     c *= 1.0f / (float)kAccelPositions;  // opposite positions: the offset, roughly
     x_[0] = x_[1] = x_[2] = 1.0f;
     x_[3] = c.x;

@@ -44,6 +44,10 @@ public:
 
     // Starts a fit of the six means (board axes, m/s^2): o the means' centre, s 1.
     void begin(const linalg::Vector3f means_m_s2[kAccelPositions], float g_m_s2);
+    // The same from the means already given one by one (set_mean, no copy of them kept
+    // elsewhere: RAM).
+    void set_mean(uint8_t k, const linalg::Vector3f& mean_m_s2);
+    void begin(float g_m_s2);
     // One Newton iteration; the quality after it (Fitting: call again).
     Quality step();
     Quality quality() const { return quality_; }

@@ -422,6 +422,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& board_sample) {
         start_gyro_calibration();
     }
     if (st_.gyro_cal_active) step_calibration(s);
+    if (st_.accel_collecting) step_accel_position(board_sample);
     if (st_.phase != Phase::Running) {
         profile::end(profile::kChecks);
         return;
@@ -511,6 +512,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& board_sample) {
         fit_step = st_.mag_fit_active;
         if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
         else if (fit_step) step_mag_fit();
+        else if (st_.accel_pos == calib::kAccelPositions + 1) step_accel_fit();
         else if (st_.frame_due) refresh_board_frame();
         else report_deferred();
         st_.cal_pending = false;
@@ -557,11 +559,75 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
 }
 
 bool AttitudePipeline::start_level_calibration() {
-    if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating()) return false;
+    if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating() || accel_calibrating()) return false;
     begin_gyro_window();
     st_.level_cal_active = true;
     tell(EventKind::kLevelStart);
     return true;
+}
+
+bool AttitudePipeline::start_accel_calibration() {
+    if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating() || accel_calibrating()) return false;
+    st_.accel_pos = (uint8_t)calib::AccelPosition::kLevel;
+    st_.accel_waiting = true;
+    tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+    return true;
+}
+
+bool AttitudePipeline::confirm_accel_position(uint8_t position) {
+    if (!st_.accel_waiting || position != st_.accel_pos) return false;
+    st_.accel_waiting = false;
+    st_.accel_collecting = true;
+    gyro_cal_.restart();
+    return true;
+}
+
+// A still second's mean of the board's own counts (before INS_ACC* and the orientation:
+// the fit is in the board's axes), checked against the position asked in the airframe's.
+void AttitudePipeline::step_accel_position(const mpu6000::Sample& b) {
+    const calib::GyroCalibrator::Result r =
+        gyro_cal_.add(b.gyro, b.accel, b.gyro_rad_s_per_count, b.accel_m_s2_per_count);
+    if (r == calib::GyroCalibrator::Result::Collecting) return;
+    st_.accel_collecting = false;
+    const calib::AccelPosition p = (calib::AccelPosition)st_.accel_pos;
+    Vector3f mean = gyro_cal_.mean_accel_m_s2();
+    Vector3f in_airframe = mean;
+    calib::rotate(frame_.rotation, in_airframe);
+    const bool moved = r == calib::GyroCalibrator::Result::Moved;
+    if (moved || !calib::in_position(p, in_airframe)) {
+        tell(EventKind::kAccelCalRefused, 0, 0, moved ? 0.0f : 1.0f, st_.accel_pos);
+        st_.accel_waiting = true;  // asked again
+        tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+        return;
+    }
+    accel_fit_.set_mean((uint8_t)(st_.accel_pos - 1), mean);
+    ++st_.accel_pos;
+    if (st_.accel_pos <= calib::kAccelPositions) {
+        st_.accel_waiting = true;
+        tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+        return;
+    }
+    accel_fit_.begin(kG);  // then a Newton iteration a step with room
+}
+
+void AttitudePipeline::step_accel_fit() {
+    profile::begin(profile::kMagFit);
+    const calib::AccelFit::Quality q = accel_fit_.step();
+    profile::end(profile::kMagFit);
+    if (q == calib::AccelFit::Quality::Fitting) return;
+    st_.accel_pos = 0;
+    if (q == calib::AccelFit::Quality::Ok) {
+        settings::VehicleSettings& v = settings_.vehicle;
+        const Vector3f o = accel_fit_.offset_m_s2(), sc = accel_fit_.scale();
+        v.ins_accoffs_m_s2[0] = o.x;
+        v.ins_accoffs_m_s2[1] = o.y;
+        v.ins_accoffs_m_s2[2] = o.z;
+        v.ins_accscal[0] = sc.x;
+        v.ins_accscal[1] = sc.y;
+        v.ins_accscal[2] = sc.z;
+        refresh_board_frame();
+    }
+    tell(EventKind::kAccelCalDone, 0, 0, accel_fit_.residual_m_s2(), (uint8_t)q);
 }
 
 void AttitudePipeline::finish_level_calibration(LevelResult r) {
@@ -601,6 +667,9 @@ void AttitudePipeline::begin_gyro_window() {
     st_.gyro_cal_active = true;
     st_.start_moved = false;  // asked for (`cal gyro`): the user says the board is still
     st_.level_cal_active = false;
+    st_.accel_pos = 0;  // a six-position calibration under way is given up
+    st_.accel_waiting = false;
+    st_.accel_collecting = false;
 }
 
 void AttitudePipeline::restart_estimator() {

@@ -43,6 +43,7 @@
 
 #include <stdint.h>
 
+#include "AccelFit.h"
 #include "BoardFrame.h"
 #include "Calibration.h"
 #include "Dcm.h"
@@ -193,6 +194,9 @@ enum class EventKind : uint8_t {
     kLevelStart,       // the level calibration begins
     kLevelDone,        // its verdict: code a LevelResult (Ok: the trims in settings().vehicle)
     kOrientation,      // AHRS_ORIENTATION changed to code: the estimator and the gyro start again
+    kAccelCalAsk,      // the six-position calibration asks for position code (calib::AccelPosition)
+    kAccelCalRefused,  // position code not taken: value 0 the board moved, 1 not in that position
+    kAccelCalDone,     // its verdict: code a calib::AccelFit::Quality (Ok: INS_ACC* in settings().vehicle)
 };
 
 // The level calibration's verdict (kLevelDone's code).
@@ -300,6 +304,19 @@ public:
     // while another calibration runs. The verdict is kLevelDone.
     bool start_level_calibration();
     bool level_calibrating() const { return st_.level_cal_active; }
+    // The accelerometer's six-position calibration (ArduPilot's, PREFLIGHT_CALIBRATION
+    // param5 1): asks for each position in turn (kAccelCalAsk), takes a still second's
+    // mean of the raw accelerometer once the user says the airframe is there
+    // (confirm_accel_position), refuses a moving board or a wrong position (asking again),
+    // then fits INS_ACCOFFS_* and INS_ACCSCAL_* (calib::AccelFit, one iteration a step with
+    // room) and uses them at once (kAccelCalDone). False while not running or busy.
+    bool start_accel_calibration();
+    // The user says the airframe is in `position` (1..6): false unless that is the one asked.
+    bool confirm_accel_position(uint8_t position);
+    bool accel_calibrating() const { return st_.accel_pos != 0; }
+    calib::AccelFit::Quality accel_fit_quality() const { return accel_fit_.quality(); }
+    // The position asked and not yet confirmed (0: none), for a ground station's prompt.
+    uint8_t accel_position_asked() const { return st_.accel_waiting ? st_.accel_pos : 0; }
     // The board's frame and trim from the settings now (AHRS_ORIENTATION, AHRS_TRIM_*,
     // INS_ACC*): the pipeline takes them up by itself within a second of a change.
     void refresh_board_frame();
@@ -342,6 +359,8 @@ private:
     void report_deferred();
     void finish_level_calibration(LevelResult r);
     void begin_gyro_window();  // start_gyro_calibration without its line
+    void step_accel_position(const mpu6000::Sample& board_sample);
+    void step_accel_fit();
     // The trim's rotation for the angles (null: none).
     const int16_t (*trim_rows() const)[3] { return trim_.active ? trim_.t : nullptr; }
     // An event to the sink; the short forms keep each call site small (flash).
@@ -406,10 +425,14 @@ private:
         bool gps_moving;                // the GPS's ground speed passed kCourseMinSpeed_m_s (and not below kGpsStillSpeed_m_s since)
         bool level_cal_active;          // the gyro calibration under way is the level calibration
         bool frame_due;                 // refresh_board_frame on the next step with room
+        uint8_t accel_pos;              // the six-position calibration's position (1..6; 7 fitting; 0 off)
+        bool accel_waiting;             // ... asked, not yet confirmed
+        bool accel_collecting;          // ... confirmed: its still second under way (gyro_cal_)
     };
     State st_;
     calib::BoardFrame frame_;  // the accelerometer's calibration and the board's orientation, in counts
     calib::TrimQ14 trim_;      // the level trim for the angles
+    calib::AccelFit accel_fit_;  // the six positions' means and their fit
     // One space for two phases (RAM): before the estimator runs the start's gravity if
     // never still (StartGravity.h), then the turn's mean (TurnMean: a plain struct, taken
     // up by assignment in start_estimator; the phase never goes back).
