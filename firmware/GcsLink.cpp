@@ -208,20 +208,19 @@ void send_streams() {
 
 // The six-position calibration's position asked (and at its end SUCCESS or FAILED) as
 // ArduPilot sends it: COMMAND_LONG ACCELCAL_VEHICLE_POS to the ground station, once.
-static uint8_t accel_pos_sent = 0;
+static uint8_t accel_asks_sent = 0;
 static bool accel_cal_running = false;
 static void announce_accel_position(uint8_t frame[mav::kMaxFrame]) {
     const uint8_t asked = pipe.accel_position_asked();
     float param1 = 0.0f;
-    if (asked != 0u && asked != accel_pos_sent) {
-        param1 = (float)asked;
+    if (asked != 0u && pipe.accel_asks() != accel_asks_sent) {
+        param1 = (float)asked;  // a position asked, or asked again after a refusal
     } else if (accel_cal_running && !pipe.accel_calibrating()) {
         param1 = pipe.accel_fit_quality() == calib::AccelFit::Quality::Ok ? mav::kAccelcalSuccess : mav::kAccelcalFailed;
     }
     accel_cal_running = pipe.accel_calibrating();
-    if (!accel_cal_running) accel_pos_sent = 0;
     if (param1 == 0.0f) return;
-    accel_pos_sent = asked;
+    accel_asks_sent = pipe.accel_asks();
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame),
                                     port::mavlink.command_long(frame, mav::kCmdAccelcalVehiclePos, param1));
 }

@@ -70,51 +70,47 @@ float AccelFit::residual_m_s2() const {
 
 AccelFit::Quality AccelFit::step() {
     if (quality_ != Quality::Fitting) return quality_;
-    // J delta = -F: rows the positions, columns d/ds_i then d/do_i.
-    float a[6][7];
-    for (uint8_t k = 0; k < kAccelPositions; ++k) {
-        float f = -g2_;
-        for (uint8_t i = 0; i < 3; ++i) {
-            const float d = m_[k][i] - x_[3 + i], s = x_[i];
-            f += s * s * d * d;
-            a[k][i] = 2.0f * s * d * d;
-            a[k][3 + i] = -2.0f * s * s * d;
+    // The position reading most along +axis and most along -axis, for each axis: the six
+    // must be six different positions (each axis seen both ways), else no unique fit.
+    uint8_t plus[3], minus[3], used = 0;
+    for (uint8_t i = 0; i < 3; ++i) {
+        plus[i] = minus[i] = 0;
+        for (uint8_t k = 1; k < kAccelPositions; ++k) {
+            if (m_[k][i] > m_[plus[i]][i]) plus[i] = k;
+            if (m_[k][i] < m_[minus[i]][i]) minus[i] = k;
         }
-        a[k][6] = -f;
+        used = (uint8_t)(used | (1u << plus[i]) | (1u << minus[i]));
+        if (!(m_[plus[i]][i] - m_[minus[i]][i] > 1.0f * sqrtf(g2_))) return quality_ = Quality::Singular;
     }
-    // Gaussian elimination with partial pivoting.
-    for (uint8_t c = 0; c < 6; ++c) {
-        uint8_t p = c;
-        for (uint8_t r = (uint8_t)(c + 1); r < 6; ++r)
-            if (absf(a[r][c]) > absf(a[p][c])) p = r;
-        // A pivot this small against g^2 per unit: positions that leave an axis unseen.
-        if (!(absf(a[p][c]) > 1e-3f)) return quality_ = Quality::Singular;
-        if (p != c)
-            for (uint8_t j = 0; j < 7; ++j) {
-                const float t = a[c][j];
-                a[c][j] = a[p][j];
-                a[p][j] = t;
+    if (used != (1u << kAccelPositions) - 1u) return quality_ = Quality::Singular;
+    // One sweep: for each axis, its two positions' equations solved for (o_i, s_i) with
+    // the other axes as they stand: s_i (m+ - o_i) = c+, s_i (m- - o_i) = -c-, with
+    // c = sqrt(g^2 - the other axes' corrected squares). The other axes read little in
+    // those positions, so the sweeps contract fast (a few) to F_k = 0 for all six.
+    float change = 0.0f;
+    for (uint8_t i = 0; i < 3; ++i) {
+        float c[2];
+        const uint8_t ks[2] = {plus[i], minus[i]};
+        for (uint8_t n = 0; n < 2; ++n) {
+            float rest = 0.0f;
+            for (uint8_t j = 0; j < 3; ++j) {
+                if (j == i) continue;
+                const float d = x_[j] * (m_[ks[n]][j] - x_[3 + j]);
+                rest += d * d;
             }
-        const float inv = 1.0f / a[c][c];
-        for (uint8_t r = (uint8_t)(c + 1); r < 6; ++r) {
-            const float q = a[r][c] * inv;
-            for (uint8_t j = c; j < 7; ++j) a[r][j] -= q * a[c][j];
+            const float c2 = g2_ - rest;
+            if (!(c2 > 0.25f * g2_)) return quality_ = Quality::NoConvergence;  // NaN too
+            c[n] = sqrtf(c2);
         }
-    }
-    float step2 = 0.0f;
-    for (int8_t r = 5; r >= 0; --r) {
-        float v = a[r][6];
-        for (uint8_t j = (uint8_t)(r + 1); j < 6; ++j) v -= a[r][j] * a[j][6];
-        a[r][6] = v / a[r][r];
-        x_[r] += a[r][6];
-        step2 += a[r][6] * a[r][6];
+        const float s = (c[0] + c[1]) / (m_[plus[i]][i] - m_[minus[i]][i]);
+        const float o = m_[plus[i]][i] - c[0] / s;
+        change += absf(s - x_[i]) + absf(o - x_[3 + i]);
+        x_[i] = s;
+        x_[3 + i] = o;
     }
     ++iterations_;
-    const bool finite = x_[0] == x_[0] && x_[1] == x_[1] && x_[2] == x_[2] && x_[3] == x_[3] && x_[4] == x_[4] &&
-                        x_[5] == x_[5];
-    if (!finite) return quality_ = Quality::NoConvergence;
-    // Converged: the last step moved nothing that matters (1e-5 of a scale or m/s^2).
-    if (step2 > 1e-10f) {
+    // Converged: the last sweep moved nothing that matters (1e-5 of a scale or m/s^2).
+    if (change > 1e-5f) {
         if (iterations_ >= kMaxIterations) quality_ = Quality::NoConvergence;
         return quality_;
     }

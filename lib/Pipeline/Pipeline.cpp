@@ -569,9 +569,14 @@ bool AttitudePipeline::start_level_calibration() {
 bool AttitudePipeline::start_accel_calibration() {
     if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating() || accel_calibrating()) return false;
     st_.accel_pos = (uint8_t)calib::AccelPosition::kLevel;
-    st_.accel_waiting = true;
-    tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+    ask_accel_position();
     return true;
+}
+
+void AttitudePipeline::ask_accel_position() {
+    st_.accel_waiting = true;
+    ++st_.accel_asks;
+    tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
 }
 
 bool AttitudePipeline::confirm_accel_position(uint8_t position) {
@@ -596,15 +601,13 @@ void AttitudePipeline::step_accel_position(const mpu6000::Sample& b) {
     const bool moved = r == calib::GyroCalibrator::Result::Moved;
     if (moved || !calib::in_position(p, in_airframe)) {
         tell(EventKind::kAccelCalRefused, 0, 0, moved ? 0.0f : 1.0f, st_.accel_pos);
-        st_.accel_waiting = true;  // asked again
-        tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+        ask_accel_position();  // again
         return;
     }
     accel_fit_.set_mean((uint8_t)(st_.accel_pos - 1), mean);
     ++st_.accel_pos;
     if (st_.accel_pos <= calib::kAccelPositions) {
-        st_.accel_waiting = true;
-        tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+        ask_accel_position();
         return;
     }
     accel_fit_.begin(kG);  // then a Newton iteration a step with room

@@ -317,6 +317,8 @@ public:
     calib::AccelFit::Quality accel_fit_quality() const { return accel_fit_.quality(); }
     // The position asked and not yet confirmed (0: none), for a ground station's prompt.
     uint8_t accel_position_asked() const { return st_.accel_waiting ? st_.accel_pos : 0; }
+    // How many times a position has been asked (again after a refusal): a new prompt to send.
+    uint8_t accel_asks() const { return st_.accel_asks; }
     // The board's frame and trim from the settings now (AHRS_ORIENTATION, AHRS_TRIM_*,
     // INS_ACC*): the pipeline takes them up by itself within a second of a change.
     void refresh_board_frame();
@@ -361,6 +363,7 @@ private:
     void begin_gyro_window();  // start_gyro_calibration without its line
     void step_accel_position(const mpu6000::Sample& board_sample);
     void step_accel_fit();
+    void ask_accel_position();
     // The trim's rotation for the angles (null: none).
     const int16_t (*trim_rows() const)[3] { return trim_.active ? trim_.t : nullptr; }
     // An event to the sink; the short forms keep each call site small (flash).
@@ -428,6 +431,7 @@ private:
         uint8_t accel_pos;              // the six-position calibration's position (1..6; 7 fitting; 0 off)
         bool accel_waiting;             // ... asked, not yet confirmed
         bool accel_collecting;          // ... confirmed: its still second under way (gyro_cal_)
+        uint8_t accel_asks;             // positions asked so far (wraps)
     };
     State st_;
     calib::BoardFrame frame_;  // the accelerometer's calibration and the board's orientation, in counts

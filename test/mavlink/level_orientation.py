@@ -82,6 +82,12 @@ def write_tilted_board(path, seconds, rock_from_s):
             t += 0.01
 
 
+def no_overrun(board, what):
+    """Nothing cost a sample (the firmware says "loop overrun" when one is missed)."""
+    overruns = [m.text for _, m in board.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
+    soft_assert(not overruns, "%s: samples missed: %r" % (what, overruns))
+
+
 def servo_widths(path, out, t0, t1):
     with open(path) as f:
         return [float(r["width_us"]) for r in csv.DictReader(f) if int(r["out"]) == out and t0 <= float(r["t"]) < t1]
@@ -146,6 +152,7 @@ def level(args):
     soft_assert(v is not None and abs(math.degrees(v.param_value) - trims["AHRS_TRIM_X"]) < 1e-4,
                 "a refused calibration changed AHRS_TRIM_X")
     b.stop()
+    no_overrun(b, "level")
     # STABILIZE with centred sticks: off trim before (the board's tilt), on trim after
     # (from a new STABILIZE at 14 s: the integrators of the first one were reset in MANUAL).
     soft_assert(t_done < 13.0, "the calibration ended at %.1f s, after MANUAL" % t_done)
@@ -183,6 +190,7 @@ def run_text(args, traj, name, orientation, seconds):
     with open(os.path.join(args.work, name + ".out"), "w") as f:
         f.write(p.stdout)
     soft_assert(p.returncode == 0, "%s: apm25sim exited %d" % (name, p.returncode))
+    soft_assert("overrun" not in p.stdout, "%s: samples missed" % name)
     return angle_lines(p.stdout)
 
 
@@ -225,13 +233,153 @@ def orientation(args):
                     "%s: roll %.3f pitch %.3f heading %.3f deg off" % (rot_name, worst[0], worst[1], worst[2]))
 
 
+# The six positions (ACCELCAL_VEHICLE_POS 1..6) as quaternions of the airframe, each held
+# HOLD_S after a MOVE_S turn from the one before (the first from 0 s).
+def q_axis(axis, deg):
+    h = math.radians(deg) / 2.0
+    q = [math.cos(h), 0.0, 0.0, 0.0]
+    q[1 + axis] = math.sin(h)
+    return q
+
+
+POSES = [q_axis(0, 0), q_axis(0, -90), q_axis(0, 90), q_axis(1, -90), q_axis(1, 90), q_axis(0, 180)]
+FIRST_MOVE_S, HOLD_S, MOVE_S = 14.0, 7.0, 2.0
+ACCEL_OFFSET = (0.3, -0.25, 0.2)    # m/s^2, the board's axes
+ACCEL_SCALE = (1.02, 0.98, 1.015)
+
+
+def hold_start(k):
+    return 0.0 if k == 0 else FIRST_MOVE_S + MOVE_S + (k - 1) * (HOLD_S + MOVE_S)
+
+
+def qmul(a, b):
+    return [a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3], a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+            a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]]
+
+
+def slerp(a, b, u):
+    d = sum(x * y for x, y in zip(a, b))
+    if d < 0:
+        b, d = [-x for x in b], -d
+    th = math.acos(min(1.0, d))
+    if th < 1e-9:
+        return list(a)
+    return [(math.sin((1 - u) * th) * x + math.sin(u * th) * y) / math.sin(th) for x, y in zip(a, b)]
+
+
+def attitude_at(t):
+    for k in range(1, len(POSES)):
+        t0 = hold_start(k) - MOVE_S
+        if t < t0:
+            return POSES[k - 1]
+        if t < t0 + MOVE_S:
+            u = (t - t0) / MOVE_S
+            return slerp(POSES[k - 1], POSES[k], 0.5 - 0.5 * math.cos(math.pi * u))  # eased
+    return POSES[-1]
+
+
+def rot_of(q):
+    w, x, y, z = q
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
+def write_six_positions(path, seconds):
+    dt = 0.005
+    with open(path, "w") as f:
+        f.write("t,gx,gy,gz,ax,ay,az,mx,my,mz,qw,qx,qy,qz\n")
+        t = 0.0
+        while t <= seconds + 1e-9:
+            q, q2 = attitude_at(t), attitude_at(t + dt)
+            # body rate: 2 q^-1 dq/dt
+            dq = qmul([q[0], -q[1], -q[2], -q[3]], q2)
+            if dq[0] < 0:
+                dq = [-v for v in dq]
+            w = [2.0 * v / dt for v in dq[1:]]
+            r = rot_of(q)
+            a = body_of(r, (0.0, 0.0, -G))
+            m = body_of(r, EARTH_UT)
+            f.write("%.3f,%s\n" % (t, ",".join("%.7f" % v for v in w + a + m + list(q))))
+            t += dt
+
+
+def accel_six(args):
+    truth = os.path.join(args.work, "six_positions_truth.csv")
+    total_s = hold_start(5) + HOLD_S + 2.0
+    write_six_positions(truth, total_s)
+    traj = os.path.join(args.work, "six_positions.csv")
+    with open(traj, "wb") as f:  # the accelerometer's errors (the scenario tool's model: scale .* f + offset)
+        subprocess.run([os.path.join(args.tools, "scenario"), "--from", truth, "--accel-offset",
+                        ",".join(str(v) for v in ACCEL_OFFSET), "--accel-scale",
+                        ",".join(str(v) for v in ACCEL_SCALE)], stdout=f, check=True)
+    b = Board(args.tools, args.work, "accel", ["--trajectory", traj, "--seconds", str(total_s)])
+    if b.pump(lambda m: m.get_type() == "HEARTBEAT", "HEARTBEAT") is None:
+        b.stop()
+        return
+    b.pump(lambda m: m.get_type() == "ATTITUDE" and b.t_s >= 4.0, "ATTITUDE at 4 s")
+    command(b, mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, 0, 0, 0, 0, 1)
+    ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, "COMMAND_ACK of the accel calibration")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "accel calibration ACK %r" % ack)
+
+    def asked(p):
+        return b.pump(lambda m: m.get_type() == "COMMAND_LONG" and m.command == 42429 and int(m.param1) == p,
+                      "ACCELCAL_VEHICLE_POS %d asked" % p)
+
+    def confirm(p, k):
+        if k < 3:  # Mission Planner's way
+            command(b, 42429, p)
+            a = b.ack(42429, "ACK of position %d" % p)
+            return a is not None and a.result == mavlink2.MAV_RESULT_ACCEPTED
+        b.conn.mav.command_ack_send(p, 1)  # MAVProxy's accelcal: COMMAND_ACK, command = the position
+        return True
+
+    prompts = []
+    for k in range(6):
+        p = k + 1
+        if asked(p) is None:
+            break
+        if k == 1:
+            # Confirmed while still level: refused, asked again.
+            soft_assert(confirm(p, k), "position 2's early confirmation not ACCEPTED")
+            r = b.pump(lambda m: m.get_type() == "STATUSTEXT" and "not in that position" in m.text,
+                       "the refusal of a wrong position", timeout_s=60)
+            print("wrong position: %s" % (r.text if r else None))
+            if asked(p) is None:
+                break
+        b.pump(lambda m: b.t_s >= hold_start(k) + 1.5, "the airframe in position %d" % p)
+        soft_assert(confirm(p, k), "position %d's confirmation not ACCEPTED" % p)
+    done = b.pump(lambda m: m.get_type() == "COMMAND_LONG" and m.command == 42429 and m.param1 >= 16777215.0,
+                  "ACCELCAL_VEHICLE_POS SUCCESS or FAILED")
+    soft_assert(done is not None and done.param1 == 16777215.0, "the calibration's end: %r" % done)
+    prompts = [m.text for _, m in b.msgs if m.get_type() == "STATUSTEXT" and m.text.startswith("Place vehicle")]
+    soft_assert(len(prompts) == 7 and prompts[0] == "Place vehicle level and press any key",
+                "the prompts: %r" % prompts)
+    got = {}
+    for name in ("INS_ACCOFFS_X", "INS_ACCOFFS_Y", "INS_ACCOFFS_Z", "INS_ACCSCAL_X", "INS_ACCSCAL_Y", "INS_ACCSCAL_Z"):
+        b.conn.mav.param_request_read_send(1, 1, name.encode(), -1)
+        v = b.param(name, "PARAM_VALUE " + name)
+        got[name] = v.param_value if v else float("nan")
+    b.stop()
+    no_overrun(b, "six positions")
+    worst_o = max(abs(got["INS_ACCOFFS_" + a] - o) for a, o in zip("XYZ", ACCEL_OFFSET))
+    worst_s = max(abs(got["INS_ACCSCAL_" + a] - 1.0 / s) for a, s in zip("XYZ", ACCEL_SCALE))
+    print("six positions: offsets %s (injected %s), worst %.4f m/s^2; scales %s (1/injected %s), worst %.5f" %
+          (["%.4f" % got["INS_ACCOFFS_" + a] for a in "XYZ"], ACCEL_OFFSET, worst_o,
+           ["%.5f" % got["INS_ACCSCAL_" + a] for a in "XYZ"], ["%.5f" % (1 / s) for s in ACCEL_SCALE], worst_s))
+    soft_assert(worst_o < 0.02, "INS_ACCOFFS %.4f m/s^2 off the injected offsets" % worst_o)
+    soft_assert(worst_s < 0.002, "INS_ACCSCAL %.5f off 1/the injected scales" % worst_s)
+
+
 def main():
     args = tools_and_work()
-    which = os.environ.get("LEVEL_PARTS", "level,orientation").split(",")
+    which = os.environ.get("LEVEL_PARTS", "level,orientation,accel").split(",")
     if "level" in which:
         level(args)
     if "orientation" in which:
         orientation(args)
+    if "accel" in which:
+        accel_six(args)
 
 
 if __name__ == "__main__":
