@@ -549,7 +549,17 @@ AnglesCentideg AttitudePipeline::angles_centideg() const {
 linalg::Quaternion AttitudePipeline::quaternion() const {
     // The DCM's earth frame is magnetic north: turned about down by the declination.
     const float half_rad = 0.5f * settings_.declination_deg() * linalg::kRadPerDeg;
-    return linalg::quat_turned_about_down(linalg::quat_from_rotation(dcm_.matrix()), cosf(half_rad), sinf(half_rad));
+    linalg::Matrix3f r = dcm_.matrix();
+    if (trim_.active) {
+        // The airframe's: R T^T, as the angles (27 products, only in `mode quat`).
+        const int16_t(*t)[3] = trim_.t;
+        const float k = 1.0f / 16384.0f;
+        const linalg::Matrix3f tt(Vector3f((float)t[0][0] * k, (float)t[1][0] * k, (float)t[2][0] * k),
+                                  Vector3f((float)t[0][1] * k, (float)t[1][1] * k, (float)t[2][1] * k),
+                                  Vector3f((float)t[0][2] * k, (float)t[1][2] * k, (float)t[2][2] * k));
+        r = r * tt;
+    }
+    return linalg::quat_turned_about_down(linalg::quat_from_rotation(r), cosf(half_rad), sinf(half_rad));
 }
 
 Vector3f AttitudePipeline::gyro_rad_s() const { return calib::apply_gyro(settings_.cal, last_.gyro_rad_s()); }
