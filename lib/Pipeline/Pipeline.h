@@ -26,6 +26,11 @@
 // (waiting out up to kMaxMagWaitSteps of the DCM's heavy steps), and on a step with room
 // the deferred compass work (the `cal mag` sums and fit, the offset learner).
 //
+// The board in its airframe (calib::BoardFrame, docs/board_frame.md): each sample's counts
+// get INS_ACCOFFS/INS_ACCSCAL (board axes) and AHRS_ORIENTATION's turn, the field sample the
+// turn, before anything else; AHRS_TRIM_X/Y is taken off where the angles and the
+// quaternion are taken. The level and six-position calibrations set them.
+//
 // Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
 // the offset learned in motion) before the DCM sees it; while running, the learner
 // (calib::OffsetLearner) estimates the hard iron from the field's change against the
