@@ -11,8 +11,9 @@
 // Gauss-Newton). Here by sweeps over the axes: each axis's two positions (the one reading
 // most along +axis, the one most along -axis) give its o_i and s_i exactly with the other
 // axes held, and the sweeps contract in a few to the solution of all six: a sweep is six
-// square roots (about 11k cycles on the 2560, where a 6x6 Newton step took 120k), one
-// per call (step()) so that a caller with a time budget spreads them, and no matrix kept.
+// square roots and no matrix kept (a 6x6 Newton step would not fit one estimator step),
+// one per call (step()) so that a caller with a time budget spreads them
+// (docs/board_frame.md has the costs).
 // Units m/s^2. Pure C++: no clock, no bus, no Arduino include.
 #pragma once
 
