@@ -150,6 +150,7 @@ static bool answer(const console::Command& c, uint8_t part) {
             const float before = params::get(pipe.settings(), c.arg);
             console::apply_setting(c, pipe.settings(), out);
             if (params::get(pipe.settings(), c.arg) != before) mag_cal_link::parameter_changed(c.arg);
+            pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
             flight_io.configure();
         } else {
             pipe.restore_defaults();
@@ -161,6 +162,16 @@ static bool answer(const console::Command& c, uint8_t part) {
     switch (c.id) {
         case console::CommandId::CalGyro: pipe.start_gyro_calibration(); break;
         case console::CommandId::CalMag: pipe.start_mag_calibration(); break;
+        case console::CommandId::CalAccel:
+            // The first starts it; each next one says the airframe is in the position asked.
+            if (pipe.accel_calibrating() ? !pipe.confirm_accel_position(pipe.accel_position_asked())
+                                         : !pipe.start_accel_calibration())
+                text::Writer(out).str(TXT(TXT_ERROR "cal accel: not now (busy, or measuring a position)")).end();
+            break;
+        case console::CommandId::CalLevel:
+            if (!pipe.start_level_calibration())
+                text::Writer(out).str(TXT(TXT_ERROR "cal level: not now (starting, or a calibration runs); nothing changed")).end();
+            break;
         case console::CommandId::Flight:
         case console::CommandId::Show: flight_io.answer(c); break;  // flight manual|stabilize, rc, servo
         case console::CommandId::Mode:

@@ -71,12 +71,33 @@ static mav::Result set_home(const float* p) {
 }
 
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
-// (`cal mag`, saved when good: MagCalLink's START with autosave); the others (baro, accel,
-// airspeed ...) the board does not have.
+// (`cal mag`, saved when good: MagCalLink's START with autosave), param5 2 the level
+// (`cal level`), param5 1 the accelerometer's six positions; the others (baro, airspeed
+// ...) the board does not have.
 // MAV_CMD_PREFLIGHT_STORAGE: param1 1 write (`save`), 2 defaults (`defaults`, not
 // saved); 0 (read) UNSUPPORTED. The result comes as "# " lines.
 static mav::Result run_command(const mav::CommandLong& c) {
     const float* p = c.param;
+    if (c.command == mav::kCmdPreflightCalibration && p[4] == 1.0f) {
+        // param5 1: the accelerometer in six positions (Mission Planner's Calibrate Accel,
+        // MAVProxy's accelcal); each position asked by STATUSTEXT and ACCELCAL_VEHICLE_POS.
+        for (uint8_t i = 0; i < 7; ++i)
+            if (i != 4 && p[i] != 0.0f) return mav::Result::Unsupported;
+        return pipe.start_accel_calibration() ? mav::Result::Accepted : mav::Result::TemporarilyRejected;
+    }
+    if (c.command == mav::kCmdAccelcalVehiclePos) {
+        // Mission Planner: the vehicle is in the position asked (param1).
+        const float pos = p[0];
+        return pos >= 1.0f && pos <= 6.0f && pipe.confirm_accel_position((uint8_t)pos) ? mav::Result::Accepted
+                                                                                       : mav::Result::Failed;
+    }
+    if (c.command == mav::kCmdPreflightCalibration && p[4] == 2.0f) {
+        // param5 2: the level (Mission Planner's "Calibrate Level", MAVProxy's ahrstrim):
+        // accepted as it starts, the verdict a "# cal level" line (STATUSTEXT).
+        for (uint8_t i = 0; i < 7; ++i)
+            if (i != 4 && p[i] != 0.0f) return mav::Result::Unsupported;
+        return pipe.start_level_calibration() ? mav::Result::Accepted : mav::Result::TemporarilyRejected;
+    }
     if (c.command == mav::kCmdPreflightCalibration) {
         const bool gyro = p[0] == 1.0f, mag = p[1] == 1.0f;
         for (uint8_t i = 2; i < 7; ++i)
@@ -137,7 +158,14 @@ void take_request() {
         if (changed) {
             save_pending = true;
             mag_cal_link::parameter_changed((uint16_t)index);
+            pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
         }
+    } else if (rx.msgid == mav::kMsgCommandAck) {
+        // MAVProxy's accelcal: COMMAND_ACK with command = the position it confirms.
+        uint16_t position;
+        uint8_t result;
+        if (mav::decode_command_ack(rx, position, result) && position >= 1u && position <= 6u)
+            pipe.confirm_accel_position((uint8_t)position);
     } else if (mav::decode_command_long(rx, cmd)) {
         const mav::Result r = run_command(cmd);
         uint8_t frame[mav::kMaxFrame];
@@ -188,6 +216,25 @@ void send_streams() {
         port::send_frame(frame, port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c()));
 }
 
+// The six-position calibration's position asked (and at its end SUCCESS or FAILED) as
+// ArduPilot sends it: COMMAND_LONG ACCELCAL_VEHICLE_POS to the ground station, once.
+static uint8_t accel_asks_sent = 0;
+static bool accel_cal_running = false;
+static void announce_accel_position(uint8_t frame[mav::kMaxFrame]) {
+    const uint8_t asked = pipe.accel_position_asked();
+    float param1 = 0.0f;
+    if (asked != 0u && pipe.accel_asks() != accel_asks_sent) {
+        param1 = (float)asked;  // a position asked, or asked again after a refusal
+    } else if (accel_cal_running && !pipe.accel_calibrating()) {
+        param1 = pipe.accel_fit_quality() == calib::AccelFit::Quality::Ok ? mav::kAccelcalSuccess : mav::kAccelcalFailed;
+    }
+    accel_cal_running = pipe.accel_calibrating();
+    if (param1 == 0.0f) return;
+    accel_asks_sent = pipe.accel_asks();
+    serial_text::write_line_if_room(reinterpret_cast<const char*>(frame),
+                                    port::mavlink.command_long(frame, mav::kCmdAccelcalVehiclePos, param1));
+}
+
 void send_heartbeat_and_status() {
     if (!port::mavlink_mode()) return;
     const pipeline::Phase ph = pipe.phase();
@@ -210,6 +257,7 @@ void send_heartbeat_and_status() {
                                  (uint16_t)(loop_load::percent() * 10u),
                                  (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu));
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
+    announce_accel_position(frame);
 }
 
 // The position messages: each round (kPositionPeriodMs) GLOBAL_POSITION_INT and VFR_HUD,

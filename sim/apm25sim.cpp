@@ -36,7 +36,7 @@ const char* const kUsage =
     "                [--earth-field N,E,D] [--verbose]\n"
     "                [--gps ublox|nmea|none] [--gps-baud B] [--gps-fix-after S] [--gps-latency S]\n"
     "                [--baro ms5611|none] [--baro-noise HPA] [--baro-temp C] [--home LAT,LON,ALT_M]\n"
-    "                [--seed N]\n"
+    "                [--seed N] [--orientation R]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6), MS5611 on SPI (CS pin 40 = PG1),\n"
@@ -175,6 +175,11 @@ const char* const kUsage =
     "                   (default 7.135045,-73.119421,1028: the thesis' field)\n"
     "  --seed N         the GPS and barometer models' noise (default 1; the same seed, the same\n"
     "                   run)\n"
+    "  --orientation R  the board mounted in the airframe at ArduPilot's rotation R (0..37, the\n"
+    "                   firmware's AHRS_ORIENTATION; MAVLink's MAV_SENSOR_ORIENTATION gives each one's\n"
+    "                   roll, pitch, yaw): the trajectory's (or the backend's) values are the\n"
+    "                   airframe's, and the MPU6000 and the HMC5883L, on the board, read them turned\n"
+    "                   by M^T with M = Rz(yaw) Ry(pitch) Rx(roll) (default 0: as the arrow says)\n"
     "\n"
     "Bus check: the barometer chip select (pin 40 = PG1, PORTG bit 1) must be high whenever the\n"
     "MPU6000 chip select (pin 53) is low, checked when pin 53 goes low and at every SPI byte.\n"
@@ -225,6 +230,7 @@ int main(int argc, char** argv) {
     sim::GeodeticPoint home{sim::kHomeLat_deg, sim::kHomeLon_deg, sim::kHomeAlt_m};
     double seconds = -1.0;
     bool verbose = false;
+    double mount_rpy_deg[3] = {0.0, 0.0, 0.0};  // --orientation
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         auto value = [&](const char* name) -> const char* {
@@ -399,6 +405,15 @@ int main(int argc, char** argv) {
                 return 1;
             }
             options.gps.seed = options.baro.seed = (uint64_t)seed;
+        } else if (arg == "--orientation") {
+            const char* text = value("--orientation");
+            char* end = nullptr;
+            const long r = std::strtol(text, &end, 10);
+            if (*end != '\0' || text[0] == 0 || !sim::board_rotation_rpy((int)r, mount_rpy_deg)) {
+                std::fprintf(stderr, "apm25sim: --orientation '%s': a rotation number 0..%d\n", text,
+                             sim::kBoardRotations - 1);
+                return 1;
+            }
         } else {
             std::fprintf(stderr, "apm25sim: unknown argument '%s'\n%s", arg.c_str(), kUsage);
             return 1;
@@ -415,6 +430,14 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "apm25sim: %s\n", trajectory.error().c_str());
         return 1;
     }
+    // The board's mounting: what its sensors read of the airframe's motion.
+    auto mount = [&mount_rpy_deg](sim::TrajectorySample& t) {
+        if (mount_rpy_deg[0] == 0.0 && mount_rpy_deg[1] == 0.0 && mount_rpy_deg[2] == 0.0) return;
+        sim::airframe_to_board(mount_rpy_deg, t.gyro_rad_s);
+        sim::airframe_to_board(mount_rpy_deg, t.accel_m_s2);
+        sim::airframe_to_board(mount_rpy_deg, t.mag_uT);
+    };
+    for (sim::TrajectorySample& t : trajectory.samples()) mount(t);
     if (!input_path.empty() && !read_file(input_path, options.input)) {
         std::fprintf(stderr, "apm25sim: cannot read the input file '%s'\n", input_path.c_str());
         return 1;
@@ -484,7 +507,9 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "apm25sim: %s\n", link.error().c_str());
             return link.stopped() ? 0 : 4;
         }
-        trajectory.append(sim::physics_sample(first, 0.0, earth_field_uT));
+        sim::TrajectorySample s0 = sim::physics_sample(first, 0.0, earth_field_uT);
+        mount(s0);
+        trajectory.append(s0);
         if (!physics_log_path.empty()) {
             physics_log = std::fopen(physics_log_path.c_str(), "w");
             if (!physics_log) {
@@ -538,7 +563,8 @@ int main(int argc, char** argv) {
                                   state.timestamp_s, (unsigned)frame, last_t + first.timestamp_s);
                     error = why;
                 } else {
-                    const sim::TrajectorySample sample = sim::physics_sample(state, t, earth_field_uT);
+                    sim::TrajectorySample sample = sim::physics_sample(state, t, earth_field_uT);
+                    mount(sample);
                     board.append_sample(sample, 1.0);
                     if (state.has_airspeed) board.set_a0_mV(sim::Mpxv7002dpModel::output_mV(state.airspeed_m_s));
                     if (physics_log) std::fputs(sim::format_trajectory_row_ned(sample).c_str(), physics_log);

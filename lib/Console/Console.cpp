@@ -184,9 +184,9 @@ Command parse_line(const char* line) {
         return r;
     }
     // cal
-    const int8_t t = find_word(arg, TXT("gyro\0mag\0"));
+    const int8_t t = find_word(arg, TXT("gyro\0mag\0level\0accel\0"));
     if (t < 0) return fail(Error::BadCalTarget);
-    r.id = t == 0 ? CommandId::CalGyro : CommandId::CalMag;
+    r.id = t == 0 ? CommandId::CalGyro : t == 1 ? CommandId::CalMag : t == 2 ? CommandId::CalLevel : CommandId::CalAccel;
     return r;
 }
 
@@ -255,7 +255,7 @@ bool print_error(const Command& c, uint8_t part, const text::Sink* out) {
         case Error::RateRange: w.str(TXT("rate must be a whole number 1..100 Hz")); break;
         case Error::DeclRange: w.str(TXT("decl must be -180..180 degrees")); break;
         case Error::BadMode: w.str(TXT("mode must be plot, csv, quat, raw, mavlink or quiet")); break;
-        case Error::BadCalTarget: w.str(TXT("cal gyro or cal mag")); break;
+        case Error::BadCalTarget: w.str(TXT("cal gyro|mag|level|accel")); break;
         case Error::UnknownParam: w.str(TXT("unknown parameter (type params)")); break;
         case Error::BadFlightMode: w.str(TXT("flight manual or flight stabilize")); break;
         case Error::ParamRange: {
@@ -286,6 +286,8 @@ bool print_help(uint8_t part, const text::Sink* out) {
                         "# status: health, load, bias, temperature, uptime\0"
                         "# cal gyro: gyro bias (keep still 1 s)\0"
                         "# cal mag: compass (turn every way for 30 s)\0"
+                        "# cal level: AHRS_TRIM (airframe level, still 1 s)\0"
+                        "# cal accel: 6 positions; again at each one asked\0"
                         "# save | defaults: store settings / back to defaults\0"
                         "# flight manual|stabilize: flight mode\0"
                         "# rc | servo: receiver / output widths, us\0"

@@ -10,6 +10,8 @@
 //   status               sensor health, loop load, overruns, gyro bias, temperature, uptime
 //   cal gyro             measure the gyro bias again (keep the board still ~1 s)
 //   cal mag              hard iron + scale: turn the board every way for 30 s
+//   cal level            AHRS_TRIM_X/Y: the airframe level and still ~1 s
+//   cal accel            INS_ACCOFFS/SCAL in six positions: again for each one asked
 //   save                 write settings and calibration to EEPROM
 //   defaults             back to the defaults (not saved until `save`)
 //   flight manual|stabilize  the flight mode (the mode switch's next move overrides it)
@@ -57,6 +59,8 @@ enum class CommandId : uint8_t {
     Show,      // arg = Show*
     Set,       // arg = parameter index, value = the value x kParamScale
     Get,       // arg = parameter index
+    CalLevel,  // the level calibration (AHRS_TRIM_X/Y)
+    CalAccel,  // the six-position calibration: starts it, or confirms the position asked
 };
 
 enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowGps = 3, kShowBaro = 4 };
@@ -74,7 +78,7 @@ enum class Error : uint8_t {
     RateRange,        // not 1..100 or not whole
     DeclRange,        // outside -180..180
     BadMode,          // not plot|csv|quat|raw|mavlink|quiet
-    BadCalTarget,     // cal without gyro|mag
+    BadCalTarget,     // cal without gyro|mag|level|accel
     UnknownParam,     // get/set of a name the table does not have
     ParamRange,       // set: outside the parameter's range, or not whole for an integer (arg: the index)
     BadFlightMode,    // flight without manual|stabilize

@@ -407,24 +407,29 @@ void Dcm::correct_heading(const linalg::Vector3i& field, uint8_t age_steps) {
     if (result.bias_learned) update_offset();
 }
 
-EulerQ24 Dcm::euler_now_q24() const {
+EulerQ24 Dcm::euler_now_q24(const int16_t (*trim_q14)[3]) const {
     // R carried forward by the lead and any turn not yet integrated (at most one step
     // when the update was told a line is due), in fixed point.
+    int32_t theta_q26[3];
     if (k_.theta_q26_per_unit_q15 == 0) {  // scales beyond the integer path's factors: in float
         const Vector3f theta_rad = last_rate_rad_s() * settings_->output_lead_s + pending_turn_rad();
-        return euler_carried_q24(strapdown_.r(), linalg::fixed_from_float(theta_rad.x, 26),
-                                 linalg::fixed_from_float(theta_rad.y, 26), linalg::fixed_from_float(theta_rad.z, 26));
+        theta_q26[0] = linalg::fixed_from_float(theta_rad.x, 26);
+        theta_q26[1] = linalg::fixed_from_float(theta_rad.y, 26);
+        theta_q26[2] = linalg::fixed_from_float(theta_rad.z, 26);
+    } else {
+        // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
+        // times the radians per unit, each factor Q15 (16x16 multiplies, no float).
+        const Vector3l rate = last_rate_units(), pending = pending_turn_units();
+        const uint16_t lead = k_.lead_steps_q15, k = k_.theta_q26_per_unit_q15;
+        theta_q26[0] = scale_q15(pending.x + scale_q15(rate.x, lead), k);
+        theta_q26[1] = scale_q15(pending.y + scale_q15(rate.y, lead), k);
+        theta_q26[2] = scale_q15(pending.z + scale_q15(rate.z, lead), k);
     }
-    // From the integer sums: theta = (pending + rate * lead / dt) in the turn sums' units,
-    // times the radians per unit, each factor Q15 (16x16 multiplies, no float).
-    const Vector3l rate = last_rate_units(), pending = pending_turn_units();
-    const uint16_t lead = k_.lead_steps_q15, k = k_.theta_q26_per_unit_q15;
-    return euler_carried_q24(strapdown_.r(), scale_q15(pending.x + scale_q15(rate.x, lead), k),
-                             scale_q15(pending.y + scale_q15(rate.y, lead), k),
-                             scale_q15(pending.z + scale_q15(rate.z, lead), k));
+    // The level trim, when there is one (AHRS_TRIM: the airframe's angles, not the board's).
+    if (trim_q14 != nullptr)
+        return euler_carried_trimmed_q24(strapdown_.r(), theta_q26[0], theta_q26[1], theta_q26[2], trim_q14);
+    return euler_carried_q24(strapdown_.r(), theta_q26[0], theta_q26[1], theta_q26[2]);
 }
-
-
 
 // A matrix that renormalisation cannot save (NaN, or rows far from unit length)
 // is rebuilt from the last good gravity and field, as at start-up; the bias

@@ -205,8 +205,9 @@ public:
     // was taken. R (I + [w lead x]), first order: the lead is a few ms. What the
     // firmware prints.
     EulerAngles euler_now() const { return euler_in_rad(euler_now_q24()); }
-    // The same in Q24 radians, for the integer output path.
-    EulerQ24 euler_now_q24() const;
+    // The same in Q24 radians, for the integer output path; with trim_q14 (rows of a Q14
+    // rotation T, Euler.h), the angles of R T^T: the airframe's for a board trimmed by T.
+    EulerQ24 euler_now_q24(const int16_t (*trim_q14)[3] = nullptr) const;
 
     // The step's fixed constants (Coefficients.h), here too for the callers and tests
     // that name them as Dcm's.

@@ -159,6 +159,30 @@ EulerQ24 euler_carried_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int
     return e;
 }
 
+// One carried row (r + r x theta), all three entries.
+static linalg::Vector3l carried_row(const Theta& t, const linalg::Vector3l& p) {
+    return linalg::Vector3l(carried_entry(t, p.x, p.y, t.z, p.z, t.y), carried_entry(t, p.y, p.z, t.x, p.x, t.z),
+                            carried_entry(t, p.z, p.x, t.y, p.y, t.x));
+}
+// Row p of R' times row j of T (Q14): entry (., j) of R' T^T, Q30.
+static int32_t times_trim_row(const linalg::Vector3l& p, const int16_t* tj) {
+    return linalg::hot::mul_q14(tj[0], p.x) + linalg::hot::mul_q14(tj[1], p.y) + linalg::hot::mul_q14(tj[2], p.z);
+}
+
+EulerQ24 euler_carried_trimmed_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                                   int32_t theta_z_q26, const int16_t trim_q14[3][3]) {
+    const Theta t = theta_for(theta_x_q26, theta_y_q26, theta_z_q26);
+    const linalg::Vector3l a = carried_row(t, r.a), b = carried_row(t, r.b), c = carried_row(t, r.c);
+    // R' T^T: the entries the angles read (the third row, the first two columns of the
+    // first two rows), then the one extraction with no further turn (one copy of it in
+    // flash: this path adds 21 products, not another atan2).
+    linalg::Matrix3q30 v;
+    v.a = linalg::Vector3l(times_trim_row(a, trim_q14[0]), times_trim_row(a, trim_q14[1]), 0);
+    v.b = linalg::Vector3l(times_trim_row(b, trim_q14[0]), times_trim_row(b, trim_q14[1]), 0);
+    v.c = linalg::Vector3l(times_trim_row(c, trim_q14[0]), times_trim_row(c, trim_q14[1]), times_trim_row(c, trim_q14[2]));
+    return euler_carried_q24(v, 0, 0, 0);
+}
+
 EulerQ24 euler_carried_q24(const Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26, int32_t theta_z_q26) {
     return euler_carried_q24(linalg::q30_from_matrix(r), theta_x_q26, theta_y_q26, theta_z_q26);
 }

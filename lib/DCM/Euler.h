@@ -69,6 +69,12 @@ EulerQ24 euler_q24_from_q30(int32_t r11, int32_t r12, int32_t r21, int32_t r22, 
 // integers; the float theta is the same after fixed_from_float(theta, 26).
 EulerQ24 euler_carried_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,
                            int32_t theta_z_q26);
+// The same, then turned by a level trim T (Q14 rows, 1.0 = 16384): the angles of
+// R' T^T, the airframe's when the board sits at T in it (lib/Calibration/BoardFrame.h,
+// ArduPilot's AHRS_TRIM): nine carried entries and 21 32x16 products, then the same
+// extraction.
+EulerQ24 euler_carried_trimmed_q24(const linalg::Matrix3q30& r, int32_t theta_x_q26, int32_t theta_y_q26,
+                                   int32_t theta_z_q26, const int16_t trim_q14[3][3]);
 EulerQ24 euler_carried_q24(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,
                            int32_t theta_z_q26);
 EulerAngles euler_carried(const linalg::Matrix3f& r, int32_t theta_x_q26, int32_t theta_y_q26,

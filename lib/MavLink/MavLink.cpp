@@ -392,6 +392,9 @@ uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
         case MAVLINK_MSG_ID_COMMAND_LONG:
             max_len = MAVLINK_MSG_ID_COMMAND_LONG_LEN;
             return MAVLINK_MSG_ID_COMMAND_LONG_CRC;
+        case MAVLINK_MSG_ID_COMMAND_ACK:  // MAVProxy's accelcal confirms a position with one
+            max_len = MAVLINK_MSG_ID_COMMAND_ACK_LEN;
+            return MAVLINK_MSG_ID_COMMAND_ACK_CRC;
         default: return 0;
     }
 }
@@ -508,6 +511,23 @@ bool decode_param_set(const Received& rx, ParamSet& out) {
     copy_id(out.name, m.param_id);
     out.value = m.param_value;
     return true;
+}
+
+bool decode_command_ack(const Received& rx, uint16_t& command, uint8_t& result) {
+    if (rx.msgid != kMsgCommandAck) return false;
+    mavlink_command_ack_t m;
+    copy_payload(m, rx);
+    command = m.command;
+    result = m.result;
+    return true;
+}
+
+uint8_t Packer::command_long(uint8_t out[kMaxFrame], uint16_t command, float param1) {
+    Frame f(seq_);
+    // To every ground station (target 0, 0): the board does not know which one asked.
+    mavlink_msg_command_long_pack_status(kSystemId, kComponentId, &f.status, &f.msg, 0u, 0u, command, 0u, param1,
+                                         0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+    return f.finish(out, seq_);
 }
 
 bool decode_command_long(const Received& rx, CommandLong& out) {

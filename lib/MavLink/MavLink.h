@@ -158,6 +158,9 @@ public:
     // COMMAND_ACK to the ground station that sent the command.
     uint8_t command_ack(uint8_t out[kMaxFrame], uint16_t command, Result result, uint8_t target_system,
                         uint8_t target_component);
+    // COMMAND_LONG from the board to the ground stations (ArduPilot's accel calibration asks
+    // for a position with MAV_CMD_ACCELCAL_VEHICLE_POS, param1 the position).
+    uint8_t command_long(uint8_t out[kMaxFrame], uint16_t command, float param1);
     // RC_CHANNELS: `count` channels (0: no receiver signal), the eight widths in us
     // (channels 9-18 unused: UINT16_MAX), RSSI unknown.
     uint8_t rc_channels(uint8_t out[kMaxFrame], uint32_t time_boot_ms, const uint16_t width_us[8], uint8_t count);
@@ -236,6 +239,7 @@ enum MsgId : uint8_t {
     kMsgParamRequestList = 21,
     kMsgParamSet = 23,
     kMsgCommandLong = 76,
+    kMsgCommandAck = 77,
 };
 constexpr uint8_t kRxPayloadMax = 33;  // COMMAND_LONG's, the longest of them
 
@@ -305,6 +309,9 @@ struct CommandLong {
     float param[7];
 };
 bool decode_command_long(const Received& rx, CommandLong& out);
+// A ground station's COMMAND_ACK (MAVProxy's accelcal answers a position with one whose
+// command is the position's number); not addressed, so not checked.
+bool decode_command_ack(const Received& rx, uint16_t& command, uint8_t& result);
 
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;
@@ -318,5 +325,11 @@ constexpr uint8_t kMsgHomePosition = 242;
 constexpr uint16_t kCmdDoStartMagCal = 42424;
 constexpr uint16_t kCmdDoAcceptMagCal = 42425;
 constexpr uint16_t kCmdDoCancelMagCal = 42426;
+// ArduPilot's accelerometer calibration: the board asks for a position, the ground station
+// answers with the same when the vehicle is there (param1: ACCELCAL_VEHICLE_POS 1..6,
+// SUCCESS 16777215, FAILED 16777216).
+constexpr uint16_t kCmdAccelcalVehiclePos = 42429;
+constexpr float kAccelcalSuccess = 16777215.0f;
+constexpr float kAccelcalFailed = 16777216.0f;
 
 }  // namespace mav

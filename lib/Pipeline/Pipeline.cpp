@@ -135,7 +135,7 @@ AttitudePipeline::AttitudePipeline(const EventSink* events, const dcm::DcmSettin
 }
 
 AttitudePipeline::AttitudePipeline(const EventSink* events, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
-    : events_(events), settings_(), dcm_(dcm_settings), st_(), start_gravity_() {
+    : events_(events), settings_(), dcm_(dcm_settings), st_(), frame_(), trim_(), start_gravity_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f, mpu6000::kGyroRange, mpu6000::kAccelRange);
 }
 
@@ -150,8 +150,12 @@ void AttitudePipeline::set_mag_present(bool present) {
     if (!present) st_.mag_pending = false;
 }
 
-void AttitudePipeline::on_mag_sample(const Vector3f& field_uT) {
-    if (!field_uT.is_finite()) return;
+void AttitudePipeline::on_mag_sample(const Vector3f& board_field_uT) {
+    if (!board_field_uT.is_finite()) return;
+    // The compass is on the board (the APM 2.5's HMC5883L): it turns with it. Everything
+    // after this, the calibration too, is in the airframe's axes, as ArduPilot's.
+    Vector3f field_uT = board_field_uT;
+    calib::rotate(frame_.rotation, field_uT);
     // The fit's sums wait for a step free of heavy work, as the learner does.
     cal_field_uT_ = field_uT;
     if (st_.mag_cal_active) st_.cal_pending = true;
@@ -327,6 +331,23 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
             return;
         }
     }
+    if (st_.level_cal_active && r == calib::GyroCalibrator::Result::Moved) {
+        st_.gyro_cal_active = false;
+        finish_level_calibration(LevelResult::kMoved);
+        return;
+    }
+    if (r == calib::GyroCalibrator::Result::Done && st_.level_cal_active) {
+        // The still second's mean specific force, in the airframe's axes less the trim.
+        float tx, ty;
+        const bool ok = calib::level_trim(gyro_cal_.mean_accel_m_s2(), tx, ty);
+        if (ok) {
+            settings_.vehicle.ahrs_trim_x_rad = tx;
+            settings_.vehicle.ahrs_trim_y_rad = ty;
+            trim_ = calib::trim_q14(tx, ty);
+        }
+        finish_level_calibration(ok ? LevelResult::kOk : LevelResult::kTooFar);
+        // and the bias of the same still second, as `cal gyro`'s (below)
+    }
     if (r == calib::GyroCalibrator::Result::Done) {
         st_.gyro_cal_active = false;
         settings_.cal.gyro_bias_rad_s = gyro_cal_.bias();
@@ -359,7 +380,8 @@ void AttitudePipeline::step_calibration(const mpu6000::Sample& raw) {
     }
     if (st_.phase == Phase::Running && st_.gyro_cal_steps >= kGyroCalTimeoutSteps) {
         st_.gyro_cal_active = false;
-        tell(EventKind::kGyroCalTimeout);
+        if (st_.level_cal_active) finish_level_calibration(LevelResult::kTimeout);
+        else tell(EventKind::kGyroCalTimeout);
     }
 }
 
@@ -368,9 +390,24 @@ static uint8_t clipped_axes(const linalg::Vector3i& a) {
     return (uint8_t)((a.x >= 32767 || a.x <= -32767) + (a.y >= 32767 || a.y <= -32767) + (a.z >= 32767 || a.z <= -32767));
 }
 
-void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
+void AttitudePipeline::on_imu_sample(const mpu6000::Sample& board_sample) {
     st_.output_due = false;
     ++st_.steps;
+    if (st_.phase == Phase::WaitImu) refresh_board_frame();  // the settings as loaded
+    // Once a second the frame follows the settings (a parameter set meanwhile).
+    if ((uint8_t)st_.steps == 0u) st_.frame_due = true;
+    // The accelerometer's calibration and the board's orientation, on the counts: the
+    // vehicle's axes from here on.
+    profile::begin(profile::kBoardFrame);
+    mpu6000::Sample turned;
+    const bool identity = frame_.rotation == 0 && !frame_.accel_corrected;
+    if (!identity) {
+        turned = board_sample;
+        calib::apply_gyro(frame_, turned.gyro);
+        calib::apply_accel(frame_, turned.accel);
+    }
+    const mpu6000::Sample& raw = identity ? board_sample : turned;
+    profile::end(profile::kBoardFrame);
     if (st_.steps_since_mag < 0xFFFFu) ++st_.steps_since_mag;
     profile::begin(profile::kChecks);
     if (st_.start_message == StartMessage::kBias) tell(EventKind::kGyroBias);
@@ -388,6 +425,7 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         start_gyro_calibration();
     }
     if (st_.gyro_cal_active) step_calibration(s);
+    if (st_.accel_collecting) step_accel_position(board_sample);
     if (st_.phase != Phase::Running) {
         profile::end(profile::kChecks);
         return;
@@ -477,6 +515,8 @@ void AttitudePipeline::on_imu_sample(const mpu6000::Sample& raw) {
         fit_step = st_.mag_fit_active;
         if (st_.cal_pending && st_.mag_cal_active) mag_cal_.add(cal_field_uT_);
         else if (fit_step) step_mag_fit();
+        else if (st_.accel_pos == calib::kAccelPositions + 1) step_accel_fit();
+        else if (st_.frame_due) refresh_board_frame();
         else report_deferred();
         st_.cal_pending = false;
     }
@@ -500,19 +540,29 @@ void AttitudePipeline::report_deferred() {
 }
 
 Angles AttitudePipeline::angles() const {
-    const dcm::EulerAngles e = dcm_.euler_now();
+    const dcm::EulerAngles e = dcm::euler_in_rad(dcm_.euler_now_q24(trim_rows()));
     const float h = dcm::heading_deg(e.yaw_rad, settings_.declination_deg());
     return Angles{e.roll_rad * linalg::kDegPerRad, e.pitch_rad * linalg::kDegPerRad, h};
 }
 
 AnglesCentideg AttitudePipeline::angles_centideg() const {
-    return dcm::angles_centideg(dcm_.euler_now_q24(), settings_.declination_centideg);
+    return dcm::angles_centideg(dcm_.euler_now_q24(trim_rows()), settings_.declination_centideg);
 }
 
 linalg::Quaternion AttitudePipeline::quaternion() const {
     // The DCM's earth frame is magnetic north: turned about down by the declination.
     const float half_rad = 0.5f * settings_.declination_deg() * linalg::kRadPerDeg;
-    return linalg::quat_turned_about_down(linalg::quat_from_rotation(dcm_.matrix()), cosf(half_rad), sinf(half_rad));
+    linalg::Matrix3f r = dcm_.matrix();
+    if (trim_.active) {
+        // The airframe's: R T^T, as the angles (27 products, only in `mode quat`).
+        const int16_t(*t)[3] = trim_.t;
+        const float k = 1.0f / 16384.0f;
+        const linalg::Matrix3f tt(Vector3f((float)t[0][0] * k, (float)t[1][0] * k, (float)t[2][0] * k),
+                                  Vector3f((float)t[0][1] * k, (float)t[1][1] * k, (float)t[2][1] * k),
+                                  Vector3f((float)t[0][2] * k, (float)t[1][2] * k, (float)t[2][2] * k));
+        r = r * tt;
+    }
+    return linalg::quat_turned_about_down(linalg::quat_from_rotation(r), cosf(half_rad), sinf(half_rad));
 }
 
 Vector3f AttitudePipeline::gyro_rad_s() const { return calib::apply_gyro(settings_.cal, last_.gyro_rad_s()); }
@@ -521,13 +571,121 @@ Vector3f AttitudePipeline::gyro_bias_rad_s() const {
     return settings_.cal.gyro_bias_rad_s + dcm_.gyro_bias_rad_s();
 }
 
+bool AttitudePipeline::start_level_calibration() {
+    if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating() || accel_calibrating()) return false;
+    begin_gyro_window();
+    st_.level_cal_active = true;
+    tell(EventKind::kLevelStart);
+    return true;
+}
+
+bool AttitudePipeline::start_accel_calibration() {
+    if (st_.phase != Phase::Running || st_.gyro_cal_active || mag_calibrating() || accel_calibrating()) return false;
+    st_.accel_pos = (uint8_t)calib::AccelPosition::kLevel;
+    ask_accel_position();
+    return true;
+}
+
+void AttitudePipeline::ask_accel_position() {
+    st_.accel_waiting = true;
+    ++st_.accel_asks;
+    tell(EventKind::kAccelCalAsk, 0, 0, 0.0f, st_.accel_pos);
+}
+
+bool AttitudePipeline::confirm_accel_position(uint8_t position) {
+    if (!st_.accel_waiting || position != st_.accel_pos) return false;
+    st_.accel_waiting = false;
+    st_.accel_collecting = true;
+    gyro_cal_.restart();
+    return true;
+}
+
+// A still second's mean of the board's own counts (before INS_ACC* and the orientation:
+// the fit is in the board's axes), checked against the position asked in the airframe's.
+void AttitudePipeline::step_accel_position(const mpu6000::Sample& b) {
+    const calib::GyroCalibrator::Result r =
+        gyro_cal_.add(b.gyro, b.accel, b.gyro_rad_s_per_count, b.accel_m_s2_per_count);
+    if (r == calib::GyroCalibrator::Result::Collecting) return;
+    st_.accel_collecting = false;
+    const calib::AccelPosition p = (calib::AccelPosition)st_.accel_pos;
+    Vector3f mean = gyro_cal_.mean_accel_m_s2();
+    Vector3f in_airframe = mean;
+    calib::rotate(frame_.rotation, in_airframe);
+    const bool moved = r == calib::GyroCalibrator::Result::Moved;
+    if (moved || !calib::in_position(p, in_airframe)) {
+        tell(EventKind::kAccelCalRefused, 0, 0, moved ? 0.0f : 1.0f, st_.accel_pos);
+        ask_accel_position();  // again
+        return;
+    }
+    accel_fit_.set_mean((uint8_t)(st_.accel_pos - 1), mean);
+    ++st_.accel_pos;
+    if (st_.accel_pos <= calib::kAccelPositions) {
+        ask_accel_position();
+        return;
+    }
+    accel_fit_.begin(kG);  // then a Newton iteration a step with room
+}
+
+void AttitudePipeline::step_accel_fit() {
+    profile::begin(profile::kMagFit);
+    const calib::AccelFit::Quality q = accel_fit_.step();
+    profile::end(profile::kMagFit);
+    if (q == calib::AccelFit::Quality::Fitting) return;
+    st_.accel_pos = 0;
+    if (q == calib::AccelFit::Quality::Ok) {
+        settings::VehicleSettings& v = settings_.vehicle;
+        const Vector3f o = accel_fit_.offset_m_s2(), sc = accel_fit_.scale();
+        v.ins_accoffs_m_s2[0] = o.x;
+        v.ins_accoffs_m_s2[1] = o.y;
+        v.ins_accoffs_m_s2[2] = o.z;
+        v.ins_accscal[0] = sc.x;
+        v.ins_accscal[1] = sc.y;
+        v.ins_accscal[2] = sc.z;
+        refresh_board_frame();
+    }
+    tell(EventKind::kAccelCalDone, 0, 0, accel_fit_.residual_m_s2(), (uint8_t)q);
+}
+
+void AttitudePipeline::finish_level_calibration(LevelResult r) {
+    st_.level_cal_active = false;
+    tell(EventKind::kLevelDone, 0, 0, 0.0f, (uint8_t)r);
+}
+
+// The settings' frame and trim in the sample path's forms (a few thousand cycles, on a
+// step with room). A new orientation makes the gyro bias and the estimator's attitude
+// those of another frame: both start again (the user is setting the board up: it is
+// still, as a start).
+void AttitudePipeline::refresh_board_frame() {
+    st_.frame_due = false;
+    const settings::VehicleSettings& v = settings_.vehicle;
+    const uint8_t before = frame_.rotation;
+    frame_ = calib::make_board_frame(Vector3f(v.ins_accoffs_m_s2[0], v.ins_accoffs_m_s2[1], v.ins_accoffs_m_s2[2]),
+                                     Vector3f(v.ins_accscal[0], v.ins_accscal[1], v.ins_accscal[2]),
+                                     v.ahrs_orientation, kAccelCount_m_s2);
+    const bool trims_ok = v.ahrs_trim_x_rad <= calib::kTrimMax_rad && v.ahrs_trim_x_rad >= -calib::kTrimMax_rad &&
+                          v.ahrs_trim_y_rad <= calib::kTrimMax_rad && v.ahrs_trim_y_rad >= -calib::kTrimMax_rad;
+    trim_ = calib::trim_q14(trims_ok ? v.ahrs_trim_x_rad : 0.0f, trims_ok ? v.ahrs_trim_y_rad : 0.0f);
+    if (frame_.rotation == before || st_.phase != Phase::Running) return;
+    tell(EventKind::kOrientation, 0, 0, 0.0f, frame_.rotation);
+    restart_estimator();
+    if (!st_.gyro_cal_active) start_gyro_calibration();
+}
+
 void AttitudePipeline::start_gyro_calibration() {
+    begin_gyro_window();
+    if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);
+}
+
+void AttitudePipeline::begin_gyro_window() {
     gyro_cal_.restart();
     if (st_.phase != Phase::Running) start_gravity_.restart();  // running: the space is the turn's
     st_.gyro_cal_steps = 0;
     st_.gyro_cal_active = true;
     st_.start_moved = false;  // asked for (`cal gyro`): the user says the board is still
-    if (st_.phase == Phase::Running) tell(EventKind::kGyroCalAgain);
+    st_.level_cal_active = false;
+    st_.accel_pos = 0;  // a six-position calibration under way is given up
+    st_.accel_waiting = false;
+    st_.accel_collecting = false;
 }
 
 void AttitudePipeline::restart_estimator() {

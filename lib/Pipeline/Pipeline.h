@@ -26,6 +26,11 @@
 // (waiting out up to kMaxMagWaitSteps of the DCM's heavy steps), and on a step with room
 // the deferred compass work (the `cal mag` sums and fit, the offset learner).
 //
+// The board in its airframe (calib::BoardFrame, docs/board_frame.md): each sample's counts
+// get INS_ACCOFFS/INS_ACCSCAL (board axes) and AHRS_ORIENTATION's turn, the field sample the
+// turn, before anything else; AHRS_TRIM_X/Y is taken off where the angles and the
+// quaternion are taken. The level and six-position calibrations set them.
+//
 // Compass: each field sample is calibrated (calib::apply_mag: the `cal mag` fit, then
 // the offset learned in motion) before the DCM sees it; while running, the learner
 // (calib::OffsetLearner) estimates the hard iron from the field's change against the
@@ -44,6 +49,8 @@
 
 #include <stdint.h>
 
+#include "AccelFit.h"
+#include "BoardFrame.h"
 #include "Calibration.h"
 #include "Dcm.h"
 #include "GpsFix.h"
@@ -190,6 +197,20 @@ enum class EventKind : uint8_t {
     kMagCalNoCompass,  // `cal mag` refused: no magnetometer
     kMagCalProgress,   // `cal mag` collecting: count seconds left, total samples
     kMagCalDone,       // the verdict: code a calib::MagCalibrator::Quality (Ok: in settings().cal)
+    kLevelStart,       // the level calibration begins
+    kLevelDone,        // its verdict: code a LevelResult (Ok: the trims in settings().vehicle)
+    kOrientation,      // AHRS_ORIENTATION changed to code: the estimator and the gyro start again
+    kAccelCalAsk,      // the six-position calibration asks for position code (calib::AccelPosition)
+    kAccelCalRefused,  // position code not taken: value 0 the board moved, 1 not in that position
+    kAccelCalDone,     // its verdict: code a calib::AccelFit::Quality (Ok: INS_ACC* in settings().vehicle)
+};
+
+// The level calibration's verdict (kLevelDone's code).
+enum class LevelResult : uint8_t {
+    kOk,
+    kMoved,     // the board moved: nothing changed
+    kTooFar,    // the board is more than AHRS_TRIM's 10 deg from level: nothing changed
+    kTimeout,   // never still for 1 s within 10 s
 };
 
 // One event. count, for the rate-limited kinds (kGyroCalMoved, kSpike, kGyroSaturated,
@@ -307,6 +328,31 @@ public:
     MagCalState mag_cal_state() const;
     // The run's progress, percent: the collection's time, 100 once the fit is over.
     uint8_t mag_cal_progress_pct() const;
+    // The level calibration (ArduPilot's "Calibrate Level", MAV_CMD_PREFLIGHT_CALIBRATION
+    // param5 2): a still second's mean specific force sets AHRS_TRIM_X/Y so that the
+    // airframe, level and at rest, reads level (calib::level_trim); the gyro bias is
+    // measured again in the same second. False (nothing started) while not running or
+    // while another calibration runs. The verdict is kLevelDone.
+    bool start_level_calibration();
+    bool level_calibrating() const { return st_.level_cal_active; }
+    // The accelerometer's six-position calibration (ArduPilot's, PREFLIGHT_CALIBRATION
+    // param5 1): asks for each position in turn (kAccelCalAsk), takes a still second's
+    // mean of the raw accelerometer once the user says the airframe is there
+    // (confirm_accel_position), refuses a moving board or a wrong position (asking again),
+    // then fits INS_ACCOFFS_* and INS_ACCSCAL_* (calib::AccelFit, one iteration a step with
+    // room) and uses them at once (kAccelCalDone). False while not running or busy.
+    bool start_accel_calibration();
+    // The user says the airframe is in `position` (1..6): false unless that is the one asked.
+    bool confirm_accel_position(uint8_t position);
+    bool accel_calibrating() const { return st_.accel_pos != 0; }
+    calib::AccelFit::Quality accel_fit_quality() const { return accel_fit_.quality(); }
+    // The position asked and not yet confirmed (0: none), for a ground station's prompt.
+    uint8_t accel_position_asked() const { return st_.accel_waiting ? st_.accel_pos : 0; }
+    // How many times a position has been asked (again after a refusal): a new prompt to send.
+    uint8_t accel_asks() const { return st_.accel_asks; }
+    // The board's frame and trim from the settings now (AHRS_ORIENTATION, AHRS_TRIM_*,
+    // INS_ACC*): the pipeline takes them up by itself within a second of a change.
+    void refresh_board_frame();
     // After a sensor outage: the next sample restarts the DCM from gravity and the latest
     // field, keeping the gyro bias (before the first start it just goes on calibrating).
     void restart_estimator();
@@ -345,6 +391,13 @@ private:
     void finish_mag_calibration();
     void use_mag_calibration();
     void report_deferred();
+    void finish_level_calibration(LevelResult r);
+    void begin_gyro_window();  // start_gyro_calibration without its line
+    void step_accel_position(const mpu6000::Sample& board_sample);
+    void step_accel_fit();
+    void ask_accel_position();
+    // The trim's rotation for the angles (null: none).
+    const int16_t (*trim_rows() const)[3] { return trim_.active ? trim_.t : nullptr; }
     // An event to the sink; the short forms keep each call site small (flash).
     void tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const;
     __attribute__((noinline)) void tell(EventKind kind, uint16_t count) const;
@@ -407,8 +460,17 @@ private:
         bool gps_moving;                // the GPS's ground speed passed kCourseMinSpeed_m_s (and not below kGpsStillSpeed_m_s since)
         bool mag_cal_hold;              // the run's good result waits for accept_mag_calibration()
         MagCalState mag_cal_end;        // how the last run ended (kNone, kWaiting, kApplied, kFailed)
+        bool level_cal_active;          // the gyro calibration under way is the level calibration
+        bool frame_due;                 // refresh_board_frame on the next step with room
+        uint8_t accel_pos;              // the six-position calibration's position (1..6; 7 fitting; 0 off)
+        bool accel_waiting;             // ... asked, not yet confirmed
+        bool accel_collecting;          // ... confirmed: its still second under way (gyro_cal_)
+        uint8_t accel_asks;             // positions asked so far (wraps)
     };
     State st_;
+    calib::BoardFrame frame_;  // the accelerometer's calibration and the board's orientation, in counts
+    calib::TrimQ14 trim_;      // the level trim for the angles
+    calib::AccelFit accel_fit_;  // the six positions' means and their fit
     // One space for two phases (RAM): before the estimator runs the start's gravity if
     // never still (StartGravity.h), then the turn's mean (TurnMean: a plain struct, taken
     // up by assignment in start_estimator; the phase never goes back).

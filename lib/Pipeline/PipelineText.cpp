@@ -42,6 +42,24 @@ void write_cal_mag_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, co
     w.str(TXT("; calibration unchanged")).end();
 }
 
+// The level calibration's verdict (kLevelDone).
+void write_level_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
+    using pipeline::LevelResult;
+    const LevelResult r = (LevelResult)e.code;
+    if (r == LevelResult::kOk) {
+        const settings::VehicleSettings& v = pipe.settings().vehicle;
+        w.str(TXT("# cal level: trim roll ")).fixed2(v.ahrs_trim_x_rad * linalg::kDegPerRad).str(TXT(" pitch "))
+            .fixed2(v.ahrs_trim_y_rad * linalg::kDegPerRad).str(TXT(" deg")).end();
+        return;
+    }
+    // Short enough for one STATUSTEXT (50 characters).
+    w.str(TXT(TXT_ERROR "cal level: "));
+    if (r == LevelResult::kMoved) w.str(TXT("board moved"));
+    else if (r == LevelResult::kTooFar) w.str(TXT("over 10 deg off level"));
+    else w.str(TXT("never still"));
+    w.str(TXT("; trim unchanged")).end();
+}
+
 }  // namespace
 
 void write_event(void* out, const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
@@ -95,6 +113,31 @@ void write_event(void* out, const pipeline::AttitudePipeline& pipe, const pipeli
                 .str(TXT(" samples)"));
             break;
         case EventKind::kMagCalDone: write_cal_mag_verdict(w, pipe, e); return;
+        case EventKind::kLevelStart: w.str(TXT("# cal level: keep the airframe level and still for 1 s")); break;
+        case EventKind::kLevelDone: write_level_verdict(w, pipe, e); return;
+        case EventKind::kAccelCalAsk: {
+            // ArduPilot's words (AP_AccelCal): MAVProxy's accelcal waits for "Place ".
+            const char* p = TXT("level\0on its LEFT side\0on its RIGHT side\0nose DOWN\0nose UP\0on its BACK\0").p;
+            for (uint8_t k = 1; k < e.code; ++k)
+                while (text::flash_byte(p++) != 0u) {}
+            w.str(TXT("# Place vehicle ")).str(text::flash(p)).str(TXT(" and press any key"));
+            break;
+        }
+        case EventKind::kAccelCalRefused:
+            w.str(TXT(TXT_ERROR "cal accel: ")).str(e.value == 0.0f ? TXT("board moved") : TXT("not in that position"));
+            break;
+        case EventKind::kAccelCalDone:
+            if (e.code == (uint8_t)calib::AccelFit::Quality::Ok) {
+                w.str(TXT("# Calibration successful"));
+                break;
+            }
+            w.str(TXT(TXT_ERROR "Calibration FAILED: ")).str(e.code == (uint8_t)calib::AccelFit::Quality::OutOfRange
+                                                               ? TXT("offsets or scales out of range")
+                                                               : TXT("positions do not fit"));
+            break;
+        case EventKind::kOrientation:
+            w.str(TXT("# AHRS_ORIENTATION ")).u32(e.code).str(TXT(": estimator restarted, calibrating gyro: keep the board still"));
+            break;
         default: return;
     }
     w.end();

@@ -279,6 +279,37 @@ const Row kRows[] PARAM_TABLE = {
                "the throttle follows the stick from power-up and the board always reports armed.")},
 
     // Board orientation, level, the accelerometer's calibration.
+    {"AHRS_ORIENTATION", Type::UInt8, 0, 1, 0, AT(vehicle.ahrs_orientation), 0.0f, 37.0f, 0.0f,
+     PARAM_DOC("Board orientation", "",
+               "How the board is mounted in the airframe, as ArduPilot's rotation numbers: 0 as its arrow says, "
+               "1..7 yawed 45..315 deg, 8 upside down (ROLL_180), 9..15 upside down and yawed, 12 PITCH_180, "
+               "16..23 ROLL_90/ROLL_270 and their yaws, 24..37 the pitch 90/180/270 combinations. The gyro, "
+               "accelerometer and compass are turned by it before the estimator; a change restarts the "
+               "estimator and the gyro calibration (keep the board still).")},
+    {"AHRS_TRIM_X", Type::Float, 0, 1, 0, AT(vehicle.ahrs_trim_x_rad), -0.1745f, 0.1745f, 0.0f,
+     PARAM_DOC("Roll trim", "rad",
+               "The board's roll when the airframe is level (set by the level calibration, MAV_CMD_PREFLIGHT_"
+               "CALIBRATION param5 2 or `cal level`): taken off the roll reported and flown.")},
+    {"AHRS_TRIM_Y", Type::Float, 0, 1, 0, AT(vehicle.ahrs_trim_y_rad), -0.1745f, 0.1745f, 0.0f,
+     PARAM_DOC("Pitch trim", "rad",
+               "The board's pitch when the airframe is level (set by the level calibration): taken off the "
+               "pitch reported and flown.")},
+    {"INS_ACCOFFS_X", Type::Float, 0, 1, 0, AT(vehicle.ins_accoffs_m_s2[0]), -3.5f, 3.5f, 0.0f,
+     PARAM_DOC("Accelerometer offset X", "m/s/s",
+               "Subtracted from the accelerometer's x axis (the board's) before its scale; set by the "
+               "six-position calibration.")},
+    {"INS_ACCOFFS_Y", Type::Float, 0, 1, 0, AT(vehicle.ins_accoffs_m_s2[1]), -3.5f, 3.5f, 0.0f,
+     PARAM_DOC("Accelerometer offset Y", "m/s/s", "As INS_ACCOFFS_X, the y axis.")},
+    {"INS_ACCOFFS_Z", Type::Float, 0, 1, 0, AT(vehicle.ins_accoffs_m_s2[2]), -3.5f, 3.5f, 0.0f,
+     PARAM_DOC("Accelerometer offset Z", "m/s/s", "As INS_ACCOFFS_X, the z axis.")},
+    {"INS_ACCSCAL_X", Type::Float, 0, 1, 0, AT(vehicle.ins_accscal[0]), 0.8f, 1.2f, 1.0f,
+     PARAM_DOC("Accelerometer scale X", "",
+               "The accelerometer's x axis, less its offset, is multiplied by this; set by the six-position "
+               "calibration.")},
+    {"INS_ACCSCAL_Y", Type::Float, 0, 1, 0, AT(vehicle.ins_accscal[1]), 0.8f, 1.2f, 1.0f,
+     PARAM_DOC("Accelerometer scale Y", "", "As INS_ACCSCAL_X, the y axis.")},
+    {"INS_ACCSCAL_Z", Type::Float, 0, 1, 0, AT(vehicle.ins_accscal[2]), 0.8f, 1.2f, 1.0f,
+     PARAM_DOC("Accelerometer scale Z", "", "As INS_ACCSCAL_X, the z axis.")},
 
     // Compass. The `cal mag` result as ArduPilot's AP_Compass names it: rows into Settings::cal
     // (saved in the first record with the calibration, not in `flight` or `vehicle`). Both

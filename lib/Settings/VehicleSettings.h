@@ -18,6 +18,11 @@ struct VehicleSettings {
     uint8_t arming_require;     // ARMING_REQUIRE: 0 never disarmed, 1 throttle at its minimum until armed
 
     // Board orientation, level, the accelerometer's calibration (AP_AHRS, AP_InertialSensor).
+    uint8_t ahrs_orientation;   // AHRS_ORIENTATION: ArduPilot's Rotation, 0..37 (lib/Calibration/BoardFrame.h)
+    float ahrs_trim_x_rad;      // AHRS_TRIM_X: the board's roll on a level airframe
+    float ahrs_trim_y_rad;      // AHRS_TRIM_Y: its pitch
+    float ins_accoffs_m_s2[3];  // INS_ACCOFFS_X/Y/Z: subtracted from the accelerometer (board axes)
+    float ins_accscal[3];       // INS_ACCSCAL_X/Y/Z: then multiplied
 
     // Compass (AP_Compass). Its calibration's rows (COMPASS_OFS_*, _DIA_*, _ODI_*) point into
     // Settings::cal: saved with it in the first record.

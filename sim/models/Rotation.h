@@ -40,4 +40,30 @@ inline void earth_to_body(const Quat& q, const double v[3], double out[3]) {
     out[2] = r.z;
 }
 
+// The board mounted in the airframe at ArduPilot's Rotation r (AHRS_ORIENTATION, 0..37:
+// MAVLink's MAV_SENSOR_ORIENTATION names them by roll, pitch, yaw): the firmware turns
+// the board's vectors by M = Rz(yaw) Ry(pitch) Rx(roll) into the airframe's, so the
+// sensors on the board read M^T times the airframe's (apm25sim --orientation).
+constexpr int kBoardRotations = 38;
+inline bool board_rotation_rpy(int r, double rpy_deg[3]) {
+    static const short kRpy[kBoardRotations][3] = {
+        {0, 0, 0},    {0, 0, 45},    {0, 0, 90},   {0, 0, 135},  {0, 0, 180},   {0, 0, 225},  {0, 0, 270},
+        {0, 0, 315},  {180, 0, 0},   {180, 0, 45}, {180, 0, 90}, {180, 0, 135}, {0, 180, 0},  {180, 0, 225},
+        {180, 0, 270}, {180, 0, 315}, {90, 0, 0},  {90, 0, 45},  {90, 0, 90},   {90, 0, 135}, {270, 0, 0},
+        {270, 0, 45}, {270, 0, 90},  {270, 0, 135}, {0, 90, 0},  {0, 270, 0},   {0, 180, 90}, {0, 180, 270},
+        {90, 90, 0},  {180, 90, 0},  {270, 90, 0}, {90, 180, 0}, {270, 180, 0}, {90, 270, 0}, {180, 270, 0},
+        {270, 270, 0}, {90, 180, 90}, {90, 0, 270}};
+    if (r < 0 || r >= kBoardRotations) return false;
+    for (int i = 0; i < 3; ++i) rpy_deg[i] = kRpy[r][i];
+    return true;
+}
+// v <- M^T v for the board at rpy_deg (roll, pitch, yaw) in the airframe.
+inline void airframe_to_board(const double rpy_deg[3], double v[3]) {
+    const double d = 3.14159265358979323846 / 180.0;
+    const Quat q = from_euler(rpy_deg[0] * d, rpy_deg[1] * d, rpy_deg[2] * d);
+    double out[3];
+    earth_to_body(q, v, out);  // q's R^T v
+    for (int i = 0; i < 3; ++i) v[i] = out[i];
+}
+
 }  // namespace sim

@@ -106,7 +106,7 @@ TEST(Console, UnknownAndMalformed) {
     EXPECT_EQ(parse("help me").error, Error::ExtraArgument);
     EXPECT_EQ(parse("status now").error, Error::ExtraArgument);
     EXPECT_EQ(parse("cal").error, Error::MissingArgument);
-    EXPECT_EQ(parse("cal accel").error, Error::BadCalTarget);
+    EXPECT_EQ(parse("cal baro").error, Error::BadCalTarget);
     EXPECT_EQ(parse("cal gyro mag").error, Error::ExtraArgument);
     EXPECT_EQ(parse("a b c d e").error, Error::ExtraArgument);
     EXPECT_EQ(parse("ratee 5").error, Error::Unknown);
