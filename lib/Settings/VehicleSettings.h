@@ -11,6 +11,8 @@
 
 #include <stdint.h>
 
+#include "BatterySettings.h"
+
 namespace settings {
 
 struct VehicleSettings {
@@ -22,6 +24,7 @@ struct VehicleSettings {
     // Compass (AP_Compass).
 
     // Battery monitor and its failsafe (AP_BattMonitor, ArduPlane's FS_BATT_*).
+    battery::Settings battery;  // BATT_MONITOR .. FS_BATT_MAH (lib/Battery/BatterySettings.h)
 
     // Telemetry rates (GCS_MAVLink's SRn_*).
 };
