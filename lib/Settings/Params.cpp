@@ -298,7 +298,7 @@ const Row kRows[] PARAM_TABLE = {
                "3's name (later ArduPilot: BATT_AMP_PERVLT).")},
     {"BATT_AMP_OFFSET", Type::Float, 0, 1, 0, AT(vehicle.battery.amp_offset_v), -5.0f, 5.0f, 0.0f,
      PARAM_DOC("Amps offset", "V", "The current pin's voltage at zero current.")},
-    {"BATT_CAPACITY", Type::UInt16, 0, 1, 0, AT(vehicle.battery.capacity_mah), 0.0f, 65000.0f, 3300.0f,
+    {"BATT_CAPACITY", Type::UInt16, 0, 1, 0, AT(vehicle.battery.capacity_mah), 0.0f, 30000.0f, 3300.0f,
      PARAM_DOC("Battery capacity", "mAh",
                "The full pack's charge: the remaining percentage is what is left of it after the charge used "
                "since power-up (so plug in a full pack).")},
@@ -307,7 +307,7 @@ const Row kRows[] PARAM_TABLE = {
                "The battery failsafe when the voltage stays below this for 10 s (a short sag under load does "
                "not count); 0: off. ArduPlane's action, RTL, needs navigation: until then the board says "
                "\"Low battery\" and keeps its mode.")},
-    {"FS_BATT_MAH", Type::UInt16, 0, 1, 0, AT(vehicle.battery.fs_mah), 0.0f, 65000.0f, 0.0f,
+    {"FS_BATT_MAH", Type::UInt16, 0, 1, 0, AT(vehicle.battery.fs_mah), 0.0f, 30000.0f, 0.0f,
      PARAM_DOC("Failsafe battery mAh", "mAh",
                "The battery failsafe when less than this is left of BATT_CAPACITY (BATT_MONITOR 4 only); 0: off.")},
 
