@@ -319,15 +319,24 @@ constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
 
 constexpr float kRadPerCentideg = linalg::kPi / 18000.0f;
 
+// A byte of a row in flash, without copying the row: the walks below (every PARAM_SET
+// takes four) read one or two bytes of each row they pass, not its 35.
+#if defined(__AVR__)
+#define ROW_BYTE(field) pgm_read_byte(&(field))
+#else
+#define ROW_BYTE(field) (field)
+#endif
+
 // The row holding index, and the instance within it; false past the end.
 bool locate(uint16_t index, Row& row, uint8_t& instance) {
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
-        if (index < row.count) {
+        const uint8_t n = ROW_BYTE(kRows[r].count);
+        if (index < n) {
+            COPY_ROW(&row, &kRows[r]);
             instance = (uint8_t)index;
             return true;
         }
-        index = (uint16_t)(index - row.count);
+        index = (uint16_t)(index - n);
     }
     return false;
 }
@@ -421,6 +430,12 @@ int16_t find(const char* name) {
     Row row;
     uint16_t index = 0;
     for (uint8_t r = 0; r < kRowCount; ++r) {
+        // A name starts with a letter ('#' only stands for a number later): a row whose first
+        // letter differs is passed without being copied.
+        if ((char)ROW_BYTE(kRows[r].name[0]) != upper(name[0])) {
+            index = (uint16_t)(index + ROW_BYTE(kRows[r].count));
+            continue;
+        }
         COPY_ROW(&row, &kRows[r]);
         uint8_t i = 0, j = 0;  // row.name, name
         int16_t instance = 0;

@@ -839,11 +839,11 @@ void Board::rc_changed() { schedule_ppm_edge(); }
 void Board::set_a0_mV(double mV) { set_adc_mV(0, mV); }
 
 void Board::set_adc_mV(int channel, double mV) {
-    const uint32_t v = (uint32_t)std::lround(std::max(mV, 0.0));
     if (channel < 8)
-        avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + channel), v);
+        avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + channel),
+                      (uint32_t)std::lround(std::max(mV, 0.0)));
     else if (channel < 16)
-        adc_high_mV_[channel - 8] = v;
+        adc_high_mV_[channel - 8] = std::max(mV, 0.0);
 }
 
 // A read of ADCL after a conversion of ADC8..15 (MUX5 set, single-ended: MUX4:3 clear):
@@ -857,9 +857,9 @@ uint8_t Board::on_adcl_read(uint16_t addr) {
     const bool high = (avr_->data[kAdcsrb] & 0x08u) != 0u && (admux & 0x18u) == 0u;
     if (!high || adc->read_status) return adcl_original_(avr_, addr, adcl_original_param_);
     const uint32_t vref_mV[4] = {avr_->aref, avr_->avcc, 1100u, 2560u};
-    const uint32_t vref = vref_mV[admux >> 6] ? vref_mV[admux >> 6] : 5000u;
-    uint32_t counts = (uint32_t)((uint64_t)adc_high_mV_[admux & 0x07u] * 1024u / vref);
-    if (counts > 0x3FFu) counts = 0x3FFu;
+    const double vref = vref_mV[admux >> 6] ? vref_mV[admux >> 6] : 5000.0;
+    const double exact = std::floor(adc_high_mV_[admux & 0x07u] * 1024.0 / vref);
+    uint32_t counts = exact > 1023.0 ? 0x3FFu : (uint32_t)exact;
     if (admux & 0x20u) counts <<= 6;  // ADLAR
     avr_->data[kAdcl] = (uint8_t)counts;
     avr_->data[kAdcl + 1] = (uint8_t)(counts >> 8);

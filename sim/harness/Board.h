@@ -209,7 +209,7 @@ private:
     void (*eecr_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
     uint8_t (*adcl_original_)(avr_t*, uint16_t, void*) = nullptr;
     void* adcl_original_param_ = nullptr;
-    uint32_t adc_high_mV_[8] = {};  // ADC8..15 (simavr 1.6 keeps ADC0..7 only)
+    double adc_high_mV_[8] = {};  // ADC8..15 (simavr 1.6 keeps ADC0..7 only)
     void* eecr_original_param_ = nullptr;
 
     uint8_t spi_out_byte_ = 0;
