@@ -71,6 +71,23 @@ void take_battery_conversion() {
     start(0, kA0);
 }
 
+void convert_battery_pins_now() {
+    while (busy()) {
+    }
+    if (converting != kA0) take_battery_conversion();  // hands it on, starts A0's
+    while (busy()) {
+    }
+    for (uint8_t slot = kVolt; slot <= kCurr; ++slot) {
+        if (pins[slot] == kNoPin) continue;
+        start(pins[slot], slot);
+        while (busy()) {
+        }
+        take_battery_conversion();  // and A0's started again
+        while (busy()) {
+        }
+    }
+}
+
 void set_battery_pins(uint8_t volt_pin, uint8_t curr_pin) {
     pins[kVolt] = volt_pin;
     pins[kCurr] = curr_pin;

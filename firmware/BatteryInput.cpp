@@ -51,7 +51,14 @@ void update() {
     const bool on = battery::Monitor::enabled(s);
     adc::set_battery_pins(on ? s.volt_pin : adc::kNoPin,
                           on && battery::Monitor::has_current(s) ? s.curr_pin : adc::kNoPin);
-    if (on && sums.volt_n == 0u) return;  // just switched on: nothing converted yet
+    if (on && sums.volt_n == 0u) {
+        // No conversion in 100 ms: just switched on, or no sample flows (nobody takes A0's
+        // conversion, so the battery's never start): the pins converted here, the failsafe
+        // rule still kept.
+        adc::convert_battery_pins_now();
+        adc::take_battery_sums(sums);
+        if (sums.volt_n == 0u) return;
+    }
     if (monitor.update(s, battery::pin_volts(sums.volt_counts, sums.volt_n),
                        battery::pin_volts(sums.curr_counts, sums.curr_n), dt_s, now_ms)) {
         say_failsafe();
