@@ -59,15 +59,21 @@ bool take_a0(uint16_t& counts) {
 
 bool battery_conversion_due() { return converting != kA0 && !busy(); }
 
+static void add(uint16_t& sum, uint8_t& n, uint16_t counts) {
+    if (n >= 63u) {
+        sum = (uint16_t)(sum / 2u);
+        n = (uint8_t)(n / 2u);
+    }
+    sum = (uint16_t)(sum + counts);
+    ++n;
+}
+
 void take_battery_conversion() {
     const uint16_t counts = ADC;
-    if (converting == kVolt) {
-        sums.volt_counts += counts;
-        ++sums.volt_n;
-    } else if (converting == kCurr) {
-        sums.curr_counts += counts;
-        ++sums.curr_n;
-    }
+    if (converting == kVolt)
+        add(sums.volt_counts, sums.volt_n, counts);
+    else if (converting == kCurr)
+        add(sums.curr_counts, sums.curr_n, counts);
     start(0, kA0);
 }
 

@@ -32,10 +32,12 @@ void take_battery_conversion();
 
 // The battery pins to convert (kNoPin: none), from the battery task.
 void set_battery_pins(uint8_t volt_pin, uint8_t curr_pin);
-// The sums of the battery pins' conversions since the last call, and their counts.
+// The sums of the battery pins' conversions since the last call, and their counts. At 63
+// conversions a sum and its count are halved, as ArduPilot's APM2 AnalogIn does: the mean
+// stays that of the latest ones and 16 bits never overflow (64 x 1023 < 65536).
 struct Sums {
-    uint32_t volt_counts, curr_counts;
-    uint16_t volt_n, curr_n;
+    uint16_t volt_counts, curr_counts;
+    uint8_t volt_n, curr_n;
 };
 void take_battery_sums(Sums& out);
 // While no sample flows (the MPU6000 down: nobody takes A0), the battery task converts its

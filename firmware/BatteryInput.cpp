@@ -13,13 +13,16 @@ namespace battery_input {
 using vehicle::pipe;
 
 static battery::Monitor monitor;
-static uint32_t last_update_ms = 0;
+// Low 16 bits of millis(): the intervals measured are well under 65 s.
+static uint16_t last_update_ms = 0;
 static bool updated_before = false;  // the first update has no interval to integrate
-static uint32_t last_status_ms = 0;
+static uint16_t last_status_ms = 0;
 
 static const battery::Settings& settings() { return pipe.settings().vehicle.battery; }
 
-bool due() { return millis() - last_update_ms >= battery::kUpdatePeriodMs; }
+static uint16_t now16() { return (uint16_t)millis(); }
+
+bool due() { return (uint16_t)(now16() - last_update_ms) >= battery::kUpdatePeriodMs; }
 
 // The low-battery failsafe's action. ArduPlane's (low_battery_event) is RTL; the board has
 // no navigation yet (issue 47), so it keeps flying the mode it is in and says so. When RTL
@@ -41,8 +44,8 @@ static void say_failsafe() {
 
 void update() {
     const uint32_t now_ms = millis();
-    const float dt_s = updated_before ? (float)(now_ms - last_update_ms) * 0.001f : 0.0f;
-    last_update_ms = now_ms;
+    const float dt_s = updated_before ? (float)(uint16_t)((uint16_t)now_ms - last_update_ms) * 0.001f : 0.0f;
+    last_update_ms = (uint16_t)now_ms;
     updated_before = true;
     const battery::Settings& s = settings();
     adc::Sums sums;
@@ -72,11 +75,11 @@ bool failsafe() { return monitor.failsafe() != battery::Failsafe::kNone; }
 mav::BatteryReport report() { return mav::battery_report(monitor, settings()); }
 
 bool status_due() {
-    return enabled() && millis() - last_status_ms >= 1000u && gcs_link::room_for(mav::kBatteryStatusFrame);
+    return enabled() && (uint16_t)(now16() - last_status_ms) >= 1000u && gcs_link::room_for(mav::kBatteryStatusFrame);
 }
 
 void send_status() {
-    last_status_ms = millis();
+    last_status_ms = now16();
     uint8_t frame[mav::kMaxFrame];
     port::send_frame(frame, port::mavlink.battery_status(frame, report()));
 }
