@@ -65,6 +65,7 @@ SECTIONS = [
     (37, "baro", "the barometer task: a conversion read, the next started (PROM at start)", ()),
     (46, "barocomp", "the MS5611 compensation: a D2's temperature terms or a D1's pressure", ()),
     (47, "baroheight", "the barometer's height and climb (10 Hz)", ()),
+    (53, "battery", "the battery monitor's 10 Hz update (and its failsafe line)", ()),
     (17, "gcsreply", "one PARAM_VALUE, or RC_CHANNELS + SERVO_OUTPUT_RAW, packed", ()),
 ]
 

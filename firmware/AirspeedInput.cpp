@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "AirspeedInput.h"
 
+#include "Adc.h"
 #include "Airspeed.h"
 #include "ArduinoCore.h"
 #include "Vehicle.h"
@@ -33,13 +34,13 @@ static void say_no_sensor(bool moving) {
     w.end();
 }
 
-void begin() {
-    ADMUX = _BV(REFS0);  // AVcc reference, channel 0 (MUX5 in ADCSRB clear)
-    ADCSRB &= (uint8_t)~_BV(MUX5);
-    ADCSRA |= _BV(ADEN) | _BV(ADSC);
-}
+void begin() { adc::begin(); }
 
 void step() {
+    // A0's reading when its conversion is over, and the ADC's next (a battery pin's turn:
+    // Adc.h), with or without a sensor.
+    uint16_t counts = 0;
+    const bool converted = adc::take_a0(counts);
     if (state_ == State::kNone) {
         // No sensor: the configured cruise speed (TRIM_ARSPD_CM, grown in a banked turn as
         // the lift needs), only while the receiver's throttle is above idle (FlightIo).
@@ -48,9 +49,7 @@ void step() {
         pipe.set_cruise_airspeed_m_s(vehicle::flight_io.powered() ? (float)fs.trim_arspd_cm * 0.01f : 0.0f);
         return;
     }
-    if (ADCSRA & _BV(ADSC)) return;
-    const uint16_t counts = ADC;
-    ADCSRA |= _BV(ADSC);
+    if (!converted) return;
     if (!started) {  // the first conversion is the ADC's longer first one: not used
         started = true;
         return;

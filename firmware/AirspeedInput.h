@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The airspeed sensor on A0 (an MPXV7002DP pitot; lib/Pipeline/Airspeed.h converts), for
 // the estimator's centripetal correction. Never blocking: each sample reads the
-// conversion the previous one started (13 ADC clocks at 125 kHz, long done 5 ms later)
-// and starts the next. While the gyro calibrates (the board still) the readings are the
+// conversion of A0 started after the previous one (13 ADC clocks at 125 kHz, long done
+// 5 ms later) and starts the next (the ADC is shared with the battery's pins: Adc.h). While the gyro calibrates (the board still) the readings are the
 // sensor's zero; a zero far from 2.5 V is no sensor, and the configured cruise speed
 // (TRIM_ARSPD_CM) is used instead, as it is when the start's gyro calibration never found
 // the board still (it may be flying: no still-air zero to take). Then the mean of each

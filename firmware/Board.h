@@ -69,6 +69,9 @@ enum Section : uint8_t {
     kSecGcsPosition = 39,  // GPS_RAW_INT, GLOBAL_POSITION_INT, VFR_HUD ... packed and queued
     // 46 is lib/MS5611's compensation (lib/LinAlg/Profile.h), inside 37.
     kSecBaroHeight = 47,   // the barometer's 10 Hz height and climb (inside 37)
+    kSecAdc = 52,          // a battery pin's conversion taken, A0's next started
+    kSecBattery = 53,      // the battery monitor's 10 Hz update (and its failsafe line)
+    kSecGcsBattery = 54,   // BATTERY_STATUS packed and queued
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

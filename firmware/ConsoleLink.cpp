@@ -4,6 +4,7 @@
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
 #include "Baro.h"
+#include "BatteryInput.h"
 #include "Console.h"
 #include "GcsLink.h"
 #include "GpsPort.h"
@@ -109,7 +110,8 @@ static bool print_status(uint8_t part) {
         case 6: tasks::print_status_line(out); return true;
         case 7: gps_port::print_status_line(out); return true;
         case 8: position::print_status_line(out); return true;
-        case 9: return flight_io.print_status_line();
+        case 9: battery_input::print_status_line(out); return true;
+        case 10: return flight_io.print_status_line();
         default: return false;
     }
 }

@@ -2,6 +2,7 @@
 #include "GcsLink.h"
 
 #include "Baro.h"
+#include "BatteryInput.h"
 #include "Board.h"
 #include "Console.h"
 #include "ConsoleLink.h"
@@ -47,7 +48,7 @@ void take_heartbeat() {
 // An output line after a reply: a raw line, the longest, or an ATTITUDE frame.
 uint16_t output_line_bytes() { return port::mavlink_mode() ? mav::kAttitudeFrame : fmt::kRawLineMax; }
 
-static bool room_for(uint16_t frame_bytes) {
+bool room_for(uint16_t frame_bytes) {
     return port::mavlink_mode() && serial_text::room() >= frame_bytes + output_line_bytes();
 }
 
@@ -249,13 +250,15 @@ void send_heartbeat_and_status() {
     mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
                     fix.fix == gps::FixType::k3D && !fix.glitching);
     mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
+    mav::add_sensor(health, mav::kBattery, battery_input::enabled(), battery_input::healthy());
+    const mav::BatteryReport battery = battery_input::report();
     uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
                                         flight_io.plane_mode());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = port::mavlink.sys_status(frame, health,
                                  (uint16_t)(loop_load::percent() * 10u),
-                                 (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu));
+                                 (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu), &battery);
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     announce_accel_position(frame);
 }

@@ -22,6 +22,8 @@ mav::Parser& parser();
 void take_heartbeat();
 // Output queue bytes an output line takes at most in the port's language.
 uint16_t output_line_bytes();
+// In MAVLink, room in the queue for a frame of frame_bytes and an output line after it.
+bool room_for(uint16_t frame_bytes);
 
 // Loop tasks, each with its budget: a request (PARAM_SET, COMMAND_LONG ...), the
 // defaults' line after PREFLIGHT_STORAGE, a save after a PARAM_SET, one PARAM_VALUE,

@@ -17,7 +17,9 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Adc.h"
 #include "Baro.h"
+#include "BatteryInput.h"
 #include "Board.h"
 #include "ConsoleLink.h"
 #include "GcsLink.h"
@@ -102,9 +104,12 @@ static void once_a_second() {
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
+    X(gcs_battery,  battery_input::status_due,       battery_input::send_status,       1000, kSecGcsBattery,   0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
     X(store,        nullptr,                         store_service,                    1800, kSecStore,        kAlways) \
     X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
+    X(adc,          adc::battery_conversion_due,     adc::take_battery_conversion,      100, kSecAdc,          kAlways) \
+    X(battery,      battery_input::due,              battery_input::update,            2800, kSecBattery,      0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
     X(flight,       nullptr,                         flight_poll,                       800, kSecFlightPoll,   kAlways) \

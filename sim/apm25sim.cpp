@@ -36,7 +36,7 @@ const char* const kUsage =
     "                [--earth-field N,E,D] [--verbose]\n"
     "                [--gps ublox|nmea|none] [--gps-baud B] [--gps-fix-after S] [--gps-latency S]\n"
     "                [--baro ms5611|none] [--baro-noise HPA] [--baro-temp C] [--home LAT,LON,ALT_M]\n"
-    "                [--seed N] [--orientation R]\n"
+    "                [--seed N] [--orientation R] [--battery SPEC] [--battery-log FILE]\n"
     "\n"
     "Runs the firmware as an ATmega2560 at 16 MHz on the APM 2.5: MPU6000 on SPI (CS pin 53 = PB0,\n"
     "INT on PE6), HMC5883L on I2C at 0x1E (DRDY on pin 31 = PC6), MS5611 on SPI (CS pin 40 = PG1),\n"
@@ -180,6 +180,17 @@ const char* const kUsage =
     "                   roll, pitch, yaw): the trajectory's (or the backend's) values are the\n"
     "                   airframe's, and the MPU6000 and the HMC5883L, on the board, read them turned\n"
     "                   by M^T with M = Rz(yaw) Ry(pitch) Rx(roll) (default 0: as the arrow says)\n"
+    "  --battery SPEC   a LiPo pack behind a 3DR power module on the APM 2.5's A13 (pack volts /\n"
+    "                   10.1) and A12 (amps / 17 A/V): KEY=VALUE,... of cells (3), mah (2200),\n"
+    "                   charge (1: full, 0..1 at the start), r_ohm (0.04: the pack's internal\n"
+    "                   resistance), amps (a fixed current; else from the throttle on OUT3:\n"
+    "                   idle_a + (max_a - idle_a) x t^1.5, t = (width - 1000 us) / 1000 us in 0..1,\n"
+    "                   idle_a without a pulse), max_a (30), idle_a (0.5), volt_mult (10.1),\n"
+    "                   amp_per_volt (17), amp_offset (0 V); '' for the defaults. A cell's\n"
+    "                   open-circuit voltage follows a LiPo curve (4.20 V full, 3.27 V empty),\n"
+    "                   less current x r_ohm; the charge falls with the current. Without it A12\n"
+    "                   and A13 read 0 V. docs/simulator.md has the curve\n"
+    "  --battery-log FILE  the pack's truth at 10 Hz: CSV t,volts,amps,mah,charge\n"
     "\n"
     "Bus check: the barometer chip select (pin 40 = PG1, PORTG bit 1) must be high whenever the\n"
     "MPU6000 chip select (pin 53) is low, checked when pin 53 goes low and at every SPI byte.\n"
@@ -221,6 +232,7 @@ bool take_backend_rc(const sim::PhysicsState& state, double t_s, bool from_backe
 
 int main(int argc, char** argv) {
     sim::BoardOptions options;
+    std::string battery_log_path;
     std::string trajectory_path, input_path, profile_path, rc_path, servo_log_path, serial_spec, physics_spec,
         physics_log_path;
     double speed = -1.0;
@@ -383,6 +395,15 @@ int main(int argc, char** argv) {
             }
             options.baro.fixed_temperature = true;
             options.baro.temperature_c = c;
+        } else if (arg == "--battery") {
+            std::string error;
+            if (!sim::parse_battery_spec(value("--battery"), options.battery, error)) {
+                std::fprintf(stderr, "apm25sim: %s\n", error.c_str());
+                return 1;
+            }
+            options.battery_attached = true;
+        } else if (arg == "--battery-log") {
+            battery_log_path = value("--battery-log");
         } else if (arg == "--home") {
             const char* text = value("--home");
             double lat = 0, lon = 0, alt = 0;
@@ -451,6 +472,17 @@ int main(int argc, char** argv) {
         options.rc = &rc;
     }
     FILE* servo_log = nullptr;
+    if (!battery_log_path.empty()) {
+        if (!options.battery_attached) {
+            std::fprintf(stderr, "apm25sim: --battery-log needs --battery\n");
+            return 1;
+        }
+        options.battery_log = std::fopen(battery_log_path.c_str(), "w");
+        if (!options.battery_log) {
+            std::fprintf(stderr, "apm25sim: cannot write the battery log '%s'\n", battery_log_path.c_str());
+            return 1;
+        }
+    }
     if (!servo_log_path.empty()) {
         servo_log = std::fopen(servo_log_path.c_str(), "w");
         if (!servo_log) {
@@ -590,6 +622,10 @@ int main(int argc, char** argv) {
     board.finish_output();
     if (physics_log && std::fclose(physics_log) != 0) {
         std::fprintf(stderr, "apm25sim: cannot write the physics log '%s'\n", physics_log_path.c_str());
+        return 1;
+    }
+    if (options.battery_log && std::fclose(options.battery_log) != 0) {
+        std::fprintf(stderr, "apm25sim: cannot write the battery log '%s'\n", battery_log_path.c_str());
         return 1;
     }
     if (servo_log && std::fclose(servo_log) != 0) {

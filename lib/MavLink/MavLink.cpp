@@ -67,6 +67,11 @@ static_assert(kMsgHeartbeat == MAVLINK_MSG_ID_HEARTBEAT && kMsgParamRequestRead 
 static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE,
               "MAV_CMD values");
 static_assert(kGps == (uint32_t)MAV_SYS_STATUS_SENSOR_GPS, "MAV_SYS_STATUS_SENSOR_GPS");
+static_assert(kBattery == (uint32_t)MAV_SYS_STATUS_SENSOR_BATTERY, "MAV_SYS_STATUS_SENSOR_BATTERY");
+// BATTERY_STATUS: its payload up to charge_state (41 bytes) fits; the extensions after it
+// are sent 0 and trimmed (MAVLink 2 drops trailing zero bytes).
+static_assert(kBatteryStatusFrame == kFrameOverhead + 41 && kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_BATTERY_STATUS_LEN,
+              "BATTERY_STATUS fits kMaxFrame");
 static_assert(kCmdDoSetHome == MAV_CMD_DO_SET_HOME && kCmdGetHomePosition == MAV_CMD_GET_HOME_POSITION &&
                   kCmdRequestMessage == MAV_CMD_REQUEST_MESSAGE && kMsgHomePosition == MAVLINK_MSG_ID_HOME_POSITION,
               "the position commands' values");
@@ -153,13 +158,55 @@ uint8_t Packer::attitude(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float ro
     return f.finish(out, seq_);
 }
 
-uint8_t Packer::sys_status(uint8_t out[kMaxFrame], const Health& h, uint16_t load_permille, uint16_t errors) {
+uint8_t Packer::sys_status(uint8_t out[kMaxFrame], const Health& h, uint16_t load_permille, uint16_t errors,
+                           const BatteryReport* battery) {
     Frame f(seq_);
     const uint16_t load = load_permille > 1000u ? 1000u : load_permille;
-    // Battery: voltage UINT16_MAX, current -1, remaining -1 = "not measured" (the board has no sensor).
+    // Without a battery report: voltage UINT16_MAX, current -1, remaining -1 = "not measured".
+    const uint16_t mv = battery ? battery->voltage_mv : UINT16_MAX;
+    const int16_t ca = battery ? battery->current_ca : (int16_t)-1;
+    const int8_t pct = battery ? battery->remaining_pct : (int8_t)-1;
     mavlink_msg_sys_status_pack_status(kSystemId, kComponentId, &f.status, &f.msg, h.present, h.present,
-                                       h.healthy, load, UINT16_MAX, -1, -1, 0u, 0u, errors, 0u, 0u, 0u, 0u,
+                                       h.healthy, load, mv, ca, pct, 0u, 0u, errors, 0u, 0u, 0u, 0u,
                                        0u, 0u);
+    return f.finish(out, seq_);
+}
+
+namespace {
+// A reading rounded to the nearest unit and held within lo..hi (NaN: `unknown`).
+int32_t rounded(float v, int32_t lo, int32_t hi, int32_t unknown) {
+    if (v != v) return unknown;
+    if (v <= (float)lo) return lo;
+    if (v >= (float)hi) return hi;
+    return (int32_t)(v >= 0.0f ? v + 0.5f : v - 0.5f);
+}
+}  // namespace
+
+BatteryReport battery_report(const battery::Monitor& m, const battery::Settings& s) {
+    BatteryReport r{UINT16_MAX, -1, -1, -1, false};
+    if (!battery::Monitor::enabled(s)) return r;
+    // UINT16_MAX is "unknown": a reading held at one less.
+    r.voltage_mv = (uint16_t)rounded(m.voltage_v() * 1000.0f, 0, UINT16_MAX - 1, 0);
+    if (battery::Monitor::has_current(s)) {
+        r.current_ca = (int16_t)rounded(m.current_a() * 100.0f, -32767, 32767, -1);
+        r.consumed_mah = rounded(m.consumed_mah(), -1000000, 1000000, -1);
+        r.remaining_pct = m.remaining_pct(s);
+    }
+    r.failsafe = m.failsafe() != battery::Failsafe::kNone;
+    return r;
+}
+
+uint8_t Packer::battery_status(uint8_t out[kMaxFrame], const BatteryReport& b) {
+    Frame f(seq_);
+    uint16_t cells[MAVLINK_MSG_BATTERY_STATUS_FIELD_VOLTAGES_LEN];
+    for (uint16_t& c : cells) c = UINT16_MAX;
+    cells[0] = b.voltage_mv;
+    const uint16_t ext[MAVLINK_MSG_BATTERY_STATUS_FIELD_VOLTAGES_EXT_LEN] = {0u, 0u, 0u, 0u};
+    const uint8_t charge = b.failsafe ? MAV_BATTERY_CHARGE_STATE_LOW : MAV_BATTERY_CHARGE_STATE_OK;
+    mavlink_msg_battery_status_pack_status(kSystemId, kComponentId, &f.status, &f.msg, 0u,
+                                           MAV_BATTERY_FUNCTION_UNKNOWN, MAV_BATTERY_TYPE_UNKNOWN, INT16_MAX, cells,
+                                           b.current_ca, b.consumed_mah, -1, b.remaining_pct, 0, charge, ext, 0u,
+                                           0u);
     return f.finish(out, seq_);
 }
 

@@ -18,6 +18,7 @@
 //   HOME_POSITION    on request and when home changes, <= 40
 //   MAG_CAL_PROGRESS 2 Hz      39 bytes   while a ground station's compass calibration runs
 //   MAG_CAL_REPORT   once      <= 66      its end: offsets, soft iron, fitness
+//   BATTERY_STATUS   1 Hz      <= 53      the power module's voltage, current, charge used (BATT_MONITOR 3, 4)
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -39,6 +40,7 @@
 
 #include <stdint.h>
 
+#include "BatteryMonitor.h"
 #include "GpsFix.h"
 #include "LinAlg.h"
 #include "Text.h"
@@ -93,6 +95,7 @@ constexpr uint32_t kAccel3d = 2u;
 constexpr uint32_t kMag3d = 4u;
 constexpr uint32_t kAbsolutePressure = 8u;
 constexpr uint32_t kGps = 32u;
+constexpr uint32_t kBattery = 0x2000000u;  // MAV_SYS_STATUS_SENSOR_BATTERY
 
 struct Health {
     uint32_t present;  // sensor bits found at start-up (also reported as enabled)
@@ -121,6 +124,18 @@ struct MagCalReport {
     linalg::Vector3f ofs_mgauss;  // added to the field
     linalg::Vector3f diag, offdiag;  // the soft-iron matrix: diagonal; xy, xz, yz
 };
+// The battery as SYS_STATUS and BATTERY_STATUS carry it; MAVLink's "unknown" where the
+// monitor does not measure it (voltage UINT16_MAX, current, consumed and remaining -1).
+struct BatteryReport {
+    uint16_t voltage_mv;
+    int16_t current_ca;     // 10 mA units
+    int32_t consumed_mah;
+    int8_t remaining_pct;
+    bool failsafe;          // BATTERY_STATUS's charge_state LOW (else OK)
+};
+// The monitor's readings (BATT_MONITOR 0: all unknown), rounded and held within the fields.
+BatteryReport battery_report(const battery::Monitor& m, const battery::Settings& s);
+constexpr uint8_t kBatteryStatusFrame = kFrameOverhead + 41;  // at most: the extensions after charge_state are 0
 
 // GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
 struct PositionReport {
@@ -145,8 +160,12 @@ public:
     uint8_t attitude(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float roll_deg, float pitch_deg,
                      float heading_deg, const linalg::Vector3f& rate_rad_s);
     // load_permille: loop CPU load, 0..1000; errors: autopilot-specific count 1 (the
-    // firmware's loop overruns, saturated). Battery fields say "not measured".
-    uint8_t sys_status(uint8_t out[kMaxFrame], const Health& h, uint16_t load_permille, uint16_t errors);
+    // firmware's loop overruns, saturated). battery: its fields (nullptr: "not measured").
+    uint8_t sys_status(uint8_t out[kMaxFrame], const Health& h, uint16_t load_permille, uint16_t errors,
+                       const BatteryReport* battery = nullptr);
+    // BATTERY_STATUS (id 0, function and type unknown as ArduPilot sends them): the pack's
+    // voltage in voltages[0] (no cell voltages: the others UINT16_MAX), no temperature.
+    uint8_t battery_status(uint8_t out[kMaxFrame], const BatteryReport& b);
     // text: up to kTextChunk characters (shorter ones NUL-terminated). id 0 = a message
     // in one chunk; otherwise chunks of one message share id and count chunk_seq from 0.
     uint8_t statustext(uint8_t out[kMaxFrame], Severity severity, const char* text, uint8_t len,

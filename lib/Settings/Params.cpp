@@ -342,6 +342,39 @@ const Row kRows[] PARAM_TABLE = {
                "learned so far is kept until `cal mag` or a COMPASS_OFS_* change clears it).")},
 
     // Battery monitor and its failsafe.
+    {"BATT_MONITOR", Type::UInt8, 0, 1, 0, AT(vehicle.battery.monitor), 0.0f, 4.0f, 0.0f,
+     PARAM_DOC("Battery monitoring", "",
+               "0: off (a board without a power module: nothing reported, SYS_STATUS says not measured); 3: the "
+               "voltage; 4: the voltage and the current (the 3DR power module); 1 and 2 monitor nothing, as in "
+               "ArduPilot. Off by default: unconnected analog inputs read whatever floats there.")},
+    {"BATT_VOLT_PIN", Type::UInt8, 0, 1, 0, AT(vehicle.battery.volt_pin), 0.0f, 15.0f, 13.0f,
+     PARAM_DOC("Battery voltage pin", "",
+               "The analog input (A0..A15) of the pack's voltage: 13 for the 3DR power module on the APM 2.5. A0 "
+               "is the airspeed sensor's.")},
+    {"BATT_CURR_PIN", Type::UInt8, 0, 1, 0, AT(vehicle.battery.curr_pin), 0.0f, 15.0f, 12.0f,
+     PARAM_DOC("Battery current pin", "", "The analog input (A0..A15) of the current: 12 for the 3DR power module.")},
+    {"BATT_VOLT_MULT", Type::Float, 0, 1, 0, AT(vehicle.battery.volt_mult), 0.1f, 100.0f, 10.1f,
+     PARAM_DOC("Voltage multiplier", "",
+               "The pack's volts per volt on the voltage pin: 10.1 for the 3DR power module. Set it so that the "
+               "reported voltage matches a voltmeter's.")},
+    {"BATT_AMP_PERVOLT", Type::Float, 0, 1, 0, AT(vehicle.battery.amp_per_volt), 0.0f, 1000.0f, 17.0f,
+     PARAM_DOC("Amps per volt", "A/V",
+               "Amps per volt on the current pin above BATT_AMP_OFFSET: 17 for the 3DR power module. ArduPlane "
+               "3's name (later ArduPilot: BATT_AMP_PERVLT).")},
+    {"BATT_AMP_OFFSET", Type::Float, 0, 1, 0, AT(vehicle.battery.amp_offset_v), -5.0f, 5.0f, 0.0f,
+     PARAM_DOC("Amps offset", "V", "The current pin's voltage at zero current.")},
+    {"BATT_CAPACITY", Type::UInt16, 0, 1, 0, AT(vehicle.battery.capacity_mah), 0.0f, 30000.0f, 3300.0f,
+     PARAM_DOC("Battery capacity", "mAh",
+               "The full pack's charge: the remaining percentage is what is left of it after the charge used "
+               "since power-up (so plug in a full pack).")},
+    {"FS_BATT_VOLTAGE", Type::Float, 0, 1, 0, AT(vehicle.battery.fs_voltage_v), 0.0f, 100.0f, 0.0f,
+     PARAM_DOC("Failsafe battery voltage", "V",
+               "The battery failsafe when the voltage stays below this for 10 s (a short sag under load does "
+               "not count); 0: off. ArduPlane's action, RTL, needs navigation: until then the board says "
+               "\"Low battery\" and keeps its mode.")},
+    {"FS_BATT_MAH", Type::UInt16, 0, 1, 0, AT(vehicle.battery.fs_mah), 0.0f, 30000.0f, 0.0f,
+     PARAM_DOC("Failsafe battery mAh", "mAh",
+               "The battery failsafe when less than this is left of BATT_CAPACITY (BATT_MONITOR 4 only); 0: off.")},
 
     // Telemetry rates.
 

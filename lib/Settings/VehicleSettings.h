@@ -11,6 +11,8 @@
 
 #include <stdint.h>
 
+#include "BatterySettings.h"
+
 namespace settings {
 
 struct VehicleSettings {
@@ -30,6 +32,7 @@ struct VehicleSettings {
     uint8_t compass_learn;      // COMPASS_LEARN: 1 the hard iron learned in motion (OffsetLearner), 0 not
 
     // Battery monitor and its failsafe (AP_BattMonitor, ArduPlane's FS_BATT_*).
+    battery::Settings battery;  // BATT_MONITOR .. FS_BATT_MAH (lib/Battery/BatterySettings.h)
 
     // Telemetry rates (GCS_MAVLink's SRn_*).
 };

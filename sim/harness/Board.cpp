@@ -54,6 +54,9 @@ constexpr uint8_t kRxen = 1u << 4;   // UCSRnB
 constexpr uint16_t kSpcr = 0x4C;     // SPI control: CPOL bit 3, CPHA bit 2
 constexpr uint16_t kGpior0 = 0x3E;  // profiling: section start
 constexpr uint16_t kGpior1 = 0x4A;  // profiling: section end
+constexpr uint16_t kAdcl = 0x78;    // ADC data low, high at 0x79 (datasheet 26.8.3)
+constexpr uint16_t kAdcsrb = 0x7B;  // MUX5: bit 3
+constexpr uint16_t kAdmux = 0x7C;   // REFS1:0 bits 7:6, MUX4:0 bits 4:0
 constexpr uint8_t kMpuCsBit = 0;    // PB0, Arduino pin 53
 constexpr uint8_t kBaroCsBit = 1;   // PG1, Arduino pin 40
 constexpr uint32_t kSramStart = 0x200;  // ATmega2560: SRAM after the 512 register and I/O addresses
@@ -104,6 +107,10 @@ avr_cycle_count_t eeprom_done_timer(avr_t* avr, avr_cycle_count_t, void*) {
     avr->data[kEecr] = (uint8_t)(avr->data[kEecr] & ~kEepe);
     return 0;
 }
+uint8_t adcl_read_hook(avr_t*, avr_io_addr_t addr, void* param) {
+    return static_cast<Board*>(param)->on_adcl_read(addr);
+}
+
 void twcr_write_hook(avr_t*, avr_io_addr_t addr, uint8_t v, void* param) {
     static_cast<Board*>(param)->on_twcr_write(addr, v);
 }
@@ -197,6 +204,7 @@ Board::Board(const Trajectory& trajectory, const BoardOptions& options)
     : mpu_(trajectory), mag_(trajectory), options_(options) {
     if (options_.gps_attached) gps_.reset(new UbloxModel(trajectory, options_.gps));
     if (options_.baro_attached) baro_.reset(new Ms5611Model(trajectory, options_.baro));
+    if (options_.battery_attached) battery_.reset(new BatteryModel(options_.battery));
 }
 
 FaultTargets Board::fault_targets() {
@@ -300,6 +308,15 @@ bool Board::init() {
         avr_->io[AVR_DATA_TO_IO(kTwcr)].w.param = this;
     }
 
+    // ADC8..ADC15: simavr 1.6 keeps a value for ADC0..7 only and reads past its table for
+    // the others (MUX5 set): the ADCL read hook converts those channels here.
+    adcl_original_ = avr_->io[AVR_DATA_TO_IO(kAdcl)].r.c;
+    adcl_original_param_ = avr_->io[AVR_DATA_TO_IO(kAdcl)].r.param;
+    if (adcl_original_) {
+        avr_->io[AVR_DATA_TO_IO(kAdcl)].r.c = adcl_read_hook;
+        avr_->io[AVR_DATA_TO_IO(kAdcl)].r.param = this;
+    }
+
     // EEPROM: a write keeps EEPE set for the chip's write time (simavr 1.6: no time).
     eecr_original_ = avr_->io[AVR_DATA_TO_IO(kEecr)].w.c;
     eecr_original_param_ = avr_->io[AVR_DATA_TO_IO(kEecr)].w.param;
@@ -327,7 +344,11 @@ bool Board::init() {
     }
 
     if (!init_rc()) return false;
-    if (options_.servo_log || options_.measure_servos) init_servo_outputs();
+    if (options_.servo_log || options_.measure_servos || battery_) init_servo_outputs();
+    if (battery_) {
+        if (options_.battery_log) std::fputs("t,volts,amps,mah,charge\n", options_.battery_log);
+        advance_battery();
+    }
 
     avr_cycle_timer_register(avr_, 1, sensor_timer, this);
     if (options_.serial || options_.speed > 0.0) {
@@ -369,6 +390,24 @@ void Board::advance_models() {
     if (baro_) baro_->advance_to(t_s);
 }
 
+// The pack (BatteryModel.h) run to now at the current the throttle on OUT3 asks for now
+// (or its fixed one), and its power module's outputs on A13 and A12: simavr's ADC
+// converts the millivolts last raised on a channel's IRQ. Called by the sensor timer,
+// at least every 1 ms.
+void Board::advance_battery() {
+    const double t_s = time_s();
+    const double amps = battery_->current_a(servo_width_now_us(3));
+    battery_->step(t_s - battery_t_s_, amps);
+    battery_t_s_ = t_s;
+    set_adc_mV(13, battery_->volt_pin_mV());
+    set_adc_mV(12, battery_->curr_pin_mV());
+    if (options_.battery_log && t_s >= battery_log_next_s_) {
+        std::fprintf(options_.battery_log, "%.3f,%.4f,%.4f,%.4f,%.6f\n", t_s, battery_->voltage_v(),
+                     battery_->current_a(), battery_->consumed_mah(), battery_->charge());
+        battery_log_next_s_ += 0.1;
+    }
+}
+
 void Board::update_pins() {
     const int int_level = mpu_.int_pin_high() ? 1 : 0;
     if (int_level != int_level_) {
@@ -384,6 +423,7 @@ void Board::update_pins() {
 
 uint64_t Board::on_sensor_tick() {
     advance_models();
+    if (battery_) advance_battery();
     update_pins();
     // Next: the earliest model event, at least every 1 ms (fault windows, pulse ends).
     const double now_s = time_s();
@@ -796,8 +836,35 @@ uint64_t Board::on_ppm_edge() {
 void Board::rc_changed() { schedule_ppm_edge(); }
 
 // simavr's ADC converts the millivolts last raised on the channel's IRQ.
-void Board::set_a0_mV(double mV) {
-    avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0), (uint32_t)std::lround(mV));
+void Board::set_a0_mV(double mV) { set_adc_mV(0, mV); }
+
+void Board::set_adc_mV(int channel, double mV) {
+    if (channel < 8)
+        avr_raise_irq(avr_io_getirq(avr_, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + channel),
+                      (uint32_t)std::lround(std::max(mV, 0.0)));
+    else if (channel < 16)
+        adc_high_mV_[channel - 8] = std::max(mV, 0.0);
+}
+
+// A read of ADCL after a conversion of ADC8..15 (MUX5 set, single-ended: MUX4:3 clear):
+// the result the datasheet gives (26.7: ADC = Vin x 1024 / Vref, at most 1023) from the
+// millivolts set_adc_mV() keeps, at the reference REFS1:0 select (AREF, AVCC, 1.1 V,
+// 2.56 V), left-adjusted with ADLAR, as simavr's own conversion of ADC0..7 stores it: its
+// register pair until the next conversion ends (read_status). Everything else: simavr's.
+uint8_t Board::on_adcl_read(uint16_t addr) {
+    avr_adc_t* adc = static_cast<avr_adc_t*>(adcl_original_param_);
+    const uint8_t admux = avr_->data[kAdmux];
+    const bool high = (avr_->data[kAdcsrb] & 0x08u) != 0u && (admux & 0x18u) == 0u;
+    if (!high || adc->read_status) return adcl_original_(avr_, addr, adcl_original_param_);
+    const uint32_t vref_mV[4] = {avr_->aref, avr_->avcc, 1100u, 2560u};
+    const double vref = vref_mV[admux >> 6] ? vref_mV[admux >> 6] : 5000.0;
+    const double exact = std::floor(adc_high_mV_[admux & 0x07u] * 1024.0 / vref);
+    uint32_t counts = exact > 1023.0 ? 0x3FFu : (uint32_t)exact;
+    if (admux & 0x20u) counts <<= 6;  // ADLAR
+    avr_->data[kAdcl] = (uint8_t)counts;
+    avr_->data[kAdcl + 1] = (uint8_t)(counts >> 8);
+    adc->read_status = 1;
+    return avr_->data[addr];
 }
 
 // Each output's level is the OCnx unit's while TCCRnA's COMnx bits connect it to the pin

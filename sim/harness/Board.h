@@ -10,6 +10,8 @@
 // - TWI: after each TWCR write, simavr's pending TWI state timer (1 us per bit in 1.6)
 //   is re-armed at the bit time TWBR/TWPS give: 16 + 2 * TWBR * 4^TWPS cycles per bit.
 // - EEPROM: a write keeps EEPE set for the chip's 3.4 ms (simavr 1.6: no time at all).
+// - ADC8..15 (MUX5): simavr 1.6 keeps values for ADC0..7 only; the harness converts the
+//   others when ADCL is read (the battery's A12 and A13).
 // - UART1: simavr 1.6 paces a character at 11 bit times (it counts a parity bit that
 //   8N1 has not), slower than the GPS line: after each UBRR1L write the character time is
 //   set to 10 bit times.
@@ -26,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "BatteryModel.h"
 #include "FaultSpec.h"
 #include "Hmc5883Model.h"
 #include "Mpu6000Model.h"
@@ -67,6 +70,11 @@ struct BoardOptions {
     // --baro: the MS5611 behind pin 40 (false: --baro none, nobody behind the chip select).
     bool baro_attached = true;
     Ms5611Options baro;
+    // --battery: a pack behind the 3DR power module on A13 (voltage) and A12 (current);
+    // without it those pins read 0 V. --battery-log: its truth at 10 Hz.
+    bool battery_attached = false;
+    BatteryOptions battery;
+    FILE* battery_log = nullptr;
 };
 
 // What the GPS port carried, counted by the harness.
@@ -110,6 +118,7 @@ public:
     BusFaults& bus_faults() { return bus_faults_; }
     UbloxModel* gps() { return gps_.get(); }   // null with --gps none
     Ms5611Model* baro() { return baro_.get(); } // null with --baro none
+    BatteryModel* battery() { return battery_.get(); }  // null without --battery
     FaultTargets fault_targets();
     const GpsPortCounters& gps_port_counters() const { return gps_port_; }
 
@@ -149,11 +158,15 @@ public:
     void append_sample(const TrajectorySample& sample, double keep_s);
     // The voltage on analog input A0 (ADC0), in millivolts: the airspeed sensor (--physics).
     void set_a0_mV(double mV);
+    // The voltage on analog input A0..A15, in millivolts (A12, A13: the battery's).
+    void set_adc_mV(int channel, double mV);
+    uint8_t on_adcl_read(uint16_t addr);
     // After RcScript::push: restarts the PPM line if it had gone quiet.
     void rc_changed();
 
 private:
     void advance_models();
+    void advance_battery();
     void update_pins();
     bool mpu_selected() const;
     bool baro_deselected() const;
@@ -179,6 +192,9 @@ private:
     BoardOptions options_;
     std::unique_ptr<UbloxModel> gps_;
     std::unique_ptr<Ms5611Model> baro_;
+    std::unique_ptr<BatteryModel> battery_;
+    double battery_t_s_ = 0.0;        // the pack's state is this time's
+    double battery_log_next_s_ = 0.0;
     std::string error_;
 
     avr_t* avr_ = nullptr;
@@ -191,6 +207,9 @@ private:
     void (*twcr_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
     void* twcr_original_param_ = nullptr;
     void (*eecr_original_)(avr_t*, uint16_t, uint8_t, void*) = nullptr;
+    uint8_t (*adcl_original_)(avr_t*, uint16_t, void*) = nullptr;
+    void* adcl_original_param_ = nullptr;
+    double adc_high_mV_[8] = {};  // ADC8..15 (simavr 1.6 keeps ADC0..7 only)
     void* eecr_original_param_ = nullptr;
 
     uint8_t spi_out_byte_ = 0;

@@ -1060,3 +1060,88 @@ TEST(MavLinkMagCal, ReportCarriesArduPilotsUnits) {
 }
 
 }  // namespace
+
+// The battery (lib/Battery's monitor) in SYS_STATUS and BATTERY_STATUS: MAVLink's units
+// (mV, 10 mA, mAh, %), and its "unknown" for what BATT_MONITOR does not measure.
+namespace {
+constexpr uint8_t kExtraBatteryStatus = 154;
+
+battery::Settings module_settings(uint8_t monitor) {
+    battery::Settings s{};
+    s.monitor = monitor;
+    s.volt_mult = 10.1f;
+    s.amp_per_volt = 17.0f;
+    s.capacity_mah = 2000;
+    return s;
+}
+}  // namespace
+
+TEST(MavLinkBattery, ReportsWhatTheMonitorMeasures) {
+    battery::Monitor m;
+    battery::Settings s = module_settings(battery::kMonitorVoltageAndCurrent);
+    m.update(s, 1.2345f, 12.5f / 17.0f, 0.0f, 0);
+    for (int i = 0; i < 100; ++i) m.update(s, 1.2345f, 12.5f / 17.0f, 0.1f, 0);  // 10 s at 12.5 A: 34.7 mAh
+    mav::BatteryReport r = mav::battery_report(m, s);
+    EXPECT_EQ(r.voltage_mv, 12468u);  // 1.2345 x 10.1 = 12.468 V
+    EXPECT_EQ(r.current_ca, 1250);
+    EXPECT_EQ(r.consumed_mah, 35);
+    EXPECT_EQ(r.remaining_pct, 98);
+    EXPECT_FALSE(r.failsafe);
+    s.monitor = battery::kMonitorVoltage;
+    r = mav::battery_report(m, s);
+    EXPECT_EQ(r.voltage_mv, 12468u);
+    EXPECT_EQ(r.current_ca, -1);
+    EXPECT_EQ(r.consumed_mah, -1);
+    EXPECT_EQ(r.remaining_pct, -1);
+    s.monitor = battery::kMonitorDisabled;
+    r = mav::battery_report(m, s);
+    EXPECT_EQ(r.voltage_mv, UINT16_MAX);
+    EXPECT_EQ(r.current_ca, -1);
+    EXPECT_EQ(r.remaining_pct, -1);
+    // A reading beyond a field is held at its end, never wrapped (UINT16_MAX is "unknown").
+    s.monitor = battery::kMonitorVoltageAndCurrent;
+    battery::Monitor big;
+    big.update(s, 100.0f, 2000.0f, 0.0f, 0);  // 1010 V, 34000 A: a wrong multiplier
+    r = mav::battery_report(big, s);
+    EXPECT_EQ(r.voltage_mv, UINT16_MAX - 1u);
+    EXPECT_EQ(r.current_ca, 32767);
+}
+
+TEST(MavLinkBattery, SysStatusCarriesTheBattery) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    mav::Health h = mav::health(true, true, true, true);
+    mav::add_sensor(h, mav::kBattery, true, true);
+    const mav::BatteryReport b{11870u, 1234, 456, 77, false};
+    const Frame f = parse(buf, p.sys_status(buf, h, 100u, 0u, &b), kExtraSysStatus);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(u32(f.payload, 0), 7u | 0x2000000u);  // MAV_SYS_STATUS_SENSOR_BATTERY
+    EXPECT_EQ(u32(f.payload, 8), 7u | 0x2000000u);
+    EXPECT_EQ(u16(f.payload, 14), 11870u);
+    EXPECT_EQ(u16(f.payload, 16), 1234u);
+    EXPECT_EQ(u8(f.payload, 30), 77u);
+}
+
+TEST(MavLinkBattery, BatteryStatusFrame) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const mav::BatteryReport b{11870u, 1234, 456, 77, true};
+    const uint8_t n = p.battery_status(buf, b);
+    const Frame f = parse(buf, n, kExtraBatteryStatus);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 147u);
+    EXPECT_EQ(n, mav::kBatteryStatusFrame);  // trimmed after charge_state
+    EXPECT_EQ(u32(f.payload, 0), 456u);                 // current_consumed, mAh
+    EXPECT_EQ(u32(f.payload, 4), 0xFFFFFFFFu);          // energy_consumed -1
+    EXPECT_EQ(u16(f.payload, 8), 0x7FFFu);              // temperature unknown
+    EXPECT_EQ(u16(f.payload, 10), 11870u);              // voltages[0]: the pack
+    for (size_t i = 1; i < 10; ++i) EXPECT_EQ(u16(f.payload, 10 + 2 * i), 0xFFFFu) << i;
+    EXPECT_EQ(u16(f.payload, 30), 1234u);               // current_battery, 10 mA
+    EXPECT_EQ(u8(f.payload, 32), 0u);                   // id
+    EXPECT_EQ(u8(f.payload, 35), 77u);                  // battery_remaining
+    EXPECT_EQ(u8(f.payload, 40), 2u);                   // charge_state LOW (failsafe)
+    const mav::BatteryReport ok{11870u, -1, -1, -1, false};
+    const Frame g = parse(buf, p.battery_status(buf, ok), kExtraBatteryStatus);
+    EXPECT_EQ(u8(g.payload, 40), 1u);                   // OK
+    EXPECT_EQ(u16(g.payload, 30), 0xFFFFu);             // current -1
+}
