@@ -25,7 +25,7 @@ enum class Type : uint8_t {
     UInt16,   // uint16_t
     UInt8,    // uint8_t
     Bit,      // bit n of a uint8_t (n = the instance), 0 or 1
-    DeclRad,  // the declination: int16_t centi-degrees, shown in radians (ArduPilot's COMPASS_DEC)
+    DeclRad,  // the declination: a float in radians (ArduPilot's COMPASS_DEC), set with its hundredths (Settings.h)
 };
 
 constexpr uint8_t kNameMax = 16;  // MAVLink's param_id length
@@ -71,6 +71,9 @@ uint16_t flight_bytes();
 void vehicle_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* out);
 void decode_vehicle(const uint8_t* in, uint8_t n, settings::Settings& s);
 uint16_t vehicle_bytes();
+// crc brought on (settings::crc16_update) over the vehicle_bytes() bytes vehicle_part gives,
+// in one walk of the table (vehicle_part walks it once a part).
+uint16_t vehicle_crc(const settings::Settings& s, uint16_t crc);
 // Every parameter within its range and the end points in order (settings::is_valid).
 bool all_valid(const settings::Settings& s);
 

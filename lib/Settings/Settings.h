@@ -26,6 +26,7 @@
 
 #include <stdint.h>
 
+#include "Constants.h"
 #include "SensorCalibration.h"
 #include "FlightSettings.h"
 #include "OutputMode.h"
@@ -66,7 +67,7 @@ enum Flags : uint8_t {
 
 struct Settings {
     uint8_t rate_hz;               // output lines per second, 1..100
-    int16_t declination_centideg;  // magnetic declination, east positive, hundredths of a degree
+    int16_t declination_centideg;  // COMPASS_DEC rounded to hundredths of a degree (set_declination_*)
     fmt::OutputMode mode;
     uint8_t flags;                 // Flags
     calib::Calibration cal;
@@ -74,8 +75,18 @@ struct Settings {
     flight::FlightSettings flight;  // Params.h has their names, ranges and defaults
     VehicleSettings vehicle;        // the second record's (VehicleSettings.h)
 
-    float declination_deg() const { return (float)declination_centideg * 0.01f; }
+    float declination_rad() const { return vehicle.compass_dec_rad; }
+    float declination_deg() const { return vehicle.compass_dec_rad * linalg::kDegPerRad; }
 };
+
+// The declination (COMPASS_DEC) is the float a ground station sent, vehicle.compass_dec_rad
+// (the second record); declination_centideg is it rounded to hundredths of a degree: the
+// first record's copy (what a firmware before the second record reads) and the integer
+// heading's (the output lines print hundredths). Both are set together, here only.
+// East positive; the hundredths clamped to -18000..18000.
+int16_t centideg_of_rad(float rad);
+void set_declination_rad(Settings& s, float rad);
+void set_declination_centideg(Settings& s, int16_t centideg);  // `decl`; the first record alone
 
 Settings defaults();
 

@@ -20,6 +20,7 @@ struct VehicleSettings {
     // Board orientation, level, the accelerometer's calibration (AP_AHRS, AP_InertialSensor).
 
     // Compass (AP_Compass).
+    float compass_dec_rad;      // COMPASS_DEC: declination, east positive, as sent (record 1 keeps it rounded)
 
     // Battery monitor and its failsafe (AP_BattMonitor, ArduPlane's FS_BATT_*).
 

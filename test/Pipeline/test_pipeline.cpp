@@ -61,7 +61,7 @@ TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
     EXPECT_NEAR(a.pitch_deg, 0.0f, 0.1f);
     EXPECT_TRUE(a.heading_deg < 0.5f || a.heading_deg > 359.5f) << a.heading_deg;
     EXPECT_NE(log.find("# gyro bias: "), std::string::npos) << log;
-    p.settings().declination_centideg = 250;
+    settings::set_declination_centideg(p.settings(), 250);
     EXPECT_NEAR(p.angles().heading_deg, 2.5f, 0.5f);
 }
 

@@ -73,7 +73,7 @@ std::vector<uint8_t> slot_bytes(std::vector<uint8_t> slot) {
 settings::Settings stored_sample() {
     settings::Settings s = settings::defaults();
     s.rate_hz = 25;
-    s.declination_centideg = 850;
+    settings::set_declination_centideg(s, 850);
     s.mode = fmt::OutputMode::Csv;
     return s;
 }
@@ -160,7 +160,7 @@ TEST(Eeprom, HalfWrittenSlotGivesThePreviousSettingsOrDefaults) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     settings::Settings old_settings = settings::defaults();
     old_settings.rate_hz = 10;
-    old_settings.declination_centideg = -4500;
+    settings::set_declination_centideg(old_settings, -4500);
     const std::vector<uint8_t> old_slot = slot_of(encoded(old_settings), 4);
     const std::vector<uint8_t> new_slot = slot_of(encoded(stored_sample()), 5);
     std::vector<uint8_t> half(new_slot.begin(), new_slot.begin() + (long)(slots::kSlotSize / 2));
@@ -367,7 +367,7 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
 settings::Settings numbered_settings(uint8_t n, bool mag_cal) {
     settings::Settings s = settings::defaults();
     s.rate_hz = (uint8_t)(10 + n);
-    s.declination_centideg = (int16_t)(-2000 + 333 * n);
+    settings::set_declination_centideg(s, (int16_t)(-2000 + 333 * n));
     if (mag_cal) {
         s.flags = settings::kFlagMagCalibrated;
         s.cal.mag_offset_uT = linalg::Vector3f(2.5f * n, -1.25f * n, 4.0f);
