@@ -57,10 +57,15 @@ void SettingsStore::start_save(const settings::Settings& s) {
 
 void SettingsStore::begin() {
     expected2_crc_ = record2::slot_crc(*source_, next_sequence_, vehicle_bytes_);
-    slot_crc_ = settings::kCrc16Init;
+    start(kWriteSecond);
+}
+
+void SettingsStore::start(Stage stage) {
+    stage_ = stage;
     index_ = 0;
+    record_crc_ = settings::kCrc16Init;
+    slot_crc_ = settings::kCrc16Init;
     part_from_ = 0xFFu;
-    stage_ = kWriteSecond;
 }
 
 uint8_t SettingsStore::part_byte(Part part, uint8_t i, uint8_t end) {
@@ -105,10 +110,7 @@ uint8_t SettingsStore::first_byte() {
 
 // The slot's last byte written: read it back from the start.
 void SettingsStore::written(uint16_t size, Stage next) {
-    if (++index_ < size) return;
-    index_ = 0;
-    slot_crc_ = settings::kCrc16Init;
-    stage_ = next;
+    if (++index_ == size) start(next);
 }
 
 void SettingsStore::service() {
@@ -126,21 +128,19 @@ void SettingsStore::service() {
             return;
         case kVerifySecond: {
             const uint8_t v = verify_some(record2::slot_address(write_slot_), second_covered, expected2_crc_);
-            if (v == 1) stage_ = kNoteFirst;
+            if (v == 1) start(kNoteFirst);
             if (v != 2) return;
             break;  // not verified: the first record's slot stays as it is
         }
-        case kNoteFirst: {
-            uint8_t record[settings::kRecordSize];
-            settings::encode(*source_, record);
-            expected_crc_ = slots::slot_crc(record, next_sequence_);
-            record_crc_ = settings::kCrc16Init;
-            slot_crc_ = settings::kCrc16Init;
-            index_ = 0;
-            part_from_ = 0xFFu;
-            stage_ = kWriteFirst;
+        case kNoteFirst:
+            // The bytes the write will make, their CRC: a few a pass, so that a pass that
+            // walks the parameter table for a part costs what a writing one does (the whole
+            // record at once took ~4.8 ms, a walk ~1.5 ms).
+            for (uint8_t n = 0; n < kNoteBytesPerPass && index_ < kFirstCovered; ++n, ++index_) first_byte();
+            if (index_ < kFirstCovered) return;
+            expected_crc_ = slot_crc_;
+            start(kWriteFirst);
             return;
-        }
         case kWriteFirst:
             if (index_ == kFirstCovered) {
                 stage_ = kCheckSecond;  // before the CRC that makes the new pair the loaded one

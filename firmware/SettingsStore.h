@@ -13,10 +13,12 @@
 // The first slot's CRC makes the new pair the one a start loads; a second record that did
 // not verify stops the save before the first slot is touched. No copy of a record is kept
 // (RAM): each byte is encoded from the live settings when it is written, and the CRCs run
-// along. Each record's CRC is noted when its slot starts (the second at `save`), and the
-// second's checked against the live settings again before the first slot's CRC: if a
+// along. Each record's CRC is noted before its slot is written (the second's at `save`, in
+// one walk of the parameter table; the first's a part a pass, as its write encodes it), and
+// the second's checked against the live settings again before the first slot's CRC: if a
 // setting changed meanwhile, the save starts again (of the settings then) before that
-// CRC is written, so the pair is the settings of one instant.
+// CRC is written, so the pair is the settings of one instant. No pass takes more than one
+// walk of the parameter table.
 #pragma once
 
 #include <stdint.h>
@@ -44,15 +46,17 @@ private:
         kIdle,
         kWriteSecond,   // the second record's slot, byte index_
         kVerifySecond,  // ... read back
-        kNoteFirst,     // the first record's slot CRC noted (encoding it takes a pass)
+        kNoteFirst,     // the first record's slot CRC noted, a part a pass
         kWriteFirst,    // the first record's slot up to its CRC
         kCheckSecond,   // the second record still the live settings' (a pass)
         kCommitFirst,   // the first record's slot CRC
         kVerifyFirst,   // ... read back
     };
     using Part = void (*)(const settings::Settings&, uint8_t from, uint8_t n, uint8_t* out);
-    // The second record's slot noted: writing it from byte 0.
+    // The second record's slot CRC noted: writing it from byte 0.
     void begin();
+    // A stage from its first byte, the running CRCs and the part anew.
+    void start(Stage stage);
     uint8_t second_byte();
     uint8_t first_byte();
     // Byte i (< end) of a record's values, encoded a part at a time by `part`.
@@ -75,6 +79,7 @@ private:
     // The record's values from part_from_ on, encoded a part at a time (the parameter
     // table is walked once a part, not once a byte).
     static constexpr uint8_t kPartSize = 12;
+    static constexpr uint8_t kNoteBytesPerPass = 4;
     uint8_t part_[kPartSize];
     uint8_t part_from_ = 0xFFu;
     uint16_t next_sequence_ = 1;

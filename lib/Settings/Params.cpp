@@ -10,10 +10,15 @@
 #include <avr/pgmspace.h>
 #define PARAM_TABLE PROGMEM
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
+#define COPY_BYTES memcpy_P
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
+#define COPY_BYTES memcpy
 #endif
+// A row's storage fields alone (type .. offset, a sixth of the row): the walks over every
+// row that a save makes a part at a time (each_flight_value ...) read no names or ranges.
+#define COPY_STORAGE(dst, src) COPY_BYTES(&(dst)->type, &(src)->type, offsetof(Row, min) - offsetof(Row, type))
 
 // What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
 // parameter reference, docs/parameters.md, is printed from these (tools/paramdoc, make
@@ -464,7 +469,7 @@ template <typename F>
 void each_flight_value(const Settings& s, F f) {
     Row row;
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
+        COPY_STORAGE(&row, &kRows[r]);
         if (row.offset < offsetof(Settings, flight) || row.offset >= offsetof(Settings, vehicle)) continue;
         const uint8_t n = row.type == Type::Bit ? 1 : row.count;
         for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
@@ -507,7 +512,7 @@ template <typename F>
 void each_vehicle_value(const Settings& s, F f) {
     Row row;
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
+        COPY_STORAGE(&row, &kRows[r]);
         if (row.offset < offsetof(Settings, vehicle)) continue;
         const uint8_t n = row.type == Type::Bit ? 1 : row.count;
         for (uint8_t i = 0; i < n; ++i) f(where(const_cast<Settings&>(s), row, i), stored_bytes(row.type));
