@@ -103,7 +103,7 @@ static void once_a_second() {
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
-    X(store,        nullptr,                         store_service,                    1800, kSecStore,        kAlways) \
+    X(store,        nullptr,                         store_service,                    1800, kSecStore,        0)       \
     X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
     X(user_loop,    nullptr,                         user_loop,                         200, kSecUserLoop,     kAlways) \
