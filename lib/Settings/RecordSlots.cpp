@@ -61,6 +61,7 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     out.newest_cut = p.newest_cut;
     out.write = p.write;
     out.next_sequence = p.next_sequence;
+    out.vehicle = record2::Result::NotRead;
     // This firmware's record, or version 3's or 4's (Settings.h: they load, the newer rows at defaults).
     if (p.load >= 0 && info[(uint8_t)p.load].record_length != settings::kRecordSize &&
         info[(uint8_t)p.load].record_length != settings::kV3RecordSize &&
@@ -74,7 +75,6 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     out.result = settings::decode(bytes, s);
     if (out.from_legacy && out.result == settings::LoadResult::Blank && p.newest_cut)
         out.result = settings::LoadResult::BadCrc;
-    out.vehicle = record2::Result::NotRead;
     if (!out.from_legacy && out.result == settings::LoadResult::Ok) {
         read(record2::slot_address((uint8_t)p.load), bytes, record2::kSlotSpace);
         out.vehicle = record2::load(bytes, info[(uint8_t)p.load].sequence, s);

@@ -216,6 +216,7 @@ TEST(RecordSlots, SlotOfAnotherRecordLengthIsRefused) {
     EXPECT_TRUE(same(s, settings::defaults()));
     EXPECT_EQ(l.write, 1);  // that slot is kept for a downgrade; the next save goes to the other
     EXPECT_EQ(l.next_sequence, 10);
+    EXPECT_EQ(l.vehicle, record2::Result::NotRead);  // the second record only beside a first one loaded
 }
 
 }  // namespace
