@@ -64,7 +64,7 @@ void flight_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* 
 void decode_flight(const uint8_t* in, uint8_t n, settings::Settings& s);
 // What encode_flight writes (a test holds it to settings::kFlightBytes).
 uint16_t flight_bytes();
-// The second record's values (Settings::vehicle: the rows after COMPASS_DEC), in table
+// The second record's values (Settings::vehicle: the rows after GND_ABS_PRESS), in table
 // order as encode_flight's: vehicle_bytes() of them. A record with fewer (an older
 // firmware's) is this one's first part: decode_vehicle reads the values it holds whole
 // and leaves the others as they are (their defaults).

@@ -6,15 +6,17 @@
 //          2  version           kSettingsVersion; any other value: defaults
 //          3  payload length    kPayloadLength
 //          4  payload           little-endian fields, floats as IEEE-754 bytes:
-//             4  rate, 5 decl (int16), 7 mode, 8 flags, 9 calibration (15 floats)
+//             4  rate, 5 decl (int16: COMPASS_DEC's hundredths of a degree), 7 mode, 8 flags,
+//             9  calibration (15 floats)
 //             69 the flight settings (version 3 on): params::encode_flight, the parameter
 //                table's rows in order (a Bit row's eight bits one byte), kFlightBytes
 //          4+len  CRC-16/CCITT-FALSE of bytes 0 .. 3+len, little-endian
 //
 // encode/decode are explicit byte by byte, so the layout is the same on the AVR and
 // the host (no struct padding or endianness in the record). GND_ABS_PRESS is measured at
-// each start and lives before `flight`: not in the record. No EEPROM access here:
-// the firmware copies kRecordSize bytes to and from EEPROM.
+// each start and lives before `flight`: not in the record. `vehicle` is the second
+// record's (VehicleRecord.h). No EEPROM access here: the firmware copies kRecordSize bytes
+// to and from EEPROM.
 //
 // A version 2 record (a 65-byte payload, no flight settings) still loads: its rate,
 // declination, mode and calibration are kept, the flight settings are the defaults and
