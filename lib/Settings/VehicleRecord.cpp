@@ -39,7 +39,9 @@ Result load(const uint8_t* b, uint16_t sequence, settings::Settings& s) {
     if (stored != settings::crc16(b, (uint16_t)(kHeaderSize + n))) return Result::BadCrc;
     // Another save's (a firmware before this record saved the first one since).
     if ((uint16_t)(b[4] | (uint16_t)((uint16_t)b[5] << 8)) != sequence) return Result::Missing;
-    if (b[2] != kVersion) return Result::OldVersion;
+    // Another layout, or a later firmware's rows (after a downgrade): as the first record's
+    // other versions, refused whole.
+    if (b[2] != kVersion || n > params::vehicle_bytes()) return Result::OldVersion;
     const settings::VehicleSettings before = s.vehicle;
     const int16_t before_centideg = s.declination_centideg;
     params::decode_vehicle(b + kHeaderSize, n, s);

@@ -20,8 +20,9 @@
 // the first record's hundredths.
 //
 // A payload shorter than this firmware's (an earlier firmware's rows) loads as its first
-// part, the rows after it at their defaults; a longer one (a later firmware's) loads the
-// rows this one has. Pure: the caller reads and writes the EEPROM.
+// part, the rows after it at their defaults; a longer one (a later firmware's, after a
+// downgrade) or another version is refused whole, as the first record's other versions
+// are. Pure: the caller reads and writes the EEPROM.
 #pragma once
 
 #include <stdint.h>
@@ -49,7 +50,7 @@ enum class Result : uint8_t {
     NotRead,     // the first record did not load from a slot: everything at its defaults or the legacy record
     Missing,     // no slot of the first record's sequence: saved by an earlier firmware
     BadCrc,      // the paired slot is corrupted
-    OldVersion,  // another version of this record
+    OldVersion,  // another version of this record, or a later firmware's (a longer payload)
     BadValue,    // a value out of range
 };
 

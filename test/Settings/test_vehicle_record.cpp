@@ -285,8 +285,8 @@ TEST(VehicleRecord, PairedSlotOfAnotherVersionCorruptedOrOutOfRangeGivesDefaults
 }
 
 // A second record with fewer rows (an earlier firmware's) is this one's first part; one
-// with more (a later firmware's, after a downgrade) gives the rows this one has.
-TEST(VehicleRecord, ShorterAndLongerPayloadsLoadTheRowsTheyShare) {
+// with more (a later firmware's, after a downgrade) is refused as another version is.
+TEST(VehicleRecord, ShorterPayloadLoadsAsTheFirstPartALongerIsRefused) {
     const Settings saved = numbered(1);  // ARMING_REQUIRE 1 ... declination 0.21 rad
     Settings zero_arming = saved;
     zero_arming.vehicle.arming_require = 0;
@@ -304,14 +304,16 @@ TEST(VehicleRecord, ShorterAndLongerPayloadsLoadTheRowsTheyShare) {
         put(record2::slot_address(0), slot);
         Settings s;
         const slots::Loaded l = load(s);
-        ASSERT_EQ(l.vehicle, record2::Result::Paired) << (int)n;
-        EXPECT_EQ(s.vehicle.arming_require, 0) << (int)n;
+        // The declination the earlier record lacked, or of the record refused: the first
+        // record's hundredths.
+        EXPECT_EQ(s.declination_centideg, saved.declination_centideg);
+        EXPECT_NEAR(s.declination_rad(), saved.declination_rad(), 1e-4f);
         if (n == 1) {
-            // The declination the earlier record lacked: the first record's hundredths.
-            EXPECT_EQ(s.declination_centideg, saved.declination_centideg);
-            EXPECT_NEAR(s.declination_rad(), saved.declination_rad(), 1e-4f);
+            EXPECT_EQ(l.vehicle, record2::Result::Paired);
+            EXPECT_EQ(s.vehicle.arming_require, 0);
         } else {
-            EXPECT_EQ(s.declination_rad(), saved.declination_rad());
+            EXPECT_EQ(l.vehicle, record2::Result::OldVersion);
+            EXPECT_EQ(s.vehicle.arming_require, settings::defaults().vehicle.arming_require);
         }
     }
 }
