@@ -108,7 +108,7 @@ uint8_t SettingsStore::first_byte() {
     return b;
 }
 
-// The slot's last byte written: read it back from the start.
+// A byte written; after the slot's last, the next stage (its read-back) from the start.
 void SettingsStore::written(uint16_t size, Stage next) {
     if (++index_ == size) start(next);
 }
@@ -135,7 +135,7 @@ void SettingsStore::service() {
         case kNoteFirst:
             // The bytes the write will make, their CRC: a few a pass, so that a pass that
             // walks the parameter table for a part costs what a writing one does (the whole
-            // record at once took ~4.8 ms, a walk ~1.5 ms).
+            // record at once took ~4.8 ms, a part's walk takes ~1.1 ms).
             for (uint8_t n = 0; n < kNoteBytesPerPass && index_ < kFirstCovered; ++n, ++index_) first_byte();
             if (index_ < kFirstCovered) return;
             expected_crc_ = slot_crc_;
