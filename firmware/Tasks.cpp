@@ -106,7 +106,7 @@ static void once_a_second() {
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(gcs_battery,  battery_input::status_due,       battery_input::send_status,       1000, kSecGcsBattery,   0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
-    X(store,        nullptr,                         store_service,                    1800, kSecStore,        kAlways) \
+    X(store,        nullptr,                         store_service,                    1800, kSecStore,        0)       \
     X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(adc,          adc::battery_conversion_due,     adc::take_battery_conversion,      100, kSecAdc,          kAlways) \
     X(battery,      battery_input::due,              battery_input::update,            2800, kSecBattery,      0)       \

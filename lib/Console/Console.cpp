@@ -340,7 +340,7 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
             w.str(TXT("# rate ")).i32(c.value).str(TXT(" Hz")).end();
             return true;
         case CommandId::Decl: {
-            s.declination_centideg = (int16_t)c.value;
+            settings::set_declination_centideg(s, (int16_t)c.value);
             char buf[14];
             w.str(TXT("# decl ")).str(buf, text::format_centi(buf, c.value)).str(TXT(" deg")).end();
             return true;

@@ -96,7 +96,7 @@ void AttitudePipeline::take_gps_fix(const gps::Fix& fix) {
     gps_itow_ms_ = fix.itow_ms != 0u ? fix.itow_ms : 1u;
     // Into the estimator's earth axes, whose north is the magnetic one: turned about down
     // by the declination (a vector at true bearing b is at magnetic bearing b - decl).
-    const float decl_rad = settings_.declination_deg() * linalg::kRadPerDeg;
+    const float decl_rad = settings_.declination_rad();
     const float c = cosf(decl_rad), s = sinf(decl_rad);
     const float n = (float)fix.vel_ned_cm_s[0] * 0.01f, e = (float)fix.vel_ned_cm_s[1] * 0.01f;
     // NMEA carries no vertical speed: level, its change unseen (a climb's start, small).
@@ -551,7 +551,7 @@ AnglesCentideg AttitudePipeline::angles_centideg() const {
 
 linalg::Quaternion AttitudePipeline::quaternion() const {
     // The DCM's earth frame is magnetic north: turned about down by the declination.
-    const float half_rad = 0.5f * settings_.declination_deg() * linalg::kRadPerDeg;
+    const float half_rad = 0.5f * settings_.declination_rad();
     linalg::Matrix3f r = dcm_.matrix();
     if (trim_.active) {
         // The airframe's: R T^T, as the angles (27 products, only in `mode quat`).

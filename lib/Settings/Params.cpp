@@ -267,10 +267,6 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Ground pressure", "Pa",
                "The pressure at home, measured at each start while the gyro calibrates (0 until then): the "
                "height above home is taken from it. Not saved.")},
-    {"COMPASS_DEC", Type::DeclRad, 0, 1, 0, AT(declination_centideg), -3.1416f, 3.1416f, 0.0f,
-     PARAM_DOC("Compass declination", "rad",
-               "The angle from true north to magnetic north, east positive, added to the heading the board "
-               "reports: `decl` sets the same in degrees. Kept to a hundredth of a degree.")},
     // The second record's rows (settings::VehicleSettings), each feature under its heading.
     // Arming.
     {"ARMING_REQUIRE", Type::UInt8, 0, 1, 0, AT(vehicle.arming_require), 0.0f, 1.0f, 1.0f,
@@ -315,6 +311,11 @@ const Row kRows[] PARAM_TABLE = {
     // (saved in the first record with the calibration, not in `flight` or `vehicle`). Both
     // correct a field as M (m + COMPASS_OFS), M the symmetric matrix of COMPASS_DIA_* and
     // COMPASS_ODI_*. The ranges are calib::is_plausible's: a saved calibration stays valid.
+    {"COMPASS_DEC", Type::DeclRad, 0, 1, 0, AT(vehicle.compass_dec_rad), -3.1416f, 3.1416f, 0.0f,
+     PARAM_DOC("Compass declination", "rad",
+               "The angle from true north to magnetic north, east positive, added to the heading the board "
+               "reports: `decl` sets the same in degrees. Kept as the float sent; the output lines show the "
+               "heading to a hundredth of a degree.")},
     {"COMPASS_OFS_#", Type::MagOfs, kLetterX, 3, 4, AT(cal.mag_offset_uT), -2000.0f, 2000.0f, 0.0f,
      PARAM_DOC("Compass offsets", "mGauss",
                "The hard iron along the board's x (forward), y (right) or z (down) axis, n X, Y or Z, as "
@@ -382,8 +383,6 @@ const Row kRows[] PARAM_TABLE = {
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
 
-constexpr float kRadPerCentideg = linalg::kPi / 18000.0f;
-
 // The row holding index, and the instance within it; false past the end. Only the counts
 // are read on the way and the one row copied: a walk copying every row (35 bytes from
 // flash each) took a PARAM_SET of a row near the table's end past its task's budget.
@@ -412,7 +411,7 @@ float read(const Settings& s, const Row& row, uint8_t instance) {
         case Type::UInt16: { uint16_t v; memcpy(&v, p, sizeof v); return (float)v; }
         case Type::UInt8: return (float)*p;
         case Type::Bit: return (float)((*p >> instance) & 1u);
-        case Type::DeclRad: { int16_t v; memcpy(&v, p, sizeof v); return (float)v * kRadPerCentideg; }
+        case Type::DeclRad: { float v; memcpy(&v, p, sizeof v); return v; }
         case Type::MagOfs: { float v; memcpy(&v, p, sizeof v); return compass_ofs_mgauss(v); }
     }
     return 0.0f;
@@ -430,14 +429,7 @@ void write(Settings& s, const Row& row, uint8_t instance, float value) {
         case Type::Bit:
             *p = whole != 0 ? (uint8_t)(*p | (1u << instance)) : (uint8_t)(*p & ~(1u << instance));
             break;
-        case Type::DeclRad: {
-            const float cd = value / kRadPerCentideg;
-            int16_t v = (int16_t)(cd >= 0.0f ? cd + 0.5f : cd - 0.5f);
-            if (v > settings::kDeclMaxCentideg) v = settings::kDeclMaxCentideg;
-            if (v < settings::kDeclMinCentideg) v = settings::kDeclMinCentideg;
-            memcpy(p, &v, sizeof v);
-            break;
-        }
+        case Type::DeclRad: settings::set_declination_rad(s, value); break;  // with the first record's copy
         case Type::MagOfs: {
             const float uT = value / -kMilliGaussPerMicroTesla;
             memcpy(p, &uT, sizeof uT);
@@ -575,10 +567,10 @@ namespace {
 uint8_t stored_bytes(Type t) {
     switch (t) {
         case Type::Float:
+        case Type::DeclRad:
         case Type::MagOfs: return 4;
         case Type::Int16:
-        case Type::UInt16:
-        case Type::DeclRad: return 2;
+        case Type::UInt16: return 2;
         default: return 1;
     }
 }
@@ -664,6 +656,13 @@ void decode_vehicle(const uint8_t* in, uint8_t len, Settings& s) {
         if (at + n <= len) memcpy(p, in + at, n);
         at = (uint16_t)(at + n);
     });
+}
+
+uint16_t vehicle_crc(const Settings& s, uint16_t crc) {
+    each_vehicle_value(s, [&](uint8_t* p, uint8_t n) {
+        for (uint8_t j = 0; j < n; ++j) crc = settings::crc16_update(crc, p[j]);
+    });
+    return crc;
 }
 
 uint16_t vehicle_bytes() {

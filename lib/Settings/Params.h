@@ -25,7 +25,7 @@ enum class Type : uint8_t {
     UInt16,   // uint16_t
     UInt8,    // uint8_t
     Bit,      // bit n of a uint8_t (n = the instance), 0 or 1
-    DeclRad,  // the declination: int16_t centi-degrees, shown in radians (ArduPilot's COMPASS_DEC)
+    DeclRad,  // the declination: a float in radians (ArduPilot's COMPASS_DEC), set with its hundredths (Settings.h)
     // The compass's hard-iron offset: a float in uT that calib::apply_mag subtracts from the
     // field, shown as ArduPilot's COMPASS_OFS_*, which AP_Compass adds to the field, in
     // milligauss: its negation times 10 (1 uT = 10 mGauss), rounded to 0.01 mGauss so that
@@ -77,13 +77,16 @@ void flight_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* 
 void decode_flight(const uint8_t* in, uint8_t n, settings::Settings& s);
 // What encode_flight writes (a test holds it to settings::kFlightBytes).
 uint16_t flight_bytes();
-// The second record's values (Settings::vehicle: the rows after COMPASS_DEC), in table
+// The second record's values (Settings::vehicle: the rows after GND_ABS_PRESS), in table
 // order as encode_flight's: vehicle_bytes() of them. A record with fewer (an older
 // firmware's) is this one's first part: decode_vehicle reads the values it holds whole
 // and leaves the others as they are (their defaults).
 void vehicle_part(const settings::Settings& s, uint8_t from, uint8_t n, uint8_t* out);
 void decode_vehicle(const uint8_t* in, uint8_t n, settings::Settings& s);
 uint16_t vehicle_bytes();
+// crc brought on (settings::crc16_update) over the vehicle_bytes() bytes vehicle_part gives,
+// in one walk of the table (vehicle_part walks it once a part).
+uint16_t vehicle_crc(const settings::Settings& s, uint16_t crc);
 // Every parameter within its range and the end points in order (settings::is_valid).
 bool all_valid(const settings::Settings& s);
 

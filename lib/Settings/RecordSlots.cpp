@@ -7,6 +7,14 @@ namespace slots {
 
 static_assert(kSlots == 2, "plan() writes the slot it does not load");
 static_assert(slot_address(1) >= slot_address(0) + kMaxSlotSize, "slots of any length apart");
+static_assert(record2::kSlotSpace <= kMaxSlotSize, "load reads the second record into the first's buffer");
+// The second record's slots in the gaps: after the legacy record (at most 256 bytes), before
+// slot 0; after slot 0, before slot 1.
+static_assert(record2::slot_address(0) >= kLegacyAddress + 256u &&
+                  record2::slot_address(0) + record2::kSlotSpace <= slot_address(0) &&
+                  record2::slot_address(1) >= slot_address(0) + kMaxSlotSize &&
+                  record2::slot_address(1) + record2::kSlotSpace <= slot_address(1),
+              "the second record's slots overlap no first record of any length");
 
 SlotInfo inspect(const uint8_t* b) {
     SlotInfo info;
@@ -53,6 +61,7 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     out.newest_cut = p.newest_cut;
     out.write = p.write;
     out.next_sequence = p.next_sequence;
+    out.vehicle = record2::Result::NotRead;
     // This firmware's record, or version 3's or 4's (Settings.h: they load, the newer rows at defaults).
     if (p.load >= 0 && info[(uint8_t)p.load].record_length != settings::kRecordSize &&
         info[(uint8_t)p.load].record_length != settings::kV3RecordSize &&
@@ -66,6 +75,10 @@ Loaded load(ReadBlock read, settings::Settings& s) {
     out.result = settings::decode(bytes, s);
     if (out.from_legacy && out.result == settings::LoadResult::Blank && p.newest_cut)
         out.result = settings::LoadResult::BadCrc;
+    if (!out.from_legacy && out.result == settings::LoadResult::Ok) {
+        read(record2::slot_address((uint8_t)p.load), bytes, record2::kSlotSpace);
+        out.vehicle = record2::load(bytes, info[(uint8_t)p.load].sequence, s);
+    }
     return out;
 }
 

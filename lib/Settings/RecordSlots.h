@@ -20,6 +20,7 @@
 #include <stdint.h>
 
 #include "Settings.h"
+#include "VehicleRecord.h"
 
 namespace slots {
 
@@ -67,13 +68,15 @@ struct Loaded {
     settings::LoadResult result;
     bool from_legacy;  // the record at address 0 of a firmware before the slots
     bool newest_cut;   // Plan::newest_cut: the last save was cut short
-    uint8_t write;     // Plan::write and next_sequence: where the next save goes
-    uint16_t next_sequence;
+    uint8_t write;     // Plan::write and next_sequence: where the next save goes (both records'
+    uint16_t next_sequence;  // slot `write`: VehicleRecord.h)
+    record2::Result vehicle;  // the second record, when the first loaded Ok from a slot
 };
 // The settings at start: the newer valid slot's record or, with no valid slot, the
 // legacy record; `s` is defaults() unless the result is Ok. A slot of another record
-// length is OldVersion. Nothing valid but a slot cut short is BadCrc, not Blank.
-// Uses ~kMaxSlotSize bytes of stack.
+// length is OldVersion. Nothing valid but a slot cut short is BadCrc, not Blank. With
+// the first record Ok from slot i, the second record's slot i when it pairs with it
+// (record2::load). Uses ~kMaxSlotSize bytes of stack.
 Loaded load(ReadBlock read, settings::Settings& s);
 
 // Header byte i (< kHeaderSize) of a slot of this firmware with `sequence`.

@@ -8,10 +8,29 @@
 
 namespace settings {
 
+constexpr float kRadPerCentideg = linalg::kPi / 18000.0f;
+
+int16_t centideg_of_rad(float rad) {
+    const float cd = rad * (18000.0f / linalg::kPi);
+    if (!(cd > (float)kDeclMinCentideg)) return kDeclMinCentideg;  // NaN too: never reached (params' range)
+    if (cd >= (float)kDeclMaxCentideg) return kDeclMaxCentideg;
+    return (int16_t)(cd >= 0.0f ? cd + 0.5f : cd - 0.5f);
+}
+
+void set_declination_rad(Settings& s, float rad) {
+    s.vehicle.compass_dec_rad = rad;
+    s.declination_centideg = centideg_of_rad(rad);
+}
+
+void set_declination_centideg(Settings& s, int16_t centideg) {
+    s.vehicle.compass_dec_rad = (float)centideg * kRadPerCentideg;
+    s.declination_centideg = centideg;
+}
+
 Settings defaults() {
     Settings s;
     s.rate_hz = kRateDefaultHz;
-    s.declination_centideg = 0;
+    set_declination_centideg(s, 0);
     s.mode = fmt::OutputMode::Plot;
     s.flags = 0;
     s.cal = calib::default_calibration();
@@ -74,6 +93,7 @@ void encode(const Settings& s, uint8_t out[kRecordSize]) {
 bool is_valid(const Settings& s) {
     return s.rate_hz >= kRateMinHz && s.rate_hz <= kRateMaxHz &&
            s.declination_centideg >= kDeclMinCentideg && s.declination_centideg <= kDeclMaxCentideg &&
+           s.declination_centideg == centideg_of_rad(s.vehicle.compass_dec_rad) &&
            (uint8_t)s.mode <= (uint8_t)fmt::kLastOutputMode && (s.flags & ~0x07u) == 0u &&
            calib::is_plausible(s.cal) && params::all_valid(s);
 }
@@ -98,7 +118,8 @@ FIXED_COLD LoadResult decode(const uint8_t in[kRecordSize], Settings& out) {
     // Into `out` itself (a copy would be a Settings more of stack), defaults again when
     // a value is out of range.
     out.rate_hz = in[4];
-    out.declination_centideg = (int16_t)(uint16_t)(in[5] | (uint16_t)((uint16_t)in[6] << 8));
+    // The declination's float from the hundredths: the second record, when it pairs, has it as sent.
+    set_declination_centideg(out, (int16_t)(uint16_t)(in[5] | (uint16_t)((uint16_t)in[6] << 8)));
     out.mode = (fmt::OutputMode)in[7];
     out.flags = in[8];
     memcpy(&out.cal, in + 9, sizeof out.cal);

@@ -6,15 +6,17 @@
 //          2  version           kSettingsVersion; any other value: defaults
 //          3  payload length    kPayloadLength
 //          4  payload           little-endian fields, floats as IEEE-754 bytes:
-//             4  rate, 5 decl (int16), 7 mode, 8 flags, 9 calibration (15 floats)
+//             4  rate, 5 decl (int16: COMPASS_DEC's hundredths of a degree), 7 mode, 8 flags,
+//             9  calibration (15 floats)
 //             69 the flight settings (version 3 on): params::encode_flight, the parameter
 //                table's rows in order (a Bit row's eight bits one byte), kFlightBytes
 //          4+len  CRC-16/CCITT-FALSE of bytes 0 .. 3+len, little-endian
 //
 // encode/decode are explicit byte by byte, so the layout is the same on the AVR and
 // the host (no struct padding or endianness in the record). GND_ABS_PRESS is measured at
-// each start and lives before `flight`: not in the record. No EEPROM access here:
-// the firmware copies kRecordSize bytes to and from EEPROM.
+// each start and lives before `flight`: not in the record. `vehicle` is the second
+// record's (VehicleRecord.h). No EEPROM access here: the firmware copies kRecordSize bytes
+// to and from EEPROM.
 //
 // A version 2 record (a 65-byte payload, no flight settings) still loads: its rate,
 // declination, mode and calibration are kept, the flight settings are the defaults and
@@ -26,6 +28,7 @@
 
 #include <stdint.h>
 
+#include "Constants.h"
 #include "SensorCalibration.h"
 #include "FlightSettings.h"
 #include "OutputMode.h"
@@ -66,7 +69,7 @@ enum Flags : uint8_t {
 
 struct Settings {
     uint8_t rate_hz;               // output lines per second, 1..100
-    int16_t declination_centideg;  // magnetic declination, east positive, hundredths of a degree
+    int16_t declination_centideg;  // COMPASS_DEC rounded to hundredths of a degree (set_declination_*)
     fmt::OutputMode mode;
     uint8_t flags;                 // Flags
     calib::Calibration cal;
@@ -74,8 +77,18 @@ struct Settings {
     flight::FlightSettings flight;  // Params.h has their names, ranges and defaults
     VehicleSettings vehicle;        // the second record's (VehicleSettings.h)
 
-    float declination_deg() const { return (float)declination_centideg * 0.01f; }
+    float declination_rad() const { return vehicle.compass_dec_rad; }
+    float declination_deg() const { return vehicle.compass_dec_rad * linalg::kDegPerRad; }
 };
+
+// The declination (COMPASS_DEC) is the float a ground station sent, vehicle.compass_dec_rad
+// (the second record); declination_centideg is it rounded to hundredths of a degree: the
+// first record's copy (what a firmware before the second record reads) and the integer
+// heading's (the output lines print hundredths). Both are set together, here only.
+// East positive; the hundredths clamped to -18000..18000.
+int16_t centideg_of_rad(float rad);
+void set_declination_rad(Settings& s, float rad);
+void set_declination_centideg(Settings& s, int16_t centideg);  // `decl`; the first record alone
 
 Settings defaults();
 

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The settings added after the first record's version 5: the vehicle's arming, board
 // orientation and level, the accelerometer's and compass's calibration as parameters,
-// the battery monitor, the telemetry rates. They are the parameter table's rows that
-// live here (Params.cpp, after COMPASS_DEC), in table order, and go in the second EEPROM
-// record (params::encode_vehicle): the first record is full (251 of its 255 bytes).
+// the battery monitor, the telemetry rates, and COMPASS_DEC as sent. They are the parameter
+// table's rows that live here (Params.cpp, after GND_ABS_PRESS), in table order, and go in
+// the second EEPROM record (params::vehicle_part, VehicleRecord.h: at most 244 bytes, a
+// unit test holds them to it): the first record is full (251 of its 255 bytes).
 //
 // Each feature keeps its fields under its own heading, ArduPilot's names beside them;
 // units in the names. Defaults are in the parameter table only.
@@ -28,6 +29,7 @@ struct VehicleSettings {
 
     // Compass (AP_Compass). Its calibration's rows (COMPASS_OFS_*, _DIA_*, _ODI_*) point into
     // Settings::cal: saved with it in the first record.
+    float compass_dec_rad;      // COMPASS_DEC: declination, east positive, as sent (record 1 keeps it rounded)
     uint8_t compass_use;        // COMPASS_USE: 1 the heading from the compass, 0 the gyro's (or the GPS course)
     uint8_t compass_learn;      // COMPASS_LEARN: 1 the hard iron learned in motion (OffsetLearner), 0 not
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "Params.h"
 #include "Pipeline.h"
 #include "PipelineText.h"
 #include "pipeline_test_support.h"
@@ -61,8 +62,16 @@ TEST(Pipeline, StartsAfterOneStillSecondLevelAndNorth) {
     EXPECT_NEAR(a.pitch_deg, 0.0f, 0.1f);
     EXPECT_TRUE(a.heading_deg < 0.5f || a.heading_deg > 359.5f) << a.heading_deg;
     EXPECT_NE(log.find("# gyro bias: "), std::string::npos) << log;
-    p.settings().declination_centideg = 250;
+    settings::set_declination_centideg(p.settings(), 250);
     EXPECT_NEAR(p.angles().heading_deg, 2.5f, 0.5f);
+    // COMPASS_DEC as a ground station sends it: the heading moves by the float, not by its
+    // hundredths of a degree (11.46).
+    const float before_deg = p.angles().heading_deg - 2.5f;
+    ASSERT_TRUE(params::set(p.settings(), (uint16_t)params::find("COMPASS_DEC"), 0.2f));
+    EXPECT_NEAR(p.angles().heading_deg - before_deg, 11.459156f, 2e-4f);
+    // The lines' integer heading adds the hundredths.
+    EXPECT_EQ(p.angles_centideg().heading_centideg,
+              (1146 + dcm::angles_centideg(p.estimator().euler_now_q24(), 0).heading_centideg) % 36000);
 }
 
 TEST(Pipeline, RolledAndPitchedBoardFromGravity) {

@@ -96,7 +96,7 @@ TEST(PipelineGps, TooFewSatellitesA2dFixOrAhrsGpsUse0DoNot) {
 // leave 2 m/s^2 sin(20 deg) = 0.68 m/s^2 across the path: 4 deg of tilt.
 TEST(PipelineGps, TheVelocityIsTurnedByTheDeclination) {
     GpsRun r;
-    r.p.settings().declination_centideg = 2000;
+    settings::set_declination_centideg(r.p.settings(), 2000);
     r.bearing_deg = 60.0f;
     r.go(25.0f);
     EXPECT_TRUE(r.p.estimator().gps_aiding());
@@ -108,7 +108,7 @@ TEST(PipelineGps, TheVelocityIsTurnedByTheDeclination) {
 TEST(PipelineGps, WithoutACompassTheCourseIsTheHeading) {
     GpsRun r;
     r.field = false;
-    r.p.settings().declination_centideg = 500;
+    settings::set_declination_centideg(r.p.settings(), 500);
     r.bearing_deg = 120.0f;
     r.p.set_mag_present(false);
     r.go(10.0f);

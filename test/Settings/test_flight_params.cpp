@@ -57,8 +57,13 @@ TEST(FlightParams, SetChecksRangeWholenessAndEndPointOrder) {
     EXPECT_EQ(s.flight.rc_reversed, 0x10);
     const uint16_t dec = (uint16_t)params::find("COMPASS_DEC");
     EXPECT_TRUE(params::set(s, dec, 0.1f));
-    EXPECT_EQ(s.declination_centideg, 573);  // 0.1 rad = 5.73 deg
-    EXPECT_NEAR(params::get(s, dec), 0.1f, 1e-4f);
+    EXPECT_EQ(s.declination_centideg, 573);  // 0.1 rad = 5.73 deg: the first record's copy
+    EXPECT_EQ(params::get(s, dec), 0.1f);    // kept as sent (a ground station compares it)
+    EXPECT_EQ(s.declination_rad(), 0.1f);    // and in force as sent
+    EXPECT_TRUE(params::set(s, dec, 0.2f));
+    EXPECT_EQ(params::get(s, dec), 0.2f);
+    EXPECT_EQ(s.declination_centideg, 1146);  // 11.459 deg
+    EXPECT_TRUE(settings::is_valid(s));
 }
 
 TEST(FlightParams, RecordVersion5RoundTripsAndVersion2StillLoads) {
@@ -82,7 +87,7 @@ TEST(FlightParams, RecordVersion5RoundTripsAndVersion2StillLoads) {
     std::memset(v2, 0xFF, sizeof v2);
     settings::Settings old = settings::defaults();
     old.rate_hz = 25;
-    old.declination_centideg = -345;
+    settings::set_declination_centideg(old, -345);
     old.mode = fmt::OutputMode::Csv;
     old.flags = settings::kFlagMagCalibrated;
     old.cal.mag_offset_uT = linalg::Vector3f(8.0f, -5.0f, 3.0f);

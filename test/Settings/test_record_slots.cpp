@@ -30,7 +30,7 @@ std::vector<uint8_t> record_of(const Settings& s) {
 Settings numbered(uint8_t n) {
     Settings s = settings::defaults();
     s.rate_hz = (uint8_t)(10 + n);
-    s.declination_centideg = (int16_t)(-1000 + 137 * n);
+    settings::set_declination_centideg(s, (int16_t)(-1000 + 137 * n));
     s.mode = n % 2 ? fmt::OutputMode::Csv : fmt::OutputMode::Plot;
     s.flags = settings::kFlagMagCalibrated;
     s.cal.mag_offset_uT = linalg::Vector3f(1.5f * n, -2.0f * n, 0.25f * n);
@@ -216,6 +216,7 @@ TEST(RecordSlots, SlotOfAnotherRecordLengthIsRefused) {
     EXPECT_TRUE(same(s, settings::defaults()));
     EXPECT_EQ(l.write, 1);  // that slot is kept for a downgrade; the next save goes to the other
     EXPECT_EQ(l.next_sequence, 10);
+    EXPECT_EQ(l.vehicle, record2::Result::NotRead);  // the second record only beside a first one loaded
 }
 
 }  // namespace

@@ -14,7 +14,7 @@ namespace {
 Settings sample() {
     Settings s = settings::defaults();
     s.rate_hz = 25;
-    s.declination_centideg = -1234;
+    settings::set_declination_centideg(s, -1234);
     s.mode = fmt::OutputMode::Csv;
     s.flags = settings::kFlagGyroCalibrated | settings::kFlagMagCalibrated;
     s.cal.gyro_bias_rad_s = linalg::Vector3f(0.01f, -0.02f, 0.03f);

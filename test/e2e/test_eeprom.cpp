@@ -4,13 +4,18 @@
 // half-written slot, a record of another version or a first save cut short by power loss
 // give the defaults and a message, never garbage; a slot cut short beside a whole one
 // gives the whole one's settings. A board upgraded from the firmware before the slots
-// (one record at address 0) keeps its settings. The chips are built on the host with the
-// firmware's own settings::encode and slots::encode (lib/Console), not from fixed offsets.
+// (one record at address 0) keeps its settings. The second record (the vehicle settings,
+// lib/Settings/VehicleRecord.h) pairs with the first: a power cut at any instant of a save
+// leaves both of the save before or both new ones; a board saved by a firmware without it
+// keeps the first and says so. The chips are built on the host with the firmware's own
+// settings::encode, slots::encode and record2::encode (lib/Settings), not from fixed offsets.
 #include <cstring>
 #include <map>
 
+#include "Params.h"
 #include "RecordSlots.h"
 #include "Settings.h"
+#include "VehicleRecord.h"
 #include "e2e_support.h"
 
 namespace {
@@ -64,6 +69,23 @@ std::vector<uint8_t> slot_of(const std::vector<uint8_t>& record, uint16_t sequen
     return slot;
 }
 
+// The second record's slot of `s` paired with the first record's slot of `sequence`.
+std::vector<uint8_t> slot2_of(const settings::Settings& s, uint16_t sequence) {
+    std::vector<uint8_t> slot(record2::slot_size((uint8_t)params::vehicle_bytes()));
+    record2::encode(s, sequence, slot.data());
+    return slot;
+}
+
+// Both records' bytes, the first's and the vehicle settings': what a start must give
+// wholly from one save.
+std::vector<uint8_t> pair_of(const settings::Settings& s) {
+    std::vector<uint8_t> bytes = encoded(s);
+    const uint8_t n = (uint8_t)params::vehicle_bytes();
+    bytes.resize(kRecordSize + n);
+    params::vehicle_part(s, 0, n, bytes.data() + kRecordSize);
+    return bytes;
+}
+
 // A slot's bytes padded to kMaxSlotSize for slots::inspect.
 std::vector<uint8_t> slot_bytes(std::vector<uint8_t> slot) {
     slot.resize(slots::kMaxSlotSize, 0xFF);
@@ -73,7 +95,7 @@ std::vector<uint8_t> slot_bytes(std::vector<uint8_t> slot) {
 settings::Settings stored_sample() {
     settings::Settings s = settings::defaults();
     s.rate_hz = 25;
-    s.declination_centideg = 850;
+    settings::set_declination_centideg(s, 850);
     s.mode = fmt::OutputMode::Csv;
     return s;
 }
@@ -101,7 +123,8 @@ void expect_defaults_and_message(const e2e::SimRun& run, const std::string& why)
 TEST(Eeprom, SavedSettingsSurviveAPowerCycle) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     const std::string chip = eeprom_path("save");
-    const std::string input = e2e::input_file("eeprom_save", "rate 25\r\ndecl 8.5\r\nmode csv\r\nsave\r\n");
+    const std::string input = e2e::input_file(
+        "eeprom_save", "rate 25\r\ndecl 8.5\r\nmode csv\r\nset ARMING_REQUIRE 0\r\nset COMPASS_DEC 0.2\r\nsave\r\n");
     const e2e::SimRun first = e2e::run_sim(e2e::firmware_elf(), "rest", 3.0, "--eeprom " + chip + " --input " + input);
     unlink(input.c_str());
     ASSERT_EQ(first.result.exit_code, 0) << e2e::dump(first);
@@ -119,14 +142,25 @@ TEST(Eeprom, SavedSettingsSurviveAPowerCycle) {
     ASSERT_EQ(loaded.result, settings::LoadResult::Ok);
     EXPECT_FALSE(loaded.from_legacy);
     EXPECT_EQ(on_chip.rate_hz, 25);
-    EXPECT_EQ(on_chip.declination_centideg, 850);
     EXPECT_EQ(on_chip.mode, fmt::OutputMode::Csv);
+    // The second record beside it, of the same save: ARMING_REQUIRE and COMPASS_DEC as set
+    // (the float sent; the first record keeps its hundredths).
+    EXPECT_EQ(loaded.vehicle, record2::Result::Paired);
+    EXPECT_EQ(on_chip.vehicle.arming_require, 0);
+    EXPECT_EQ(on_chip.declination_rad(), 0.2f);
+    EXPECT_EQ(on_chip.declination_centideg, 1146);
 
     // Power cycle: the next run starts from the same chip.
-    const e2e::SimRun second = e2e::run_sim(e2e::firmware_elf(), "rest", 2.5, "--eeprom " + chip);
+    const std::string gets = e2e::input_file("eeprom_get", "get ARMING_REQUIRE\r\nget COMPASS_DEC\r\n");
+    const e2e::SimRun second =
+        e2e::run_sim(e2e::firmware_elf(), "rest", 2.5, "--eeprom " + chip + " --input " + gets + " --input-at 2.0");
+    unlink(gets.c_str());
     ASSERT_EQ(second.result.exit_code, 0) << e2e::dump(second);
     EXPECT_TRUE(find_line(second.lines, "# settings loaded from EEPROM")) << e2e::dump(second);
-    EXPECT_TRUE(find_line(second.lines, "# settings: rate 25 Hz, decl 8.50 deg, mode csv")) << e2e::dump(second);
+    EXPECT_FALSE(find_line(second.lines, "earlier firmware")) << e2e::dump(second);
+    EXPECT_TRUE(find_line(second.lines, "# settings: rate 25 Hz, decl 11.46 deg, mode csv")) << e2e::dump(second);
+    EXPECT_TRUE(find_line(second.lines, "# ARMING_REQUIRE 0")) << e2e::dump(second, 200);
+    EXPECT_TRUE(find_line(second.lines, "# COMPASS_DEC 0.2000")) << e2e::dump(second, 200);
     // In force: csv rows at 25 Hz after the header.
     EXPECT_TRUE(find_line(second.lines, "t_ms,roll,pitch,yaw")) << e2e::dump(second);
     int rows = 0;
@@ -160,7 +194,7 @@ TEST(Eeprom, HalfWrittenSlotGivesThePreviousSettingsOrDefaults) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     settings::Settings old_settings = settings::defaults();
     old_settings.rate_hz = 10;
-    old_settings.declination_centideg = -4500;
+    settings::set_declination_centideg(old_settings, -4500);
     const std::vector<uint8_t> old_slot = slot_of(encoded(old_settings), 4);
     const std::vector<uint8_t> new_slot = slot_of(encoded(stored_sample()), 5);
     std::vector<uint8_t> half(new_slot.begin(), new_slot.begin() + (long)(slots::kSlotSize / 2));
@@ -207,6 +241,57 @@ TEST(Eeprom, RecordOfAnotherVersionGivesDefaultsAndAMessage) {
     expect_defaults_and_message(run, "older version");
     EXPECT_TRUE(find_line(run.lines, "another version")) << e2e::dump(run);
     unlink(chip.c_str());
+}
+
+// A board saved by a firmware before the second record: its first record loads, the
+// vehicle settings take their defaults and the start says so once; COMPASS_DEC is the
+// first record's hundredths. A second record of another version: the same, with a warning.
+TEST(Eeprom, FirstRecordWithoutItsSecondLoadsAndSaysSo) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    settings::Settings saved = stored_sample();  // rate 25, decl 8.50, mode csv
+    saved.vehicle.arming_require = 0;
+    std::vector<uint8_t> other_version = slot2_of(saved, 1);
+    other_version[2] = (uint8_t)(record2::kVersion + 1u);  // VehicleRecord.h: magic, magic, version
+    const uint16_t crc = settings::crc16(other_version.data(), (uint16_t)(other_version.size() - 2u));
+    other_version[other_version.size() - 2] = (uint8_t)(crc & 0xFFu);
+    other_version[other_version.size() - 1] = (uint8_t)(crc >> 8);
+    struct Case {
+        const char* what;
+        std::vector<uint8_t> second;  // at the second record's slot 0 (empty: none)
+        record2::Result result;
+        const char* said;
+    };
+    const Case cases[] = {
+        {"no second record", {}, record2::Result::Missing,
+         "# settings: saved by an earlier firmware: the newer parameters at their defaults (save to keep)"},
+        {"second record of another version", other_version, record2::Result::OldVersion,
+         "# warn: EEPROM second record from another version: its parameters at their defaults"},
+        {"second record of another save", slot2_of(saved, 2), record2::Result::Missing,
+         "# settings: saved by an earlier firmware"},
+    };
+    for (const Case& c : cases) {
+        const std::string chip = eeprom_path("first_only");
+        std::vector<std::pair<uint16_t, std::vector<uint8_t>>> parts = {{slots::slot_address(0), slot_of(encoded(saved), 1)}};
+        if (!c.second.empty()) parts.push_back({record2::slot_address(0), c.second});
+        write_chip(chip, parts);
+        settings::Settings s;
+        const slots::Loaded l = load_chip(chip, s);
+        ASSERT_EQ(l.result, settings::LoadResult::Ok) << c.what;
+        EXPECT_EQ(l.vehicle, c.result) << c.what;
+        const std::string gets = e2e::input_file("first_only", "get ARMING_REQUIRE\r\nget COMPASS_DEC\r\n");
+        const e2e::SimRun run =
+            e2e::run_sim(e2e::firmware_elf(), "rest", 2.2, "--eeprom " + chip + " --input " + gets + " --input-at 2.0");
+        unlink(gets.c_str());
+        ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+        EXPECT_TRUE(find_line(run.lines, "# settings loaded from EEPROM")) << c.what << "\n" << e2e::dump(run);
+        EXPECT_TRUE(find_line(run.lines, "# settings: rate 25 Hz, decl 8.50 deg, mode csv")) << c.what;
+        int said = 0;
+        for (const e2e::Line& line : run.lines) said += line.text.find(c.said) == 0 ? 1 : 0;
+        EXPECT_EQ(said, 1) << c.what << "\n" << e2e::dump(run);
+        EXPECT_TRUE(find_line(run.lines, "# ARMING_REQUIRE 1")) << c.what << "\n" << e2e::dump(run, 200);
+        EXPECT_TRUE(find_line(run.lines, "# COMPASS_DEC 0.1484")) << c.what << "\n" << e2e::dump(run, 200);  // 8.5 deg
+        unlink(chip.c_str());
+    }
 }
 
 // A board upgraded from the firmware before the slots: its one record at address 0, of
@@ -270,11 +355,13 @@ struct Boot {
     bool loaded = false;
 };
 Boot boot_line(const std::string& chip) {
-    const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "rest", 0.05, "--eeprom " + chip);
+    // 0.07 s: past the settings line after a warning (the start reads both records first).
+    const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "rest", 0.07, "--eeprom " + chip);
     Boot b;
     EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
-    const e2e::Line* line = find_line(run.lines, "# settings: ");
+    const e2e::Line* line = find_line(run.lines, "# settings: rate");
     if (line) b.settings_line = line->text;
+    EXPECT_TRUE(line) << chip << "\n" << e2e::dump(run);
     b.loaded = find_line(run.lines, "# settings loaded from EEPROM") != nullptr;
     return b;
 }
@@ -289,9 +376,9 @@ struct SweepResult {
 // One simavr run from the chip `start` that types `input` (at input_at_s) ending with a
 // save; apm25sim --eeprom-cuts writes the chip as a power cut at every 1 ms from from_s
 // to to_s leaves it. Every cut must start with the settings before the save or those
-// after it, whole: the firmware's own load, run on the host, gives one of the two
-// records byte for byte, and a start in simavr prints that one's settings line and
-// "settings loaded". Chips alike give the same start (simavr is deterministic): each
+// after it, whole: the firmware's own load, run on the host, gives both records of one
+// of the two saves byte for byte (never the first record of one and the second of the
+// other), and a start in simavr prints that one's settings line and "settings loaded". Chips alike give the same start (simavr is deterministic): each
 // distinct one is started once.
 SweepResult sweep(const std::string& name, const std::string& csv, double seconds, const std::string& input_text,
                   double input_at_s, const std::vector<std::pair<uint16_t, std::vector<uint8_t>>>& start, double from_s,
@@ -300,7 +387,9 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
     const std::string chip = eeprom_path(name);
     write_chip(chip, start);
     settings::Settings old_settings, new_settings;
-    EXPECT_EQ(load_chip(chip, old_settings).result, settings::LoadResult::Ok);
+    slots::Loaded l = load_chip(chip, old_settings);
+    EXPECT_EQ(l.result, settings::LoadResult::Ok);
+    EXPECT_EQ(l.vehicle, record2::Result::Paired);
     const Boot old_boot = boot_line(chip);
     EXPECT_TRUE(old_boot.loaded);
 
@@ -319,9 +408,14 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
     r.saving_s = saving->t_s;
     EXPECT_GT(saving->t_s, from_s + 0.01) << "the cuts begin before the save";
     EXPECT_LT(saved->t_s, to_s - 0.01) << "the cuts end before the save has ended";
-    EXPECT_EQ(load_chip(chip, new_settings).result, settings::LoadResult::Ok);
-    const std::vector<uint8_t> old_record = encoded(old_settings), new_record = encoded(new_settings);
-    EXPECT_NE(old_record, new_record);
+    l = load_chip(chip, new_settings);
+    EXPECT_EQ(l.result, settings::LoadResult::Ok);
+    EXPECT_EQ(l.vehicle, record2::Result::Paired);
+    const std::vector<uint8_t> old_record = pair_of(old_settings), new_record = pair_of(new_settings);
+    // The save changes both records.
+    EXPECT_NE(encoded(old_settings), encoded(new_settings));
+    EXPECT_NE(std::vector<uint8_t>(old_record.begin() + kRecordSize, old_record.end()),
+              std::vector<uint8_t>(new_record.begin() + kRecordSize, new_record.end()));
     const Boot new_boot = boot_line(chip);
     EXPECT_TRUE(new_boot.loaded);
     EXPECT_NE(old_boot.settings_line, new_boot.settings_line) << "the starts must tell the two apart";
@@ -339,10 +433,12 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
         auto known = is_new_of_chip.find(bytes);
         if (known == is_new_of_chip.end()) {
             settings::Settings s;
-            EXPECT_EQ(load_chip(cut_path, s).result, settings::LoadResult::Ok) << "cut at " << t_s;
-            const std::vector<uint8_t> rec = encoded(s);
+            const slots::Loaded cut_load = load_chip(cut_path, s);
+            EXPECT_EQ(cut_load.result, settings::LoadResult::Ok) << "cut at " << t_s;
+            EXPECT_EQ(cut_load.vehicle, record2::Result::Paired) << "cut at " << t_s;
+            const std::vector<uint8_t> rec = pair_of(s);
             const bool is_new = rec == new_record;
-            EXPECT_TRUE(is_new || rec == old_record) << "cut at " << t_s << ": neither record";
+            EXPECT_TRUE(is_new || rec == old_record) << "cut at " << t_s << ": neither pair";
             const Boot b = boot_line(cut_path);
             EXPECT_TRUE(b.loaded) << "cut at " << t_s;
             EXPECT_EQ(b.settings_line, is_new ? new_boot.settings_line : old_boot.settings_line) << "cut at " << t_s;
@@ -367,7 +463,8 @@ SweepResult sweep(const std::string& name, const std::string& csv, double second
 settings::Settings numbered_settings(uint8_t n, bool mag_cal) {
     settings::Settings s = settings::defaults();
     s.rate_hz = (uint8_t)(10 + n);
-    s.declination_centideg = (int16_t)(-2000 + 333 * n);
+    settings::set_declination_centideg(s, (int16_t)(-2000 + 333 * n));
+    s.vehicle.arming_require = (uint8_t)(n % 2);
     if (mag_cal) {
         s.flags = settings::kFlagMagCalibrated;
         s.cal.mag_offset_uT = linalg::Vector3f(2.5f * n, -1.25f * n, 4.0f);
@@ -377,14 +474,21 @@ settings::Settings numbered_settings(uint8_t n, bool mag_cal) {
     return s;
 }
 
-// `save` of three changed settings, with both slots whole (the older one is written over).
+// `save` of settings changed in both records (the rate and mode in the first,
+// ARMING_REQUIRE in the second, the declination in both), with both pairs whole (the
+// older one is written over).
 TEST(Eeprom, PowerCutAtEveryMillisecondOfASettingsSave) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
-    const SweepResult r =
-        sweep("sweep_settings", e2e::scenario_csv("rest", 2.0), 2.0, "rate 40\r\ndecl -3\r\nmode csv\r\nsave\r\n", 1.4,
-              {{slots::slot_address(0), slot_of(encoded(numbered_settings(1, false)), 7)},
-               {slots::slot_address(1), slot_of(encoded(numbered_settings(2, true)), 8)}},
-              1.35, 1.85);
+    const SweepResult r = sweep(
+        "sweep_settings", e2e::scenario_csv("rest", 2.1), 2.1,
+        "rate 40\r\ndecl -3\r\nmode csv\r\nset ARMING_REQUIRE 1\r\nsave\r\n", 1.4,
+        {{slots::slot_address(0), slot_of(encoded(numbered_settings(1, false)), 7)},
+         {record2::slot_address(0), slot2_of(numbered_settings(1, false), 7)},
+         {slots::slot_address(1), slot_of(encoded(numbered_settings(2, true)), 8)},
+         {record2::slot_address(1), slot2_of(numbered_settings(2, true), 8)}},
+        1.35, 2.05);
+    EXPECT_EQ(r.before.vehicle.arming_require, 0);
+    EXPECT_EQ(r.after.vehicle.arming_require, 1);
     // The slot's changed bytes at 3.4 ms each.
     EXPECT_GE(r.cuts_during_save, 100);
     EXPECT_GT(r.old_boots, 0);
@@ -394,7 +498,7 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfASettingsSave) {
 // `cal mag` on a tumble, then `save`: the calibration's floats all change. The console
 // waits through the 30 s of turning on empty lines (ignored) before the declination and
 // the save (the characters come a little slower than the baud rate: the save starts near
-// 36.1 s and ends near 36.3 s).
+// 36.15 s and ends near 36.6 s).
 TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     const double input_at_s = 5.5, char_s = 10.0 / 115200.0;
@@ -403,7 +507,9 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
     text += "decl 12.5\r\nsave\r\n";
     const SweepResult r = sweep("sweep_cal_mag", e2e::scenario_csv("tumble", 37.0), 36.8, text, input_at_s,
                                 {{slots::slot_address(1), slot_of(encoded(numbered_settings(3, true)), 3)},
-                                 {slots::slot_address(0), slot_of(encoded(numbered_settings(4, false)), 2)}},
+                                 {record2::slot_address(1), slot2_of(numbered_settings(3, true), 3)},
+                                 {slots::slot_address(0), slot_of(encoded(numbered_settings(4, false)), 2)},
+                                 {record2::slot_address(0), slot2_of(numbered_settings(4, false), 2)}},
                                 35.8, 36.7);
     // The save is the new calibration's: the fit's verdict came before it.
     const e2e::Line* fit = find_line(r.lines, "# cal mag: offset");

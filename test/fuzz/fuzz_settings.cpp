@@ -67,8 +67,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Bytes in{data, size};
     settings::Settings v = settings::defaults();
     v.rate_hz = (uint8_t)(settings::kRateMinHz + in.u8() % (settings::kRateMaxHz - settings::kRateMinHz + 1));
-    v.declination_centideg = (int16_t)(settings::kDeclMinCentideg +
-                                       (int32_t)(in.u16() % (settings::kDeclMaxCentideg - settings::kDeclMinCentideg + 1)));
+    settings::set_declination_centideg(
+        v, (int16_t)(settings::kDeclMinCentideg +
+                     (int32_t)(in.u16() % (settings::kDeclMaxCentideg - settings::kDeclMinCentideg + 1))));
     v.mode = (fmt::OutputMode)(in.u8() % 3u);
     v.flags = (uint8_t)(in.u8() & 0x03u);
     const float bias = calib::kGyroBiasMax_rad_s;

@@ -24,14 +24,16 @@ and must switch to MAVLink by itself). Checks:
   - RC_CHANNELS equal to the --rc script (within 1 us), no channels while it is dead;
   - SERVO_OUTPUT_RAW equal to a pulse measured on the pin around it (within 1.5 us);
   - no sample missed meanwhile (no "loop overrun" STATUSTEXT).
-Then a second run on the same EEPROM file (a power cycle): the two parameters set come back
-as set; PREFLIGHT_STORAGE defaults brings the defaults, read is UNSUPPORTED; no sample missed.
+Then a second run on the same EEPROM file (a power cycle): the parameters set come back
+as set (RLL2SRV_P and SERVO1_TRIM in the first EEPROM record, ARMING_REQUIRE and COMPASS_DEC,
+the float sent, in the second); PREFLIGHT_STORAGE defaults brings the defaults, read is UNSUPPORTED; no sample missed.
 Exit 1 with every failure listed. Timing assertions are on simulated time only.
 """
 import bisect
 import csv
 import os
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -59,6 +61,11 @@ RC = [
 # to a second old).
 MODES = [(0.5, 0), (4.0, 2), (8.5, 5), (11.0, 2), (14.0, 0)]
 SETTLE_S = 1.2
+# The second record's parameters set with the first's, and what they read back: COMPASS_DEC
+# exactly the float sent (PARAM_VALUE carries a float32).
+F32_0_2 = struct.unpack("<f", struct.pack("<f", 0.2))[0]
+SECOND_RECORD = (("ARMING_REQUIRE", 0, mavlink2.MAV_PARAM_TYPE_INT8), ("COMPASS_DEC", F32_0_2,
+                                                                      mavlink2.MAV_PARAM_TYPE_REAL32))
 
 
 def write_rc(path):
@@ -193,6 +200,10 @@ def first_session(args, trajectory, eeprom, rc_path, servo_log):
     b.conn.mav.param_set_send(1, 1, b"RLL2SRV_P", 9.0, mavlink2.MAV_PARAM_TYPE_REAL32)
     pv = b.param("RLL2SRV_P", "PARAM_VALUE for PARAM_SET RLL2SRV_P 9 (out of range)")
     soft_assert(pv is not None and abs(pv.param_value - 1.25) < 1e-6, "refused PARAM_SET -> %r (the old 1.25)" % pv)
+    for name, value, ptype in SECOND_RECORD:
+        b.conn.mav.param_set_send(1, 1, name.encode(), value, ptype)
+        pv = b.param(name, "PARAM_VALUE for PARAM_SET %s %r" % (name, value))
+        soft_assert(pv is not None and pv.param_value == value, "PARAM_SET %s %r -> %r" % (name, value, pv))
     b.conn.mav.param_set_send(1, 1, b"SERVO1_TRIM", 1450, mavlink2.MAV_PARAM_TYPE_INT16)
     pv = b.param("SERVO1_TRIM", "PARAM_VALUE for PARAM_SET SERVO1_TRIM 1450")
     soft_assert(pv is not None and pv.param_value == 1450 and pv.param_type == mavlink2.MAV_PARAM_TYPE_INT16,
@@ -314,10 +325,12 @@ def second_session(args, trajectory, eeprom):
     if b.pump(lambda m: m.get_type() == "HEARTBEAT", "HEARTBEAT after the power cycle") is None:
         b.stop()
         return
-    for name, value in (("RLL2SRV_P", 1.25), ("SERVO1_TRIM", 1450)):
+    for name, value in (("RLL2SRV_P", 1.25), ("SERVO1_TRIM", 1450)) + tuple((n, v) for n, v, _ in SECOND_RECORD):
         b.conn.mav.param_request_read_send(1, 1, name.encode(), -1)
         pv = b.param(name, "PARAM_VALUE %s after the power cycle" % name)
         soft_assert(pv is not None and abs(pv.param_value - value) < 1e-6, "%s after the power cycle: %r" % (name, pv))
+        if name == "COMPASS_DEC":
+            soft_assert(pv is not None and pv.param_value == value, "COMPASS_DEC not the float sent: %r" % pv)
     # Defaults (param1 2) bring RLL2SRV_P's default back; read (param1 0) is refused:
     # reading and checking both EEPROM slots takes longer than a sample period (README
     # "Ground stations"), and nothing changes.
@@ -332,7 +345,8 @@ def second_session(args, trajectory, eeprom):
     b.stop()
     overruns = [m.text for _, m in b.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
     soft_assert(not overruns, "samples missed while serving the ground station after the power cycle: %r" % overruns)
-    print("# after the power cycle: RLL2SRV_P 1.25, SERVO1_TRIM 1450; defaults as asked, read refused")
+    print("# after the power cycle: RLL2SRV_P 1.25, SERVO1_TRIM 1450, ARMING_REQUIRE 0, COMPASS_DEC 0.2 (as sent); "
+          "defaults as asked, read refused")
 
 
 def main():

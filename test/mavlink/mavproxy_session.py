@@ -15,7 +15,10 @@ console driven through stdin as a user types, and checks what it prints:
     the vehicle is armed (the outputs are live);
   - `status ATTITUDE` prints the board's ATTITUDE: the board is held still at roll 30 deg,
     pitch 10 deg (a two-row trajectory, its last state held), and ATTITUDE says so within
-    3 degrees.
+    3 degrees;
+  - `param set COMPASS_DEC 0.2` is taken as sent: MAVProxy, which compares the value the
+    board returns with the one it sent (to 1e-5), never says "Failed to set", `param show`
+    prints 0.2, and ATTITUDE's yaw then is 0.2 rad (the board points north) within 3 deg.
 Exit 1 with every failure listed.
 """
 import math
@@ -47,7 +50,7 @@ class Lines:
             self.seen.append(line)
             self.q.put(line)
 
-    def wait(self, pattern, what, timeout_s=WALL_TIMEOUT_S):
+    def wait(self, pattern, what, timeout_s=WALL_TIMEOUT_S, required=True):
         end = time.time() + timeout_s
         while time.time() < end:
             try:
@@ -57,7 +60,7 @@ class Lines:
             m = re.search(pattern, line)
             if m:
                 return m
-        soft_assert(False, "MAVProxy never printed %s (%r)" % (what, pattern))
+        soft_assert(not required, "MAVProxy never printed %s (%r)" % (what, pattern))
         return None
 
 
@@ -156,7 +159,22 @@ def main():
             checked += 1
             time.sleep(1)
         soft_assert(checked == 5, "%d ATTITUDE shown" % checked)
-        print("# MAVProxy: parameters fetched, RLL2SRV_P set and saved, MANUAL> shown, %d ATTITUDE checked" % checked)
+        # COMPASS_DEC as sent (it was once kept in hundredths of a degree: 0.19999 came back
+        # and MAVProxy said "Failed to set" after its three attempts, a second apart).
+        type_line("param set COMPASS_DEC 0.2")
+        soft_assert(out.wait(r"AP: saved", "the board's 'saved' of COMPASS_DEC"), "COMPASS_DEC not saved")
+        failed = out.wait(r"Failed to set COMPASS_DEC.*", "a failure", timeout_s=5, required=False)
+        soft_assert(failed is None, "MAVProxy: %s" % (failed and failed.group(0)))
+        type_line("param show COMPASS_DEC")
+        m = out.wait(r"COMPASS_DEC\s+([-0-9.e]+)", "COMPASS_DEC's new value")
+        soft_assert(m and abs(float(m.group(1)) - 0.2) < 1e-6, "COMPASS_DEC %s after set, 0.2" % (m and m.group(1)))
+        type_line("status ATTITUDE")
+        m = out.wait(r"ATTITUDE \{time_boot_ms : (\d+), roll : ([-0-9.e]+), pitch : ([-0-9.e]+), "
+                     r"yaw : ([-0-9.e]+)", "status ATTITUDE after COMPASS_DEC")
+        soft_assert(m and abs(math.degrees(float(m.group(4)) - 0.2)) < 3,
+                    "ATTITUDE yaw after COMPASS_DEC 0.2: %s rad" % (m and m.group(4)))
+        print("# MAVProxy: parameters fetched, RLL2SRV_P and COMPASS_DEC set and saved, MANUAL> shown, "
+              "%d ATTITUDE checked" % checked)
     finally:
         session.stop()
 

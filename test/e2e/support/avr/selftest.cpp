@@ -473,7 +473,7 @@ void check_settings_crc() {
     EXPECT(settings::crc16(reinterpret_cast<const uint8_t*>(check), 9) == 0x29B1);
     settings::Settings in = settings::defaults();
     in.rate_hz = 25;
-    in.declination_centideg = -1234;
+    settings::set_declination_centideg(in, -1234);
     in.mode = fmt::OutputMode::Csv;
     in.flags = settings::kFlagGyroCalibrated;
     in.cal.gyro_bias_rad_s = Vector3f(0.01f, -0.02f, 0.003f);
