@@ -43,7 +43,7 @@ enum Section : uint8_t {
     kSecLoop = 6,       // one sample's work, from data-ready seen to its tasks done
     kSecControl = 13,   // the flight control step (50 Hz, the servo frame)
     kSecConsoleReply = 15,  // one part of a console reply, as text
-    kSecGcsRequest = 16,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
+    kSecGcsRequest = 16,  // a ground station's MAVLink frame taken (PARAM_SET applied, a command set aside ...)
     kSecGcsReply = 17,    // one PARAM_VALUE packed and queued
     kSecCompassTask = 18,  // the compass task: DRDY watched, a read when due (5 inside)
     kSecAirspeed = 19,
@@ -62,13 +62,14 @@ enum Section : uint8_t {
     kSecSecond = 32,       // once a second: load, LEDs, HEARTBEAT, held-back warnings
     kSecStatusText = 33,   // one part of a console reply, as STATUSTEXT frames
     kSecCommand = 34,      // the work of `save`, `defaults` or `set` typed at the console
-    kSecGcsDefaults = 35,  // the defaults' line after a ground station's PREFLIGHT_STORAGE
+    kSecGcsDefaults = 35,  // a ground station's PREFLIGHT_STORAGE defaults: restored, then their line
     kSecGps = 36,          // the GPS task: received bytes parsed, the u-blox configuration sent
     kSecBaro = 37,         // the barometer task: a conversion read and the next one started
     kSecNav = 38,          // position and home from a new fix, the position moved on between fixes
     kSecGcsPosition = 39,  // GPS_RAW_INT, GLOBAL_POSITION_INT, VFR_HUD ... packed and queued
     // 46 is lib/MS5611's compensation (lib/LinAlg/Profile.h), inside 37.
     kSecBaroHeight = 47,   // the barometer's 10 Hz height and climb (inside 37)
+    kSecGcsCommand = 52,   // a ground station's COMMAND_LONG run and ACKed (52..59: the MAVLink conversation's)
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

@@ -147,6 +147,7 @@ static bool answer(const console::Command& c, uint8_t part) {
         } else if (c.id == console::CommandId::Set) {
             console::apply_setting(c, pipe.settings(), out);
             flight_io.configure();
+            gcs_link::announce_param(c.arg);
         } else {
             pipe.restore_defaults();
             flight_io.configure();

@@ -22,8 +22,16 @@ using vehicle::pipe;
 
 static mav::Parser input;
 static mav::ParamReplies param_replies;
-static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
-static bool defaults_said_pending = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
+static bool save_pending = false;           // a PARAM_SET changed a value: configure and save when there is time
+// PREFLIGHT_STORAGE defaults: restored (and every parameter announced) in a pass, its line in the next.
+enum class Defaults : uint8_t { None, Restore, Say };
+static Defaults defaults_pending = Defaults::None;
+// A COMMAND_LONG taken off the parser at once (a burst behind it keeps flowing), run and
+// ACKed when the output has room for the ACK and the lines it may say.
+static mav::CommandLong command;
+static uint8_t command_sysid = 0, command_compid = 0;
+static bool command_pending = false;
+static uint32_t last_frame_ms = 0;  // the last request taken (a save waits for a quiet link)
 constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
@@ -92,8 +100,7 @@ static mav::Result run_command(const mav::CommandLong& c) {
         if (p[0] == 1.0f) {
             vehicle::store.start_save(pipe.settings());
         } else if (p[0] == 2.0f) {
-            pipe.restore_defaults();
-            defaults_said_pending = true;
+            defaults_pending = Defaults::Restore;
         } else {
             return mav::Result::Unsupported;
         }
@@ -109,14 +116,20 @@ static mav::Result run_command(const mav::CommandLong& c) {
     return mav::Result::Unsupported;
 }
 
-// A request: room for its ACK (and the "# " lines a save or calibration says).
-bool request_due() { return input.ready() && room_for(2u * mav::kMaxFrame); }
+// A frame: taken as soon as it is complete, whatever the output's backlog, so that the
+// parser never stops reading the 64-byte receive ring (5.6 ms of bytes at 115200 baud):
+// what a frame asks for is noted (a PARAM_VALUE's bit, a command's slot) and sent by
+// the tasks below when the link has room. A PARAM_SET costs ~0.3 ms (a parameter looked
+// up and set), so a burst is taken as fast as it arrives (issue 46: 20 sent, 4 applied).
+// A second command while one waits stays in the parser: a ground station sends the
+// next after the ACK.
+bool request_due() { return input.ready() && !(command_pending && input.frame().msgid == mav::kMsgCommandLong); }
 
 void take_request() {
     const mav::Received& rx = input.frame();
+    last_frame_ms = millis();
     mav::ParamRequest read;
     mav::ParamSet set;
-    mav::CommandLong cmd;
     if (mav::decode_param_request_list(rx)) {
         param_replies.request_all();
     } else if (mav::decode_param_request_read(rx, read)) {
@@ -129,23 +142,49 @@ void take_request() {
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) save_pending = true;
-    } else if (mav::decode_command_long(rx, cmd)) {
-        const mav::Result r = run_command(cmd);
-        uint8_t frame[mav::kMaxFrame];
-        port::send_frame(frame, port::mavlink.command_ack(frame, cmd.command, r, rx.sysid, rx.compid));
+    } else if (mav::decode_command_long(rx, command)) {
+        command_sysid = rx.sysid;
+        command_compid = rx.compid;
+        command_pending = true;
     }
     input.release();
 }
 
-bool defaults_line_due() { return defaults_said_pending && room_for(2u * mav::kMaxFrame); }
-void say_defaults() {
-    defaults_said_pending = false;
+bool command_due() { return command_pending && room_for(2u * mav::kMaxFrame); }
+void run_pending_command() {
+    command_pending = false;
+    const mav::Result r = run_command(command);
+    uint8_t frame[mav::kMaxFrame];
+    port::send_frame(frame, port::mavlink.command_ack(frame, command.command, r, command_sysid, command_compid));
+}
+
+void announce_param(uint16_t index) {
+    if (port::mavlink_mode()) param_replies.request_one(index);
+}
+
+bool defaults_due() { return defaults_pending != Defaults::None && room_for(2u * mav::kMaxFrame); }
+void run_defaults() {
+    if (defaults_pending == Defaults::Restore) {
+        pipe.restore_defaults();
+        flight_io.configure();
+        param_replies.request_every_one();  // the ground station's list is stale
+        defaults_pending = Defaults::Say;
+        return;
+    }
+    defaults_pending = Defaults::None;
     console::print_defaults(vehicle::out);
 }
 
-bool save_due() { return save_pending && room_for(2u * mav::kMaxFrame); }
+// The save's start (the record encoded: ~5.6 ms, as long as the receive ring takes to
+// fill) waits for a link quiet for kSaveQuietMs: a burst of PARAM_SETs (one every ~3 ms)
+// is over, its frames all read, and one save keeps them all.
+constexpr uint16_t kSaveQuietMs = 50;
+bool save_due() {
+    return save_pending && millis() - last_frame_ms >= kSaveQuietMs && room_for(2u * mav::kMaxFrame);
+}
 void save() {
     save_pending = false;
+    flight_io.configure();  // the controllers' terms from the new gains
     vehicle::store.start_save(pipe.settings());
 }
 

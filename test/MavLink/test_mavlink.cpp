@@ -873,15 +873,35 @@ TEST(ParamLink, RepliesSinglesFirstThenTheWholeListOnce) {
     std::vector<uint16_t> list(sent.begin() + 1, sent.begin() + 5);
     list.insert(list.end(), sent.begin() + 6, sent.end());
     for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(list[i], i);
-    // More singles than it holds: the extra ones are dropped, none repeated.
-    for (uint16_t i = 0; i < 10; ++i) r.request_one(i);
-    unsigned n = 0;
+    // A burst (20 PARAM_SETs before the link has room for one reply, each asked twice):
+    // every one answered, once, lowest index first (issue 46: 20 sent, 4 answered).
+    for (int pass = 0; pass < 2; ++pass)
+        for (uint16_t i = 0; i < 20; ++i) r.request_one((uint16_t)(params::count() - 1u - i * 3u));
+    std::vector<uint16_t> burst;
     while (r.peek(index)) {
-        EXPECT_EQ(index, n);
+        burst.push_back(index);
         r.pop();
-        ++n;
+        ASSERT_LT(burst.size(), 400u);
     }
-    EXPECT_EQ(n, (unsigned)mav::ParamReplies::kSingles);
+    ASSERT_EQ(burst.size(), 20u);
+    for (size_t k = 0; k < burst.size(); ++k) EXPECT_EQ(burst[k], params::count() - 1u - (19u - k) * 3u);
+}
+
+TEST(ParamLink, EveryParameterFitsTheRepliesBitmapAndIsSentOnce) {
+    ASSERT_LE(params::count(), (uint16_t)mav::ParamReplies::kMaxParams);
+    mav::ParamReplies r;
+    r.request_one(5);
+    r.request_every_one();  // the defaults restored: every parameter announced
+    std::vector<int> seen(params::count(), 0);
+    uint16_t index = 0;
+    while (r.peek(index)) {
+        ASSERT_LT(index, params::count());
+        ++seen[index];
+        r.pop();
+    }
+    for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(seen[i], 1) << i;
+    r.request_one((uint16_t)mav::ParamReplies::kMaxParams);  // past the bitmap: ignored, never written past it
+    EXPECT_FALSE(r.peek(index));
 }
 
 // --- The parameter reference's table (docs/parameters.md) ----------------------------------
