@@ -70,6 +70,7 @@ enum Section : uint8_t {
     // 46 is lib/MS5611's compensation (lib/LinAlg/Profile.h), inside 37.
     kSecBaroHeight = 47,   // the barometer's 10 Hz height and climb (inside 37)
     kSecGcsCommand = 52,   // a ground station's COMMAND_LONG run and ACKed (52..59: the MAVLink conversation's)
+    kSecGcsAnswer = 53,    // TIMESYNC, AUTOPILOT_VERSION, MISSION_COUNT/ACK or SYSTEM_TIME packed and queued
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include "AirspeedInput.h"
 #include "Baro.h"
 #include "Board.h"
 #include "Console.h"
@@ -12,6 +13,7 @@
 #include "Position.h"
 #include "SerialText.h"
 #include "Vehicle.h"
+#include "Version.h"
 
 namespace gcs_link {
 
@@ -32,6 +34,21 @@ static mav::CommandLong command;
 static uint8_t command_sysid = 0, command_compid = 0;
 static bool command_pending = false;
 static uint32_t last_frame_ms = 0;  // the last request taken (a save waits for a quiet link)
+
+// The answers a frame or the clock asks for, sent one a run by send_reply() when the
+// output has room: a byte of flags and what they need (7 + 8 bytes).
+enum ReplyFlag : uint8_t {
+    kReplyVersion = 1u << 0,      // AUTOPILOT_VERSION (REQUEST_AUTOPILOT_CAPABILITIES, REQUEST_MESSAGE 148)
+    kReplyTimesync = 1u << 1,     // TIMESYNC: timesync_ts1 echoed
+    kReplySystemTime = 1u << 2,   // SYSTEM_TIME, once a second
+    kReplyMissionCount = 1u << 3, // MISSION_COUNT 0 of mission_type
+    kReplyMissionAck = 1u << 4,   // MISSION_ACK mission_result of mission_type
+};
+static uint8_t replies = 0;
+static int64_t timesync_ts1 = 0;
+static uint8_t mission_type = 0;
+static mav::MissionResult mission_result = mav::MissionResult::Accepted;
+static uint8_t mission_sysid = 0, mission_compid = 0;
 constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
@@ -107,6 +124,11 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdDoSetHome) return set_home(p);
+    if (c.command == mav::kCmdRequestAutopilotCapabilities ||
+        (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgAutopilotVersion)) {
+        replies |= kReplyVersion;  // after the ACK, as ArduPilot
+        return mav::Result::Accepted;
+    }
     if (c.command == mav::kCmdGetHomePosition ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
         if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
@@ -114,6 +136,59 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     return mav::Result::Unsupported;
+}
+
+// The mission, fence and rally protocols until issue 47 stores them (ArduPilot's
+// answers for empty ones): a list asked for is empty (MISSION_COUNT 0), an upload is
+// refused (MISSION_ACK UNSUPPORTED), a clear or an empty upload accepted; a ground
+// station never waits in silence. TIMESYNC is answered as ArduPilot does.
+static void take_conversation(const mav::Received& rx) {
+    uint16_t count = 0;
+    uint8_t type = 0;
+    if (mav::decode_mission_request_list(rx, type)) {
+        replies |= kReplyMissionCount;
+    } else if (mav::decode_mission_count(rx, count, type)) {
+        mission_result = count == 0u ? mav::MissionResult::Accepted : mav::MissionResult::Unsupported;
+        replies |= kReplyMissionAck;
+    } else if (mav::decode_mission_clear_all(rx, type)) {
+        mission_result = mav::MissionResult::Accepted;
+        replies |= kReplyMissionAck;
+    } else if (mav::decode_timesync_request(rx, timesync_ts1)) {
+        replies |= kReplyTimesync;
+        return;
+    } else {
+        return;
+    }
+    mission_type = type;
+    mission_sysid = rx.sysid;
+    mission_compid = rx.compid;
+}
+
+bool reply_due() { return replies != 0u && room_for(mav::kMaxFrame); }
+void send_reply() {
+    uint8_t frame[mav::kMaxFrame];
+    uint8_t n = 0;
+    if (replies & kReplyTimesync) {  // first: its use is the round trip's time
+        replies &= (uint8_t)~kReplyTimesync;
+        n = port::mavlink.timesync(frame, (int64_t)micros() * 1000, timesync_ts1);
+    } else if (replies & kReplyVersion) {
+        replies &= (uint8_t)~kReplyVersion;
+        mav::Version v{APM25_VERSION_MAJOR, APM25_VERSION_MINOR, APM25_VERSION_PATCH, {}};
+        const char* git = APM25_GIT_HASH;
+        for (uint8_t i = 0; i < sizeof v.git && git[i] != '\0'; ++i) v.git[i] = (uint8_t)git[i];
+        n = port::mavlink.autopilot_version(frame, v);
+    } else if (replies & kReplyMissionCount) {
+        replies &= (uint8_t)~kReplyMissionCount;
+        n = port::mavlink.mission_count(frame, mission_sysid, mission_compid, 0u, mission_type);
+    } else if (replies & kReplyMissionAck) {
+        replies &= (uint8_t)~kReplyMissionAck;
+        n = port::mavlink.mission_ack(frame, mission_sysid, mission_compid, mission_result, mission_type);
+    } else {
+        replies = 0;  // kReplySystemTime
+        const uint32_t now_ms = millis();
+        n = port::mavlink.system_time(frame, gps::unix_time_us(gps_port::fix(), now_ms), now_ms);
+    }
+    if (n > 0) port::send_frame(frame, n);
 }
 
 // A frame: taken as soon as it is complete, whatever the output's backlog, so that the
@@ -146,6 +221,8 @@ void take_request() {
         command_sysid = rx.sysid;
         command_compid = rx.compid;
         command_pending = true;
+    } else {
+        take_conversation(rx);
     }
     input.release();
 }
@@ -219,6 +296,7 @@ void send_streams() {
 
 void send_heartbeat_and_status() {
     if (!port::mavlink_mode()) return;
+    replies |= kReplySystemTime;
     const pipeline::Phase ph = pipe.phase();
     const mav::State state = !imu.ok() || !compass.ok() ? mav::State::Critical
                              : ph == pipeline::Phase::WaitImu ? mav::State::Boot
@@ -231,8 +309,14 @@ void send_heartbeat_and_status() {
     mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
                     fix.fix == gps::FixType::k3D && !fix.glitching);
     mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
-    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
-                                        flight_io.plane_mode());
+    const airspeed_input::State airspeed = airspeed_input::state();
+    mav::add_sensor(health, mav::kDifferentialPressure, airspeed != airspeed_input::State::kNone,
+                    airspeed == airspeed_input::State::kSensor);
+    const mav::PlaneMode mode = flight_io.plane_mode();
+    mav::add_plane_status(health, mav::PlaneStatus{FlightIo::kEnabled, mode != mav::PlaneMode::Manual,
+                                                   !flight_io.failsafe(), ph == pipeline::Phase::Running});
+    // (The battery monitor's bits go here: add_sensor(health, kBattery, ...).)
+    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state, mode);
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = port::mavlink.sys_status(frame, health,

@@ -35,6 +35,11 @@ bool defaults_due();
 void run_defaults();
 bool save_due();
 void save();
+// The answers sent when the output has room, one a run: TIMESYNC, AUTOPILOT_VERSION,
+// MISSION_COUNT / MISSION_ACK (the mission, fence and rally protocols: empty until issue
+// 47), SYSTEM_TIME once a second.
+bool reply_due();
+void send_reply();
 // A parameter changed by another path (the console's `set`, a calibration accepted):
 // the ground station is told with a PARAM_VALUE (no-op outside MAVLink: it asks anew).
 void announce_param(uint16_t index);

@@ -183,6 +183,30 @@ TEST(MavLink, SysStatusReportsSensorBitsLoadAndNoBattery) {
     EXPECT_EQ(u8(f.payload, 30), 0xFFu);     // battery_remaining -1
 }
 
+TEST(MavLink, SysStatusHasArduPlanesControllerBitsAndTheFenceHealthy) {
+    mav::Health h = mav::health(true, true, true, true);
+    mav::add_plane_status(h, mav::PlaneStatus{true, false, true, true});  // MANUAL, receiver good
+    const uint32_t control = mav::kAngularRateControl | mav::kAttitudeStabilization;
+    EXPECT_EQ(h.present, 7u | control | mav::kYawPosition | mav::kMotorOutputs | mav::kRcReceiver | mav::kAhrs);
+    EXPECT_EQ(h.enabled, 7u | mav::kMotorOutputs | mav::kRcReceiver | mav::kAhrs) << "MANUAL: no controller";
+    EXPECT_EQ(h.healthy, h.present | mav::kGeofence) << "MAVProxy: no fence bit in health is a breach";
+    mav::Health s = mav::health(true, true, true, true);
+    mav::add_plane_status(s, mav::PlaneStatus{true, true, false, false});  // STABILIZE, no receiver, no AHRS
+    EXPECT_EQ(s.enabled & control, control);
+    EXPECT_EQ(s.healthy & (mav::kRcReceiver | mav::kAhrs), 0u);
+    EXPECT_EQ(s.healthy & mav::kGeofence, mav::kGeofence);
+    mav::Health a = mav::health(true, true, true, true);
+    mav::add_plane_status(a, mav::PlaneStatus{false, false, false, true});  // the attitude-only build
+    EXPECT_EQ(a.present, 7u | mav::kAhrs);
+    EXPECT_EQ(a.healthy, 7u | mav::kAhrs | mav::kGeofence);
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const Frame f = parse(buf, p.sys_status(buf, h, 100u, 0u), kExtraSysStatus);
+    EXPECT_EQ(u32(f.payload, 0), h.present);
+    EXPECT_EQ(u32(f.payload, 4), h.enabled);
+    EXPECT_EQ(u32(f.payload, 8), h.healthy);
+}
+
 TEST(MavLink, SysStatusWithoutTheMpuHasOnlyTheCompass) {
     const mav::Health h = mav::health(false, false, true, true);
     EXPECT_EQ(h.present, mav::kMag3d);
