@@ -90,6 +90,9 @@ void idle_until_interrupt();
 // LEDs off, every SPI chip select high (53 before 40, as ArduPilot brought the bus
 // up on APM2) before any SPI traffic, the data-ready lines as inputs.
 void init_pins();
+// Resets the board with the watchdog (15 ms) and never returns; the next start stops the
+// watchdog before the C runtime's set-up (a watchdog reset leaves it running).
+[[noreturn]] void reset_by_watchdog();
 void set_leds(bool calibrating, bool running, bool fault);
 
 // SPI.begin() (after init_pins). Transactions: 1 MHz for the MPU6000's register

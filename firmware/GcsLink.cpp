@@ -94,6 +94,11 @@ static mav::Result set_home(const float* p) {
     return ok ? mav::Result::Accepted : mav::Result::Failed;
 }
 
+// ArduPilot refuses MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN while armed: the arming's check
+// goes here (until then the board is never refused a reboot).
+static bool safe_to_reboot() { return true; }
+static bool reboot_pending = false;  // ACKed: the reboot once the ACK and any save are out
+
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
 // (`cal mag`); the others (baro, accel, airspeed ...) the board does not have.
 // MAV_CMD_PREFLIGHT_STORAGE: param1 1 write (`save`), 2 defaults (`defaults`, not
@@ -124,6 +129,14 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdDoSetHome) return set_home(p);
+    if (c.command == mav::kCmdPreflightRebootShutdown) {
+        // param1 1: the autopilot (ArduPilot's 2 shutdown, 3 the bootloader: not here);
+        // param2 (the companion computer) 0 or absent.
+        if (p[0] != 1.0f) return mav::Result::Unsupported;
+        if (!safe_to_reboot()) return mav::Result::TemporarilyRejected;
+        reboot_pending = true;
+        return mav::Result::Accepted;
+    }
     if (c.command == mav::kCmdRequestAutopilotCapabilities ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgAutopilotVersion)) {
         replies |= kReplyVersion;  // after the ACK, as ArduPilot
@@ -233,6 +246,18 @@ void run_pending_command() {
     const mav::Result r = run_command(command);
     uint8_t frame[mav::kMaxFrame];
     port::send_frame(frame, port::mavlink.command_ack(frame, command.command, r, command_sysid, command_compid));
+}
+
+// The reboot: when the ACK has left (the queue empty, the UART drained) and no save is
+// pending or under way, the watchdog at its shortest (15 ms) and a wait for it, as
+// ArduPilot's APM2 HAL does: the board resets and starts as at power-up (Board.cpp stops
+// the watchdog before anything else runs).
+bool reboot_due() {
+    return reboot_pending && !save_pending && !vehicle::store.busy() && serial_text::queued() == 0u;
+}
+void reboot() {
+    Serial.flush();
+    board::reset_by_watchdog();
 }
 
 void announce_param(uint16_t index) {

@@ -40,6 +40,9 @@ void save();
 // 47), SYSTEM_TIME once a second.
 bool reply_due();
 void send_reply();
+// MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN param1 1, ACKed: a watchdog reset once the ACK is out.
+bool reboot_due();
+void reboot();
 // A parameter changed by another path (the console's `set`, a calibration accepted):
 // the ground station is told with a PARAM_VALUE (no-op outside MAVLink: it asks anew).
 void announce_param(uint16_t index);

@@ -30,6 +30,8 @@ public:
     void start_save(const settings::Settings& s);
     // Every loop iteration: the next byte, or a part of the verification at the end.
     void service();
+    // A save is under way (a reboot waits for its end).
+    bool busy() const { return index_ != slots::kSlotSize; }
 
 private:
     uint16_t slot_address() const { return slots::slot_address(write_slot_); }

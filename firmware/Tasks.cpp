@@ -102,6 +102,7 @@ static void once_a_second() {
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_reply,    gcs_link::reply_due,             gcs_link::send_reply,             2000, kSecGcsAnswer,    0)       \
+    X(gcs_reboot,   gcs_link::reboot_due,            gcs_link::reboot,                 6000, kSecGcsAnswer,    0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \

@@ -82,7 +82,8 @@ static_assert(kMsgMissionRequestList == MAVLINK_MSG_ID_MISSION_REQUEST_LIST &&
                   kMsgMissionCount == MAVLINK_MSG_ID_MISSION_COUNT &&
                   kMsgMissionClearAll == MAVLINK_MSG_ID_MISSION_CLEAR_ALL && kMsgTimesync == MAVLINK_MSG_ID_TIMESYNC &&
                   kMsgAutopilotVersion == MAVLINK_MSG_ID_AUTOPILOT_VERSION &&
-                  kCmdRequestAutopilotCapabilities == MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES,
+                  kCmdRequestAutopilotCapabilities == MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES &&
+                  kCmdPreflightRebootShutdown == MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN,
               "the conversation's message and command ids");
 static_assert(kCapabilities == (MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT | MAV_PROTOCOL_CAPABILITY_MAVLINK2) &&
                   kVersionTypeOfficial == FIRMWARE_VERSION_TYPE_OFFICIAL &&

@@ -354,6 +354,7 @@ constexpr uint16_t kCmdGetHomePosition = 410;    // answered with HOME_POSITION 
 constexpr uint16_t kCmdRequestMessage = 512;     // param1 the message id: 242 HOME_POSITION here
 constexpr uint8_t kMsgHomePosition = 242;
 constexpr uint16_t kCmdRequestAutopilotCapabilities = 520;  // answered with AUTOPILOT_VERSION
+constexpr uint16_t kCmdPreflightRebootShutdown = 246;       // param1 1: reboot (a watchdog reset)
 constexpr uint8_t kMsgAutopilotVersion = 148;               // ... and REQUEST_MESSAGE 148
 
 }  // namespace mav

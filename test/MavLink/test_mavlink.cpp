@@ -573,6 +573,40 @@ TEST(MavLinkParser, CommandLongDecodes) {
     EXPECT_EQ(c.param[6], 0.0f);
 }
 
+TEST(MavLinkParser, MissionRequestsAndTimesyncDecode) {
+    // CRC_EXTRA (common.xml): MISSION_REQUEST_LIST 132, MISSION_COUNT 221, MISSION_CLEAR_ALL 232, TIMESYNC 34.
+    mav::Parser parser;
+    Bytes in = frame_v2(43, 132, Bytes{1, 1, 2});            // rally list, for us
+    const Bytes count = frame_v2(44, 221, Bytes{3, 0, 1, 0, 1});  // 3 fence items, for us
+    in.insert(in.end(), count.begin(), count.end());
+    const Bytes other = frame_v2(45, 232, Bytes{7, 1, 0});   // a clear for system 7: not ours
+    in.insert(in.end(), other.begin(), other.end());
+    Bytes ts;
+    for (int i = 0; i < 8; ++i) ts.push_back(0);              // tc1 0: a request
+    for (int i = 0; i < 8; ++i) ts.push_back((uint8_t)(0x11 * (i + 1)));
+    const Bytes tsf = frame_v2(111, 34, ts);
+    in.insert(in.end(), tsf.begin(), tsf.end());
+    ts[0] = 1;                                                // tc1 set: someone's reply, not answered
+    const Bytes tsr = frame_v2(111, 34, ts);
+    in.insert(in.end(), tsr.begin(), tsr.end());
+    const auto got = feed(parser, in);
+    ASSERT_EQ(got.size(), 5u);
+    EXPECT_EQ(parser.bad_crc(), 0u);
+    uint8_t type = 99;
+    uint16_t n = 0;
+    EXPECT_TRUE(mav::decode_mission_request_list(got[0], type));
+    EXPECT_EQ(type, 2u);
+    EXPECT_FALSE(mav::decode_mission_count(got[0], n, type));
+    EXPECT_TRUE(mav::decode_mission_count(got[1], n, type));
+    EXPECT_EQ(n, 3u);
+    EXPECT_EQ(type, 1u);
+    EXPECT_FALSE(mav::decode_mission_clear_all(got[2], type));
+    int64_t ts1 = 0;
+    EXPECT_TRUE(mav::decode_timesync_request(got[3], ts1));
+    EXPECT_EQ((uint64_t)ts1, 0x8877665544332211ull);
+    EXPECT_FALSE(mav::decode_timesync_request(got[4], ts1));
+}
+
 // --- Outgoing replies and streams ------------------------------------------------------
 
 TEST(MavLink, ParamValueCommandAckRcChannelsServoOutputRawOnTheWire) {

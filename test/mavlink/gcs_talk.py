@@ -15,6 +15,8 @@ second). Checks:
     HEARTBEATs go on);
   - three returns in a row give the text console back (its `help` reply as text, then angle
     lines), and the next HEARTBEAT switches to MAVLink again;
+  - MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: param1 2 (shutdown) UNSUPPORTED; param1 1 ACCEPTED (the
+    watchdog reset that follows is not yet observable in apm25sim: the last check of the run);
 then a second run with a client that sends no HEARTBEAT: `set SERIAL0_PROTOCOL 2` typed
 into the text console switches the board to MAVLink, and pymavlink's plain
 wait_heartbeat() hears it.
@@ -106,6 +108,21 @@ def escape(b):
           % (text.count(b"\nroll:"), t0))
 
 
+def reboot(b):
+    """MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: 2 refused, 1 ACKed (then a watchdog reset)."""
+    b.conn.mav.command_long_send(1, 1, mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, 0, 2, 0, 0, 0, 0, 0, 0)
+    ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, "COMMAND_ACK for a shutdown (param1 2)")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_UNSUPPORTED, "shutdown: %r" % ack)
+    b.conn.mav.command_long_send(1, 1, mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, 0, 1, 0, 0, 0, 0, 0, 0)
+    ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, "COMMAND_ACK for the reboot")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "reboot: %r" % ack)
+    # The board then resets by its watchdog (simavr's log: "WATCHDOG: timer fired without
+    # interrupt. Resetting", then "disabled" by the restarted firmware), but apm25sim's own
+    # timers (sensors, the TCP link) do not survive simavr's avr_reset: the restart is not
+    # observable here yet (docs/mavlink.md).
+    print("# reboot: shutdown UNSUPPORTED, reboot ACCEPTED")
+
+
 def serial0_protocol(args, trajectory):
     """A client that never sends a HEARTBEAT: SERIAL0_PROTOCOL 2 makes the board speak MAVLink."""
     log = open(os.path.join(args.work, "protocol.stderr"), "w")
@@ -150,6 +167,7 @@ def main():
         burst(b)
         text_in_mavlink(b)
         escape(b)
+        reboot(b)
     finally:
         b.stop()
     overruns = [m.text for _, m in b.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
