@@ -268,12 +268,12 @@ bool defaults_due() { return defaults_pending != Defaults::None && room_for(2u *
 void run_defaults() {
     if (defaults_pending == Defaults::Restore) {
         pipe.restore_defaults();
-        flight_io.configure();
         param_replies.request_every_one();  // the ground station's list is stale
         defaults_pending = Defaults::Say;
         return;
     }
     defaults_pending = Defaults::None;
+    flight_io.configure();  // the controllers' terms from the defaults (a pass of its own)
     console::print_defaults(vehicle::out);
 }
 
