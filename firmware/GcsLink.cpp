@@ -187,8 +187,8 @@ void send_reply() {
     } else if (replies & kReplyVersion) {
         replies &= (uint8_t)~kReplyVersion;
         mav::Version v{APM25_VERSION_MAJOR, APM25_VERSION_MINOR, APM25_VERSION_PATCH, {}};
-        const char* git = APM25_GIT_HASH;
-        for (uint8_t i = 0; i < sizeof v.git && git[i] != '\0'; ++i) v.git[i] = (uint8_t)git[i];
+        static const char kGit[] PROGMEM = APM25_GIT_HASH;  // in flash: RAM is for the loop
+        for (uint8_t i = 0; i < sizeof v.git && i + 1u < sizeof kGit; ++i) v.git[i] = pgm_read_byte(&kGit[i]);
         n = port::mavlink.autopilot_version(frame, v);
     } else if (replies & kReplyMissionCount) {
         replies &= (uint8_t)~kReplyMissionCount;

@@ -81,6 +81,13 @@ def main():
             soft_assert(decode_flight_sw_version(sw) == want, "flight_sw_version %d decodes to %r, expected %r"
                         % (sw, decode_flight_sw_version(sw), want))
             soft_assert(caps == 2 | 8192, "capabilities %d: PARAM_FLOAT | MAVLINK2 expected" % caps)
+            # The commit's hash the build wrote (mk/build.mk), as 8 characters.
+            gen = os.path.join(args.tools, "avr", "gen", "git_version.h")
+            h = re.search(r'"([0-9a-f]{8})"', open(gen).read()) if os.path.exists(gen) else None
+            if h:
+                custom = re.search(r"flight_custom_version : \[([0-9, ]+)\]", m.string)
+                got = bytes(int(x) for x in custom.group(1).split(",")) if custom else b""
+                soft_assert(got == h.group(1).encode(), "flight_custom_version %r, the build's %s" % (got, h.group(1)))
         for cmd, what in (("wp list", "waypoints"), ("fence list", "fence items"), ("rally list", "rally items")):
             type_line(cmd)
             soft_assert(out.wait(r"Requesting 0 %s" % what, "`%s`'s answer" % cmd, 60),
