@@ -151,7 +151,7 @@ static mav::Result run_command(const mav::CommandLong& c) {
     return mav::Result::Unsupported;
 }
 
-// The mission, fence and rally protocols until issue 47 stores them (ArduPilot's
+// The mission, fence and rally protocols until the board stores them (ArduPilot's
 // answers for empty ones): a list asked for is empty (MISSION_COUNT 0), an upload is
 // refused (MISSION_ACK UNSUPPORTED), a clear or an empty upload accepted; a ground
 // station never waits in silence. TIMESYNC is answered as ArduPilot does.
@@ -208,7 +208,7 @@ void send_reply() {
 // parser never stops reading the 64-byte receive ring (5.6 ms of bytes at 115200 baud):
 // what a frame asks for is noted (a PARAM_VALUE's bit, a command's slot) and sent by
 // the tasks below when the link has room. A PARAM_SET costs ~0.3 ms (a parameter looked
-// up and set), so a burst is taken as fast as it arrives (issue 46: 20 sent, 4 applied).
+// up and set), so a burst is taken as fast as it arrives.
 // A second command while one waits stays in the parser: a ground station sends the
 // next after the ACK.
 bool request_due() { return input.ready() && !(command_pending && input.frame().msgid == mav::kMsgCommandLong); }

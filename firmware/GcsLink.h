@@ -36,8 +36,8 @@ void run_defaults();
 bool save_due();
 void save();
 // The answers sent when the output has room, one a run: TIMESYNC, AUTOPILOT_VERSION,
-// MISSION_COUNT / MISSION_ACK (the mission, fence and rally protocols: empty until issue
-// 47), SYSTEM_TIME once a second.
+// MISSION_COUNT / MISSION_ACK (the mission, fence and rally protocols: empty until the
+// board stores missions), SYSTEM_TIME once a second.
 bool reply_due();
 void send_reply();
 // MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN param1 1, ACKed: a watchdog reset once the ACK is out.

@@ -201,7 +201,7 @@ public:
     // temperature (degC, sent in 0.01 degC); no differential pressure (0).
     uint8_t scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c);
     // MISSION_COUNT and MISSION_ACK to the ground station that asked (the mission, fence
-    // and rally protocols: issue 47 fills them; until then every list is empty).
+    // and rally protocols: every list is empty until the board stores missions).
     uint8_t mission_count(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t count,
                           uint8_t mission_type);
     uint8_t mission_ack(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, MissionResult result,
