@@ -15,8 +15,8 @@ second). Checks:
     HEARTBEATs go on);
   - three returns in a row give the text console back (its `help` reply as text, then angle
     lines), and the next HEARTBEAT switches to MAVLink again;
-  - MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: param1 2 (shutdown) UNSUPPORTED; param1 1 ACCEPTED (the
-    watchdog reset that follows is not yet observable in apm25sim: the last check of the run);
+  - MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: param1 2 (shutdown) UNSUPPORTED; param1 1 ACCEPTED, then
+    the board starts again (a watchdog reset: an ATTITUDE's time_boot_ms from 0, HEARTBEAT again);
 then a second run with a client that sends no HEARTBEAT: `set SERIAL0_PROTOCOL 2` typed
 into the text console switches the board to MAVLink, and pymavlink's plain
 wait_heartbeat() hears it.
@@ -109,18 +109,24 @@ def escape(b):
 
 
 def reboot(b):
-    """MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: 2 refused, 1 ACKed (then a watchdog reset)."""
+    """MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: 2 refused, 1 ACKed, then a watchdog reset: the clock starts again."""
     b.conn.mav.command_long_send(1, 1, mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, 0, 2, 0, 0, 0, 0, 0, 0)
     ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, "COMMAND_ACK for a shutdown (param1 2)")
     soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_UNSUPPORTED, "shutdown: %r" % ack)
     b.conn.mav.command_long_send(1, 1, mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, 0, 1, 0, 0, 0, 0, 0, 0)
     ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, "COMMAND_ACK for the reboot")
     soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "reboot: %r" % ack)
-    # The board then resets by its watchdog (simavr's log: "WATCHDOG: timer fired without
-    # interrupt. Resetting", then "disabled" by the restarted firmware), but apm25sim's own
-    # timers (sensors, the TCP link) do not survive simavr's avr_reset: the restart is not
-    # observable here yet (docs/mavlink.md).
-    print("# reboot: shutdown UNSUPPORTED, reboot ACCEPTED")
+    acked_at = b.t_s
+    # A watchdog reset: the firmware starts again, in its text mode until the ground
+    # station's next HEARTBEAT (pump sends one a second), its clock from 0.
+    again = b.pump(lambda m: m.get_type() == "ATTITUDE" and m.time_boot_ms < acked_at * 1000 - 1000,
+                   "an ATTITUDE whose time_boot_ms restarted after the reboot", 240)
+    soft_assert(again is not None, "no restart after the reboot's ACK at %.2f s" % acked_at)
+    hb = b.pump(lambda m: m.get_type() == "HEARTBEAT", "HEARTBEAT after the reboot", 120)
+    soft_assert(hb is not None, "no HEARTBEAT after the reboot")
+    if again is not None:
+        print("# reboot: shutdown UNSUPPORTED, reboot ACCEPTED at %.2f s, then time_boot_ms %d ms: started again"
+              % (acked_at, again.time_boot_ms))
 
 
 def serial0_protocol(args, trajectory):
