@@ -2,6 +2,7 @@
 #include "Board.h"
 
 #include <avr/sleep.h>
+#include <avr/wdt.h>
 
 #include <SPI.h>
 #include <Wire.h>
@@ -133,4 +134,18 @@ void i2c_recover() {
     wire_begin();
 }
 
+void reset_by_watchdog() {
+    cli();
+    wdt_enable(WDTO_15MS);
+    for (;;) {}
+}
+
 }  // namespace board
+
+// After a watchdog reset WDRF keeps the watchdog on at its shortest period: off before
+// the start-up's waits (avr-libc's wdt.h: in .init3, MCUSR cleared first). The APM 2.5's
+// bootloader does it too; an ELF run without one (apm25sim) needs this.
+extern "C" __attribute__((naked, used, section(".init3"))) void apm25_stop_watchdog() {
+    MCUSR = 0;
+    wdt_disable();
+}

@@ -43,7 +43,7 @@ enum Section : uint8_t {
     kSecLoop = 6,       // one sample's work, from data-ready seen to its tasks done
     kSecControl = 13,   // the flight control step (50 Hz, the servo frame)
     kSecConsoleReply = 15,  // one part of a console reply, as text
-    kSecGcsRequest = 16,  // a ground station's MAVLink request handled (PARAM_SET, COMMAND_LONG ...)
+    kSecGcsRequest = 16,  // a ground station's MAVLink frame taken (PARAM_SET applied, a command set aside ...)
     kSecGcsReply = 17,    // one PARAM_VALUE packed and queued
     kSecCompassTask = 18,  // the compass task: DRDY watched, a read when due (5 inside)
     kSecAirspeed = 19,
@@ -62,7 +62,7 @@ enum Section : uint8_t {
     kSecSecond = 32,       // once a second: load, LEDs, HEARTBEAT, held-back warnings
     kSecStatusText = 33,   // one part of a console reply, as STATUSTEXT frames
     kSecCommand = 34,      // the work of `save`, `defaults` or `set` typed at the console
-    kSecGcsDefaults = 35,  // the defaults' line after a ground station's PREFLIGHT_STORAGE
+    kSecGcsDefaults = 35,  // a ground station's PREFLIGHT_STORAGE defaults: restored, then their line
     kSecGps = 36,          // the GPS task: received bytes parsed, the u-blox configuration sent
     kSecBaro = 37,         // the barometer task: a conversion read and the next one started
     kSecNav = 38,          // position and home from a new fix, the position moved on between fixes
@@ -72,6 +72,8 @@ enum Section : uint8_t {
     kSecAdc = 52,          // a battery pin's conversion taken, A0's next started
     kSecBattery = 53,      // the battery monitor's 10 Hz update (and its failsafe line)
     kSecGcsBattery = 54,   // BATTERY_STATUS packed and queued
+    kSecGcsCommand = 55,   // a ground station's COMMAND_LONG run and ACKed
+    kSecGcsAnswer = 56,    // TIMESYNC, AUTOPILOT_VERSION, MISSION_COUNT/ACK or SYSTEM_TIME packed and queued
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }
@@ -91,6 +93,9 @@ void idle_until_interrupt();
 // LEDs off, every SPI chip select high (53 before 40, as ArduPilot brought the bus
 // up on APM2) before any SPI traffic, the data-ready lines as inputs.
 void init_pins();
+// Resets the board with the watchdog (15 ms) and never returns; the next start stops the
+// watchdog before the C runtime's set-up (a watchdog reset leaves it running).
+[[noreturn]] void reset_by_watchdog();
 void set_leds(bool calibrating, bool running, bool fault);
 
 // SPI.begin() (after init_pins). Transactions: 1 MHz for the MPU6000's register

@@ -31,6 +31,8 @@ using vehicle::pipe;
 static console::LineReader reader;
 static console::CommandQueue commands;
 static uint8_t reply_part = 0;  // the next part of the reply to commands.peek()
+constexpr uint8_t kEscapeReturns = 3;
+static uint8_t returns = 0;     // CR or LF in a row outside frames, in MAVLink
 
 void forget_partial_line() { reader = console::LineReader(); }
 
@@ -52,8 +54,24 @@ static void take(bool in_step) {
         // next ~260 bytes), and the parser only looks for a ground station's HEARTBEAT.
         const bool was_mavlink = port::mavlink_mode();
         if (frames.consume((uint8_t)b)) {
+            returns = 0;
             gcs_link::take_heartbeat();
             if (was_mavlink || port::mavlink_mode()) continue;
+        }
+        if (was_mavlink) {
+            // In MAVLink only frames act: no text line is a command (a ground station's
+            // garbage must not set a gain or silence the link). The one escape is
+            // ArduPilot's: three returns (CR or LF) in a row give the text console.
+            returns = (b == '\r' || b == '\n') ? (uint8_t)(returns + 1u) : (uint8_t)0;
+            if (returns == kEscapeReturns) {
+                returns = 0;
+                port::escape_to_text();
+                forget_partial_line();
+                console::Command help{};
+                help.id = console::CommandId::Help;  // the console's first words: what it takes
+                commands.push(help);
+            }
+            continue;
         }
         const console::Command c = reader.feed((uint8_t)b);
         if (c.id != console::CommandId::None) commands.push(c);
@@ -154,6 +172,7 @@ static bool answer(const console::Command& c, uint8_t part) {
             if (params::get(pipe.settings(), c.arg) != before) mag_cal_link::parameter_changed(c.arg);
             pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
             flight_io.configure();
+            gcs_link::announce_param(c.arg);
         } else {
             pipe.restore_defaults();
             flight_io.configure();

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include "AirspeedInput.h"
 #include "Baro.h"
 #include "BatteryInput.h"
 #include "Board.h"
@@ -14,6 +15,7 @@
 #include "Position.h"
 #include "SerialText.h"
 #include "Vehicle.h"
+#include "Version.h"
 
 namespace gcs_link {
 
@@ -24,8 +26,31 @@ using vehicle::pipe;
 
 static mav::Parser input;
 static mav::ParamReplies param_replies;
-static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
-static bool defaults_said_pending = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
+static bool save_pending = false;           // a PARAM_SET changed a value: configure and save when there is time
+// PREFLIGHT_STORAGE defaults: restored (and every parameter announced) in a pass, its line in the next.
+enum class Defaults : uint8_t { None, Restore, Say };
+static Defaults defaults_pending = Defaults::None;
+// A COMMAND_LONG taken off the parser at once (a burst behind it keeps flowing), run and
+// ACKed when the output has room for the ACK and the lines it may say.
+static mav::CommandLong command;
+static uint8_t command_sysid = 0, command_compid = 0;
+static bool command_pending = false;
+static uint32_t last_frame_ms = 0;  // the last request taken (a save waits for a quiet link)
+
+// The answers a frame or the clock asks for, sent one a run by send_reply() when the
+// output has room: a byte of flags and what they need (7 + 8 bytes).
+enum ReplyFlag : uint8_t {
+    kReplyVersion = 1u << 0,      // AUTOPILOT_VERSION (REQUEST_AUTOPILOT_CAPABILITIES, REQUEST_MESSAGE 148)
+    kReplyTimesync = 1u << 1,     // TIMESYNC: timesync_ts1 echoed
+    kReplySystemTime = 1u << 2,   // SYSTEM_TIME, once a second
+    kReplyMissionCount = 1u << 3, // MISSION_COUNT 0 of mission_type
+    kReplyMissionAck = 1u << 4,   // MISSION_ACK mission_result of mission_type
+};
+static uint8_t replies = 0;
+static int64_t timesync_ts1 = 0;
+static uint8_t mission_type = 0;
+static mav::MissionResult mission_result = mav::MissionResult::Accepted;
+static uint8_t mission_sysid = 0, mission_compid = 0;
 constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
@@ -70,6 +95,11 @@ static mav::Result set_home(const float* p) {
     }
     return ok ? mav::Result::Accepted : mav::Result::Failed;
 }
+
+// ArduPilot refuses MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN while armed: the arming's check
+// goes here (until then the board is never refused a reboot).
+static bool safe_to_reboot() { return true; }
+static bool reboot_pending = false;  // ACKed: the reboot once the ACK and any save are out
 
 // MAV_CMD_PREFLIGHT_CALIBRATION: param1 1 the gyro (`cal gyro`), param2 1 the compass
 // (`cal mag`, saved when good: MagCalLink's START with autosave), param5 2 the level
@@ -119,8 +149,7 @@ static mav::Result run_command(const mav::CommandLong& c) {
         if (p[0] == 1.0f) {
             vehicle::store.start_save(pipe.settings());
         } else if (p[0] == 2.0f) {
-            pipe.restore_defaults();
-            defaults_said_pending = true;
+            defaults_pending = Defaults::Restore;
         } else {
             return mav::Result::Unsupported;
         }
@@ -128,6 +157,19 @@ static mav::Result run_command(const mav::CommandLong& c) {
     }
     if (c.command == mav::kCmdDoSetHome) return set_home(p);
     if (mag_cal_link::handles(c.command)) return mag_cal_link::command(c);
+    if (c.command == mav::kCmdPreflightRebootShutdown) {
+        // param1 1: the autopilot (ArduPilot's 2 shutdown, 3 the bootloader: not here);
+        // param2 (the companion computer) 0 or absent.
+        if (p[0] != 1.0f) return mav::Result::Unsupported;
+        if (!safe_to_reboot()) return mav::Result::TemporarilyRejected;
+        reboot_pending = true;
+        return mav::Result::Accepted;
+    }
+    if (c.command == mav::kCmdRequestAutopilotCapabilities ||
+        (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgAutopilotVersion)) {
+        replies |= kReplyVersion;  // after the ACK, as ArduPilot
+        return mav::Result::Accepted;
+    }
     if (c.command == mav::kCmdGetHomePosition ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
         if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
@@ -137,14 +179,73 @@ static mav::Result run_command(const mav::CommandLong& c) {
     return mav::Result::Unsupported;
 }
 
-// A request: room for its ACK (and the "# " lines a save or calibration says).
-bool request_due() { return input.ready() && room_for(2u * mav::kMaxFrame); }
+// The mission, fence and rally protocols until the board stores them (ArduPilot's
+// answers for empty ones): a list asked for is empty (MISSION_COUNT 0), an upload is
+// refused (MISSION_ACK UNSUPPORTED), a clear or an empty upload accepted; a ground
+// station never waits in silence. TIMESYNC is answered as ArduPilot does.
+static void take_conversation(const mav::Received& rx) {
+    uint16_t count = 0;
+    uint8_t type = 0;
+    if (mav::decode_mission_request_list(rx, type)) {
+        replies |= kReplyMissionCount;
+    } else if (mav::decode_mission_count(rx, count, type)) {
+        mission_result = count == 0u ? mav::MissionResult::Accepted : mav::MissionResult::Unsupported;
+        replies |= kReplyMissionAck;
+    } else if (mav::decode_mission_clear_all(rx, type)) {
+        mission_result = mav::MissionResult::Accepted;
+        replies |= kReplyMissionAck;
+    } else if (mav::decode_timesync_request(rx, timesync_ts1)) {
+        replies |= kReplyTimesync;
+        return;
+    } else {
+        return;
+    }
+    mission_type = type;
+    mission_sysid = rx.sysid;
+    mission_compid = rx.compid;
+}
+
+bool reply_due() { return replies != 0u && room_for(mav::kMaxFrame); }
+void send_reply() {
+    uint8_t frame[mav::kMaxFrame];
+    uint8_t n = 0;
+    if (replies & kReplyTimesync) {  // first: its use is the round trip's time
+        replies &= (uint8_t)~kReplyTimesync;
+        n = port::mavlink.timesync(frame, (int64_t)micros() * 1000, timesync_ts1);
+    } else if (replies & kReplyVersion) {
+        replies &= (uint8_t)~kReplyVersion;
+        mav::Version v{APM25_VERSION_MAJOR, APM25_VERSION_MINOR, APM25_VERSION_PATCH, {}};
+        static const char kGit[] PROGMEM = APM25_GIT_HASH;  // in flash: RAM is for the loop
+        for (uint8_t i = 0; i < sizeof v.git && i + 1u < sizeof kGit; ++i) v.git[i] = pgm_read_byte(&kGit[i]);
+        n = port::mavlink.autopilot_version(frame, v);
+    } else if (replies & kReplyMissionCount) {
+        replies &= (uint8_t)~kReplyMissionCount;
+        n = port::mavlink.mission_count(frame, mission_sysid, mission_compid, 0u, mission_type);
+    } else if (replies & kReplyMissionAck) {
+        replies &= (uint8_t)~kReplyMissionAck;
+        n = port::mavlink.mission_ack(frame, mission_sysid, mission_compid, mission_result, mission_type);
+    } else {
+        replies = 0;  // kReplySystemTime
+        const uint32_t now_ms = millis();
+        n = port::mavlink.system_time(frame, gps::unix_time_us(gps_port::fix(), now_ms), now_ms);
+    }
+    if (n > 0) port::send_frame(frame, n);
+}
+
+// A frame: taken as soon as it is complete, whatever the output's backlog, so that the
+// parser never stops reading the 64-byte receive ring (5.6 ms of bytes at 115200 baud):
+// what a frame asks for is noted (a PARAM_VALUE's bit, a command's slot) and sent by
+// the tasks below when the link has room. A PARAM_SET costs ~0.3 ms (a parameter looked
+// up and set), so a burst is taken as fast as it arrives.
+// A second command while one waits stays in the parser: a ground station sends the
+// next after the ACK.
+bool request_due() { return input.ready() && !(command_pending && input.frame().msgid == mav::kMsgCommandLong); }
 
 void take_request() {
     const mav::Received& rx = input.frame();
+    last_frame_ms = millis();
     mav::ParamRequest read;
     mav::ParamSet set;
-    mav::CommandLong cmd;
     if (mav::decode_param_request_list(rx)) {
         param_replies.request_all();
     } else if (mav::decode_param_request_read(rx, read)) {
@@ -167,23 +268,63 @@ void take_request() {
         uint8_t result;
         if (mav::decode_command_ack(rx, position, result) && position >= 1u && position <= 6u)
             pipe.confirm_accel_position((uint8_t)position);
-    } else if (mav::decode_command_long(rx, cmd)) {
-        const mav::Result r = run_command(cmd);
-        uint8_t frame[mav::kMaxFrame];
-        port::send_frame(frame, port::mavlink.command_ack(frame, cmd.command, r, rx.sysid, rx.compid));
+    } else if (mav::decode_command_long(rx, command)) {
+        command_sysid = rx.sysid;
+        command_compid = rx.compid;
+        command_pending = true;
+    } else {
+        take_conversation(rx);
     }
     input.release();
 }
 
-bool defaults_line_due() { return defaults_said_pending && room_for(2u * mav::kMaxFrame); }
-void say_defaults() {
-    defaults_said_pending = false;
+bool command_due() { return command_pending && room_for(2u * mav::kMaxFrame); }
+void run_pending_command() {
+    command_pending = false;
+    const mav::Result r = run_command(command);
+    uint8_t frame[mav::kMaxFrame];
+    port::send_frame(frame, port::mavlink.command_ack(frame, command.command, r, command_sysid, command_compid));
+}
+
+// The reboot: when the ACK has left (the queue empty, the UART drained) and no save is
+// pending or under way, the watchdog at its shortest (15 ms) and a wait for it, as
+// ArduPilot's APM2 HAL does: the board resets and starts as at power-up (Board.cpp stops
+// the watchdog before anything else runs).
+bool reboot_due() {
+    return reboot_pending && !save_pending && !vehicle::store.busy() && serial_text::queued() == 0u;
+}
+void reboot() {
+    Serial.flush();
+    board::reset_by_watchdog();
+}
+
+void announce_param(uint16_t index) {
+    if (port::mavlink_mode()) param_replies.request_one(index);
+}
+
+bool defaults_due() { return defaults_pending != Defaults::None && room_for(2u * mav::kMaxFrame); }
+void run_defaults() {
+    if (defaults_pending == Defaults::Restore) {
+        pipe.restore_defaults();
+        param_replies.request_every_one();  // the ground station's list is stale
+        defaults_pending = Defaults::Say;
+        return;
+    }
+    defaults_pending = Defaults::None;
+    flight_io.configure();  // the controllers' terms from the defaults (a pass of its own)
     console::print_defaults(vehicle::out);
 }
 
-bool save_due() { return save_pending && room_for(2u * mav::kMaxFrame); }
+// The save's start (the record encoded: ~5.6 ms, as long as the receive ring takes to
+// fill) waits for a link quiet for kSaveQuietMs: a burst of PARAM_SETs (one every ~3 ms)
+// is over, its frames all read, and one save keeps them all.
+constexpr uint16_t kSaveQuietMs = 50;
+bool save_due() {
+    return save_pending && millis() - last_frame_ms >= kSaveQuietMs && room_for(2u * mav::kMaxFrame);
+}
 void save() {
     save_pending = false;
+    flight_io.configure();  // the controllers' terms from the new gains
     vehicle::store.start_save(pipe.settings());
 }
 void save_soon() { save_pending = true; }
@@ -238,6 +379,7 @@ static void announce_accel_position(uint8_t frame[mav::kMaxFrame]) {
 
 void send_heartbeat_and_status() {
     if (!port::mavlink_mode()) return;
+    replies |= kReplySystemTime;
     const pipeline::Phase ph = pipe.phase();
     const mav::State state = !imu.ok() || !compass.ok() ? mav::State::Critical
                              : ph == pipeline::Phase::WaitImu ? mav::State::Boot
@@ -250,10 +392,15 @@ void send_heartbeat_and_status() {
     mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
                     fix.fix == gps::FixType::k3D && !fix.glitching);
     mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
+    const airspeed_input::State airspeed = airspeed_input::state();
+    mav::add_sensor(health, mav::kDifferentialPressure, airspeed != airspeed_input::State::kNone,
+                    airspeed == airspeed_input::State::kSensor);
+    const mav::PlaneMode mode = flight_io.plane_mode();
+    mav::add_plane_status(health, mav::PlaneStatus{FlightIo::kEnabled, mode != mav::PlaneMode::Manual,
+                                                   !flight_io.failsafe(), ph == pipeline::Phase::Running});
     mav::add_sensor(health, mav::kBattery, battery_input::enabled(), battery_input::healthy());
     const mav::BatteryReport battery = battery_input::report();
-    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
-                                        flight_io.plane_mode());
+    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state, mode);
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = port::mavlink.sys_status(frame, health,

@@ -25,17 +25,31 @@ uint16_t output_line_bytes();
 // In MAVLink, room in the queue for a frame of frame_bytes and an output line after it.
 bool room_for(uint16_t frame_bytes);
 
-// Loop tasks, each with its budget: a request (PARAM_SET, COMMAND_LONG ...), the
-// defaults' line after PREFLIGHT_STORAGE, a save after a PARAM_SET, one PARAM_VALUE,
-// the RC_CHANNELS + SERVO_OUTPUT_RAW pair at 5 Hz.
+// Loop tasks, each with its budget: a received frame taken (PARAM_SET applied, a
+// command set aside), the command run and ACKed, PREFLIGHT_STORAGE's defaults (restored,
+// then their line), a save after a PARAM_SET, one PARAM_VALUE, the RC_CHANNELS +
+// SERVO_OUTPUT_RAW pair at 5 Hz.
 bool request_due();
 void take_request();
-bool defaults_line_due();
-void say_defaults();
+bool command_due();
+void run_pending_command();
+bool defaults_due();
+void run_defaults();
 bool save_due();
 void save();
 // A save in a pass of its own, as after a PARAM_SET (the compass calibration accepted).
 void save_soon();
+// The answers sent when the output has room, one a run: TIMESYNC, AUTOPILOT_VERSION,
+// MISSION_COUNT / MISSION_ACK (the mission, fence and rally protocols: empty until the
+// board stores missions), SYSTEM_TIME once a second.
+bool reply_due();
+void send_reply();
+// MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN param1 1, ACKed: a watchdog reset once the ACK is out.
+bool reboot_due();
+void reboot();
+// A parameter changed by another path (the console's `set`, a calibration accepted):
+// the ground station is told with a PARAM_VALUE (no-op outside MAVLink: it asks anew).
+void announce_param(uint16_t index);
 bool param_value_due();
 void send_param_value();
 bool streams_due();

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The serial port's language: text (the output mode of the settings: plot, csv, quat,
-// raw, quiet) or MAVLink, and the writing of "# " messages in it. A ground station's
-// HEARTBEAT switches a text mode to MAVLink until reset (not a setting: `save` keeps the
-// mode typed), and a typed `mode` ends it.
+// raw, quiet) or MAVLink, and the writing of "# " messages in it. At power-up the port
+// speaks text unless SERIAL0_PROTOCOL is 1 or 2 (ArduPilot's MAVLink: then MAVLink from
+// the first byte) or the saved mode is `mavlink`. A ground station's HEARTBEAT switches
+// a text mode to MAVLink until reset (not a setting), a typed `mode` sets the mode typed,
+// and three returns in a row in MAVLink (ArduPilot's way into its CLI) give the text
+// console back, in the saved text mode (plot when that is `mavlink`).
 #pragma once
 
 #include <stdint.h>
@@ -20,6 +23,8 @@ fmt::OutputMode output_mode();
 bool mavlink_mode();
 // A ground station's HEARTBEAT arrived (true), or a `mode` was typed (false).
 void set_gcs_link(bool on);
+// Three returns in a row in MAVLink: the text console.
+void escape_to_text();
 
 // text::Sink's write for every "# " message: text, or STATUSTEXT frames in MAVLink.
 void write_message(void*, const char* data, uint8_t len);

@@ -40,6 +40,8 @@ public:
     void start_save(const settings::Settings& s);
     // Every loop iteration: the next byte, or a part of a verification or of a CRC's note.
     void service();
+    // A save is under way (a reboot waits for its end).
+    bool busy() const { return index_ != slots::kSlotSize; }
 
 private:
     enum Stage : uint8_t {

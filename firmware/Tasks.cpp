@@ -98,10 +98,13 @@ static void once_a_second() {
     X(command,      console_link::command_due,       console_link::reply,              5800, kSecCommand,      0)       \
     X(reply,        console_link::reply_due_text,    console_link::reply,              3200, kSecConsoleReply, 0)       \
     X(statustext,   console_link::reply_due_mavlink, console_link::reply,              3000, kSecStatusText,   0)       \
-    X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           5800, kSecGcsRequest,   0)       \
-    X(gcs_defaults, gcs_link::defaults_line_due,     gcs_link::say_defaults,           2300, kSecGcsDefaults,  0)       \
+    X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           1500, kSecGcsRequest,   0)       \
+    X(gcs_command,  gcs_link::command_due,           gcs_link::run_pending_command,    5800, kSecGcsCommand,   0)       \
+    X(gcs_defaults, gcs_link::defaults_due,          gcs_link::run_defaults,           5800, kSecGcsDefaults,  0)       \
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
+    X(gcs_reply,    gcs_link::reply_due,             gcs_link::send_reply,             2000, kSecGcsAnswer,    0)       \
+    X(gcs_reboot,   gcs_link::reboot_due,            gcs_link::reboot,                 6000, kSecGcsAnswer,    0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(gcs_battery,  battery_input::status_due,       battery_input::send_status,       1000, kSecGcsBattery,   0)       \

@@ -24,6 +24,7 @@
 #include "Tasks.h"
 #include "UserCode.h"
 #include "Vehicle.h"
+#include "Version.h"
 
 using namespace vehicle;
 
@@ -37,7 +38,7 @@ void setup() {
     board::init_pins();  // every chip select high before any SPI traffic
     board::set_leds(true, false, false);
     serial_text::begin();
-    say(TXT("# apm25-attitude 0.2.0: APM 2.5, 200 Hz loop\n"
+    say(TXT("# apm25-attitude " APM25_VERSION_TEXT ": APM 2.5, 200 Hz loop\n"
             "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 16 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     store.load(pipe.settings());
     flight_io.begin();  // the outputs from here on (the loaded settings' end points), the receiver

@@ -111,6 +111,19 @@ $(FW_BUILD)/avr/%.cpp.o: %.cpp $(FW_HDR)
 	@mkdir -p $(dir $@)
 	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(FW_DEFS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
 
+# The commit's hash for AUTOPILOT_VERSION (firmware/Version.h: git_version.h when the build
+# has one), rewritten only when HEAD moves, so that only GcsLink is compiled again.
+GIT_VERSION_H := $(FW_BUILD)/avr/gen/git_version.h
+$(GIT_VERSION_H): FORCE
+	@mkdir -p $(dir $@)
+	@h=$$(git rev-parse --short=8 HEAD 2>/dev/null); line="#define APM25_GIT_HASH \"$$h\""; \
+	  [ -n "$$h" ] || line="/* not built from a git checkout */"; \
+	  [ -f $@ ] && [ "$$(cat $@)" = "$$line" ] || echo "$$line" > $@
+$(FW_BUILD)/avr/firmware/GcsLink.cpp.o: $(GIT_VERSION_H)
+$(FW_BUILD)/avr/firmware/GcsLink.cpp.o: AVR_INC += -I$(FW_BUILD)/avr/gen
+.PHONY: FORCE
+FORCE:
+
 $(FW_BUILD)/firmware.elf: $(FW_OBJ) $(BUILD)/avr/core.a
 	$(call say,LINK,$@)
 	$(Q)$(AVR_CXX) $(AVR_LDFLAGS) $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@

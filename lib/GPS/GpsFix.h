@@ -20,6 +20,7 @@ enum class FixType : uint8_t {
 
 struct Fix {
     uint32_t itow_ms = 0;            // GPS time of week of the solution (NAV-* iTOW; NMEA: time of day)
+    uint16_t week = 0;               // GPS week (NAV-SOL week); 0: unknown (NMEA)
     uint32_t received_ms = 0;        // the board's millis() when the solution was complete
     int32_t lat_e7 = 0;              // degrees * 1e7, north positive
     int32_t lon_e7 = 0;              // degrees * 1e7, east positive
@@ -36,5 +37,11 @@ struct Fix {
     bool glitching = false;  // the position jumped further than the last good one, its velocity and
                              // 10 m/s/s explain (AP_GPS_Glitch): do not use lat/lon/alt
 };
+
+// The solution's UNIX time in microseconds, moved on to now_ms on the board's clock
+// (received_ms is the fix's arrival), from the GPS week and time of week: the GPS epoch
+// (1980-01-06, UNIX 315964800 s) less the leap seconds (18 s since 2017, as ArduPilot's
+// GPS_LEAPSECONDS_MILLIS). 0 without a 2D or 3D fix or a week (NMEA).
+uint64_t unix_time_us(const Fix& f, uint32_t now_ms);
 
 }  // namespace gps

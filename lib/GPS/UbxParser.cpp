@@ -89,6 +89,7 @@ UbxParser::Message UbxParser::decode() {
             fix_ok_ = (p[kSolFlags] & kFlagFixOk) != 0;
             fix_.hdop_cm = get_u2(p + kSolPdop);  // pDOP, as ArduPilot's u-blox driver reports it
             fix_.sats = p[kSolNumSv];
+            fix_.week = get_u2(p + kSolWeek);
             return Message::kOther;
         } else if (id_ == kNavVelned && length_ == kLenNavVelned) {
             vel_itow_ = get_u4(p + kVelnedItow);

@@ -67,7 +67,7 @@ constexpr uint16_t kLenCfgSbas = 8;
 // Payload offsets of the fields decoded (the same sections).
 constexpr uint8_t kPosllhItow = 0, kPosllhLon = 4, kPosllhLat = 8, kPosllhHmsl = 16, kPosllhHacc = 20;
 constexpr uint8_t kStatusItow = 0, kStatusFix = 4, kStatusFlags = 5;
-constexpr uint8_t kSolItow = 0, kSolFix = 10, kSolFlags = 11, kSolPdop = 44, kSolNumSv = 47;
+constexpr uint8_t kSolItow = 0, kSolWeek = 8, kSolFix = 10, kSolFlags = 11, kSolPdop = 44, kSolNumSv = 47;
 constexpr uint8_t kVelnedItow = 0, kVelnedN = 4, kVelnedGspeed = 20, kVelnedHeading = 24, kVelnedSacc = 28;
 constexpr uint8_t kNav5Mask = 0, kNav5DynModel = 2;
 constexpr uint8_t kFlagFixOk = 0x01;  // NAV-STATUS and NAV-SOL flags bit 0: gpsFixOk

@@ -23,7 +23,7 @@ enum Part : uint8_t {
     // 15..39 are the firmware's (firmware/Board.h).
     kGpsAid = 40,         // a GPS fix into the estimator (Pipeline::on_gps_fix, 5 Hz)
     kBaroCompensation = 46,  // lib/MS5611: a D2's temperature terms or a D1's pressure (in the baro task)
-    kBoardFrame = 52,     // the accelerometer's calibration and the board's orientation on a sample (Pipeline)
+    kBoardFrame = 41,     // the accelerometer's calibration and the board's orientation on a sample (Pipeline)
 };
 
 // The byte the firmware paints its free RAM with at start-up (firmware/StackPaint.cpp):

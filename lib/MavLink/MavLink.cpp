@@ -72,9 +72,35 @@ static_assert(kBattery == (uint32_t)MAV_SYS_STATUS_SENSOR_BATTERY, "MAV_SYS_STAT
 // are sent 0 and trimmed (MAVLink 2 drops trailing zero bytes).
 static_assert(kBatteryStatusFrame == kFrameOverhead + 41 && kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_BATTERY_STATUS_LEN,
               "BATTERY_STATUS fits kMaxFrame");
+static_assert(kDifferentialPressure == (uint32_t)MAV_SYS_STATUS_SENSOR_DIFFERENTIAL_PRESSURE &&
+                  kAngularRateControl == (uint32_t)MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL &&
+                  kAttitudeStabilization == (uint32_t)MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION &&
+                  kYawPosition == (uint32_t)MAV_SYS_STATUS_SENSOR_YAW_POSITION &&
+                  kMotorOutputs == (uint32_t)MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS &&
+                  kRcReceiver == (uint32_t)MAV_SYS_STATUS_SENSOR_RC_RECEIVER &&
+                  kGeofence == (uint32_t)MAV_SYS_STATUS_GEOFENCE && kAhrs == (uint32_t)MAV_SYS_STATUS_AHRS,
+              "the plane's SYS_STATUS bits are MAV_SYS_STATUS_SENSOR's");
 static_assert(kCmdDoSetHome == MAV_CMD_DO_SET_HOME && kCmdGetHomePosition == MAV_CMD_GET_HOME_POSITION &&
                   kCmdRequestMessage == MAV_CMD_REQUEST_MESSAGE && kMsgHomePosition == MAVLINK_MSG_ID_HOME_POSITION,
               "the position commands' values");
+static_assert(kMsgMissionRequestList == MAVLINK_MSG_ID_MISSION_REQUEST_LIST &&
+                  kMsgMissionCount == MAVLINK_MSG_ID_MISSION_COUNT &&
+                  kMsgMissionClearAll == MAVLINK_MSG_ID_MISSION_CLEAR_ALL && kMsgTimesync == MAVLINK_MSG_ID_TIMESYNC &&
+                  kMsgAutopilotVersion == MAVLINK_MSG_ID_AUTOPILOT_VERSION &&
+                  kCmdRequestAutopilotCapabilities == MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES &&
+                  kCmdPreflightRebootShutdown == MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN,
+              "the conversation's message and command ids");
+static_assert(kCapabilities == (MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT | MAV_PROTOCOL_CAPABILITY_MAVLINK2) &&
+                  kVersionTypeOfficial == FIRMWARE_VERSION_TYPE_OFFICIAL &&
+                  (uint8_t)MissionResult::Unsupported == MAV_MISSION_UNSUPPORTED &&
+                  (uint8_t)MissionResult::Accepted == MAV_MISSION_ACCEPTED,
+              "capabilities, version type and mission results are MAVLink's");
+static_assert(kRxPayloadMax >= MAVLINK_MSG_ID_MISSION_COUNT_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_TIMESYNC_LEN &&
+                  kRxPayloadMax >= MAVLINK_MSG_ID_MISSION_REQUEST_LIST_LEN,
+              "the conversation's received payloads fit");
+static_assert(kFrameOverhead + MAVLINK_MSG_ID_TIMESYNC_LEN <= kMaxFrame &&
+                  kFrameOverhead + MAVLINK_MSG_ID_SYSTEM_TIME_LEN <= kMaxFrame,
+              "TIMESYNC and SYSTEM_TIME fit kMaxFrame");
 // Whole frames fit kMaxFrame: GPS_RAW_INT with its extensions (64), GLOBAL_POSITION_INT
 // (40), VFR_HUD (32); HOME_POSITION without its time_usec extension, which is sent 0
 // and so trimmed (MAVLink 2 drops trailing zero bytes).
@@ -125,19 +151,29 @@ float yaw_rad(float heading_deg) {
 }  // namespace
 
 Health health(bool mpu_present, bool mpu_ok, bool mag_present, bool mag_ok) {
-    const uint32_t mpu = kGyro3d | kAccel3d;
-    Health h{0u, 0u};
-    if (mpu_present) h.present |= mpu;
-    if (mpu_present && mpu_ok) h.healthy |= mpu;
-    if (mag_present) h.present |= kMag3d;
-    if (mag_present && mag_ok) h.healthy |= kMag3d;
+    Health h{0u, 0u, 0u};
+    add_sensor(h, kGyro3d | kAccel3d, mpu_present, mpu_ok);
+    add_sensor(h, kMag3d, mag_present, mag_ok);
     return h;
 }
 
 void add_sensor(Health& h, uint32_t bits, bool present, bool ok) {
     if (!present) return;
     h.present |= bits;
+    h.enabled |= bits;
     if (ok) h.healthy |= bits;
+}
+
+void add_plane_status(Health& h, const PlaneStatus& p) {
+    add_sensor(h, kAhrs, true, p.ahrs_ok);
+    h.healthy |= kGeofence;
+    if (!p.flight) return;
+    const uint32_t control = kAngularRateControl | kAttitudeStabilization;
+    h.present |= control | kYawPosition;
+    h.healthy |= control | kYawPosition;
+    if (p.stabilizing) h.enabled |= control;
+    add_sensor(h, kMotorOutputs, true, true);
+    add_sensor(h, kRcReceiver, true, p.receiver_ok);
 }
 
 uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode) {
@@ -166,7 +202,7 @@ uint8_t Packer::sys_status(uint8_t out[kMaxFrame], const Health& h, uint16_t loa
     const uint16_t mv = battery ? battery->voltage_mv : UINT16_MAX;
     const int16_t ca = battery ? battery->current_ca : (int16_t)-1;
     const int8_t pct = battery ? battery->remaining_pct : (int8_t)-1;
-    mavlink_msg_sys_status_pack_status(kSystemId, kComponentId, &f.status, &f.msg, h.present, h.present,
+    mavlink_msg_sys_status_pack_status(kSystemId, kComponentId, &f.status, &f.msg, h.present, h.enabled,
                                        h.healthy, load, mv, ca, pct, 0u, 0u, errors, 0u, 0u, 0u, 0u,
                                        0u, 0u);
     return f.finish(out, seq_);
@@ -442,6 +478,16 @@ uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
         case MAVLINK_MSG_ID_COMMAND_ACK:  // MAVProxy's accelcal confirms a position with one
             max_len = MAVLINK_MSG_ID_COMMAND_ACK_LEN;
             return MAVLINK_MSG_ID_COMMAND_ACK_CRC;
+        case MAVLINK_MSG_ID_MISSION_REQUEST_LIST:
+            max_len = MAVLINK_MSG_ID_MISSION_REQUEST_LIST_LEN;
+            return MAVLINK_MSG_ID_MISSION_REQUEST_LIST_CRC;
+        case MAVLINK_MSG_ID_MISSION_COUNT:
+            max_len = MAVLINK_MSG_ID_MISSION_COUNT_LEN;
+            return MAVLINK_MSG_ID_MISSION_COUNT_CRC;
+        case MAVLINK_MSG_ID_MISSION_CLEAR_ALL:
+            max_len = MAVLINK_MSG_ID_MISSION_CLEAR_ALL_LEN;
+            return MAVLINK_MSG_ID_MISSION_CLEAR_ALL_CRC;
+        case MAVLINK_MSG_ID_TIMESYNC: max_len = MAVLINK_MSG_ID_TIMESYNC_LEN; return MAVLINK_MSG_ID_TIMESYNC_CRC;
         default: return 0;
     }
 }
@@ -591,6 +637,80 @@ bool decode_command_long(const Received& rx, CommandLong& out) {
     out.param[5] = m.param6;
     out.param[6] = m.param7;
     return true;
+}
+
+bool decode_mission_request_list(const Received& rx, uint8_t& mission_type) {
+    if (rx.msgid != kMsgMissionRequestList) return false;
+    mavlink_mission_request_list_t m;
+    copy_payload(m, rx);
+    mission_type = m.mission_type;
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_mission_count(const Received& rx, uint16_t& count, uint8_t& mission_type) {
+    if (rx.msgid != kMsgMissionCount) return false;
+    mavlink_mission_count_t m;
+    copy_payload(m, rx);
+    count = m.count;
+    mission_type = m.mission_type;
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_mission_clear_all(const Received& rx, uint8_t& mission_type) {
+    if (rx.msgid != kMsgMissionClearAll) return false;
+    mavlink_mission_clear_all_t m;
+    copy_payload(m, rx);
+    mission_type = m.mission_type;
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_timesync_request(const Received& rx, int64_t& ts1) {
+    if (rx.msgid != kMsgTimesync) return false;
+    mavlink_timesync_t m;
+    copy_payload(m, rx);
+    ts1 = m.ts1;
+    return m.tc1 == 0;
+}
+
+uint8_t Packer::mission_count(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t count,
+                              uint8_t mission_type) {
+    Frame f(seq_);
+    mavlink_msg_mission_count_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system, target_component,
+                                          count, mission_type);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::mission_ack(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component,
+                            MissionResult result, uint8_t mission_type) {
+    Frame f(seq_);
+    mavlink_msg_mission_ack_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system, target_component,
+                                        (uint8_t)result, mission_type);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::timesync(uint8_t out[kMaxFrame], int64_t tc1_ns, int64_t ts1) {
+    Frame f(seq_);
+    mavlink_msg_timesync_pack_status(kSystemId, kComponentId, &f.status, &f.msg, tc1_ns, ts1);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::system_time(uint8_t out[kMaxFrame], uint64_t time_unix_us, uint32_t time_boot_ms) {
+    Frame f(seq_);
+    mavlink_msg_system_time_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_unix_us, time_boot_ms);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::autopilot_version(uint8_t out[kMaxFrame], const Version& v) {
+    Frame f(seq_);
+    const uint32_t sw = (uint32_t)v.major << 24 | (uint32_t)v.minor << 16 | (uint32_t)v.patch << 8 |
+                        kVersionTypeOfficial;
+    const uint8_t none[18] = {};
+    mavlink_msg_autopilot_version_pack_status(kSystemId, kComponentId, &f.status, &f.msg, kCapabilities, sw, 0u, 0u,
+                                              0u, v.git, none, none, kUsbVendorId, kUsbProductId, 0u, none);
+    // The trimmed payload ends within flight_custom_version (byte 44): no uid, no
+    // middleware or OS version, zeros after it.
+    if (kFrameOverhead + f.msg.len > kMaxFrame) return 0;
+    return f.finish(out, seq_);
 }
 
 uint8_t Packer::scaled_pressure(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float pressure_pa, float temperature_c) {

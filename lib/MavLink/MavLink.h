@@ -94,11 +94,21 @@ constexpr uint32_t kGyro3d = 1u;
 constexpr uint32_t kAccel3d = 2u;
 constexpr uint32_t kMag3d = 4u;
 constexpr uint32_t kAbsolutePressure = 8u;
+constexpr uint32_t kDifferentialPressure = 16u;
 constexpr uint32_t kGps = 32u;
 constexpr uint32_t kBattery = 0x2000000u;  // MAV_SYS_STATUS_SENSOR_BATTERY
+// ... and the controllers and the rest ArduPlane reports (MAV_SYS_STATUS_SENSOR_*).
+constexpr uint32_t kAngularRateControl = 0x400u;
+constexpr uint32_t kAttitudeStabilization = 0x800u;
+constexpr uint32_t kYawPosition = 0x1000u;
+constexpr uint32_t kMotorOutputs = 0x8000u;
+constexpr uint32_t kRcReceiver = 0x10000u;
+constexpr uint32_t kGeofence = 0x100000u;
+constexpr uint32_t kAhrs = 0x200000u;
 
 struct Health {
-    uint32_t present;  // sensor bits found at start-up (also reported as enabled)
+    uint32_t present;  // sensor bits found at start-up
+    uint32_t enabled;  // ... in use now (a sensor: when present; a controller: in the modes that use it)
     uint32_t healthy;  // sensor bits answering with plausible data now
 };
 // The MPU6000 is both the 3D gyro and the 3D accelerometer.
@@ -136,6 +146,23 @@ struct BatteryReport {
 // The monitor's readings (BATT_MONITOR 0: all unknown), rounded and held within the fields.
 BatteryReport battery_report(const battery::Monitor& m, const battery::Settings& s);
 constexpr uint8_t kBatteryStatusFrame = kFrameOverhead + 41;  // at most: the extensions after charge_state are 0
+// What ArduPlane's SYS_STATUS says beyond the sensors (GCS_Plane's
+// update_sensor_status_flags), for a board that flies (the attitude-only build: only the
+// AHRS and the fence bit).
+struct PlaneStatus {
+    bool flight;          // the flight build: receiver, outputs and controllers present
+    bool stabilizing;     // a mode whose controllers fly the attitude (STABILIZE, the failsafe's FBWA)
+    bool receiver_ok;     // good receiver frames (not in the receiver failsafe)
+    bool ahrs_ok;         // the estimator running
+};
+// Adds the controllers' bits: angular rate control and attitude stabilisation present,
+// enabled in a stabilizing mode, healthy; yaw position present (enabled only by
+// navigation modes, which the board has not); motor outputs present, enabled (no safety
+// switch on the APM 2.5) and healthy; the RC receiver healthy when its frames are good;
+// the AHRS healthy when running. The geofence's health bit is set, as ArduPlane does
+// whenever no fence is breached (no fence: never): MAVProxy says "fence breach" when a
+// SYS_STATUS lacks it.
+void add_plane_status(Health& h, const PlaneStatus& p);
 
 // GLOBAL_POSITION_INT's and VFR_HUD's fields (the firmware's Position module fills them).
 struct PositionReport {
@@ -149,6 +176,24 @@ struct PositionReport {
     float climb_m_s;             // up positive
     uint8_t throttle_pct;
 };
+
+// MISSION_ACK's type (MAV_MISSION_RESULT).
+enum class MissionResult : uint8_t { Accepted = 0, Unsupported = 3 };
+
+// AUTOPILOT_VERSION's contents. flight_sw_version is ArduPilot's packing: major << 24 |
+// minor << 16 | patch << 8 | FIRMWARE_VERSION_TYPE (MAVProxy's decode_flight_sw_version).
+struct Version {
+    uint8_t major, minor, patch;
+    uint8_t git[8];  // the first 8 characters of the commit's hash (ArduPilot's GIT_VERSION), or zeros
+};
+constexpr uint8_t kVersionTypeOfficial = 255;  // FIRMWARE_VERSION_TYPE_OFFICIAL
+// What the board supports (MAV_PROTOCOL_CAPABILITY): PARAM_FLOAT (values as floats) and
+// MAVLINK2 (it speaks only MAVLink 2). Not MISSION_INT (no mission yet), COMMAND_INT
+// (add it when the board takes COMMAND_INT), FTP, SET_*_TARGET.
+constexpr uint32_t kCapabilities = 0x2u | 0x2000u;
+// The USB ids the APM 2.5's ATmega32U2 enumerates with (the Arduino Mega 2560's).
+constexpr uint16_t kUsbVendorId = 0x2341u;
+constexpr uint16_t kUsbProductId = 0x0010u;
 
 // Packs messages; one sequence counter across all of them (a GCS counts gaps as loss).
 // Each call writes one frame into `out` and returns its length (0 only on bad input).
@@ -205,6 +250,18 @@ public:
     // MAG_CAL_REPORT, compass 0: orientation unchanged (ROTATION_NONE, confidence 0), no
     // scale factor (0).
     uint8_t mag_cal_report(uint8_t out[kMaxFrame], const MagCalReport& r);
+    // MISSION_COUNT and MISSION_ACK to the ground station that asked (the mission, fence
+    // and rally protocols: every list is empty until the board stores missions).
+    uint8_t mission_count(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t count,
+                          uint8_t mission_type);
+    uint8_t mission_ack(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, MissionResult result,
+                        uint8_t mission_type);
+    // TIMESYNC: tc1 the board's clock in ns, ts1 the request's echoed (ArduPilot's answer).
+    uint8_t timesync(uint8_t out[kMaxFrame], int64_t tc1_ns, int64_t ts1);
+    // SYSTEM_TIME: UNIX time in us (0: unknown, no GPS time yet) and the board's clock.
+    uint8_t system_time(uint8_t out[kMaxFrame], uint64_t time_unix_us, uint32_t time_boot_ms);
+    // AUTOPILOT_VERSION: kCapabilities, the version packed as ArduPilot does, the git hash.
+    uint8_t autopilot_version(uint8_t out[kMaxFrame], const Version& v);
     uint8_t next_sequence() const { return seq_; }
 
 private:
@@ -259,6 +316,10 @@ enum MsgId : uint8_t {
     kMsgParamSet = 23,
     kMsgCommandLong = 76,
     kMsgCommandAck = 77,
+    kMsgMissionRequestList = 43,
+    kMsgMissionCount = 44,
+    kMsgMissionClearAll = 45,
+    kMsgTimesync = 111,
 };
 constexpr uint8_t kRxPayloadMax = 33;  // COMMAND_LONG's, the longest of them
 
@@ -332,6 +393,13 @@ bool decode_command_long(const Received& rx, CommandLong& out);
 // command is the position's number); not addressed, so not checked.
 bool decode_command_ack(const Received& rx, uint16_t& command, uint8_t& result);
 
+// The mission protocols' requests: mission_type 0 mission, 1 fence, 2 rally (MAV_MISSION_TYPE).
+bool decode_mission_request_list(const Received& rx, uint8_t& mission_type);
+bool decode_mission_count(const Received& rx, uint16_t& count, uint8_t& mission_type);
+bool decode_mission_clear_all(const Received& rx, uint8_t& mission_type);
+// TIMESYNC: a request (tc1 0) to answer; false for a reply to someone else's request.
+bool decode_timesync_request(const Received& rx, int64_t& ts1);
+
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;
 constexpr uint16_t kCmdPreflightStorage = 245;
@@ -350,5 +418,8 @@ constexpr uint16_t kCmdDoCancelMagCal = 42426;
 constexpr uint16_t kCmdAccelcalVehiclePos = 42429;
 constexpr float kAccelcalSuccess = 16777215.0f;
 constexpr float kAccelcalFailed = 16777216.0f;
+constexpr uint16_t kCmdRequestAutopilotCapabilities = 520;  // answered with AUTOPILOT_VERSION
+constexpr uint16_t kCmdPreflightRebootShutdown = 246;       // param1 1: reboot (a watchdog reset)
+constexpr uint8_t kMsgAutopilotVersion = 148;               // ... and REQUEST_MESSAGE 148
 
 }  // namespace mav

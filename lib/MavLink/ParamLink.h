@@ -39,21 +39,25 @@ int16_t requested_index(const ParamRequest& r);
 int16_t apply_param_set(settings::Settings& s, const ParamSet& p, bool& changed);
 
 // The PARAM_VALUE replies still to send: the whole list (after PARAM_REQUEST_LIST, from
-// index 0; a new request starts it over) and a few single ones (READ, SET), those first.
-// Single replies beyond kSingles are dropped (a ground station asks again on its time-out).
+// index 0; a new request starts it over) and single ones, those first, lowest index
+// first. A single one is a bit per parameter: a burst of PARAM_SETs (or READs, or a
+// parameter changed by the console, the defaults, a calibration) is each answered once,
+// however many come before the link has room, in ~kMaxParams / 8 bytes of RAM.
 class ParamReplies {
 public:
-    static constexpr uint8_t kSingles = 4;
+    static constexpr uint16_t kMaxParams = 192;  // params::count() must stay below (a test holds it)
     void request_all();
     void request_one(uint16_t index);
+    // Every parameter once (the defaults restored: ArduPilot resends the list too).
+    void request_every_one();
     // The next index to send; false when none is pending.
     bool peek(uint16_t& index) const;
     void pop();  // the peeked one was sent
     uint16_t count() const { return count_; }  // params::count(), taken at a request
 
 private:
-    uint8_t singles_[kSingles] = {};
-    uint8_t single_count_ = 0;
+    uint8_t pending_[kMaxParams / 8] = {};
+    uint8_t singles_ = 0;  // bits set in pending_
     uint8_t next_of_list_ = kNone;
     uint8_t count_ = 0;
     static constexpr uint8_t kNone = 0xFF;  // params::count() < 255

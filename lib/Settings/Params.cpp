@@ -379,6 +379,14 @@ const Row kRows[] PARAM_TABLE = {
 
     // Telemetry rates.
 
+    // Serial port.
+    {"SERIAL0_PROTOCOL", Type::UInt8, 0, 1, 0, AT(vehicle.serial0_protocol), 0.0f, 2.0f, 0.0f,
+     PARAM_DOC("USB console protocol", "",
+               "0: the text console of the README (the Arduino Serial Monitor's), switched to MAVLink by a "
+               "ground station's first HEARTBEAT; 1 or 2 (ArduPilot's MAVLink1/MAVLink2): MAVLink from "
+               "power-up, so a ground station that only listens hears the board (the frames are MAVLink 2 "
+               "for either). Three returns in a row in MAVLink give the text console until the next start.")},
+
 };
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);

@@ -37,6 +37,12 @@ struct VehicleSettings {
     battery::Settings battery;  // BATT_MONITOR .. FS_BATT_MAH (lib/Battery/BatterySettings.h)
 
     // Telemetry rates (GCS_MAVLink's SRn_*).
+
+    // Serial port (AP_SerialManager's SERIALn_*).
+    uint8_t serial0_protocol;   // SERIAL0_PROTOCOL: kSerialConsole, or 1/2 MAVLink from power-up
 };
+
+// SERIAL0_PROTOCOL's values: ArduPilot's SerialProtocol_Console (0), _MAVLink (1), _MAVLink2 (2).
+constexpr uint8_t kSerialConsole = 0;
 
 }  // namespace settings

@@ -149,6 +149,14 @@ avr_cycle_count_t link_timer(avr_t*, avr_cycle_count_t, void* param) {
     return static_cast<Board*>(param)->on_link_tick();
 }
 volatile std::sig_atomic_t g_stop_requested = 0;
+// simavr's avr_reset (the watchdog's reset: the firmware's reboot command) clears every
+// cycle timer: the core's reset hook re-arms the board's own (sensors, link, GPS, PPM).
+Board* g_reset_board = nullptr;
+void (*g_core_reset)(avr_t*) = nullptr;
+void core_reset_hook(avr_t* avr) {
+    if (g_core_reset) g_core_reset(avr);
+    if (g_reset_board) g_reset_board->on_core_reset();
+}
 avr_cycle_count_t uart_input_start_timer(avr_t*, avr_cycle_count_t, void* param) {
     static_cast<Board*>(param)->on_uart_input_tick();  // starts the input if not yet
     return 0;
@@ -262,6 +270,9 @@ bool Board::init() {
     avr_->vcc = avr_->avcc = avr_->aref = 5000;
     if (!load_eeprom()) return false;
     avr_->sleep = no_sleep;  // else simavr sleeps in wall-clock time when the core idles
+    g_reset_board = this;
+    g_core_reset = avr_->reset;
+    avr_->reset = core_reset_hook;
     avr_->log = LOG_WARNING;
 
     // External interrupts INT0-7: a low level raises its interrupt once, not again at every
@@ -363,6 +374,18 @@ bool Board::init() {
     }
     update_pins();
     return true;
+}
+
+void Board::on_core_reset() {
+    ++core_resets_;
+    std::fprintf(stderr, "apm25sim: t=%.6f s: the AVR was reset (watchdog)\n", time_s());
+    avr_cycle_timer_register(avr_, 1, sensor_timer, this);
+    if (options_.serial || options_.speed > 0.0) avr_cycle_timer_register(avr_, 1, link_timer, this);
+    input_timer_armed_ = false;
+    gps_timer_at_ = 0;
+    if (gps_) arm_gps_timer();
+    ppm_pending_ = false;
+    schedule_ppm_edge();
 }
 
 bool Board::run(double seconds) {

@@ -144,6 +144,8 @@ public:
     uint64_t on_sensor_tick();
     uint64_t on_uart_input_tick();
     void on_uart_input_timer_ended() { input_timer_armed_ = false; }
+    // simavr reset the core (the watchdog): the board's cycle timers again.
+    void on_core_reset();
     uint64_t on_link_tick();
     void set_uart_input_held(bool held) { uart_input_held_ = held; }
     void on_gpior_write(bool end, uint8_t value);
@@ -229,6 +231,7 @@ private:
     size_t input_pos_ = 0;
     uint64_t input_consumed_ = 0;         // bytes typed and dropped from `input` (a live client's)
     bool input_timer_armed_ = false;      // uart_input_timer is registered
+    unsigned core_resets_ = 0;            // watchdog resets seen
     Pacer pacer_{0.0};
 
     // The GPS port (UART1): the firmware's USART1 receiving the module's line, and the

@@ -55,9 +55,11 @@ inline Bytes velned(uint32_t itow, int32_t n, int32_t e, int32_t d, uint32_t gsp
     return frame(gps::ubx::kClassNav, gps::ubx::kNavVelned, p);
 }
 
-inline Bytes sol(uint32_t itow, uint8_t gps_fix, uint8_t flags, uint8_t num_sv, uint16_t pdop) {
+inline Bytes sol(uint32_t itow, uint8_t gps_fix, uint8_t flags, uint8_t num_sv, uint16_t pdop, uint16_t week = 0) {
     Bytes p(gps::ubx::kLenNavSol, 0);
     for (int i = 0; i < 4; ++i) p[(size_t)i] = (uint8_t)(itow >> (8 * i));
+    p[gps::ubx::kSolWeek] = (uint8_t)week;
+    p[gps::ubx::kSolWeek + 1] = (uint8_t)(week >> 8);
     p[gps::ubx::kSolFix] = gps_fix;
     p[gps::ubx::kSolFlags] = flags;
     p[gps::ubx::kSolPdop] = (uint8_t)pdop;

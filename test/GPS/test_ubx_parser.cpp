@@ -77,6 +77,28 @@ TEST(UbxParser, DecodesAnEpoch) {
     EXPECT_EQ(p.counters().frames, 3u);
 }
 
+TEST(UbxParser, TheWeekOfNavSolGivesUnixTime) {
+    gps::Fix work;
+    UbxParser p(work);
+    // GPS week 1760, 399616370 ms into it (the simulator's start): the GPS epoch's UNIX
+    // 315964800 s + 1760 weeks + 399616.370 s - 18 leap seconds = 1380812398.370 s; 250 ms
+    // after the fix arrived, 0.25 s later.
+    const Bytes bytes = cat({gpstest::posllh(399616370, -71350450, -731194210, 1028300, 1200),
+                             gpstest::sol(399616370, 3, 0x0D, 9, 180, 1760),
+                             gpstest::velned(399616370, -150, 250, -30, 292, 12103000)});
+    const std::vector<Msg> got = feed(p, bytes);
+    ASSERT_EQ(got.back(), Msg::kFix);
+    gps::Fix f = p.fix();
+    EXPECT_EQ(f.week, 1760u);
+    f.received_ms = 5000u;
+    EXPECT_EQ(gps::unix_time_us(f, 5250u), 1380812398620000ull);
+    f.fix = FixType::kNoFix;
+    EXPECT_EQ(gps::unix_time_us(f, 5250u), 0u) << "no fix: no time";
+    f.fix = FixType::k3D;
+    f.week = 0;
+    EXPECT_EQ(gps::unix_time_us(f, 5250u), 0u) << "no week (NMEA): no time";
+}
+
 // A frame split between two reads at every byte decodes the same.
 TEST(UbxParser, FramesSplitAtEveryByte) {
     const Bytes bytes = gpstest::epoch(5000, 71350450, -731194210, 1500);

@@ -183,6 +183,30 @@ TEST(MavLink, SysStatusReportsSensorBitsLoadAndNoBattery) {
     EXPECT_EQ(u8(f.payload, 30), 0xFFu);     // battery_remaining -1
 }
 
+TEST(MavLink, SysStatusHasArduPlanesControllerBitsAndTheFenceHealthy) {
+    mav::Health h = mav::health(true, true, true, true);
+    mav::add_plane_status(h, mav::PlaneStatus{true, false, true, true});  // MANUAL, receiver good
+    const uint32_t control = mav::kAngularRateControl | mav::kAttitudeStabilization;
+    EXPECT_EQ(h.present, 7u | control | mav::kYawPosition | mav::kMotorOutputs | mav::kRcReceiver | mav::kAhrs);
+    EXPECT_EQ(h.enabled, 7u | mav::kMotorOutputs | mav::kRcReceiver | mav::kAhrs) << "MANUAL: no controller";
+    EXPECT_EQ(h.healthy, h.present | mav::kGeofence) << "MAVProxy: no fence bit in health is a breach";
+    mav::Health s = mav::health(true, true, true, true);
+    mav::add_plane_status(s, mav::PlaneStatus{true, true, false, false});  // STABILIZE, no receiver, no AHRS
+    EXPECT_EQ(s.enabled & control, control);
+    EXPECT_EQ(s.healthy & (mav::kRcReceiver | mav::kAhrs), 0u);
+    EXPECT_EQ(s.healthy & mav::kGeofence, mav::kGeofence);
+    mav::Health a = mav::health(true, true, true, true);
+    mav::add_plane_status(a, mav::PlaneStatus{false, false, false, true});  // the attitude-only build
+    EXPECT_EQ(a.present, 7u | mav::kAhrs);
+    EXPECT_EQ(a.healthy, 7u | mav::kAhrs | mav::kGeofence);
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const Frame f = parse(buf, p.sys_status(buf, h, 100u, 0u), kExtraSysStatus);
+    EXPECT_EQ(u32(f.payload, 0), h.present);
+    EXPECT_EQ(u32(f.payload, 4), h.enabled);
+    EXPECT_EQ(u32(f.payload, 8), h.healthy);
+}
+
 TEST(MavLink, SysStatusWithoutTheMpuHasOnlyTheCompass) {
     const mav::Health h = mav::health(false, false, true, true);
     EXPECT_EQ(h.present, mav::kMag3d);
@@ -549,6 +573,40 @@ TEST(MavLinkParser, CommandLongDecodes) {
     EXPECT_EQ(c.param[6], 0.0f);
 }
 
+TEST(MavLinkParser, MissionRequestsAndTimesyncDecode) {
+    // CRC_EXTRA (common.xml): MISSION_REQUEST_LIST 132, MISSION_COUNT 221, MISSION_CLEAR_ALL 232, TIMESYNC 34.
+    mav::Parser parser;
+    Bytes in = frame_v2(43, 132, Bytes{1, 1, 2});            // rally list, for us
+    const Bytes count = frame_v2(44, 221, Bytes{3, 0, 1, 0, 1});  // 3 fence items, for us
+    in.insert(in.end(), count.begin(), count.end());
+    const Bytes other = frame_v2(45, 232, Bytes{7, 1, 0});   // a clear for system 7: not ours
+    in.insert(in.end(), other.begin(), other.end());
+    Bytes ts;
+    for (int i = 0; i < 8; ++i) ts.push_back(0);              // tc1 0: a request
+    for (int i = 0; i < 8; ++i) ts.push_back((uint8_t)(0x11 * (i + 1)));
+    const Bytes tsf = frame_v2(111, 34, ts);
+    in.insert(in.end(), tsf.begin(), tsf.end());
+    ts[0] = 1;                                                // tc1 set: someone's reply, not answered
+    const Bytes tsr = frame_v2(111, 34, ts);
+    in.insert(in.end(), tsr.begin(), tsr.end());
+    const auto got = feed(parser, in);
+    ASSERT_EQ(got.size(), 5u);
+    EXPECT_EQ(parser.bad_crc(), 0u);
+    uint8_t type = 99;
+    uint16_t n = 0;
+    EXPECT_TRUE(mav::decode_mission_request_list(got[0], type));
+    EXPECT_EQ(type, 2u);
+    EXPECT_FALSE(mav::decode_mission_count(got[0], n, type));
+    EXPECT_TRUE(mav::decode_mission_count(got[1], n, type));
+    EXPECT_EQ(n, 3u);
+    EXPECT_EQ(type, 1u);
+    EXPECT_FALSE(mav::decode_mission_clear_all(got[2], type));
+    int64_t ts1 = 0;
+    EXPECT_TRUE(mav::decode_timesync_request(got[3], ts1));
+    EXPECT_EQ((uint64_t)ts1, 0x8877665544332211ull);
+    EXPECT_FALSE(mav::decode_timesync_request(got[4], ts1));
+}
+
 // --- Outgoing replies and streams ------------------------------------------------------
 
 TEST(MavLink, ParamValueCommandAckRcChannelsServoOutputRawOnTheWire) {
@@ -873,15 +931,35 @@ TEST(ParamLink, RepliesSinglesFirstThenTheWholeListOnce) {
     std::vector<uint16_t> list(sent.begin() + 1, sent.begin() + 5);
     list.insert(list.end(), sent.begin() + 6, sent.end());
     for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(list[i], i);
-    // More singles than it holds: the extra ones are dropped, none repeated.
-    for (uint16_t i = 0; i < 10; ++i) r.request_one(i);
-    unsigned n = 0;
+    // A burst (20 PARAM_SETs before the link has room for one reply, each asked twice):
+    // every one answered, once, lowest index first (issue 46: 20 sent, 4 answered).
+    for (int pass = 0; pass < 2; ++pass)
+        for (uint16_t i = 0; i < 20; ++i) r.request_one((uint16_t)(params::count() - 1u - i * 3u));
+    std::vector<uint16_t> burst;
     while (r.peek(index)) {
-        EXPECT_EQ(index, n);
+        burst.push_back(index);
         r.pop();
-        ++n;
+        ASSERT_LT(burst.size(), 400u);
     }
-    EXPECT_EQ(n, (unsigned)mav::ParamReplies::kSingles);
+    ASSERT_EQ(burst.size(), 20u);
+    for (size_t k = 0; k < burst.size(); ++k) EXPECT_EQ(burst[k], params::count() - 1u - (19u - k) * 3u);
+}
+
+TEST(ParamLink, EveryParameterFitsTheRepliesBitmapAndIsSentOnce) {
+    ASSERT_LE(params::count(), (uint16_t)mav::ParamReplies::kMaxParams);
+    mav::ParamReplies r;
+    r.request_one(5);
+    r.request_every_one();  // the defaults restored: every parameter announced
+    std::vector<int> seen(params::count(), 0);
+    uint16_t index = 0;
+    while (r.peek(index)) {
+        ASSERT_LT(index, params::count());
+        ++seen[index];
+        r.pop();
+    }
+    for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(seen[i], 1) << i;
+    r.request_one((uint16_t)mav::ParamReplies::kMaxParams);  // past the bitmap: ignored, never written past it
+    EXPECT_FALSE(r.peek(index));
 }
 
 // --- The parameter reference's table (docs/parameters.md) ----------------------------------

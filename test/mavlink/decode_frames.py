@@ -29,7 +29,8 @@ def main():
     types = [m.get_type() for m in msgs]
     want = ["HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT",
             "HEARTBEAT", "PARAM_VALUE", "COMMAND_ACK", "RC_CHANNELS", "SERVO_OUTPUT_RAW",
-            "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION"]
+            "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION",
+            "AUTOPILOT_VERSION", "MISSION_COUNT", "MISSION_ACK", "TIMESYNC", "SYSTEM_TIME"]
     soft_assert(types == want, "message order %r, expected %r" % (types, want))
     if types != want:
         return
@@ -83,6 +84,21 @@ def main():
                 "VFR_HUD %r" % hud)
     soft_assert(home.latitude == 71350450 and home.longitude == -731194210 and home.altitude == 1028000
                 and list(home.q) == [1.0, 0.0, 0.0, 0.0] and home.time_usec == 0, "HOME_POSITION %r" % home)
+
+    ver, count, mack, ts, st = msgs[16:21]
+    from MAVProxy.modules.lib.mp_util import decode_flight_sw_version
+    soft_assert(decode_flight_sw_version(ver.flight_sw_version) == (1, 2, 3, "official")
+                and bytes(ver.flight_custom_version) == b"0123abcd"
+                and ver.capabilities == (mavlink2.MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+                                         | mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2)
+                and ver.vendor_id == 0x2341 and ver.product_id == 0x0010 and ver.uid == 0,
+                "AUTOPILOT_VERSION %r (MAVProxy decodes %r)" % (ver, decode_flight_sw_version(ver.flight_sw_version)))
+    soft_assert(count.count == 0 and count.mission_type == mavlink2.MAV_MISSION_TYPE_FENCE
+                and count.target_system == 255 and count.target_component == 190, "MISSION_COUNT %r" % count)
+    soft_assert(mack.type == mavlink2.MAV_MISSION_UNSUPPORTED and mack.mission_type == mavlink2.MAV_MISSION_TYPE_RALLY
+                and mack.target_system == 255, "MISSION_ACK %r" % mack)
+    soft_assert(ts.tc1 == 61234000000 and ts.ts1 == -5, "TIMESYNC %r" % ts)
+    soft_assert(st.time_unix_usec == 1380812400370000 and st.time_boot_ms == 61300, "SYSTEM_TIME %r" % st)
 
     att = msgs[1]
     soft_assert(att.time_boot_ms == 123456, "time_boot_ms %d" % att.time_boot_ms)

@@ -86,7 +86,8 @@ def main():
           "%d bad frames, %d receive errors: %r" % (len(bad), mav.total_receive_errors, bad[:3]))
     types = [m.get_type() for m in msgs]
     soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "RC_CHANNELS", "SERVO_OUTPUT_RAW",
-                               "SCALED_PRESSURE", "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION"},
+                               "SCALED_PRESSURE", "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION",
+                               "SYSTEM_TIME"},
                 "unexpected: %r" % set(types))
     soft_assert(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
           "first frame: the reply to the command, got %r" % (msgs[:1],))
