@@ -100,6 +100,16 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdDoSetHome) return set_home(p);
+    // Arming and modes (FlightIo; ArduPlane's answers: a refusal FAILED, its reasons said).
+    if (c.command == mav::kCmdComponentArmDisarm) {
+        if (p[0] != 0.0f && p[0] != 1.0f) return mav::Result::Unsupported;
+        return flight_io.arm_disarm(p[0] == 1.0f, p[1] == mav::kForceMagic);
+    }
+    if (c.command == mav::kCmdDoSetMode && FlightIo::kEnabled) {
+        if (((uint8_t)p[0] & mav::kModeFlagCustomModeEnabled) == 0u || !(p[1] >= 0.0f && p[1] < 256.0f))
+            return mav::Result::Unsupported;
+        return flight_io.set_mode((uint32_t)p[1]) ? mav::Result::Accepted : mav::Result::Failed;
+    }
     if (c.command == mav::kCmdGetHomePosition ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
         if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
@@ -117,7 +127,19 @@ void take_request() {
     mav::ParamRequest read;
     mav::ParamSet set;
     mav::CommandLong cmd;
-    if (mav::decode_param_request_list(rx)) {
+    mav::SetMode set_mode;
+    uint16_t override_us[8];
+    if (mav::decode_rc_channels_override(rx, override_us)) {
+        flight_io.rc_override(override_us);  // no answer, as ArduPilot
+    } else if (mav::decode_set_mode(rx, set_mode)) {
+        // Only a custom mode (ArduPlane's number); answered as ArduPilot does, with a
+        // COMMAND_ACK whose command is SET_MODE's message id.
+        mav::Result r = mav::Result::Unsupported;
+        if ((set_mode.base_mode & mav::kModeFlagCustomModeEnabled) != 0u && FlightIo::kEnabled)
+            r = flight_io.set_mode(set_mode.custom_mode) ? mav::Result::Accepted : mav::Result::Failed;
+        uint8_t frame[mav::kMaxFrame];
+        port::send_frame(frame, port::mavlink.command_ack(frame, mav::kSetModeAck, r, rx.sysid, rx.compid));
+    } else if (mav::decode_param_request_list(rx)) {
         param_replies.request_all();
     } else if (mav::decode_param_request_read(rx, read)) {
         const int16_t index = mav::requested_index(read);
@@ -129,7 +151,7 @@ void take_request() {
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) save_pending = true;
-    } else if (mav::decode_command_long(rx, cmd)) {
+    } else if (mav::decode_command_long(rx, cmd) || mav::decode_command_int(rx, cmd)) {
         const mav::Result r = run_command(cmd);
         uint8_t frame[mav::kMaxFrame];
         port::send_frame(frame, port::mavlink.command_ack(frame, cmd.command, r, rx.sysid, rx.compid));
@@ -193,7 +215,7 @@ void send_heartbeat_and_status() {
                     fix.fix == gps::FixType::k3D && !fix.glitching);
     mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
     uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
-                                        flight_io.plane_mode());
+                                        flight_io.plane_mode(), flight_io.armed());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = port::mavlink.sys_status(frame, health,

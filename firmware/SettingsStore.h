@@ -30,6 +30,11 @@ public:
     void start_save(const settings::Settings& s);
     // Every loop iteration: the next byte, or a part of the verification at the end.
     void service();
+    // The settings in use are the user's: loaded, or the EEPROM blank (a new board's
+    // defaults), or saved since; false while the board runs on defaults because the
+    // record was unreadable (corrupt, another firmware's, out of range): the pre-arm
+    // check "Settings not loaded" until the user saves.
+    bool settings_loaded() const { return settings_loaded_; }
 
 private:
     uint16_t slot_address() const { return slots::slot_address(write_slot_); }
@@ -54,4 +59,5 @@ private:
     uint16_t verify_crc_ = 0;
     uint16_t next_sequence_ = 1;
     uint8_t write_slot_ = 0;
+    bool settings_loaded_ = true;
 };

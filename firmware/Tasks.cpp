@@ -68,6 +68,8 @@ static void sensor_retries() {
     vehicle::compass.retry(now_ms);
 }
 static void flight_poll() { vehicle::flight_io.poll(micros(), millis()); }
+static bool prearm_due() { return vehicle::flight_io.prearm_due(); }
+static void say_prearm() { vehicle::flight_io.say_prearm(); }
 static void once_a_second() {
     loop_load::new_second();
     vehicle::update_leds();
@@ -98,6 +100,7 @@ static void once_a_second() {
     X(statustext,   console_link::reply_due_mavlink, console_link::reply,              3000, kSecStatusText,   0)       \
     X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           5800, kSecGcsRequest,   0)       \
     X(gcs_defaults, gcs_link::defaults_line_due,     gcs_link::say_defaults,           2300, kSecGcsDefaults,  0)       \
+    X(prearm,       prearm_due,                      say_prearm,                       2300, kSecPreArm,       0)       \
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_streams,  gcs_link::streams_due,           gcs_link::send_streams,           3300, kSecGcsStreams,   0)       \

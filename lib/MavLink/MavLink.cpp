@@ -64,8 +64,17 @@ static_assert(kMsgHeartbeat == MAVLINK_MSG_ID_HEARTBEAT && kMsgParamRequestRead 
                   kMsgParamRequestList == MAVLINK_MSG_ID_PARAM_REQUEST_LIST && kMsgParamSet == MAVLINK_MSG_ID_PARAM_SET &&
                   kMsgCommandLong == MAVLINK_MSG_ID_COMMAND_LONG,
               "MsgId values are the message ids");
-static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE,
+static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE &&
+                  kCmdComponentArmDisarm == MAV_CMD_COMPONENT_ARM_DISARM && kCmdDoSetMode == MAV_CMD_DO_SET_MODE,
               "MAV_CMD values");
+static_assert(kMsgSetMode == MAVLINK_MSG_ID_SET_MODE && kMsgCommandInt == MAVLINK_MSG_ID_COMMAND_INT &&
+                  kMsgRcChannelsOverride == MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE &&
+                  kModeFlagCustomModeEnabled == MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+              "the mode and override messages' values");
+// The fields kept: COMMAND_INT's up to its target_component (offset 31), the override's
+// eight channels and targets (18 bytes), SET_MODE whole (6).
+static_assert(MAVLINK_MSG_ID_SET_MODE_LEN <= kRxPayloadMax && 18 <= kRxPayloadMax && 32 <= kRxPayloadMax,
+              "the fields read fit the received payload");
 static_assert(kGps == (uint32_t)MAV_SYS_STATUS_SENSOR_GPS, "MAV_SYS_STATUS_SENSOR_GPS");
 static_assert(kCmdDoSetHome == MAV_CMD_DO_SET_HOME && kCmdGetHomePosition == MAV_CMD_GET_HOME_POSITION &&
                   kCmdRequestMessage == MAV_CMD_REQUEST_MESSAGE && kMsgHomePosition == MAVLINK_MSG_ID_HOME_POSITION,
@@ -129,9 +138,10 @@ void add_sensor(Health& h, uint32_t bits, bool present, bool ok) {
     if (ok) h.healthy |= bits;
 }
 
-uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode) {
+uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode, bool armed) {
     Frame f(seq_);
-    uint8_t base = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | MAV_MODE_FLAG_MANUAL_INPUT_ENABLED | MAV_MODE_FLAG_SAFETY_ARMED;
+    uint8_t base = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | MAV_MODE_FLAG_MANUAL_INPUT_ENABLED;
+    if (armed) base |= MAV_MODE_FLAG_SAFETY_ARMED;
     if (mode != PlaneMode::Manual) base |= MAV_MODE_FLAG_STABILIZE_ENABLED;
     mavlink_msg_heartbeat_pack_status(kSystemId, kComponentId, &f.status, &f.msg, MAV_TYPE_FIXED_WING,
                                       MAV_AUTOPILOT_ARDUPILOTMEGA, base, (uint32_t)mode, (uint8_t)state);
@@ -350,6 +360,13 @@ uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
         case MAVLINK_MSG_ID_COMMAND_LONG:
             max_len = MAVLINK_MSG_ID_COMMAND_LONG_LEN;
             return MAVLINK_MSG_ID_COMMAND_LONG_CRC;
+        case MAVLINK_MSG_ID_COMMAND_INT:
+            max_len = MAVLINK_MSG_ID_COMMAND_INT_LEN;
+            return MAVLINK_MSG_ID_COMMAND_INT_CRC;
+        case MAVLINK_MSG_ID_SET_MODE: max_len = MAVLINK_MSG_ID_SET_MODE_LEN; return MAVLINK_MSG_ID_SET_MODE_CRC;
+        case MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE:
+            max_len = MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE_LEN;
+            return MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE_CRC;
         default: return 0;
     }
 }
@@ -481,6 +498,43 @@ bool decode_command_long(const Received& rx, CommandLong& out) {
     out.param[4] = m.param5;
     out.param[5] = m.param6;
     out.param[6] = m.param7;
+    return true;
+}
+
+bool decode_command_int(const Received& rx, CommandLong& out) {
+    if (rx.msgid != kMsgCommandInt) return false;
+    mavlink_command_int_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    out.command = m.command;
+    out.param[0] = m.param1;
+    out.param[1] = m.param2;
+    out.param[2] = m.param3;
+    out.param[3] = m.param4;
+    out.param[4] = (float)m.x;
+    out.param[5] = (float)m.y;
+    out.param[6] = m.z;
+    return true;
+}
+
+bool decode_set_mode(const Received& rx, SetMode& out) {
+    if (rx.msgid != kMsgSetMode) return false;
+    mavlink_set_mode_t m;
+    copy_payload(m, rx);
+    if (m.target_system != kSystemId) return false;  // SET_MODE names a system only
+    out.base_mode = m.base_mode;
+    out.custom_mode = m.custom_mode;
+    return true;
+}
+
+bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]) {
+    if (rx.msgid != kMsgRcChannelsOverride) return false;
+    mavlink_rc_channels_override_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    const uint16_t w[8] = {m.chan1_raw, m.chan2_raw, m.chan3_raw, m.chan4_raw,
+                           m.chan5_raw, m.chan6_raw, m.chan7_raw, m.chan8_raw};
+    memcpy(width_us, w, sizeof w);
     return true;
 }
 

@@ -28,9 +28,9 @@
 // parameter names, so it says what ArduPlane says: MAV_TYPE_FIXED_WING,
 // MAV_AUTOPILOT_ARDUPILOTMEGA and custom_mode = ArduPlane's mode number, which Mission
 // Planner, QGroundControl and MAVProxy name (MANUAL, STABILIZE, FBWA). base_mode: custom
-// mode enabled, manual input enabled, stabilize enabled outside MANUAL, and armed: the
-// board has no arming, its outputs are live from power-up (ArduPlane with ARMING_REQUIRE
-// 0 says armed too).
+// mode enabled, manual input enabled, stabilize enabled outside MANUAL, and
+// MAV_MODE_FLAG_SAFETY_ARMED while the throttle is armed (ArduPlane's: always with
+// ARMING_REQUIRE 0).
 //
 // Plain C++: no Arduino include, the same code on the AVR and the host tests.
 #pragma once
@@ -118,7 +118,7 @@ struct PositionReport {
 // Each call writes one frame into `out` and returns its length (0 only on bad input).
 class Packer {
 public:
-    uint8_t heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode);
+    uint8_t heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode, bool armed);
     // The pipeline's angles in degrees (heading 0..360, declination applied) are sent
     // in radians, heading wrapped to -pi..pi as ATTITUDE's yaw; rates in rad/s, body axes.
     uint8_t attitude(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float roll_deg, float pitch_deg,
@@ -202,12 +202,17 @@ private:
 // The messages the board answers (msgid).
 enum MsgId : uint8_t {
     kMsgHeartbeat = 0,
+    kMsgSetMode = 11,
+    kMsgRcChannelsOverride = 70,
+    kMsgCommandInt = 75,
     kMsgParamRequestRead = 20,
     kMsgParamRequestList = 21,
     kMsgParamSet = 23,
     kMsgCommandLong = 76,
 };
-constexpr uint8_t kRxPayloadMax = 33;  // COMMAND_LONG's, the longest of them
+// COMMAND_LONG's, the longest kept whole; of COMMAND_INT (35) and RC_CHANNELS_OVERRIDE
+// (38) the fields after it are not needed (current, autocontinue; channels 9-18).
+constexpr uint8_t kRxPayloadMax = 33;
 
 // A frame from the ground station, CRC-checked: its payload zero-filled to the message's
 // full length (MAVLink 2 trims trailing zeros).
@@ -275,6 +280,18 @@ struct CommandLong {
     float param[7];
 };
 bool decode_command_long(const Received& rx, CommandLong& out);
+// COMMAND_INT as a CommandLong: param1-4, then x, y as param5, param6 (int32 as float,
+// enough for the commands taken so), z as param7.
+bool decode_command_int(const Received& rx, CommandLong& out);
+// SET_MODE: custom_mode taken only with MAV_MODE_FLAG_CUSTOM_MODE_ENABLED in base_mode.
+struct SetMode {
+    uint8_t base_mode;
+    uint32_t custom_mode;
+};
+bool decode_set_mode(const Received& rx, SetMode& out);
+constexpr uint8_t kModeFlagCustomModeEnabled = 1;  // MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+// RC_CHANNELS_OVERRIDE: channels 1-8 as sent (UINT16_MAX ignore, 0 release; 9-18 not kept).
+bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]);
 
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;
@@ -283,5 +300,9 @@ constexpr uint16_t kCmdDoSetHome = 179;          // param1 1: here; else param5 
 constexpr uint16_t kCmdGetHomePosition = 410;    // answered with HOME_POSITION (and the ACK)
 constexpr uint16_t kCmdRequestMessage = 512;     // param1 the message id: 242 HOME_POSITION here
 constexpr uint8_t kMsgHomePosition = 242;
+constexpr uint16_t kCmdComponentArmDisarm = 400;  // param1 1 arm, 0 disarm; param2 kForceMagic: without the checks
+constexpr uint16_t kCmdDoSetMode = 176;           // param1 base_mode (CUSTOM_MODE_ENABLED), param2 the custom mode
+constexpr uint16_t kSetModeAck = 11;               // ArduPilot answers SET_MODE with a COMMAND_ACK of "command" 11
+constexpr float kForceMagic = 21196.0f;
 
 }  // namespace mav

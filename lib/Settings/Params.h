@@ -46,9 +46,12 @@ bool is_integer(Type t);
 // The value as a float (MAVLink's PARAM_VALUE carries every type so).
 float get(const settings::Settings& s, uint16_t index);
 // Sets a value: false (nothing changed) when index is past the end, the value is NaN,
-// out of range, not whole for an integer type, or leaves an end point pair out of order
+// out of range, not whole for an integer type, not a mode the board has (FLTMODEn), or
+// leaves an end point pair out of order
 // (RCn/SERVOn: MIN <= TRIM <= MAX).
 bool set(settings::Settings& s, uint16_t index, float value);
+// FLTMODE1..6: set() takes only a mode the board has (flight::mode_known).
+bool is_flight_mode(uint16_t index);
 // Every parameter to its default.
 void apply_defaults(settings::Settings& s);
 // The flight settings in the EEPROM record (settings::encode): the rows that live in

@@ -340,9 +340,13 @@ TEST(FlightControl, AChoiceInFailsafeWaitsForTheSignal) {
     r.fc.choose((flight::Mode)1);  // not a mode here
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     r.fc.choose(flight::Mode::Stabilize);
-    r.fc.choose((flight::Mode)5);  // ArduPlane's FBWA: not one here either
+    r.fc.choose((flight::Mode)10);  // ArduPlane's AUTO: not one here either
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
+    r.fc.choose(flight::Mode::FlyByWireA);  // FBWA flies STABILIZE's law
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::FlyByWireA);
+    EXPECT_EQ(r.fc.state(), flight::State::Stabilize);
+    r.fc.choose(flight::Mode::Manual);
     // Before the first frame too.
     Rig n;
     n.fc.choose(flight::Mode::Stabilize);
