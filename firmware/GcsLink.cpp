@@ -103,7 +103,8 @@ static mav::Result run_command(const mav::CommandLong& c) {
     // Arming and modes (FlightIo; ArduPlane's answers: a refusal FAILED, its reasons said).
     if (c.command == mav::kCmdComponentArmDisarm) {
         if (p[0] != 0.0f && p[0] != 1.0f) return mav::Result::Unsupported;
-        return flight_io.arm_disarm(p[0] == 1.0f, p[1] == mav::kForceMagic);
+        // Forced by MAVLink's 21196, or to arm by ArduPilot's 2989 (MAVProxy's `arm throttle force`).
+        return flight_io.arm_disarm(p[0] == 1.0f, p[1] == mav::kForceMagic || (p[0] == 1.0f && p[1] == mav::kForceArmMagic));
     }
     if (c.command == mav::kCmdDoSetMode && FlightIo::kEnabled) {
         if (((uint8_t)p[0] & mav::kModeFlagCustomModeEnabled) == 0u || !(p[1] >= 0.0f && p[1] < 256.0f))

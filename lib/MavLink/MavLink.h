@@ -303,6 +303,7 @@ constexpr uint8_t kMsgHomePosition = 242;
 constexpr uint16_t kCmdComponentArmDisarm = 400;  // param1 1 arm, 0 disarm; param2 kForceMagic: without the checks
 constexpr uint16_t kCmdDoSetMode = 176;           // param1 base_mode (CUSTOM_MODE_ENABLED), param2 the custom mode
 constexpr uint16_t kSetModeAck = 11;               // ArduPilot answers SET_MODE with a COMMAND_ACK of "command" 11
-constexpr float kForceMagic = 21196.0f;
+constexpr float kForceMagic = 21196.0f;     // MAVLink's: arm or disarm without the checks
+constexpr float kForceArmMagic = 2989.0f;   // ArduPilot's own for arming
 
 }  // namespace mav
