@@ -39,7 +39,7 @@ static_assert(kTextChunk == MAVLINK_MSG_STATUSTEXT_FIELD_TEXT_LEN, "STATUSTEXT t
 static_assert((uint8_t)State::Calibrating == MAV_STATE_CALIBRATING && (uint8_t)State::Active == MAV_STATE_ACTIVE &&
                   (uint8_t)State::Critical == MAV_STATE_CRITICAL && (uint8_t)State::Boot == MAV_STATE_BOOT,
               "State values are MAV_STATE's");
-static_assert((uint8_t)Severity::Error == MAV_SEVERITY_ERROR && (uint8_t)Severity::Warning == MAV_SEVERITY_WARNING &&
+static_assert((uint8_t)Severity::Critical == MAV_SEVERITY_CRITICAL && (uint8_t)Severity::Error == MAV_SEVERITY_ERROR && (uint8_t)Severity::Warning == MAV_SEVERITY_WARNING &&
                   (uint8_t)Severity::Notice == MAV_SEVERITY_NOTICE && (uint8_t)Severity::Info == MAV_SEVERITY_INFO,
               "Severity values are MAV_SEVERITY's");
 static_assert(kGyro3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_GYRO && kAccel3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_ACCEL &&
@@ -334,6 +334,7 @@ void StatusText::flush_chunk() {
         severity_ = Severity::Info;
         if (starts_with(chunk_, len_, TXT("error:"))) severity_ = Severity::Error;
         else if (starts_with(chunk_, len_, TXT("warn:"))) severity_ = Severity::Warning;
+        else if (starts_with(chunk_, len_, TXT("PreArm:"))) severity_ = Severity::Critical;
     }
     uint8_t frame[kMaxFrame];
     const uint8_t n = packer_.statustext(frame, severity_, chunk_, len_, id_, chunk_seq_);
@@ -485,19 +486,27 @@ bool decode_param_set(const Received& rx, ParamSet& out) {
     return true;
 }
 
-bool decode_command_long(const Received& rx, CommandLong& out) {
-    if (rx.msgid != kMsgCommandLong) return false;
-    mavlink_command_long_t m;
-    copy_payload(m, rx);
-    if (!for_us(m.target_system, m.target_component)) return false;
+namespace {
+// COMMAND_LONG's and COMMAND_INT's common fields; p5..p7 their last three (param5-7, or x, y, z).
+template <class Message>
+void take_command(CommandLong& out, const Message& m, float p5, float p6, float p7) {
     out.command = m.command;
     out.param[0] = m.param1;
     out.param[1] = m.param2;
     out.param[2] = m.param3;
     out.param[3] = m.param4;
-    out.param[4] = m.param5;
-    out.param[5] = m.param6;
-    out.param[6] = m.param7;
+    out.param[4] = p5;
+    out.param[5] = p6;
+    out.param[6] = p7;
+}
+}  // namespace
+
+bool decode_command_long(const Received& rx, CommandLong& out) {
+    if (rx.msgid != kMsgCommandLong) return false;
+    mavlink_command_long_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    take_command(out, m, m.param5, m.param6, m.param7);
     return true;
 }
 
@@ -506,14 +515,7 @@ bool decode_command_int(const Received& rx, CommandLong& out) {
     mavlink_command_int_t m;
     copy_payload(m, rx);
     if (!for_us(m.target_system, m.target_component)) return false;
-    out.command = m.command;
-    out.param[0] = m.param1;
-    out.param[1] = m.param2;
-    out.param[2] = m.param3;
-    out.param[3] = m.param4;
-    out.param[4] = (float)m.x;
-    out.param[5] = (float)m.y;
-    out.param[6] = m.z;
+    take_command(out, m, (float)m.x, (float)m.y, m.z);
     return true;
 }
 

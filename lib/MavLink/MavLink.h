@@ -81,7 +81,7 @@ enum class State : uint8_t {
 enum class PlaneMode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
 
 // STATUSTEXT severity (MAV_SEVERITY).
-enum class Severity : uint8_t { Error = 3, Warning = 4, Notice = 5, Info = 6 };
+enum class Severity : uint8_t { Critical = 2, Error = 3, Warning = 4, Notice = 5, Info = 6 };
 
 // SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR_3D_GYRO, _3D_ACCEL, _3D_MAG,
 // _ABSOLUTE_PRESSURE, _GPS: present once a receiver has been heard, healthy with a 3D
@@ -167,7 +167,8 @@ struct FrameSink {
 
 // The console's text output in `mode mavlink`: a text::Sink whose "# " lines become
 // STATUSTEXT frames, "# " stripped; severity Error for "# error: ...", Warning for
-// "# warn: ...", Info for every other "# " line. Lines that do not start with "# "
+// "# warn: ...", Critical for "# PreArm: ..." (ArduPilot's, which ground stations show
+// as an alert), Info for every other "# " line. Lines that do not start with "# "
 // (angle or csv lines) are dropped: ATTITUDE carries the angles. A line longer than
 // kTextChunk goes out as chunks with one non-zero id, an empty last chunk when it ends
 // on a chunk boundary (a receiver takes a chunk with a NUL as the last). Streaming: no

@@ -8,6 +8,7 @@
 
 #include "Arming.h"
 #include "Flight.h"
+#include "FlightRig.h"
 #include "Settings.h"
 
 namespace {
@@ -147,33 +148,11 @@ TEST(Arming, DisarmByRudderOnlyWithArmingRudderTwoAndNotFlying) {
     for (uint32_t t = 0; t <= 4000; t += 20) EXPECT_EQ(d.rudder(flight::kRudderDisabled, 4500, 0, false, t), flight::Gesture::None);
 }
 
-namespace {
-
-struct Rig {
-    settings::Settings s = settings::defaults();
-    flight::FlightControl fc{s.flight};
-    uint16_t rc[8] = {1500, 1500, 1800, 1500, 1500, 1500, 1500, 1000};  // MANUAL, throttle 80 %
-    uint32_t now_ms = 0;
-    flight::Attitude att{0, 0, 0, 0, true, 0};
-    uint16_t out[8] = {};
-    void run(float seconds, bool signal = true) {
-        const uint32_t end = now_ms + (uint32_t)(seconds * 1000.0f);
-        uint32_t next_frame = now_ms;
-        while (now_ms < end) {
-            if (signal && now_ms >= next_frame) {
-                fc.on_frame(rc, now_ms);
-                next_frame += 22;
-            }
-            if (now_ms % 20u == 0u) fc.step(now_ms, att, out);
-            ++now_ms;
-        }
-    }
-};
-
-}  // namespace
+using flight_test::Rig;
 
 TEST(Arming, DisarmedTheThrottleHoldsItsMinimumInEveryState) {
     Rig r;
+    r.rc[2] = 1800;  // throttle 80 %
     r.s.flight.thr_fs_pct = 40;  // a failsafe throttle that is not the minimum
     r.fc.set_throttle_live(false);
     r.fc.step(0, r.att, r.out);

@@ -230,7 +230,8 @@ TEST(MavLink, StatusTextSeverityFromTheLinesFirstWord) {
     say(st, "# warn: compass overflow\n");
     say(st, "# recovered: HMC5883L\n");
     say(st, "# mode mavlink\r\n");
-    ASSERT_EQ(c.frames.size(), 5u);  // the first line is 56 characters: two chunks
+    say(st, "# PreArm: Throttle too high\n");
+    ASSERT_EQ(c.frames.size(), 6u);  // the first line is 56 characters: two chunks
     EXPECT_EQ(decode_text(c.frames[0]).severity, 3u);
     EXPECT_EQ(decode_text(c.frames[1]).severity, 3u);
     const Text w = decode_text(c.frames[2]);
@@ -241,6 +242,7 @@ TEST(MavLink, StatusTextSeverityFromTheLinesFirstWord) {
     EXPECT_EQ(decode_text(c.frames[3]).severity, 6u);
     EXPECT_EQ(decode_text(c.frames[3]).text, "recovered: HMC5883L");
     EXPECT_EQ(decode_text(c.frames[4]).text, "mode mavlink");
+    EXPECT_EQ(decode_text(c.frames[5]).severity, 2u);  // MAV_SEVERITY_CRITICAL, as ArduPilot's PreArm
 }
 
 TEST(MavLink, StatusTextChunksLongLinesUnderOneId) {
