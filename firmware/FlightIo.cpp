@@ -140,7 +140,9 @@ uint16_t FlightIo::prearm_failures() const {
     flight::PreArmInputs in;
     const pipeline::Phase ph = pipe.phase();
     in.imu_ok = imu.ok();
-    in.gyro_calibrating = ph == pipeline::Phase::Calibrating || pipe.gyro_calibrating();
+    // A restart in the air runs on the saved bias while the calibration measures on in the
+    // background: the estimator is healthy and the board may be armed again (docs/arming.md).
+    in.gyro_calibrating = ph == pipeline::Phase::Calibrating || (pipe.gyro_calibrating() && !pipe.gyro_measuring_on());
     in.estimator_ok = ph == pipeline::Phase::Running;  // its angles are finite by construction (lib/DCM)
     in.compass_used = compass_found_;
     in.compass_ok = compass.ok();
