@@ -23,6 +23,7 @@ using vehicle::pipe;
 static mav::Parser input;
 static mav::ParamReplies param_replies;
 static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
+static bool configure_pending = false;      // ... and put it in force first, in a pass of its own
 static bool defaults_said_pending = false;  // PREFLIGHT_STORAGE defaults ran: its line, in a pass of its own
 constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
@@ -151,7 +152,7 @@ void take_request() {
         if (index >= 0) param_replies.request_one((uint16_t)index);
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
         // settings before it whole until the new ones are), in a pass of its own.
-        if (changed) save_pending = true;
+        if (changed) save_pending = configure_pending = true;
     } else if (mav::decode_command_long(rx, cmd) || mav::decode_command_int(rx, cmd)) {
         const mav::Result r = run_command(cmd);
         uint8_t frame[mav::kMaxFrame];
@@ -168,6 +169,15 @@ void say_defaults() {
 
 bool save_due() { return save_pending && room_for(2u * mav::kMaxFrame); }
 void save() {
+    // The changed value in force first, as the console's `set` puts it (the controllers'
+    // terms, the end points' factors, RC_OVERRIDE_TIME; a PARAM_SET of RLL2SRV_P flew the
+    // old gains before), then the save: each a pass of its own, as the record's encoding
+    // and the gains' terms together outlast the task's budget.
+    if (configure_pending) {
+        configure_pending = false;
+        flight_io.configure();
+        return;
+    }
     save_pending = false;
     vehicle::store.start_save(pipe.settings());
 }

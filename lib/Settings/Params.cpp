@@ -435,11 +435,17 @@ float get(const Settings& s, uint16_t index) {
     return locate(index, row, instance) ? read(s, row, instance) : 0.0f;
 }
 
+namespace {
+bool holds_flight_mode(const Row& row) {
+    return row.offset >= offsetof(Settings, flight.fltmode) &&
+           row.offset < offsetof(Settings, flight.fltmode) + sizeof(flight::FlightSettings::fltmode);
+}
+}  // namespace
+
 bool is_flight_mode(uint16_t index) {
     Row row;
     uint8_t instance;
-    return locate(index, row, instance) && row.offset >= offsetof(Settings, flight.fltmode) &&
-           row.offset < offsetof(Settings, flight.fltmode) + sizeof(flight::FlightSettings::fltmode);
+    return locate(index, row, instance) && holds_flight_mode(row);
 }
 
 bool set(Settings& s, uint16_t index, float value) {
@@ -447,7 +453,7 @@ bool set(Settings& s, uint16_t index, float value) {
     uint8_t instance;
     if (!locate(index, row, instance) || !in_range(row, value)) return false;
     // FLTMODEn: a mode the board has (a stored number it lacks still loads, and flies MANUAL).
-    if (is_flight_mode(index) && !flight::mode_known((uint8_t)value)) return false;
+    if (holds_flight_mode(row) && !flight::mode_known((uint8_t)value)) return false;
     const float before = read(s, row, instance);
     write(s, row, instance, value);
     if (ends_in_order(s.flight.rc) && ends_in_order(s.flight.servo)) return true;

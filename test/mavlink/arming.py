@@ -21,7 +21,8 @@ barometer taken away for a while (--fault), and talks to it as a ground station:
     STABILIZE and FBWA, each ACCEPTED and in HEARTBEAT's custom_mode; 10 (AUTO) refused with
     FAILED and a reason; the mode switch moving takes over; PARAM_SET FLTMODE1 1 refused;
   - RC_CHANNELS_OVERRIDE of channel 1 on the pin (OUT1) and RC_CHANNELS, back to the
-    receiver's 3 s (RC_OVERRIDE_TIME) after the last message.
+    receiver's RC_OVERRIDE_TIME (set to 1.5 s by PARAM_SET: in force at once) after the last
+    message.
 Exit 1 with every failure listed. Timing assertions are on simulated time only.
 """
 import csv
@@ -187,9 +188,13 @@ def main():
     wait_until(b, 19.3)
     prearm(b, "Compass not healthy", 20.8, "compass gone")
     soft_assert(text_at(b.msgs, "PreArm: Barometer not healthy", 19.0) is not None, "no 'Barometer not healthy'")
-    # 8. RC override of channel 1 (the receiver's 1500), in MANUAL: on the pin, then 3 s
-    # (RC_OVERRIDE_TIME) after the last message the receiver's again.
-    wait_until(b, 21.5)
+    # 8. RC override of channel 1 (the receiver's 1500), in MANUAL: on the pin, then
+    # RC_OVERRIDE_TIME (1.5 s) after the last message the receiver's again.
+    wait_until(b, 21.1)  # the sensors back (their retries beside a PARAM_SET's long pass)
+    b.conn.mav.param_set_send(1, 1, b"RC_OVERRIDE_TIME", 1.5, mavlink2.MAV_PARAM_TYPE_REAL32)
+    pv = b.param("RC_OVERRIDE_TIME", "PARAM_VALUE RC_OVERRIDE_TIME 1.5")
+    soft_assert(pv is not None and abs(pv.param_value - 1.5) < 1e-6, "RC_OVERRIDE_TIME 1.5: %r" % pv)
+    wait_until(b, 21.8)
     t_override = b.t_s
     for _ in range(5):
         b.conn.mav.rc_channels_override_send(1, 1, 1800, 65535, 65535, 65535, 65535, 65535, 65535, 65535)
@@ -237,16 +242,17 @@ def main():
     print("# throttle pin: %d pulses at 1000 us while disarmed (from the first, at %.3f s), %d at the stick's "
           "1300 us armed" % (len(held), thr[0][0], len(live)))
     out1 = pulses[1]
-    on = [w for t, w in out1 if t_override + 0.1 <= t < t_last_override + 2.9]
-    back = [w for t, w in out1 if t_last_override + 3.1 <= t < 25.5]
+    on = [w for t, w in out1 if t_override + 0.1 <= t < t_last_override + 1.4]
+    back = [w for t, w in out1 if t_last_override + 1.6 <= t < 25.5]
     soft_assert(on and all(abs(w - 1800.0) <= 1.3 for w in on), "OUT1 overridden: %r" % sorted(set(on))[:3])
     soft_assert(back and all(abs(w - 1500.0) <= 1.3 for w in back), "OUT1 after the override's time: %r"
                 % sorted(set(back))[:3])
     rc = [m.chan1_raw for t, m in b.msgs if m.get_type() == "RC_CHANNELS" and t_override + 0.2 <= t < t_last_override]
     soft_assert(rc and all(c == 1800 for c in rc), "RC_CHANNELS chan1 under the override: %r" % rc)
-    print("# RC override: OUT1 at 1800 us for %d pulses, back to the receiver's 3 s after the last message"
+    print("# RC override: OUT1 at 1800 us for %d pulses, back to the receiver's 1.5 s (RC_OVERRIDE_TIME, set by "
+          "PARAM_SET) after the last message"
           % len(on))
-    overruns = [m.text for _, m in b.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
+    overruns = ["%.2f s: %s" % (t, m.text) for t, m in b.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
     soft_assert(not overruns, "samples missed: %r" % overruns)
 
 
