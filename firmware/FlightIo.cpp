@@ -376,6 +376,7 @@ mav::Result FlightIo::arm_disarm(bool, bool) { return mav::Result::Unsupported; 
 bool FlightIo::set_mode(uint32_t) { return false; }
 void FlightIo::rc_override(const uint16_t*) {}
 bool FlightIo::prearm_due() const { return false; }
+uint16_t FlightIo::prearm_failures() const { return 0; }
 void FlightIo::say_prearm() {}
 bool FlightIo::print_status_line() { return false; }
 void FlightIo::answer(const console::Command&) {

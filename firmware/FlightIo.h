@@ -73,6 +73,9 @@ public:
     bool set_mode(uint32_t number);
     // RC_CHANNELS_OVERRIDE's channels 1-8 (FlightControl::on_override).
     void rc_override(const uint16_t width_us[8]);
+    // The pre-arm checks' failures now (lib/Flight/Arming.h's PreArm bits; 0: may arm):
+    // SYS_STATUS's MAV_SYS_STATUS_PREARM_CHECK healthy bit is prearm_failures() == 0.
+    uint16_t prearm_failures() const;
     // Loop task: one "# PreArm: <reason>" line of the last refused arming a run, when the
     // output has room (a refusal can have several; each goes out as one STATUSTEXT).
     bool prearm_due() const;
@@ -95,7 +98,6 @@ private:
     void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
                       const pipeline::AnglesCentideg* angles);
 
-    uint16_t prearm_failures() const;
     void arming_step(uint32_t now_ms);
     mav::Result arm_now(bool force);
     bool flying() const;
