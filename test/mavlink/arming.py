@@ -184,16 +184,17 @@ def main():
     t_disarmed2 = b.t_s if dis else None
     soft_assert(t_disarmed2 is not None and 18.0 <= t_disarmed2 <= 18.3, "disarmed by the rudder at %s s (from 15.0)"
                 % t_disarmed2)
+    # RC_OVERRIDE_TIME 1.5 s for step 8 (before the sensors go: their recovery at 21 s and a
+    # PARAM_SET's long pass, ~6 ms, are kept apart).
+    b.conn.mav.param_set_send(1, 1, b"RC_OVERRIDE_TIME", 1.5, mavlink2.MAV_PARAM_TYPE_REAL32)
+    pv = b.param("RC_OVERRIDE_TIME", "PARAM_VALUE RC_OVERRIDE_TIME 1.5")
+    soft_assert(pv is not None and abs(pv.param_value - 1.5) < 1e-6, "RC_OVERRIDE_TIME 1.5: %r" % pv)
     # 7. The compass and the barometer gone (19 to 21 s).
     wait_until(b, 19.3)
     prearm(b, "Compass not healthy", 20.8, "compass gone")
     soft_assert(text_at(b.msgs, "PreArm: Barometer not healthy", 19.0) is not None, "no 'Barometer not healthy'")
     # 8. RC override of channel 1 (the receiver's 1500), in MANUAL: on the pin, then
     # RC_OVERRIDE_TIME (1.5 s) after the last message the receiver's again.
-    wait_until(b, 21.1)  # the sensors back (their retries beside a PARAM_SET's long pass)
-    b.conn.mav.param_set_send(1, 1, b"RC_OVERRIDE_TIME", 1.5, mavlink2.MAV_PARAM_TYPE_REAL32)
-    pv = b.param("RC_OVERRIDE_TIME", "PARAM_VALUE RC_OVERRIDE_TIME 1.5")
-    soft_assert(pv is not None and abs(pv.param_value - 1.5) < 1e-6, "RC_OVERRIDE_TIME 1.5: %r" % pv)
     wait_until(b, 21.8)
     t_override = b.t_s
     for _ in range(5):
@@ -253,6 +254,10 @@ def main():
           "PARAM_SET) after the last message"
           % len(on))
     overruns = ["%.2f s: %s" % (t, m.text) for t, m in b.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
+    if overruns:  # what the board said around them
+        t0 = float(overruns[0].split(" s:")[0])
+        print("# around the first overrun: %r" % [(round(t, 2), m.text) for t, m in b.msgs
+                                                  if m.get_type() == "STATUSTEXT" and t0 - 1.0 <= t <= t0 + 0.2])
     soft_assert(not overruns, "samples missed: %r" % overruns)
 
 
