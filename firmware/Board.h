@@ -63,6 +63,7 @@ enum Section : uint8_t {
     kSecStatusText = 33,   // one part of a console reply, as STATUSTEXT frames
     kSecCommand = 34,      // the work of `save`, `defaults` or `set` typed at the console
     kSecGcsDefaults = 35,  // a ground station's PREFLIGHT_STORAGE defaults: restored, then their line
+    kSecPreArm = 48,       // one "# PreArm: ..." line of a refused arming
     kSecGps = 36,          // the GPS task: received bytes parsed, the u-blox configuration sent
     kSecBaro = 37,         // the barometer task: a conversion read and the next one started
     kSecNav = 38,          // position and home from a new fix, the position moved on between fixes

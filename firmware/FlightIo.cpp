@@ -1,13 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "FlightIo.h"
 
+#include <string.h>
+
 #include "AirspeedInput.h"
 #include "Board.h"
 #include "Vehicle.h"
 
 #if APM25_FLIGHT
 
+#include "Baro.h"
+#include "GcsLink.h"
+#include "GpsPort.h"
 #include "RcInput.h"
+#include "SerialText.h"
 #include "ServoOutputs.h"
 
 using text::Flash;
@@ -33,15 +39,25 @@ constexpr int32_t kCdsPerCountQ10 =
 // percent): on the ground, or gliding, the velocity is not the cruise's.
 constexpr int16_t kIdleThrottle = 100;
 
+using vehicle::compass;
 using vehicle::imu;
 using vehicle::pipe;
+
+// RC_OVERRIDE_TIME (s) in the override's 8 ms units: 0 off, < 0 forever.
+static uint16_t override_timeout_8ms(float s) {
+    if (s < 0.0f) return flight::FlightControl::kOverrideForever;
+    const float t = s * 125.0f + 0.5f;
+    return t >= 65534.0f ? (uint16_t)65534u : (uint16_t)t;
+}
 
 FlightIo::FlightIo(const text::Sink* out)
     : out_(out), control_(pipe.settings().flight, flight::FlightControl::ConfiguredLater{}) {}
 
 void FlightIo::begin() {
     uint16_t widths[flight::kChannels];
-    control_.configure();  // the loaded settings
+    configure();  // the loaded settings
+    // Disarmed at power-up: with ARMING_REQUIRE 1 the throttle at its minimum from the first pulse.
+    control_.set_throttle_live(arming_.throttle_live(pipe.settings().vehicle.arming_require));
     control_.step(0, flight::Attitude{0, 0, 0, 0, false, 0}, widths);
     servo_outputs::begin(widths);
     rc_input::begin();
@@ -49,7 +65,10 @@ void FlightIo::begin() {
 
 void FlightIo::loop_starts(uint32_t now_us) { last_control_us_ = now_us; }
 
-void FlightIo::configure() { control_.configure(); }
+void FlightIo::configure() {
+    control_.configure();
+    control_.set_override_timeout(override_timeout_8ms(pipe.settings().vehicle.rc_override_time_s));
+}
 
 void FlightIo::poll(uint32_t now_us, uint32_t now_ms) {
     while (rc_input::poll(ppm_)) control_.on_frame(ppm_.frame_us(), now_ms);
@@ -101,17 +120,137 @@ void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sam
             att.airspeed_cm_s = v_cm_s >= 6000.0f ? 6000u : (v_cm_s >= 1.0f ? (uint16_t)v_cm_s : 1u);
         }
     }
+    arming_step(now_ms);
     uint16_t widths[flight::kChannels];
     control_.step(now_ms, att, widths);
     servo_outputs::set(widths);
     say_events();
 }
 
+// --- Arming (lib/Flight/Arming.h) -------------------------------------------------------
+
+// ArduPlane's is_flying, as far as the board can tell: the pitot or the GPS says 5 m/s.
+bool FlightIo::flying() const {
+    if (airspeed_input::state() == airspeed_input::State::kSensor && pipe.airspeed_m_s() >= 5.0f) return true;
+    const gps::Fix& fix = gps_port::fix();
+    return (uint8_t)fix.fix >= (uint8_t)gps::FixType::k2D && fix.ground_speed_cm_s >= 500u;
+}
+
+uint16_t FlightIo::prearm_failures() const {
+    flight::PreArmInputs in;
+    const pipeline::Phase ph = pipe.phase();
+    in.imu_ok = imu.ok();
+    // A restart in the air runs on the saved bias while the calibration measures on in the
+    // background: the estimator is healthy and the board may be armed again (docs/arming.md).
+    in.gyro_calibrating = ph == pipeline::Phase::Calibrating || (pipe.gyro_calibrating() && !pipe.gyro_measuring_on());
+    in.estimator_ok = ph == pipeline::Phase::Running;  // its angles are finite by construction (lib/DCM)
+    in.compass_used = compass_found_;
+    in.compass_ok = compass.ok();
+    // The offset is learned in motion whenever the board turns (README "Calibration"):
+    // ArduPlane's COMPASS_LEARN 1, with which its "Compass not calibrated" never fires.
+    in.compass_calibrated = true;
+    in.compass_calibrating = pipe.mag_calibrating();
+    in.baro_present = baro::present();
+    in.baro_ok = baro::healthy();
+    in.rc_seen = control_.state() != flight::State::NoSignal;
+    in.rc_failsafe = control_.state() == flight::State::Failsafe;
+    in.throttle_low = flight::throttle_at_zero(control_.stick(flight::kThrottle, millis()));
+    in.settings_loaded = vehicle::store.settings_loaded();
+    return flight::prearm_failures(in, pipe.settings().vehicle.arming_check);
+}
+
+mav::Result FlightIo::arm_now(bool force) {
+    if (arming_.armed()) return mav::Result::Accepted;
+    const uint16_t failures = force ? 0u : prearm_failures();
+    if (failures != 0u) {
+        prearm_unsaid_ = failures;  // said a line a run (say_prearm)
+        return mav::Result::Failed;
+    }
+    arming_.arm();
+    Writer(out_).str(force ? TXT("# Throttle armed (forced: no pre-arm checks)") : TXT("# Throttle armed")).end();
+    return mav::Result::Accepted;
+}
+
+// The rudder gesture while good frames arrive, then the throttle held or live.
+void FlightIo::arming_step(uint32_t now_ms) {
+    const settings::VehicleSettings& v = pipe.settings().vehicle;
+    if (compass.ok()) compass_found_ = true;
+    const flight::State st = control_.state();
+    if (st == flight::State::Manual || st == flight::State::Stabilize) {
+        const flight::Gesture g = arming_.rudder(v.arming_rudder, control_.stick(flight::kYaw, now_ms),
+                                                 control_.stick(flight::kThrottle, now_ms), flying(), now_ms);
+        if (g == flight::Gesture::Arm) {
+            arm_now(false);
+        } else if (g == flight::Gesture::Disarm) {
+            arming_.disarm();
+            Writer(out_).str(TXT("# Throttle disarmed (rudder)")).end();
+        }
+    } else {
+        arming_.rudder_released();
+    }
+    control_.set_throttle_live(arming_.throttle_live(v.arming_require));
+}
+
+bool FlightIo::armed() const { return arming_.throttle_live(pipe.settings().vehicle.arming_require); }
+
+mav::Result FlightIo::arm_disarm(bool arm, bool force) {
+    if (arm) return armed() ? mav::Result::Accepted : arm_now(force);
+    if (!arming_.armed()) return mav::Result::Accepted;
+    if (flying() && !force) {  // ArduPlane refuses a ground station's disarm in flight
+        Writer(out_).str(TXT("# Disarm refused: flying (param2 21196 forces it)")).end();
+        return mav::Result::Failed;
+    }
+    arming_.disarm();
+    Writer(out_).str(TXT("# Throttle disarmed")).end();
+    return mav::Result::Accepted;
+}
+
+// ArduPilot's words (AP_Arming), in the order of lib/Flight/Arming.h's PreArm bits.
+static Flash prearm_text(uint8_t bit) {
+    switch (bit) {
+        case 0: return TXT("Gyros not healthy");
+        case 1: return TXT("Gyros not calibrated");
+        case 2: return TXT("AHRS not healthy");
+        case 3: return TXT("Compass not healthy");
+        case 4: return TXT("Compass not calibrated");
+        case 5: return TXT("Compass calibration running");
+        case 6: return TXT("Barometer not healthy");
+        case 7: return TXT("RC not found");
+        case 8: return TXT("Radio failsafe on");
+        case 9: return TXT("Throttle too high");
+        default: return TXT("Settings are defaults (EEPROM unreadable)");
+    }
+}
+static_assert(flight::kPreArmReasons == 11, "a text for each PreArm bit");
+
+bool FlightIo::prearm_due() const {
+    return prearm_unsaid_ != 0u && serial_text::room() >= 2u * mav::kMaxFrame + gcs_link::output_line_bytes();
+}
+
+void FlightIo::say_prearm() {
+    uint8_t bit = 0;
+    while (((prearm_unsaid_ >> bit) & 1u) == 0u) ++bit;
+    prearm_unsaid_ = (uint16_t)(prearm_unsaid_ & ~(1u << bit));
+    Writer(out_).str(TXT("# PreArm: ")).str(prearm_text(bit)).end();
+}
+
+// --- The ground station's modes and sticks ------------------------------------------------
+
+bool FlightIo::set_mode(uint32_t number) {
+    if (number > 255u || !flight::mode_known((uint8_t)number)) {
+        Writer(out_).str(TXT("# Mode change refused: no mode ")).u32(number).str(TXT(" on this board")).end();
+        return false;
+    }
+    control_.choose((flight::Mode)number);
+    print_flight_line(TXT("# flight "));
+    return true;
+}
+
+void FlightIo::rc_override(const uint16_t width_us[8]) { control_.on_override(width_us, millis()); }
+
 bool FlightIo::powered() const {
-    const flight::FlightSettings& fs = pipe.settings().flight;
-    const uint8_t ch = (uint8_t)(fs.rcmap[flight::kThrottle] - 1u);
-    return control_.state() != flight::State::NoSignal && ch < flight::kChannels &&
-           flight::width_to_throttle(control_.rc_us()[ch], fs.rc[ch], (fs.rc_reversed >> ch) & 1u) > kIdleThrottle;
+    return armed() && control_.state() != flight::State::NoSignal &&
+           control_.stick(flight::kThrottle, millis()) > kIdleThrottle;
 }
 
 uint8_t FlightIo::throttle_percent() const {
@@ -122,17 +261,22 @@ uint8_t FlightIo::throttle_percent() const {
     return (uint8_t)((t + 5) / 10);
 }
 
-// The failsafe's wings-level glide is ArduPlane's FBWA glide (MavLink.h), STABILIZE
-// without an attitude flies as MANUAL.
+// The failsafe's wings-level glide is ArduPlane's FBWA glide (MavLink.h), an attitude
+// mode without an attitude flies as MANUAL.
 mav::PlaneMode FlightIo::plane_mode() const {
     if (control_.state() == flight::State::Failsafe) return mav::PlaneMode::FlyByWireA;
-    if (control_.chosen() == flight::Mode::Stabilize && !control_.without_attitude()) return mav::PlaneMode::Stabilize;
-    return mav::PlaneMode::Manual;
+    if (control_.without_attitude()) return mav::PlaneMode::Manual;
+    return (mav::PlaneMode)(uint8_t)control_.chosen();
 }
 
 bool FlightIo::failsafe() const { return control_.state() == flight::State::Failsafe; }
 
-static Flash flight_mode_name(flight::Mode m) { return m == flight::Mode::Stabilize ? TXT("STABILIZE") : TXT("MANUAL"); }
+static void write_mode_name(Writer& w, flight::Mode m) {
+    char name[flight::kModeNameMax + 1];
+    const int8_t i = flight::mode_index((uint8_t)m);
+    flight::mode_name(i >= 0 ? (uint8_t)i : 0u, name);
+    w.str(name, (uint8_t)strlen(name));
+}
 
 // "<prefix>MODE, receiver ok|no signal yet|FAILSAFE (lost|encoder failsafe)"
 void FlightIo::print_flight_line(Flash prefix) {
@@ -145,7 +289,7 @@ void FlightIo::print_flight_line(Flash prefix) {
                                                                            : TXT("receiver's encoder failsafe"))
             .str(TXT("), then "));
     }
-    w.str(flight_mode_name(control_.chosen()));
+    write_mode_name(w, control_.chosen());
     if (control_.without_attitude()) w.str(TXT(" (no attitude: MANUAL)"));
     if (st == flight::State::NoSignal) w.str(TXT(", no receiver signal yet: outputs at trim"));
     w.end();
@@ -175,16 +319,24 @@ void FlightIo::say_events() {
 }
 
 bool FlightIo::print_status_line() {
-    print_flight_line(TXT("# flight "));
+    print_flight_line(armed() ? TXT("# armed, flight ") : TXT("# disarmed, flight "));
     return true;
 }
 
 void FlightIo::answer(const console::Command& c) {
-    if (c.id == console::CommandId::Flight) {
-        control_.choose(c.arg != 0 ? flight::Mode::Stabilize : flight::Mode::Manual);
+    if (c.id == console::CommandId::Flight && (c.arg == console::kArm || c.arg == console::kDisarm)) {
+        const bool was = armed();
+        const bool arm = c.arg == console::kArm;
+        if (arm_disarm(arm, false) == mav::Result::Accepted && was == arm)
+            Writer(out_).str(arm ? TXT("# Throttle already armed") : TXT("# Throttle already disarmed")).end();
+    } else if (c.id == console::CommandId::Flight) {
+        control_.choose((flight::Mode)flight::mode_number(c.arg));
         print_flight_line(TXT("# flight "));
     } else if (c.arg == console::kShowRc) {
-        print_widths(TXT("# rc"), control_.rc_us());
+        uint16_t widths[flight::kChannels];
+        const uint32_t now_ms = millis();
+        for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = control_.input_us(i, now_ms);
+        print_widths(TXT("# rc"), widths);
     } else {
         uint16_t widths[flight::kChannels];
         for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = servo_outputs::width_us(i);
@@ -195,7 +347,9 @@ void FlightIo::answer(const console::Command& c) {
 uint8_t FlightIo::rc_channels(mav::Packer& mavlink, uint8_t* frame, uint32_t now_ms) const {
     const bool signal =
         control_.state() != flight::State::NoSignal && control_.failsafe_cause() != flight::FailsafeCause::Lost;
-    return mavlink.rc_channels(frame, now_ms, control_.rc_us(), signal ? flight::kChannels : 0u);
+    uint16_t widths[flight::kChannels];  // as flown: the overrides in force, else the receiver's
+    for (uint8_t i = 0; i < flight::kChannels; ++i) widths[i] = control_.input_us(i, now_ms);
+    return mavlink.rc_channels(frame, now_ms, widths, signal ? flight::kChannels : 0u);
 }
 
 uint8_t FlightIo::servo_output_raw(mav::Packer& mavlink, uint8_t* frame, uint32_t now_us) const {
@@ -217,6 +371,13 @@ bool FlightIo::powered() const { return false; }
 uint8_t FlightIo::throttle_percent() const { return 0; }
 mav::PlaneMode FlightIo::plane_mode() const { return mav::PlaneMode::Manual; }
 bool FlightIo::failsafe() const { return false; }
+bool FlightIo::armed() const { return true; }
+mav::Result FlightIo::arm_disarm(bool, bool) { return mav::Result::Unsupported; }
+bool FlightIo::set_mode(uint32_t) { return false; }
+void FlightIo::rc_override(const uint16_t*) {}
+bool FlightIo::prearm_due() const { return false; }
+uint16_t FlightIo::prearm_failures() const { return 0; }
+void FlightIo::say_prearm() {}
 bool FlightIo::print_status_line() { return false; }
 void FlightIo::answer(const console::Command&) {
     text::Writer(out_).str(TXT("# error: this build has no flight features (README \"Builds\"); nothing changed")).end();

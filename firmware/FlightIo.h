@@ -21,6 +21,7 @@
 #include "Pipeline.h"
 #include "Text.h"
 #if APM25_FLIGHT
+#include "Arming.h"
 #include "Flight.h"
 #include "Ppm.h"
 #endif
@@ -59,9 +60,30 @@ public:
     mav::PlaneMode plane_mode() const;
     bool failsafe() const;
 
+    // The throttle armed (lib/Flight/Arming.h; always with ARMING_REQUIRE 0): HEARTBEAT's
+    // MAV_MODE_FLAG_SAFETY_ARMED. The attitude-only build drives no throttle: armed.
+    bool armed() const;
+    // MAV_CMD_COMPONENT_ARM_DISARM: arm (the pre-arm checks first, skipped when forced)
+    // or disarm (refused while flying unless forced). Already so: ACCEPTED. A refusal's
+    // reasons follow as "# PreArm: ..." lines (prearm_due/say_prearm).
+    mav::Result arm_disarm(bool arm, bool force);
+    // SET_MODE and MAV_CMD_DO_SET_MODE: a mode of lib/Flight/Modes.h by ArduPlane's
+    // number, held until the mode switch next moves; false (and a line saying so) for a
+    // number the board does not have.
+    bool set_mode(uint32_t number);
+    // RC_CHANNELS_OVERRIDE's channels 1-8 (FlightControl::on_override).
+    void rc_override(const uint16_t width_us[8]);
+    // The pre-arm checks' failures now (lib/Flight/Arming.h's PreArm bits; 0: may arm):
+    // SYS_STATUS's MAV_SYS_STATUS_PREARM_CHECK healthy bit is prearm_failures() == 0.
+    uint16_t prearm_failures() const;
+    // Loop task: one "# PreArm: <reason>" line of the last refused arming a run, when the
+    // output has room (a refusal can have several; each goes out as one STATUSTEXT).
+    bool prearm_due() const;
+    void say_prearm();
+
     // `status`'s flight line: false (no line) without the flight features.
     bool print_status_line();
-    // `flight manual|stabilize`, `rc`, `servo`.
+    // `flight MODE`, `arm`, `disarm`, `rc`, `servo`.
     void answer(const console::Command& c);
     // The ground station's RC_CHANNELS and SERVO_OUTPUT_RAW frames (kEnabled only).
     uint8_t rc_channels(mav::Packer& mavlink, uint8_t* frame, uint32_t now_ms) const;
@@ -76,8 +98,15 @@ private:
     void control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sample* sample,
                       const pipeline::AnglesCentideg* angles);
 
+    void arming_step(uint32_t now_ms);
+    mav::Result arm_now(bool force);
+    bool flying() const;
+
     flight::PpmDecoder ppm_;
     flight::FlightControl control_;
+    flight::Arming arming_;
+    uint16_t prearm_unsaid_ = 0;  // PreArm bits still to say
+    bool compass_found_ = false;  // the HMC5883L answered since power-up: its heading is used
     uint8_t control_count_ = 0;
     uint32_t last_control_us_ = 0;
     // The gyro bias in the control's rate units, worked out again once a second.

@@ -26,7 +26,8 @@ using vehicle::pipe;
 
 static mav::Parser input;
 static mav::ParamReplies param_replies;
-static bool save_pending = false;           // a PARAM_SET changed a value: configure and save when there is time
+static bool save_pending = false;           // a PARAM_SET changed a value: save when there is time
+static bool configure_pending = false;      // ... and put it in force first, in a pass of its own
 // PREFLIGHT_STORAGE defaults: restored (and every parameter announced) in a pass, its line in the next.
 enum class Defaults : uint8_t { None, Restore, Say };
 static Defaults defaults_pending = Defaults::None;
@@ -170,6 +171,17 @@ static mav::Result run_command(const mav::CommandLong& c) {
         replies |= kReplyVersion;  // after the ACK, as ArduPilot
         return mav::Result::Accepted;
     }
+    // Arming and modes (FlightIo; ArduPlane's answers: a refusal FAILED, its reasons said).
+    if (c.command == mav::kCmdComponentArmDisarm) {
+        if (p[0] != 0.0f && p[0] != 1.0f) return mav::Result::Unsupported;
+        // Forced by MAVLink's 21196, or to arm by ArduPilot's 2989 (MAVProxy's `arm throttle force`).
+        return flight_io.arm_disarm(p[0] == 1.0f, p[1] == mav::kForceMagic || (p[0] == 1.0f && p[1] == mav::kForceArmMagic));
+    }
+    if (c.command == mav::kCmdDoSetMode && FlightIo::kEnabled) {
+        if (((uint8_t)p[0] & mav::kModeFlagCustomModeEnabled) == 0u || !(p[1] >= 0.0f && p[1] < 256.0f))
+            return mav::Result::Unsupported;
+        return flight_io.set_mode((uint32_t)p[1]) ? mav::Result::Accepted : mav::Result::Failed;
+    }
     if (c.command == mav::kCmdGetHomePosition ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
         if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
@@ -246,7 +258,19 @@ void take_request() {
     last_frame_ms = millis();
     mav::ParamRequest read;
     mav::ParamSet set;
-    if (mav::decode_param_request_list(rx)) {
+    mav::SetMode set_mode;
+    uint16_t override_us[8];
+    if (mav::decode_rc_channels_override(rx, override_us)) {
+        flight_io.rc_override(override_us);  // no answer, as ArduPilot
+    } else if (mav::decode_set_mode(rx, set_mode)) {
+        // Only a custom mode (ArduPlane's number); answered as ArduPilot does, with a
+        // COMMAND_ACK whose command is SET_MODE's message id.
+        mav::Result r = mav::Result::Unsupported;
+        if ((set_mode.base_mode & mav::kModeFlagCustomModeEnabled) != 0u && FlightIo::kEnabled)
+            r = flight_io.set_mode(set_mode.custom_mode) ? mav::Result::Accepted : mav::Result::Failed;
+        uint8_t frame[mav::kMaxFrame];
+        port::send_frame(frame, port::mavlink.command_ack(frame, mav::kSetModeAck, r, rx.sysid, rx.compid));
+    } else if (mav::decode_param_request_list(rx)) {
         param_replies.request_all();
     } else if (mav::decode_param_request_read(rx, read)) {
         const int16_t index = mav::requested_index(read);
@@ -258,7 +282,7 @@ void take_request() {
         // As ArduPilot: a parameter set is saved at once (the two-slot store keeps the
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) {
-            save_pending = true;
+            save_pending = configure_pending = true;
             mag_cal_link::parameter_changed((uint16_t)index);
             pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
         }
@@ -268,7 +292,7 @@ void take_request() {
         uint8_t result;
         if (mav::decode_command_ack(rx, position, result) && position >= 1u && position <= 6u)
             pipe.confirm_accel_position((uint8_t)position);
-    } else if (mav::decode_command_long(rx, command)) {
+    } else if (mav::decode_command_long(rx, command) || mav::decode_command_int(rx, command)) {
         command_sysid = rx.sysid;
         command_compid = rx.compid;
         command_pending = true;
@@ -323,8 +347,16 @@ bool save_due() {
     return save_pending && millis() - last_frame_ms >= kSaveQuietMs && room_for(2u * mav::kMaxFrame);
 }
 void save() {
+    // The changed value in force first, as the console's `set` puts it (the controllers'
+    // terms, the end points' factors, RC_OVERRIDE_TIME; a PARAM_SET of RLL2SRV_P flew the
+    // old gains before), then the save: each a pass of its own, as the record's encoding
+    // and the gains' terms together outlast the task's budget.
+    if (configure_pending) {
+        configure_pending = false;
+        flight_io.configure();
+        return;
+    }
     save_pending = false;
-    flight_io.configure();  // the controllers' terms from the new gains
     vehicle::store.start_save(pipe.settings());
 }
 void save_soon() { save_pending = true; }
@@ -400,7 +432,8 @@ void send_heartbeat_and_status() {
                                                    !flight_io.failsafe(), ph == pipeline::Phase::Running});
     mav::add_sensor(health, mav::kBattery, battery_input::enabled(), battery_input::healthy());
     const mav::BatteryReport battery = battery_input::report();
-    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state, mode);
+    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state, mode,
+                                        flight_io.armed());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     const uint32_t missed = imu.missed_samples();
     n = port::mavlink.sys_status(frame, health,

@@ -19,6 +19,7 @@ void SettingsStore::load(settings::Settings& s) {
     write_slot_ = loaded.write;
     next_sequence_ = loaded.next_sequence;
     const settings::LoadResult r = loaded.result;
+    settings_loaded_ = r == settings::LoadResult::Ok || r == settings::LoadResult::Blank;
     if (loaded.newest_cut && r == settings::LoadResult::Ok)
         Writer(out_).str(TXT(TXT_WARN "the last save to " TXT_EEPROM " was cut short: the one before it stands")).end();
     Flash m;
@@ -170,6 +171,7 @@ void SettingsStore::service() {
             // Both slots `write_slot_` now hold the newest pair: the next save goes to the others.
             write_slot_ = (uint8_t)(1u - write_slot_);
             ++next_sequence_;
+            settings_loaded_ = true;
             Writer(out_).str(TXT("# saved")).end();
             return;
         }

@@ -42,6 +42,11 @@ public:
     void service();
     // A save is under way (a reboot waits for its end).
     bool busy() const { return index_ != slots::kSlotSize; }
+    // The settings in use are the user's: loaded, or the EEPROM blank (a new board's
+    // defaults), or saved since; false while the board runs on defaults because the
+    // record was unreadable (corrupt, another firmware's, out of range): the pre-arm
+    // check "Settings not loaded" until the user saves.
+    bool settings_loaded() const { return settings_loaded_; }
 
 private:
     enum Stage : uint8_t {
@@ -85,4 +90,5 @@ private:
     uint8_t part_[kPartSize];
     uint8_t part_from_ = 0xFFu;
     uint16_t next_sequence_ = 1;
+    bool settings_loaded_ = true;
 };

@@ -70,6 +70,8 @@ static void sensor_retries() {
     vehicle::compass.retry(now_ms);
 }
 static void flight_poll() { vehicle::flight_io.poll(micros(), millis()); }
+static bool prearm_due() { return vehicle::flight_io.prearm_due(); }
+static void say_prearm() { vehicle::flight_io.say_prearm(); }
 static void once_a_second() {
     loop_load::new_second();
     vehicle::update_leds();
@@ -101,6 +103,7 @@ static void once_a_second() {
     X(gcs_request,  gcs_link::request_due,           gcs_link::take_request,           1500, kSecGcsRequest,   0)       \
     X(gcs_command,  gcs_link::command_due,           gcs_link::run_pending_command,    5800, kSecGcsCommand,   0)       \
     X(gcs_defaults, gcs_link::defaults_due,          gcs_link::run_defaults,           5800, kSecGcsDefaults,  0)       \
+    X(prearm,       prearm_due,                      say_prearm,                       2300, kSecPreArm,       0)       \
     X(gcs_save,     gcs_link::save_due,              gcs_link::save,                   5800, kSecGcsSave,      0)       \
     X(param_value,  gcs_link::param_value_due,       gcs_link::send_param_value,       3300, kSecGcsReply,     0)       \
     X(gcs_reply,    gcs_link::reply_due,             gcs_link::send_reply,             2000, kSecGcsAnswer,    0)       \

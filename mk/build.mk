@@ -253,7 +253,8 @@ sim: firmware tools
 # UART0 also on TCP 127.0.0.1:5760, as make sim SERIAL=... and ArduPilot's SITL, flown in
 # real time (SPEED=x: x times real time). MODE=mavlink (plot, csv, quat, raw, quiet) types
 # `mode NAME` into the board as it starts, as make view MODE=... does: in MAVLink from then
-# on, a ground station that only listens hears it. Both processes end by themselves, or
+# on, a ground station that only listens hears it. The board is armed on the stand
+# (closed_loop.py --arm: `arm` typed, the throttle at zero meanwhile). Both processes end by themselves, or
 # after FLY_TIMEOUT wall seconds.
 FLY_TIMEOUT ?= 1800
 FLY_SERIAL = $(or $(GCS),$(SERIAL))
@@ -262,7 +263,7 @@ fly: firmware tools venv
 	$(if $(MODE),@mkdir -p $(BUILD)/flight && printf 'mode $(MODE)\n' > $(BUILD)/flight/fly-input.txt)
 	@$(VENV_PY) sim/flight/closed_loop.py --flight $(or $(FLIGHT),cruise) $(if $(GUST),--gust $(GUST)) \
 	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(STAMP),--stamp) --sim $(BUILD)/apm25sim \
-	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) \
+	  --elf $(BUILD)/firmware.elf --timeout $(FLY_TIMEOUT) --arm \
 	  $(if $(FLY_SERIAL),--serial $(FLY_SERIAL)) $(if $(SPEED),--speed $(SPEED)) \
 	  $(if $(MODE),--input $(BUILD)/flight/fly-input.txt) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))

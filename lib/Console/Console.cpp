@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Console.h"
 
+#include "Modes.h"
 #include "Params.h"
 
 #include <string.h>
@@ -65,6 +66,19 @@ void write_value(Writer& w, params::Type t, float v) {
     }
 }
 
+// "manual or stabilize or fbwa" (lower case, `sep` between), "0 manual, 2 ..." with the numbers:
+// the modes the board has, from lib/Flight/Modes.h.
+void write_modes(Writer& w, text::Flash sep, bool numbers) {
+    for (uint8_t i = 0; i < flight::kModeCount; ++i) {
+        char name[flight::kModeNameMax + 1];
+        flight::mode_name(i, name);
+        if (i > 0) w.str(sep);
+        if (numbers) w.u32(flight::mode_number(i)).chr(' ');
+        for (char* p = name; *p != '\0'; ++p) *p = lower(*p);
+        w.str(name, (uint8_t)strlen(name));
+    }
+}
+
 }  // namespace
 
 bool parse_centi(const char* s, int32_t& out) { return parse_fixed(s, 2, 7, out); }
@@ -109,7 +123,7 @@ Command parse_line(const char* line) {
     // The command names in flash, those without an argument first; each name's command
     // is its byte in kIds (a TXT string too: an array would be copied to the AVR's SRAM).
     // (rc, servo, params, gps and baro are Show with kShowRc .. kShowBaro.)
-    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x0C\x0C\x0C\x0C\x0C\x03\x04\x05\x07\x0B\x0E\x0D");
+    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x0C\x0C\x0C\x0C\x0C\x0B\x0B\x03\x04\x05\x07\x0B\x0E\x0D");
     static_assert((uint8_t)CommandId::Help == 2 && (uint8_t)CommandId::Status == 6 &&
                       (uint8_t)CommandId::Save == 9 && (uint8_t)CommandId::Defaults == 10 &&
                       (uint8_t)CommandId::Rate == 3 && (uint8_t)CommandId::Decl == 4 &&
@@ -117,15 +131,16 @@ Command parse_line(const char* line) {
                       (uint8_t)CommandId::Flight == 11 && (uint8_t)CommandId::Show == 12 &&
                       (uint8_t)CommandId::Set == 13 && (uint8_t)CommandId::Get == 14,
                   "kIds holds these values");
-    constexpr int8_t kFirstShow = 5, kFirstWithArgument = 10;
+    constexpr int8_t kFirstShow = 5, kArmWord = 10, kFirstWithArgument = 12;
     const int8_t k = find_word(
-        cmd, TXT("help\0?\0status\0save\0defaults\0rc\0servo\0params\0gps\0baro\0rate\0decl\0mode\0cal\0flight\0get\0set\0"));
+        cmd, TXT("help\0?\0status\0save\0defaults\0rc\0servo\0params\0gps\0baro\0arm\0disarm\0rate\0decl\0mode\0cal\0flight\0get\0set\0"));
     if (k < 0) return fail(Error::Unknown);
     const CommandId id = (CommandId)text::flash_byte(kIds.p + k);
     if (k < kFirstWithArgument) {
         if (n != 1) return fail(Error::ExtraArgument);
         Command r = make(id);
         if (id == CommandId::Show) r.arg = (uint8_t)(k - kFirstShow);
+        if (id == CommandId::Flight) r.arg = k == kArmWord ? kArm : kDisarm;
         return r;
     }
     if (n < 2) return fail(Error::MissingArgument);
@@ -145,6 +160,11 @@ Command parse_line(const char* line) {
             r.arg = (uint8_t)index;
             return r;
         }
+        if (params::is_flight_mode((uint16_t)index) && !flight::mode_known((uint8_t)(v / kParamScale))) {
+            r = fail(Error::NoSuchMode);
+            r.arg = (uint8_t)index;
+            return r;
+        }
         r.value = v;
         return r;
     }
@@ -158,7 +178,7 @@ Command parse_line(const char* line) {
         return r;
     }
     if (id == CommandId::Flight) {
-        const int8_t m = find_word(arg, TXT("manual\0stabilize\0"));
+        const int8_t m = flight::mode_by_name(arg);
         if (m < 0) return fail(Error::BadFlightMode);
         r.arg = (uint8_t)m;
         return r;
@@ -257,7 +277,14 @@ bool print_error(const Command& c, uint8_t part, const text::Sink* out) {
         case Error::BadMode: w.str(TXT("mode must be plot, csv, quat, raw, mavlink or quiet")); break;
         case Error::BadCalTarget: w.str(TXT("cal gyro|mag|level|accel")); break;
         case Error::UnknownParam: w.str(TXT("unknown parameter (type params)")); break;
-        case Error::BadFlightMode: w.str(TXT("flight manual or flight stabilize")); break;
+        case Error::BadFlightMode: w.str(TXT("flight ")); write_modes(w, TXT(" or "), false); break;
+        case Error::NoSuchMode: {
+            params::Info in;
+            if (!params::info(c.arg, in)) break;
+            w.str(in.name, (uint8_t)strlen(in.name)).str(TXT(" must be a mode of this board: "));
+            write_modes(w, TXT(", "), true);
+            break;
+        }
         case Error::ParamRange: {
             params::Info in;
             if (!params::info(c.arg, in)) break;
@@ -289,7 +316,8 @@ bool print_help(uint8_t part, const text::Sink* out) {
                         "# cal level: AHRS_TRIM (airframe level, still 1 s)\0"
                         "# cal accel: 6 positions; again at each one asked\0"
                         "# save | defaults: store settings / back to defaults\0"
-                        "# flight manual|stabilize: flight mode\0"
+                        "# flight manual|stabilize|fbwa: flight mode\0"
+                        "# arm | disarm: the throttle (pre-arm checks first)\0"
                         "# rc | servo: receiver / output widths, us\0"
                         "# gps: fix, satellites, position, speed, counters\0"
                         "# baro: pressure, temperature, height, climb\0"
@@ -359,7 +387,7 @@ bool apply_setting(const Command& c, settings::Settings& s, const text::Sink* ou
     }
 }
 
-static_assert((uint8_t)CommandId::Get < 15 && (uint8_t)Error::BadFlightMode < 16 &&
+static_assert((uint8_t)CommandId::Get < 15 && (uint8_t)Error::NoSuchMode < 16 && flight::kModeCount < kArm &&
                   (uint8_t)fmt::kLastOutputMode < 16,
               "CommandQueue packs the id and the error or mode into 4 bits each, id 15 spare");
 static_assert((CommandQueue::kBytes & (CommandQueue::kBytes - 1u)) == 0, "kBytes must be a power of two");
@@ -367,7 +395,9 @@ static_assert((CommandQueue::kBytes & (CommandQueue::kBytes - 1u)) == 0, "kBytes
 uint8_t CommandQueue::item_bytes(uint8_t first) {
     const uint8_t id = first & 0x0Fu;
     if (id == (uint8_t)CommandId::Rate || id == (uint8_t)CommandId::Get) return 2;
-    if (id == (uint8_t)CommandId::Error && (first >> 4) == (uint8_t)Error::ParamRange) return 2;
+    if (id == (uint8_t)CommandId::Error &&
+        ((first >> 4) == (uint8_t)Error::ParamRange || (first >> 4) == (uint8_t)Error::NoSuchMode))
+        return 2;
     if (id == (uint8_t)CommandId::Decl || id == kMergedError) return 3;
     if (id == (uint8_t)CommandId::Set) return kMaxItem;
     return 1;

@@ -14,7 +14,9 @@
 //   cal accel            INS_ACCOFFS/SCAL in six positions: again for each one asked
 //   save                 write settings and calibration to EEPROM
 //   defaults             back to the defaults (not saved until `save`)
-//   flight manual|stabilize  the flight mode (the mode switch's next move overrides it)
+//   flight MODE          the flight mode by name, a mode of lib/Flight/Modes.h (manual,
+//                        stabilize, fbwa); the mode switch's next move overrides it
+//   arm, disarm          the throttle armed (the pre-arm checks first) or disarmed
 //   rc                   the receiver's eight channel widths, us (radio set-up)
 //   servo                the eight output widths, us
 //   gps                  the GPS: fix, satellites, hDOP, position, speed, course, age, counters
@@ -55,13 +57,17 @@ enum class CommandId : uint8_t {
     CalMag,
     Save,
     Defaults,
-    Flight,    // arg = 0 manual, 1 stabilize
+    Flight,    // arg = the mode's row in lib/Flight/Modes.h, or kArm, kDisarm
     Show,      // arg = Show*
     Set,       // arg = parameter index, value = the value x kParamScale
     Get,       // arg = parameter index
     CalLevel,  // the level calibration (AHRS_TRIM_X/Y)
     CalAccel,  // the six-position calibration: starts it, or confirms the position asked
 };
+
+// Flight's arg for `arm` and `disarm` (the modes' rows are below them).
+constexpr uint8_t kArm = 14;
+constexpr uint8_t kDisarm = 15;
 
 enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowGps = 3, kShowBaro = 4 };
 // `set` values are parsed with four decimals (parse_fixed) and carried as integers.
@@ -81,7 +87,8 @@ enum class Error : uint8_t {
     BadCalTarget,     // cal without gyro|mag|level|accel
     UnknownParam,     // get/set of a name the table does not have
     ParamRange,       // set: outside the parameter's range, or not whole for an integer (arg: the index)
-    BadFlightMode,    // flight without manual|stabilize
+    BadFlightMode,    // flight without a mode's name
+    NoSuchMode,       // set FLTMODEn to a number that is not a mode the board has (arg: the index)
 };
 
 struct Command {

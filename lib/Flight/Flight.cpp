@@ -251,24 +251,60 @@ void mix(const FlightSettings& s, const Scales& sc, const Surfaces& in, const ui
 
 namespace {
 
-State state_of(Mode m) { return m == Mode::Stabilize ? State::Stabilize : State::Manual; }
+// The law of a mode the board has; any other number flies MANUAL.
+State state_of(Mode m) {
+    const int8_t i = mode_index((uint8_t)m);
+    return i >= 0 && mode_law((uint8_t)i) == Law::Attitude ? State::Stabilize : State::Manual;
+}
 
 }  // namespace
 
 void FlightControl::hold_neutral(uint16_t out_us[kChannels]) const {
-    const Surfaces neutral{0, 0, (int16_t)(s_.thr_fs_pct * 10u), 0};
+    const Surfaces neutral{0, 0, throttle_live_ ? (int16_t)(s_.thr_fs_pct * 10u) : (int16_t)0, 0};
     mix(s_, scales_, neutral, nullptr, out_us);
 }
 
 void FlightControl::choose(Mode m) {
-    if (m != Mode::Stabilize) m = Mode::Manual;
+    if (!mode_known((uint8_t)m)) m = Mode::Manual;
+    const State before = state_of(chosen_);
     chosen_ = m;
     if (state_ == State::Manual || state_ == State::Stabilize) {
-        if (state_ != state_of(m)) {
+        if (before != state_of(m)) {
             roll_.reset();
             pitch_.reset();
         }
         state_ = state_of(m);
+    }
+}
+
+bool FlightControl::override_fresh(uint8_t ch, uint32_t now_ms) const {
+    if (override_us_[ch] == 0u || override_timeout_8ms_ == 0u) return false;
+    return override_timeout_8ms_ == kOverrideForever ||
+           (uint16_t)((uint16_t)(now_ms >> 3) - override_at_[ch]) < override_timeout_8ms_;
+}
+
+uint16_t FlightControl::input_us(uint8_t ch, uint32_t now_ms) const {
+    return override_fresh(ch, now_ms) ? override_us_[ch] : rc_us_[ch];
+}
+
+int16_t FlightControl::stick(uint8_t role, uint32_t now_ms) const {
+    const uint8_t ch = (uint8_t)(s_.rcmap[role] - 1u);
+    if (ch >= kChannels) return 0;
+    const bool rev = bit(s_.rc_reversed, ch);
+    const uint16_t w = input_us(ch, now_ms);
+    return role == kThrottle ? width_to_throttle(w, s_.rc[ch], scales_.in[role], rev)
+                             : width_to_angle(w, s_.rc[ch], scales_.in[role], rev);
+}
+
+void FlightControl::read_switch(uint32_t now_ms) {
+    const uint8_t ch = s_.fltmode_ch;
+    if (ch < 1u || ch > kChannels) return;
+    const uint8_t pos = switch_position(input_us((uint8_t)(ch - 1u), now_ms));
+    if (pos != switch_pos_) {
+        switch_pos_ = pos;
+        const Mode before = chosen_;
+        choose((Mode)s_.fltmode[pos - 1u]);
+        if (chosen_ != before) events_ |= kEvModeChanged;
     }
 }
 
@@ -280,19 +316,31 @@ void FlightControl::on_frame(const uint16_t width_us[kChannels], uint32_t now_ms
     // The encoder's failsafe forces the throttle channel low (raw width, as ArduPlane).
     if (thr >= 1u && thr <= kChannels && width_us[thr - 1u] < s_.thr_fs_value_us) return;
     last_good_ms_ = now_ms;
-    const uint8_t ch = s_.fltmode_ch;
-    if (ch >= 1u && ch <= kChannels) {
-        const uint8_t pos = switch_position(width_us[ch - 1u]);
-        if (pos != switch_pos_) {
-            switch_pos_ = pos;
-            const Mode before = chosen_;
-            choose((Mode)s_.fltmode[pos - 1u]);
-            if (chosen_ != before) events_ |= kEvModeChanged;
-        }
+    read_switch(now_ms);
+}
+
+void FlightControl::on_override(const uint16_t width_us[kChannels], uint32_t now_ms) {
+    if (override_timeout_8ms_ == 0u) return;  // RC_OVERRIDE_TIME 0: overrides off
+    for (uint8_t i = 0; i < kChannels; ++i) {
+        const uint16_t w = width_us[i];
+        if (w == 0u) {
+            override_us_[i] = 0;  // back to the receiver
+        } else if (w >= 800u && w <= 2200u) {
+            override_us_[i] = w;
+            override_at_[i] = (uint16_t)(now_ms >> 3);
+        }  // UINT16_MAX (ignore) and implausible widths: unchanged
     }
+    const uint8_t thr = (uint8_t)(s_.rcmap[kThrottle] - 1u);
+    if (!have_frame_ || thr >= kChannels || !override_fresh(thr, now_ms) || override_us_[thr] < s_.thr_fs_value_us)
+        return;
+    last_good_ms_ = last_frame_ms_ = now_ms;
+    read_switch(now_ms);
 }
 
 void FlightControl::update_signal(uint32_t now_ms) {
+    // Overrides past their time are dropped, before their 8 ms stamps could wrap.
+    for (uint8_t i = 0; i < kChannels; ++i)
+        if (override_us_[i] != 0u && !override_fresh(i, now_ms)) override_us_[i] = 0;
     if (!have_frame_) return;
     const bool good = now_ms - last_good_ms_ < kSignalTimeoutMs;
     if (!good && state_ != State::Failsafe) {
@@ -352,7 +400,7 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
         roll_.reset();
         pitch_.reset();
     }
-    const int16_t fs_throttle = (int16_t)(s_.thr_fs_pct * 10u);
+    const int16_t fs_throttle = throttle_live_ ? (int16_t)(s_.thr_fs_pct * 10u) : (int16_t)0;
     if (state_ == State::Failsafe) {
         Surfaces sf{0, 0, fs_throttle, 0};
         if (att.valid) sf = stabilize(att, 0, (int32_t)s_.trim_pitch_cd + s_.fs_pitch_cd);
@@ -361,15 +409,10 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
         mix(s_, scales_, sf, nullptr, out_us);
         return;
     }
-    // The sticks, by role (RCMAP_*).
+    // The sticks, by role (RCMAP_*); disarmed, the throttle at its minimum.
     int16_t in[4];
-    for (uint8_t role = 0; role < 4; ++role) {
-        const uint8_t ch = (uint8_t)(s_.rcmap[role] - 1u);
-        const bool rev = bit(s_.rc_reversed, ch);
-        in[role] = role == kThrottle ? width_to_throttle(rc_us_[ch], s_.rc[ch], scales_.in[role], rev)
-                                     : width_to_angle(rc_us_[ch], s_.rc[ch], scales_.in[role], rev);
-    }
-    Surfaces sf{in[kRoll], in[kPitch], in[kThrottle], in[kYaw]};
+    for (uint8_t role = 0; role < 4; ++role) in[role] = stick(role, now_ms);
+    Surfaces sf{in[kRoll], in[kPitch], throttle_live_ ? in[kThrottle] : (int16_t)0, in[kYaw]};
     if (state_ == State::Stabilize && !fallback) {
         const int32_t roll_demand = demand_cd(sf.aileron_cd, s_.lim_roll_cd);
         // The stick's pitch from the trim (ArduPlane's stabilize_pitch adds TRIM_PITCH_CD).
@@ -380,7 +423,9 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
         sf.aileron_cd = c.aileron_cd;
         sf.elevator_cd = c.elevator_cd;
     }
-    mix(s_, scales_, sf, rc_us_ + 4, out_us);
+    uint16_t aux_us[4];
+    for (uint8_t i = 0; i < 4; ++i) aux_us[i] = input_us((uint8_t)(i + 4u), now_ms);
+    mix(s_, scales_, sf, aux_us, out_us);
 }
 
 }  // namespace flight

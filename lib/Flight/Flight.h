@@ -19,6 +19,7 @@
 #include <stdint.h>
 
 #include "FlightSettings.h"
+#include "Modes.h"
 
 namespace flight {
 
@@ -188,8 +189,28 @@ public:
 
     // An accepted receiver frame, at now_ms.
     void on_frame(const uint16_t width_us[kChannels], uint32_t now_ms);
-    // The console's choice; the mode switch's next move overrides it.
+    // A ground station's RC_CHANNELS_OVERRIDE (MAVLink's meanings, per channel: UINT16_MAX
+    // leaves the channel as it is, 0 gives it back to the receiver, a width 800..2200 us
+    // overrides it; other widths are ignored). An override holds until
+    // set_override_timeout's time has passed since its last message. Once the receiver
+    // has been heard, a fresh override of the throttle channel above THR_FS_VALUE is
+    // valid input as a good frame is (ArduPilot's): it keeps the board out of FAILSAFE
+    // while the receiver is lost, and channels it does not override keep the receiver's
+    // last widths. When the overrides stop, each channel is the receiver's again after
+    // the timeout, and FAILSAFE follows 0.5 s after the last good input.
+    void on_override(const uint16_t width_us[kChannels], uint32_t now_ms);
+    // RC_OVERRIDE_TIME in 8 ms units: 0 overrides are ignored, kOverrideForever never time out.
+    static constexpr uint16_t kOverrideForever = 0xFFFFu;
+    void set_override_timeout(uint16_t timeout_8ms) { override_timeout_8ms_ = timeout_8ms; }
+    // The width flown for channel ch (0..7) at now_ms: a fresh override, else the receiver's.
+    uint16_t input_us(uint8_t ch, uint32_t now_ms) const;
+    // A stick by role (RCMAP_*) as the step reads it: -4500..4500 cd, the throttle 0..1000.
+    int16_t stick(uint8_t role, uint32_t now_ms) const;
+    // The console's or a ground station's choice; the mode switch's next move overrides
+    // it. A number the board does not have (Modes.h) flies MANUAL: the caller refuses it.
     void choose(Mode m);
+    // false: the throttle output holds its minimum in every state (disarmed: Arming.h).
+    void set_throttle_live(bool live) { throttle_live_ = live; }
     // One control step, every kControlDt_s: the eight output widths, within their limits.
     void step(uint32_t now_ms, const Attitude& att, uint16_t out_us[kChannels]);
 
@@ -199,7 +220,7 @@ public:
     // Whether the next step uses the attitude (STABILIZE, FAILSAFE; after update_signal):
     // else the caller need not work it out.
     bool wants_attitude() const { return state_ == State::Stabilize || state_ == State::Failsafe; }
-    // STABILIZE chosen, but flying as MANUAL for want of an attitude.
+    // An attitude mode chosen (STABILIZE, FBWA), but flying as MANUAL for want of an attitude.
     bool without_attitude() const { return no_attitude_; }
     Mode chosen() const { return chosen_; }
     FailsafeCause failsafe_cause() const { return cause_; }
@@ -233,6 +254,13 @@ private:
     uint8_t events_ = 0;
     bool have_frame_ = false;
     bool no_attitude_ = false;    // STABILIZE flying as MANUAL: the attitude is not valid
+    bool throttle_live_ = true;
+    // RC_CHANNELS_OVERRIDE: the widths (0: none) and when each came, in 8 ms units.
+    bool override_fresh(uint8_t ch, uint32_t now_ms) const;
+    void read_switch(uint32_t now_ms);
+    uint16_t override_us_[kChannels] = {};
+    uint16_t override_at_[kChannels] = {};
+    uint16_t override_timeout_8ms_ = 375;  // RC_OVERRIDE_TIME's default, 3 s
 };
 
 }  // namespace flight

@@ -32,8 +32,8 @@ struct EndPoints {
     uint16_t trim_us;  // the neutral width
 };
 
-// ArduPlane's flight mode numbers (FLTMODEn values).
-enum class Mode : uint8_t { Manual = 0, Stabilize = 2 };
+// ArduPlane's flight mode numbers (FLTMODEn values) of the modes the board has (Modes.h).
+enum class Mode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
 
 struct FlightSettings {
     AxisGains roll;             // RLL2SRV_*

@@ -39,7 +39,7 @@ static_assert(kTextChunk == MAVLINK_MSG_STATUSTEXT_FIELD_TEXT_LEN, "STATUSTEXT t
 static_assert((uint8_t)State::Calibrating == MAV_STATE_CALIBRATING && (uint8_t)State::Active == MAV_STATE_ACTIVE &&
                   (uint8_t)State::Critical == MAV_STATE_CRITICAL && (uint8_t)State::Boot == MAV_STATE_BOOT,
               "State values are MAV_STATE's");
-static_assert((uint8_t)Severity::Error == MAV_SEVERITY_ERROR && (uint8_t)Severity::Warning == MAV_SEVERITY_WARNING &&
+static_assert((uint8_t)Severity::Critical == MAV_SEVERITY_CRITICAL && (uint8_t)Severity::Error == MAV_SEVERITY_ERROR && (uint8_t)Severity::Warning == MAV_SEVERITY_WARNING &&
                   (uint8_t)Severity::Notice == MAV_SEVERITY_NOTICE && (uint8_t)Severity::Info == MAV_SEVERITY_INFO,
               "Severity values are MAV_SEVERITY's");
 static_assert(kGyro3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_GYRO && kAccel3d == (uint32_t)MAV_SYS_STATUS_SENSOR_3D_ACCEL &&
@@ -64,8 +64,17 @@ static_assert(kMsgHeartbeat == MAVLINK_MSG_ID_HEARTBEAT && kMsgParamRequestRead 
                   kMsgParamRequestList == MAVLINK_MSG_ID_PARAM_REQUEST_LIST && kMsgParamSet == MAVLINK_MSG_ID_PARAM_SET &&
                   kMsgCommandLong == MAVLINK_MSG_ID_COMMAND_LONG,
               "MsgId values are the message ids");
-static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE,
+static_assert(kCmdPreflightCalibration == MAV_CMD_PREFLIGHT_CALIBRATION && kCmdPreflightStorage == MAV_CMD_PREFLIGHT_STORAGE &&
+                  kCmdComponentArmDisarm == MAV_CMD_COMPONENT_ARM_DISARM && kCmdDoSetMode == MAV_CMD_DO_SET_MODE,
               "MAV_CMD values");
+static_assert(kMsgSetMode == MAVLINK_MSG_ID_SET_MODE && kMsgCommandInt == MAVLINK_MSG_ID_COMMAND_INT &&
+                  kMsgRcChannelsOverride == MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE &&
+                  kModeFlagCustomModeEnabled == MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+              "the mode and override messages' values");
+// The fields kept: COMMAND_INT's up to its target_component (offset 31), the override's
+// eight channels and targets (18 bytes), SET_MODE whole (6).
+static_assert(MAVLINK_MSG_ID_SET_MODE_LEN <= kRxPayloadMax && 18 <= kRxPayloadMax && 32 <= kRxPayloadMax,
+              "the fields read fit the received payload");
 static_assert(kGps == (uint32_t)MAV_SYS_STATUS_SENSOR_GPS, "MAV_SYS_STATUS_SENSOR_GPS");
 static_assert(kBattery == (uint32_t)MAV_SYS_STATUS_SENSOR_BATTERY, "MAV_SYS_STATUS_SENSOR_BATTERY");
 // BATTERY_STATUS: its payload up to charge_state (41 bytes) fits; the extensions after it
@@ -176,9 +185,10 @@ void add_plane_status(Health& h, const PlaneStatus& p) {
     add_sensor(h, kRcReceiver, true, p.receiver_ok);
 }
 
-uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode) {
+uint8_t Packer::heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode, bool armed) {
     Frame f(seq_);
-    uint8_t base = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | MAV_MODE_FLAG_MANUAL_INPUT_ENABLED | MAV_MODE_FLAG_SAFETY_ARMED;
+    uint8_t base = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | MAV_MODE_FLAG_MANUAL_INPUT_ENABLED;
+    if (armed) base |= MAV_MODE_FLAG_SAFETY_ARMED;
     if (mode != PlaneMode::Manual) base |= MAV_MODE_FLAG_STABILIZE_ENABLED;
     mavlink_msg_heartbeat_pack_status(kSystemId, kComponentId, &f.status, &f.msg, MAV_TYPE_FIXED_WING,
                                       MAV_AUTOPILOT_ARDUPILOTMEGA, base, (uint32_t)mode, (uint8_t)state);
@@ -449,6 +459,7 @@ void StatusText::flush_chunk() {
         severity_ = Severity::Info;
         if (starts_with(chunk_, len_, TXT("error:"))) severity_ = Severity::Error;
         else if (starts_with(chunk_, len_, TXT("warn:"))) severity_ = Severity::Warning;
+        else if (starts_with(chunk_, len_, TXT("PreArm:"))) severity_ = Severity::Critical;
     }
     uint8_t frame[kMaxFrame];
     const uint8_t n = packer_.statustext(frame, severity_, chunk_, len_, id_, chunk_seq_);
@@ -488,6 +499,13 @@ uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
             max_len = MAVLINK_MSG_ID_MISSION_CLEAR_ALL_LEN;
             return MAVLINK_MSG_ID_MISSION_CLEAR_ALL_CRC;
         case MAVLINK_MSG_ID_TIMESYNC: max_len = MAVLINK_MSG_ID_TIMESYNC_LEN; return MAVLINK_MSG_ID_TIMESYNC_CRC;
+        case MAVLINK_MSG_ID_COMMAND_INT:
+            max_len = MAVLINK_MSG_ID_COMMAND_INT_LEN;
+            return MAVLINK_MSG_ID_COMMAND_INT_CRC;
+        case MAVLINK_MSG_ID_SET_MODE: max_len = MAVLINK_MSG_ID_SET_MODE_LEN; return MAVLINK_MSG_ID_SET_MODE_CRC;
+        case MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE:
+            max_len = MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE_LEN;
+            return MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE_CRC;
         default: return 0;
     }
 }
@@ -623,19 +641,57 @@ uint8_t Packer::command_long(uint8_t out[kMaxFrame], uint16_t command, float par
     return f.finish(out, seq_);
 }
 
-bool decode_command_long(const Received& rx, CommandLong& out) {
-    if (rx.msgid != kMsgCommandLong) return false;
-    mavlink_command_long_t m;
-    copy_payload(m, rx);
-    if (!for_us(m.target_system, m.target_component)) return false;
+namespace {
+// COMMAND_LONG's and COMMAND_INT's common fields; p5..p7 their last three (param5-7, or x, y, z).
+template <class Message>
+void take_command(CommandLong& out, const Message& m, float p5, float p6, float p7) {
     out.command = m.command;
     out.param[0] = m.param1;
     out.param[1] = m.param2;
     out.param[2] = m.param3;
     out.param[3] = m.param4;
-    out.param[4] = m.param5;
-    out.param[5] = m.param6;
-    out.param[6] = m.param7;
+    out.param[4] = p5;
+    out.param[5] = p6;
+    out.param[6] = p7;
+}
+}  // namespace
+
+bool decode_command_long(const Received& rx, CommandLong& out) {
+    if (rx.msgid != kMsgCommandLong) return false;
+    mavlink_command_long_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    take_command(out, m, m.param5, m.param6, m.param7);
+    return true;
+}
+
+bool decode_command_int(const Received& rx, CommandLong& out) {
+    if (rx.msgid != kMsgCommandInt) return false;
+    mavlink_command_int_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    take_command(out, m, (float)m.x, (float)m.y, m.z);
+    return true;
+}
+
+bool decode_set_mode(const Received& rx, SetMode& out) {
+    if (rx.msgid != kMsgSetMode) return false;
+    mavlink_set_mode_t m;
+    copy_payload(m, rx);
+    if (m.target_system != kSystemId) return false;  // SET_MODE names a system only
+    out.base_mode = m.base_mode;
+    out.custom_mode = m.custom_mode;
+    return true;
+}
+
+bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]) {
+    if (rx.msgid != kMsgRcChannelsOverride) return false;
+    mavlink_rc_channels_override_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    const uint16_t w[8] = {m.chan1_raw, m.chan2_raw, m.chan3_raw, m.chan4_raw,
+                           m.chan5_raw, m.chan6_raw, m.chan7_raw, m.chan8_raw};
+    memcpy(width_us, w, sizeof w);
     return true;
 }
 

@@ -31,9 +31,9 @@
 // parameter names, so it says what ArduPlane says: MAV_TYPE_FIXED_WING,
 // MAV_AUTOPILOT_ARDUPILOTMEGA and custom_mode = ArduPlane's mode number, which Mission
 // Planner, QGroundControl and MAVProxy name (MANUAL, STABILIZE, FBWA). base_mode: custom
-// mode enabled, manual input enabled, stabilize enabled outside MANUAL, and armed: the
-// board has no arming, its outputs are live from power-up (ArduPlane with ARMING_REQUIRE
-// 0 says armed too).
+// mode enabled, manual input enabled, stabilize enabled outside MANUAL, and
+// MAV_MODE_FLAG_SAFETY_ARMED while the throttle is armed (ArduPlane's: always with
+// ARMING_REQUIRE 0).
 //
 // Plain C++: no Arduino include, the same code on the AVR and the host tests.
 #pragma once
@@ -85,7 +85,7 @@ enum class State : uint8_t {
 enum class PlaneMode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
 
 // STATUSTEXT severity (MAV_SEVERITY).
-enum class Severity : uint8_t { Error = 3, Warning = 4, Notice = 5, Info = 6 };
+enum class Severity : uint8_t { Critical = 2, Error = 3, Warning = 4, Notice = 5, Info = 6 };
 
 // SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR_3D_GYRO, _3D_ACCEL, _3D_MAG,
 // _ABSOLUTE_PRESSURE, _GPS: present once a receiver has been heard, healthy with a 3D
@@ -199,7 +199,7 @@ constexpr uint16_t kUsbProductId = 0x0010u;
 // Each call writes one frame into `out` and returns its length (0 only on bad input).
 class Packer {
 public:
-    uint8_t heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode);
+    uint8_t heartbeat(uint8_t out[kMaxFrame], State state, PlaneMode mode, bool armed);
     // The pipeline's angles in degrees (heading 0..360, declination applied) are sent
     // in radians, heading wrapped to -pi..pi as ATTITUDE's yaw; rates in rad/s, body axes.
     uint8_t attitude(uint8_t out[kMaxFrame], uint32_t time_boot_ms, float roll_deg, float pitch_deg,
@@ -276,7 +276,8 @@ struct FrameSink {
 
 // The console's text output in `mode mavlink`: a text::Sink whose "# " lines become
 // STATUSTEXT frames, "# " stripped; severity Error for "# error: ...", Warning for
-// "# warn: ...", Info for every other "# " line. Lines that do not start with "# "
+// "# warn: ...", Critical for "# PreArm: ..." (ArduPilot's, which ground stations show
+// as an alert), Info for every other "# " line. Lines that do not start with "# "
 // (angle or csv lines) are dropped: ATTITUDE carries the angles. A line longer than
 // kTextChunk goes out as chunks with one non-zero id, an empty last chunk when it ends
 // on a chunk boundary (a receiver takes a chunk with a NUL as the last). Streaming: no
@@ -311,6 +312,9 @@ private:
 // The messages the board answers (msgid).
 enum MsgId : uint8_t {
     kMsgHeartbeat = 0,
+    kMsgSetMode = 11,
+    kMsgRcChannelsOverride = 70,
+    kMsgCommandInt = 75,
     kMsgParamRequestRead = 20,
     kMsgParamRequestList = 21,
     kMsgParamSet = 23,
@@ -321,7 +325,9 @@ enum MsgId : uint8_t {
     kMsgMissionClearAll = 45,
     kMsgTimesync = 111,
 };
-constexpr uint8_t kRxPayloadMax = 33;  // COMMAND_LONG's, the longest of them
+// COMMAND_LONG's, the longest kept whole; of COMMAND_INT (35) and RC_CHANNELS_OVERRIDE
+// (38) the fields after it are not needed (current, autocontinue; channels 9-18).
+constexpr uint8_t kRxPayloadMax = 33;
 
 // A frame from the ground station, CRC-checked: its payload zero-filled to the message's
 // full length (MAVLink 2 trims trailing zeros).
@@ -399,6 +405,18 @@ bool decode_mission_count(const Received& rx, uint16_t& count, uint8_t& mission_
 bool decode_mission_clear_all(const Received& rx, uint8_t& mission_type);
 // TIMESYNC: a request (tc1 0) to answer; false for a reply to someone else's request.
 bool decode_timesync_request(const Received& rx, int64_t& ts1);
+// COMMAND_INT as a CommandLong: param1-4, then x, y as param5, param6 (int32 as float,
+// enough for the commands taken so), z as param7.
+bool decode_command_int(const Received& rx, CommandLong& out);
+// SET_MODE: custom_mode taken only with MAV_MODE_FLAG_CUSTOM_MODE_ENABLED in base_mode.
+struct SetMode {
+    uint8_t base_mode;
+    uint32_t custom_mode;
+};
+bool decode_set_mode(const Received& rx, SetMode& out);
+constexpr uint8_t kModeFlagCustomModeEnabled = 1;  // MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+// RC_CHANNELS_OVERRIDE: channels 1-8 as sent (UINT16_MAX ignore, 0 release; 9-18 not kept).
+bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]);
 
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;
@@ -421,5 +439,10 @@ constexpr float kAccelcalFailed = 16777216.0f;
 constexpr uint16_t kCmdRequestAutopilotCapabilities = 520;  // answered with AUTOPILOT_VERSION
 constexpr uint16_t kCmdPreflightRebootShutdown = 246;       // param1 1: reboot (a watchdog reset)
 constexpr uint8_t kMsgAutopilotVersion = 148;               // ... and REQUEST_MESSAGE 148
+constexpr uint16_t kCmdComponentArmDisarm = 400;  // param1 1 arm, 0 disarm; param2 kForceMagic: without the checks
+constexpr uint16_t kCmdDoSetMode = 176;           // param1 base_mode (CUSTOM_MODE_ENABLED), param2 the custom mode
+constexpr uint16_t kSetModeAck = 11;               // ArduPilot answers SET_MODE with a COMMAND_ACK of "command" 11
+constexpr float kForceMagic = 21196.0f;     // MAVLink's: arm or disarm without the checks
+constexpr float kForceArmMagic = 2989.0f;   // ArduPilot's own for arming
 
 }  // namespace mav

@@ -363,6 +363,9 @@ public:
 
     Phase phase() const { return st_.phase; }
     bool gyro_calibrating() const { return st_.gyro_cal_active; }
+    // After a start that was never still (a restart in the air): running on the saved bias,
+    // the calibration measuring on in the background (gyro_calibrating() true meanwhile).
+    bool gyro_measuring_on() const { return st_.gyro_cal_active && st_.start_moved; }
     bool mag_calibrating() const { return st_.mag_cal_active || st_.mag_fit_active; }
     uint32_t steps() const { return st_.steps; }
     uint32_t time_ms() const { return st_.steps * 5u; }

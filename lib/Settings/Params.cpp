@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "Constants.h"
+#include "Modes.h"
 
 #ifdef __AVR__
 #include <avr/pgmspace.h>
@@ -171,14 +172,14 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Flight mode channel", "",
                "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
                "ArduPlane's six bands. 0: no switch, the console's `flight` command only.")},
-    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 2.0f, 0.0f,
+    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 5.0f, 0.0f,
      PARAM_DOC("Flight mode 1", "",
-               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 2 STABILIZE (ArduPlane's numbers; "
-               "1 flies as MANUAL).")},
-    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 2.0f, 2.0f,
+               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 2 STABILIZE, 5 FBWA (ArduPlane's "
+               "numbers; FBWA flies as STABILIZE does). Any other number is refused.")},
+    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 5.0f, 2.0f,
      PARAM_DOC("Flight mode n", "",
                "The mode of the switch's position n (2: 1231 to 1360 us, 3: to 1490, 4: to 1620, 5: to 1749, 6: "
-               "above): 0 MANUAL, 2 STABILIZE.")},
+               "above): 0 MANUAL, 2 STABILIZE, 5 FBWA; any other number is refused.")},
     {"RCMAP_ROLL", Type::UInt8, 0, 1, 0, AT(flight.rcmap[0]), 1.0f, 8.0f, 1.0f,
      PARAM_DOC("Roll channel", "", "The receiver channel of the roll (aileron) stick.")},
     {"RCMAP_PITCH", Type::UInt8, 0, 1, 0, AT(flight.rcmap[1]), 1.0f, 8.0f, 2.0f,
@@ -273,6 +274,26 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Require arming", "",
                "1: the throttle output holds its minimum until the board is armed (the surfaces stay live); 0: "
                "the throttle follows the stick from power-up and the board always reports armed.")},
+    {"ARMING_CHECK", Type::UInt16, 0, 1, 0, AT(vehicle.arming_check), 0.0f, 8191.0f, 1.0f,
+     PARAM_DOC("Arm checks to perform", "",
+               "The pre-arm checks, ArduPilot's bitmask: 1 all; else 2 barometer (healthy if present), 4 compass "
+               "(healthy and calibrated if found at start-up, not calibrating), 16 inertial sensors (the MPU6000 "
+               "answering, the gyro calibrated, the estimator running), 32 parameters (the settings loaded, not "
+               "defaults after an unreadable record), 64 receiver (a frame seen, no failsafe, the throttle at "
+               "zero). 8 (GPS) and the others have nothing to check on this board. 0: none.")},
+    // ARMING_RUDDER's default, ArduPlane's 1 (arm only): the board cannot tell it is flying
+    // without a pitot or a GPS fix, and a full-left rudder with the throttle closed (a
+    // spin's recovery, a glide's crosswind) must not cut the motor in the air.
+    {"ARMING_RUDDER", Type::UInt8, 0, 1, 0, AT(vehicle.arming_rudder), 0.0f, 2.0f, 1.0f,
+     PARAM_DOC("Rudder arming", "",
+               "Arming by the rudder stick with the throttle at zero (within 3 % of RCn_MIN): 1 full right rudder "
+               "for 3 s arms (if the pre-arm checks pass); 2 also full left for 3 s disarms, unless the pitot or "
+               "the GPS says the aeroplane moves faster than 5 m/s; 0 no rudder arming.")},
+    {"RC_OVERRIDE_TIME", Type::Float, 0, 1, 0, AT(vehicle.rc_override_time_s), -1.0f, 120.0f, 3.0f,
+     PARAM_DOC("RC override timeout", "s",
+               "How long a ground station's RC_CHANNELS_OVERRIDE holds a channel after its last message; then "
+               "the receiver has it again. 0: overrides are ignored; -1: they never time out (until released "
+               "with 0).")},
 
     // Board orientation, level, the accelerometer's calibration.
     {"AHRS_ORIENTATION", Type::UInt8, 0, 1, 0, AT(vehicle.ahrs_orientation), 0.0f, 37.0f, 0.0f,
@@ -530,10 +551,25 @@ float get(const Settings& s, uint16_t index) {
     return locate(index, row, instance) ? read(s, row, instance) : 0.0f;
 }
 
+namespace {
+bool holds_flight_mode(const Row& row) {
+    return row.offset >= offsetof(Settings, flight.fltmode) &&
+           row.offset < offsetof(Settings, flight.fltmode) + sizeof(flight::FlightSettings::fltmode);
+}
+}  // namespace
+
+bool is_flight_mode(uint16_t index) {
+    Row row;
+    uint8_t instance;
+    return locate(index, row, instance) && holds_flight_mode(row);
+}
+
 bool set(Settings& s, uint16_t index, float value) {
     Row row;
     uint8_t instance;
     if (!locate(index, row, instance) || !in_range(row, value)) return false;
+    // FLTMODEn: a mode the board has (a stored number it lacks still loads, and flies MANUAL).
+    if (holds_flight_mode(row) && !flight::mode_known((uint8_t)value)) return false;
     const float before = read(s, row, instance);
     write(s, row, instance, value);
     if (ends_in_order(s.flight.rc) && ends_in_order(s.flight.servo)) return true;

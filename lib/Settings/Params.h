@@ -51,7 +51,8 @@ bool is_integer(Type t);
 // The value as a float (MAVLink's PARAM_VALUE carries every type so).
 float get(const settings::Settings& s, uint16_t index);
 // Sets a value: false (nothing changed) when index is past the end, the value is NaN,
-// out of range, not whole for an integer type, or leaves an end point pair out of order
+// out of range, not whole for an integer type, not a mode the board has (FLTMODEn), or
+// leaves an end point pair out of order
 // (RCn/SERVOn: MIN <= TRIM <= MAX).
 bool set(settings::Settings& s, uint16_t index, float value);
 // ArduPilot's COMPASS_OFS (mGauss, added to the field) of a `cal mag` offset (uT, subtracted
@@ -62,6 +63,8 @@ float compass_ofs_mgauss(float offset_uT);
 // True for the rows of the compass calibration (COMPASS_OFS_*, _DIA_*, _ODI_*: Settings::cal's
 // offset and soft iron): a change is a new calibration (the pipeline takes it as `cal mag`'s).
 bool is_compass_calibration(uint16_t index);
+// FLTMODE1..6: set() takes only a mode the board has (flight::mode_known).
+bool is_flight_mode(uint16_t index);
 // Every parameter to its default.
 void apply_defaults(settings::Settings& s);
 // The flight settings in the EEPROM record (settings::encode): the rows that live in

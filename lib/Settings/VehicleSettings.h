@@ -17,8 +17,11 @@
 namespace settings {
 
 struct VehicleSettings {
-    // Arming (ArduPlane's AP_Arming).
+    // Arming (ArduPlane's AP_Arming), and a ground station's sticks (RC_Channels' override).
     uint8_t arming_require;     // ARMING_REQUIRE: 0 never disarmed, 1 throttle at its minimum until armed
+    uint16_t arming_check;      // ARMING_CHECK: the pre-arm checks, ArduPilot's bitmask (1 all; flight::CheckBit)
+    uint8_t arming_rudder;      // ARMING_RUDDER: 0 no rudder arming, 1 arm only, 2 arm and disarm
+    float rc_override_time_s;   // RC_OVERRIDE_TIME: an override's life, s (0 overrides off, -1 forever)
 
     // Board orientation, level, the accelerometer's calibration (AP_AHRS, AP_InertialSensor).
     uint8_t ahrs_orientation;   // AHRS_ORIENTATION: ArduPilot's Rotation, 0..37 (lib/Calibration/BoardFrame.h)

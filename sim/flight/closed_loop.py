@@ -8,7 +8,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
-        [--gps ublox|nmea|none]
+        [--gps ublox|nmea|none] [--arm]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -24,6 +24,10 @@ tcp:PORT attaches a ground station: apm25sim also serves the board's UART0 on TC
 127.0.0.1:PORT (MAVProxy, QGroundControl, Mission Planner connect as to SITL's 5760) and
 flies in real time (--speed X for X times real time; 0 as fast as the host goes). --gps
 KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS).
+--arm arms the board on the launch stand as a pilot would (ARMING_REQUIRE 1 holds the
+throttle at its minimum until armed): the stick script's throttle at zero until ARM_S
+(2 s) and `arm` typed into the board (apm25sim --input: at its first angle line, ~1.4 s,
+after any --input lines).
 Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
@@ -46,6 +50,37 @@ PILOTS = os.path.join(HERE, "pilots")
 # The cruise throttle of the default trim, only to build the named flights' list (their
 # stick scripts come from sim/flight/pilots/, written by fly.py --write-pilots).
 NOMINAL_THROTTLE_US = 1106
+
+
+# --arm: the throttle stick at zero until then, `arm` typed before it.
+ARM_S = 2.0
+
+
+def armed_script(rc, input_path, work):
+    """The stick script with its throttle (channel 3) at zero (1000 us) before ARM_S, the
+    rows in force from ARM_S on unchanged; and an input file ending in `arm`. Their paths."""
+    with open(rc) as f:
+        header, rows = f.readline(), [line.rstrip("\n").split(",") for line in f if line.strip()]
+    out_rows = []
+    for i, r in enumerate(rows):
+        t = float(r[0])
+        nxt = float(rows[i + 1][0]) if i + 1 < len(rows) else float("inf")
+        if t < ARM_S and r[3] != "":
+            out_rows.append([r[0]] + r[1:3] + ["1000"] + r[4:])
+            if nxt > ARM_S:
+                out_rows.append(["%.3f" % ARM_S] + r[1:])
+        else:
+            out_rows.append(r)
+    rc_out = os.path.join(work, "armed_rc.csv")
+    with open(rc_out, "w") as f:
+        f.write(header + "".join(",".join(r) + "\n" for r in out_rows))
+    text = open(input_path).read() if input_path else ""
+    if text and not text.endswith("\n"):
+        text += "\n"
+    input_out = os.path.join(work, "armed_input.txt")
+    with open(input_out, "w") as f:
+        f.write(text + "arm\n")
+    return rc_out, input_out
 
 
 def named_flights():
@@ -82,6 +117,8 @@ def parse_args(argv):
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
     p.add_argument("--serial", metavar="tcp:PORT",
                    help="apm25sim --serial: the board's UART0 on TCP for a ground station, in real time")
+    p.add_argument("--arm", action="store_true",
+                   help="arm on the launch stand: the throttle at zero until 2 s and `arm` typed")
     p.add_argument("--speed", type=float, metavar="X",
                    help="apm25sim --speed: X simulated seconds a wall second (default 1 with --serial, else 0)")
     return p.parse_args(argv)
@@ -127,6 +164,9 @@ def run(args):
         return 2
     work = tempfile.mkdtemp(prefix="closed_loop_")
     port_file = os.path.join(work, "port")
+    console_input = args.input
+    if args.arm:
+        rc, console_input = armed_script(rc, args.input, work)
     backend_cmd = [args.python, os.path.join(HERE, "jsbsim_backend.py"), "--port", "0", "--port-file", port_file,
                    "--rc", rc, "--gust", str(gust), "--seed", str(args.seed), "--seconds", "%g" % seconds,
                    "--idle-timeout", "60", "--hold", "%g" % args.hold] + extra
@@ -160,8 +200,8 @@ def run(args):
                    "--physics-rate", str(args.physics_rate), "--physics-timeout", "60"]
         if args.stamp:
             sim_cmd.append("--stamp")
-        if args.input:
-            sim_cmd += ["--input", args.input]
+        if console_input:
+            sim_cmd += ["--input", console_input]
         if args.servo_log:
             sim_cmd += ["--servo-log", args.servo_log]
         if args.serial:

@@ -26,6 +26,16 @@ TEST(FlightConsole, SetGetFlightShowParse) {
     EXPECT_EQ(console::parse_line("flight stabilize").arg, 1);
     EXPECT_EQ(console::parse_line("flight manual").arg, 0);
     EXPECT_EQ(console::parse_line("flight acro").error, console::Error::BadFlightMode);
+    EXPECT_EQ(console::parse_line("flight FBWA").arg, 2);  // the row of lib/Flight/Modes.h
+    c = console::parse_line("arm");
+    EXPECT_EQ(c.id, console::CommandId::Flight);
+    EXPECT_EQ(c.arg, console::kArm);
+    EXPECT_EQ(console::parse_line("DISARM").arg, console::kDisarm);
+    EXPECT_EQ(console::parse_line("arm now").error, console::Error::ExtraArgument);
+    c = console::parse_line("set FLTMODE3 1");
+    EXPECT_EQ(c.error, console::Error::NoSuchMode);
+    EXPECT_EQ(c.arg, params::find("FLTMODE3"));
+    EXPECT_EQ(console::parse_line("set FLTMODE3 5").id, console::CommandId::Set);
     EXPECT_EQ(console::parse_line("rc").arg, console::kShowRc);
     EXPECT_EQ(console::parse_line("servo").arg, console::kShowServo);
     EXPECT_EQ(console::parse_line("params").arg, console::kShowParams);
@@ -41,7 +51,8 @@ TEST(FlightConsole, SetGetFlightShowParse) {
     console::CommandQueue q;
     for (int round = 0; round < 30; ++round) {
         for (const char* line : {"set RLL2SRV_D -0.0", "set LIM_PITCH_MIN -2000", "get RC8_TRIM", "flight stabilize",
-                                 "servo", "set RC1_MIN 3000", "params", "gps", "baro"}) {
+                                 "servo", "set RC1_MIN 3000", "params", "gps", "baro", "arm", "disarm",
+                                 "flight fbwa", "set FLTMODE2 1"}) {
             const console::Command in = console::parse_line(line);
             ASSERT_TRUE(q.push(in));
             const console::Command back = q.pop();
@@ -69,4 +80,10 @@ TEST(FlightConsole, SetAndGetReplies) {
     out.clear();
     console::print_error(console::parse_line("set RLL2SRV_P 9"), &sink);
     EXPECT_EQ(out, "# error: RLL2SRV_P must be 0.1000..4.0000; nothing changed\n");
+    out.clear();
+    console::print_error(console::parse_line("set FLTMODE2 1"), &sink);
+    EXPECT_EQ(out, "# error: FLTMODE2 must be a mode of this board: 0 manual, 2 stabilize, 5 fbwa; nothing changed\n");
+    out.clear();
+    console::print_error(console::parse_line("flight circle"), &sink);
+    EXPECT_EQ(out, "# error: flight manual or stabilize or fbwa; nothing changed\n");
 }

@@ -9,34 +9,10 @@
 #include <cstring>
 
 #include "Flight.h"
+#include "FlightRig.h"
 #include "Settings.h"
 
-namespace {
-
-struct Rig {
-    settings::Settings s = settings::defaults();
-    flight::FlightControl fc{s.flight};
-    uint16_t rc[8] = {1500, 1500, 1100, 1500, 1500, 1500, 1500, 1000};  // mode switch low: MANUAL
-    uint32_t now_ms = 0;
-    flight::Attitude att{0, 0, 0, 0, true};
-    uint16_t out[8] = {};
-
-    // Runs `seconds` of 50 Hz steps with frames every 22 ms while `signal`.
-    void run(float seconds, bool signal = true) {
-        const uint32_t end = now_ms + (uint32_t)(seconds * 1000.0f);
-        uint32_t next_frame = now_ms;
-        while (now_ms < end) {
-            if (signal && now_ms >= next_frame) {
-                fc.on_frame(rc, now_ms);
-                next_frame += 22;
-            }
-            if (now_ms % 20u == 0u) fc.step(now_ms, att, out);
-            ++now_ms;
-        }
-    }
-};
-
-}  // namespace
+using flight_test::Rig;
 
 TEST(FlightControl, NeutralBeforeTheFirstFrameThenManualPassThrough) {
     Rig r;
@@ -340,9 +316,13 @@ TEST(FlightControl, AChoiceInFailsafeWaitsForTheSignal) {
     r.fc.choose((flight::Mode)1);  // not a mode here
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     r.fc.choose(flight::Mode::Stabilize);
-    r.fc.choose((flight::Mode)5);  // ArduPlane's FBWA: not one here either
+    r.fc.choose((flight::Mode)10);  // ArduPlane's AUTO: not one here either
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
+    r.fc.choose(flight::Mode::FlyByWireA);  // FBWA flies STABILIZE's law
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::FlyByWireA);
+    EXPECT_EQ(r.fc.state(), flight::State::Stabilize);
+    r.fc.choose(flight::Mode::Manual);
     // Before the first frame too.
     Rig n;
     n.fc.choose(flight::Mode::Stabilize);

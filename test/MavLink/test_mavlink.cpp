@@ -80,7 +80,7 @@ float f32(const Bytes& p, size_t off) {
 TEST(MavLink, HeartbeatIsAnArduPlaneOfComponentOneWithItsModeNumber) {
     mav::Packer p;
     uint8_t buf[mav::kMaxFrame];
-    const uint8_t n = p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Manual);
+    const uint8_t n = p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Manual, true);
     ASSERT_EQ(n, mav::kHeartbeatFrame);
     ASSERT_EQ(n, 21u);
     const Frame f = parse(buf, n, kExtraHeartbeat);
@@ -98,19 +98,22 @@ TEST(MavLink, HeartbeatIsAnArduPlaneOfComponentOneWithItsModeNumber) {
     EXPECT_EQ(u8(f.payload, 7), 4u);  // MAV_STATE_ACTIVE
     EXPECT_EQ(u8(f.payload, 8), 3u);  // mavlink_version
 
-    const Frame s = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Stabilize), kExtraHeartbeat);
+    const Frame s = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Stabilize, true), kExtraHeartbeat);
     EXPECT_EQ(u32(s.payload, 0), 2u);                   // ArduPlane STABILIZE
     EXPECT_EQ(u8(s.payload, 6), 1u + 16u + 64u + 128u);  // ... STABILIZE_ENABLED 16
-    const Frame fs = parse(buf, p.heartbeat(buf, mav::State::Critical, mav::PlaneMode::FlyByWireA), kExtraHeartbeat);
+    const Frame fs = parse(buf, p.heartbeat(buf, mav::State::Critical, mav::PlaneMode::FlyByWireA, true), kExtraHeartbeat);
     EXPECT_EQ(u32(fs.payload, 0), 5u);  // ArduPlane FLY_BY_WIRE_A: the failsafe glide
     EXPECT_EQ(u8(fs.payload, 7), 5u);   // MAV_STATE_CRITICAL
+    // Disarmed: SAFETY_ARMED clear, the rest as armed.
+    const Frame d = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Stabilize, false), kExtraHeartbeat);
+    EXPECT_EQ(u8(d.payload, 6), 1u + 16u + 64u);
 }
 
 TEST(MavLink, SequenceCountsAcrossMessagesAndWraps) {
     mav::Packer p;
     uint8_t buf[mav::kMaxFrame];
     for (int i = 0; i < 300; ++i) {
-        const uint8_t n = (i % 2 == 0) ? p.heartbeat(buf, mav::State::Boot, mav::PlaneMode::Manual)
+        const uint8_t n = (i % 2 == 0) ? p.heartbeat(buf, mav::State::Boot, mav::PlaneMode::Manual, false)
                                        : p.attitude(buf, 0u, 1.0f, 2.0f, 3.0f, linalg::Vector3f(0.1f, 0.2f, 0.3f));
         ASSERT_GT(n, 0u);
         EXPECT_EQ(buf[4], (uint8_t)(i & 0xFF));
@@ -251,7 +254,8 @@ TEST(MavLink, StatusTextSeverityFromTheLinesFirstWord) {
     say(st, "# warn: compass overflow\n");
     say(st, "# recovered: HMC5883L\n");
     say(st, "# mode mavlink\r\n");
-    ASSERT_EQ(c.frames.size(), 5u);  // the first line is 56 characters: two chunks
+    say(st, "# PreArm: Throttle too high\n");
+    ASSERT_EQ(c.frames.size(), 6u);  // the first line is 56 characters: two chunks
     EXPECT_EQ(decode_text(c.frames[0]).severity, 3u);
     EXPECT_EQ(decode_text(c.frames[1]).severity, 3u);
     const Text w = decode_text(c.frames[2]);
@@ -262,6 +266,7 @@ TEST(MavLink, StatusTextSeverityFromTheLinesFirstWord) {
     EXPECT_EQ(decode_text(c.frames[3]).severity, 6u);
     EXPECT_EQ(decode_text(c.frames[3]).text, "recovered: HMC5883L");
     EXPECT_EQ(decode_text(c.frames[4]).text, "mode mavlink");
+    EXPECT_EQ(decode_text(c.frames[5]).severity, 2u);  // MAV_SEVERITY_CRITICAL, as ArduPilot's PreArm
 }
 
 TEST(MavLink, StatusTextChunksLongLinesUnderOneId) {
@@ -321,7 +326,7 @@ TEST(MavLink, StatusTextDropsLinesThatAreNotHashLines) {
 TEST(MavLink, ParserKeepsMavlinkAwayFromTheConsole) {
     mav::Packer p;
     uint8_t hb[mav::kMaxFrame], st[mav::kMaxFrame];
-    const uint8_t n_hb = p.heartbeat(hb, mav::State::Active, mav::PlaneMode::Manual);
+    const uint8_t n_hb = p.heartbeat(hb, mav::State::Active, mav::PlaneMode::Manual, true);
     const uint8_t n_st = p.statustext(st, mav::Severity::Info, "status\nhelp\r", 12, 0u, 0u);
     Bytes in;
     const std::string typed = "status\n";
@@ -605,6 +610,65 @@ TEST(MavLinkParser, MissionRequestsAndTimesyncDecode) {
     EXPECT_TRUE(mav::decode_timesync_request(got[3], ts1));
     EXPECT_EQ((uint64_t)ts1, 0x8877665544332211ull);
     EXPECT_FALSE(mav::decode_timesync_request(got[4], ts1));
+}
+
+// SET_MODE (custom_mode u32, target_system, base_mode), COMMAND_INT (param1-4, x, y, z,
+// command, targets, frame, current, autocontinue) and RC_CHANNELS_OVERRIDE (chan1..8 u16,
+// targets, then the extension's chan9..18) as a ground station sends them.
+TEST(MavLinkParser, SetModeCommandIntAndRcOverrideDecode) {
+    constexpr uint8_t kExtraSetMode = 89, kExtraCommandInt = 158, kExtraRcOverride = 124;
+    mav::Parser parser;
+    Bytes sm = {5, 0, 0, 0, 1, 1};  // FBWA, system 1, CUSTOM_MODE_ENABLED
+    auto got = feed(parser, frame_v2(11, kExtraSetMode, sm));
+    ASSERT_EQ(got.size(), 1u);
+    mav::SetMode m;
+    ASSERT_TRUE(mav::decode_set_mode(got[0], m));
+    EXPECT_EQ(m.custom_mode, 5u);
+    EXPECT_EQ(m.base_mode, mav::kModeFlagCustomModeEnabled);
+    sm[4] = 2;  // another system
+    got = feed(parser, frame_v2(11, kExtraSetMode, sm));
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_FALSE(mav::decode_set_mode(got[0], m));
+
+    Bytes ci;
+    for (float v : {1.0f, 2.0f, 0.0f, 0.0f}) put_f32(ci, v);
+    for (int32_t v : {71350450, -731194210}) {
+        uint8_t raw[4];
+        memcpy(raw, &v, 4);
+        ci.insert(ci.end(), raw, raw + 4);
+    }
+    put_f32(ci, 12.5f);
+    for (uint8_t b : {176 & 0xFF, 0, 1, 1, 0, 0, 0}) ci.push_back((uint8_t)b);
+    ASSERT_EQ(ci.size(), 35u);
+    got = feed(parser, frame_v2(75, kExtraCommandInt, ci));
+    ASSERT_EQ(got.size(), 1u);
+    mav::CommandLong c;
+    EXPECT_FALSE(mav::decode_command_long(got[0], c));
+    ASSERT_TRUE(mav::decode_command_int(got[0], c));
+    EXPECT_EQ(c.command, mav::kCmdDoSetMode);
+    EXPECT_EQ(c.param[0], 1.0f);
+    EXPECT_EQ(c.param[1], 2.0f);
+    EXPECT_EQ(c.param[4], 71350450.0f);
+    EXPECT_EQ(c.param[6], 12.5f);
+
+    Bytes ro;
+    for (uint16_t w : {1100, 0, 65535, 1500, 1900, 2000, 1000, 1234}) {
+        ro.push_back((uint8_t)(w & 0xFF));
+        ro.push_back((uint8_t)(w >> 8));
+    }
+    ro.push_back(1);
+    ro.push_back(1);
+    for (int i = 0; i < 10; ++i) {  // channels 9-18: not kept
+        ro.push_back(0xDC);
+        ro.push_back(0x05);
+    }
+    ASSERT_EQ(ro.size(), 38u);
+    got = feed(parser, frame_v2(70, kExtraRcOverride, ro));
+    ASSERT_EQ(got.size(), 1u);
+    uint16_t w[8];
+    ASSERT_TRUE(mav::decode_rc_channels_override(got[0], w));
+    const uint16_t want[8] = {1100, 0, 65535, 1500, 1900, 2000, 1000, 1234};
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(w[i], want[i]) << i;
 }
 
 // --- Outgoing replies and streams ------------------------------------------------------
@@ -1104,7 +1168,7 @@ TEST(MavLinkMagCal, ProgressFieldsInWireOrder) {
     EXPECT_EQ(u8(f.payload, 16), 42u);  // completion_pct
     EXPECT_EQ(u32(f.payload, 17), 0x02ABCDEFu);  // completion_mask[0..3], little-endian bits
     for (size_t i = 21; i < 27; ++i) EXPECT_EQ(u8(f.payload, i), 0u);
-    const Frame next = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Manual), kExtraHeartbeat);
+    const Frame next = parse(buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Manual, true), kExtraHeartbeat);
     EXPECT_EQ(next.seq, (uint8_t)(f.seq + 1u)) << "one sequence with the others";
 }
 

@@ -382,6 +382,8 @@ def split_stream(data):
             n = data[i + 1]
             end = i + 12 + n + (13 if data[i + 2] & 1 else 0)
             msgid = data[i + 7] | data[i + 8] << 8 | data[i + 9] << 16
+            if end > len(data):
+                break  # the run stopped in the middle of this frame: no frame (both images' cut differs)
             out.append(("frame", msgid, bytes(data[i + 10:i + 10 + n])))
             i = end
             continue

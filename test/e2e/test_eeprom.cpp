@@ -523,3 +523,29 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
 }
 
 }  // namespace
+
+// The pre-arm check "settings loaded" (docs/arming.md): a board running on defaults
+// because its record was unreadable refuses `arm` with the reason; a blank chip (a new
+// board's defaults) does not give it (the receiver's absence is the other reason both say).
+TEST(Eeprom, UnreadableRecordRefusesArmingBlankDoesNot) {
+    E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
+    std::vector<uint8_t> bad = slot_of(encoded(stored_sample()), 1);
+    bad[slots::kSlotSize / 2] = (uint8_t)(bad[slots::kSlotSize / 2] ^ 0x10u);
+    const std::string chip = eeprom_path("arm_flip");
+    write_chip(chip, {{slots::slot_address(0), bad}});
+    const std::string input = e2e::input_file("arm", "arm\n");
+    const std::string kReason = "# PreArm: Settings are defaults (EEPROM unreadable)";
+    e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "rest", 2.5, "--eeprom " + chip + " --input " + input);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    EXPECT_TRUE(find_line(run.lines, "# PreArm: RC not found")) << e2e::dump(run);
+    EXPECT_TRUE(find_line(run.lines, kReason)) << e2e::dump(run);
+    EXPECT_FALSE(find_line(run.lines, "# Throttle armed")) << e2e::dump(run);
+    unlink(chip.c_str());
+    const std::string blank = eeprom_path("arm_blank");
+    run = e2e::run_sim(e2e::firmware_elf(), "rest", 2.5, "--eeprom " + blank + " --input " + input);
+    ASSERT_EQ(run.result.exit_code, 0) << e2e::dump(run);
+    EXPECT_TRUE(find_line(run.lines, "# PreArm: RC not found")) << e2e::dump(run);
+    EXPECT_FALSE(find_line(run.lines, kReason)) << e2e::dump(run);
+    unlink(blank.c_str());
+    unlink(input.c_str());
+}

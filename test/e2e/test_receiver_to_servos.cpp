@@ -3,6 +3,9 @@
 // from a stick script (--rc) and every servo pulse is measured from OUT1-OUT8's pin edges
 // (--servo-log). Defaults: MANUAL with the mode switch (channel 8) low, STABILIZE high;
 // end points 1000-2000 us around 1500; THR_FS_OUT 0 (OUT3 at 1000 us in failsafe).
+// ARMING_REQUIRE 1 holds OUT3 at 1000 us until armed: the tests of the throttle's path
+// type `set ARMING_REQUIRE 0` (taken at the first angle line, ~1.4 s: kLiveFrom_s), and
+// check OUT3 at 1000 us before it (mavlink.arming tests arming itself).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -85,14 +88,18 @@ struct FlightRun {
     std::vector<Pulse> pulses;
 };
 
+constexpr double kLiveFrom_s = 1.6;
+
 FlightRun fly(const std::string& name, const std::string& trajectory, double seconds, const RcScript& rc,
-              const std::string& extra = "") {
+              const std::string& extra = "", bool throttle_live = false) {
     const std::string tag = name + "_" + std::to_string(getpid());
     const std::string rc_path = e2e::write_work_file(tag + "_rc.csv", rc.csv());
     const std::string log = e2e::work_dir() + "/" + tag + "_servo.csv";
+    const std::string input =
+        throttle_live ? " --input " + e2e::input_file(tag + "_live", "set ARMING_REQUIRE 0\n") : std::string();
     FlightRun r;
     r.sim = e2e::run_sim_file(e2e::firmware_elf(), trajectory, seconds,
-                              "--rc " + rc_path + " --servo-log " + log + " " + extra);
+                              "--rc " + rc_path + " --servo-log " + log + " " + extra + input);
     r.pulses = read_pulses(log);
     return r;
 }
@@ -143,7 +150,7 @@ TEST(Flight, PassThroughNeutralBeforeTheReceiverAndLimits) {
     rc.add(1.0, {1600, 1400, 1200, 1700, 1300, 1800, 1111, 1000});
     rc.add(2.0, {1234, 1567, 1890, 1001, 1999, 1500, 1650, 1000});
     rc.add(3.0, {900, 2100, 2150, 850, 1500, 1500, 1500, 1000});  // plausible, beyond the limits
-    const FlightRun r = fly("passthrough", e2e::scenario_csv("rest", 4.0), 4.0, rc);
+    const FlightRun r = fly("passthrough", e2e::scenario_csv("rest", 4.0), 4.0, rc, "", true);
     ASSERT_EQ(r.sim.result.exit_code, 0) << e2e::dump(r.sim);
     expect_steady_and_within_limits(r.pulses, 4.0);
     const double neutral[8] = {1500, 1500, 1000, 1500, 1500, 1500, 1500, 1500};
@@ -158,10 +165,13 @@ TEST(Flight, PassThroughNeutralBeforeTheReceiverAndLimits) {
                                  {1000, 2000, 2000, 1000, 1500, 1500, 1500, 1000}};
     for (int row = 0; row < 3; ++row)
         for (int out = 1; out <= 8; ++out) {
-            const auto w = widths(r.pulses, out, 1.1 + row, 2.0 + row);
-            ASSERT_GE(w.size(), 40u);
+            const double from = out == 3 && row == 0 ? kLiveFrom_s : 1.1 + row;  // the throttle once live
+            const auto w = widths(r.pulses, out, from, 2.0 + row);
+            ASSERT_GE(w.size(), 20u);
             for (double x : w) EXPECT_NEAR(x, expect[row][out - 1], kFollow_us) << "row " << row << " OUT" << out;
         }
+    // Disarmed until `set ARMING_REQUIRE 0` was taken: the throttle at its minimum.
+    for (double x : widths(r.pulses, 3, 0.0, 1.3)) EXPECT_NEAR(x, 1000.0, kStamp_us);
     // The first followed pulse comes within 0.1 s of the first frame.
     const auto early = widths(r.pulses, 1, 1.0, 1.1);
     EXPECT_NEAR(early.back(), 1600.0, kFollow_us);
@@ -182,7 +192,7 @@ TEST(Flight, FailsafeEnteredAndLeft) {
     encoder[2] = 900;
     rc.add(6.0, encoder);
     rc.add(7.5, fly_row);
-    const FlightRun r = fly("failsafe", e2e::scenario_csv("rest", 9.0), 9.0, rc);
+    const FlightRun r = fly("failsafe", e2e::scenario_csv("rest", 9.0), 9.0, rc, "", true);
     ASSERT_EQ(r.sim.result.exit_code, 0) << e2e::dump(r.sim);
     expect_steady_and_within_limits(r.pulses, 9.0);
     const e2e::Line* lost = first_line(r.sim.lines, "# failsafe: receiver lost");
@@ -281,12 +291,12 @@ TEST(Flight, SixtySecondsOfChangingCommandsWithoutAGlitch) {
         rc.add(t, row);
     }
     const double seconds = 60.0;
-    const FlightRun r = fly("glitch", e2e::scenario_csv("rest", seconds), seconds, rc);
+    const FlightRun r = fly("glitch", e2e::scenario_csv("rest", seconds), seconds, rc, "", true);
     ASSERT_EQ(r.sim.result.exit_code, 0) << e2e::dump(r.sim);
     expect_steady_and_within_limits(r.pulses, seconds);
     size_t checked = 0, glitches = 0;
     for (const Pulse& p : r.pulses) {
-        if (p.t_s < 0.5 || p.out > 7) continue;
+        if (p.t_s < 0.5 || p.out > 7 || (p.out == 3 && p.t_s < kLiveFrom_s)) continue;
         bool matched = false;
         for (const auto& row : rc.rows)
             if (row.first <= p.t_s && row.first >= p.t_s - 0.1 && std::fabs(row.second[p.out - 1] - p.width_us) <= kFollow_us)

@@ -106,6 +106,15 @@ DEFAULT_TRIM_ARSPD_CM = 1500  # lib/Settings/Params.cpp: the cruise speed a boar
 MODEL_TRIM_PITCH_CD = 140
 
 
+# Arming (ARMING_REQUIRE 1, the default: the throttle at its minimum until armed): on the
+# launch stand the sticks' throttle is at zero and the board is armed from the console
+# (closed_loop.py --arm: `arm` typed at its first angle line, ~1.4 s, once the gyro is
+# calibrated), as a ground station's arm command would; the script's own sticks from
+# ARM_S. ArduPlane's rudder gesture takes 3 s and would end after the stand's 3 s; the
+# restart in the air arms by it (below), and the mavlink.arming test covers it on the pins.
+ARM_S = 2.0  # closed_loop.py's
+
+
 def row(t, roll=1500, pitch=1500, throttle=THROTTLE_US, yaw=1500, mode=STABILIZE):
     return (t, (roll, pitch, throttle, yaw, 1500, 1500, 1500, mode))
 
@@ -126,11 +135,11 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=(), hold=HOLD_S, airframe="plain", gps=None):
+                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
         board (apm25sim --input: from its first angle line); airframe: how the backend reads
         the outputs (closed_loop.py --airframe: plain, elevons, vtail); gps: apm25sim --gps
-        (None: its default)."""
+        (None: its default); arm: closed_loop.py --arm (armed on the stand)."""
         self.name, self.seconds = name, seconds
         base = os.path.join(work, name)
         self.rc = write_rc(base + "_rc.csv", rows)
@@ -148,6 +157,8 @@ class Flight:
             cmd += ["--airframe", airframe]
         if gps:
             cmd += ["--gps", gps]
+        if arm:
+            cmd.append("--arm")
         if console:
             with open(base + "_console.txt", "w") as f:
                 f.write("".join(line + "\n" for line in console))
@@ -236,11 +247,19 @@ def check_manual_circuit(args):
     seconds = h + 17.0
     f = Flight(args.work, "manual_circuit", rows, seconds, tools=args.tools)
     # The outputs follow the sticks: every pulse from 0.1 s after a stick row (a PPM frame
-    # and an output period) to the next row, from the receiver's first frame taken (before
-    # it, the outputs are at their trims and the throttle at its failsafe value, 1000 us;
-    # MANUAL is the board's mode at power-up, so it says nothing when the switch agrees).
+    # and an output period) to the next row, from the throttle's stick taken (before the
+    # receiver's first frame, the outputs are at their trims and the throttle at its
+    # failsafe value, 1000 us; MANUAL is the board's mode at power-up, so it says nothing
+    # when the switch agrees). Disarmed, the throttle holds 1000 us from the first pulse;
+    # armed (`arm` at ~1.4 s), it takes its stick, raised at ARM_S.
+    armed = f.said("# Throttle armed")
+    soft_assert(armed is not None and armed[0] < ARM_S, "MANUAL: not armed before %.1f s: %r" % (ARM_S, armed))
+    thr_before = [w for t, out, w in f.pulses if out == 3 and t < ARM_S]
+    soft_assert(thr_before and all(abs(w - 1000.0) <= 0.3 for w in thr_before),
+                "MANUAL: the throttle left 1000 us before its stick rose: %r" % sorted(set(thr_before))[-3:])
     first = next((t for t, out, w in f.pulses if out == 3 and abs(w - THROTTLE_US) <= FOLLOW_US), None)
-    soft_assert(first is not None and first < 1.0, "MANUAL: the throttle took its stick at %s s" % first)
+    soft_assert(first is not None and ARM_S <= first < ARM_S + 0.1,
+                "MANUAL: the throttle took its stick at %s s" % first)
     start = (first if first is not None else 1.0) + 0.1
     worst = 0.0
     for i, (t0, widths) in enumerate(rows):
@@ -529,7 +548,14 @@ def check_climb_pitch(args):
 
 def check_restart_air(args):
     seconds = 20.0
+    # Disarmed after the restart (always at power-up, as ArduPlane 3): the pilot closes the
+    # throttle and arms from the ground station (here the console's `arm`, closed_loop.py
+    # --arm) as soon as the board answers; running on its saved gyro bias (the calibration
+    # measuring on) it may. (Full rudder for 3 s before the estimator runs, MANUAL's surfaces,
+    # spun the aeroplane in: docs/arming.md.)
     f = Flight(args.work, "restart_air", [row(0.0)], seconds, gust=1, tools=args.tools, seed=4404, hold=0.0)
+    armed = f.said("# Throttle armed")
+    soft_assert(armed is not None and armed[0] < 2.0, "restart_air: not armed after the restart: %r" % (armed,))
     said = f.said("# airspeed:")
     soft_assert(said is not None and said[1].startswith("# airspeed: the board was moving at start") and
                 "TRIM_ARSPD_CM" in said[1], "restart_air: the board did not refuse the pitot's zero: %r" % (said,))

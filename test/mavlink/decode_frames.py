@@ -49,8 +49,8 @@ def main():
                 and hb.mavlink_version == 3, "heartbeat state %d base_mode %d custom_mode %d version %d"
                 % (hb.system_status, hb.base_mode, hb.custom_mode, hb.mavlink_version))
     soft_assert(msgs[7].system_status == mavlink2.MAV_STATE_CRITICAL and msgs[7].custom_mode == 5
-                and msgs[7].base_mode == stabilize,
-                "second heartbeat: critical, FBWA (the failsafe glide)")
+                and msgs[7].base_mode == stabilize & ~mavlink2.MAV_MODE_FLAG_SAFETY_ARMED,
+                "second heartbeat: critical, FBWA (the failsafe glide), disarmed")
     # pymavlink's own mode names for an ArduPlane (what MAVProxy shows).
     from pymavlink import mavutil
     soft_assert(mavutil.mode_string_v10(hb) == "STABILIZE" and mavutil.mode_string_v10(msgs[7]) == "FBWA",

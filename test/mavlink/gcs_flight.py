@@ -13,6 +13,9 @@ in its text mode and switches to MAVLink on the first one) and reads what the bo
 while it flies. Checks:
   - HEARTBEAT: FIXED_WING, ARDUPILOTMEGA, STABILIZE (custom_mode 2; MANUAL before the switch is
     read), about one a second;
+  - arming from the ground station: the flight's throttle stick is up, so the client arms
+    with MAV_CMD_COMPONENT_ARM_DISARM forced (param2 2989, MAVProxy's `arm throttle force`)
+    on the board's first HEARTBEAT: ACCEPTED, and every HEARTBEAT after it says armed;
   - ATTITUDE: several a simulated second, roll and pitch against the backend's true
     attitude (its --log) at the message's time_boot_ms, from 4.5 s (the board calibrated
     on the stand): worst error under 3 deg, RMS under 1.5 deg; the turn's bank seen (over
@@ -185,6 +188,7 @@ def main():
             return 1
         closed = conn.closed
         last_hb = 0.0
+        arm_sent = False
         while time.monotonic() - launched < WALL_GUARD_S:
             now = time.monotonic()
             if now - last_hb > 1.0:
@@ -200,6 +204,9 @@ def main():
                 continue
             if m.get_srcSystem() == 1:
                 msgs.append((time.monotonic() - launched, m))
+                if m.get_type() == "HEARTBEAT" and not arm_sent:
+                    conn.mav.command_long_send(1, 1, mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 0, 1, 2989, 0, 0, 0, 0, 0)
+                    arm_sent = True
         conn.close()
         status, err = flight.end()
     finally:
@@ -226,6 +233,11 @@ def main():
     for hb in heartbeats:
         soft_assert(hb.type == mavlink2.MAV_TYPE_FIXED_WING and hb.autopilot == mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA,
                     "HEARTBEAT %r" % hb)
+    acks = [m for _, m in msgs if m.get_type() == "COMMAND_ACK" and m.command == mavlink2.MAV_CMD_COMPONENT_ARM_DISARM]
+    soft_assert(acks and acks[0].result == mavlink2.MAV_RESULT_ACCEPTED, "the forced arm: %r" % acks)
+    armed = [bool(hb.base_mode & mavlink2.MAV_MODE_FLAG_SAFETY_ARMED) for hb in heartbeats]
+    first_armed = armed.index(True) if True in armed else len(armed)
+    soft_assert(first_armed <= 2 and all(armed[first_armed:]), "HEARTBEATs armed: %r" % armed)
     first_s = attitudes[0][1].time_boot_ms / 1000.0
     last_s = attitudes[-1][1].time_boot_ms / 1000.0
     span_s = last_s - first_s

@@ -11,8 +11,11 @@ console driven through stdin as a user types, and checks what it prints:
   - `param show RLL2SRV_P` prints the default 1.0;
   - `param set RLL2SRV_P 0.55` is saved by the board ("AP: saved") and `param show` then
     prints 0.55;
-  - the prompt names the mode (MANUAL>, from HEARTBEAT's ArduPlane mode number) and it says
-    the vehicle is armed (the outputs are live);
+  - the prompt names the mode (MANUAL>, from HEARTBEAT's ArduPlane mode number); `mode
+    STABILIZE`, `mode FBWA`, `mode MANUAL` change it (the prompt follows);
+  - the board starts disarmed: `arm throttle` is refused with the board's reason (no
+    receiver here: "PreArm: RC not found"), `arm throttle force` arms it (MAVProxy says
+    ARMED), `disarm` disarms it (DISARMED);
   - `status ATTITUDE` prints the board's ATTITUDE: the board is held still at roll 30 deg,
     pitch 10 deg (a two-row trajectory, its last state held), and ATTITUDE says so within
     3 degrees;
@@ -138,7 +141,16 @@ def main():
         soft_assert(m and abs(float(m.group(1)) - 0.55) < 1e-6, "RLL2SRV_P %s after set, 0.55" % (m and m.group(1)))
         # The prompt is the mode's name from HEARTBEAT (printed whenever it comes: look at all).
         soft_assert(any("MANUAL>" in line for line in out.seen), "MAVProxy never showed the MANUAL> prompt")
-        soft_assert(any(line.strip().endswith("ARMED") for line in out.seen), "MAVProxy never said ARMED")
+        for mode in ("STABILIZE", "FBWA", "MANUAL"):
+            type_line("mode " + mode)
+            soft_assert(out.wait(re.escape(mode) + ">", "the %s> prompt" % mode), "mode %s not shown" % mode)
+        type_line("arm throttle")
+        soft_assert(out.wait(r"PreArm: RC not found", "the board's pre-arm reason"), "no pre-arm reason")
+        soft_assert(not any(line.strip() == "ARMED" for line in out.seen), "armed without a receiver")
+        type_line("arm throttle force")
+        soft_assert(out.wait(r"^ARMED", "ARMED"), "arm throttle force: not armed")
+        type_line("disarm")
+        soft_assert(out.wait(r"^DISARMED", "DISARMED"), "disarm: not disarmed")
         # The estimator has long converged by now (the gyro calibration and the parameters
         # took seconds).
         checked = 0
@@ -173,8 +185,8 @@ def main():
                      r"yaw : ([-0-9.e]+)", "status ATTITUDE after COMPASS_DEC")
         soft_assert(m and abs(math.degrees(float(m.group(4)) - 0.2)) < 3,
                     "ATTITUDE yaw after COMPASS_DEC 0.2: %s rad" % (m and m.group(4)))
-        print("# MAVProxy: parameters fetched, RLL2SRV_P and COMPASS_DEC set and saved, MANUAL> shown, "
-              "%d ATTITUDE checked" % checked)
+        print("# MAVProxy: parameters fetched, RLL2SRV_P and COMPASS_DEC set and saved, MANUAL> shown, the modes set, arming refused "
+              "with its reason, forced, disarmed; %d ATTITUDE checked" % checked)
     finally:
         session.stop()
 

@@ -15,7 +15,7 @@ void put(void*, const uint8_t* frame, uint8_t len) { fwrite(frame, 1, len, stdou
 int main() {
     mav::Packer p;
     uint8_t buf[mav::kMaxFrame];
-    put(nullptr, buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Stabilize));
+    put(nullptr, buf, p.heartbeat(buf, mav::State::Active, mav::PlaneMode::Stabilize, true));
     put(nullptr, buf, p.attitude(buf, 123456u, -30.0f, 45.0f, 270.0f, linalg::Vector3f(0.5f, -0.25f, 1.5f)));
     put(nullptr, buf, p.sys_status(buf, mav::health(true, true, true, false), 593u, 12u));
     mav::StatusText st(p, mav::FrameSink{nullptr, &put});
@@ -25,7 +25,7 @@ int main() {
         "# error: MPU6000 not found (WHO_AM_I=0x00, expected 0x68); retrying every second\n"
         "# status: ok\n";
     st.write(lines, (uint8_t)(sizeof lines - 1));
-    put(nullptr, buf, p.heartbeat(buf, mav::State::Critical, mav::PlaneMode::FlyByWireA));
+    put(nullptr, buf, p.heartbeat(buf, mav::State::Critical, mav::PlaneMode::FlyByWireA, false));  // disarmed
     put(nullptr, buf, p.param_value(buf, "RLL2SRV_P", 0.4f, mav::kParamTypeReal32, 97u, 1u));
     put(nullptr, buf, p.command_ack(buf, mav::kCmdPreflightCalibration, mav::Result::Accepted, 255u, 190u));
     const uint16_t rc[8] = {1100, 1200, 1300, 1400, 1500, 1600, 1700, 1800};
