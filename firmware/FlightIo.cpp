@@ -144,11 +144,12 @@ uint16_t FlightIo::prearm_failures() const {
     // background: the estimator is healthy and the board may be armed again (docs/arming.md).
     in.gyro_calibrating = ph == pipeline::Phase::Calibrating || (pipe.gyro_calibrating() && !pipe.gyro_measuring_on());
     in.estimator_ok = ph == pipeline::Phase::Running;  // its angles are finite by construction (lib/DCM)
-    in.compass_used = compass_found_;
+    const settings::Settings& s = pipe.settings();
+    in.compass_used = compass_found_ && s.vehicle.compass_use != 0u;  // COMPASS_USE 0: the heading is the gyro's
     in.compass_ok = compass.ok();
-    // The offset is learned in motion whenever the board turns (README "Calibration"):
-    // ArduPlane's COMPASS_LEARN 1, with which its "Compass not calibrated" never fires.
-    in.compass_calibrated = true;
+    // Calibrated by `cal mag` (or a ground station's), or learning the offset in motion
+    // (COMPASS_LEARN 1, the default: ArduPlane's, with which its check passes).
+    in.compass_calibrated = (s.flags & settings::kFlagMagCalibrated) != 0u || s.vehicle.compass_learn != 0u;
     in.compass_calibrating = pipe.mag_calibrating();
     in.baro_present = baro::present();
     in.baro_ok = baro::healthy();

@@ -11,7 +11,8 @@ barometer taken away for a while (--fault), and talks to it as a ground station:
     STATUSTEXT "PreArm: ...": with no receiver (RC not found), the throttle stick up (Throttle too high), the
     compass and the barometer gone (Compass not healthy, Barometer not healthy), the
     receiver lost (Radio failsafe on), during `cal gyro` (Gyros not calibrated; tried at
-    start-up too) and `cal mag` (Compass calibration running);
+    start-up too), `cal mag` (Compass calibration running) and, the calibration cancelled,
+    with COMPASS_LEARN 0 (Compass not calibrated);
   - armed by the rudder (full right, throttle at zero, 3 s: "Throttle armed" 3 s after the
     gesture began), disarmed by the command, armed by the command, disarmed by the rudder
     (full left 3 s with ARMING_RUDDER 2 set by PARAM_SET); HEARTBEAT's SAFETY_ARMED follows;
@@ -39,7 +40,7 @@ from sim_run import scenario_file, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
 MANUAL, HIGH = 1000, 1900  # channel 8: MANUAL low, STABILIZE high (FLTMODE6)
-END_S = 46.0
+END_S = 49.0
 # (t, ch1..ch8) or (t, None): no receiver.
 RC = [
     (0.0, None),                                                # no receiver: RC not found
@@ -224,6 +225,16 @@ def main():
     ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, "COMMAND_ACK to the compass calibration")
     soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "cal mag: %r" % ack)
     prearm(b, "Compass calibration running", 45.0, "compass calibration")
+    # 14. The compass calibration cancelled, learning off (COMPASS_LEARN 0) on a board never
+    # calibrated: "Compass not calibrated" (with COMPASS_LEARN 1 the offset is learned in motion).
+    wait_until(b, 45.2)
+    command(b, 42426)  # MAV_CMD_DO_CANCEL_MAG_CAL
+    ack = b.ack(42426, "COMMAND_ACK to the cancel")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "cancel mag cal: %r" % ack)
+    b.conn.mav.param_set_send(1, 1, b"COMPASS_LEARN", 0, mavlink2.MAV_PARAM_TYPE_UINT8)
+    pv = b.param("COMPASS_LEARN", "PARAM_VALUE COMPASS_LEARN 0")
+    soft_assert(pv is not None and pv.param_value == 0, "COMPASS_LEARN 0: %r" % pv)
+    prearm(b, "Compass not calibrated", 48.5, "compass never calibrated, not learning")
     wait_until(b, END_S)
     b.stop()
 
