@@ -64,7 +64,11 @@ namespace pipeline {
 // The set-up timeline, fixed so that a run is reproducible: each stage starts at
 // this time after reset (or as soon after as the one before it is done). The host
 // replay tool follows the same timeline, so both sample the same instants of a
-// trajectory and their angles can be compared one for one.
+// trajectory and their angles can be compared one for one. The timeline itself starts
+// kBootMs after reset (firmware/StartTime.cpp: Arduino's millis() starts then, whatever the
+// C runtime's start-up took before it), so the stages sit kBootMs + kXStartMs after reset
+// in the sensors' time; replay starts its timeline there too.
+constexpr uint16_t kBootMs = 12;        // > the C runtime's start-up (~4.5 ms), < 32 ms
 constexpr uint16_t kMpuStartMs = 50;    // after the banner
 constexpr uint16_t kMagStartMs = 200;   // after the MPU6000's 100 ms reset and wake
 constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the banner's drain
@@ -250,8 +254,8 @@ public:
     explicit AttitudePipeline(const EventSink* events = nullptr,
                               const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
     // The firmware's static object: settings zeroed until setup() loads them. A static
-    // constructor runs before Arduino's init() starts millis(), so its work would shift
-    // the firmware's timeline (kMpuStartMs ...) against reset, and replay's with it.
+    // constructor runs before Arduino's init() starts millis(): its work is within the
+    // start-up that kBootMs absorbs (firmware/StartTime.cpp), but kept light all the same.
     struct SettingsLoadedLater {};
     AttitudePipeline(const EventSink* events, SettingsLoadedLater,
                      const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
