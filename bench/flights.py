@@ -67,7 +67,7 @@ TURBULENT_FLIGHTS = (("gusty", None), ("turn", 1), ("figure8", 1))
 # zero. The peers run from t = 0: VQF from the loop's start sees what the board sees (on
 # the gusty flights most of VQF's lead over ours was its calm first sample, README
 # "Flying in simulation").
-LOOP_START_S = 0.362  # pipeline::kBootMs + kLoopStartMs (firmware/StartTime.cpp)
+LOOP_START_S = 0.35
 # ... and the first line of a start that is never still (pipeline::kStartupDeadlineSteps,
 # 1.3 s of samples): where ours is scored from.
 FIRST_LINE_S = LOOP_START_S + 1.3

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The firmware's timeline starts a fixed time after reset (pipeline::kBootMs), whatever the C
-// runtime's start-up costs: the copy of .data, the clearing of .bss, the stack's paint
-// (StackPaint.cpp) and the static constructors take time that grows with the static RAM and
-// the constructors' work (about 4.5 ms today), and Arduino's init() starts millis() only
-// after them. The sensors' clocks are their own: the MPU6000 samples on its own 5 ms grid
-// from power-up, so the sample the loop takes first (pipeline::kLoopStartMs after millis()
-// starts) depended on that duration, and a few microseconds more moved it to the next
-// sample (replay, which follows the same timeline from kBootMs, then ran a step apart).
+// millis() starts a fixed time after reset (pipeline::kBootMs), whatever the C runtime's
+// start-up costs: the copy of .data, the clearing of .bss, the stack's paint (StackPaint.cpp)
+// and the static constructors take time that grows with the static RAM and the constructors'
+// work (about 4.5 ms today), and Arduino's init() starts millis() only after them. The
+// sensors' clocks are their own: the MPU6000 samples on its own 5 ms grid from power-up, so
+// the sample the loop took first (at pipeline::kLoopStartMs of millis()) depended on that
+// duration, and a few microseconds more moved it to the next sample: replay, whose timeline
+// counts from reset, then ran a step apart. setup() waits for each stage's time less kBootMs
+// (firmware.ino), so its timeline counts from reset too.
 //
 // Timer1 counts from the start of the C runtime (.init1, before anything else runs) at
 // clk/8 (0.5 us ticks); .init8 (after the constructors, before main) waits until it reads

@@ -501,19 +501,18 @@ int main(int argc, char** argv) {
     dcm::DcmTrace trace;
     if (trace_file) pipe.set_trace(&trace);
     TraceWriter trace_writer(trace_file);
-    const double boot_s = pipeline::kBootMs * 1e-3;  // the firmware's millis() starts here
-    board.advance(boot_s + pipeline::kMpuStartMs * 1e-3);
+    board.advance(pipeline::kMpuStartMs * 1e-3);
     const mpu6000::InitResult mpu_init = mpu.begin();
     if (mpu_init.status != mpu6000::InitStatus::Ok) {
         fprintf(stderr, "replay: the MPU6000 model did not come up (status %d)\n", (int)mpu_init.status);
         return 2;
     }
-    board.advance(boot_s + pipeline::kMagStartMs * 1e-3);
+    board.advance(pipeline::kMagStartMs * 1e-3);
     const bool mag_ok = mag.begin(true).status == hmc5883::InitStatus::Ok;
     pipe.set_mag_present(mag_ok);
     if (!mag_ok) fprintf(stderr, "replay: the HMC5883L model did not come up: yaw is gyro-only\n");
 
-    board.advance(boot_s + pipeline::kLoopStartMs * 1e-3);
+    board.advance(pipeline::kLoopStartMs * 1e-3);
     printf("t,roll,pitch,yaw\n");
     uint32_t last_mag_read_step = 0;
     size_t airspeed_cursor = 0;

@@ -64,11 +64,10 @@ namespace pipeline {
 // The set-up timeline, fixed so that a run is reproducible: each stage starts at
 // this time after reset (or as soon after as the one before it is done). The host
 // replay tool follows the same timeline, so both sample the same instants of a
-// trajectory and their angles can be compared one for one. The timeline itself starts
-// kBootMs after reset (firmware/StartTime.cpp: Arduino's millis() starts then, whatever the
-// C runtime's start-up took before it), so the stages sit kBootMs + kXStartMs after reset
-// in the sensors' time; replay starts its timeline there too.
-constexpr uint16_t kBootMs = 12;        // > the C runtime's start-up (~4.5 ms), < 32 ms
+// trajectory and their angles can be compared one for one. The firmware's millis() starts
+// kBootMs after reset, whatever the C runtime's start-up took before it
+// (firmware/StartTime.cpp), so it waits for each stage's time less kBootMs.
+constexpr uint16_t kBootMs = 10;        // > the C runtime's start-up (~4.5 ms), < 32 ms
 constexpr uint16_t kMpuStartMs = 50;    // after the banner
 constexpr uint16_t kMagStartMs = 200;   // after the MPU6000's 100 ms reset and wake
 constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the banner's drain

@@ -93,12 +93,12 @@ TEST(Equivalence, ReplayPrintsTheFirmwaresHundredths) {
 
 // The two tests above on the firmware linked with a longer C runtime start-up (`make
 // startup-variants`, test/sketch/start_delay.S): a busy loop after the static constructors
-// of 0 to 80000 cycles (5 ms), 33 or 400 bytes more of initialised static data. The
-// firmware's timeline starts pipeline::kBootMs after reset whatever the start-up took
-// (firmware/StartTime.cpp), so replay's equivalence holds for each; before it, 5 us more
-// (the 80 cycles of a bigger constructor, or ~30 bytes of .data) moved the loop's first
-// MPU6000 read across the chip's 5 ms sample grid. The control takes 12.5 ms more, past
-// kBootMs: its timeline starts late, and the comparison must see it.
+// of 0 to 80000 cycles (5 ms), 33 or 400 bytes more of initialised static data. millis()
+// starts pipeline::kBootMs after reset whatever the start-up took (firmware/StartTime.cpp),
+// so replay's equivalence holds for each; before it, 5 us more (the 80 cycles of a bigger
+// constructor, or ~30 bytes of .data) moved the loop's first MPU6000 read across the chip's
+// 5 ms sample grid. The control takes 12.5 ms more, past kBootMs: its timeline starts late,
+// and the comparison must see it.
 TEST(Equivalence, WhateverTheStartUpTakes) {
     E2E_REQUIRE_TOOLS("apm25sim", "replay", "scenario");
     const std::string dir = e2e::tool("startup");
