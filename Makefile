@@ -5,6 +5,8 @@
 #                   the host tools build/apm25sim, build/replay, build/scenario, build/score
 #   make APM25_FLIGHT=0   the attitude-only firmware, without the flight features
 #                   (build/attitude-only/firmware.elf; with sim, upload too; README "Builds")
+#   make startup-variants  the firmware linked with longer C runtime start-ups
+#                   (build/startup/*.elf: the test e2e.Equivalence.WhateverTheStartUpTakes)
 #   make big        the firmware padded past 128 KB to the 200 KB budget (build/big/firmware.elf:
 #                   the test e2e.Beyond128K runs it beside the firmware)
 #   make sim        the firmware in simavr on a default scenario, shown as a serial monitor would
@@ -29,7 +31,7 @@
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
                 libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-BUILD_GOALS := all firmware attitude-only big tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
+BUILD_GOALS := all firmware attitude-only big startup-variants tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean

@@ -29,9 +29,11 @@
 using namespace vehicle;
 
 // The set-up runs on a fixed timeline (pipeline::kMpuStartMs ...): the same instants of
-// a trajectory are sampled here and in the host replay tool.
-static void wait_until_ms(uint16_t ms) {
-    while (millis() < ms) serial_text::pump();
+// a trajectory are sampled here and in the host replay tool. Its times count from reset;
+// millis() counts from pipeline::kBootMs after it (StartTime.cpp).
+static_assert(pipeline::kBootMs < pipeline::kMpuStartMs, "millis() starts before the first stage");
+static void wait_until_ms(uint16_t ms_since_reset) {
+    while (millis() < (uint16_t)(ms_since_reset - pipeline::kBootMs)) serial_text::pump();
 }
 
 void setup() {

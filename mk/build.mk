@@ -20,7 +20,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools unit sim fly test bench tune upload size attitude-only big docs
+.PHONY: all firmware tools unit sim fly test bench tune upload size attitude-only big docs startup-variants
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -135,6 +135,26 @@ size: $(FW_BUILD)/firmware.elf
 	@avr-size -A $< | awk '/^\.text|^\.data|^\.bss/ {s[$$1]=$$2} END { \
 	  printf "# %s: flash %d bytes (of 253952), static RAM %d bytes (of 8192)\n", \
 	  "$(if $(FW_DEFS),attitude-only firmware,firmware)", s[".text"]+s[".data"], s[".data"]+s[".bss"] }'
+
+# ---------------------------------------------------------------------------
+# The firmware with a longer C runtime start-up (make startup-variants ->
+# build/startup/*.elf, for the test e2e.Equivalence.WhateverTheStartUpTakes): the same objects
+# linked after test/sketch/start_delay.S, a busy loop of N cycles after the static
+# constructors (dN) or N bytes more of initialised static data (rN). kBootMs
+# (firmware/StartTime.cpp) absorbs them all but late-d200000 (12.5 ms more, past kBootMs: the
+# control the test must see fail).
+STARTUP_BUILD    := $(BUILD)/startup
+STARTUP_VARIANTS := d0 d20 d80 d500 d2000 d20000 d80000 r33 r400 late-d200000
+startup-variants: $(patsubst %,$(STARTUP_BUILD)/%.elf,$(STARTUP_VARIANTS))
+.PRECIOUS: $(STARTUP_BUILD)/%.S.o
+$(STARTUP_BUILD)/%.S.o: test/sketch/start_delay.S
+	@mkdir -p $(dir $@)
+	$(Q)n=$$(echo $* | sed 's/^late-//; s/^[a-z]//'); \
+	  case $* in *d*) defs="-DAPM25_START_DELAY_CYCLES=$$n";; *) defs="-DAPM25_START_DATA_BYTES=$$n";; esac; \
+	  $(AVR_CC) $(AVR_DEFS) $$defs -x assembler-with-cpp -c $< -o $@
+$(STARTUP_BUILD)/%.elf: $(STARTUP_BUILD)/%.S.o $(FW_OBJ) $(BUILD)/avr/core.a
+	$(call say,LINK,$@ (start-up variant))
+	$(Q)$(AVR_CXX) $(AVR_LDFLAGS) $< $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@
 
 # ---------------------------------------------------------------------------
 # The firmware past 128 KB (make big -> build/big/firmware.elf, for the test e2e.Beyond128K):
@@ -268,7 +288,7 @@ fly: firmware tools venv
 	  $(if $(MODE),--input $(BUILD)/flight/fly-input.txt) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
 
-test: firmware attitude-only big tools venv
+test: firmware attitude-only big startup-variants tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)
 
 bench: firmware attitude-only tools flash-attr

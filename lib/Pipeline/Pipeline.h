@@ -64,7 +64,10 @@ namespace pipeline {
 // The set-up timeline, fixed so that a run is reproducible: each stage starts at
 // this time after reset (or as soon after as the one before it is done). The host
 // replay tool follows the same timeline, so both sample the same instants of a
-// trajectory and their angles can be compared one for one.
+// trajectory and their angles can be compared one for one. The firmware's millis() starts
+// kBootMs after reset, whatever the C runtime's start-up took before it
+// (firmware/StartTime.cpp), so it waits for each stage's time less kBootMs.
+constexpr uint16_t kBootMs = 10;        // > the C runtime's start-up (~4.5 ms), < 32 ms
 constexpr uint16_t kMpuStartMs = 50;    // after the banner
 constexpr uint16_t kMagStartMs = 200;   // after the MPU6000's 100 ms reset and wake
 constexpr uint16_t kLoopStartMs = 350;  // after the compass self-test and the banner's drain
@@ -250,8 +253,8 @@ public:
     explicit AttitudePipeline(const EventSink* events = nullptr,
                               const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);
     // The firmware's static object: settings zeroed until setup() loads them. A static
-    // constructor runs before Arduino's init() starts millis(), so its work would shift
-    // the firmware's timeline (kMpuStartMs ...) against reset, and replay's with it.
+    // constructor runs before Arduino's init() starts millis(): its work is within the
+    // start-up that kBootMs absorbs (firmware/StartTime.cpp), but kept light all the same.
     struct SettingsLoadedLater {};
     AttitudePipeline(const EventSink* events, SettingsLoadedLater,
                      const dcm::DcmSettings& dcm_settings = dcm::kDefaultDcmSettings);

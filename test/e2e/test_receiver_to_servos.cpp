@@ -365,10 +365,11 @@ std::string roll_pitch_trajectory(const std::string& name, double seconds,
 //   surface = P' w_d + D (w_d - w),  w_d = -angle / TCONST,  P' = P TCONST - D = 0.3,
 // at 100 cd of surface per 1.11 us (500 us for 4500 cd). The rate's part is D x 40 deg/s =
 // 8 deg of surface, 89 us: a rate with the wrong sign, scale or axis is 89 us or more off,
-// a bias left in or added twice 3 to 9 us. The angle is the board's angle line in the 20 ms
-// before the pulse (at 50 Hz the step takes the angles the line has just printed, and the
-// pulse starts at the period after it). Within 2 us: the width's rounding to 1 us, the
-// line's 0.01 deg, the servo log's 0.3 us.
+// a bias left in or added twice 3 to 9 us. The angle is the board's angle line begun in the
+// 20 ms before the pulse (at 50 Hz the step prints the angles it controls on, and the pulse
+// starts at the servo period after it: depending on the servo timers' phase against the
+// samples, before or after the line's last byte has left). Within 2 us: the width's rounding
+// to 1 us, the line's 0.01 deg, the servo log's 0.3 us.
 TEST(Flight, StabilizeDampsTheBodyRatesItMeasures) {
     E2E_REQUIRE_TOOLS("apm25sim");
     const double seconds = 10.0;
@@ -417,9 +418,18 @@ TEST(Flight, StabilizeDampsTheBodyRatesItMeasures) {
             if (p.out != leg.out || p.t_s < leg.t0 + 0.06 || p.t_s > leg.t1) continue;
             const e2e::Line* line = nullptr;
             int lines = 0;
-            for (const e2e::Line& l : r.sim.lines)
-                if (l.is_angle && l.t_s >= p.t_s - 0.020 && l.t_s < p.t_s) line = &l, ++lines;
-            ASSERT_EQ(lines, 1) << "angle lines in the 20 ms before the pulse at " << p.t_s;
+            for (const e2e::Line& l : r.sim.lines) {
+                // The line's first byte: its step (the output task, before the control
+                // task) was then; the stamp is its newline, the line's bytes later at
+                // 115200 baud, which may be after a pulse the step's control already set.
+                const double start_s = l.t_s - (double)(l.text.size() + 1) * 10.0 / 115200.0;
+                if (l.is_angle && start_s >= p.t_s - 0.020 && start_s < p.t_s) line = &l, ++lines;
+            }
+            ASSERT_EQ(lines, 1) << "angle lines begun in the 20 ms before the pulse at " << p.t_s;
+            // The trajectory's rows are 10 ms apart: the rate ramps to the hold's after the
+            // leg's last row at t1 - 0.01; a step on a later sample (its line begun ~1 ms
+            // after it) controls on that ramp, not on the leg's rate.
+            if (line->t_s - (double)(line->text.size() + 1) * 10.0 / 115200.0 > leg.t1 - 0.008) continue;
             const double want = expected_us(leg.roll ? line->roll : line->pitch, leg.rate_deg_s);
             const double off = std::fabs(p.width_us - want);
             worst = std::max(worst, off);
