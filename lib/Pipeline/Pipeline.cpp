@@ -137,6 +137,7 @@ AttitudePipeline::AttitudePipeline(const EventSink* events, const dcm::DcmSettin
 AttitudePipeline::AttitudePipeline(const EventSink* events, SettingsLoadedLater, const dcm::DcmSettings& dcm_settings)
     : events_(events), settings_(), dcm_(dcm_settings), st_(), frame_(), trim_(), start_gravity_() {
     last_ = mpu6000::sample_from_si(Vector3f(), Vector3f(0.0f, 0.0f, -kG), 25.0f, mpu6000::kGyroRange, mpu6000::kAccelRange);
+    st_.frame_due = true;  // the board frame from the settings: refresh_board_frame, or the first sample
 }
 
 void AttitudePipeline::tell(EventKind kind, uint16_t count, uint32_t total, float value, uint8_t code) const {
@@ -390,12 +391,28 @@ static uint8_t clipped_axes(const linalg::Vector3i& a) {
     return (uint8_t)((a.x >= 32767 || a.x <= -32767) + (a.y >= 32767 || a.y <= -32767) + (a.z >= 32767 || a.z <= -32767));
 }
 
+namespace {
+// The bytes of the settings the board frame is made of (AHRS_ORIENTATION .. INS_ACCSCAL_*,
+// together in VehicleSettings), summed: a change of any of them changes it (almost surely;
+// a coincidence only waits for the next refresh a path asks for).
+uint16_t frame_settings_sum(const settings::VehicleSettings& v) {
+    const uint8_t* p = &v.ahrs_orientation;
+    const uint8_t* const end = reinterpret_cast<const uint8_t*>(&v.ins_accscal[3]);
+    uint16_t sum = 0;
+    for (uint8_t k = 1; p < end; ++p, ++k) sum = (uint16_t)(sum + (uint16_t)(*p * k));
+    return sum;
+}
+}  // namespace
+
 void AttitudePipeline::on_imu_sample(const mpu6000::Sample& board_sample) {
     st_.output_due = false;
     ++st_.steps;
-    if (st_.phase == Phase::WaitImu) refresh_board_frame();  // the settings as loaded
-    // Once a second the frame follows the settings (a parameter set meanwhile).
-    if ((uint8_t)st_.steps == 0u) st_.frame_due = true;
+    // The settings as loaded, unless the caller took them up before the samples (the
+    // firmware does, in setup: the refresh, ~6k cycles, would lengthen the first step).
+    if (st_.phase == Phase::WaitImu && st_.frame_due) refresh_board_frame();
+    // Once a second the frame follows the settings if they changed by a path that did not
+    // refresh it (the refresh itself, ~5k cycles, would take a busy step past its budget).
+    if ((uint8_t)st_.steps == 0u && frame_settings_sum(settings_.vehicle) != st_.frame_sum) st_.frame_due = true;
     // The accelerometer's calibration and the board's orientation, on the counts: the
     // vehicle's axes from here on.
     profile::begin(profile::kBoardFrame);
@@ -658,6 +675,7 @@ void AttitudePipeline::finish_level_calibration(LevelResult r) {
 void AttitudePipeline::refresh_board_frame() {
     st_.frame_due = false;
     const settings::VehicleSettings& v = settings_.vehicle;
+    st_.frame_sum = frame_settings_sum(v);
     const uint8_t before = frame_.rotation;
     frame_ = calib::make_board_frame(Vector3f(v.ins_accoffs_m_s2[0], v.ins_accoffs_m_s2[1], v.ins_accoffs_m_s2[2]),
                                      Vector3f(v.ins_accscal[0], v.ins_accscal[1], v.ins_accscal[2]),

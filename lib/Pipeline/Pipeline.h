@@ -468,6 +468,7 @@ private:
         MagCalState mag_cal_end;        // how the last run ended (kNone, kWaiting, kApplied, kFailed)
         bool level_cal_active;          // the gyro calibration under way is the level calibration
         bool frame_due;                 // refresh_board_frame on the next step with room
+        uint16_t frame_sum;             // the frame's settings' bytes summed at the last refresh (frame_settings_sum)
         uint8_t accel_pos;              // the six-position calibration's position (1..6; 7 fitting; 0 off)
         bool accel_waiting;             // ... asked, not yet confirmed
         bool accel_collecting;          // ... confirmed: its still second under way (gyro_cal_)
