@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include <string.h>
+
 #include "AirspeedInput.h"
 #include "Baro.h"
 #include "BatteryInput.h"
@@ -283,8 +285,9 @@ void take_request() {
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) {
             save_pending = configure_pending = true;
-            mag_cal_link::parameter_changed((uint16_t)index);
-            pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* at once
+            // Only a COMPASS_ row can be the calibration's: the table is not walked again
+            // for the others (a burst's frames wait in the 64-byte receive ring meanwhile).
+            if (strncmp(set.name, "COMPASS_", 8) == 0) mag_cal_link::parameter_changed((uint16_t)index);
         }
     } else if (rx.msgid == mav::kMsgCommandAck) {
         // MAVProxy's accelcal: COMMAND_ACK with command = the position it confirms.

@@ -41,7 +41,7 @@ public:
     // Every loop iteration: the next byte, or a part of a verification or of a CRC's note.
     void service();
     // A save is under way (a reboot waits for its end).
-    bool busy() const { return index_ != slots::kSlotSize; }
+    bool busy() const { return stage_ != kIdle; }
     // The settings in use are the user's: loaded, or the EEPROM blank (a new board's
     // defaults), or saved since; false while the board runs on defaults because the
     // record was unreadable (corrupt, another firmware's, out of range): the pre-arm

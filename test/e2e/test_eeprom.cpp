@@ -357,9 +357,9 @@ struct Boot {
 // 60 ms: the start-up's lines leave by ~55 ms (millis() starts at pipeline::kBootMs, 10 ms
 // after reset: firmware/StartTime.cpp).
 Boot boot_line(const std::string& chip) {
-    // 0.08 s: past the settings line after a warning (the start reads both records first; the
-    // timeline counts from reset, 10 ms of start-up included).
-    const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "rest", 0.08, "--eeprom " + chip);
+    // 0.4 s: past the settings line: the start reads and checks both records (~50 ms) before the
+    // MPU6000 is due, so the line finishes in the waits that follow, by the loop at 0.35 s.
+    const e2e::SimRun run = e2e::run_sim(e2e::firmware_elf(), "rest", 0.4, "--eeprom " + chip);
     Boot b;
     EXPECT_EQ(run.result.exit_code, 0) << e2e::dump(run);
     const e2e::Line* line = find_line(run.lines, "# settings: rate");
