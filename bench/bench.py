@@ -73,7 +73,7 @@ SECTIONS = [
 # 200 KB with every feature (the 2560 has 256 KB, its bootloader 8 KB: cycles and RAM are
 # the scarce resources); static RAM at 4.5 KB with arming, calibration, battery, missions
 # and navigation: the stack's high-water mark was 1.7 KB with the GPS, barometer and
-# position (issue 45), so 4.5 + 1.7 leaves more than STACK_SPARE_MIN of the 8 KB.
+# position, so 4.5 + 1.7 leaves more than STACK_SPARE_MIN of the 8 KB.
 CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 10000, ""),
                  ("step_cycles_max", "estimator step, max cycles", 30000, ""),
                  ("step_cycles_avg_shake", "estimator step on `shake`, avg cycles", 10000, ""),
@@ -94,7 +94,7 @@ CYCLE_TARGETS = [("step_cycles_avg", "estimator step, avg cycles", 10000, ""),
                  ("flash_bytes", "flash", 204800, " B"),
                  ("flash_attitude_only_bytes", "flash, attitude-only build (APM25_FLIGHT=0)", 204800, " B")]
 # The stack's high-water mark: the painted RAM (firmware/StackPaint.cpp) no profiled run
-# reached must be at least this (issue 45: 512 B to spare).
+# reached must be at least this (512 B to spare).
 STACK_SPARE_MIN = 512
 # The estimator's running step is measured from here on: past the gyro calibration (~1.5 s)
 # and the start-up ramp's first second.

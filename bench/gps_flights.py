@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The GPS-aided attitude on flights of fresh seeds (issue 45): ours with the GPS against
+"""The GPS-aided attitude on flights of fresh seeds: ours with the GPS against
 ours without it and against VQF, per flight.
 
     build/venv/bin/python bench/gps_flights.py --seeds 52001-52005

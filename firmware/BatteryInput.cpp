@@ -25,7 +25,7 @@ static uint16_t now16() { return (uint16_t)millis(); }
 bool due() { return (uint16_t)(now16() - last_update_ms) >= battery::kUpdatePeriodMs; }
 
 // The low-battery failsafe's action. ArduPlane's (low_battery_event) is RTL; the board has
-// no navigation yet (issue 47), so it keeps flying the mode it is in and says so. When RTL
+// no navigation yet, so it keeps flying the mode it is in and says so. When RTL
 // exists, this is where it is asked for.
 static void failsafe_action() {}
 

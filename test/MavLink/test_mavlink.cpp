@@ -996,7 +996,7 @@ TEST(ParamLink, RepliesSinglesFirstThenTheWholeListOnce) {
     list.insert(list.end(), sent.begin() + 6, sent.end());
     for (uint16_t i = 0; i < params::count(); ++i) EXPECT_EQ(list[i], i);
     // A burst (20 PARAM_SETs before the link has room for one reply, each asked twice):
-    // every one answered, once, lowest index first (issue 46: 20 sent, 4 answered).
+    // every one answered, once, lowest index first.
     for (int pass = 0; pass < 2; ++pass)
         for (uint16_t i = 0; i < 20; ++i) r.request_one((uint16_t)(params::count() - 1u - i * 3u));
     std::vector<uint16_t> burst;

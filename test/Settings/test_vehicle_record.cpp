@@ -17,7 +17,7 @@ using settings::Settings;
 namespace {
 
 constexpr uint16_t kChipSize = 4096;
-constexpr uint16_t kMissionStart = 1284;  // issue 47's mission storage: 1284..4095 stays free
+constexpr uint16_t kMissionStart = 1284;  // the mission's storage: 1284..4095 stays free
 std::vector<uint8_t> g_chip;
 
 void read_chip(uint16_t address, uint8_t* out, uint16_t n) {

@@ -59,7 +59,7 @@ TEST(ConsoleReplies, StatusAndHelpWholeInRawModeWithoutOverrun) {
 
 TEST(ConsoleReplies, StatusAndHelpWholeInMavlinkModeWithoutOverrun) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
-    // In MAVLink no text line acts (issue 46), so the commands are typed in text and a
+    // In MAVLink no text line acts, so the commands are typed in text and a
     // ground station's HEARTBEAT (pymavlink's, system 255) right behind them switches the
     // port while their replies are still queued: they go out as STATUSTEXT.
     static const unsigned char kGcsHeartbeat[] = {0xFD, 0x09, 0x00, 0x00, 0x00, 0xFF, 0xBE, 0x00, 0x00, 0x00, 0x00,

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The stack's high-water mark (firmware/StackPaint.cpp, apm25sim --profile's stack rows):
 // the firmware paints the RAM above its static data at start-up, and after a run with a
-// console session the stack has left at least 512 B of it untouched (issue 45). The rows
+// console session the stack has left at least 512 B of it untouched. The rows
 // add up to the RAM above the static data (avr-size's .data + .bss), so a paint that did
 // not happen (0 free) or a count from the wrong address would fail.
 #include <fstream>

@@ -54,7 +54,7 @@ GROUP is one of:
                   pitch within 5 (the aim is 3: the pitch estimate reads the aeroplane's
                   acceleration after the restart as nose up, and lags it by ~3 deg at 10 s)
   turn_gps        the 60 s, 30 deg turn in light gusts on the DEFAULT settings without a pitot, with
-                  the simulator's u-blox on the GPS port (issue 45), from 10 s (the board says its
+                  the simulator's u-blox on the GPS port, from 10 s (the board says its
                   3D fix before): the GPS's acceleration takes the turn's out of the accelerometer;
                   the worst roll error in flight under 1 deg (DIR/turn_gps_bank.csv), against the
                   same flight with `--gps none` (printed)
@@ -98,7 +98,7 @@ GUST_NAMES = {0: "no", 1: "light", 2: "moderate"}
 # the configured cruise speed only (TRIM_ARSPD_CM, the backend's trim speed: the turn's
 # power setting flies faster, the honest mismatch of a configured speed).
 TURN_SENSOR_MAX_DEG, TURN_CRUISE_MAX_DEG = 2.0, 5.0
-TURN_GPS_MAX_DEG = 1.0  # issue 45: with the GPS, without the airspeed sensor
+TURN_GPS_MAX_DEG = 1.0  # with the GPS, without the airspeed sensor
 TRIM_ARSPD_CM = 1800
 DEFAULT_TRIM_ARSPD_CM = 1500  # lib/Settings/Params.cpp: the cruise speed a board assumes unless set
 # The pitch the Rascal flies level at its trim speed (the backend's trim: alpha 1.40 deg),
@@ -661,7 +661,7 @@ def check_vtail(args):
         row(h - 0.1), row(t_rudder, yaw=1650), row(t_pitch, pitch=pitch_stick, throttle=1300), row(t_level)]
     # Without a GPS, as the flight's bounds were set: with one the estimate follows the true
     # pitch within 0.3 deg and STABILIZE's own overshoot on this airframe (13.8 deg for 10, ~6 s
-    # after the step) shows; that is the pitch loop's (issue 44), not the mixer's, to answer.
+    # after the step) shows; that is the pitch loop's, not the mixer's, to answer.
     f = Flight(args.work, name, rows, seconds, gust=1, tools=args.tools, seed=4406,
                console=["set VTAIL_OUTPUT 1"], airframe="vtail", gps="none")
     said_set(f, name, "VTAIL_OUTPUT")

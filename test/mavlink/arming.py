@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Arming, modes and RC overrides from a ground station (issue 46), pymavlink over TCP.
+"""Arming, modes and RC overrides from a ground station, pymavlink over TCP.
 
     build/venv/bin/python test/mavlink/arming.py --tools build --work DIR
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The battery monitor as a ground station sees it (issue 46): the firmware in
+"""The battery monitor as a ground station sees it: the firmware in
 `apm25sim --battery ... --serial tcp:0`, a pymavlink ground station on it.
 
     build/venv/bin/python test/mavlink/battery_monitor.py --tools build --work DIR

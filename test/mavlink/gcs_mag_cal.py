@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The ground station's compass calibration on the simulated board over TCP (issue 46).
+"""The ground station's compass calibration on the simulated board over TCP.
 
     build/venv/bin/python test/mavlink/gcs_mag_cal.py --tools build --work DIR
 

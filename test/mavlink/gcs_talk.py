@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The MAVLink conversation's rules on the simulated board over TCP, with pymavlink (issue 46).
+"""The MAVLink conversation's rules on the simulated board over TCP, with pymavlink.
 
     build/venv/bin/python test/mavlink/gcs_talk.py --tools build --work DIR
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The board in its airframe (issue 46): AHRS_ORIENTATION and the level calibration.
+"""The board in its airframe: AHRS_ORIENTATION and the level calibration.
 
     build/venv/bin/python test/mavlink/level_orientation.py --tools build --work DIR
 

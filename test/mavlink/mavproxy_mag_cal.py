@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""MAVProxy's own compass calibration on the simulated board over TCP (issue 46).
+"""MAVProxy's own compass calibration on the simulated board over TCP.
 
     build/venv/bin/python test/mavlink/mavproxy_mag_cal.py --tools build --work DIR
 

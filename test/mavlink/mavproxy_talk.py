@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""MAVProxy's view of the conversation (issue 46) on the simulated board over TCP.
+"""MAVProxy's view of the conversation on the simulated board over TCP.
 
     build/venv/bin/python test/mavlink/mavproxy_talk.py --tools build --work DIR
 
@@ -13,7 +13,7 @@ into its console as a user does, and checks what it prints:
     `status AUTOPILOT_VERSION` shows: flight_sw_version decodes (as MAVProxy does) to the
     start-up line's version, official; capabilities PARAM_FLOAT and MAVLINK2;
   - `wp list`, `fence list`, `rally list` each answered ("Requesting 0 waypoints", "0 fence
-    items", "0 rally items"): the lists are empty until issue 47, never waited for;
+    items", "0 rally items"): the lists are empty until the board stores missions, never waited for;
   - `status SYSTEM_TIME` shows the board's clock (time_boot_ms within the session).
 Exit 1 with every failure listed.
 """

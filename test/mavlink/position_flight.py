@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Position and home as a ground station sees them: the firmware in apm25sim with the u-blox
-and MS5611 models on a flight path, its MAVLink stream decoded by pymavlink (issue 45).
+and MS5611 models on a flight path, its MAVLink stream decoded by pymavlink.
 
     build/venv/bin/python test/mavlink/position_flight.py --tools build --work DIR
 

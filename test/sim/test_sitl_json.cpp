@@ -177,7 +177,7 @@ TEST(SitlJson, TrajectoryHistoryIsTrimmedKeepingWhatInterpolationNeeds) {
     EXPECT_EQ(t.size(), 5u);
 }
 
-// The race of issue 46 on a loaded machine: frame 47172 is sent again after a time-out and
+// The race seen on a loaded machine: frame 47172 is sent again after a time-out and
 // answered twice; the second answer (timestamp 47.173 s) arrives while frame 47173 is
 // awaited. It is not after the last state taken: stale, dropped and counted; the next
 // frame's own answer is taken. Any timestamp not after the last is stale (an older late

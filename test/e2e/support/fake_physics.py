@@ -16,7 +16,7 @@ readme's resend). Prints 'port N' on stdout once listening.
   --log FILE            one CSV row per packet: frame_count,frame_rate,pwm1..pwm16
   --silent-after N      stop answering after frame N (the link's timeout test)
   --garbage-after N     answer frames after N with text that is not a state
-  --late N              a loaded machine's race (issue 46), deterministically: frame N is
+  --late N              a loaded machine's race, deterministically: frame N is
                         answered only once it came again (apm25sim sent it again after its
                         1 s time-out); the answer to that resend, the same state, is held
                         and sent just before the next frame's answer, when apm25sim already

@@ -60,7 +60,7 @@ int main() {
     put(nullptr, buf, p.global_position_int(buf, r));
     put(nullptr, buf, p.vfr_hud(buf, r));
     put(nullptr, buf, p.home_position(buf, 71350450, -731194210, 1028000));
-    // The conversation (issue 46).
+    // The conversation.
     const mav::Version v{1, 2, 3, {'0', '1', '2', '3', 'a', 'b', 'c', 'd'}};
     put(nullptr, buf, p.autopilot_version(buf, v));
     put(nullptr, buf, p.mission_count(buf, 255u, 190u, 0u, 1u));
