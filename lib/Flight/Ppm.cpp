@@ -5,7 +5,7 @@ namespace flight {
 
 void PpmDecoder::reset() {
     have_capture_ = false;
-    count_ = kNoSync;
+    count_ = 0;
     last_count_ = 0;
 }
 
@@ -13,7 +13,12 @@ bool PpmDecoder::feed(uint16_t capture_ticks) {
     const uint16_t last = last_capture_;
     last_capture_ = capture_ticks;
     if (!have_capture_) {
+        // The first edge after an idle line (a receiver switched on, or captures lost)
+        // is taken as a frame's first: if it was not, that frame has too few widths and
+        // the count test rejects it and the next, as a frame after no sync gap would be.
         have_capture_ = true;
+        count_ = 0;
+        bad_ = false;
         return false;
     }
     // The timer counts 0..kPeriodTicks-1 and wraps: the width is the difference modulo
@@ -29,7 +34,6 @@ bool PpmDecoder::feed(uint16_t capture_ticks) {
         bad_ = false;
         return accept;
     }
-    if (count_ == kNoSync) return false;  // no frame start seen yet
     if (width_us < kMinUs || width_us > kMaxUs) bad_ = true;
     if (count_ < kChannels) frame_us_[count_] = width_us;
     else bad_ = true;  // too many widths: a glitch split one

@@ -9,7 +9,8 @@
 // its 400 us pulse, and at least ~4.5 ms of sync). A frame is accepted only when every
 // width is plausible (kMinUs..kMaxUs) and it has kChannels widths, as the frame before
 // it: a glitch that splits or swallows a pulse costs that frame and the next, never a
-// wrong width. Pure C++: no clock, no registers.
+// wrong width. The first edge after an idle line opens a frame, so a receiver switched on
+// is accepted from its second frame (45 ms). Pure C++: no clock, no registers.
 #pragma once
 
 #include <stdint.h>
@@ -35,10 +36,9 @@ public:
     const uint16_t* frame_us() const { return frame_us_; }
 
 private:
-    static constexpr uint8_t kNoSync = 0xFF;
     uint16_t frame_us_[kChannels] = {};
     uint16_t last_capture_ = 0;
-    uint8_t count_ = kNoSync;   // widths in the frame in progress; kNoSync before the first gap
+    uint8_t count_ = 0;         // widths in the frame in progress
     uint8_t last_count_ = 0;    // widths in the last closed frame
     bool have_capture_ = false;
     bool bad_ = false;          // the frame in progress had an implausible width

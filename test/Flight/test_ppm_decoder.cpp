@@ -49,11 +49,26 @@ TEST(PpmDecoder, GoodFramesAcceptedFromTheSecondWholeOne) {
     uint32_t t = 12345;
     for (int i = 0; i < 5; ++i) t = ppm_frame(kFrame, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));  // the edge after the last sync gap
-    // A frame closes at the next frame's first edge. Frame 1 has no sync before it (its
-    // widths are ignored); frame 2 is whole but follows no whole frame; 3, 4, 5 are
-    // accepted.
-    EXPECT_EQ(feed_all(d, caps, &last), 3);
+    // A frame closes at the next frame's first edge. Frame 1 opens at the first edge (a
+    // receiver switched on) but follows no whole frame; 2, 3, 4, 5 are accepted.
+    EXPECT_EQ(feed_all(d, caps, &last), 4);
     EXPECT_EQ(last, kFrame);
+}
+
+TEST(PpmDecoder, SwitchedOnMidFrameTheThirdFrameIsTheFirstAccepted) {
+    // The board starts while the receiver runs: its first edge is one inside a frame (the
+    // 2nd to the 9th). That frame's few widths and the next whole frame (after no whole
+    // one) are rejected; frames 3 and 4 accepted.
+    for (int skipped = 1; skipped < 9; ++skipped) {
+        PpmDecoder d;
+        std::vector<uint16_t> caps, last;
+        uint32_t t = 777;
+        for (int i = 0; i < 4; ++i) t = ppm_frame(kFrame, t, caps);
+        caps.push_back((uint16_t)(t % kTimerTicks));
+        caps.erase(caps.begin(), caps.begin() + skipped);
+        EXPECT_EQ(feed_all(d, caps, &last), 2) << skipped;
+        EXPECT_EQ(last, kFrame);
+    }
 }
 
 TEST(PpmDecoder, WidthsExactThroughTheTimerWrap) {
@@ -63,7 +78,7 @@ TEST(PpmDecoder, WidthsExactThroughTheTimerWrap) {
     const std::vector<uint16_t> odd = {800, 2200, 1501, 999, 1000, 2000, 1234, 1777};
     for (int i = 0; i < 6; ++i) t = ppm_frame(odd, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));
-    EXPECT_EQ(feed_all(d, caps, &last), 4);
+    EXPECT_EQ(feed_all(d, caps, &last), 5);
     EXPECT_EQ(last, odd);
 }
 
@@ -83,10 +98,10 @@ TEST(PpmDecoder, ShortFrameAndImplausibleWidthsRejected) {
     t = ppm_frame(low, t, caps);
     t = ppm_frame(high, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));
-    // Accepted: frame 3 (after a whole 2), not 4 (7 widths), not 5 (after 7), 6, not 7
-    // (700 us), not 8 (2300 us).
+    // Accepted: frames 2 and 3 (each after a whole one), not 4 (7 widths), not 5 (after
+    // 7), 6, not 7 (700 us), not 8 (2300 us).
     PpmDecoder d;
-    EXPECT_EQ(feed_all(d, caps), 2);
+    EXPECT_EQ(feed_all(d, caps), 3);
 }
 
 TEST(PpmDecoder, GlitchSplittingAPulseCostsTheFrameNotAWrongWidth) {
@@ -107,8 +122,8 @@ TEST(PpmDecoder, GlitchSplittingAPulseCostsTheFrameNotAWrongWidth) {
             ++n;
             EXPECT_EQ(std::vector<uint16_t>(d.frame_us(), d.frame_us() + 8), kFrame);
         }
-    // Accepted: frame 3, not the glitched 4, not 5 (after a 9-count), 6, 7.
-    EXPECT_EQ(n, 3);
+    // Accepted: frames 2 and 3, not the glitched 4, not 5 (after a 9-count), 6, 7.
+    EXPECT_EQ(n, 4);
 }
 
 TEST(PpmDecoder, ResetDropsTheFrameInProgress) {
@@ -117,13 +132,15 @@ TEST(PpmDecoder, ResetDropsTheFrameInProgress) {
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
     t = ppm_frame(kFrame, t, caps);
     PpmDecoder d;
-    // Three frames and the fourth's first 5 edges: frame 3 accepted at the 4th's first edge.
-    EXPECT_EQ(feed_all(d, std::vector<uint16_t>(caps.begin(), caps.begin() + 27 + 5)), 1);
-    d.reset();  // captures lost mid-frame
-    std::vector<uint16_t> more;
+    // Three frames and the fourth's first 5 edges: frames 2 and 3 accepted (3 at the 4th's
+    // first edge).
+    EXPECT_EQ(feed_all(d, std::vector<uint16_t>(caps.begin(), caps.begin() + 27 + 5)), 2);
+    d.reset();  // captures lost mid-frame: the next edge is the fourth frame's eighth
+    std::vector<uint16_t> more(caps.begin() + 27 + 7, caps.end());
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, more);
     more.push_back((uint16_t)(t % kTimerTicks));
-    EXPECT_EQ(feed_all(d, more), 1);  // as from power-up: the third whole frame is the first accepted
+    // The fourth's rest (one width) and the fifth (after it) rejected; 6 and 7 accepted.
+    EXPECT_EQ(feed_all(d, more), 2);
 }
 
 namespace {
@@ -153,7 +170,7 @@ TEST(PpmDecoder, WidthsRoundedToTheNearestMicrosecondAcrossTheWrap) {
         for (int i = 0; i < 6; ++i) t = ppm_ticks(ticks, 9001 + (uint32_t)i * 997, t, caps);
         caps.push_back((uint16_t)(t % kTimerTicks));
         PpmDecoder d;
-        EXPECT_EQ(feed_all(d, caps, &last), 4) << start;
+        EXPECT_EQ(feed_all(d, caps, &last), 5) << start;
         EXPECT_EQ(last, us) << start;
     }
 }
@@ -167,7 +184,7 @@ TEST(PpmDecoder, ASyncGapIsOver3000us) {
         for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, gap, t, caps);
         caps.push_back((uint16_t)(t % kTimerTicks));
         PpmDecoder d;
-        EXPECT_EQ(feed_all(d, caps), 3) << gap;
+        EXPECT_EQ(feed_all(d, caps), 4) << gap;
     }
     // ... 3000 us does not: it is a width, and too long for one.
     for (uint32_t gap : {5999u, 6000u}) {
@@ -190,9 +207,9 @@ TEST(PpmDecoder, WidthsJustOutsideThePlausibleOnesCostTheirFrameOnly) {
         t = ppm_frame(odd, t, caps);
         for (int i = 0; i < 2; ++i) t = ppm_frame(kFrame, t, caps);
         caps.push_back((uint16_t)(t % kTimerTicks));
-        // Accepted: frame 3, not 4, then 5 (a whole count before it) and 6.
+        // Accepted: frames 2 and 3, not 4, then 5 (a whole count before it) and 6.
         PpmDecoder d;
-        EXPECT_EQ(feed_all(d, caps, &last), 3) << bad;
+        EXPECT_EQ(feed_all(d, caps, &last), 4) << bad;
         EXPECT_EQ(last, kFrame);
     }
     // The ends themselves are plausible.
@@ -202,12 +219,12 @@ TEST(PpmDecoder, WidthsJustOutsideThePlausibleOnesCostTheirFrameOnly) {
     for (int i = 0; i < 4; ++i) t = ppm_frame(ends, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));
     PpmDecoder d;
-    EXPECT_EQ(feed_all(d, caps, &last), 2);
+    EXPECT_EQ(feed_all(d, caps, &last), 3);
     EXPECT_EQ(last, ends);
 }
 
 TEST(PpmDecoder, ALongRunWithoutASyncGapThenFramesAgain) {
-    // Three frames (the third accepted), then edges 1 ms apart (a stuck encoder: the count
+    // Three frames (the second and third accepted), then edges 1 ms apart (a stuck encoder: the count
     // saturates), then frames: the second whole one after the run is accepted.
     std::vector<uint16_t> caps, last;
     uint32_t t = 0;
@@ -217,7 +234,7 @@ TEST(PpmDecoder, ALongRunWithoutASyncGapThenFramesAgain) {
     for (int i = 0; i < 4; ++i) t = ppm_frame(kFrame, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));
     PpmDecoder d;
-    EXPECT_EQ(feed_all(d, caps, &last), 1 + 3);
+    EXPECT_EQ(feed_all(d, caps, &last), 2 + 3);
     EXPECT_EQ(last, kFrame);
 }
 
@@ -227,14 +244,14 @@ TEST(PpmDecoder, ResetRightAfterASyncGapStartsAsFromPowerUp) {
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));  // closes frame 3: the count is 0 again
     PpmDecoder d;
-    EXPECT_EQ(feed_all(d, caps), 1);
+    EXPECT_EQ(feed_all(d, caps), 2);
     d.reset();
-    // The next edge starts afresh: the first frame is not counted, the second follows no
-    // whole frame, the third is accepted.
+    // The next edge starts afresh: the first frame follows no whole frame, the second and
+    // third are accepted.
     std::vector<uint16_t> more;
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, more);
     more.push_back((uint16_t)(t % kTimerTicks));
-    EXPECT_EQ(feed_all(d, more), 1);
+    EXPECT_EQ(feed_all(d, more), 2);
 }
 
 TEST(PpmDecoder, ASyncGapAcrossTheWrapFromMidPeriod) {
@@ -246,7 +263,7 @@ TEST(PpmDecoder, ASyncGapAcrossTheWrapFromMidPeriod) {
     for (int i = 0; i < 5; ++i) t = ppm_ticks(widths, 23000, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));
     PpmDecoder d;
-    EXPECT_EQ(feed_all(d, caps, &last), 3);
+    EXPECT_EQ(feed_all(d, caps, &last), 4);
     EXPECT_EQ(last, std::vector<uint16_t>(8, 1063));
 }
 
@@ -266,8 +283,8 @@ TEST(PpmDecoder, ASplitPulseCostsItsFrameAndTheNextWhateverTheTiming) {
     ASSERT_EQ(t % kTimerTicks, 3000u);
     for (int i = 0; i < 3; ++i) t = ppm_frame(kFrame, t, caps);
     caps.push_back((uint16_t)(t % kTimerTicks));
-    // Accepted: frame 3, not the split one, not the one after it, then both of the others.
+    // Accepted: frames 2 and 3, not the split one, not the one after it, then both others.
     PpmDecoder d;
-    EXPECT_EQ(feed_all(d, caps, &last), 1 + 2);
+    EXPECT_EQ(feed_all(d, caps, &last), 2 + 2);
     EXPECT_EQ(last, kFrame);
 }

@@ -37,7 +37,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from sim_run import serve, tools_and_work  # noqa: E402
 from soft_assert import finish, soft_assert  # noqa: E402
 
-WALL_TIMEOUT_S = 600
+WALL_TIMEOUT_S = 120  # per line awaited: a missing one fails the test, not its time-out
 
 
 class Lines:
@@ -50,6 +50,7 @@ class Lines:
     def _read(self, stream):
         for line in stream:
             self.log.write(line)
+            self.log.flush()  # whole in the work folder even when the test is killed
             self.seen.append(line)
             self.q.put(line)
 
@@ -126,7 +127,7 @@ def main():
     args = tools_and_work()
     trajectory = os.path.join(args.work, "banked.csv")
     write_banked(trajectory)
-    session = Session(args, ["--trajectory", trajectory], "param,mode")
+    session = Session(args, ["--trajectory", trajectory], "param,mode,arm")
     out, type_line = session.out, session.type_line
     try:
         m = out.wait(r"Received (\d+) parameters", "the parameter list")
