@@ -6,6 +6,7 @@
 #include "ArduinoCore.h"
 #include "Board.h"
 #include "BaroHeight.h"
+#include "GcsLink.h"
 #include "LinAlg.h"
 #include "Ms5611.h"
 #include "Vehicle.h"
@@ -113,6 +114,7 @@ static void new_period(uint32_t now_us) {
         ground_chip_c = temperature_c();
         Writer(vehicle::out).str(TXT("# baro: MS5611, ground ")).u32((uint32_t)(s.gnd_abs_press_pa + 0.5f))
             .str(TXT(" Pa (GND_ABS_PRESS), ")).fixed2(ground_chip_c).str(TXT(" C")).end();
+        gcs_link::announce_calibration(gcs_link::Calibrated::kBaroGround);
     }
     const float t_c = s.flight.gnd_temp_c != 0.0f ? s.flight.gnd_temp_c : ground_chip_c;
     if (!height.have_ground() || s.gnd_abs_press_pa != ground_pa || t_c != ground_c) {

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "GcsLink.h"
 
+#include <stddef.h>
 #include <string.h>
+
+#include "Params.h"
 
 #include "AirspeedInput.h"
 #include "Baro.h"
@@ -56,6 +59,15 @@ static mav::MissionResult mission_result = mav::MissionResult::Accepted;
 static uint8_t mission_sysid = 0, mission_compid = 0;
 constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
+
+// COMPASS_OFS/DIA/ODI_*: their indices, found once (the table walked at the first use).
+static params::Rows compass_rows() {
+    static params::Rows rows{0, 0};
+    if (rows.count == 0u)
+        rows = params::rows_within(offsetof(settings::Settings, cal.mag_offset_uT),
+                                   offsetof(settings::Settings, cal.mag_learned_uT));
+    return rows;
+}
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
 
 mav::Parser& parser() { return input; }
@@ -285,9 +297,9 @@ void take_request() {
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) {
             save_pending = configure_pending = true;
-            // Only a COMPASS_ row can be the calibration's: the table is not walked again
-            // for the others (a burst's frames wait in the 64-byte receive ring meanwhile).
-            if (strncmp(set.name, "COMPASS_", 8) == 0) mag_cal_link::parameter_changed((uint16_t)index);
+            // The calibration's rows, known once (a table walk per frame would keep a
+            // burst's frames waiting in the receive ring).
+            if (compass_rows().holds((uint16_t)index)) mag_cal_link::parameter_changed((uint16_t)index);
         }
     } else if (rx.msgid == mav::kMsgCommandAck) {
         // MAVProxy's accelcal: COMMAND_ACK with command = the position it confirms.
@@ -327,6 +339,37 @@ void reboot() {
 
 void announce_param(uint16_t index) {
     if (port::mavlink_mode()) param_replies.request_one(index);
+}
+
+static params::Rows calibration_rows(Calibrated what) {
+    using settings::Settings;
+    switch (what) {
+        case Calibrated::kLevel:
+            return params::rows_within(offsetof(Settings, vehicle.ahrs_trim_x_rad),
+                                       offsetof(Settings, vehicle.ins_accoffs_m_s2));
+        case Calibrated::kAccel:
+            return params::rows_within(offsetof(Settings, vehicle.ins_accoffs_m_s2),
+                                       offsetof(Settings, vehicle.ins_accscal) + sizeof(float[3]));
+        case Calibrated::kCompass: return compass_rows();
+        default:
+            return params::rows_within(offsetof(Settings, gnd_abs_press_pa),
+                                       offsetof(Settings, gnd_abs_press_pa) + sizeof(float));
+    }
+}
+
+void announce_calibration(Calibrated what) {
+    if (!port::mavlink_mode()) return;
+    const params::Rows rows = calibration_rows(what);
+    for (uint8_t i = 0; i < rows.count; ++i) param_replies.request_one((uint16_t)(rows.first + i));
+}
+
+void announce_calibration(const pipeline::AttitudePipeline& p, const pipeline::Event& e) {
+    using pipeline::EventKind;
+    if (e.code != 0u) return;  // each verdict's Ok is 0: nothing was written otherwise
+    if (e.kind == EventKind::kLevelDone) announce_calibration(Calibrated::kLevel);
+    else if (e.kind == EventKind::kAccelCalDone) announce_calibration(Calibrated::kAccel);
+    else if (e.kind == EventKind::kMagCalDone && p.mag_cal_state() == pipeline::MagCalState::kApplied)
+        announce_calibration(Calibrated::kCompass);
 }
 
 bool defaults_due() { return defaults_pending != Defaults::None && room_for(2u * mav::kMaxFrame); }

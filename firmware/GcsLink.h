@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "MavLink.h"
+#include "Pipeline.h"
 
 namespace gcs_link {
 
@@ -50,6 +51,13 @@ void reboot();
 // A parameter changed by another path (the console's `set`, a calibration accepted):
 // the ground station is told with a PARAM_VALUE (no-op outside MAVLink: it asks anew).
 void announce_param(uint16_t index);
+// The rows a calibration wrote, each told with a PARAM_VALUE as ArduPilot's AP_Param does
+// when the vehicle sets a parameter: the level (AHRS_TRIM_*), the six positions
+// (INS_ACC*), `cal mag` applied (COMPASS_OFS/DIA/ODI_*), the barometer's ground.
+enum class Calibrated : uint8_t { kLevel, kAccel, kCompass, kBaroGround };
+void announce_calibration(Calibrated what);
+// The pipeline's events: a calibration's good verdict announces its rows.
+void announce_calibration(const pipeline::AttitudePipeline& pipe, const pipeline::Event& e);
 bool param_value_due();
 void send_param_value();
 bool streams_due();

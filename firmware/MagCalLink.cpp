@@ -46,6 +46,7 @@ mav::Result command(const mav::CommandLong& c) {
     if (c.command == mav::kCmdDoAcceptMagCal) {
         if (pipe.accept_mag_calibration()) {
             gcs_link::save_soon();
+            gcs_link::announce_calibration(gcs_link::Calibrated::kCompass);
             return mav::Result::Accepted;
         }
         // Already in use (autosaved, or accepted before: MAVProxy accepts every report): nothing to do.

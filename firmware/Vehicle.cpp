@@ -2,6 +2,7 @@
 #include "Vehicle.h"
 
 #include "Board.h"
+#include "GcsLink.h"
 #include "Port.h"
 #include "PipelineText.h"
 
@@ -9,7 +10,13 @@ namespace vehicle {
 
 static const text::Sink message_sink = {nullptr, port::write_message};
 const text::Sink* const out = &message_sink;
-static const pipeline::EventSink pipeline_events = pipeline_text::events_to(&message_sink);
+// Each event's line; a calibration's good verdict also tells the ground station the
+// parameters it wrote.
+static void tell(void* out, const pipeline::AttitudePipeline& p, const pipeline::Event& e) {
+    pipeline_text::write_event(out, p, e);
+    gcs_link::announce_calibration(p, e);
+}
+static const pipeline::EventSink pipeline_events = {const_cast<text::Sink*>(&message_sink), tell};
 pipeline::AttitudePipeline pipe(&pipeline_events, pipeline::AttitudePipeline::SettingsLoadedLater{});
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);

@@ -492,10 +492,24 @@ float compass_ofs_mgauss(float offset_uT) {
 bool is_integer(Type t) { return t != Type::Float && t != Type::DeclRad && t != Type::MagOfs; }
 
 bool is_compass_calibration(uint16_t index) {
-    Row row;
-    uint8_t instance;
-    return locate(index, row, instance) && row.offset >= offsetof(Settings, cal.mag_offset_uT) &&
-           row.offset < offsetof(Settings, cal.mag_learned_uT);
+    return rows_within(offsetof(Settings, cal.mag_offset_uT), offsetof(Settings, cal.mag_learned_uT)).holds(index);
+}
+
+Rows rows_within(uint16_t from, uint16_t to) {
+    Rows rows{0, 0};
+    uint16_t index = 0;
+    for (uint8_t r = 0; r < kRowCount; ++r) {
+        const uint8_t n = ROW_BYTE(r, count);
+        const uint16_t offset = ROW_WORD(r, offset);
+        if (offset >= from && offset < to) {
+            if (rows.count == 0u) rows.first = index;
+            rows.count = (uint8_t)(rows.count + n);
+        } else if (rows.count != 0u) {
+            break;  // the block ended
+        }
+        index = (uint16_t)(index + n);
+    }
+    return rows;
 }
 
 uint16_t count() {

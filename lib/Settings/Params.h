@@ -65,6 +65,16 @@ float compass_ofs_mgauss(float offset_uT);
 bool is_compass_calibration(uint16_t index);
 // FLTMODE1..6: set() takes only a mode the board has (flight::mode_known).
 bool is_flight_mode(uint16_t index);
+// The parameters stored in Settings bytes [from, to) (offsetof values): the first one's
+// index and how many follow it (they are consecutive in the table); count 0 when none.
+// A calibration announces what it changed with it (PARAM_VALUE, as ArduPilot's
+// AP_Param::notify), and a PARAM_SET checks an index against it without a table walk.
+struct Rows {
+    uint16_t first;
+    uint8_t count;
+    bool holds(uint16_t index) const { return (uint16_t)(index - first) < count; }
+};
+Rows rows_within(uint16_t from, uint16_t to);
 // Every parameter to its default.
 void apply_defaults(settings::Settings& s);
 // The flight settings in the EEPROM record (settings::encode): the rows that live in

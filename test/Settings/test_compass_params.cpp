@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
+#include <string>
+#include <vector>
 
 #include "Params.h"
 #include "SensorCalibration.h"
@@ -124,6 +127,43 @@ TEST(CompassParams, RowsLiveInTheFirstRecordsCalibration) {
     EXPECT_FLOAT_EQ(params::get(out, index_of("COMPASS_OFS_X")), -80.0f);
     EXPECT_FLOAT_EQ(out.cal.mag_scale.y, 1.05f);
     EXPECT_FLOAT_EQ(out.cal.mag_cross.z, 0.03f);
+}
+
+}  // namespace
+
+namespace {
+
+// What each calibration announces when it ends (params::rows_within): exactly the rows it
+// wrote, by name, in table order.
+TEST(CalibrationRows, EachCalibrationsRowsByName) {
+    using settings::Settings;
+    struct Case {
+        uint16_t from, to;
+        std::vector<std::string> names;
+    };
+    const Case cases[] = {
+        {offsetof(Settings, cal.mag_offset_uT), offsetof(Settings, cal.mag_learned_uT),
+         {"COMPASS_OFS_X", "COMPASS_OFS_Y", "COMPASS_OFS_Z", "COMPASS_DIA_X", "COMPASS_DIA_Y", "COMPASS_DIA_Z",
+          "COMPASS_ODI_X", "COMPASS_ODI_Y", "COMPASS_ODI_Z"}},
+        {offsetof(Settings, vehicle.ahrs_trim_x_rad), offsetof(Settings, vehicle.ins_accoffs_m_s2),
+         {"AHRS_TRIM_X", "AHRS_TRIM_Y"}},
+        {offsetof(Settings, vehicle.ins_accoffs_m_s2), offsetof(Settings, vehicle.ins_accscal) + 12,
+         {"INS_ACCOFFS_X", "INS_ACCOFFS_Y", "INS_ACCOFFS_Z", "INS_ACCSCAL_X", "INS_ACCSCAL_Y", "INS_ACCSCAL_Z"}},
+        {offsetof(Settings, gnd_abs_press_pa), offsetof(Settings, gnd_abs_press_pa) + 4, {"GND_ABS_PRESS"}},
+    };
+    for (const Case& c : cases) {
+        const params::Rows rows = params::rows_within(c.from, c.to);
+        ASSERT_EQ(rows.count, c.names.size()) << c.names[0];
+        for (uint8_t i = 0; i < rows.count; ++i) {
+            params::Info in;
+            ASSERT_TRUE(params::info((uint16_t)(rows.first + i), in));
+            EXPECT_EQ(std::string(in.name), c.names[i]);
+        }
+        EXPECT_FALSE(rows.holds((uint16_t)(rows.first - 1u)));
+        EXPECT_FALSE(rows.holds((uint16_t)(rows.first + rows.count)));
+    }
+    // Bytes no parameter lives in: none.
+    EXPECT_EQ(params::rows_within(sizeof(Settings), sizeof(Settings) + 4).count, 0u);
 }
 
 }  // namespace

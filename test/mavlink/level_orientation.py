@@ -9,7 +9,8 @@
    (--rc) and its outputs measured on the pins (--servo-log). Before the calibration the
    board reads 2 and 3 deg and STABILIZE moves the aileron and elevator off trim; then, in
    MANUAL, MAV_CMD_PREFLIGHT_CALIBRATION param5 2 (Mission Planner's Calibrate Level,
-   MAVProxy's ahrstrim) is ACCEPTED, "cal level" is said, AHRS_TRIM_X/Y read back as 2 and
+   MAVProxy's ahrstrim) is ACCEPTED, "cal level" is said, the board sends AHRS_TRIM_X/Y's
+   PARAM_VALUEs unasked (as ArduPilot does for a value it sets), they read back as 2 and
    3 deg (within 0.05 deg: a count of the accelerometer is 0.03 deg), ATTITUDE reads level
    (within 0.1 deg) and STABILIZE again holds the airframe level: OUT1 and OUT2 within 3 us
    of their trim. A second level calibration on a board rocking in roll is refused with its
@@ -19,6 +20,8 @@
    ROLL_180_YAW_90 (10) and at YAW_45 (1) (apm25sim --orientation, `set AHRS_ORIENTATION`
    typed at 1.5 s, while still): every angle line from 5 s on within 0.2 deg of the plain
    run's angles at its time (roll, pitch and heading; measured 0.10, 0.05, 0.07).
+3. The six-position accelerometer calibration (param5 1, ACCELCAL_VEHICLE_POS) on injected
+   offsets and scales: the six INS_ACC* values announced unasked, then read back.
 Exit 1 with every failure listed.
 """
 import bisect
@@ -88,6 +91,22 @@ def no_overrun(board, what):
     soft_assert(not overruns, "%s: samples missed: %r" % (what, overruns))
 
 
+def announced(b, since, names, what):
+    """The PARAM_VALUEs of names the board sent unasked after b.msgs[since] (a calibration
+    that writes parameters tells the ground station, as ArduPilot): the set of those seen."""
+    seen = set()
+
+    def take(m):
+        if m.get_type() == "PARAM_VALUE" and m.param_id in names:
+            seen.add(m.param_id)
+        return len(seen) == len(names)
+    for _, m in b.msgs[since:]:
+        take(m)
+    if len(seen) < len(names):
+        b.pump(take, what, timeout_s=60)
+    return seen
+
+
 def servo_widths(path, out, t0, t1):
     with open(path) as f:
         return [float(r["width_us"]) for r in csv.DictReader(f) if int(r["out"]) == out and t0 <= float(r["t"]) < t1]
@@ -118,6 +137,7 @@ def level(args):
         p = max(abs(math.degrees(m.pitch) - TRIM_PITCH_DEG) for m in before)
         print("before: the board reads its tilt within %.3f deg roll, %.3f deg pitch" % (r, p))
         soft_assert(r < 0.1 and p < 0.1, "before the calibration the board does not read its 2/3 deg tilt")
+    since = len(b.msgs)
     command(b, mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, 0, 0, 0, 0, 2)
     ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, "COMMAND_ACK of the level calibration")
     soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "level calibration ACK %r" % ack)
@@ -125,6 +145,8 @@ def level(args):
                   "the level calibration's verdict")
     print("said: %s" % (said.text if said else None))
     soft_assert(said is not None and "trim roll" in said.text, "level calibration verdict %r" % said)
+    told = announced(b, since, ("AHRS_TRIM_X", "AHRS_TRIM_Y"), "the new trims' PARAM_VALUEs, unasked")
+    soft_assert(len(told) == 2, "the level calibration's trims announced: only %r" % sorted(told))
     t_done = b.t_s
     trims = {}
     for name in ("AHRS_TRIM_X", "AHRS_TRIM_Y"):
@@ -318,6 +340,7 @@ def accel_six(args):
         b.stop()
         return
     b.pump(lambda m: m.get_type() == "ATTITUDE" and b.t_s >= 4.0, "ATTITUDE at 4 s")
+    since = len(b.msgs)
     command(b, mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, 0, 0, 0, 0, 1)
     ack = b.ack(mavlink2.MAV_CMD_PREFLIGHT_CALIBRATION, "COMMAND_ACK of the accel calibration")
     soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_ACCEPTED, "accel calibration ACK %r" % ack)
@@ -355,8 +378,11 @@ def accel_six(args):
     prompts = [m.text for _, m in b.msgs if m.get_type() == "STATUSTEXT" and m.text.startswith("Place vehicle")]
     soft_assert(len(prompts) == 7 and prompts[0] == "Place vehicle level and press any key",
                 "the prompts: %r" % prompts)
+    names = ("INS_ACCOFFS_X", "INS_ACCOFFS_Y", "INS_ACCOFFS_Z", "INS_ACCSCAL_X", "INS_ACCSCAL_Y", "INS_ACCSCAL_Z")
+    told = announced(b, since, names, "the six values' PARAM_VALUEs, unasked")
+    soft_assert(len(told) == 6, "the accel calibration's values announced: only %r" % sorted(told))
     got = {}
-    for name in ("INS_ACCOFFS_X", "INS_ACCOFFS_Y", "INS_ACCOFFS_Z", "INS_ACCSCAL_X", "INS_ACCSCAL_Y", "INS_ACCSCAL_Z"):
+    for name in names:
         b.conn.mav.param_request_read_send(1, 1, name.encode(), -1)
         v = b.param(name, "PARAM_VALUE " + name)
         got[name] = v.param_value if v else float("nan")
