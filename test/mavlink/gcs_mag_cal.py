@@ -14,7 +14,8 @@ same COMMAND_LONGs: target component 0, the compass mask 0). Checks:
   - MAG_CAL_REPORT: SUCCESS, not autosaved, fitness under 5 mGauss, ofs within 3 mGauss (0.3 uT,
     the bound of the console's `cal mag` e2e test) of ArduPilot's offsets for the hard iron
     (-80, 50, -30) mGauss, diag y/x and z/x 1.03 within 0.01;
-  - COMPASS_OFS_* unchanged (0) before the accept; DO_ACCEPT_MAG_CAL: ACCEPTED, "saved", and
+  - COMPASS_OFS_* unchanged (0) before the accept; DO_ACCEPT_MAG_CAL: ACCEPTED, "saved", the nine
+    values sent unasked as PARAM_VALUEs equal to the report's, and
     COMPASS_OFS_X/Y/Z, _DIA_*, _ODI_* read back (PARAM_REQUEST_READ) equal to the report's;
   - DO_START_MAG_CAL (MAVProxy's, autosave 1) then DO_CANCEL_MAG_CAL: both ACCEPTED, no report,
     the offsets unchanged;
@@ -146,12 +147,27 @@ def calibrate_and_accept(b):
 
     before = read_params(b, "before the accept")
     soft_assert(all(before[n] == 0.0 for n in NAMES[:3]), "COMPASS_OFS_* in use before the accept: %r" % before)
+    since = len(b.msgs)
     ack = magcal(b, mav.MAV_CMD_DO_ACCEPT_MAG_CAL, 1)
     soft_assert(ack is not None and ack.result == mav.MAV_RESULT_ACCEPTED, "DO_ACCEPT_MAG_CAL: %r" % ack)
     saved = b.pump(lambda m: m.get_type() == "STATUSTEXT" and m.text == "saved", "STATUSTEXT 'saved' after ACCEPT")
     soft_assert(saved is not None, "the accepted calibration was not saved")
-    after = read_params(b, "after the accept")
+    # The nine values told unasked (ArduPilot's PARAM_VALUE for a value the vehicle sets),
+    # each the report's.
     want = report_values(report)
+    told = {}
+
+    def take(m):
+        if m.get_type() == "PARAM_VALUE" and m.param_id in NAMES:
+            told[m.param_id] = m.param_value
+        return len(told) == len(NAMES)
+    for _, m in b.msgs[since:]:
+        take(m)
+    if len(told) < len(NAMES):
+        b.pump(take, "the accepted calibration's PARAM_VALUEs, unasked", timeout_s=60)
+    soft_assert(len(told) == len(NAMES) and all(abs(told[n] - want[n]) <= 0.01 for n in NAMES),
+                "announced after the accept: %r, the report's %r" % (told, want))
+    after = read_params(b, "after the accept")
     soft_assert(all(after[n] is not None and abs(after[n] - want[n]) <= 0.01 for n in NAMES),
                 "parameters after the accept %r, the report's %r" % (after, want))
     return report
