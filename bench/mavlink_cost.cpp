@@ -49,7 +49,7 @@ int main() {
     uint8_t frame[mav::kMaxFrame];
     uint8_t gcs[mav::kMaxFrame];
     mav::Packer gcs_packer;
-    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active, mav::PlaneMode::Manual);
+    const uint8_t gcs_len = gcs_packer.heartbeat(gcs, mav::State::Active, mav::PlaneMode::Manual, false);
     // A PARAM_SET as QGroundControl sends it (MAVLink 2, system 255, component 190).
     static const uint8_t kParamSet[] = {0xFD, 0x17, 0x00, 0x00, 0x07, 0xFF, 0xBE, 0x17, 0x00, 0x00, 0x00, 0x00,
                                         0xA0, 0x3F, 0x01, 0x01, 'R',  'L',  'L',  '2',  'S',  'R',  'V',  '_',
@@ -78,7 +78,7 @@ int main() {
     for (uint8_t k = 0; k < 20; ++k) {
 #ifndef MAV_COST_EMPTY
         begin(1);
-        uint8_t n = packer.heartbeat(frame, mav::State::Active, mav::PlaneMode::Stabilize);
+        uint8_t n = packer.heartbeat(frame, mav::State::Active, mav::PlaneMode::Stabilize, true);
         end(1);
         sink(nullptr, frame, n);
         begin(2);
