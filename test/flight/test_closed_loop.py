@@ -254,9 +254,16 @@ def check_manual_circuit(args):
     # armed (`arm` at ~1.4 s), it takes its stick, raised at ARM_S.
     armed = f.said("# Throttle armed")
     soft_assert(armed is not None and armed[0] < ARM_S, "MANUAL: not armed before %.1f s: %r" % (ARM_S, armed))
-    thr_before = [w for t, out, w in f.pulses if out == 3 and t < ARM_S]
-    soft_assert(thr_before and all(abs(w - 1000.0) <= 0.3 for w in thr_before),
-                "MANUAL: the throttle left 1000 us before its stick rose: %r" % sorted(set(thr_before))[-3:])
+    # Disarmed: held at 1000 us to the pin's stamp; armed, it follows its stick, still at
+    # 1000 us, within the receiver's rounding (armed up to an output period and the line's
+    # few ms on the UART before its stamp).
+    t_armed = (armed[0] if armed is not None else ARM_S) - 0.025
+    held = [w for t, out, w in f.pulses if out == 3 and t < t_armed]
+    soft_assert(held and all(abs(w - 1000.0) <= 0.3 for w in held),
+                "MANUAL: the throttle left 1000 us while disarmed: %r" % sorted(set(held))[-3:])
+    low = [w for t, out, w in f.pulses if out == 3 and t_armed <= t < ARM_S]
+    soft_assert(all(abs(w - 1000.0) <= FOLLOW_US for w in low),
+                "MANUAL: the throttle left 1000 us before its stick rose: %r" % sorted(set(low))[-3:])
     first = next((t for t, out, w in f.pulses if out == 3 and abs(w - THROTTLE_US) <= FOLLOW_US), None)
     soft_assert(first is not None and ARM_S <= first < ARM_S + 0.1,
                 "MANUAL: the throttle took its stick at %s s" % first)
