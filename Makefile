@@ -31,7 +31,7 @@
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
                 libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-BUILD_GOALS := all firmware attitude-only big startup-variants tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
+BUILD_GOALS := all firmware attitude-only big startup-variants tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost nav-cost fuzz fuzz-smoke asan-unit mutate
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean
