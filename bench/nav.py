@@ -30,7 +30,8 @@ PIECES = [(1, "L1 `update_waypoint` + `nav_roll_cd`", "10 Hz"),
           (5, "TECS `update_50hz`", "50 Hz")]
 STEPS = [(8, "whole step on a leg, pitot (1 + 3 + 7)"),
          (9, "whole step on a leg, no pitot (1 + 4 + 7)"),
-         (10, "whole step on a loiter's circle, pitot (2 + 3 + 11)")]
+         (10, "whole step on a loiter's circle, pitot (2 + 3 + 11)"),
+         (12, "whole step reaching a waypoint, the next leg started (pitot)")]
 # The objects whose RAM is the navigation's state (bench/nav_cost.cpp's statics).
 OBJECTS = [("g_l1", "L1Control"), ("g_tecs", "Tecs"), ("g_exec", "MissionExecutor"),
            ("g_store_leg", "MissionStore")]

@@ -11,7 +11,9 @@
 //   a leg with a pitot     section 8: the whole step; inside it 1 L1, 3 TECS, 7 executor
 //   the same leg, no pitot section 9: the whole step; inside it 4 TECS
 //   on a loiter's circle   section 10: the whole step (pitot); inside it 2 L1, 11 executor
-// and section 5 TECS's 50 Hz filters (five per 10 Hz step), 6 the whole run.
+// and section 5 TECS's 50 Hz filters (five per 10 Hz step), 6 the whole run; then 12, one
+// whole step (pitot) that reaches the waypoint and starts the next leg. The first step of
+// each stack is a leg's first for L1 (its length and unit vector worked out).
 // The objects are static (g_*) so that `avr-nm -S` gives their RAM.
 #include <avr/io.h>
 #include <math.h>
@@ -167,6 +169,13 @@ int main() {
         step(g_l1_lo, g_tecs_lo, g_exec_lo, lo, nav::ne(-15.0f * sn, 15.0f * c + w), in_lo, 2, 0, 11);
         end(10);
     }
+    // The step that reaches the leg's waypoint and starts the next leg (the executor's
+    // advance: the store read, the next place, the turn to the leg after).
+    s.pos_m = g_exec.target().next_m - nav::ne(10.0f, 0.0f);
+    s.now_ms += 100;
+    begin(12);
+    step(g_l1, g_tecs, g_exec, s, nav::ne(15.0f, 1.0f), in, 0, 0, 0);
+    end(12);
     end(6);
     for (;;) {
     }
