@@ -12,11 +12,6 @@ namespace {
 constexpr float kTwoPi = 2.0f * linalg::kPi;
 constexpr float kGlideAboveM = 20.0f;  // AUTO spreads a climb only above this (ArduPlane's 20 m)
 
-nav::NorthEast unit(const nav::NorthEast& v) {
-    const float len = nav::length(v);
-    return len > 1e-3f ? v * (1.0f / len) : nav::ne(1.0f, 0.0f);
-}
-
 }  // namespace
 
 int16_t* MissionExecutor::jump_runs(uint8_t index) {
@@ -132,6 +127,14 @@ void MissionExecutor::setup_slope(const NavState& s, bool auto_mode) {
     target_.slope_m = offset;
 }
 
+void MissionExecutor::leg_started() {
+    leg_m_ = target_.next_m - target_.prev_m;
+    const float len2 = nav::length_squared(leg_m_);
+    leg_over_1m_ = len2 > 1.0f;
+    if (leg_over_1m_) leg_per_len2_ = leg_m_ * (1.0f / len2);
+    leg_has_line_ = len2 > 1e-2f;
+}
+
 void MissionExecutor::loiter_at(const nav::NorthEast& centre, float height_m, float radius_m, int8_t direction,
                                 const NavState& s) {
     target_.kind = TargetKind::kLoiter;
@@ -149,6 +152,7 @@ void MissionExecutor::return_home(const NavState& s) {
     const int16_t r = params_.loiter_radius_m;
     loiter_at(nav::ne(0.0f, 0.0f), rtl_height_m(s), (float)(r < 0 ? -r : r), r < 0 ? (int8_t)-1 : (int8_t)1, s);
     setup_slope(s, false);
+    leg_started();
 }
 
 void MissionExecutor::start_nav(uint8_t index, const NavState& s) {
@@ -213,21 +217,22 @@ void MissionExecutor::start_nav(uint8_t index, const NavState& s) {
     } else {
         setup_slope(s, true);
     }
+    leg_started();
 }
 
 float MissionExecutor::height_demand_m(const NavState& s) const {
     if (target_.slope_m == 0.0f) return target_.height_m;
     // ArduPlane's set_target_altitude_proportion: the slope's part still ahead.
-    const nav::NorthEast leg = target_.next_m - target_.prev_m;
-    const float len2 = nav::length_squared(leg);
-    const float along = len2 > 1.0f ? nav::dot(s.pos_m - target_.prev_m, leg) / len2 : 1.0f;
+    if (!leg_over_1m_) return target_.height_m;  // no length to spread it along
+    const float along = nav::dot(s.pos_m - target_.prev_m, leg_per_len2_);
     return target_.height_m - target_.slope_m * (1.0f - linalg::constrain(along, 0.0f, 1.0f));
 }
 
 bool MissionExecutor::loiter_progress(const NavState& s, const nav::L1Control& l1) {
     // Turns are counted from the capture of the circle: the sum of the small angles between
-    // successive radials (their cross product, the sine: 1e-4 short at 10 Hz on 60 m).
-    const nav::NorthEast r = unit(s.pos_m - target_.next_m);
+    // successive radials (their cross product, the sine: 1e-4 short at 10 Hz on 60 m). The
+    // radial is L1's loiter step's (its nav direction points at the centre).
+    const nav::NorthEast r = l1.nav_direction() * -1.0f;
     if (!loiter_captured_) {
         if (!l1.loiter_captured()) return false;
         loiter_captured_ = true;
@@ -246,8 +251,7 @@ bool MissionExecutor::verify(const NavState& s, const nav::L1Control& l1) {
         const nav::NorthEast to_wp = target_.next_m - s.pos_m;
         const float accept = l1.turn_distance_m(params_.wp_radius_m, turn_angle_deg_);
         if (nav::length_squared(to_wp) <= accept * accept) return true;
-        const nav::NorthEast leg = target_.next_m - target_.prev_m;
-        return nav::length_squared(leg) > 1e-2f && nav::dot(s.pos_m - target_.next_m, leg) >= 0.0f;
+        return leg_has_line_ && nav::dot(s.pos_m - target_.next_m, leg_m_) >= 0.0f;
     }
     case kNavLoiterTurns:
         return loiter_progress(s, l1) && loiter_sum_rad_ >= (float)loiter_turns(command_) * kTwoPi;
