@@ -19,15 +19,21 @@ constexpr float kMinGroundSpeed_m_s = 0.1f;    // update_waypoint's floor
 constexpr float kMinLoiterSpeed_m_s = 1.0f;    // update_loiter's floor for the gains
 constexpr float kPassedB_s = 3.0f;             // past next by this long: back to next
 
-// The same bits (a float's == would take NaN as a change every step, and costs more).
-bool same_bits(const void* a, const void* b, size_t n) { return memcmp(a, b, n) == 0; }
+// The same bits: a float's == is a call, and would take a NaN for a change every step.
+bool same_bits(float a, float b) {
+    uint32_t x, y;
+    memcpy(&x, &a, sizeof x);
+    memcpy(&y, &b, sizeof y);
+    return x == y;
+}
+bool same_point(const NorthEast& a, const NorthEast& b) {
+    return same_bits(a.north_m, b.north_m) && same_bits(a.east_m, b.east_m);
+}
 
 }  // namespace
 
 void L1Control::refresh_coefficients() {
-    if (same_bits(&k_.period_s, &params_.period_s, sizeof(float)) &&
-        same_bits(&k_.damping, &params_.damping, sizeof(float)))
-        return;
+    if (same_bits(k_.period_s, params_.period_s) && same_bits(k_.damping, params_.damping)) return;
     k_.period_s = params_.period_s;
     k_.damping = params_.damping;
     k_.l1_per_vg = kInvPi * k_.damping * k_.period_s;
@@ -40,7 +46,7 @@ void L1Control::refresh_coefficients() {
 }
 
 void L1Control::refresh_leg(const NorthEast& prev_m, const NorthEast& next_m) {
-    if (same_bits(&leg_prev_m_, &prev_m, sizeof prev_m) && same_bits(&leg_next_m_, &next_m, sizeof next_m)) return;
+    if (same_point(leg_prev_m_, prev_m) && same_point(leg_next_m_, next_m)) return;
     leg_prev_m_ = prev_m;
     leg_next_m_ = next_m;
     const NorthEast ab = next_m - prev_m;
@@ -103,9 +109,12 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
     const float along_m = dot(a_air, ab_unit);
     // Behind prev by more than L1, beyond +-135 deg of the track: along < -0.7071 max(|a|, 1),
     // squared to spare a square root.
-    const float a_dist2 = length_squared(a_air);
-    const bool behind_prev = along_m < 0.0f && a_dist2 > l1_m_ * l1_m_ &&
-                             (a_dist2 >= 1.0f ? along_m * along_m > 0.5f * a_dist2 : along_m < -kSin45);
+    bool behind_prev = false;
+    if (along_m < 0.0f) {
+        const float a_dist2 = length_squared(a_air);
+        behind_prev = a_dist2 > l1_m_ * l1_m_ &&
+                      (a_dist2 >= 1.0f ? along_m * along_m > 0.5f * a_dist2 : along_m < -kSin45);
+    }
 
     float sin_eta, cos_eta, xvel;
     if (behind_prev || along_m > ab_len + vg * kPassedB_s) {
