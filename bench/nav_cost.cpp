@@ -8,12 +8,15 @@
 //
 // Three navigation stacks (executor, L1, TECS), each stepped at 10 Hz in the firmware's
 // order (the guidance, the executor, TECS on the executor's height):
-//   a leg with a pitot     section 8: the whole step; inside it 1 L1, 3 TECS, 7 executor
+//   a leg with a pitot     section 8: the whole step; inside it 1 L1, 3 TECS, 7 executor,
+//                          and 13 the guidance (L1 and the executor)
 //   the same leg, no pitot section 9: the whole step; inside it 4 TECS
-//   on a loiter's circle   section 10: the whole step (pitot); inside it 2 L1, 11 executor
+//   on a loiter's circle   section 10: the whole step (pitot); inside it 2 L1, 11 executor,
+//                          14 the guidance
 // and section 5 TECS's 50 Hz filters (five per 10 Hz step), 6 the whole run; then 12, one
-// whole step (pitot) that reaches the waypoint and starts the next leg. The first step of
-// each stack is a leg's first for L1 (its length and unit vector worked out).
+// whole step (pitot) that reaches the waypoint and starts the next leg, 15 its guidance;
+// 16 the next step (the new leg's first), 17 its guidance.
+// The first step of each stack is a leg's first for L1 (its length and unit vector).
 // The objects are static (g_*) so that `avr-nm -S` gives their RAM.
 #include <avr/io.h>
 #include <math.h>
@@ -97,8 +100,10 @@ mission::Command place(uint16_t id, float north_m, float east_m) {
 // guidance: it takes L1's turn distance) and TECS's height demand, TECS. The sub-sections
 // (0: none) are the pieces.
 void step(nav::L1Control& l1, nav::Tecs& tecs, mission::MissionExecutor& exec, const mission::NavState& s,
-          const nav::NorthEast& vel, nav::TecsInput& in, uint8_t l1_id, uint8_t tecs_id, uint8_t exec_id) {
+          const nav::NorthEast& vel, nav::TecsInput& in, uint8_t guidance_id, uint8_t l1_id, uint8_t tecs_id,
+          uint8_t exec_id) {
     const mission::NavTarget& t = exec.target();
+    begin(guidance_id);
     begin(l1_id);
     if (t.kind == mission::TargetKind::kLoiter) {
         l1.update_loiter(s.pos_m, vel, t.next_m, t.radius_m, t.direction);
@@ -111,6 +116,7 @@ void step(nav::L1Control& l1, nav::Tecs& tecs, mission::MissionExecutor& exec, c
     exec.update(s, l1);
     in.height_dem_m = exec.height_demand_m(s);
     end(exec_id);
+    end(guidance_id);
     begin(tecs_id);
     tecs.update_pitch_throttle(in, 0.1f);
     end(tecs_id);
@@ -122,9 +128,12 @@ void step(nav::L1Control& l1, nav::Tecs& tecs, mission::MissionExecutor& exec, c
 int main() {
     begin(6);
     for (uint16_t i = 0; i < mission::kAreaSize; ++i) g_area_leg[i] = g_area_loiter[i] = 0xFF;
-    const mission::Command leg[2] = {place(mission::kNavWaypoint, 500.0f, 0.0f),
-                                     place(mission::kNavWaypoint, 500.0f, 400.0f)};
-    upload(g_store_leg, leg, 2);
+    // A right angle at the first waypoint, 53 degrees at the second (a gentle turn: its
+    // angle is worked out when the leg to it starts).
+    const mission::Command leg[3] = {place(mission::kNavWaypoint, 500.0f, 0.0f),
+                                     place(mission::kNavWaypoint, 500.0f, 400.0f),
+                                     place(mission::kNavWaypoint, 800.0f, 800.0f)};
+    upload(g_store_leg, leg, 3);
     mission::Command loiter = place(mission::kNavLoiterTurns, 300.0f, 0.0f);
     loiter.p1 = 50;  // turns; the radius WP_LOITER_RAD's
     upload(g_store_loiter, &loiter, 1);
@@ -155,10 +164,10 @@ int main() {
         in_np.eas_m_s = in.eas_m_s;
         in_lo.eas_m_s = in.eas_m_s;
         begin(8);
-        step(g_l1, g_tecs, g_exec, s, vel, in, 1, 3, 7);
+        step(g_l1, g_tecs, g_exec, s, vel, in, 13, 1, 3, 7);
         end(8);
         begin(9);
-        step(g_l1_np, g_tecs_np, g_exec_np, s, vel, in_np, 0, 4, 0);
+        step(g_l1_np, g_tecs_np, g_exec_np, s, vel, in_np, 0, 0, 4, 0);
         end(9);
         // On the loiter's circle (60 m about 300 m north), clockwise at 15 m/s, 2 m out.
         const float angle = 0.25f * (float)i;
@@ -166,7 +175,7 @@ int main() {
         lo.pos_m = nav::ne(300.0f + 62.0f * c, 62.0f * sn);
         lo.now_ms = s.now_ms;
         begin(10);
-        step(g_l1_lo, g_tecs_lo, g_exec_lo, lo, nav::ne(-15.0f * sn, 15.0f * c + w), in_lo, 2, 0, 11);
+        step(g_l1_lo, g_tecs_lo, g_exec_lo, lo, nav::ne(-15.0f * sn, 15.0f * c + w), in_lo, 14, 2, 0, 11);
         end(10);
     }
     // The step that reaches the leg's waypoint and starts the next leg (the executor's
@@ -174,8 +183,15 @@ int main() {
     s.pos_m = g_exec.target().next_m - nav::ne(10.0f, 0.0f);
     s.now_ms += 100;
     begin(12);
-    step(g_l1, g_tecs, g_exec, s, nav::ne(15.0f, 1.0f), in, 0, 0, 0);
+    step(g_l1, g_tecs, g_exec, s, nav::ne(15.0f, 1.0f), in, 15, 0, 0, 0);
     end(12);
+    // The new leg's first step: L1 works its length and unit vector out, the executor the
+    // turn's angle at its end.
+    s.pos_m = s.pos_m + nav::ne(1.5f, 0.0f);
+    s.now_ms += 100;
+    begin(16);
+    step(g_l1, g_tecs, g_exec, s, nav::ne(15.0f, 1.0f), in, 17, 0, 0, 0);
+    end(16);
     end(6);
     for (;;) {
     }

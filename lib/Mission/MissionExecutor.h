@@ -105,11 +105,14 @@ private:
         int16_t runs;
     };
     enum Walk : uint8_t { kPeek = 0, kRun = 1 };
-    // The index of the navigation command reached from `from` (kNone: the end).
-    uint8_t walk(uint8_t from, Walk mode);
+    // The index of the navigation command reached from `from` (kNone: the end), and the
+    // command itself in `nav` (read once: a read is 14 EEPROM bytes unpacked).
+    uint8_t walk(uint8_t from, Walk mode, Command& nav);
     void advance(uint8_t from, const NavState& s);
     void apply_do(const Command& c);
-    void start_nav(uint8_t index, const NavState& s);
+    // Returns the index of the navigation command after it when it looked (a waypoint's
+    // turn), else kNone.
+    uint8_t start_nav(uint8_t index, const Command& c, const NavState& s);
     void loiter_at(const nav::NorthEast& centre, float height_m, float radius_m, int8_t direction,
                    const NavState& s);
     void setup_slope(const NavState& s, bool auto_mode);
@@ -138,6 +141,11 @@ private:
     bool leg_has_line_ = false;        // longer than 0.1 m: has a line across its end
     float loiter_sum_rad_ = 0.0f;
     float turn_angle_deg_ = 90.0f;     // to the next leg, for the turn distance
+    // The turn's sine and cosine times the two legs' lengths, when a leg starts; its angle
+    // at the next verify (the leg's start has the store's reads to do).
+    float turn_cross_ = 0.0f;
+    float turn_dot_ = 0.0f;
+    bool turn_pending_ = false;
     uint32_t loiter_start_ms_ = 0;
     uint16_t airspeed_cm_s_ = 0;
     uint16_t reached_seq_ = 0;
