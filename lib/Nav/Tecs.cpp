@@ -36,6 +36,10 @@ void Tecs::set_params() {
     k_.pitch_min_rad = (float)p.pitch_min_cd * kRadPerCd;
     k_.inv_pitch_max = k_.pitch_max_rad > 0.0f ? 1.0f / k_.pitch_max_rad : 0.0f;
     k_.inv_pitch_min = k_.pitch_min_rad < 0.0f ? 1.0f / k_.pitch_min_rad : 0.0f;
+    const float w = p.hgt_omega_rad_s;
+    k_.hgt_k1 = w * w * w;
+    k_.hgt_k2 = 3.0f * w * w;
+    k_.hgt_k3 = 3.0f * w;
     k_.spd_kx = p.spd_omega_rad_s * p.spd_omega_rad_s;
     k_.spd_kv = p.spd_omega_rad_s * 1.4142135f;
     k_.arspd_min = (float)p.arspd_min_m_s;
@@ -67,12 +71,10 @@ void Tecs::update_50hz(float height_m, float accel_up_m_s2, float accel_fwd_m_s2
     }
     // Third-order complementary filter, all three poles at omega (Widnall & Sinha),
     // integrated by backward Euler as AP_TECS::update_50hz.
-    const float w = params_.hgt_omega_rad_s;
-    const float w2 = w * w;
     const float err = height_m - height_m_;
-    accel_bias_m_s2_ += err * w2 * w * dt_s;
-    climb_m_s_ += (accel_bias_m_s2_ + accel_up_m_s2 + err * w2 * 3.0f) * dt_s;
-    height_m_ += (climb_m_s_ + err * w * 3.0f) * dt_s;
+    accel_bias_m_s2_ += err * k_.hgt_k1 * dt_s;
+    climb_m_s_ += (accel_bias_m_s2_ + accel_up_m_s2 + err * k_.hgt_k2) * dt_s;
+    height_m_ += (climb_m_s_ + err * k_.hgt_k3) * dt_s;
     // AP_TECS takes a 5-point moving average (a 2-sample delay); a first-order low-pass of
     // the same delay keeps one float instead of five.
     vel_dot_m_s2_ += (accel_fwd_m_s2 - vel_dot_m_s2_) * (1.0f / 3.0f);

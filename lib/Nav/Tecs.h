@@ -66,6 +66,7 @@ struct TecsCoefficients {
     float pitch_max_rad, pitch_min_rad;
     float inv_pitch_max, inv_pitch_min;  // 1/rad: the throttle without airspeed
     float thr_max, thr_min, thr_trim;  // fractions
+    float hgt_k1, hgt_k2, hgt_k3;  // the height filter's gains: TECS_HGT_OMEGA^3, 3 omega^2, 3 omega
     // The 10 Hz step's (AP_TECS's constants for its 0.1 s step folded in):
     float spd_kx, spd_kv;          // the airspeed filter's TECS_SPD_OMEGA^2 and sqrt(2) TECS_SPD_OMEGA
     float arspd_min, arspd_max;    // ARSPD_FBW_MIN and _MAX (the larger), m/s
