@@ -17,6 +17,8 @@
 #   make unit       the host unit tests alone (test/<Library>/, test/sim/): built and run in
 #                   seconds (FILTER='Mixer.*' for some)
 #   make bench      cycles, size and accuracy against the peers (build/bench/report.md)
+#   make nav-cost   the navigation step's cycles on the 2560 alone (bench/nav_cost.cpp in
+#                   apm25sim; part of make bench; fails when the guidance is over 20 000)
 #   make tune       cross-validation of the estimator's gains on the BROAD recordings
 #   make docs       docs/parameters.md from the parameter table (lib/Settings/Params.cpp)
 #   make deps       install what is missing (apt-get; through sudo when not root)
