@@ -36,11 +36,13 @@ STEPS = [(13, "guidance on a leg (1 + 7)", True),
          (14, "guidance on a loiter's circle (2 + 11)", True),
          (15, "guidance reaching a waypoint, the next leg started", False),
          (17, "guidance on the new leg's first step", True),
+         (19, "guidance first within the turn distance (the turn's angle)", True),
          (8, "whole step on a leg, pitot (1 + 7 + 3)", False),
          (9, "whole step on a leg, no pitot (1 + 7 + 4)", False),
          (10, "whole step on a loiter's circle, pitot (2 + 11 + 3)", False),
          (12, "whole step reaching a waypoint, the next leg started, pitot", False),
-         (16, "whole step on the new leg's first step, pitot", False)]
+         (16, "whole step on the new leg's first step, pitot", False),
+         (18, "whole step first within the turn distance, pitot", False)]
 # The objects whose RAM is the navigation's state (bench/nav_cost.cpp's statics).
 OBJECTS = [("g_l1", "L1Control"), ("g_tecs", "Tecs"), ("g_exec", "MissionExecutor"),
            ("g_store_leg", "MissionStore")]

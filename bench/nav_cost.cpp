@@ -15,7 +15,8 @@
 //                          14 the guidance
 // and section 5 TECS's 50 Hz filters (five per 10 Hz step), 6 the whole run; then 12, one
 // whole step (pitot) that reaches the waypoint and starts the next leg, 15 its guidance;
-// 16 the next step (the new leg's first), 17 its guidance.
+// 16 the next step (the new leg's first), 17 its guidance; 18 a step within the turn
+// distance of the next waypoint (the turn's angle taken), 19 its guidance.
 // The first step of each stack is a leg's first for L1 (its length and unit vector).
 // The objects are static (g_*) so that `avr-nm -S` gives their RAM.
 #include <avr/io.h>
@@ -192,6 +193,13 @@ int main() {
     begin(16);
     step(g_l1, g_tecs, g_exec, s, nav::ne(15.0f, 1.0f), in, 17, 0, 0, 0);
     end(16);
+    // 25 m before the next waypoint, within the whole turn distance (30 m): the turn's angle
+    // (53 degrees: 17.7 m) is taken.
+    s.pos_m = g_exec.target().next_m - nav::ne(0.0f, 25.0f);
+    s.now_ms += 100;
+    begin(18);
+    step(g_l1, g_tecs, g_exec, s, nav::ne(1.0f, 15.0f), in, 19, 0, 0, 0);
+    end(18);
     end(6);
     for (;;) {
     }

@@ -253,14 +253,20 @@ bool MissionExecutor::loiter_progress(const NavState& s, const nav::L1Control& l
 bool MissionExecutor::verify(const NavState& s, const nav::L1Control& l1) {
     switch (command_.id) {
     case kNavWaypoint: {
-        if (turn_pending_) {
-            const float cr = turn_cross_ < 0.0f ? -turn_cross_ : turn_cross_;
-            turn_angle_deg_ = linalg::fast_atan2(cr, turn_dot_) * linalg::kDegPerRad;
-            turn_pending_ = false;
-        }
         const nav::NorthEast to_wp = target_.next_m - s.pos_m;
-        const float accept = l1.turn_distance_m(params_.wp_radius_m, turn_angle_deg_);
-        if (nav::length_squared(to_wp) <= accept * accept) return true;
+        const float dist2 = nav::length_squared(to_wp);
+        // The turn distance is at most the whole one (a turn of 90 degrees or more): the
+        // turn's angle is needed only within it, and taken there once.
+        const float whole = l1.turn_distance_m(params_.wp_radius_m);
+        if (dist2 <= whole * whole) {
+            if (turn_pending_) {
+                const float cr = turn_cross_ < 0.0f ? -turn_cross_ : turn_cross_;
+                turn_angle_deg_ = linalg::fast_atan2(cr, turn_dot_) * linalg::kDegPerRad;
+                turn_pending_ = false;
+            }
+            const float accept = l1.turn_distance_m(params_.wp_radius_m, turn_angle_deg_);
+            if (dist2 <= accept * accept) return true;
+        }
         return leg_has_line_ && nav::dot(to_wp, leg_m_) <= 0.0f;  // past the line across next
     }
     case kNavLoiterTurns:

@@ -142,7 +142,8 @@ private:
     float loiter_sum_rad_ = 0.0f;
     float turn_angle_deg_ = 90.0f;     // to the next leg, for the turn distance
     // The turn's sine and cosine times the two legs' lengths, when a leg starts; its angle
-    // at the next verify (the leg's start has the store's reads to do).
+    // once within the whole turn distance of the waypoint (not at the leg's start, which
+    // has the store's reads to do).
     float turn_cross_ = 0.0f;
     float turn_dot_ = 0.0f;
     bool turn_pending_ = false;
