@@ -33,7 +33,10 @@ bool same_point(const NorthEast& a, const NorthEast& b) {
 }  // namespace
 
 void L1Control::refresh_coefficients() {
-    if (same_bits(k_.period_s, params_.period_s) && same_bits(k_.damping, params_.damping)) return;
+    if (!same_bits(k_.period_s, params_.period_s) || !same_bits(k_.damping, params_.damping)) set_coefficients();
+}
+
+void L1Control::set_coefficients() {
     k_.period_s = params_.period_s;
     k_.damping = params_.damping;
     k_.l1_per_vg = kInvPi * k_.damping * k_.period_s;

@@ -52,7 +52,7 @@ struct L1Coefficients {
 
 class L1Control {
 public:
-    explicit L1Control(const L1Params& params) : params_(params) { refresh_coefficients(); }
+    explicit L1Control(const L1Params& params) : params_(params) { set_coefficients(); }
 
     // Track the line from prev to next (metres from home), at position pos_m with the GPS
     // ground velocity vel_m_s. Behind prev by more than L1 (beyond +-135 deg of the
@@ -90,7 +90,8 @@ private:
     // beyond 90 deg; holds the last side when the target is behind (ArduPilot's
     // _prevent_indecision).
     float limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel, float speed);
-    // The coefficients again when the parameters changed.
+    // The coefficients from the parameters; again when a parameter's bits changed.
+    void set_coefficients();
     void refresh_coefficients();
     // The leg's length and unit vector again when prev or next moved (a new leg).
     void refresh_leg(const NorthEast& prev_m, const NorthEast& next_m);
