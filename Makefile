@@ -17,6 +17,8 @@
 #   make unit       the host unit tests alone (test/<Library>/, test/sim/): built and run in
 #                   seconds (FILTER='Mixer.*' for some)
 #   make bench      cycles, size and accuracy against the peers (build/bench/report.md)
+#   make nav-cost   the navigation step's cycles on the 2560 alone (bench/nav_cost.cpp in
+#                   apm25sim; part of make bench; fails when the guidance is over 20 000)
 #   make tune       cross-validation of the estimator's gains on the BROAD recordings
 #   make docs       docs/parameters.md from the parameter table (lib/Settings/Params.cpp)
 #   make deps       install what is missing (apt-get; through sudo when not root)
@@ -31,7 +33,7 @@
 DEB_PACKAGES := gcc-avr avr-libc binutils-avr arduino-core-avr arduino-builder simavr libsimavr-dev \
                 libelf-dev avrdude cmake libgtest-dev g++ make zlib1g-dev pkg-config python3 python3-venv python3-tk clang libclang-rt-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-BUILD_GOALS := all firmware attitude-only big startup-variants tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost fuzz fuzz-smoke asan-unit mutate
+BUILD_GOALS := all firmware attitude-only big startup-variants tools docs sim fly test unit bench tune upload size venv mavlink view mavlink-cost nav-cost fuzz fuzz-smoke asan-unit mutate
 
 .DEFAULT_GOAL := all
 .PHONY: deps $(BUILD_GOALS) monitor clean

@@ -890,6 +890,11 @@ def main():
                                                               fmt(size_attitude_only["ram"])))
         rep.append("")
 
+    # The navigation step (lib/Nav, lib/Mission) on its own: bench/nav.py.
+    import nav
+    nav_rep, nav_errors = nav.nav_section(build, log)
+    rep += nav_rep
+    errors += nav_errors
     # Flash per library and the budget: bench/flash.py.
     import flash
     rep += [flash.flash_section(build)[0]]

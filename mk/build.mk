@@ -308,3 +308,4 @@ include mk/python.mk
 include mk/mavlink.mk
 include mk/fuzz.mk
 include mk/mutate.mk
+include mk/navcost.mk

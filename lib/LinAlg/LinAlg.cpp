@@ -3,6 +3,16 @@
 
 namespace linalg {
 
+namespace {
+
+// atan on [0, 1]: odd minimax polynomial, |error| <= 1.15e-5 rad.
+float atan_unit(float t) {
+    const float t2 = t * t;
+    return t * (0.99986631f + t2 * (-0.33030486f + t2 * (0.18015960f + t2 * (-0.08515681f + t2 * 0.02084534f))));
+}
+
+}  // namespace
+
 float fast_atan2(float y, float x) {
     const float abs_y = y < 0.0f ? -y : y;
     const float abs_x = x < 0.0f ? -x : x;
@@ -11,13 +21,23 @@ float fast_atan2(float y, float x) {
     const bool steep = abs_y > abs_x;
     const float t = steep ? abs_x / abs_y : abs_y / abs_x;
     if (!is_finite(t)) return 0.0f;
-    const float t2 = t * t;
-    // Odd minimax polynomial, |error| <= 1.15e-5 rad on [0, 1].
-    float a = t * (0.99986631f +
-                   t2 * (-0.33030486f + t2 * (0.18015960f + t2 * (-0.08515681f + t2 * 0.02084534f))));
+    float a = atan_unit(t);
     if (steep) a = 0.5f * kPi - a;
     if (x < 0.0f) a = kPi - a;
     return y < 0.0f ? -a : a;
+}
+
+float fast_atan(float x) {
+    const float abs_x = x < 0.0f ? -x : x;
+    float a;
+    if (abs_x <= 1.0f) {
+        a = atan_unit(abs_x);  // no divide
+    } else if (abs_x > 1.0f) {
+        a = 0.5f * kPi - atan_unit(1.0f / abs_x);
+    } else {
+        return 0.0f;  // NaN
+    }
+    return x < 0.0f ? -a : a;
 }
 
 Vector3f Vector3f::operator+(const Vector3f& v) const { return Vector3f(x + v.x, y + v.y, z + v.z); }

@@ -48,6 +48,9 @@ inline float safe_sqrt(float x) { return (x > 0.0f && is_finite(x)) ? sqrtf(x) :
 // error) to atan on [0, 1], with the octant folded in by symmetry. atan2(0, 0) = 0; NaN
 // in gives 0 out.
 float fast_atan2(float y, float x);
+// atan(x) with the same polynomial, for any x: fast_atan2(x, 1) without its divide when
+// |x| <= 1 (a bank within 45 degrees from a_lat / g). NaN gives 0.
+float fast_atan(float x);
 
 // Operations are out of line (LinAlg.cpp): inlined, each float operation is a call
 // with its own register shuffling, copied into every caller's flash.

@@ -22,8 +22,10 @@ void put_le(uint8_t* out, uint32_t v, uint8_t n) {
     for (uint8_t i = 0; i < n; ++i) out[i] = (uint8_t)(v >> (8u * i));
 }
 uint32_t get_le(const uint8_t* in, uint8_t n) {
+    // From the last byte down, a whole byte's shift each time: on the AVR a uint32_t
+    // shifted by a variable count is a loop of single-bit shifts.
     uint32_t v = 0;
-    for (uint8_t i = 0; i < n; ++i) v |= (uint32_t)in[i] << (8u * i);
+    while (n > 0) v = (v << 8) | in[--n];
     return v;
 }
 

@@ -12,11 +12,6 @@ namespace {
 constexpr float kTwoPi = 2.0f * linalg::kPi;
 constexpr float kGlideAboveM = 20.0f;  // AUTO spreads a climb only above this (ArduPlane's 20 m)
 
-nav::NorthEast unit(const nav::NorthEast& v) {
-    const float len = nav::length(v);
-    return len > 1e-3f ? v * (1.0f / len) : nav::ne(1.0f, 0.0f);
-}
-
 }  // namespace
 
 int16_t* MissionExecutor::jump_runs(uint8_t index) {
@@ -31,12 +26,11 @@ int16_t* MissionExecutor::jump_runs(uint8_t index) {
     return &free_slot->runs;
 }
 
-uint8_t MissionExecutor::walk(uint8_t from, Walk mode) {
+uint8_t MissionExecutor::walk(uint8_t from, Walk mode, Command& c) {
     uint8_t i = from;
     // Each command is passed at most twice without a navigation command between: a loop
     // of DO_JUMPs only is the end (AP_Mission's endless-loop check).
     for (uint16_t guard = 0; guard < 2u * kMaxCommands + 2u; ++guard) {
-        Command c;
         if (!store_.read(i, c)) return kNone;
         if (is_nav(c.id)) return i;
         if (c.id == kDoJump) {
@@ -81,15 +75,18 @@ bool MissionExecutor::set_current(uint16_t seq, const NavState& s) {
 }
 
 void MissionExecutor::advance(uint8_t from, const NavState& s) {
-    const uint8_t next = walk(from, kRun);
+    Command nav;
+    const uint8_t next = walk(from, kRun, nav);
     if (next == kNone) {
         complete_ = true;
         return_home(s);
         return;
     }
-    start_nav(next, s);
+    const uint8_t after = start_nav(next, nav, s);
     // The DO_ commands after it act now (AP_Mission's do commands of this leg), up to the
-    // next navigation command or DO_JUMP.
+    // next navigation command or DO_JUMP: none when the next command is the navigation
+    // command start_nav found.
+    if (after == (uint8_t)(next + 1u)) return;
     for (uint8_t i = (uint8_t)(next + 1u); i < store_.count(); ++i) {
         Command c;
         if (!store_.read(i, c) || is_nav(c.id) || c.id == kDoJump) break;
@@ -132,6 +129,14 @@ void MissionExecutor::setup_slope(const NavState& s, bool auto_mode) {
     target_.slope_m = offset;
 }
 
+void MissionExecutor::leg_started() {
+    leg_m_ = target_.next_m - target_.prev_m;
+    const float len2 = nav::length_squared(leg_m_);
+    leg_over_1m_ = len2 > 1.0f;
+    if (leg_over_1m_) leg_per_len2_ = leg_m_ * (1.0f / len2);
+    leg_has_line_ = len2 > 1e-2f;
+}
+
 void MissionExecutor::loiter_at(const nav::NorthEast& centre, float height_m, float radius_m, int8_t direction,
                                 const NavState& s) {
     target_.kind = TargetKind::kLoiter;
@@ -149,11 +154,11 @@ void MissionExecutor::return_home(const NavState& s) {
     const int16_t r = params_.loiter_radius_m;
     loiter_at(nav::ne(0.0f, 0.0f), rtl_height_m(s), (float)(r < 0 ? -r : r), r < 0 ? (int8_t)-1 : (int8_t)1, s);
     setup_slope(s, false);
+    leg_started();
 }
 
-void MissionExecutor::start_nav(uint8_t index, const NavState& s) {
-    Command c;
-    store_.read(index, c);
+uint8_t MissionExecutor::start_nav(uint8_t index, const Command& c, const NavState& s) {
+    uint8_t after = kNone;
     const bool after_waypoint = target_.kind == TargetKind::kWaypoint && index_ != kNone;
     const nav::NorthEast last_next = target_.next_m;
     index_ = index;
@@ -168,17 +173,20 @@ void MissionExecutor::start_nav(uint8_t index, const NavState& s) {
         target_.next_m = place_m(c, s);
         target_.height_m = height_of(c);
         // The turn at its end, for the turn distance: to the next navigation command's place.
+        // Beyond 90 degrees it leaves the turn distance whole: no angle needed.
         turn_angle_deg_ = 90.0f;
-        const uint8_t after = walk((uint8_t)(index + 1u), kPeek);
+        turn_pending_ = false;
         Command n;
-        if (after != kNone && store_.read(after, n) && n.has_place() && n.id != kNavTakeoff) {
+        after = walk((uint8_t)(index + 1u), kPeek, n);
+        if (after != kNone && n.has_place() && n.id != kNavTakeoff) {
             const nav::NorthEast leg = target_.next_m - target_.prev_m;
             nav::Location l;
             l.lat_e7 = n.lat_e7;
             l.lon_e7 = n.lon_e7;
             const nav::NorthEast next_leg = map_.offset_m(home_, l) - target_.next_m;
-            const float cr = nav::cross(leg, next_leg);
-            turn_angle_deg_ = linalg::fast_atan2(cr < 0.0f ? -cr : cr, nav::dot(leg, next_leg)) * linalg::kDegPerRad;
+            turn_cross_ = nav::cross(leg, next_leg);
+            turn_dot_ = nav::dot(leg, next_leg);
+            turn_pending_ = turn_dot_ >= 0.0f;
         }
         break;
     }
@@ -213,21 +221,23 @@ void MissionExecutor::start_nav(uint8_t index, const NavState& s) {
     } else {
         setup_slope(s, true);
     }
+    leg_started();
+    return after;
 }
 
 float MissionExecutor::height_demand_m(const NavState& s) const {
     if (target_.slope_m == 0.0f) return target_.height_m;
     // ArduPlane's set_target_altitude_proportion: the slope's part still ahead.
-    const nav::NorthEast leg = target_.next_m - target_.prev_m;
-    const float len2 = nav::length_squared(leg);
-    const float along = len2 > 1.0f ? nav::dot(s.pos_m - target_.prev_m, leg) / len2 : 1.0f;
+    if (!leg_over_1m_) return target_.height_m;  // no length to spread it along
+    const float along = nav::dot(s.pos_m - target_.prev_m, leg_per_len2_);
     return target_.height_m - target_.slope_m * (1.0f - linalg::constrain(along, 0.0f, 1.0f));
 }
 
 bool MissionExecutor::loiter_progress(const NavState& s, const nav::L1Control& l1) {
     // Turns are counted from the capture of the circle: the sum of the small angles between
-    // successive radials (their cross product, the sine: 1e-4 short at 10 Hz on 60 m).
-    const nav::NorthEast r = unit(s.pos_m - target_.next_m);
+    // successive radials (their cross product, the sine: 1e-4 short at 10 Hz on 60 m). The
+    // radial is L1's loiter step's (its nav direction points at the centre).
+    const nav::NorthEast r = l1.nav_direction() * -1.0f;
     if (!loiter_captured_) {
         if (!l1.loiter_captured()) return false;
         loiter_captured_ = true;
@@ -244,10 +254,20 @@ bool MissionExecutor::verify(const NavState& s, const nav::L1Control& l1) {
     switch (command_.id) {
     case kNavWaypoint: {
         const nav::NorthEast to_wp = target_.next_m - s.pos_m;
-        const float accept = l1.turn_distance_m(params_.wp_radius_m, turn_angle_deg_);
-        if (nav::length_squared(to_wp) <= accept * accept) return true;
-        const nav::NorthEast leg = target_.next_m - target_.prev_m;
-        return nav::length_squared(leg) > 1e-2f && nav::dot(s.pos_m - target_.next_m, leg) >= 0.0f;
+        const float dist2 = nav::length_squared(to_wp);
+        // The turn distance is at most the whole one (a turn of 90 degrees or more): the
+        // turn's angle is needed only within it, and taken there once.
+        const float whole = l1.turn_distance_m(params_.wp_radius_m);
+        if (dist2 <= whole * whole) {
+            if (turn_pending_) {
+                const float cr = turn_cross_ < 0.0f ? -turn_cross_ : turn_cross_;
+                turn_angle_deg_ = linalg::fast_atan2(cr, turn_dot_) * linalg::kDegPerRad;
+                turn_pending_ = false;
+            }
+            const float accept = l1.turn_distance_m(params_.wp_radius_m, turn_angle_deg_);
+            if (dist2 <= accept * accept) return true;
+        }
+        return leg_has_line_ && nav::dot(to_wp, leg_m_) <= 0.0f;  // past the line across next
     }
     case kNavLoiterTurns:
         return loiter_progress(s, l1) && loiter_sum_rad_ >= (float)loiter_turns(command_) * kTwoPi;

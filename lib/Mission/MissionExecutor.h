@@ -79,7 +79,8 @@ public:
     bool set_current(uint16_t seq, const NavState& s);
     // RTL mode: loiter at home at ALT_HOLD_RTL.
     void return_home(const NavState& s);
-    // Each navigation step, after the guidance's: done yet, and on to the next command.
+    // Each navigation step, after the guidance's: done yet, and on to the next command (on a
+    // loiter, the radial is L1's: its update_loiter on target() comes first).
     void update(const NavState& s, const nav::L1Control& l1);
 
     const NavTarget& target() const { return target_; }
@@ -104,14 +105,19 @@ private:
         int16_t runs;
     };
     enum Walk : uint8_t { kPeek = 0, kRun = 1 };
-    // The index of the navigation command reached from `from` (kNone: the end).
-    uint8_t walk(uint8_t from, Walk mode);
+    // The index of the navigation command reached from `from` (kNone: the end), and the
+    // command itself in `nav` (read once: a read is 14 EEPROM bytes unpacked).
+    uint8_t walk(uint8_t from, Walk mode, Command& nav);
     void advance(uint8_t from, const NavState& s);
     void apply_do(const Command& c);
-    void start_nav(uint8_t index, const NavState& s);
+    // Returns the index of the navigation command after it when it looked (a waypoint's
+    // turn), else kNone.
+    uint8_t start_nav(uint8_t index, const Command& c, const NavState& s);
     void loiter_at(const nav::NorthEast& centre, float height_m, float radius_m, int8_t direction,
                    const NavState& s);
     void setup_slope(const NavState& s, bool auto_mode);
+    // The leg's constants, once per command started (target_'s prev and next set).
+    void leg_started();
     bool verify(const NavState& s, const nav::L1Control& l1);
     bool loiter_progress(const NavState& s, const nav::L1Control& l1);
     int16_t* jump_runs(uint8_t index);
@@ -127,8 +133,20 @@ private:
     NavTarget target_ = {TargetKind::kNone, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0f, 1, 0.0f, 0.0f, 0};
     Jump jumps_[kMaxJumps] = {};
     nav::NorthEast radial_ = {0.0f, 0.0f};  // the last unit vector from the loiter's centre
+    // The leg from target_.prev_m to next_m, and that over its length squared (for the
+    // glide slope), worked out when a command starts.
+    nav::NorthEast leg_m_ = {0.0f, 0.0f};
+    nav::NorthEast leg_per_len2_ = {0.0f, 0.0f};
+    bool leg_over_1m_ = false;         // long enough to spread a slope along
+    bool leg_has_line_ = false;        // longer than 0.1 m: has a line across its end
     float loiter_sum_rad_ = 0.0f;
     float turn_angle_deg_ = 90.0f;     // to the next leg, for the turn distance
+    // The turn's sine and cosine times the two legs' lengths, when a leg starts; its angle
+    // once within the whole turn distance of the waypoint (not at the leg's start, which
+    // has the store's reads to do).
+    float turn_cross_ = 0.0f;
+    float turn_dot_ = 0.0f;
+    bool turn_pending_ = false;
     uint32_t loiter_start_ms_ = 0;
     uint16_t airspeed_cm_s_ = 0;
     uint16_t reached_seq_ = 0;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "L1Control.h"
 
+#include <string.h>
+
 #include "Constants.h"
 #include "LinAlg.h"
 #include "NeVector.h"
@@ -17,7 +19,43 @@ constexpr float kMinGroundSpeed_m_s = 0.1f;    // update_waypoint's floor
 constexpr float kMinLoiterSpeed_m_s = 1.0f;    // update_loiter's floor for the gains
 constexpr float kPassedB_s = 3.0f;             // past next by this long: back to next
 
+// The same bits: a float's == is a call, and would take a NaN for a change every step.
+bool same_bits(float a, float b) {
+    uint32_t x, y;
+    memcpy(&x, &a, sizeof x);
+    memcpy(&y, &b, sizeof y);
+    return x == y;
+}
+bool same_point(const NorthEast& a, const NorthEast& b) {
+    return same_bits(a.north_m, b.north_m) && same_bits(a.east_m, b.east_m);
+}
+
 }  // namespace
+
+void L1Control::refresh_coefficients() {
+    if (!same_bits(k_.period_s, params_.period_s) || !same_bits(k_.damping, params_.damping)) set_coefficients();
+}
+
+void L1Control::set_coefficients() {
+    k_.period_s = params_.period_s;
+    k_.damping = params_.damping;
+    k_.l1_per_vg = kInvPi * k_.damping * k_.period_s;
+    k_.vg_per_l1 = 1.0f / k_.l1_per_vg;
+    // K_L1 Vg^2 / L1 with K_L1 = 4 damping^2 (AP_L1_Control's): 4 damping^2 / l1_per_vg.
+    k_.acc_per_vg = 4.0f * k_.damping * k_.damping * k_.vg_per_l1;
+    const float omega = 2.0f * linalg::kPi / k_.period_s;
+    k_.loiter_kx = omega * omega;
+    k_.loiter_kv = 2.0f * k_.damping * omega;
+}
+
+void L1Control::refresh_leg(const NorthEast& prev_m, const NorthEast& next_m) {
+    if (same_point(leg_prev_m_, prev_m) && same_point(leg_next_m_, next_m)) return;
+    leg_prev_m_ = prev_m;
+    leg_next_m_ = next_m;
+    const NorthEast ab = next_m - prev_m;
+    leg_len_m_ = length(ab);
+    if (leg_len_m_ > 1e-3f) leg_unit_ = ab * (1.0f / leg_len_m_);
+}
 
 float L1Control::limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel, float speed) {
     const int8_t side = eta_positive ? 1 : -1;
@@ -39,17 +77,17 @@ float L1Control::limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive
 
 void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s, const NorthEast& prev_m,
                                 const NorthEast& next_m) {
-    const float k_l1 = 4.0f * params_.damping * params_.damping;
+    refresh_coefficients();
+    refresh_leg(prev_m, next_m);
     circling_ = false;
     to_target_m_ = next_m - pos_m;
 
     // The track's direction: prev to next, else here to next, else the way it flies.
     float vg = length(vel_m_s);
-    const NorthEast ab = next_m - prev_m;
-    const float ab_len = length(ab);
+    const float ab_len = leg_len_m_;
     NorthEast ab_unit;
     if (ab_len > 1e-3f) {
-        ab_unit = ab * (1.0f / ab_len);
+        ab_unit = leg_unit_;
     } else {
         const float to_next_len = length(to_target_m_);
         if (to_next_len > 1e-3f) {
@@ -66,17 +104,20 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
         vel = ab_unit * vg;
     }
     const float inv_vg = 1.0f / vg;
-    l1_m_ = kInvPi * params_.damping * params_.period_s * vg;
-    const float inv_l1 = 1.0f / l1_m_;
+    l1_m_ = k_.l1_per_vg * vg;
+    const float inv_l1 = k_.vg_per_l1 * inv_vg;
 
     const NorthEast a_air = pos_m - prev_m;
     crosstrack_m_ = cross(a_air, ab_unit);
     const float along_m = dot(a_air, ab_unit);
     // Behind prev by more than L1, beyond +-135 deg of the track: along < -0.7071 max(|a|, 1),
     // squared to spare a square root.
-    const float a_dist2 = length_squared(a_air);
-    const bool behind_prev = along_m < 0.0f && a_dist2 > l1_m_ * l1_m_ &&
-                             (a_dist2 >= 1.0f ? along_m * along_m > 0.5f * a_dist2 : along_m < -kSin45);
+    bool behind_prev = false;
+    if (along_m < 0.0f) {
+        const float a_dist2 = length_squared(a_air);
+        behind_prev = a_dist2 > l1_m_ * l1_m_ &&
+                      (a_dist2 >= 1.0f ? along_m * along_m > 0.5f * a_dist2 : along_m < -kSin45);
+    }
 
     float sin_eta, cos_eta, xvel;
     if (behind_prev || along_m > ab_len + vg * kPassedB_s) {
@@ -101,22 +142,18 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
     }
     // Beyond 90 deg eta has eta2's sign (|eta1| <= 45 deg), the sign of the cross product.
     const float s = limited_sin_eta(sin_eta, cos_eta, xvel >= 0.0f, vel, vg);
-    lat_acc_m_s2_ = k_l1 * vg * vg * inv_l1 * s;
+    lat_acc_m_s2_ = k_.acc_per_vg * vg * s;  // K_L1 Vg^2 / L1 sin eta
 }
 
 void L1Control::update_loiter(const NorthEast& pos_m, const NorthEast& vel_m_s, const NorthEast& centre_m,
                               float radius_m, int8_t direction) {
-    // omega = 2 pi / T; and K_L1 Vg^2 / L1 = 4 pi damping Vg / T: one divide for both.
-    const float inv_period = 1.0f / params_.period_s;
-    const float omega = 2.0f * linalg::kPi * inv_period;
-    const float kx = omega * omega;
-    const float kv = 2.0f * params_.damping * omega;
+    refresh_coefficients();
     const float dir = direction < 0 ? -1.0f : 1.0f;
 
     const float speed = length(vel_m_s);
     const float inv_speed = speed > 1e-3f ? 1.0f / speed : 0.0f;
     const float vg = speed > kMinLoiterSpeed_m_s ? speed : kMinLoiterSpeed_m_s;
-    l1_m_ = kInvPi * params_.damping * params_.period_s * vg;
+    l1_m_ = k_.l1_per_vg * vg;
 
     // From the centre to the plane; on the centre itself, along the velocity (or north).
     const NorthEast a_air = pos_m - centre_m;
@@ -135,13 +172,13 @@ void L1Control::update_loiter(const NorthEast& pos_m, const NorthEast& vel_m_s, 
     nav_dir_ = out_unit * -1.0f;
     const float s = limited_sin_eta(xvel_cap * inv_speed, speed > 1e-3f ? lvel_cap * inv_speed : 1.0f,
                                     xvel_cap >= 0.0f, vel_m_s, speed);
-    const float acc_capture = 4.0f * linalg::kPi * params_.damping * vg * inv_period * s;
+    const float acc_capture = k_.acc_per_vg * vg * s;
 
     // On the circle: PD on the radius error plus the centripetal acceleration.
     const float radial_vel = -lvel_cap;
     const float radius_err_m = dist_m - radius_m;
     crosstrack_m_ = radius_err_m;
-    float acc_pd = radius_err_m * kx + radial_vel * kv;
+    float acc_pd = radius_err_m * k_.loiter_kx + radial_vel * k_.loiter_kv;
     const float vel_tangent = xvel_cap * dir;
     // Flying the wrong way round: the PD term must not turn it further the wrong way.
     if (lvel_cap < 0.0f && vel_tangent < 0.0f && acc_pd < 0.0f) acc_pd = 0.0f;
@@ -160,7 +197,8 @@ void L1Control::update_loiter(const NorthEast& pos_m, const NorthEast& vel_m_s, 
 }
 
 int16_t L1Control::nav_roll_cd(int16_t lim_roll_cd, float cos_pitch) const {
-    const float bank_cd = cos_pitch * linalg::fast_atan2(lat_acc_m_s2_, linalg::kGravity_m_s2) * linalg::kDegPerRad * 100.0f;
+    constexpr float kInvG = 1.0f / linalg::kGravity_m_s2;
+    const float bank_cd = cos_pitch * linalg::fast_atan(lat_acc_m_s2_ * kInvG) * (linalg::kDegPerRad * 100.0f);
     const float lim = (float)lim_roll_cd;
     return (int16_t)linalg::constrain(bank_cd, -lim, lim);
 }

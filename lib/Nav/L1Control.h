@@ -19,8 +19,10 @@
 //
 // Angles as sines and cosines: sin(eta1 + eta2) by the sum formula, eta2's sine and cosine
 // from the cross and dot products of the velocity and the track, the bearings kept as unit
-// vectors (bearing_rad() turns one into an angle for telemetry). Per step one atan (the
-// bank, fast_atan2), two or three square roots and three or four divides; no sin, cos or asin.
+// vectors (bearing_rad() turns one into an angle for telemetry). The leg's length and unit
+// vector are worked out when the leg changes, the gains when the parameters do
+// (L1Coefficients); per step one atan (the bank: fast_atan, no divide within 45 degrees),
+// two square roots (|v|, cos eta1) and one divide (1 / |v|); no sin, cos or asin.
 // Signs: cross-track error positive left of the track (ArduPilot's A_air % AB), lateral
 // acceleration and bank positive to the right.
 #pragma once
@@ -38,9 +40,19 @@ struct L1Params {
 // ArduPlane 3.x's defaults (APM25.md records 25 s for 2.7x, 17 s later).
 constexpr L1Params kL1Defaults = {20.0f, 0.75f};
 
+// Worked out from L1Params (L1Control refreshes them when a parameter's bits change).
+struct L1Coefficients {
+    float period_s, damping;  // the parameters they come from
+    float l1_per_vg;          // damping period / pi: L1 = this x Vg, s
+    float vg_per_l1;          // its inverse, 1/s
+    float acc_per_vg;         // K_L1 Vg^2 / L1 / Vg = 4 pi damping / period, 1/s
+    float loiter_kx;          // omega^2 (omega = 2 pi / period), the loiter PD's, 1/s^2
+    float loiter_kv;          // 2 damping omega, 1/s
+};
+
 class L1Control {
 public:
-    explicit L1Control(const L1Params& params) : params_(params) {}
+    explicit L1Control(const L1Params& params) : params_(params) { set_coefficients(); }
 
     // Track the line from prev to next (metres from home), at position pos_m with the GPS
     // ground velocity vel_m_s. Behind prev by more than L1 (beyond +-135 deg of the
@@ -78,8 +90,19 @@ private:
     // beyond 90 deg; holds the last side when the target is behind (ArduPilot's
     // _prevent_indecision).
     float limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel, float speed);
+    // The coefficients from the parameters; again when a parameter's bits changed.
+    void set_coefficients();
+    void refresh_coefficients();
+    // The leg's length and unit vector again when prev or next moved (a new leg).
+    void refresh_leg(const NorthEast& prev_m, const NorthEast& next_m);
 
     const L1Params& params_;
+    L1Coefficients k_ = {};
+    // The leg of the last update_waypoint, its length and unit vector (prev to next).
+    NorthEast leg_prev_m_ = {0.0f, 0.0f};
+    NorthEast leg_next_m_ = {0.0f, 0.0f};
+    NorthEast leg_unit_ = {1.0f, 0.0f};
+    float leg_len_m_ = 0.0f;
     float lat_acc_m_s2_ = 0.0f;
     float crosstrack_m_ = 0.0f;
     float l1_m_ = 0.0f;

@@ -36,6 +36,28 @@ void Tecs::set_params() {
     k_.pitch_min_rad = (float)p.pitch_min_cd * kRadPerCd;
     k_.inv_pitch_max = k_.pitch_max_rad > 0.0f ? 1.0f / k_.pitch_max_rad : 0.0f;
     k_.inv_pitch_min = k_.pitch_min_rad < 0.0f ? 1.0f / k_.pitch_min_rad : 0.0f;
+    const float w = p.hgt_omega_rad_s;
+    k_.hgt_k1 = w * w * w;
+    k_.hgt_k2 = 3.0f * w * w;
+    k_.hgt_k3 = 3.0f * w;
+    k_.spd_kx = p.spd_omega_rad_s * p.spd_omega_rad_s;
+    k_.spd_kv = p.spd_omega_rad_s * 1.4142135f;
+    k_.arspd_min = (float)p.arspd_min_m_s;
+    k_.arspd_max = max_of((float)p.arspd_max_m_s, k_.arspd_min);
+    k_.tas_step_up = 0.5f * k_.ste_dot_max * kStep_s;
+    k_.tas_step_down = 0.5f * k_.ste_dot_min * kStep_s;
+    k_.hgt_step_up = p.clmb_max_m_s * kStep_s;
+    k_.hgt_step_down = p.sink_max_m_s * kStep_s;
+    // TECS_SPDWEIGHT within 0..2, then neither weight above 1 (ArduPlane 3.8's AP_TECS;
+    // 3.0-3.7 let the height's reach 2 without a pitot, which doubles the pitch loop's
+    // gain and feed-forward: twice the flight path a climb rate needs).
+    const float ske_w = constrain(p.spdweight, 0.0f, 2.0f);
+    k_.spe_w = min_of(2.0f - ske_w, 1.0f);
+    k_.ske_w = min_of(ske_w, 1.0f);
+    k_.integ_thr_k = p.integ_gain * k_.k_ste_to_thr;
+    k_.tc_g = p.time_const_s * kG;
+    k_.pitch_max_margin = k_.pitch_max_rad + kPitchMargin_rad;
+    k_.pitch_min_margin = k_.pitch_min_rad - kPitchMargin_rad;
 }
 
 void Tecs::update_50hz(float height_m, float accel_up_m_s2, float accel_fwd_m_s2, float dt_s) {
@@ -49,12 +71,10 @@ void Tecs::update_50hz(float height_m, float accel_up_m_s2, float accel_fwd_m_s2
     }
     // Third-order complementary filter, all three poles at omega (Widnall & Sinha),
     // integrated by backward Euler as AP_TECS::update_50hz.
-    const float w = params_.hgt_omega_rad_s;
-    const float w2 = w * w;
     const float err = height_m - height_m_;
-    accel_bias_m_s2_ += err * w2 * w * dt_s;
-    climb_m_s_ += (accel_bias_m_s2_ + accel_up_m_s2 + err * w2 * 3.0f) * dt_s;
-    height_m_ += (climb_m_s_ + err * w * 3.0f) * dt_s;
+    accel_bias_m_s2_ += err * k_.hgt_k1 * dt_s;
+    climb_m_s_ += (accel_bias_m_s2_ + accel_up_m_s2 + err * k_.hgt_k2) * dt_s;
+    height_m_ += (climb_m_s_ + err * k_.hgt_k3) * dt_s;
     // AP_TECS takes a 5-point moving average (a 2-sample delay); a first-order low-pass of
     // the same delay keeps one float instead of five.
     vel_dot_m_s2_ += (accel_fwd_m_s2 - vel_dot_m_s2_) * (1.0f / 3.0f);
@@ -80,12 +100,11 @@ void Tecs::initialise(const TecsInput& in, float tas_m_s) {
 
 void Tecs::update_speed(const TecsInput& in, float eas_m_s, float dt_s) {
     // Second-order complementary filter: the airspeed with the along-track acceleration.
-    const float w = params_.spd_omega_rad_s;
     const float err = eas_m_s * in.eas2tas - tas_m_s_;
-    float integ_in = err * w * w;
+    float integ_in = err * k_.spd_kx;
     if (tas_m_s_ < 3.1f) integ_in = max_of(integ_in, 0.0f);  // no wind-up at standstill
     tas_integ_ += integ_in * dt_s;
-    tas_m_s_ += (tas_integ_ + vel_dot_m_s2_ + err * w * 1.4142135f) * dt_s;
+    tas_m_s_ += (tas_integ_ + vel_dot_m_s2_ + err * k_.spd_kv) * dt_s;
     tas_m_s_ = max_of(tas_m_s_, kMinTas_m_s);
 }
 
@@ -93,18 +112,18 @@ Tecs::Demands Tecs::update_demands(const TecsInput& in, float inv_tas) {
     Demands d;
     // Speed: within ARSPD_FBW_MIN..MAX (the least when underspeed or descending badly),
     // changing no faster than half the energy rate the aircraft has.
-    d.tas_max = (float)params_.arspd_max_m_s * in.eas2tas;
-    d.tas_min = (float)params_.arspd_min_m_s * in.eas2tas;
-    if (d.tas_max < d.tas_min) d.tas_max = d.tas_min;
+    d.tas_max = k_.arspd_max * in.eas2tas;
+    d.tas_min = k_.arspd_min * in.eas2tas;
     float tas_dem = in.eas_dem_m_s * in.eas2tas;
     if (bad_descent_ || underspeed_) tas_dem = d.tas_min;
     tas_dem = constrain(tas_dem, d.tas_min, d.tas_max);
-    const float up_step = 0.5f * k_.ste_dot_max * inv_tas * kStep_s;
-    const float down_step = 0.5f * k_.ste_dot_min * inv_tas * kStep_s;
-    if (tas_dem - tas_dem_adj_ > up_step) {
+    const float up_step = k_.tas_step_up * inv_tas;
+    const float down_step = k_.tas_step_down * inv_tas;
+    const float change = tas_dem - tas_dem_adj_;
+    if (change > up_step) {
         tas_dem_adj_ += up_step;
         d.tas_rate = up_step * kInvStep;
-    } else if (tas_dem - tas_dem_adj_ < down_step) {
+    } else if (change < down_step) {
         tas_dem_adj_ += down_step;
         d.tas_rate = down_step * kInvStep;
     } else {
@@ -118,12 +137,12 @@ Tecs::Demands Tecs::update_demands(const TecsInput& in, float inv_tas) {
     // TECS_SINK_MAX, then a first-order lag (AP_TECS::_update_height_demand).
     float hgt_dem = 0.5f * (in.height_dem_m + hgt_dem_in_old_);
     hgt_dem_in_old_ = hgt_dem;
-    hgt_dem = constrain(hgt_dem, hgt_dem_prev_ - params_.sink_max_m_s * kStep_s,
-                        hgt_dem_prev_ + params_.clmb_max_m_s * kStep_s);
+    hgt_dem = constrain(hgt_dem, hgt_dem_prev_ - k_.hgt_step_down, hgt_dem_prev_ + k_.hgt_step_up);
     hgt_dem_prev_ = hgt_dem;
-    const float adj = 0.05f * hgt_dem + 0.95f * hgt_dem_adj_;
-    d.hgt_rate = (adj - hgt_dem_adj_) * kInvStep;
-    hgt_dem_adj_ = adj;
+    // 0.05 of the way (0.05 new + 0.95 old), and the rate that is over 0.1 s.
+    const float change_m = hgt_dem - hgt_dem_adj_;
+    hgt_dem_adj_ += 0.05f * change_m;
+    d.hgt_rate = (0.05f * kInvStep) * change_m;
     return d;
 }
 
@@ -158,47 +177,38 @@ void Tecs::update_pitch_throttle(const TecsInput& in, float dt_s) {
                   ((tas_m_s_ < d.tas_min * 0.9f && throttle_dem_ >= k_.thr_max * 0.95f) ||
                    (height_m_ < hgt_dem_adj_ && underspeed_));
 
-    // Specific energies (m^2/s^2) and their rates.
-    const float spe_dem = hgt_dem_adj_ * kG;
-    const float ske_dem = 0.5f * tas_dem_adj_ * tas_dem_adj_;
+    // Specific energies (m^2/s^2) and their rates as errors: potential g h, kinetic V^2 / 2.
+    const float spe_err = (hgt_dem_adj_ - height_m_) * kG;
     const float spe_dot_dem = d.hgt_rate * kG;
-    const float ske_dot_dem = tas_m_s_ * d.tas_rate;
-    const float spe_est = height_m_ * kG;
-    const float ske_est = 0.5f * tas_m_s_ * tas_m_s_;
     const float spe_dot = climb_m_s_ * kG;
-    const float ske_dot = tas_m_s_ * vel_dot_m_s2_;
-
-    if (in.have_airspeed) {
-        // Total energy error, its potential part limited to what the speed range can hold.
-        const float spe_err = constrain(spe_dem - spe_est, 0.5f * d.tas_min * d.tas_min - ske_dem,
-                                        0.5f * d.tas_max * d.tas_max - ske_dem);
-        const float ste_error = spe_err + ske_dem - ske_est;
-        update_throttle(in, thr_min, ste_error, spe_dot + ske_dot, spe_dot_dem + ske_dot_dem, dt_s);
-        // Bad descent: a speed demand it cannot reach, sinking at full throttle.
-        bad_descent_ = !underspeed_ && ((ste_error > 200.0f && spe_dot + ske_dot < 0.0f &&
-                                         throttle_dem_ >= k_.thr_max * 0.9f) ||
-                                        (bad_descent_ && ste_error > 0.0f));
-    } else {
-        update_throttle_without_airspeed(in, thr_min, takeoff ? pitch_min : k_.pitch_min_rad);
-    }
-
-    // Pitch: the energy balance, speed weighted by TECS_SPDWEIGHT (0 without airspeed,
-    // 2 when underspeed or taking off).
-    float ske_w = constrain(params_.spdweight, 0.0f, 2.0f);
     if (!in.have_airspeed) {
-        ske_w = 0.0f;
-    } else if (underspeed_ || takeoff) {
-        ske_w = 2.0f;
+        update_throttle_without_airspeed(in, thr_min, takeoff ? pitch_min : k_.pitch_min_rad);
+        // Pitch holds the height alone: the speed's weight 0, the height's 1.
+        update_pitch(in, pitch_min, spe_err, spe_dot_dem, spe_dot_dem - spe_dot, inv_tas, dt_s);
+        return;
     }
-    // Neither weight above 1 (ArduPlane 3.8's AP_TECS; 3.0-3.7 let the height's reach 2
-    // without a pitot, which doubles the pitch loop's gain and feed-forward: twice the
-    // flight path a climb rate needs).
-    const float spe_w = min_of(2.0f - ske_w, 1.0f);
-    ske_w = min_of(ske_w, 1.0f);
-    const float seb_dem = spe_dem * spe_w - ske_dem * ske_w;
+    const float ske_dem = 0.5f * tas_dem_adj_ * tas_dem_adj_;
+    const float ske_err = ske_dem - 0.5f * tas_m_s_ * tas_m_s_;
+    const float ske_dot_dem = tas_m_s_ * d.tas_rate;
+    const float ske_dot = tas_m_s_ * vel_dot_m_s2_;
+    const float ste_dot = spe_dot + ske_dot;
+
+    // Total energy error, its potential part limited to what the speed range can hold.
+    const float ste_error = constrain(spe_err, 0.5f * d.tas_min * d.tas_min - ske_dem,
+                                      0.5f * d.tas_max * d.tas_max - ske_dem) + ske_err;
+    update_throttle(in, thr_min, ste_error, ste_dot, spe_dot_dem + ske_dot_dem, dt_s);
+    // Bad descent: a speed demand it cannot reach, sinking at full throttle.
+    bad_descent_ = !underspeed_ && ((ste_error > 200.0f && ste_dot < 0.0f && throttle_dem_ >= k_.thr_max * 0.9f) ||
+                                    (bad_descent_ && ste_error > 0.0f));
+
+    // Pitch: the energy balance, speed weighted by TECS_SPDWEIGHT (all speed when
+    // underspeed or taking off).
+    const bool speed_first = underspeed_ || takeoff;
+    const float spe_w = speed_first ? 0.0f : k_.spe_w;
+    const float ske_w = speed_first ? 1.0f : k_.ske_w;
+    const float seb_err = spe_err * spe_w - ske_err * ske_w;
     const float seb_dot_dem = spe_dot_dem * spe_w - ske_dot_dem * ske_w;
-    const float seb_err = seb_dem - (spe_est * spe_w - ske_est * ske_w);
-    const float seb_dot_err = seb_dot_dem - (spe_dot * spe_w - ske_dot * ske_w);
+    const float seb_dot_err = (spe_dot_dem - spe_dot) * spe_w - (ske_dot_dem - ske_dot) * ske_w;
     update_pitch(in, pitch_min, seb_err, seb_dot_dem, seb_dot_err, inv_tas, dt_s);
 }
 
@@ -206,22 +216,21 @@ void Tecs::update_throttle(const TecsInput& in, float thr_min, float ste_error, 
                            float dt_s) {
     float ste_dot_dem = constrain(ste_dot_dem_raw, k_.ste_dot_min, k_.ste_dot_max);
     // The rate error through a 0.5 s low-pass (the accelerometer's noise).
-    const float ste_dot_err = 0.2f * (ste_dot_dem - ste_dot) + 0.8f * ste_dot_err_last_;
+    const float ste_dot_err = ste_dot_err_last_ + 0.2f * (ste_dot_dem - ste_dot - ste_dot_err_last_);
     ste_dot_err_last_ = ste_dot_err;
     if (underspeed_) {
         throttle_dem_ = k_.thr_max;
         return;
     }
-    // Feed-forward: TRIM_THROTTLE plus the energy rate asked for, plus the induced drag of
-    // the bank, TECS_RLL2THR (1/cos^2 - 1).
-    ste_dot_dem += params_.rll2thr * (1.0f / constrain(in.cos_bank_sq, 0.1f, 1.0f) - 1.0f);
+    // Feed-forward: TRIM_THROTTLE plus the energy rate asked for, plus the bank's.
+    ste_dot_dem += bank_ste_dot(in);
     const float ff = k_.thr_trim + ste_dot_dem * k_.thr_per_ste_dot;
     float thr = (ste_error + ste_dot_err * params_.thr_damp) * k_.k_ste_to_thr + ff;
     thr = constrain(thr, thr_min, k_.thr_max);
     // The integrator may push 10 % beyond the limits (noise), no further.
     const float integ_max = k_.thr_max - thr + 0.1f;
     const float integ_min = thr_min - thr - 0.1f;
-    integ_thr_ += ste_error * params_.integ_gain * dt_s * k_.k_ste_to_thr;
+    integ_thr_ += ste_error * dt_s * k_.integ_thr_k;
     integ_thr_ = in.stage == TecsStage::kTakeoff ? integ_max : constrain(integ_thr_, integ_min, integ_max);
     throttle_dem_ = constrain(thr + integ_thr_, thr_min, k_.thr_max);
 }
@@ -239,8 +248,12 @@ void Tecs::update_throttle_without_airspeed(const TecsInput& in, float thr_min, 
     } else {
         thr = k_.thr_trim;
     }
-    thr += params_.rll2thr * (1.0f / constrain(in.cos_bank_sq, 0.1f, 1.0f) - 1.0f) * k_.thr_per_ste_dot;
+    thr += bank_ste_dot(in) * k_.thr_per_ste_dot;
     throttle_dem_ = constrain(thr, thr_min, k_.thr_max);
+}
+
+float Tecs::bank_ste_dot(const TecsInput& in) const {
+    return params_.rll2thr * (1.0f / constrain(in.cos_bank_sq, 0.1f, 1.0f) - 1.0f);
 }
 
 void Tecs::update_pitch(const TecsInput& in, float pitch_min, float seb_err, float seb_dot_dem, float seb_dot_err,
@@ -255,11 +268,11 @@ void Tecs::update_pitch(const TecsInput& in, float pitch_min, float seb_err, flo
     }
     integ_pitch_ += integ_in * dt_s;
     // Energy balance per radian of pitch: V TECS_TIME_CONST g.
-    const float gain_inv = tas_m_s_ * params_.time_const_s * kG;
+    const float gain_inv = tas_m_s_ * k_.tc_g;
     float temp = seb_err + seb_dot_dem * params_.time_const_s + seb_dot_err * params_.ptch_damp;
     if (in.stage == TecsStage::kTakeoff) temp += pitch_min * gain_inv;
-    integ_pitch_ = constrain(integ_pitch_, gain_inv * (pitch_min - kPitchMargin_rad) - temp,
-                             gain_inv * (pitch_max + kPitchMargin_rad) - temp);
+    const float pitch_min_margin = in.stage == TecsStage::kTakeoff ? pitch_min - kPitchMargin_rad : k_.pitch_min_margin;
+    integ_pitch_ = constrain(integ_pitch_, gain_inv * pitch_min_margin - temp, gain_inv * k_.pitch_max_margin - temp);
     float pitch = constrain((temp + integ_pitch_) * inv_tas * k_.inv_tc_g, pitch_min, pitch_max);
     // No faster than TECS_VERT_ACC allows.
     const float step = dt_s * params_.vert_acc_m_s2 * inv_tas;

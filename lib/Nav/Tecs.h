@@ -55,7 +55,8 @@ struct TecsParams {
 constexpr TecsParams kTecsDefaults = {5.0f, 5.0f, 2.0f, 5.0f, 0.5f, 0.1f, 0.0f, 1.0f, 10.0f,
                                       3.0f, 2.0f, 7.0f, 2000, -2500, 0, 75, 45, 9, 22};
 
-// Worked out from the parameters once (set_params): no divide per step but one.
+// Worked out from the parameters once (set_params): no divide per step but 1 / V and the
+// bank's 1 / cos^2, no product of two parameters.
 struct TecsCoefficients {
     float ste_dot_max;     // TECS_CLMB_MAX g: the total energy rate at THR_MAX, m^2/s^3
     float ste_dot_min;     // -TECS_SINK_MIN g: at THR_MIN
@@ -65,6 +66,17 @@ struct TecsCoefficients {
     float pitch_max_rad, pitch_min_rad;
     float inv_pitch_max, inv_pitch_min;  // 1/rad: the throttle without airspeed
     float thr_max, thr_min, thr_trim;  // fractions
+    float hgt_k1, hgt_k2, hgt_k3;  // the height filter's gains: TECS_HGT_OMEGA^3, 3 omega^2, 3 omega
+    // The 10 Hz step's (AP_TECS's constants for its 0.1 s step folded in):
+    float spd_kx, spd_kv;          // the airspeed filter's TECS_SPD_OMEGA^2 and sqrt(2) TECS_SPD_OMEGA
+    float arspd_min, arspd_max;    // ARSPD_FBW_MIN and _MAX (the larger), m/s
+    float tas_step_up, tas_step_down;  // 0.5 STEdot_max 0.1 s and 0.5 STEdot_min 0.1 s: over V,
+                                       // the speed demand's most change in a step
+    float hgt_step_up, hgt_step_down;  // TECS_CLMB_MAX 0.1 s, TECS_SINK_MAX 0.1 s
+    float spe_w, ske_w;            // the pitch loop's weights with a pitot, neither above 1
+    float integ_thr_k;             // TECS_INTEG_GAIN k_ste_to_thr
+    float tc_g;                    // TECS_TIME_CONST g: times V, the energy balance per radian
+    float pitch_max_margin, pitch_min_margin;  // the pitch integrator's reach, 4.5 deg beyond
 };
 
 enum class TecsStage : uint8_t {
@@ -125,6 +137,8 @@ private:
     void update_throttle(const TecsInput& in, float thr_min, float ste_error, float ste_dot, float ste_dot_dem,
                          float dt_s);
     void update_throttle_without_airspeed(const TecsInput& in, float thr_min, float pitch_min);
+    // TECS_RLL2THR (1/cos^2 bank - 1): the energy rate the bank's induced drag costs.
+    float bank_ste_dot(const TecsInput& in) const;
     void update_pitch(const TecsInput& in, float pitch_min, float balance_err, float balance_dot_dem,
                       float balance_dot_err, float inv_tas, float dt_s);
 

@@ -131,6 +131,20 @@ TEST(Scalar, FastAtan2WithinItsStatedError) {
     EXPECT_NEAR(linalg::fast_atan2(1e30f, 1e-30f), linalg::kPi / 2, 2e-5f);
 }
 
+TEST(Scalar, FastAtanIsFastAtan2OverOne) {
+    // The same polynomial: within 1 ulp of fast_atan2(x, 1) (the fold's 1 / |x| against
+    // 1 / |x| over 1), either side of 1 and far out.
+    for (float x = -40.0f; x <= 40.0f; x += 0.0137f) {
+        const float want = linalg::fast_atan2(x, 1.0f);
+        EXPECT_NEAR(linalg::fast_atan(x), want, 2e-7f * (1.0f + std::fabs(want))) << x;
+    }
+    EXPECT_EQ(linalg::fast_atan(0.0f), 0.0f);
+    EXPECT_FLOAT_EQ(linalg::fast_atan(1.0f), linalg::fast_atan2(1.0f, 1.0f));
+    EXPECT_NEAR(linalg::fast_atan(INFINITY), linalg::kPi / 2, 1e-6f);
+    EXPECT_NEAR(linalg::fast_atan(-1e30f), -linalg::kPi / 2, 1e-6f);
+    EXPECT_EQ(linalg::fast_atan(NAN), 0.0f);
+}
+
 TEST(Bytes, BigEndianInt16AndSaturation) {
     EXPECT_EQ(linalg::int16_from_be(0x12, 0x34), 0x1234);
     EXPECT_EQ(linalg::int16_from_be(0xFF, 0xFE), -2);

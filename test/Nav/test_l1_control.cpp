@@ -221,3 +221,31 @@ TEST(L1Control, LoiterCaptureOnlyOnTheCircle) {
 }
 
 }  // namespace
+
+// The leg's length and unit vector and the gains are kept between steps: a new leg or a
+// parameter changed in place must give what a fresh controller gives.
+TEST(L1Control, NewLegAndChangedParametersTakenAtOnce) {
+    nav::L1Params p = nav::kL1Defaults;
+    nav::L1Control kept(p);
+    const NorthEast pos = ne(40.0f, 30.0f), vel = ne(12.0f, 5.0f);
+    kept.update_waypoint(pos, vel, ne(0.0f, 0.0f), ne(500.0f, 0.0f));
+    // Another leg from the same prev: east instead of north.
+    kept.update_waypoint(pos, vel, ne(0.0f, 0.0f), ne(0.0f, 500.0f));
+    nav::L1Control fresh(p);
+    fresh.update_waypoint(pos, vel, ne(0.0f, 0.0f), ne(0.0f, 500.0f));
+    EXPECT_EQ(kept.lateral_accel_m_s2(), fresh.lateral_accel_m_s2());
+    EXPECT_EQ(kept.crosstrack_error_m(), fresh.crosstrack_error_m());
+    EXPECT_FLOAT_EQ(kept.crosstrack_error_m(), 40.0f);  // left of the eastward leg (north of it)
+    // NAVL1_PERIOD and _DAMPING changed where the controller reads them.
+    p.period_s = 12.0f;
+    p.damping = 0.9f;
+    kept.update_waypoint(pos, vel, ne(0.0f, 0.0f), ne(0.0f, 500.0f));
+    nav::L1Control fresh2(p);
+    fresh2.update_waypoint(pos, vel, ne(0.0f, 0.0f), ne(0.0f, 500.0f));
+    EXPECT_EQ(kept.l1_distance_m(), fresh2.l1_distance_m());
+    EXPECT_EQ(kept.lateral_accel_m_s2(), fresh2.lateral_accel_m_s2());
+    EXPECT_NE(kept.l1_distance_m(), fresh.l1_distance_m());
+    kept.update_loiter(pos, vel, ne(0.0f, 0.0f), 60.0f, 1);
+    fresh2.update_loiter(pos, vel, ne(0.0f, 0.0f), 60.0f, 1);
+    EXPECT_EQ(kept.lateral_accel_m_s2(), fresh2.lateral_accel_m_s2());
+}
