@@ -90,6 +90,7 @@ def main():
     soft_assert(decode_flight_sw_version(ver.flight_sw_version) == (1, 2, 3, "official")
                 and bytes(ver.flight_custom_version) == b"0123abcd"
                 and ver.capabilities == (mavlink2.MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+                                         | mavlink2.MAV_PROTOCOL_CAPABILITY_MISSION_INT
                                          | mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2)
                 and ver.vendor_id == 0x2341 and ver.product_id == 0x0010 and ver.uid == 0,
                 "AUTOPILOT_VERSION %r (MAVProxy decodes %r)" % (ver, decode_flight_sw_version(ver.flight_sw_version)))
