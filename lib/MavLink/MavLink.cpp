@@ -2,6 +2,7 @@
 #include "MavLink.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 // The generated headers (build/mavlink): one channel, no signing (the SHA-256 code and
@@ -756,10 +757,26 @@ bool decode_mission_clear_all(const Received& rx, uint8_t& mission_type) {
     return for_us(m.target_system, m.target_component);
 }
 
-namespace {
-// MISSION_ITEM and MISSION_ITEM_INT share their layout but x, y's type.
-template <class Message>
-void take_item(mission::Item& out, const Message& m) {
+// MISSION_ITEM and MISSION_ITEM_INT share their layout but x, y's type (float degrees, or
+// int32 1e-7 degrees), as do MISSION_REQUEST and MISSION_REQUEST_INT: each pair is decoded
+// and packed through its _INT struct (the generated code's aligned-fields path), with the
+// message's own id and CRC_EXTRA: one copy of the code for both (~0.5 KB of flash).
+static_assert(sizeof(mavlink_mission_item_t) == sizeof(mavlink_mission_item_int_t) &&
+                  offsetof(mavlink_mission_item_t, x) == offsetof(mavlink_mission_item_int_t, x) &&
+                  offsetof(mavlink_mission_item_t, y) == offsetof(mavlink_mission_item_int_t, y) &&
+                  offsetof(mavlink_mission_item_t, seq) == offsetof(mavlink_mission_item_int_t, seq) &&
+                  offsetof(mavlink_mission_item_t, mission_type) == offsetof(mavlink_mission_item_int_t, mission_type) &&
+                  MAVLINK_MSG_ID_MISSION_ITEM_LEN == MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN &&
+                  MAVLINK_MSG_ID_MISSION_ITEM_MIN_LEN == MAVLINK_MSG_ID_MISSION_ITEM_INT_MIN_LEN &&
+                  sizeof(mavlink_mission_request_t) == sizeof(mavlink_mission_request_int_t) &&
+                  MAVLINK_MSG_ID_MISSION_REQUEST_LEN == MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN &&
+                  MAVLINK_MSG_ID_MISSION_REQUEST_MIN_LEN == MAVLINK_MSG_ID_MISSION_REQUEST_INT_MIN_LEN,
+              "MISSION_ITEM and _INT, MISSION_REQUEST and _INT: one layout");
+
+bool decode_mission_item(const Received& rx, mission::Item& out) {
+    if (rx.msgid != kMsgMissionItemInt && rx.msgid != kMsgMissionItem) return false;
+    mavlink_mission_item_int_t m;
+    copy_payload(m, rx);
     out.seq = m.seq;
     out.command = m.command;
     out.frame = m.frame;
@@ -771,27 +788,18 @@ void take_item(mission::Item& out, const Message& m) {
     out.param4 = m.param4;
     out.z = m.z;
     out.mission_type = m.mission_type;
-}
-}  // namespace
-
-bool decode_mission_item(const Received& rx, mission::Item& out) {
-    if (rx.msgid == kMsgMissionItemInt) {
-        mavlink_mission_item_int_t m;
-        copy_payload(m, rx);
-        take_item(out, m);
-        out.x = m.x;
-        out.y = m.y;
-        out.int_form = true;
-        return for_us(m.target_system, m.target_component);
+    out.int_form = rx.msgid == kMsgMissionItemInt;
+    out.x = m.x;
+    out.y = m.y;
+    if (!out.int_form) {
+        // Float degrees (NaN or out of range: e7_from_degrees holds it within int32, the
+        // protocol refuses it).
+        float lat, lon;
+        memcpy(&lat, &m.x, sizeof lat);
+        memcpy(&lon, &m.y, sizeof lon);
+        out.x = mission::e7_from_degrees(lat);
+        out.y = mission::e7_from_degrees(lon);
     }
-    if (rx.msgid != kMsgMissionItem) return false;
-    mavlink_mission_item_t m;
-    copy_payload(m, rx);
-    take_item(out, m);
-    // NaN or out of range: e7_from_degrees holds it within int32, the protocol refuses it.
-    out.x = mission::e7_from_degrees(m.x);
-    out.y = mission::e7_from_degrees(m.y);
-    out.int_form = false;
     return for_us(m.target_system, m.target_component);
 }
 
@@ -849,28 +857,48 @@ uint8_t Packer::mission_ack(uint8_t out[kMaxFrame], uint8_t target_system, uint8
 uint8_t Packer::mission_request(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t seq,
                                 bool int_form, uint8_t mission_type) {
     Frame f(seq_);
-    if (int_form)
-        mavlink_msg_mission_request_int_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system,
-                                                    target_component, seq, mission_type);
-    else
-        mavlink_msg_mission_request_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system,
-                                                target_component, seq, mission_type);
+    mavlink_mission_request_int_t m;
+    m.seq = seq;
+    m.target_system = target_system;
+    m.target_component = target_component;
+    m.mission_type = mission_type;
+    memcpy(_MAV_PAYLOAD_NON_CONST(&f.msg), &m, MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN);
+    f.msg.msgid = int_form ? MAVLINK_MSG_ID_MISSION_REQUEST_INT : MAVLINK_MSG_ID_MISSION_REQUEST;
+    mavlink_finalize_message_buffer(&f.msg, kSystemId, kComponentId, &f.status, MAVLINK_MSG_ID_MISSION_REQUEST_INT_MIN_LEN,
+                                    MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN,
+                                    int_form ? MAVLINK_MSG_ID_MISSION_REQUEST_INT_CRC : MAVLINK_MSG_ID_MISSION_REQUEST_CRC);
     return f.finish(out, seq_);
 }
 
 uint8_t Packer::mission_item(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component,
                              const mission::Item& i) {
     Frame f(seq_);
-    if (i.int_form)
-        mavlink_msg_mission_item_int_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system,
-                                                 target_component, i.seq, i.frame, i.command, i.current,
-                                                 i.autocontinue, i.param1, i.param2, i.param3, i.param4, i.x, i.y,
-                                                 i.z, i.mission_type);
-    else
-        mavlink_msg_mission_item_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system,
-                                             target_component, i.seq, i.frame, i.command, i.current, i.autocontinue,
-                                             i.param1, i.param2, i.param3, i.param4, mission::degrees_from_e7(i.x),
-                                             mission::degrees_from_e7(i.y), i.z, i.mission_type);
+    mavlink_mission_item_int_t m;
+    m.param1 = i.param1;
+    m.param2 = i.param2;
+    m.param3 = i.param3;
+    m.param4 = i.param4;
+    m.x = i.x;
+    m.y = i.y;
+    if (!i.int_form) {
+        const float lat = mission::degrees_from_e7(i.x), lon = mission::degrees_from_e7(i.y);
+        memcpy(&m.x, &lat, sizeof lat);
+        memcpy(&m.y, &lon, sizeof lon);
+    }
+    m.z = i.z;
+    m.seq = i.seq;
+    m.command = i.command;
+    m.target_system = target_system;
+    m.target_component = target_component;
+    m.frame = i.frame;
+    m.current = i.current;
+    m.autocontinue = i.autocontinue;
+    m.mission_type = i.mission_type;
+    memcpy(_MAV_PAYLOAD_NON_CONST(&f.msg), &m, MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN);
+    f.msg.msgid = i.int_form ? MAVLINK_MSG_ID_MISSION_ITEM_INT : MAVLINK_MSG_ID_MISSION_ITEM;
+    mavlink_finalize_message_buffer(&f.msg, kSystemId, kComponentId, &f.status, MAVLINK_MSG_ID_MISSION_ITEM_INT_MIN_LEN,
+                                    MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN,
+                                    i.int_form ? MAVLINK_MSG_ID_MISSION_ITEM_INT_CRC : MAVLINK_MSG_ID_MISSION_ITEM_CRC);
     return f.finish(out, seq_);
 }
 

@@ -49,7 +49,8 @@ constexpr uint16_t area_address(uint8_t area) { return (uint16_t)(kMissionStart 
 
 class MissionStore {
 public:
-    explicit MissionStore(Eeprom eeprom) : eeprom_(eeprom) {}
+    // constexpr: a static store is initialised data, not start-up code.
+    constexpr explicit MissionStore(Eeprom eeprom) : eeprom_(eeprom) {}
 
     // Finds the current area (at start); false when neither is valid (no mission).
     bool load();
