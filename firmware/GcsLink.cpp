@@ -294,9 +294,9 @@ void run_pending_command() {
 }
 
 // The reboot: when the ACK has left (the queue empty, the UART drained) and no save (nor
-// a mission's write or reply) is pending or under way, the watchdog at its shortest (15 ms) and a wait for it, as
-// ArduPilot's APM2 HAL does: the board resets and starts as at power-up (Board.cpp stops
-// the watchdog before anything else runs).
+// a mission's write or reply) is pending or under way, the watchdog at its shortest
+// (15 ms) and a wait for it, as ArduPilot's APM2 HAL does: the board resets and starts as
+// at power-up (Board.cpp stops the watchdog before anything else runs).
 bool reboot_due() {
     return reboot_pending && !save_pending && !vehicle::store.busy() && !mission_link::busy() &&
            serial_text::queued() == 0u;

@@ -17,8 +17,8 @@ Second run on the same EEPROM file (a power cycle), pymavlink as the ground stat
   - an upload with NAV_LAND (21) refused: MISSION_ACK UNSUPPORTED and a STATUSTEXT naming
     command 21; the mission before stays;
   - MISSION_SET_CURRENT 3 answered with MISSION_CURRENT 3;
-  - 100 items uploaded (MISSION_ITEM_INT) and downloaded equal; MISSION_CLEAR_ALL: a
-    download of home alone;
+  - 100 items uploaded (MISSION_ITEM_INT) while a PARAM_SET is saved ("saved"), downloaded
+    equal; MISSION_CLEAR_ALL: a download of home alone;
   - no sample missed (no "loop overrun" STATUSTEXT, SYS_STATUS errors_count1 0).
 Exit 1 with every failure listed.
 """
@@ -224,13 +224,20 @@ def pymavlink_run(args, trajectory, eeprom):
         g.mav.mission_set_current_send(1, 1, 3)
         cur = g.wait(("MISSION_CURRENT",), "MISSION_CURRENT")
         soft_assert(cur is not None and cur.seq == 3 and cur.total == len(ITEMS), "MISSION_CURRENT %r" % cur)
-        # 100 commands, the store's all.
+        # 100 commands, the store's all, while a PARAM_SET is saved: the settings' save and
+        # the mission's writes share the EEPROM.
         full = [home] + [(3 if i % 2 else 0, 16, 0, 0, 0, 0, 7.1 + i * 1e-4, -73.1 - i * 1e-4, 50.0 + i)
                          for i in range(100)]
         t0 = b.t_s
+        first = len(b.msgs)
+        g.mav.param_set_send(1, 1, b"RLL2SRV_P", 0.75, M.MAV_PARAM_TYPE_REAL32)
         ack = g.upload(full)
         soft_assert(ack is not None and ack.type == M.MAV_MISSION_ACCEPTED, "100 items: %r" % ack)
-        print("# 100 items uploaded in %.1f s (simulated)" % (b.t_s - t0))
+        print("# 100 items uploaded in %.1f s (simulated), a PARAM_SET saved meanwhile" % (b.t_s - t0))
+        saved = [m for _, m in b.msgs[first:] if m.get_type() == "STATUSTEXT" and m.text == "saved"]
+        if not saved:
+            saved = [g.wait(("STATUSTEXT",), "the PARAM_SET's save", lambda m: m.text == "saved")]
+        soft_assert(saved[0] is not None, "the settings' save during the upload never ended")
         check_equal(g.download(), full[1:], 1.5e-7, "100 items")
         # Cleared: home alone.
         g.mav.mission_clear_all_send(1, 1, 0)
