@@ -8,7 +8,7 @@ First run (`apm25sim --serial tcp:0 --speed 1 --eeprom FILE`, a fresh EEPROM): M
 (`--default-modules wp`) loads a 10-item QGC WPL 110 file (a takeoff, waypoints at 100,
 130, 80 m, DO_CHANGE_SPEED, LOITER_TURNS counter-clockwise, DO_JUMP, LOITER_TIME, RTL)
 with `wp load`; `wp list` asks for 11 (home at seq 0) and `wp save` writes what the board
-sends back: equal to the file, home aside.
+sends back: equal to the file, home aside. The console's `mission` then lists the 10.
 Second run on the same EEPROM file (a power cycle), pymavlink as the ground station:
   - the mission is still there, downloaded with the old MISSION_REQUEST / MISSION_ITEM
     (float degrees: within 1e-5 degrees, a float's 24 bits);
@@ -19,7 +19,9 @@ Second run on the same EEPROM file (a power cycle), pymavlink as the ground stat
   - MISSION_SET_CURRENT 3 answered with MISSION_CURRENT 3;
   - 100 items uploaded (MISSION_ITEM_INT) while a PARAM_SET is saved ("saved"), downloaded
     equal; MISSION_CLEAR_ALL: a download of home alone;
-  - no sample missed (no "loop overrun" STATUSTEXT, SYS_STATUS errors_count1 0).
+  - no sample missed (no "loop overrun" STATUSTEXT, SYS_STATUS errors_count1 0);
+  - a power cut every 0.25 s of the 100-item upload (apm25sim --eeprom-cuts): each chip
+    starts with the mission before or the new one, whole (the console's `mission`).
 Exit 1 with every failure listed.
 """
 import os
@@ -54,6 +56,9 @@ ITEMS = [
     (3, 20, 0, 0, 0, 0, 0.0, 0.0, 0.0),                       # RETURN_TO_LAUNCH
 ]
 WALL_TIMEOUT_S = 120
+# The EEPROM as a power cut would leave it (apm25sim --eeprom-cuts), every CUT_STEP_S over the
+# 100-item upload (it starts at CUT_FROM_S of board time, the clear waits for CUT_TO_S).
+CUT_FROM_S, CUT_TO_S, CUT_STEP_S = 16.0, 30.0, 0.25
 
 
 def write_wpl(path):
@@ -199,8 +204,26 @@ def check_equal(got, want, tol, what):
         soft_assert(same_item(g, w, tol), "%s: item %d %r, expected %r" % (what, i + 1, g, w))
 
 
+def console_mission(args, trajectory, eeprom):
+    """The console's `mission` on a copy of the EEPROM file: (the count it says, [(seq, id)])."""
+    chip = os.path.join(args.work, "listing.bin")
+    with open(eeprom, "rb") as f, open(chip, "wb") as g:
+        g.write(f.read())
+    typed = os.path.join(args.work, "mission.in")
+    with open(typed, "w") as f:
+        f.write("mission\n")
+    r = subprocess.run([os.path.join(args.tools, "apm25sim"), "--elf", os.path.join(args.tools, "firmware.elf"),
+                        "--trajectory", trajectory, "--eeprom", chip, "--seconds", "4", "--input", typed,
+                        "--input-at", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    text = r.stdout.decode(errors="replace")
+    m = re.search(r"# mission: (\d+) commands, current (\d+)", text)
+    rows = [(int(a), int(b)) for a, b in re.findall(r"^# (\d+): (\d+) ", text, re.M)]
+    return (int(m.group(1)) if m else None), rows, text
+
+
 def pymavlink_run(args, trajectory, eeprom):
-    b = Board(args.tools, args.work, "run2", ["--trajectory", trajectory, "--eeprom", eeprom])
+    b = Board(args.tools, args.work, "run2", ["--trajectory", trajectory, "--eeprom", eeprom,
+                                              "--eeprom-cuts", "%g:%g:%g" % (CUT_FROM_S, CUT_TO_S, CUT_STEP_S)])
     g = Gcs(b)
     try:
         b.pump(lambda m: m.get_type() == "HEARTBEAT", "HEARTBEAT")
@@ -228,6 +251,7 @@ def pymavlink_run(args, trajectory, eeprom):
         # the mission's writes share the EEPROM.
         full = [home] + [(3 if i % 2 else 0, 16, 0, 0, 0, 0, 7.1 + i * 1e-4, -73.1 - i * 1e-4, 50.0 + i)
                          for i in range(100)]
+        b.pump(lambda m: b.t_s >= CUT_FROM_S, "board time %g s" % CUT_FROM_S)
         t0 = b.t_s
         first = len(b.msgs)
         g.mav.param_set_send(1, 1, b"RLL2SRV_P", 0.75, M.MAV_PARAM_TYPE_REAL32)
@@ -239,6 +263,8 @@ def pymavlink_run(args, trajectory, eeprom):
             saved = [g.wait(("STATUSTEXT",), "the PARAM_SET's save", lambda m: m.text == "saved")]
         soft_assert(saved[0] is not None, "the settings' save during the upload never ended")
         check_equal(g.download(), full[1:], 1.5e-7, "100 items")
+        soft_assert(b.t_s < CUT_TO_S, "the upload ended at %.1f s, after the cuts' window" % b.t_s)
+        b.pump(lambda m: b.t_s >= CUT_TO_S, "board time %g s" % CUT_TO_S)
         # Cleared: home alone.
         g.mav.mission_clear_all_send(1, 1, 0)
         ack = g.wait(("MISSION_ACK",), "MISSION_CLEAR_ALL's ACK")
@@ -251,6 +277,20 @@ def pymavlink_run(args, trajectory, eeprom):
         b.stop()
     overruns = [m.text for _, m in b.msgs if m.get_type() == "STATUSTEXT" and "overrun" in m.text]
     soft_assert(not overruns, "samples missed: %r" % overruns)
+    # A power cut anywhere in the upload: the board starts with the mission before or the
+    # new one, whole (the console's `mission`).
+    kinds = {}
+    k = 0
+    while os.path.exists("%s.cut%d" % (eeprom, k)):
+        n, rows, text = console_mission(args, trajectory, "%s.cut%d" % (eeprom, k))
+        old = n == len(ITEMS) and [r[1] for r in rows] == [it[1] for it in ITEMS]
+        new = n == 100 and [r[1] for r in rows] == [16] * 100
+        soft_assert(old or new, "power cut %d at %.2f s: mission %r, %d rows" % (k, CUT_FROM_S + k * CUT_STEP_S, n,
+                                                                                  len(rows)))
+        kinds["old" if old else "new" if new else "other"] = kinds.get("old" if old else "new" if new else "other", 0) + 1
+        k += 1
+    soft_assert(kinds.get("old", 0) > 0 and kinds.get("new", 0) > 0, "the cuts saw %r" % kinds)
+    print("# %d power cuts over the 100-item upload: %r" % (k, kinds))
 
 
 def main():
@@ -258,10 +298,18 @@ def main():
     trajectory = os.path.join(args.work, "banked.csv")
     write_banked(trajectory)
     eeprom = os.path.join(args.work, "eeprom.bin")
-    if os.path.exists(eeprom):
-        os.remove(eeprom)
+    for name in os.listdir(args.work):
+        if name.startswith("eeprom.bin"):
+            os.remove(os.path.join(args.work, name))
     mavproxy_run(args, trajectory, eeprom)
     soft_assert(os.path.exists(eeprom), "apm25sim wrote no EEPROM file")
+    # The console lists what MAVProxy uploaded.
+    n, rows, text = console_mission(args, trajectory, eeprom)
+    soft_assert(n == len(ITEMS) and [r for r in rows] == [(i + 1, it[1]) for i, it in enumerate(ITEMS)],
+                "`mission` said %r, %r" % (n, rows))
+    # (MAVProxy sends -73.1187210 as -731187209: its float to int truncates.)
+    soft_assert(re.search(r"^# 6: 18 15362 7\.1345450 -73\.118720\d 90\.00 ccw$", text, re.M),
+                "`mission`'s LOITER_TURNS line (turns 2, radius 60 m in p1, counter-clockwise)")
     pymavlink_run(args, trajectory, eeprom)
 
 
