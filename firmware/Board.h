@@ -55,7 +55,7 @@ enum Section : uint8_t {
     kSecInput = 25,        // the console's received bytes, between samples
     kSecGcsStreams = 26,   // RC_CHANNELS + SERVO_OUTPUT_RAW packed and queued
     kSecGcsSave = 27,      // a save started after a PARAM_SET
-    kSecStore = 28,        // the settings store's EEPROM work
+    kSecStore = 28,        // the settings store's and the mission's EEPROM work
     kSecRetry = 29,        // the sensors' retries while down
     kSecUserLoop = 30,     // user_loop
     kSecFlightPoll = 31,   // the receiver's frames; the control step without samples (13)
@@ -74,7 +74,7 @@ enum Section : uint8_t {
     kSecBattery = 53,      // the battery monitor's 10 Hz update (and its failsafe line)
     kSecGcsBattery = 54,   // BATTERY_STATUS packed and queued
     kSecGcsCommand = 55,   // a ground station's COMMAND_LONG run and ACKed
-    kSecGcsAnswer = 56,    // TIMESYNC, AUTOPILOT_VERSION, MISSION_COUNT/ACK or SYSTEM_TIME packed and queued
+    kSecGcsAnswer = 56,    // TIMESYNC, AUTOPILOT_VERSION, a mission reply or SYSTEM_TIME packed and queued
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

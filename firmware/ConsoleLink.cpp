@@ -10,6 +10,7 @@
 #include "GpsPort.h"
 #include "LoopLoad.h"
 #include "MagCalLink.h"
+#include "MissionLink.h"
 #include "Params.h"
 #include "Port.h"
 #include "PipelineText.h"
@@ -153,6 +154,7 @@ static bool answer(const console::Command& c, uint8_t part) {
         case console::CommandId::Show:
             if (c.arg == console::kShowParams) return console::print_param(part, pipe.settings(), out);
             if (c.arg == console::kShowGps) return gps_port::print(part, out);
+            if (c.arg == console::kShowMission) return mission_link::print(part, out);
             if (c.arg == console::kShowBaro) {
                 if (part > 0) return false;
                 baro::print_line(out);

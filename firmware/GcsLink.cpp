@@ -15,6 +15,7 @@
 #include "GpsPort.h"
 #include "LoopLoad.h"
 #include "MagCalLink.h"
+#include "MissionLink.h"
 #include "ParamLink.h"
 #include "Port.h"
 #include "Position.h"
@@ -49,14 +50,9 @@ enum ReplyFlag : uint8_t {
     kReplyVersion = 1u << 0,      // AUTOPILOT_VERSION (REQUEST_AUTOPILOT_CAPABILITIES, REQUEST_MESSAGE 148)
     kReplyTimesync = 1u << 1,     // TIMESYNC: timesync_ts1 echoed
     kReplySystemTime = 1u << 2,   // SYSTEM_TIME, once a second
-    kReplyMissionCount = 1u << 3, // MISSION_COUNT 0 of mission_type
-    kReplyMissionAck = 1u << 4,   // MISSION_ACK mission_result of mission_type
 };
 static uint8_t replies = 0;
 static int64_t timesync_ts1 = 0;
-static uint8_t mission_type = 0;
-static mav::MissionResult mission_result = mav::MissionResult::Accepted;
-static uint8_t mission_sysid = 0, mission_compid = 0;
 constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
 static uint32_t last_stream_ms = 0;
 
@@ -205,33 +201,14 @@ static mav::Result run_command(const mav::CommandLong& c) {
     return mav::Result::Unsupported;
 }
 
-// The mission, fence and rally protocols until the board stores them (ArduPilot's
-// answers for empty ones): a list asked for is empty (MISSION_COUNT 0), an upload is
-// refused (MISSION_ACK UNSUPPORTED), a clear or an empty upload accepted; a ground
-// station never waits in silence. TIMESYNC is answered as ArduPilot does.
+// TIMESYNC is answered as ArduPilot does.
 static void take_conversation(const mav::Received& rx) {
-    uint16_t count = 0;
-    uint8_t type = 0;
-    if (mav::decode_mission_request_list(rx, type)) {
-        replies |= kReplyMissionCount;
-    } else if (mav::decode_mission_count(rx, count, type)) {
-        mission_result = count == 0u ? mav::MissionResult::Accepted : mav::MissionResult::Unsupported;
-        replies |= kReplyMissionAck;
-    } else if (mav::decode_mission_clear_all(rx, type)) {
-        mission_result = mav::MissionResult::Accepted;
-        replies |= kReplyMissionAck;
-    } else if (mav::decode_timesync_request(rx, timesync_ts1)) {
-        replies |= kReplyTimesync;
-        return;
-    } else {
-        return;
-    }
-    mission_type = type;
-    mission_sysid = rx.sysid;
-    mission_compid = rx.compid;
+    if (mav::decode_timesync_request(rx, timesync_ts1)) replies |= kReplyTimesync;
 }
 
-bool reply_due() { return replies != 0u && room_for(mav::kMaxFrame); }
+// The mission protocols' replies (MissionLink) with room for a STATUSTEXT after them.
+static bool mission_reply_due() { return mission_link::reply_due() && room_for(2u * mav::kMaxFrame); }
+bool reply_due() { return (replies != 0u && room_for(mav::kMaxFrame)) || mission_reply_due(); }
 void send_reply() {
     uint8_t frame[mav::kMaxFrame];
     uint8_t n = 0;
@@ -244,12 +221,8 @@ void send_reply() {
         static const char kGit[] PROGMEM = APM25_GIT_HASH;  // in flash: RAM is for the loop
         for (uint8_t i = 0; i < sizeof v.git && i + 1u < sizeof kGit; ++i) v.git[i] = pgm_read_byte(&kGit[i]);
         n = port::mavlink.autopilot_version(frame, v);
-    } else if (replies & kReplyMissionCount) {
-        replies &= (uint8_t)~kReplyMissionCount;
-        n = port::mavlink.mission_count(frame, mission_sysid, mission_compid, 0u, mission_type);
-    } else if (replies & kReplyMissionAck) {
-        replies &= (uint8_t)~kReplyMissionAck;
-        n = port::mavlink.mission_ack(frame, mission_sysid, mission_compid, mission_result, mission_type);
+    } else if (mission_reply_due()) {
+        return mission_link::send_reply();
     } else {
         replies = 0;  // kReplySystemTime
         const uint32_t now_ms = millis();
@@ -265,7 +238,12 @@ void send_reply() {
 // up and set), so a burst is taken as fast as it arrives.
 // A second command while one waits stays in the parser: a ground station sends the
 // next after the ACK.
-bool request_due() { return input.ready() && !(command_pending && input.frame().msgid == mav::kMsgCommandLong); }
+// A mission frame waits while the mission's EEPROM writes or its last reply do (MissionLink.h).
+bool request_due() {
+    if (!input.ready()) return false;
+    const uint8_t id = input.frame().msgid;
+    return !(command_pending && id == mav::kMsgCommandLong) && !(mission_link::is_mission_frame(id) && mission_link::busy());
+}
 
 void take_request() {
     const mav::Received& rx = input.frame();
@@ -311,6 +289,8 @@ void take_request() {
         command_sysid = rx.sysid;
         command_compid = rx.compid;
         command_pending = true;
+    } else if (mission_link::is_mission_frame(rx.msgid)) {
+        mission_link::take(rx);
     } else {
         take_conversation(rx);
     }
@@ -325,12 +305,13 @@ void run_pending_command() {
     port::send_frame(frame, port::mavlink.command_ack(frame, command.command, r, command_sysid, command_compid));
 }
 
-// The reboot: when the ACK has left (the queue empty, the UART drained) and no save is
-// pending or under way, the watchdog at its shortest (15 ms) and a wait for it, as
-// ArduPilot's APM2 HAL does: the board resets and starts as at power-up (Board.cpp stops
-// the watchdog before anything else runs).
+// The reboot: when the ACK has left (the queue empty, the UART drained) and no save (nor
+// a mission's write or reply) is pending or under way, the watchdog at its shortest
+// (15 ms) and a wait for it, as ArduPilot's APM2 HAL does: the board resets and starts as
+// at power-up (Board.cpp stops the watchdog before anything else runs).
 bool reboot_due() {
-    return reboot_pending && !save_pending && !vehicle::store.busy() && serial_text::queued() == 0u;
+    return reboot_pending && !save_pending && !vehicle::store.busy() && !mission_link::busy() &&
+           serial_text::queued() == 0u;
 }
 void reboot() {
     Serial.flush();

@@ -41,8 +41,7 @@ void save();
 // A save in a pass of its own, as after a PARAM_SET (the compass calibration accepted).
 void save_soon();
 // The answers sent when the output has room, one a run: TIMESYNC, AUTOPILOT_VERSION,
-// MISSION_COUNT / MISSION_ACK (the mission, fence and rally protocols: empty until the
-// board stores missions), SYSTEM_TIME once a second.
+// the mission protocols' (MissionLink.h), SYSTEM_TIME once a second.
 bool reply_due();
 void send_reply();
 // MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN param1 1, ACKed: a watchdog reset once the ACK is out.

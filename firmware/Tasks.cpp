@@ -25,6 +25,7 @@
 #include "GcsLink.h"
 #include "GpsPort.h"
 #include "LoopLoad.h"
+#include "MissionLink.h"
 #include "OutputLine.h"
 #include "Position.h"
 #include "Scheduler.h"
@@ -63,7 +64,11 @@ static void control_run() {
     vehicle::flight_io.control_run(tick.now_us, tick.now_ms, tick.sample, tick.have_angles ? &tick.angles : nullptr);
 }
 // ... and the loop tasks'.
-static void store_service() { vehicle::store.service(); }
+// The settings' save and the mission's writes (MissionLink), each only when the EEPROM is ready.
+static void store_service() {
+    vehicle::store.service();
+    mission_link::service();
+}
 static void sensor_retries() {
     const uint32_t now_ms = millis();
     if (vehicle::imu.retry(now_ms)) pipe.restart_estimator();

@@ -20,6 +20,7 @@
 #include "Console.h"
 #include "ConsoleLink.h"
 #include "GpsPort.h"
+#include "MissionLink.h"
 #include "SerialText.h"
 #include "Tasks.h"
 #include "UserCode.h"
@@ -43,6 +44,7 @@ void setup() {
     say(TXT("# apm25-attitude " APM25_VERSION_TEXT ": APM 2.5, 200 Hz loop\n"
             "# " TXT_MPU " 200 Hz, DLPF 42 Hz, 2000 deg/s, 16 g; " TXT_HMC " 75 Hz, 8-sample average, 1.3 Ga"));
     store.load(pipe.settings());
+    mission_link::begin();
     pipe.refresh_board_frame();  // AHRS_ORIENTATION, AHRS_TRIM_*, INS_ACC* as loaded, before the samples
     flight_io.begin();  // the outputs from here on (the loaded settings' end points), the receiver
     airspeed_input::begin();

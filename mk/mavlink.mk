@@ -66,7 +66,7 @@ endif
 MAVCOST_DIR   := $(BUILD)/mavlink-cost
 MAVCOST_FLAGS := -mmcu=$(MCU) -DF_CPU=$(F_CPU) -Os -flto -std=gnu++11 -fno-exceptions -fno-rtti \
                  -fno-threadsafe-statics -ffunction-sections -fdata-sections -mcall-prologues -mrelax \
-                 -Wall -Wextra -Werror -Wdouble-promotion -Ilib/MavLink -Ilib/LinAlg -Ilib/Console -Ilib/GPS -Ilib/Battery \
+                 -Wall -Wextra -Werror -Wdouble-promotion -Ilib/MavLink -Ilib/LinAlg -Ilib/Console -Ilib/GPS -Ilib/Battery -Ilib/Mission -Ilib/Nav \
                  -I$(MAVLINK_DIR) -Wl,--gc-sections
 MAVCOST_SRC   := bench/mavlink_cost.cpp lib/MavLink/MavLink.cpp lib/LinAlg/LinAlg.cpp lib/Console/Text.cpp
 

@@ -122,8 +122,8 @@ Command parse_line(const char* line) {
 
     // The command names in flash, those without an argument first; each name's command
     // is its byte in kIds (a TXT string too: an array would be copied to the AVR's SRAM).
-    // (rc, servo, params, gps and baro are Show with kShowRc .. kShowBaro.)
-    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x0C\x0C\x0C\x0C\x0C\x0B\x0B\x03\x04\x05\x07\x0B\x0E\x0D");
+    // (rc, servo, params, gps, baro and mission are Show with kShowRc .. kShowMission.)
+    const text::Flash kIds = TXT("\x02\x02\x06\x09\x0A\x0C\x0C\x0C\x0C\x0C\x0C\x0B\x0B\x03\x04\x05\x07\x0B\x0E\x0D");
     static_assert((uint8_t)CommandId::Help == 2 && (uint8_t)CommandId::Status == 6 &&
                       (uint8_t)CommandId::Save == 9 && (uint8_t)CommandId::Defaults == 10 &&
                       (uint8_t)CommandId::Rate == 3 && (uint8_t)CommandId::Decl == 4 &&
@@ -131,9 +131,9 @@ Command parse_line(const char* line) {
                       (uint8_t)CommandId::Flight == 11 && (uint8_t)CommandId::Show == 12 &&
                       (uint8_t)CommandId::Set == 13 && (uint8_t)CommandId::Get == 14,
                   "kIds holds these values");
-    constexpr int8_t kFirstShow = 5, kArmWord = 10, kFirstWithArgument = 12;
+    constexpr int8_t kFirstShow = 5, kArmWord = 11, kFirstWithArgument = 13;
     const int8_t k = find_word(
-        cmd, TXT("help\0?\0status\0save\0defaults\0rc\0servo\0params\0gps\0baro\0arm\0disarm\0rate\0decl\0mode\0cal\0flight\0get\0set\0"));
+        cmd, TXT("help\0?\0status\0save\0defaults\0rc\0servo\0params\0gps\0baro\0mission\0arm\0disarm\0rate\0decl\0mode\0cal\0flight\0get\0set\0"));
     if (k < 0) return fail(Error::Unknown);
     const CommandId id = (CommandId)text::flash_byte(kIds.p + k);
     if (k < kFirstWithArgument) {
@@ -321,6 +321,7 @@ bool print_help(uint8_t part, const text::Sink* out) {
                         "# rc | servo: receiver / output widths, us\0"
                         "# gps: fix, satellites, position, speed, counters\0"
                         "# baro: pressure, temperature, height, climb\0"
+                        "# mission: the stored mission\0"
                         "# params | get NAME | set NAME VALUE: flight settings\0").p;
     for (uint8_t k = 0; k < part && text::flash_byte(p) != 0u; ++k)
         while (text::flash_byte(p++) != 0u) {}

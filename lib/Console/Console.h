@@ -22,6 +22,7 @@
 //   gps                  the GPS: fix, satellites, hDOP, position, speed, course, age, counters
 //   params               every parameter (lib/Settings/Params.h) and its value, one a line
 //   baro                 the barometer: pressure, temperature, height, climb, counters
+//   mission              the mission stored (MissionLink): a command a line
 //   get NAME             one parameter
 //   set NAME VALUE       set one (range-checked; `save` keeps it)
 //
@@ -69,7 +70,7 @@ enum class CommandId : uint8_t {
 constexpr uint8_t kArm = 14;
 constexpr uint8_t kDisarm = 15;
 
-enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowGps = 3, kShowBaro = 4 };
+enum Show : uint8_t { kShowRc = 0, kShowServo = 1, kShowParams = 2, kShowGps = 3, kShowBaro = 4, kShowMission = 5 };
 // `set` values are parsed with four decimals (parse_fixed) and carried as integers.
 constexpr int32_t kParamScale = 10000;
 

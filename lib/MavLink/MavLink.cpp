@@ -2,6 +2,7 @@
 #include "MavLink.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 // The generated headers (build/mavlink): one channel, no signing (the SHA-256 code and
@@ -27,6 +28,8 @@
 #include "mavlink_types.h"
 #include "common/mavlink.h"
 #pragma GCC diagnostic pop
+
+#include "MissionProtocol.h"
 
 namespace mav {
 
@@ -57,7 +60,7 @@ static_assert(kScaledPressureFrame == kFrameOverhead + MAVLINK_MSG_ID_SCALED_PRE
 static_assert(kMaxFrame >= kRcChannelsFrame && kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_SERVO_OUTPUT_RAW_LEN &&
                   kMaxFrame >= kFrameOverhead + MAVLINK_MSG_ID_COMMAND_ACK_LEN,
               "the replies and streams fit kMaxFrame");
-static_assert(kRxPayloadMax == MAVLINK_MSG_ID_COMMAND_LONG_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_PARAM_SET_LEN &&
+static_assert(kRxPayloadMax >= MAVLINK_MSG_ID_COMMAND_LONG_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_PARAM_SET_LEN &&
                   kRxPayloadMax >= MAVLINK_MSG_ID_PARAM_REQUEST_READ_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_HEARTBEAT_LEN,
               "the received payloads fit");
 static_assert(kMsgHeartbeat == MAVLINK_MSG_ID_HEARTBEAT && kMsgParamRequestRead == MAVLINK_MSG_ID_PARAM_REQUEST_READ &&
@@ -99,7 +102,8 @@ static_assert(kMsgMissionRequestList == MAVLINK_MSG_ID_MISSION_REQUEST_LIST &&
                   kCmdRequestAutopilotCapabilities == MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES &&
                   kCmdPreflightRebootShutdown == MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN,
               "the conversation's message and command ids");
-static_assert(kCapabilities == (MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT | MAV_PROTOCOL_CAPABILITY_MAVLINK2) &&
+static_assert(kCapabilities == (MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT | MAV_PROTOCOL_CAPABILITY_MISSION_INT |
+                                MAV_PROTOCOL_CAPABILITY_MAVLINK2) &&
                   kVersionTypeOfficial == FIRMWARE_VERSION_TYPE_OFFICIAL &&
                   (uint8_t)MissionResult::Unsupported == MAV_MISSION_UNSUPPORTED &&
                   (uint8_t)MissionResult::Accepted == MAV_MISSION_ACCEPTED,
@@ -107,6 +111,25 @@ static_assert(kCapabilities == (MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT | MAV_PROTOC
 static_assert(kRxPayloadMax >= MAVLINK_MSG_ID_MISSION_COUNT_LEN && kRxPayloadMax >= MAVLINK_MSG_ID_TIMESYNC_LEN &&
                   kRxPayloadMax >= MAVLINK_MSG_ID_MISSION_REQUEST_LIST_LEN,
               "the conversation's received payloads fit");
+// The mission protocol: MISSION_ITEM(_INT) whole with mission_type, the longest received.
+static_assert(kMsgMissionItem == MAVLINK_MSG_ID_MISSION_ITEM && kMsgMissionRequest == MAVLINK_MSG_ID_MISSION_REQUEST &&
+                  kMsgMissionSetCurrent == MAVLINK_MSG_ID_MISSION_SET_CURRENT &&
+                  kMsgMissionAck == MAVLINK_MSG_ID_MISSION_ACK && kMsgMissionRequestInt == MAVLINK_MSG_ID_MISSION_REQUEST_INT &&
+                  kMsgMissionItemInt == MAVLINK_MSG_ID_MISSION_ITEM_INT,
+              "the mission protocol's message ids");
+static_assert(kRxPayloadMax == MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN && kRxPayloadMax == MAVLINK_MSG_ID_MISSION_ITEM_LEN &&
+                  kFrameOverhead + MAVLINK_MSG_ID_MISSION_ITEM_LEN <= kMaxFrame,
+              "MISSION_ITEM(_INT) received whole and sent within kMaxFrame");
+static_assert((uint8_t)mission::Result::kUnsupported == MAV_MISSION_UNSUPPORTED &&
+                  (uint8_t)mission::Result::kNoSpace == MAV_MISSION_NO_SPACE &&
+                  (uint8_t)mission::Result::kInvalidSequence == MAV_MISSION_INVALID_SEQUENCE &&
+                  (uint8_t)mission::Result::kOperationCancelled == MAV_MISSION_OPERATION_CANCELLED &&
+                  (uint8_t)mission::Result::kUnsupportedFrame == MAV_MISSION_UNSUPPORTED_FRAME &&
+                  (uint8_t)mission::Result::kInvalidParam5 == MAV_MISSION_INVALID_PARAM5_X &&
+                  (uint8_t)mission::Result::kInvalidParam6 == MAV_MISSION_INVALID_PARAM6_Y &&
+                  (uint8_t)mission::kFrameGlobalRelativeAltInt == (uint8_t)MAV_FRAME_GLOBAL_RELATIVE_ALT_INT &&
+                  (uint8_t)mission::kFrameMission == (uint8_t)MAV_FRAME_MISSION,
+              "mission::Result is MAV_MISSION_RESULT, the frames MAV_FRAME");
 static_assert(kFrameOverhead + MAVLINK_MSG_ID_TIMESYNC_LEN <= kMaxFrame &&
                   kFrameOverhead + MAVLINK_MSG_ID_SYSTEM_TIME_LEN <= kMaxFrame,
               "TIMESYNC and SYSTEM_TIME fit kMaxFrame");
@@ -498,6 +521,20 @@ uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
         case MAVLINK_MSG_ID_MISSION_CLEAR_ALL:
             max_len = MAVLINK_MSG_ID_MISSION_CLEAR_ALL_LEN;
             return MAVLINK_MSG_ID_MISSION_CLEAR_ALL_CRC;
+        case MAVLINK_MSG_ID_MISSION_ITEM: max_len = MAVLINK_MSG_ID_MISSION_ITEM_LEN; return MAVLINK_MSG_ID_MISSION_ITEM_CRC;
+        case MAVLINK_MSG_ID_MISSION_ITEM_INT:
+            max_len = MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN;
+            return MAVLINK_MSG_ID_MISSION_ITEM_INT_CRC;
+        case MAVLINK_MSG_ID_MISSION_REQUEST:
+            max_len = MAVLINK_MSG_ID_MISSION_REQUEST_LEN;
+            return MAVLINK_MSG_ID_MISSION_REQUEST_CRC;
+        case MAVLINK_MSG_ID_MISSION_REQUEST_INT:
+            max_len = MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN;
+            return MAVLINK_MSG_ID_MISSION_REQUEST_INT_CRC;
+        case MAVLINK_MSG_ID_MISSION_ACK: max_len = MAVLINK_MSG_ID_MISSION_ACK_LEN; return MAVLINK_MSG_ID_MISSION_ACK_CRC;
+        case MAVLINK_MSG_ID_MISSION_SET_CURRENT:
+            max_len = MAVLINK_MSG_ID_MISSION_SET_CURRENT_LEN;
+            return MAVLINK_MSG_ID_MISSION_SET_CURRENT_CRC;
         case MAVLINK_MSG_ID_TIMESYNC: max_len = MAVLINK_MSG_ID_TIMESYNC_LEN; return MAVLINK_MSG_ID_TIMESYNC_CRC;
         case MAVLINK_MSG_ID_COMMAND_INT:
             max_len = MAVLINK_MSG_ID_COMMAND_INT_LEN;
@@ -720,6 +757,79 @@ bool decode_mission_clear_all(const Received& rx, uint8_t& mission_type) {
     return for_us(m.target_system, m.target_component);
 }
 
+// MISSION_ITEM and MISSION_ITEM_INT share their layout but x, y's type (float degrees, or
+// int32 1e-7 degrees), as do MISSION_REQUEST and MISSION_REQUEST_INT: each pair is decoded
+// and packed through its _INT struct (the generated code's aligned-fields path), with the
+// message's own id and CRC_EXTRA: one copy of the code for both (~0.5 KB of flash).
+static_assert(sizeof(mavlink_mission_item_t) == sizeof(mavlink_mission_item_int_t) &&
+                  offsetof(mavlink_mission_item_t, x) == offsetof(mavlink_mission_item_int_t, x) &&
+                  offsetof(mavlink_mission_item_t, y) == offsetof(mavlink_mission_item_int_t, y) &&
+                  offsetof(mavlink_mission_item_t, seq) == offsetof(mavlink_mission_item_int_t, seq) &&
+                  offsetof(mavlink_mission_item_t, mission_type) == offsetof(mavlink_mission_item_int_t, mission_type) &&
+                  MAVLINK_MSG_ID_MISSION_ITEM_LEN == MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN &&
+                  MAVLINK_MSG_ID_MISSION_ITEM_MIN_LEN == MAVLINK_MSG_ID_MISSION_ITEM_INT_MIN_LEN &&
+                  sizeof(mavlink_mission_request_t) == sizeof(mavlink_mission_request_int_t) &&
+                  MAVLINK_MSG_ID_MISSION_REQUEST_LEN == MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN &&
+                  MAVLINK_MSG_ID_MISSION_REQUEST_MIN_LEN == MAVLINK_MSG_ID_MISSION_REQUEST_INT_MIN_LEN,
+              "MISSION_ITEM and _INT, MISSION_REQUEST and _INT: one layout");
+
+bool decode_mission_item(const Received& rx, mission::Item& out) {
+    if (rx.msgid != kMsgMissionItemInt && rx.msgid != kMsgMissionItem) return false;
+    mavlink_mission_item_int_t m;
+    copy_payload(m, rx);
+    out.seq = m.seq;
+    out.command = m.command;
+    out.frame = m.frame;
+    out.current = m.current;
+    out.autocontinue = m.autocontinue;
+    out.param1 = m.param1;
+    out.param2 = m.param2;
+    out.param3 = m.param3;
+    out.param4 = m.param4;
+    out.z = m.z;
+    out.mission_type = m.mission_type;
+    out.int_form = rx.msgid == kMsgMissionItemInt;
+    out.x = m.x;
+    out.y = m.y;
+    if (!out.int_form) {
+        // Float degrees (NaN or out of range: e7_from_degrees holds it within int32, the
+        // protocol refuses it).
+        float lat, lon;
+        memcpy(&lat, &m.x, sizeof lat);
+        memcpy(&lon, &m.y, sizeof lon);
+        out.x = mission::e7_from_degrees(lat);
+        out.y = mission::e7_from_degrees(lon);
+    }
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_mission_request(const Received& rx, uint16_t& seq, bool& int_form, uint8_t& mission_type) {
+    // MISSION_REQUEST and MISSION_REQUEST_INT: the same fields.
+    if (rx.msgid != kMsgMissionRequest && rx.msgid != kMsgMissionRequestInt) return false;
+    mavlink_mission_request_int_t m;
+    copy_payload(m, rx);
+    seq = m.seq;
+    int_form = rx.msgid == kMsgMissionRequestInt;
+    mission_type = m.mission_type;
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_mission_ack(const Received& rx, uint8_t& mission_type) {
+    if (rx.msgid != kMsgMissionAck) return false;
+    mavlink_mission_ack_t m;
+    copy_payload(m, rx);
+    mission_type = m.mission_type;
+    return for_us(m.target_system, m.target_component);
+}
+
+bool decode_mission_set_current(const Received& rx, uint16_t& seq) {
+    if (rx.msgid != kMsgMissionSetCurrent) return false;
+    mavlink_mission_set_current_t m;
+    copy_payload(m, rx);
+    seq = m.seq;
+    return for_us(m.target_system, m.target_component);
+}
+
 bool decode_timesync_request(const Received& rx, int64_t& ts1) {
     if (rx.msgid != kMsgTimesync) return false;
     mavlink_timesync_t m;
@@ -741,6 +851,67 @@ uint8_t Packer::mission_ack(uint8_t out[kMaxFrame], uint8_t target_system, uint8
     Frame f(seq_);
     mavlink_msg_mission_ack_pack_status(kSystemId, kComponentId, &f.status, &f.msg, target_system, target_component,
                                         (uint8_t)result, mission_type);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::mission_request(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t seq,
+                                bool int_form, uint8_t mission_type) {
+    Frame f(seq_);
+    mavlink_mission_request_int_t m;
+    m.seq = seq;
+    m.target_system = target_system;
+    m.target_component = target_component;
+    m.mission_type = mission_type;
+    memcpy(_MAV_PAYLOAD_NON_CONST(&f.msg), &m, MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN);
+    f.msg.msgid = int_form ? MAVLINK_MSG_ID_MISSION_REQUEST_INT : MAVLINK_MSG_ID_MISSION_REQUEST;
+    mavlink_finalize_message_buffer(&f.msg, kSystemId, kComponentId, &f.status, MAVLINK_MSG_ID_MISSION_REQUEST_INT_MIN_LEN,
+                                    MAVLINK_MSG_ID_MISSION_REQUEST_INT_LEN,
+                                    int_form ? MAVLINK_MSG_ID_MISSION_REQUEST_INT_CRC : MAVLINK_MSG_ID_MISSION_REQUEST_CRC);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::mission_item(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component,
+                             const mission::Item& i) {
+    Frame f(seq_);
+    mavlink_mission_item_int_t m;
+    m.param1 = i.param1;
+    m.param2 = i.param2;
+    m.param3 = i.param3;
+    m.param4 = i.param4;
+    m.x = i.x;
+    m.y = i.y;
+    if (!i.int_form) {
+        const float lat = mission::degrees_from_e7(i.x), lon = mission::degrees_from_e7(i.y);
+        memcpy(&m.x, &lat, sizeof lat);
+        memcpy(&m.y, &lon, sizeof lon);
+    }
+    m.z = i.z;
+    m.seq = i.seq;
+    m.command = i.command;
+    m.target_system = target_system;
+    m.target_component = target_component;
+    m.frame = i.frame;
+    m.current = i.current;
+    m.autocontinue = i.autocontinue;
+    m.mission_type = i.mission_type;
+    memcpy(_MAV_PAYLOAD_NON_CONST(&f.msg), &m, MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN);
+    f.msg.msgid = i.int_form ? MAVLINK_MSG_ID_MISSION_ITEM_INT : MAVLINK_MSG_ID_MISSION_ITEM;
+    mavlink_finalize_message_buffer(&f.msg, kSystemId, kComponentId, &f.status, MAVLINK_MSG_ID_MISSION_ITEM_INT_MIN_LEN,
+                                    MAVLINK_MSG_ID_MISSION_ITEM_INT_LEN,
+                                    i.int_form ? MAVLINK_MSG_ID_MISSION_ITEM_INT_CRC : MAVLINK_MSG_ID_MISSION_ITEM_CRC);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::mission_current(uint8_t out[kMaxFrame], uint16_t seq, uint16_t total) {
+    Frame f(seq_);
+    // mission_state and mission_mode 0: unknown (the executor's state is not said here).
+    mavlink_msg_mission_current_pack_status(kSystemId, kComponentId, &f.status, &f.msg, seq, total, 0u, 0u);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::mission_item_reached(uint8_t out[kMaxFrame], uint16_t seq) {
+    Frame f(seq_);
+    mavlink_msg_mission_item_reached_pack_status(kSystemId, kComponentId, &f.status, &f.msg, seq);
     return f.finish(out, seq_);
 }
 

@@ -19,6 +19,8 @@
 //   MAG_CAL_PROGRESS 2 Hz      39 bytes   while a ground station's compass calibration runs
 //   MAG_CAL_REPORT   once      <= 66      its end: offsets, soft iron, fitness
 //   BATTERY_STATUS   1 Hz      <= 53      the power module's voltage, current, charge used (BATT_MONITOR 3, 4)
+//   MISSION_*        replies   <= 50      the mission protocol (lib/Mission/MissionProtocol.h): COUNT,
+//                                         REQUEST(_INT), ITEM(_INT), ACK, CURRENT; ITEM_REACHED
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -44,6 +46,10 @@
 #include "GpsFix.h"
 #include "LinAlg.h"
 #include "Text.h"
+
+namespace mission {
+struct Item;  // MissionProtocol.h: MISSION_ITEM(_INT)'s fields
+}
 
 namespace mav {
 
@@ -177,7 +183,7 @@ struct PositionReport {
     uint8_t throttle_pct;
 };
 
-// MISSION_ACK's type (MAV_MISSION_RESULT).
+// MISSION_ACK's type (MAV_MISSION_RESULT; mission::Result has them all).
 enum class MissionResult : uint8_t { Accepted = 0, Unsupported = 3 };
 
 // AUTOPILOT_VERSION's contents. flight_sw_version is ArduPilot's packing: major << 24 |
@@ -188,9 +194,9 @@ struct Version {
 };
 constexpr uint8_t kVersionTypeOfficial = 255;  // FIRMWARE_VERSION_TYPE_OFFICIAL
 // What the board supports (MAV_PROTOCOL_CAPABILITY): PARAM_FLOAT (values as floats) and
-// MAVLINK2 (it speaks only MAVLink 2). Not MISSION_INT (no mission yet), COMMAND_INT
+// MAVLINK2 (it speaks only MAVLink 2), MISSION_INT (MISSION_ITEM_INT taken and sent). Not COMMAND_INT
 // (add it when the board takes COMMAND_INT), FTP, SET_*_TARGET.
-constexpr uint32_t kCapabilities = 0x2u | 0x2000u;
+constexpr uint32_t kCapabilities = 0x2u | 0x4u | 0x2000u;
 // The USB ids the APM 2.5's ATmega32U2 enumerates with (the Arduino Mega 2560's).
 constexpr uint16_t kUsbVendorId = 0x2341u;
 constexpr uint16_t kUsbProductId = 0x0010u;
@@ -250,12 +256,21 @@ public:
     // MAG_CAL_REPORT, compass 0: orientation unchanged (ROTATION_NONE, confidence 0), no
     // scale factor (0).
     uint8_t mag_cal_report(uint8_t out[kMaxFrame], const MagCalReport& r);
-    // MISSION_COUNT and MISSION_ACK to the ground station that asked (the mission, fence
-    // and rally protocols: every list is empty until the board stores missions).
+    // The mission protocol's frames to the ground station that asked (MissionProtocol's
+    // replies; fence and rally lists are empty, their uploads refused).
     uint8_t mission_count(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t count,
                           uint8_t mission_type);
     uint8_t mission_ack(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, MissionResult result,
                         uint8_t mission_type);
+    // MISSION_REQUEST_INT (int_form) or MISSION_REQUEST for item seq.
+    uint8_t mission_request(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component, uint16_t seq,
+                            bool int_form, uint8_t mission_type);
+    // MISSION_ITEM_INT (item.int_form: x, y in 1e-7 degrees) or MISSION_ITEM (float degrees).
+    uint8_t mission_item(uint8_t out[kMaxFrame], uint8_t target_system, uint8_t target_component,
+                         const mission::Item& item);
+    // MISSION_CURRENT: seq, total the commands stored (home not counted, as ArduPilot).
+    uint8_t mission_current(uint8_t out[kMaxFrame], uint16_t seq, uint16_t total);
+    uint8_t mission_item_reached(uint8_t out[kMaxFrame], uint16_t seq);
     // TIMESYNC: tc1 the board's clock in ns, ts1 the request's echoed (ArduPilot's answer).
     uint8_t timesync(uint8_t out[kMaxFrame], int64_t tc1_ns, int64_t ts1);
     // SYSTEM_TIME: UNIX time in us (0: unknown, no GPS time yet) and the board's clock.
@@ -320,14 +335,20 @@ enum MsgId : uint8_t {
     kMsgParamSet = 23,
     kMsgCommandLong = 76,
     kMsgCommandAck = 77,
+    kMsgMissionItem = 39,
+    kMsgMissionRequest = 40,
+    kMsgMissionSetCurrent = 41,
     kMsgMissionRequestList = 43,
     kMsgMissionCount = 44,
     kMsgMissionClearAll = 45,
+    kMsgMissionAck = 47,
+    kMsgMissionRequestInt = 51,
+    kMsgMissionItemInt = 73,
     kMsgTimesync = 111,
 };
-// COMMAND_LONG's, the longest kept whole; of COMMAND_INT (35) and RC_CHANNELS_OVERRIDE
-// (38) the fields after it are not needed (current, autocontinue; channels 9-18).
-constexpr uint8_t kRxPayloadMax = 33;
+// MISSION_ITEM(_INT)'s with mission_type, the longest kept whole; of RC_CHANNELS_OVERRIDE
+// (38 too) the channels 9-18 are not needed.
+constexpr uint8_t kRxPayloadMax = 38;
 
 // A frame from the ground station, CRC-checked: its payload zero-filled to the message's
 // full length (MAVLink 2 trims trailing zeros).
@@ -403,6 +424,13 @@ bool decode_command_ack(const Received& rx, uint16_t& command, uint8_t& result);
 bool decode_mission_request_list(const Received& rx, uint8_t& mission_type);
 bool decode_mission_count(const Received& rx, uint16_t& count, uint8_t& mission_type);
 bool decode_mission_clear_all(const Received& rx, uint8_t& mission_type);
+// MISSION_ITEM_INT or MISSION_ITEM (its float degrees to 1e-7: mission::e7_from_degrees).
+bool decode_mission_item(const Received& rx, mission::Item& out);
+// MISSION_REQUEST_INT (int_form) or MISSION_REQUEST.
+bool decode_mission_request(const Received& rx, uint16_t& seq, bool& int_form, uint8_t& mission_type);
+// A ground station's MISSION_ACK (its type not needed: any ends a download or cancels an upload).
+bool decode_mission_ack(const Received& rx, uint8_t& mission_type);
+bool decode_mission_set_current(const Received& rx, uint16_t& seq);
 // TIMESYNC: a request (tc1 0) to answer; false for a reply to someone else's request.
 bool decode_timesync_request(const Received& rx, int64_t& ts1);
 // COMMAND_INT as a CommandLong: param1-4, then x, y as param5, param6 (int32 as float,

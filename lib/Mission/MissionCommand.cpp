@@ -5,8 +5,9 @@ namespace mission {
 
 namespace {
 
-// The code in byte 0 of each supported id (its index here).
-constexpr uint16_t kCodes[] = {kNavWaypoint,       kNavLoiterUnlim, kNavLoiterTurns, kNavLoiterTime,
+// The code in byte 0 of each supported id (its index here). Bytes: every id is below 256,
+// and the table is in the AVR's RAM (8 bytes, not 16).
+constexpr uint8_t kCodes[] = {kNavWaypoint,       kNavLoiterUnlim, kNavLoiterTurns, kNavLoiterTime,
                                kNavReturnToLaunch, kNavTakeoff,     kDoJump,         kDoChangeSpeed};
 constexpr uint8_t kCodeCount = sizeof kCodes / sizeof kCodes[0];
 constexpr uint8_t kRelativeBit = 0x10u;

@@ -105,7 +105,7 @@ public:
     static constexpr uint8_t kRetries = 5;
     static constexpr uint8_t kTypeMission = 0;
 
-    explicit MissionProtocol(MissionStore& store) : store_(store) {}
+    constexpr explicit MissionProtocol(MissionStore& store) : store_(store) {}
 
     Reply on_count(uint16_t count, uint8_t mission_type, uint32_t now_ms);
     Reply on_item(const Item& item, uint32_t now_ms);

@@ -20,7 +20,9 @@
 //
 // The EEPROM through two callbacks (the firmware: avr-libc's eeprom_read_byte and a
 // write queue; host tests: an array that can lose power at any byte). The AVR takes
-// ~3.4 ms to write a byte: a command is 14 bytes, 48 ms.
+// ~3.4 ms to write a byte: a command is 14 bytes, 48 ms. A commit reads the area twice
+// (its CRC, then the read-back): 2800 bytes for 100 commands, ~10 ms on the AVR, so the
+// firmware commits in steps (set_stepped): each step reads at most kStepBytes.
 #pragma once
 
 #include <stdint.h>
@@ -47,7 +49,8 @@ constexpr uint16_t area_address(uint8_t area) { return (uint16_t)(kMissionStart 
 
 class MissionStore {
 public:
-    explicit MissionStore(Eeprom eeprom) : eeprom_(eeprom) {}
+    // constexpr: a static store is initialised data, not start-up code.
+    constexpr explicit MissionStore(Eeprom eeprom) : eeprom_(eeprom) {}
 
     // Finds the current area (at start); false when neither is valid (no mission).
     bool load();
@@ -62,10 +65,22 @@ public:
     // Until commit() the current mission is unchanged. begin_upload() again starts over.
     void begin_upload();
     void write(uint8_t index, const Command& c);
-    // Makes the uploaded `count` commands (<= kMaxCommands) the mission.
+    // Makes the uploaded `count` commands (<= kMaxCommands) the mission. Stepped: only
+    // starts the commit, commit_step() does it.
     void commit(uint8_t count);
+    // The commit a step a call: the CRC kStepBytes at a time, the header, the marker, the
+    // read-back kStepBytes at a time; true when done (or none runs). The same writes in
+    // the same order as commit() at once; until done the mission before is current.
+    bool commit_step();
+    bool committing() const { return commit_ != Commit::kNone; }
+    void set_stepped(bool stepped) { stepped_ = stepped; }
+    static constexpr uint8_t kStepBytes = 64;
 
 private:
+    enum class Commit : uint8_t { kNone, kSum, kHeader, kMarker, kCheck };
+    // CRC of sequence and count, then of the area's command bytes from..to.
+    uint16_t crc_start(uint16_t sequence, uint8_t count) const;
+    uint16_t crc_commands(uint16_t crc, uint8_t area, uint16_t from, uint16_t to) const;
     bool area_valid(uint8_t area, uint16_t& sequence, uint8_t& count) const;
     uint16_t area_crc(uint8_t area, uint16_t sequence, uint8_t count) const;
     uint8_t byte_at(uint16_t address) const { return eeprom_.read(eeprom_.ctx, address); }
@@ -75,6 +90,13 @@ private:
     uint16_t sequence_ = 0;
     uint8_t count_ = 0;
     uint8_t area_ = 1;  // none valid: the first upload goes to area 0
+    // The commit under way (stepped): its count, the command bytes summed, their CRC.
+    Commit commit_ = Commit::kNone;
+    bool stepped_ = false;
+    uint8_t commit_count_ = 0;
+    uint16_t commit_done_ = 0;
+    uint16_t commit_crc_ = 0;
+    uint16_t check_crc_ = 0;
 };
 
 }  // namespace mission

@@ -45,6 +45,11 @@ TEST(FlightConsole, SetGetFlightShowParse) {
     EXPECT_EQ(console::parse_line("baro").id, console::CommandId::Show);
     EXPECT_EQ(console::parse_line("BARO").arg, console::kShowBaro);
     EXPECT_EQ(console::parse_line("baro 1").error, console::Error::ExtraArgument);
+    EXPECT_EQ(console::parse_line("Mission").id, console::CommandId::Show);
+    EXPECT_EQ(console::parse_line("mission").arg, console::kShowMission);
+    EXPECT_EQ(console::parse_line("mission 2").error, console::Error::ExtraArgument);
+    EXPECT_EQ(console::parse_line("arm").arg, console::kArm);  // the words after mission keep theirs
+    EXPECT_EQ(console::parse_line("disarm").arg, console::kDisarm);
     EXPECT_EQ(console::parse_line("rate 5").value, 5);  // the words after gps and baro keep their ids
     EXPECT_EQ(console::parse_line("rc 1").error, console::Error::ExtraArgument);
     // Through the queue, across the ring's wrap.

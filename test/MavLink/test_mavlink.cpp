@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "MavLink.h"
+#include "MissionProtocol.h"
 #include "ParamLink.h"
 #include "Params.h"
 #include "Settings.h"
@@ -1286,4 +1287,180 @@ TEST(MavLinkBattery, BatteryStatusFrame) {
     const Frame g = parse(buf, p.battery_status(buf, ok), kExtraBatteryStatus);
     EXPECT_EQ(u8(g.payload, 40), 1u);                   // OK
     EXPECT_EQ(u16(g.payload, 30), 0xFFFFu);             // current -1
+}
+
+// --- The mission protocol --------------------------------------------------------------
+
+// MISSION_ITEM_INT on the wire (common.xml, CRC_EXTRA 38): param1..4, x, y (int32), z,
+// seq, command, target_system, target_component, frame, current, autocontinue,
+// mission_type; and back through the parser into the same fields.
+TEST(MavLinkMission, ItemIntOnTheWireAndBack) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    mission::Item it = {};
+    it.seq = 7;
+    it.command = mission::kDoJump;
+    it.frame = mission::kFrameGlobalRelativeAltInt;
+    it.autocontinue = 1;
+    it.param1 = 3.0f;
+    it.param2 = -1.0f;
+    it.param3 = 60.0f;
+    it.param4 = 0.5f;
+    it.x = -731194210;
+    it.y = 1799999999;
+    it.z = 120.25f;
+    it.mission_type = 0;
+    it.int_form = true;
+    const uint8_t n = p.mission_item(buf, 1u, 1u, it);
+    const Frame f = parse(buf, n, 38);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 73u);
+    EXPECT_EQ(f32(f.payload, 0), 3.0f);
+    EXPECT_EQ(f32(f.payload, 4), -1.0f);
+    EXPECT_EQ(f32(f.payload, 8), 60.0f);
+    EXPECT_EQ(f32(f.payload, 12), 0.5f);
+    EXPECT_EQ((int32_t)u32(f.payload, 16), -731194210);
+    EXPECT_EQ((int32_t)u32(f.payload, 20), 1799999999);
+    EXPECT_EQ(f32(f.payload, 24), 120.25f);
+    EXPECT_EQ(u16(f.payload, 28), 7u);
+    EXPECT_EQ(u16(f.payload, 30), 177u);
+    EXPECT_EQ(u8(f.payload, 32), 1u);
+    EXPECT_EQ(u8(f.payload, 33), 1u);
+    EXPECT_EQ(u8(f.payload, 34), 6u);
+    EXPECT_EQ(u8(f.payload, 36), 1u);
+    EXPECT_EQ(u8(f.payload, 37), 0u);
+    EXPECT_LE(f.payload.size(), 37u) << "mission_type 0 trimmed";
+
+    mav::Parser parser;
+    auto got = feed(parser, Bytes(buf, buf + n));
+    ASSERT_EQ(got.size(), 1u);
+    mission::Item back = {};
+    ASSERT_TRUE(mav::decode_mission_item(got[0], back));
+    EXPECT_TRUE(back.int_form);
+    EXPECT_EQ(back.seq, it.seq);
+    EXPECT_EQ(back.command, it.command);
+    EXPECT_EQ(back.frame, it.frame);
+    EXPECT_EQ(back.autocontinue, 1u);
+    EXPECT_EQ(back.param2, -1.0f);
+    EXPECT_EQ(back.param4, 0.5f);
+    EXPECT_EQ(back.x, it.x);
+    EXPECT_EQ(back.y, it.y);
+    EXPECT_EQ(back.z, it.z);
+    uint16_t seq = 0;
+    EXPECT_FALSE(mav::decode_mission_set_current(got[0], seq));
+    // Addressed to another system: not ours.
+    got = feed(parser, Bytes(buf, buf + p.mission_item(buf, 2u, 1u, it)));
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_FALSE(mav::decode_mission_item(got[0], back));
+}
+
+// MISSION_ITEM (CRC_EXTRA 254): x, y as float degrees, to 1e-7 degrees within a float's
+// 24 bits (~1 m of longitude at 73 degrees).
+TEST(MavLinkMission, ItemInFloatDegreesBothWays) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    mission::Item it = {};
+    it.seq = 2;
+    it.command = mission::kNavWaypoint;
+    it.frame = mission::kFrameGlobalRelativeAlt;
+    it.x = 71350450;
+    it.y = -731194210;
+    it.z = 100.0f;
+    it.mission_type = 0;
+    it.int_form = false;
+    const uint8_t n = p.mission_item(buf, 1u, 1u, it);
+    const Frame f = parse(buf, n, 254);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 39u);
+    EXPECT_NEAR(f32(f.payload, 16), 7.1350450f, 1e-6f);
+    EXPECT_NEAR(f32(f.payload, 20), -73.1194210f, 1e-5f);
+    EXPECT_EQ(u8(f.payload, 34), 3u);
+    mav::Parser parser;
+    const auto got = feed(parser, Bytes(buf, buf + n));
+    ASSERT_EQ(got.size(), 1u);
+    mission::Item back = {};
+    ASSERT_TRUE(mav::decode_mission_item(got[0], back));
+    EXPECT_FALSE(back.int_form);
+    EXPECT_NEAR(back.x, it.x, 5);
+    EXPECT_NEAR(back.y, it.y, 80);
+    EXPECT_EQ(back.frame, 3u);
+}
+
+// The requests both ways (MISSION_REQUEST 230, _INT 196: seq, targets, mission_type), the
+// ACK (153: targets, type, mission_type), COUNT (221), CURRENT (28: seq, total, state,
+// mode) and ITEM_REACHED (11: seq).
+TEST(MavLinkMission, RequestsAckCountCurrentReached) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    mav::Parser parser;
+    for (int int_form = 0; int_form < 2; ++int_form) {
+        const uint8_t n = p.mission_request(buf, 1u, 1u, 513u, int_form != 0, 0u);
+        const Frame f = parse(buf, n, int_form ? 196 : 230);
+        EXPECT_TRUE(f.crc_ok);
+        EXPECT_EQ(f.msgid, int_form ? 51u : 40u);
+        EXPECT_EQ(u16(f.payload, 0), 513u);
+        EXPECT_EQ(u8(f.payload, 2), 1u);
+        const auto got = feed(parser, Bytes(buf, buf + n));
+        ASSERT_EQ(got.size(), 1u);
+        uint16_t seq = 0;
+        bool as_int = !int_form;
+        uint8_t type = 9;
+        ASSERT_TRUE(mav::decode_mission_request(got[0], seq, as_int, type));
+        EXPECT_EQ(seq, 513u);
+        EXPECT_EQ(as_int, int_form != 0);
+        EXPECT_EQ(type, 0u);
+    }
+    uint8_t n = p.mission_ack(buf, 1u, 1u, (mav::MissionResult)mission::Result::kNoSpace, 2u);
+    Frame f = parse(buf, n, 153);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(u8(f.payload, 2), 4u);
+    EXPECT_EQ(u8(f.payload, 3), 2u);
+    auto got = feed(parser, Bytes(buf, buf + n));
+    ASSERT_EQ(got.size(), 1u);
+    uint8_t type = 0;
+    ASSERT_TRUE(mav::decode_mission_ack(got[0], type));
+    EXPECT_EQ(type, 2u);
+    n = p.mission_count(buf, 1u, 1u, 101u, 0u);
+    got = feed(parser, Bytes(buf, buf + n));
+    ASSERT_EQ(got.size(), 1u);
+    uint16_t count = 0;
+    ASSERT_TRUE(mav::decode_mission_count(got[0], count, type));
+    EXPECT_EQ(count, 101u);
+    n = p.mission_current(buf, 4u, 10u);
+    f = parse(buf, n, 28);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 42u);
+    EXPECT_EQ(u16(f.payload, 0), 4u);
+    EXPECT_EQ(u16(f.payload, 2), 10u);
+    n = p.mission_item_reached(buf, 3u);
+    f = parse(buf, n, 11);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 46u);
+    EXPECT_EQ(u16(f.payload, 0), 3u);
+}
+
+// A ground station's MISSION_SET_CURRENT (CRC_EXTRA 28: seq, targets) and a MISSION_ITEM
+// in MAVLink 1 (no mission_type: 0).
+TEST(MavLinkMission, SetCurrentAndAnOldItemFromAGroundStation) {
+    mav::Parser parser;
+    auto got = feed(parser, frame_v2(41, 28, Bytes{5, 0, 1, 1}));
+    ASSERT_EQ(got.size(), 1u);
+    uint16_t seq = 0;
+    ASSERT_TRUE(mav::decode_mission_set_current(got[0], seq));
+    EXPECT_EQ(seq, 5u);
+    Bytes item;
+    for (float v : {0.0f, 0.0f, 0.0f, 0.0f, 7.5f, -73.25f, 50.0f}) put_f32(item, v);
+    for (uint8_t b : {1, 0, 16, 0, 1, 1, 3, 0, 1}) item.push_back(b);  // seq 1, WAYPOINT, frame 3
+    ASSERT_EQ(item.size(), 37u);
+    got = feed(parser, frame_v1(39, 254, item));
+    ASSERT_EQ(got.size(), 1u);
+    mission::Item it = {};
+    ASSERT_TRUE(mav::decode_mission_item(got[0], it));
+    EXPECT_EQ(it.seq, 1u);
+    EXPECT_EQ(it.command, 16u);
+    EXPECT_EQ(it.x, 75000000);
+    EXPECT_NEAR(it.y, -732500000, 64) << "1e7 x degrees in a float: 24 bits";
+    EXPECT_EQ(it.z, 50.0f);
+    EXPECT_EQ(it.mission_type, 0u);
+    EXPECT_FALSE(it.int_form);
 }

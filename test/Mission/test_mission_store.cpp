@@ -5,6 +5,10 @@
 // new one, whole, and never anything else.
 #include <gtest/gtest.h>
 
+#include <string.h>
+
+#include <vector>
+
 #include "FakeEeprom.h"
 #include "MissionCommand.h"
 #include "MissionStore.h"
@@ -117,6 +121,66 @@ TEST(MissionStore, UploadsAlternateAndTheNewerWins) {
     mission::MissionStore worn(e.port());
     ASSERT_TRUE(worn.load());
     EXPECT_EQ(worn.count(), 2u);
+}
+
+// The firmware's commit (set_stepped): the same bytes written in the same order as the
+// commit at once, no step reading more than kStepBytes of commands (plus the header's 6),
+// the mission before current until the last step.
+struct CountingEeprom : testeeprom::FakeEeprom {
+    uint32_t reads = 0;
+    std::vector<uint16_t> order;  // the addresses written, in order
+    static uint8_t count_read(void* ctx, uint16_t a) {
+        ++static_cast<CountingEeprom*>(ctx)->reads;
+        return read(ctx, a);
+    }
+    static void log_write(void* ctx, uint16_t a, uint8_t v) {
+        static_cast<CountingEeprom*>(ctx)->order.push_back(a);
+        write(ctx, a, v);
+    }
+    mission::Eeprom counting() { return mission::Eeprom{this, &count_read, &log_write}; }
+};
+
+TEST(MissionStore, SteppedCommitWritesWhatTheWholeOneDoesAPartAStep) {
+    CountingEeprom whole, stepped;
+    mission::MissionStore a(whole.counting()), b(stepped.counting());
+    b.set_stepped(true);
+    for (mission::MissionStore* s : {&a, &b}) {
+        s->load();
+        s->begin_upload();
+        s->write(0, waypoint(7, 7, 700));
+        s->commit(1);
+    }
+    while (!b.commit_step()) {}
+    ASSERT_EQ(b.count(), 1u);
+    for (mission::MissionStore* s : {&a, &b}) {
+        s->begin_upload();
+        for (uint8_t i = 0; i < mission::kMaxCommands; ++i) s->write(i, waypoint(i, -i, 100 * i));
+    }
+    a.commit(mission::kMaxCommands);
+    stepped.reads = 0;
+    b.commit(mission::kMaxCommands);
+    EXPECT_TRUE(b.committing());
+    EXPECT_EQ(stepped.reads, 0u) << "commit() only starts it";
+    uint32_t steps = 0;
+    bool done = false;
+    while (!done) {
+        stepped.reads = 0;
+        done = b.commit_step();
+        ++steps;
+        EXPECT_LE(stepped.reads, (uint32_t)mission::MissionStore::kStepBytes + mission::kHeaderBytes) << steps;
+        if (!done) EXPECT_EQ(b.count(), 1u) << "the mission before stays current until the end";
+    }
+    EXPECT_FALSE(b.committing());
+    // 1400 bytes summed and read back, 64 a step: 22 + 22, the header, the marker.
+    EXPECT_EQ(steps, 46u);
+    EXPECT_EQ(b.count(), mission::kMaxCommands);
+    EXPECT_EQ(a.count(), mission::kMaxCommands);
+    EXPECT_EQ(whole.order, stepped.order);
+    EXPECT_EQ(0, memcmp(whole.bytes, stepped.bytes, sizeof whole.bytes));
+    mission::Command c;
+    ASSERT_TRUE(b.read(99, c));
+    EXPECT_TRUE(same(c, waypoint(99, -99, 9900)));
+    EXPECT_TRUE(b.commit_step()) << "none under way";
 }
 
 // Uploads 5 new commands over a store holding 3 old ones (and, in the area the upload

@@ -30,7 +30,9 @@ def main():
     want = ["HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT", "STATUSTEXT",
             "HEARTBEAT", "PARAM_VALUE", "COMMAND_ACK", "RC_CHANNELS", "SERVO_OUTPUT_RAW",
             "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION",
-            "AUTOPILOT_VERSION", "MISSION_COUNT", "MISSION_ACK", "TIMESYNC", "SYSTEM_TIME"]
+            "AUTOPILOT_VERSION", "MISSION_COUNT", "MISSION_ACK", "TIMESYNC", "SYSTEM_TIME",
+            "MISSION_ITEM_INT", "MISSION_ITEM", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_CURRENT",
+            "MISSION_ITEM_REACHED"]
     soft_assert(types == want, "message order %r, expected %r" % (types, want))
     if types != want:
         return
@@ -90,6 +92,7 @@ def main():
     soft_assert(decode_flight_sw_version(ver.flight_sw_version) == (1, 2, 3, "official")
                 and bytes(ver.flight_custom_version) == b"0123abcd"
                 and ver.capabilities == (mavlink2.MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+                                         | mavlink2.MAV_PROTOCOL_CAPABILITY_MISSION_INT
                                          | mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2)
                 and ver.vendor_id == 0x2341 and ver.product_id == 0x0010 and ver.uid == 0,
                 "AUTOPILOT_VERSION %r (MAVProxy decodes %r)" % (ver, decode_flight_sw_version(ver.flight_sw_version)))
@@ -99,6 +102,16 @@ def main():
                 and mack.target_system == 255, "MISSION_ACK %r" % mack)
     soft_assert(ts.tc1 == 61234000000 and ts.ts1 == -5, "TIMESYNC %r" % ts)
     soft_assert(st.time_unix_usec == 1380812400370000 and st.time_boot_ms == 61300, "SYSTEM_TIME %r" % st)
+    ii, fi, rqi, rq, cur, reached = msgs[21:27]
+    for m, x, y, frame in ((ii, 71350450, -731194210, 6), (fi, 7.1350450, -73.1194210, 3)):
+        soft_assert(m.seq == 5 and m.command == 18 and m.frame == frame and m.param1 == 2.0 and m.param3 == -60.0
+                    and abs(m.x - x) <= (0 if frame == 6 else 1e-6) and abs(m.y - y) <= (0 if frame == 6 else 1e-5)
+                    and m.z == 90.5 and m.autocontinue == 1 and m.current == 0 and m.mission_type == 0
+                    and m.target_system == 255 and m.target_component == 190, "%s %r" % (m.get_type(), m))
+    soft_assert(rqi.seq == 7 and rq.seq == 8 and rqi.target_system == 255 and rq.target_component == 190,
+                "MISSION_REQUEST(_INT) %r %r" % (rqi, rq))
+    soft_assert(cur.seq == 4 and cur.total == 10, "MISSION_CURRENT %r" % cur)
+    soft_assert(reached.seq == 3, "MISSION_ITEM_REACHED %r" % reached)
 
     att = msgs[1]
     soft_assert(att.time_boot_ms == 123456, "time_boot_ms %d" % att.time_boot_ms)

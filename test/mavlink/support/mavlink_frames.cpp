@@ -5,6 +5,7 @@
 #include <stdio.h>
 
 #include "MavLink.h"
+#include "MissionProtocol.h"
 
 namespace {
 
@@ -67,5 +68,25 @@ int main() {
     put(nullptr, buf, p.mission_ack(buf, 255u, 190u, mav::MissionResult::Unsupported, 2u));
     put(nullptr, buf, p.timesync(buf, 61234000000ll, -5ll));
     put(nullptr, buf, p.system_time(buf, 1380812400370000ull, 61300u));
+    // The mission protocol.
+    mission::Item it = {};
+    it.seq = 5;
+    it.command = 18;  // NAV_LOITER_TURNS
+    it.frame = 6;     // GLOBAL_RELATIVE_ALT_INT
+    it.autocontinue = 1;
+    it.param1 = 2.0f;
+    it.param3 = -60.0f;
+    it.x = 71350450;
+    it.y = -731194210;
+    it.z = 90.5f;
+    it.int_form = true;
+    put(nullptr, buf, p.mission_item(buf, 255u, 190u, it));
+    it.int_form = false;
+    it.frame = 3;     // GLOBAL_RELATIVE_ALT
+    put(nullptr, buf, p.mission_item(buf, 255u, 190u, it));
+    put(nullptr, buf, p.mission_request(buf, 255u, 190u, 7u, true, 0u));
+    put(nullptr, buf, p.mission_request(buf, 255u, 190u, 8u, false, 0u));
+    put(nullptr, buf, p.mission_current(buf, 4u, 10u));
+    put(nullptr, buf, p.mission_item_reached(buf, 3u));
     return 0;
 }
