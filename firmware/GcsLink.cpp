@@ -16,6 +16,7 @@
 #include "Port.h"
 #include "Position.h"
 #include "SerialText.h"
+#include "StreamRates.h"
 #include "Vehicle.h"
 #include "Version.h"
 
@@ -54,8 +55,11 @@ static int64_t timesync_ts1 = 0;
 static uint8_t mission_type = 0;
 static mav::MissionResult mission_result = mav::MissionResult::Accepted;
 static uint8_t mission_sysid = 0, mission_compid = 0;
-constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
-static uint32_t last_stream_ms = 0;
+// The stream groups a REQUEST_DATA_STREAM sets (mav::StreamRates, 2 bytes): SR0_RC_CHAN
+// (RC_CHANNELS, SERVO_OUTPUT_RAW) and SR0_RAW_SENS (SCALED_PRESSURE), 5 Hz until asked, each
+// on its own timer.
+static mav::StreamRates stream_rates;
+static uint32_t last_group_ms[mav::kStreamGroups] = {};
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
 
 mav::Parser& parser() { return input; }
@@ -253,6 +257,14 @@ void send_reply() {
 // up and set), so a burst is taken as fast as it arrives.
 // A second command while one waits stays in the parser: a ground station sends the
 // next after the ACK.
+// What the port carries besides the stream groups, bytes a second at the frames' longest:
+// HEARTBEAT, SYS_STATUS, SYSTEM_TIME, BATTERY_STATUS once a second, the position round
+// (GPS_RAW_INT 2 Hz, GLOBAL_POSITION_INT and VFR_HUD 4 Hz), ATTITUDE at the console's rate.
+static uint16_t fixed_link_load() {
+    return (uint16_t)(mav::kHeartbeatFrame + mav::kMaxFrame + 24u + mav::kBatteryStatusFrame + 2u * 64u +
+                      4u * (40u + 32u) + (uint16_t)pipe.settings().rate_hz * mav::kAttitudeFrame);
+}
+
 bool request_due() { return input.ready() && !(command_pending && input.frame().msgid == mav::kMsgCommandLong); }
 
 void take_request() {
@@ -261,8 +273,12 @@ void take_request() {
     mav::ParamRequest read;
     mav::ParamSet set;
     mav::SetMode set_mode;
+    mav::DataStreamRequest stream;
     uint16_t override_us[8];
-    if (mav::decode_rc_channels_override(rx, override_us)) {
+    if (mav::decode_request_data_stream(rx, stream)) {
+        // As ArduPilot: no answer, the rate held in RAM; the link's budget caps it.
+        stream_rates.request(stream.stream_id, stream.rate_hz, stream.start_stop, fixed_link_load());
+    } else if (mav::decode_rc_channels_override(rx, override_us)) {
         flight_io.rc_override(override_us);  // no answer, as ArduPilot
     } else if (mav::decode_set_mode(rx, set_mode)) {
         // Only a custom mode (ArduPlane's number); answered as ArduPilot does, with a
@@ -377,20 +393,28 @@ void send_param_value() {
     param_replies.pop();
 }
 
+static bool group_due(mav::StreamGroup g, uint32_t now_ms) {
+    const uint16_t period = stream_rates.period_ms(g);
+    return period != 0u && now_ms - last_group_ms[g] >= period;
+}
 bool streams_due() {
-    return (FlightIo::kEnabled || baro::present()) && millis() - last_stream_ms >= kStreamPeriodMs &&
+    const uint32_t now_ms = millis();
+    return ((FlightIo::kEnabled && group_due(mav::kGroupRcChan, now_ms)) ||
+            (baro::present() && group_due(mav::kGroupRawSens, now_ms))) &&
            room_for(2u * mav::kRcChannelsFrame + mav::kScaledPressureFrame);
 }
 void send_streams() {
     const uint32_t now_ms = millis();
-    last_stream_ms = now_ms;
     uint8_t frame[mav::kMaxFrame];
-    if (FlightIo::kEnabled) {
+    if (FlightIo::kEnabled && group_due(mav::kGroupRcChan, now_ms)) {
+        last_group_ms[mav::kGroupRcChan] = now_ms;
         port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
         port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
     }
-    if (baro::present())
+    if (baro::present() && group_due(mav::kGroupRawSens, now_ms)) {
+        last_group_ms[mav::kGroupRawSens] = now_ms;
         port::send_frame(frame, port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c()));
+    }
 }
 
 // The six-position calibration's position asked (and at its end SUCCESS or FAILED) as

@@ -7,7 +7,8 @@
 //   ATTITUDE         per line  40 bytes   roll, pitch, yaw (rad, yaw with declination), body rates
 //   SYS_STATUS       1 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
 //   STATUSTEXT       per "# "  15..66     every "# " console line, severity from its first word
-//   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us
+//   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us (5 Hz: until a
+//                                         REQUEST_DATA_STREAM sets its group, StreamRates.h)
 //   SERVO_OUTPUT_RAW 5 Hz      33 bytes   the eight outputs' widths, us
 //   SCALED_PRESSURE  5 Hz      ~28 bytes  the barometer's pressure (hPa) and temperature
 //   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
@@ -324,6 +325,7 @@ enum MsgId : uint8_t {
     kMsgMissionCount = 44,
     kMsgMissionClearAll = 45,
     kMsgTimesync = 111,
+    kMsgRequestDataStream = 66,
 };
 // COMMAND_LONG's, the longest kept whole; of COMMAND_INT (35) and RC_CHANNELS_OVERRIDE
 // (38) the fields after it are not needed (current, autocontinue; channels 9-18).
@@ -417,6 +419,14 @@ bool decode_set_mode(const Received& rx, SetMode& out);
 constexpr uint8_t kModeFlagCustomModeEnabled = 1;  // MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
 // RC_CHANNELS_OVERRIDE: channels 1-8 as sent (UINT16_MAX ignore, 0 release; 9-18 not kept).
 bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]);
+// REQUEST_DATA_STREAM (deprecated by MAVLink, still what Mission Planner and MAVProxy send):
+// a stream group (MAV_DATA_STREAM), its rate in Hz, start_stop 0 to stop it.
+struct DataStreamRequest {
+    uint8_t stream_id;
+    uint16_t rate_hz;
+    uint8_t start_stop;
+};
+bool decode_request_data_stream(const Received& rx, DataStreamRequest& out);
 
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;
