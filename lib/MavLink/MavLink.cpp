@@ -773,6 +773,12 @@ uint8_t Packer::system_time(uint8_t out[kMaxFrame], uint64_t time_unix_us, uint3
     return f.finish(out, seq_);
 }
 
+uint8_t Packer::message_interval(uint8_t out[kMaxFrame], uint16_t message_id, int32_t interval_us) {
+    Frame f(seq_);
+    mavlink_msg_message_interval_pack_status(kSystemId, kComponentId, &f.status, &f.msg, message_id, interval_us);
+    return f.finish(out, seq_);
+}
+
 uint8_t Packer::autopilot_version(uint8_t out[kMaxFrame], const Version& v) {
     Frame f(seq_);
     const uint32_t sw = (uint32_t)v.major << 24 | (uint32_t)v.minor << 16 | (uint32_t)v.patch << 8 |

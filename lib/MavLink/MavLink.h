@@ -5,21 +5,22 @@
 //
 //   HEARTBEAT        1 Hz      21 bytes   FIXED_WING, ARDUPILOTMEGA, ArduPlane's mode number
 //   ATTITUDE         per line  40 bytes   roll, pitch, yaw (rad, yaw with declination), body rates
-//   SYS_STATUS       1 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
+//   SYS_STATUS       2 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
 //   STATUSTEXT       per "# "  15..66     every "# " console line, severity from its first word
-//   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us (5 Hz: until a
-//                                         REQUEST_DATA_STREAM sets its group, StreamRates.h)
+//   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us
 //   SERVO_OUTPUT_RAW 5 Hz      33 bytes   the eight outputs' widths, us
 //   SCALED_PRESSURE  5 Hz      ~28 bytes  the barometer's pressure (hPa) and temperature
 //   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
 //   COMMAND_ACK      replies   ~15 bytes
 //   GPS_RAW_INT      2 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
-//   GLOBAL_POSITION_INT 2 Hz   <= 40      the position now, the height above home, velocity
-//   VFR_HUD          2 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
+//   GLOBAL_POSITION_INT 4 Hz   <= 40      the position now, the height above home, velocity
+//   VFR_HUD          4 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
 //   HOME_POSITION    on request and when home changes, <= 40
 //   MAG_CAL_PROGRESS 2 Hz      39 bytes   while a ground station's compass calibration runs
 //   MAG_CAL_REPORT   once      <= 66      its end: offsets, soft iron, fitness
 //   BATTERY_STATUS   1 Hz      <= 53      the power module's voltage, current, charge used (BATT_MONITOR 3, 4)
+//   MESSAGE_INTERVAL on MAV_CMD_GET_MESSAGE_INTERVAL, 18 bytes
+// (The rates are the SR0_ parameters' defaults: StreamRates.h says which sets which.)
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -261,6 +262,8 @@ public:
     uint8_t timesync(uint8_t out[kMaxFrame], int64_t tc1_ns, int64_t ts1);
     // SYSTEM_TIME: UNIX time in us (0: unknown, no GPS time yet) and the board's clock.
     uint8_t system_time(uint8_t out[kMaxFrame], uint64_t time_unix_us, uint32_t time_boot_ms);
+    // MESSAGE_INTERVAL: MAV_CMD_GET_MESSAGE_INTERVAL's answer (interval_us -1: not sent).
+    uint8_t message_interval(uint8_t out[kMaxFrame], uint16_t message_id, int32_t interval_us);
     // AUTOPILOT_VERSION: kCapabilities, the version packed as ArduPilot does, the git hash.
     uint8_t autopilot_version(uint8_t out[kMaxFrame], const Version& v);
     uint8_t next_sequence() const { return seq_; }
