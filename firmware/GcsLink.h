@@ -28,8 +28,8 @@ bool room_for(uint16_t frame_bytes);
 
 // Loop tasks, each with its budget: a received frame taken (PARAM_SET applied, a
 // command set aside), the command run and ACKed, PREFLIGHT_STORAGE's defaults (restored,
-// then their line), a save after a PARAM_SET, one PARAM_VALUE, the RC_CHANNELS +
-// SERVO_OUTPUT_RAW pair at 5 Hz.
+// then their line), a save after a PARAM_SET (or a REQUEST_DATA_STREAM that changed an
+// SR0_ rate), one PARAM_VALUE.
 bool request_due();
 void take_request();
 bool command_due();
@@ -42,7 +42,7 @@ void save();
 void save_soon();
 // The answers sent when the output has room, one a run: TIMESYNC, AUTOPILOT_VERSION,
 // MISSION_COUNT / MISSION_ACK (the mission, fence and rally protocols: empty until the
-// board stores missions), SYSTEM_TIME once a second.
+// board stores missions).
 bool reply_due();
 void send_reply();
 // MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN param1 1, ACKed: a watchdog reset once the ACK is out.
@@ -63,7 +63,7 @@ void send_streams();
 bool stream_due(mav::StreamMsg m);
 bool take_stream(mav::StreamMsg m, uint32_t now_ms);
 // The position messages (Position.h), one frame a run: GPS_RAW_INT, GLOBAL_POSITION_INT
-// and VFR_HUD at their streams' rates (2, 4, 4 Hz by default); HOME_POSITION when home changes and when asked for
+// and VFR_HUD at their streams' rates (1, 4, 4 Hz by default); HOME_POSITION when home changes and when asked for
 // (MAV_CMD_GET_HOME_POSITION, MAV_CMD_REQUEST_MESSAGE 242). The compass calibration's
 // MAG_CAL_PROGRESS and REPORT (MagCalLink) go first when due.
 bool position_due();

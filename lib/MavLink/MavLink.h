@@ -5,14 +5,14 @@
 //
 //   HEARTBEAT        1 Hz      21 bytes   FIXED_WING, ARDUPILOTMEGA, ArduPlane's mode number
 //   ATTITUDE         per line  40 bytes   roll, pitch, yaw (rad, yaw with declination), body rates
-//   SYS_STATUS       2 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
+//   SYS_STATUS       1 Hz      ~43 bytes  gyro/accel/compass present+enabled+healthy bits, load
 //   STATUSTEXT       per "# "  15..66     every "# " console line, severity from its first word
 //   RC_CHANNELS      5 Hz      54 bytes   the receiver's eight widths, us
 //   SERVO_OUTPUT_RAW 5 Hz      33 bytes   the eight outputs' widths, us
 //   SCALED_PRESSURE  5 Hz      ~28 bytes  the barometer's pressure (hPa) and temperature
 //   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
 //   COMMAND_ACK      replies   ~15 bytes
-//   GPS_RAW_INT      2 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
+//   GPS_RAW_INT      1 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
 //   GLOBAL_POSITION_INT 4 Hz   <= 40      the position now, the height above home, velocity
 //   VFR_HUD          4 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
 //   HOME_POSITION    on request and when home changes, <= 40

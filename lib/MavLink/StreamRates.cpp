@@ -96,6 +96,7 @@ StreamRates::StreamRates() {
 void StreamRates::plan(const uint8_t sr0_hz[kStreamGroups], uint8_t output_rate_hz) {
     uint16_t asked[kStreamMsgs];
     uint32_t load = 0;  // bytes a second at the intervals asked
+    bool every_line = false;
     for (uint8_t m = 0; m < kStreamMsgs; ++m) {
         uint16_t ms = own_ms_[m];
         if (ms == kFollowGroup) {
@@ -104,14 +105,17 @@ void StreamRates::plan(const uint8_t sr0_hz[kStreamGroups], uint8_t output_rate_
             ms = hz == 0u ? 0u : (uint16_t)(1000u / hz);
         }
         // ATTITUDE goes with an output line: never more often than the console's `rate`.
-        if (m == kStreamAttitude && ms != 0u && output_rate_hz != 0u && ms < 1000u / output_rate_hz)
+        if (m == kStreamAttitude && ms != 0u && output_rate_hz != 0u && ms <= 1000u / output_rate_hz) {
+            every_line = true;
             ms = (uint16_t)(1000u / output_rate_hz);
+        }
         asked[m] = ms;
         if (ms != 0u) load += (uint32_t)frame_bytes_of(m) * 1000u / ms;
     }
     // Over the budget: every interval stretched by load / budget (Q8, rounded up).
     uint32_t stretch_q8 = 256;
     if (load > kStreamBudgetBytesPerS) stretch_q8 = (load * 256u + kStreamBudgetBytesPerS - 1u) / kStreamBudgetBytesPerS;
+    every_line_ = every_line && stretch_q8 == 256u;
     for (uint8_t m = 0; m < kStreamMsgs; ++m) {
         uint32_t ms = ((uint32_t)asked[m] * stretch_q8 + 255u) >> 8;
         if (ms > kMaxIntervalMs) ms = kMaxIntervalMs;

@@ -84,8 +84,11 @@ public:
     // over time is the one asked; a period late or more (a full queue, the text console),
     // an interval from now, with no burst to catch up.
     void sent(StreamMsg m, uint32_t now_ms);
-    // due() then sent().
+    // due() then sent(). ATTITUDE asked at least as often as the output lines come goes
+    // with every line: the lines keep the MPU6000's clock, and a timer of the same period on
+    // the board's would drop one each time the two drift a step apart.
     bool take(StreamMsg m, uint32_t now_ms) {
+        if (m == kStreamAttitude && every_line_) return true;
         if (!due(m, now_ms)) return false;
         sent(m, now_ms);
         return true;
@@ -108,6 +111,7 @@ private:
     uint16_t own_ms_[kStreamMsgs];       // SET_MESSAGE_INTERVAL's, 0 stopped, or kFollowGroup
     uint16_t interval_ms_[kStreamMsgs];  // in force (plan())
     uint32_t next_ms_[kStreamMsgs];      // when due next
+    bool every_line_ = false;            // ATTITUDE on every output line (take())
 };
 
 }  // namespace mav

@@ -16,7 +16,7 @@ using mav::StreamRates;
 
 // The SR0_ defaults: the rates the board sent before they existed.
 struct Sr0 {
-    uint8_t hz[mav::kStreamGroups] = {5, 2, 5, 4, 50, 4, 1, 10};
+    uint8_t hz[mav::kStreamGroups] = {5, 1, 5, 4, 50, 4, 1, 10};
 };
 
 uint16_t ms(const StreamRates& r, mav::StreamMsg m) { return r.interval_ms(m); }
@@ -53,8 +53,8 @@ TEST(StreamRates, DefaultsPlanTheRatesTheBoardSent) {
     Sr0 s;
     r.plan(s.hz, 50);
     EXPECT_EQ(ms(r, mav::kStreamScaledPressure), 200u);
-    EXPECT_EQ(ms(r, mav::kStreamSysStatus), 500u);
-    EXPECT_EQ(ms(r, mav::kStreamGpsRawInt), 500u);
+    EXPECT_EQ(ms(r, mav::kStreamSysStatus), 1000u);
+    EXPECT_EQ(ms(r, mav::kStreamGpsRawInt), 1000u);
     EXPECT_EQ(ms(r, mav::kStreamRcChannels), 200u);
     EXPECT_EQ(ms(r, mav::kStreamServoOutputRaw), 200u);
     EXPECT_EQ(ms(r, mav::kStreamGlobalPositionInt), 250u);
@@ -70,9 +70,14 @@ TEST(StreamRates, AttitudeNoMoreOftenThanTheConsolesRate) {
     Sr0 s;
     r.plan(s.hz, 10);
     EXPECT_EQ(ms(r, mav::kStreamAttitude), 100u);
+    // Every line, whatever the board's clock says (the lines keep the MPU6000's).
+    for (uint32_t t = 5000; t < 5100; t += 10) EXPECT_TRUE(r.take(mav::kStreamAttitude, t)) << t;
     s.hz[mav::kGroupExtra1] = 4;
     r.plan(s.hz, 10);
     EXPECT_EQ(ms(r, mav::kStreamAttitude), 250u);
+    EXPECT_TRUE(r.take(mav::kStreamAttitude, 6000));
+    EXPECT_FALSE(r.take(mav::kStreamAttitude, 6100));
+    EXPECT_TRUE(r.take(mav::kStreamAttitude, 6250));
     s.hz[mav::kGroupExtra1] = 0;
     r.plan(s.hz, 10);
     EXPECT_EQ(ms(r, mav::kStreamAttitude), 0u);

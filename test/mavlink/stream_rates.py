@@ -8,7 +8,7 @@ Runs build/firmware.elf in `apm25sim --serial tcp:0 --speed 1 --eeprom FILE` on 
 scenario and counts messages by the board's own clock (their time_boot_ms) over WINDOW_S
 seconds after each request has settled:
   - before any request, the SR0_ defaults: RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE
-    5 Hz, SYS_STATUS 2 Hz, VFR_HUD 4 Hz, SYSTEM_TIME and HEARTBEAT 1 Hz, ATTITUDE 50 Hz;
+    5 Hz, SYS_STATUS 1 Hz, VFR_HUD 4 Hz, SYSTEM_TIME and HEARTBEAT 1 Hz, ATTITUDE 50 Hz;
   - PARAM_SET SR0_RAW_SENS 2: SCALED_PRESSURE at 2 Hz, answered by its PARAM_VALUE;
   - REQUEST_DATA_STREAM RC_CHANNELS (3) at 2 Hz: RC_CHANNELS and SERVO_OUTPUT_RAW at 2 Hz,
     SCALED_PRESSURE still 2; SR0_RC_CHAN read back 2; start_stop 0: neither sent;
@@ -143,7 +143,7 @@ def first_session(args, trajectory, eeprom):
             return
         b.pump(lambda m: b.t_s > 2.0, "the estimator to start")
         r = rates(b, "the SR0_ defaults")
-        for name, hz in (("RC_CHANNELS", 5), ("SERVO_OUTPUT_RAW", 5), ("SCALED_PRESSURE", 5), ("SYS_STATUS", 2),
+        for name, hz in (("RC_CHANNELS", 5), ("SERVO_OUTPUT_RAW", 5), ("SCALED_PRESSURE", 5), ("SYS_STATUS", 1),
                          ("VFR_HUD", 4), ("SYSTEM_TIME", 1), ("HEARTBEAT", 1), ("ATTITUDE", 50)):
             near(r[name], hz, "%s at the defaults" % name)
 
