@@ -85,14 +85,6 @@ bool apply_data_stream_request(uint8_t sr0_hz[kStreamGroups], uint8_t stream_id,
     return changed;
 }
 
-StreamRates::StreamRates() {
-    for (uint8_t m = 0; m < kStreamMsgs; ++m) {
-        own_ms_[m] = kFollowGroup;
-        interval_ms_[m] = 0;
-        next_ms_[m] = 0;
-    }
-}
-
 void StreamRates::plan(const uint8_t sr0_hz[kStreamGroups], uint8_t output_rate_hz) {
     uint16_t asked[kStreamMsgs];
     uint32_t load = 0;  // bytes a second at the intervals asked
@@ -103,6 +95,8 @@ void StreamRates::plan(const uint8_t sr0_hz[kStreamGroups], uint8_t output_rate_
             uint8_t hz = sr0_hz[group_of(m)];
             if (hz > kStreamRateMaxHz) hz = kStreamRateMaxHz;
             ms = hz == 0u ? 0u : (uint16_t)(1000u / hz);
+        } else if (ms == kStopped) {
+            ms = 0;
         }
         // ATTITUDE goes with an output line: never more often than the console's `rate`.
         if (m == kStreamAttitude && ms != 0u && output_rate_hz != 0u && ms <= 1000u / output_rate_hz) {
@@ -132,20 +126,20 @@ void StreamRates::sent(StreamMsg m, uint32_t now_ms) {
 
 Result StreamRates::set_interval(uint32_t msgid, float interval_us) {
     const StreamMsg m = stream_msg_of(msgid);
-    if (m == kStreamMsgs || !(interval_us == interval_us)) return Result::Denied;
+    // NaN, below -1 and beyond int32 refused; a fraction of a us is the whole us below it.
+    if (m == kStreamMsgs || !(interval_us >= -1.0f && interval_us < 2147483647.0f)) return Result::Denied;
+    const int32_t us = (int32_t)interval_us;
     uint16_t ms;
-    if (interval_us == 0.0f) {
+    if (us == 0) {
         ms = kFollowGroup;
-    } else if (interval_us == -1.0f) {
-        ms = 0;
-    } else if (interval_us < 0.0f) {
-        return Result::Denied;
-    } else if (interval_us < 1000.0f) {
+    } else if (us < 0) {
+        ms = kStopped;  // -1
+    } else if (us < 1000) {
         ms = 1;  // as fast as it may (the cap and the output's room decide)
-    } else if (interval_us > (float)kMaxIntervalMs * 1000.0f) {
+    } else if (us > (int32_t)kMaxIntervalMs * 1000) {
         ms = kMaxIntervalMs;
     } else {
-        ms = (uint16_t)(interval_us / 1000.0f);
+        ms = (uint16_t)(us / 1000);
     }
     own_ms_[m] = ms;
     return Result::Accepted;

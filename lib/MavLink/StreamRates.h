@@ -70,7 +70,6 @@ bool apply_data_stream_request(uint8_t sr0_hz[kStreamGroups], uint8_t stream_id,
 
 class StreamRates {
 public:
-    StreamRates();
     // The intervals in force from the SR0_ rates, the messages' own (set_interval) and the
     // console's output rate (ATTITUDE at most one an output line), capped to the link.
     void plan(const uint8_t sr0_hz[kStreamGroups], uint8_t output_rate_hz);
@@ -107,10 +106,13 @@ public:
     uint16_t bytes_per_s() const;
 
 private:
-    static constexpr uint16_t kFollowGroup = 0xFFFFu;
-    uint16_t own_ms_[kStreamMsgs];       // SET_MESSAGE_INTERVAL's, 0 stopped, or kFollowGroup
-    uint16_t interval_ms_[kStreamMsgs];  // in force (plan())
-    uint32_t next_ms_[kStreamMsgs];      // when due next
+    // All zeros at start (no constructor: nothing to run, nothing in flash): every message
+    // follows its group, none planned yet.
+    static constexpr uint16_t kFollowGroup = 0;
+    static constexpr uint16_t kStopped = 0xFFFFu;
+    uint16_t own_ms_[kStreamMsgs] = {};       // SET_MESSAGE_INTERVAL's, kStopped, or kFollowGroup
+    uint16_t interval_ms_[kStreamMsgs] = {};  // in force (plan())
+    uint32_t next_ms_[kStreamMsgs] = {};      // when due next
     bool every_line_ = false;            // ATTITUDE on every output line (take())
 };
 

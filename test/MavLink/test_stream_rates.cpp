@@ -197,6 +197,7 @@ TEST(StreamRates, SetMessageIntervalAsArduPilot) {
     EXPECT_EQ(r.set_interval(0xFFFFFFFFu, 100000.0f), mav::Result::Denied);
     EXPECT_EQ(r.set_interval(65, NAN), mav::Result::Denied);
     EXPECT_EQ(r.set_interval(65, -5.0f), mav::Result::Denied);
+    EXPECT_EQ(r.set_interval(65, 3e9f), mav::Result::Denied);
     // GET: HEARTBEAT 1 s, a message not sent -1.
     EXPECT_EQ(r.interval_us(0), 1000000);
     EXPECT_EQ(r.interval_us(27), -1);
