@@ -16,7 +16,6 @@ static battery::Monitor monitor;
 // Low 16 bits of millis(): the intervals measured are well under 65 s.
 static uint16_t last_update_ms = 0;
 static bool updated_before = false;  // the first update has no interval to integrate
-static uint16_t last_status_ms = 0;
 
 static const battery::Settings& settings() { return pipe.settings().vehicle.battery; }
 
@@ -75,11 +74,11 @@ bool failsafe() { return monitor.failsafe() != battery::Failsafe::kNone; }
 mav::BatteryReport report() { return mav::battery_report(monitor, settings()); }
 
 bool status_due() {
-    return enabled() && (uint16_t)(now16() - last_status_ms) >= 1000u && gcs_link::room_for(mav::kBatteryStatusFrame);
+    return enabled() && gcs_link::stream_due(mav::kStreamBatteryStatus) && gcs_link::room_for(mav::kBatteryStatusFrame);
 }
 
 void send_status() {
-    last_status_ms = now16();
+    gcs_link::take_stream(mav::kStreamBatteryStatus, millis());  // SR0_EXTRA3's rate
     uint8_t frame[mav::kMaxFrame];
     port::send_frame(frame, port::mavlink.battery_status(frame, report()));
 }

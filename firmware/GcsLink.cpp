@@ -20,6 +20,7 @@
 #include "Port.h"
 #include "Position.h"
 #include "SerialText.h"
+#include "StreamRates.h"
 #include "Vehicle.h"
 #include "Version.h"
 
@@ -49,12 +50,9 @@ static uint32_t last_frame_ms = 0;  // the last request taken (a save waits for 
 enum ReplyFlag : uint8_t {
     kReplyVersion = 1u << 0,      // AUTOPILOT_VERSION (REQUEST_AUTOPILOT_CAPABILITIES, REQUEST_MESSAGE 148)
     kReplyTimesync = 1u << 1,     // TIMESYNC: timesync_ts1 echoed
-    kReplySystemTime = 1u << 2,   // SYSTEM_TIME, once a second
 };
 static uint8_t replies = 0;
 static int64_t timesync_ts1 = 0;
-constexpr uint16_t kStreamPeriodMs = 200;   // RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE at 5 Hz
-static uint32_t last_stream_ms = 0;
 
 // COMPASS_OFS/DIA/ODI_*: their indices, found once (the table walked at the first use).
 static params::Rows compass_rows() {
@@ -64,9 +62,36 @@ static params::Rows compass_rows() {
                                    offsetof(settings::Settings, cal.mag_learned_uT));
     return rows;
 }
+// The messages on a timer (mav::StreamRates): their intervals planned from the SR0_ rates,
+// a ground station's SET_MESSAGE_INTERVAL and the console's `rate`, again whenever one of
+// them differs from what the plan was made with (a PARAM_SET, the console's `set`, the
+// defaults: no path needs to say so).
+static mav::StreamRates streams;
+static uint8_t planned_sr0_hz[mav::kStreamGroups];
+static uint8_t planned_rate_hz = 0;  // 0: not planned yet
+static bool replan = false;          // a REQUEST_DATA_STREAM or SET_MESSAGE_INTERVAL taken
+static_assert(sizeof(settings::VehicleSettings::sr0_hz) == mav::kStreamGroups, "an SR0_ row per stream group");
 static bool home_requested = false;         // GET_HOME_POSITION or REQUEST_MESSAGE 242: HOME_POSITION to send
 
 mav::Parser& parser() { return input; }
+
+static bool plan_stale() {
+    const settings::Settings& s = pipe.settings();
+    return replan || s.rate_hz != planned_rate_hz || memcmp(s.vehicle.sr0_hz, planned_sr0_hz, sizeof planned_sr0_hz) != 0;
+}
+static void plan() {
+    const settings::Settings& s = pipe.settings();
+    replan = false;
+    planned_rate_hz = s.rate_hz;
+    memcpy(planned_sr0_hz, s.vehicle.sr0_hz, sizeof planned_sr0_hz);
+    streams.plan(planned_sr0_hz, planned_rate_hz);
+}
+bool stream_due(mav::StreamMsg m) { return streams.due(m, millis()); }
+bool take_stream(mav::StreamMsg m, uint32_t now_ms) { return streams.take(m, now_ms); }
+
+// A COMMAND_LONG's message id (a float): the id, or kNoMessage when it is none.
+constexpr uint32_t kNoMessage = 0xFFFFFFFFu;
+static uint32_t message_id(float f) { return f >= 0.0f && f < 65536.0f ? (uint32_t)f : kNoMessage; }
 
 void take_heartbeat() {
     if (!input.ready()) return;
@@ -192,6 +217,11 @@ static mav::Result run_command(const mav::CommandLong& c) {
             return mav::Result::Unsupported;
         return flight_io.set_mode((uint32_t)p[1]) ? mav::Result::Accepted : mav::Result::Failed;
     }
+    if (c.command == mav::kCmdSetMessageInterval) {
+        // In RAM, as ArduPilot; a message the board does not send on a timer is DENIED.
+        replan = true;
+        return streams.set_interval(message_id(p[0]), p[1]);
+    }
     if (c.command == mav::kCmdGetHomePosition ||
         (c.command == mav::kCmdRequestMessage && p[0] == (float)mav::kMsgHomePosition)) {
         if (!position::navigator().home_set()) return mav::Result::Failed;  // as ArduPilot: no home yet
@@ -223,10 +253,6 @@ void send_reply() {
         n = port::mavlink.autopilot_version(frame, v);
     } else if (mission_reply_due()) {
         return mission_link::send_reply();
-    } else {
-        replies = 0;  // kReplySystemTime
-        const uint32_t now_ms = millis();
-        n = port::mavlink.system_time(frame, gps::unix_time_us(gps_port::fix(), now_ms), now_ms);
     }
     if (n > 0) port::send_frame(frame, n);
 }
@@ -251,8 +277,18 @@ void take_request() {
     mav::ParamRequest read;
     mav::ParamSet set;
     mav::SetMode set_mode;
+    mav::DataStreamRequest stream;
     uint16_t override_us[8];
-    if (mav::decode_rc_channels_override(rx, override_us)) {
+    if (mav::decode_request_data_stream(rx, stream)) {
+        // As ArduPilot: no answer (no PARAM_VALUE either), the SR0_ rates saved only when
+        // changed; the group's messages follow it again.
+        uint8_t groups;
+        if (mav::apply_data_stream_request(pipe.settings().vehicle.sr0_hz, stream.stream_id, stream.rate_hz,
+                                           stream.start_stop, &groups))
+            save_pending = true;
+        streams.follow_groups(groups);
+        replan = true;
+    } else if (mav::decode_rc_channels_override(rx, override_us)) {
         flight_io.rc_override(override_us);  // no answer, as ArduPilot
     } else if (mav::decode_set_mode(rx, set_mode)) {
         // Only a custom mode (ArduPlane's number); answered as ArduPilot does, with a
@@ -300,8 +336,18 @@ void take_request() {
 bool command_due() { return command_pending && room_for(2u * mav::kMaxFrame); }
 void run_pending_command() {
     command_pending = false;
-    const mav::Result r = run_command(command);
     uint8_t frame[mav::kMaxFrame];
+    mav::Result r = mav::Result::Denied;
+    if (command.command == mav::kCmdGetMessageInterval) {
+        // As ArduPilot: MESSAGE_INTERVAL (-1 for a message not sent), then the ACK.
+        const uint32_t id = message_id(command.param[0]);
+        if (id != kNoMessage) {
+            port::send_frame(frame, port::mavlink.message_interval(frame, (uint16_t)id, streams.interval_us(id)));
+            r = mav::Result::Accepted;
+        }
+    } else {
+        r = run_command(command);
+    }
     port::send_frame(frame, port::mavlink.command_ack(frame, command.command, r, command_sysid, command_compid));
 }
 
@@ -401,20 +447,57 @@ void send_param_value() {
     param_replies.pop();
 }
 
+// SYS_STATUS: the sensors, the controllers' bits, the load, the missed samples, the battery.
+static uint8_t sys_status(uint8_t frame[mav::kMaxFrame]) {
+    const pipeline::Phase ph = pipe.phase();
+    mav::Health health = mav::health(true, imu.ok(), true, compass.ok());
+    const gps::Fix& fix = gps_port::fix();
+    mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
+                    fix.fix == gps::FixType::k3D && !fix.glitching);
+    mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
+    const airspeed_input::State airspeed = airspeed_input::state();
+    mav::add_sensor(health, mav::kDifferentialPressure, airspeed != airspeed_input::State::kNone,
+                    airspeed == airspeed_input::State::kSensor);
+    const mav::PlaneMode mode = flight_io.plane_mode();
+    mav::add_plane_status(health, mav::PlaneStatus{FlightIo::kEnabled, mode != mav::PlaneMode::Manual,
+                                                   !flight_io.failsafe(), ph == pipeline::Phase::Running});
+    mav::add_sensor(health, mav::kBattery, battery_input::enabled(), battery_input::healthy());
+    const mav::BatteryReport battery = battery_input::report();
+    const uint32_t missed = imu.missed_samples();
+    return port::mavlink.sys_status(frame, health, (uint16_t)(loop_load::percent() * 10u),
+                                    (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu), &battery);
+}
+
+// The streams task's messages (the position task and the battery's have theirs, ATTITUDE
+// goes with the output line), one frame a run; a message due whose source is absent (no
+// barometer, the attitude-only build's receiver) is passed over until next time.
 bool streams_due() {
-    return (FlightIo::kEnabled || baro::present()) && millis() - last_stream_ms >= kStreamPeriodMs &&
-           room_for(2u * mav::kRcChannelsFrame + mav::kScaledPressureFrame);
+    if (!port::mavlink_mode()) return false;
+    if (plan_stale()) return true;
+    const uint32_t now_ms = millis();
+    return (streams.due(mav::kStreamSysStatus, now_ms) || streams.due(mav::kStreamRcChannels, now_ms) ||
+            streams.due(mav::kStreamServoOutputRaw, now_ms) || streams.due(mav::kStreamScaledPressure, now_ms) ||
+            streams.due(mav::kStreamSystemTime, now_ms)) &&
+           room_for(mav::kMaxFrame);
 }
 void send_streams() {
+    if (plan_stale()) return plan();  // a pass of its own
     const uint32_t now_ms = millis();
-    last_stream_ms = now_ms;
     uint8_t frame[mav::kMaxFrame];
-    if (FlightIo::kEnabled) {
-        port::send_frame(frame, flight_io.rc_channels(port::mavlink, frame, now_ms));
-        port::send_frame(frame, flight_io.servo_output_raw(port::mavlink, frame, micros()));
+    uint8_t n = 0;
+    if (streams.take(mav::kStreamSysStatus, now_ms)) {
+        n = sys_status(frame);
+    } else if (streams.take(mav::kStreamRcChannels, now_ms)) {
+        if (FlightIo::kEnabled) n = flight_io.rc_channels(port::mavlink, frame, now_ms);
+    } else if (streams.take(mav::kStreamServoOutputRaw, now_ms)) {
+        if (FlightIo::kEnabled) n = flight_io.servo_output_raw(port::mavlink, frame, micros());
+    } else if (streams.take(mav::kStreamScaledPressure, now_ms)) {
+        if (baro::present())
+            n = port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c());
+    } else if (streams.take(mav::kStreamSystemTime, now_ms)) {
+        n = port::mavlink.system_time(frame, gps::unix_time_us(gps_port::fix(), now_ms), now_ms);
     }
-    if (baro::present())
-        port::send_frame(frame, port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c()));
+    if (n > 0) port::send_frame(frame, n);
 }
 
 // The six-position calibration's position asked (and at its end SUCCESS or FAILED) as
@@ -438,7 +521,6 @@ static void announce_accel_position(uint8_t frame[mav::kMaxFrame]) {
 
 void send_heartbeat_and_status() {
     if (!port::mavlink_mode()) return;
-    replies |= kReplySystemTime;
     const pipeline::Phase ph = pipe.phase();
     const mav::State state = !imu.ok() || !compass.ok() ? mav::State::Critical
                              : ph == pipeline::Phase::WaitImu ? mav::State::Boot
@@ -446,37 +528,15 @@ void send_heartbeat_and_status() {
                                  ? mav::State::Calibrating
                                  : mav::State::Active;
     uint8_t frame[mav::kMaxFrame];
-    mav::Health health = mav::health(true, imu.ok(), true, compass.ok());
-    const gps::Fix& fix = gps_port::fix();
-    mav::add_sensor(health, mav::kGps, fix.fix != gps::FixType::kNoGps,
-                    fix.fix == gps::FixType::k3D && !fix.glitching);
-    mav::add_sensor(health, mav::kAbsolutePressure, baro::present(), baro::healthy());
-    const airspeed_input::State airspeed = airspeed_input::state();
-    mav::add_sensor(health, mav::kDifferentialPressure, airspeed != airspeed_input::State::kNone,
-                    airspeed == airspeed_input::State::kSensor);
-    const mav::PlaneMode mode = flight_io.plane_mode();
-    mav::add_plane_status(health, mav::PlaneStatus{FlightIo::kEnabled, mode != mav::PlaneMode::Manual,
-                                                   !flight_io.failsafe(), ph == pipeline::Phase::Running});
-    mav::add_sensor(health, mav::kBattery, battery_input::enabled(), battery_input::healthy());
-    const mav::BatteryReport battery = battery_input::report();
-    uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state, mode,
-                                        flight_io.armed());
-    serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
-    const uint32_t missed = imu.missed_samples();
-    n = port::mavlink.sys_status(frame, health,
-                                 (uint16_t)(loop_load::percent() * 10u),
-                                 (uint16_t)(missed < 0xFFFFu ? missed : 0xFFFFu), &battery);
+    const uint8_t n = port::mavlink.heartbeat(frame, flight_io.failsafe() ? mav::State::Critical : state,
+                                              flight_io.plane_mode(), flight_io.armed());
     serial_text::write_line_if_room(reinterpret_cast<const char*>(frame), n);
     announce_accel_position(frame);
 }
 
-// The position messages: each round (kPositionPeriodMs) GLOBAL_POSITION_INT and VFR_HUD,
-// every other round GPS_RAW_INT first; HOME_POSITION before them when due. One frame a run.
-constexpr uint16_t kPositionPeriodMs = 250;
-enum PositionFrame : uint8_t { kGpsRaw, kGlobalPosition, kVfrHud, kRoundDone };
-static uint8_t next_position_frame = kRoundDone;
-static uint8_t position_rounds = 0;
-static uint32_t position_round_ms = 0;
+// The position messages, each at its stream's interval: GPS_RAW_INT (SR0_EXT_STAT),
+// GLOBAL_POSITION_INT (SR0_POSITION), VFR_HUD (SR0_EXTRA2); HOME_POSITION before them when
+// due. One frame a run.
 static uint8_t home_changes_sent = 0;
 
 static bool home_due() {
@@ -488,8 +548,10 @@ static bool home_due() {
 // move the firmware's timeline (the compass's DRDY read falls on another step).
 bool position_due() {
     if (!port::mavlink_mode() || !room_for(mav::kMaxFrame)) return false;
-    if (mag_cal_link::due() || home_due() || next_position_frame != kRoundDone) return true;
-    return millis() - position_round_ms >= kPositionPeriodMs;
+    if (mag_cal_link::due() || home_due()) return true;
+    const uint32_t now_ms = millis();
+    return streams.due(mav::kStreamGpsRawInt, now_ms) || streams.due(mav::kStreamGlobalPositionInt, now_ms) ||
+           streams.due(mav::kStreamVfrHud, now_ms);
 }
 
 void send_position() {
@@ -502,23 +564,19 @@ void send_position() {
         const nav::Location& h = position::navigator().home();
         n = port::mavlink.home_position(frame, h.lat_e7, h.lon_e7, h.alt_cm * 10);
     } else {
-        if (next_position_frame == kRoundDone) {
-            position_round_ms = millis();
-            next_position_frame = (position_rounds++ & 1u) == 0u ? kGpsRaw : kGlobalPosition;
-        }
-        // No GLOBAL_POSITION_INT before the first fix: a map would put the plane at 0, 0.
-        if (next_position_frame == kGlobalPosition && !position::navigator().have_position()) ++next_position_frame;
+        const uint32_t now_ms = millis();
         mav::PositionReport r;
-        switch (next_position_frame++) {
-            case kGpsRaw: n = port::mavlink.gps_raw_int(frame, gps_port::fix()); break;
-            case kGlobalPosition:
+        if (streams.take(mav::kStreamGpsRawInt, now_ms)) {
+            n = port::mavlink.gps_raw_int(frame, gps_port::fix());
+        } else if (streams.take(mav::kStreamGlobalPositionInt, now_ms)) {
+            // None before the first fix: a map would put the plane at 0, 0.
+            if (position::navigator().have_position()) {
                 position::report(r);
                 n = port::mavlink.global_position_int(frame, r);
-                break;
-            default:
-                position::report(r);
-                n = port::mavlink.vfr_hud(frame, r);
-                break;
+            }
+        } else if (streams.take(mav::kStreamVfrHud, now_ms)) {
+            position::report(r);
+            n = port::mavlink.vfr_hud(frame, r);
         }
     }
     if (n > 0) port::send_frame(frame, n);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The ground station link (lib/MavLink: Parser, ParamLink): a ground station's requests
-// answered, its parameters and commands, HEARTBEAT and SYS_STATUS once a second, the
-// radio and servo pages' streams. Replies go through the same queue as everything else,
+// answered, its parameters and commands, HEARTBEAT once a second, the streams at the
+// rates asked (StreamRates.h). Replies go through the same queue as everything else,
 // each only when it fits whole with an output line after it and ends before the next
 // sample is due (the task table's budgets), so no sample is missed and no frame
 // dropped: a PARAM_REQUEST_LIST's ~100 PARAM_VALUEs go out a few per sample as the UART
@@ -12,6 +12,7 @@
 
 #include "MavLink.h"
 #include "Pipeline.h"
+#include "StreamRates.h"
 
 namespace gcs_link {
 
@@ -28,8 +29,8 @@ bool room_for(uint16_t frame_bytes);
 
 // Loop tasks, each with its budget: a received frame taken (PARAM_SET applied, a
 // command set aside), the command run and ACKed, PREFLIGHT_STORAGE's defaults (restored,
-// then their line), a save after a PARAM_SET, one PARAM_VALUE, the RC_CHANNELS +
-// SERVO_OUTPUT_RAW pair at 5 Hz.
+// then their line), a save after a PARAM_SET (or a REQUEST_DATA_STREAM that changed an
+// SR0_ rate), one PARAM_VALUE.
 bool request_due();
 void take_request();
 bool command_due();
@@ -41,7 +42,7 @@ void save();
 // A save in a pass of its own, as after a PARAM_SET (the compass calibration accepted).
 void save_soon();
 // The answers sent when the output has room, one a run: TIMESYNC, AUTOPILOT_VERSION,
-// the mission protocols' (MissionLink.h), SYSTEM_TIME once a second.
+// the mission protocols' (MissionLink.h).
 bool reply_due();
 void send_reply();
 // MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN param1 1, ACKed: a watchdog reset once the ACK is out.
@@ -59,17 +60,23 @@ void announce_calibration(Calibrated what);
 void announce_calibration(const pipeline::AttitudePipeline& pipe, const pipeline::Event& e);
 bool param_value_due();
 void send_param_value();
+// The messages on a timer (mav::StreamRates: the SR0_ rates, SET_MESSAGE_INTERVAL, the
+// link's cap): one of SYS_STATUS, RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE,
+// SYSTEM_TIME a run, or the intervals planned again after a change.
 bool streams_due();
 void send_streams();
-// The position messages (Position.h), one frame a run: GPS_RAW_INT at 2 Hz,
-// GLOBAL_POSITION_INT and VFR_HUD at 4 Hz (ArduPlane's usual rates for a ground
-// station's map and HUD); HOME_POSITION when home changes and when asked for
+// A stream message of another task due (BATTERY_STATUS); take_stream: due, and counted as
+// sent at now_ms (ATTITUDE with the output line).
+bool stream_due(mav::StreamMsg m);
+bool take_stream(mav::StreamMsg m, uint32_t now_ms);
+// The position messages (Position.h), one frame a run: GPS_RAW_INT, GLOBAL_POSITION_INT
+// and VFR_HUD at their streams' rates (1, 4, 4 Hz by default); HOME_POSITION when home changes and when asked for
 // (MAV_CMD_GET_HOME_POSITION, MAV_CMD_REQUEST_MESSAGE 242). The compass calibration's
 // MAG_CAL_PROGRESS and REPORT (MagCalLink) go first when due.
 bool position_due();
 void send_position();
-// Once a second in MAVLink: HEARTBEAT and SYS_STATUS (a ground station drops a link
-// after ~3 s without a heartbeat).
+// Once a second in MAVLink: HEARTBEAT, whatever the rates asked (a ground station drops a
+// link after ~3 s without a heartbeat).
 void send_heartbeat_and_status();
 
 }  // namespace gcs_link

@@ -2,6 +2,7 @@
 #include "OutputLine.h"
 
 #include "Board.h"
+#include "GcsLink.h"
 #include "Port.h"
 #include "SerialText.h"
 #include "Vehicle.h"
@@ -22,6 +23,12 @@ bool due() {
 static bool emit(uint32_t now_ms, pipeline::AnglesCentideg& c) {
     const fmt::OutputMode mode = port::output_mode();
     if (mode == fmt::OutputMode::Quiet) return false;
+    // ATTITUDE at SR0_EXTRA1's rate (or its own interval), on the output lines it falls on
+    // (every line when asked as often or more); a line moves a sample step later when a field
+    // sample takes its step, so one a step early counts.
+    constexpr uint16_t kStepMs = 1000u / pipeline::kRateHz;
+    if (mode == fmt::OutputMode::Mavlink && !gcs_link::take_stream(mav::kStreamAttitude, now_ms + kStepMs))
+        return false;
     // Plot and csv lines print hundredths, which the integer path gives without a float;
     // MAVLink's ATTITUDE carries floats.
     pipeline::Angles a{};

@@ -543,6 +543,9 @@ uint8_t crc_extra_of(uint32_t msgid, uint8_t& max_len) {
         case MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE:
             max_len = MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE_LEN;
             return MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE_CRC;
+        case MAVLINK_MSG_ID_REQUEST_DATA_STREAM:
+            max_len = MAVLINK_MSG_ID_REQUEST_DATA_STREAM_LEN;
+            return MAVLINK_MSG_ID_REQUEST_DATA_STREAM_CRC;
         default: return 0;
     }
 }
@@ -729,6 +732,20 @@ bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]) {
     const uint16_t w[8] = {m.chan1_raw, m.chan2_raw, m.chan3_raw, m.chan4_raw,
                            m.chan5_raw, m.chan6_raw, m.chan7_raw, m.chan8_raw};
     memcpy(width_us, w, sizeof w);
+    return true;
+}
+
+static_assert(kMsgRequestDataStream == MAVLINK_MSG_ID_REQUEST_DATA_STREAM &&
+                  MAVLINK_MSG_ID_REQUEST_DATA_STREAM_LEN <= kRxPayloadMax,
+              "REQUEST_DATA_STREAM's id and payload");
+bool decode_request_data_stream(const Received& rx, DataStreamRequest& out) {
+    if (rx.msgid != kMsgRequestDataStream) return false;
+    mavlink_request_data_stream_t m;
+    copy_payload(m, rx);
+    if (!for_us(m.target_system, m.target_component)) return false;
+    out.stream_id = m.req_stream_id;
+    out.rate_hz = m.req_message_rate;
+    out.start_stop = m.start_stop;
     return true;
 }
 
@@ -924,6 +941,12 @@ uint8_t Packer::timesync(uint8_t out[kMaxFrame], int64_t tc1_ns, int64_t ts1) {
 uint8_t Packer::system_time(uint8_t out[kMaxFrame], uint64_t time_unix_us, uint32_t time_boot_ms) {
     Frame f(seq_);
     mavlink_msg_system_time_pack_status(kSystemId, kComponentId, &f.status, &f.msg, time_unix_us, time_boot_ms);
+    return f.finish(out, seq_);
+}
+
+uint8_t Packer::message_interval(uint8_t out[kMaxFrame], uint16_t message_id, int32_t interval_us) {
+    Frame f(seq_);
+    mavlink_msg_message_interval_pack_status(kSystemId, kComponentId, &f.status, &f.msg, message_id, interval_us);
     return f.finish(out, seq_);
 }
 

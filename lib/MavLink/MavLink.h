@@ -12,15 +12,17 @@
 //   SCALED_PRESSURE  5 Hz      ~28 bytes  the barometer's pressure (hPa) and temperature
 //   PARAM_VALUE      replies   37 bytes   (ParamLink.h)
 //   COMMAND_ACK      replies   ~15 bytes
-//   GPS_RAW_INT      2 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
-//   GLOBAL_POSITION_INT 2 Hz   <= 40      the position now, the height above home, velocity
-//   VFR_HUD          2 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
+//   GPS_RAW_INT      1 Hz      <= 64      the fix as the receiver gave it (GpsFix.h)
+//   GLOBAL_POSITION_INT 4 Hz   <= 40      the position now, the height above home, velocity
+//   VFR_HUD          4 Hz      <= 32      airspeed, ground speed, heading, throttle, height, climb
 //   HOME_POSITION    on request and when home changes, <= 40
 //   MAG_CAL_PROGRESS 2 Hz      39 bytes   while a ground station's compass calibration runs
 //   MAG_CAL_REPORT   once      <= 66      its end: offsets, soft iron, fitness
 //   BATTERY_STATUS   1 Hz      <= 53      the power module's voltage, current, charge used (BATT_MONITOR 3, 4)
 //   MISSION_*        replies   <= 50      the mission protocol (lib/Mission/MissionProtocol.h): COUNT,
 //                                         REQUEST(_INT), ITEM(_INT), ACK, CURRENT; ITEM_REACHED
+//   MESSAGE_INTERVAL on MAV_CMD_GET_MESSAGE_INTERVAL, 18 bytes
+// (The rates are the SR0_ parameters' defaults: StreamRates.h says which sets which.)
 //
 // The packing is pymavlink's generated C code (build/mavlink, made by `make mavlink` from
 // the common.xml that PyPI's pymavlink ships; nothing generated is committed), so field
@@ -275,6 +277,8 @@ public:
     uint8_t timesync(uint8_t out[kMaxFrame], int64_t tc1_ns, int64_t ts1);
     // SYSTEM_TIME: UNIX time in us (0: unknown, no GPS time yet) and the board's clock.
     uint8_t system_time(uint8_t out[kMaxFrame], uint64_t time_unix_us, uint32_t time_boot_ms);
+    // MESSAGE_INTERVAL: MAV_CMD_GET_MESSAGE_INTERVAL's answer (interval_us -1: not sent).
+    uint8_t message_interval(uint8_t out[kMaxFrame], uint16_t message_id, int32_t interval_us);
     // AUTOPILOT_VERSION: kCapabilities, the version packed as ArduPilot does, the git hash.
     uint8_t autopilot_version(uint8_t out[kMaxFrame], const Version& v);
     uint8_t next_sequence() const { return seq_; }
@@ -345,6 +349,7 @@ enum MsgId : uint8_t {
     kMsgMissionRequestInt = 51,
     kMsgMissionItemInt = 73,
     kMsgTimesync = 111,
+    kMsgRequestDataStream = 66,
 };
 // MISSION_ITEM(_INT)'s with mission_type, the longest kept whole; of RC_CHANNELS_OVERRIDE
 // (38 too) the channels 9-18 are not needed.
@@ -445,6 +450,14 @@ bool decode_set_mode(const Received& rx, SetMode& out);
 constexpr uint8_t kModeFlagCustomModeEnabled = 1;  // MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
 // RC_CHANNELS_OVERRIDE: channels 1-8 as sent (UINT16_MAX ignore, 0 release; 9-18 not kept).
 bool decode_rc_channels_override(const Received& rx, uint16_t width_us[8]);
+// REQUEST_DATA_STREAM (deprecated by MAVLink, still what Mission Planner and MAVProxy send):
+// a stream group (MAV_DATA_STREAM), its rate in Hz, start_stop 0 to stop it.
+struct DataStreamRequest {
+    uint8_t stream_id;
+    uint16_t rate_hz;
+    uint8_t start_stop;
+};
+bool decode_request_data_stream(const Received& rx, DataStreamRequest& out);
 
 // The commands the board carries out (MAV_CMD).
 constexpr uint16_t kCmdPreflightCalibration = 241;

@@ -398,7 +398,33 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Failsafe battery mAh", "mAh",
                "The battery failsafe when less than this is left of BATT_CAPACITY (BATT_MONITOR 4 only); 0: off.")},
 
-    // Telemetry rates.
+    // Telemetry rates. ArduPilot's SR0_ (0..50 Hz), the stream groups of ArduPlane's
+    // GCS_Mavlink.cpp; the defaults are the rates the board sent before them (lib/MavLink/
+    // StreamRates.h, docs/mavlink.md), but for EXT_STAT: ArduPlane's 1, SYS_STATUS's rate
+    // before (GPS_RAW_INT, 2 Hz before, goes with it).
+    {"SR0_RAW_SENS", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[0]), 0.0f, 50.0f, 5.0f,
+     PARAM_DOC("Raw sensor stream rate", "Hz",
+               "SCALED_PRESSURE (the barometer) a second to the ground station; 0 none. A ground station's "
+               "REQUEST_DATA_STREAM sets it (and saves it when it changes); every rate is capped by what the "
+               "115200-baud link carries (docs/mavlink.md).")},
+    {"SR0_EXT_STAT", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[1]), 0.0f, 50.0f, 1.0f,
+     PARAM_DOC("Extended status stream rate", "Hz", "SYS_STATUS and GPS_RAW_INT a second; 0 none.")},
+    {"SR0_RC_CHAN", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[2]), 0.0f, 50.0f, 5.0f,
+     PARAM_DOC("RC channel stream rate", "Hz", "RC_CHANNELS and SERVO_OUTPUT_RAW a second; 0 none.")},
+    {"SR0_POSITION", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[3]), 0.0f, 50.0f, 4.0f,
+     PARAM_DOC("Position stream rate", "Hz", "GLOBAL_POSITION_INT a second (after the first fix); 0 none.")},
+    {"SR0_EXTRA1", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[4]), 0.0f, 50.0f, 50.0f,
+     PARAM_DOC("Extra data type 1 stream rate", "Hz",
+               "ATTITUDE a second, at most one an output line (the console's `rate`, 50 by default); 0 none.")},
+    {"SR0_EXTRA2", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[5]), 0.0f, 50.0f, 4.0f,
+     PARAM_DOC("Extra data type 2 stream rate", "Hz", "VFR_HUD a second; 0 none.")},
+    {"SR0_EXTRA3", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[6]), 0.0f, 50.0f, 1.0f,
+     PARAM_DOC("Extra data type 3 stream rate", "Hz",
+               "SYSTEM_TIME and BATTERY_STATUS (with BATT_MONITOR set) a second; 0 none.")},
+    {"SR0_PARAMS", Type::UInt8, 0, 1, 0, AT(vehicle.sr0_hz[7]), 0.0f, 50.0f, 10.0f,
+     PARAM_DOC("Parameter stream rate", "Hz",
+               "Kept for the ground stations that set it; the parameter list goes as fast as the link has room "
+               "(about 200 a second), as ArduPilot's queued parameters do. REQUEST_DATA_STREAM's ALL leaves it.")},
 
     // Serial port.
     {"SERIAL0_PROTOCOL", Type::UInt8, 0, 1, 0, AT(vehicle.serial0_protocol), 0.0f, 2.0f, 0.0f,
@@ -591,10 +617,21 @@ bool set(Settings& s, uint16_t index, float value) {
     return false;
 }
 
+// Only the fields write() reads are copied from flash (10 of a row's 35 bytes): a ground
+// station's PREFLIGHT_STORAGE defaults runs this between samples, and with the SR0_ rows
+// the whole-row copy took its pass past the task's budget (a sample missed).
 void apply_defaults(Settings& s) {
     Row row;
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
+        row.type = (Type)ROW_BYTE(r, type);
+        row.count = ROW_BYTE(r, count);
+        row.stride = ROW_BYTE(r, stride);
+        row.offset = ROW_WORD(r, offset);
+#ifdef __AVR__
+        memcpy_P(&row.def, &kRows[r].def, sizeof row.def);
+#else
+        row.def = kRows[r].def;
+#endif
         for (uint8_t i = 0; i < row.count; ++i) write(s, row, i, row.def);
     }
 }

@@ -39,7 +39,9 @@ struct VehicleSettings {
     // Battery monitor and its failsafe (AP_BattMonitor, ArduPlane's FS_BATT_*).
     battery::Settings battery;  // BATT_MONITOR .. FS_BATT_MAH (lib/Battery/BatterySettings.h)
 
-    // Telemetry rates (GCS_MAVLink's SRn_*).
+    // Telemetry rates (GCS_MAVLink's SRn_*), Hz: SR0_RAW_SENS, _EXT_STAT, _RC_CHAN, _POSITION,
+    // _EXTRA1, _EXTRA2, _EXTRA3, _PARAMS in this order (mav::StreamGroup, StreamRates.h).
+    uint8_t sr0_hz[8];
 
     // Serial port (AP_SerialManager's SERIALn_*).
     uint8_t serial0_protocol;   // SERIAL0_PROTOCOL: kSerialConsole, or 1/2 MAVLink from power-up

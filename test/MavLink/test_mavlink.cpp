@@ -672,6 +672,29 @@ TEST(MavLinkParser, SetModeCommandIntAndRcOverrideDecode) {
     for (int i = 0; i < 8; ++i) EXPECT_EQ(w[i], want[i]) << i;
 }
 
+TEST(MavLinkParser, RequestDataStreamDecodes) {
+    mav::Parser parser;
+    // Wire order: req_message_rate (u16), target_system, target_component, req_stream_id, start_stop.
+    auto got = feed(parser, frame_v2(66, 148, Bytes{2, 0, 1, 1, 3, 1}));
+    ASSERT_EQ(got.size(), 1u);
+    mav::DataStreamRequest r;
+    ASSERT_TRUE(mav::decode_request_data_stream(got[0], r));
+    EXPECT_EQ(r.stream_id, 3u);
+    EXPECT_EQ(r.rate_hz, 2u);
+    EXPECT_EQ(r.start_stop, 1u);
+    got = feed(parser, frame_v2(66, 148, Bytes{0x2C, 0x01, 0, 0, 0, 0}));  // ALL at 300 Hz, stop (trimmed)
+    ASSERT_EQ(got.size(), 1u);
+    ASSERT_TRUE(mav::decode_request_data_stream(got[0], r));
+    EXPECT_EQ(r.stream_id, 0u);
+    EXPECT_EQ(r.rate_hz, 300u);
+    EXPECT_EQ(r.start_stop, 0u);
+    got = feed(parser, frame_v2(66, 148, Bytes{2, 0, 9, 1, 3, 1}));  // another system's
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_FALSE(mav::decode_request_data_stream(got[0], r));
+    mav::CommandLong c;
+    EXPECT_FALSE(mav::decode_command_long(got[0], c));
+}
+
 // --- Outgoing replies and streams ------------------------------------------------------
 
 TEST(MavLink, ParamValueCommandAckRcChannelsServoOutputRawOnTheWire) {

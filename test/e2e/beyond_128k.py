@@ -333,7 +333,8 @@ TIMING_FIELDS = {1: [(12, 2)],   # SYS_STATUS.load
                  # GLOBAL_POSITION_INT: its instant, the position moved on to it (lat, lon, alt,
                  # relative_alt) and the attitude's heading then; the fix's velocity is compared
                  33: [(0, 20), (26, 2)],
-                 74: [(8, 10)]}  # VFR_HUD: the barometer's height and climb, the heading, at its instant
+                 74: [(8, 10)],  # VFR_HUD: the barometer's height and climb, the heading, at its instant
+                 2: [(0, 12)]}   # SYSTEM_TIME: its instant (a stream's timer, GPS time moved on to it)
 # Receiver widths, in us, and what follows from them. simavr applies a pin edge at the end of
 # the instruction running when it is due, so Timer5's capture (0.5 us a count) of the same
 # edge may read one count apart when other instructions run (on the chip it is cycle-exact):
@@ -354,8 +355,10 @@ WIDTH_FIELDS = {65: (4, 18, RC_TOLERANCE_US),       # RC_CHANNELS chan1..18_raw
 KEYED_MESSAGES = (30,)  # ATTITUDE
 # Messages sent when a loop pass finds their period over: the millisecond they are stamped
 # with is timing; matched in order, their stamps within this many ms.
-ORDERED_MESSAGES = {65: 5,  # RC_CHANNELS (5 Hz)
-                    29: 5}  # SCALED_PRESSURE (with them)
+# SCALED_PRESSURE goes a run of the streams task after RC_CHANNELS and SERVO_OUTPUT_RAW when
+# due with them (one frame a run): a pass or two later, up to two samples apart.
+ORDERED_MESSAGES = {65: 5,   # RC_CHANNELS (5 Hz)
+                    29: 10}  # SCALED_PRESSURE (5 Hz, after them)
 # The barometer's pressure and temperature are timing too (TIMING_TEXT): SCALED_PRESSURE's
 # within 0.1 hPa (a conversion's noise) and 0.02 degC.
 BARO_TOLERANCE_HPA = 0.1
