@@ -165,8 +165,8 @@ $(STARTUP_BUILD)/%.elf: $(STARTUP_BUILD)/%.S.o $(FW_OBJ) $(BUILD)/avr/core.a
 # features to come will move it. -q keeps the relocations in the ELF, for the test to follow
 # every function pointer (the flash bytes are the same with or without it).
 # Beside it, two controls that the test must see fail: the image linked without trampolines
-# (--no-stubs: a word address of code above 128 KB wraps round), and 64 KB of padding before
-# the PROGMEM data (which then lies past LPM's reach).
+# (--no-stubs: a word address of code above 128 KB wraps round), and padding before the
+# PROGMEM data that lifts its end past LPM's 64 KB.
 FLASH_BUDGET := 204800
 BIG_BUILD    := $(FW_BUILD)/big
 BIG_LINK      = $(AVR_CXX) $(AVR_LDFLAGS) -Wl,-q $(BIG_LDFLAGS) $< $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@
@@ -178,9 +178,13 @@ $(BIG_BUILD)/padding.S.o: test/sketch/padding.S $(FW_BUILD)/firmware.elf
 	$(Q)flash=$$(avr-size -A $(FW_BUILD)/firmware.elf | awk '/^\.text|^\.data/ {s+=$$2} END {print s}'); \
 	  pad=$$(($(FLASH_BUDGET) - flash)); [ $$pad -gt 0 ] || pad=0; \
 	  $(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=$$pad -x assembler-with-cpp -c $< -o $@
-$(BIG_BUILD)/padding-low.S.o: test/sketch/padding.S
+# The control's padding: enough to lift the end of the PROGMEM data (__ctors_start follows
+# it) 256 bytes past 64 KB, so that the firmware with it still fits the 2560's flash.
+$(BIG_BUILD)/padding-low.S.o: test/sketch/padding.S $(FW_BUILD)/firmware.elf
 	@mkdir -p $(dir $@)
-	$(Q)$(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=65536 -DAPM25_PAD_BELOW_PROGMEM -x assembler-with-cpp -c $< -o $@
+	$(Q)end=$$(avr-nm $(FW_BUILD)/firmware.elf | awk '$$3 == "__ctors_start" {print $$1}'); \
+	  pad=$$((65536 + 256 - 0x$$end)); \
+	  $(AVR_CC) $(AVR_DEFS) -DAPM25_PAD_BYTES=$$pad -DAPM25_PAD_BELOW_PROGMEM -x assembler-with-cpp -c $< -o $@
 $(BIG_BUILD)/firmware.elf: $(BIG_BUILD)/padding.S.o $(FW_OBJ) $(BUILD)/avr/core.a
 	$(call say,LINK,$@ (padded to the $(FLASH_BUDGET)-byte budget))
 	$(Q)$(BIG_LINK)

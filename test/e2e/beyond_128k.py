@@ -649,7 +649,7 @@ def cmd_run(args):
 # Broken images the test must catch: (the ELF beside the padded one, the check that must
 # fail, what is wrong with it).
 CONTROLS = [("no-trampolines", "words", "linked with --no-stubs: code addresses above 128 KB wrap round"),
-            ("progmem-high", "progmem", "64 KB of padding before the PROGMEM data, which lies above 64 KB")]
+            ("progmem-high", "progmem", "padding before the PROGMEM data, whose end lies above 64 KB")]
 
 
 def main():
