@@ -16,6 +16,7 @@
 #include "Port.h"
 #include "Position.h"
 #include "SerialText.h"
+#include "Tasks.h"
 #include "Vehicle.h"
 #include "Version.h"
 
@@ -255,7 +256,7 @@ void send_reply() {
 // next after the ACK.
 bool request_due() { return input.ready() && !(command_pending && input.frame().msgid == mav::kMsgCommandLong); }
 
-void take_request() {
+TASK_OWN_FRAME void take_request() {
     const mav::Received& rx = input.frame();
     last_frame_ms = millis();
     mav::ParamRequest read;
@@ -306,7 +307,7 @@ void take_request() {
 }
 
 bool command_due() { return command_pending && room_for(2u * mav::kMaxFrame); }
-void run_pending_command() {
+TASK_OWN_FRAME void run_pending_command() {
     command_pending = false;
     const mav::Result r = run_command(command);
     uint8_t frame[mav::kMaxFrame];
@@ -349,7 +350,7 @@ constexpr uint16_t kSaveQuietMs = 50;
 bool save_due() {
     return save_pending && millis() - last_frame_ms >= kSaveQuietMs && room_for(2u * mav::kMaxFrame);
 }
-void save() {
+TASK_OWN_FRAME void save() {
     // The changed value in force first, as the console's `set` puts it (the controllers'
     // terms, the end points' factors, RC_OVERRIDE_TIME; a PARAM_SET of RLL2SRV_P flew the
     // old gains before), then the save: each a pass of its own, as the record's encoding

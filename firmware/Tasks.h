@@ -6,6 +6,13 @@
 
 #include "Text.h"
 
+// On a loop task's job (the table's `run`) that a single row calls, the inliner would fold
+// it into run_loop_tasks: its locals (a MAVLink frame ...) would join that function's frame,
+// beyond the 63 bytes ldd/std reach, and every access to the others would take a subi,
+// sbci pair before and after (1.2 KB over take_request, run_pending_command, save,
+// position::run and battery_input::update). Loop tasks run between samples: a call is free.
+#define TASK_OWN_FRAME __attribute__((noinline))
+
 namespace tasks {
 
 // In setup(), the last thing before the loop starts.
