@@ -6,7 +6,6 @@
 #include "BatteryMonitor.h"
 #include "GcsLink.h"
 #include "Port.h"
-#include "Tasks.h"
 #include "Vehicle.h"
 
 namespace battery_input {
@@ -43,7 +42,7 @@ static void say_failsafe() {
         .end();
 }
 
-TASK_OWN_FRAME void update() {
+void update() {
     const uint32_t now_ms = millis();
     const float dt_s = updated_before ? (float)(uint16_t)((uint16_t)now_ms - last_update_ms) * 0.001f : 0.0f;
     last_update_ms = (uint16_t)now_ms;

@@ -8,7 +8,6 @@
 #include "GcsLink.h"
 #include "GpsPort.h"
 #include "SerialText.h"
-#include "Tasks.h"
 #include "Vehicle.h"
 
 namespace position {
@@ -75,7 +74,7 @@ static void learn_wind(const gps::Fix& fix) {
                  (float)a.pitch_centideg * kRadPerCentideg, (float)dt_ms * 0.001f);
 }
 
-TASK_OWN_FRAME void run() {
+void run() {
     const uint32_t now_ms = millis();
     last_run_ms = now_ms;
     const nav::BaroReading baro = baro_now();
