@@ -21,6 +21,7 @@
 #include "Position.h"
 #include "SerialText.h"
 #include "StreamRates.h"
+#include "Tasks.h"
 #include "Vehicle.h"
 #include "Version.h"
 
@@ -271,7 +272,7 @@ bool request_due() {
     return !(command_pending && id == mav::kMsgCommandLong) && !(mission_link::is_mission_frame(id) && mission_link::busy());
 }
 
-void take_request() {
+TASK_OWN_FRAME void take_request() {
     const mav::Received& rx = input.frame();
     last_frame_ms = millis();
     mav::ParamRequest read;
@@ -334,7 +335,7 @@ void take_request() {
 }
 
 bool command_due() { return command_pending && room_for(2u * mav::kMaxFrame); }
-void run_pending_command() {
+TASK_OWN_FRAME void run_pending_command() {
     command_pending = false;
     uint8_t frame[mav::kMaxFrame];
     mav::Result r = mav::Result::Denied;
@@ -419,7 +420,7 @@ constexpr uint16_t kSaveQuietMs = 50;
 bool save_due() {
     return save_pending && millis() - last_frame_ms >= kSaveQuietMs && room_for(2u * mav::kMaxFrame);
 }
-void save() {
+TASK_OWN_FRAME void save() {
     // The changed value in force first, as the console's `set` puts it (the controllers'
     // terms, the end points' factors, RC_OVERRIDE_TIME; a PARAM_SET of RLL2SRV_P flew the
     // old gains before), then the save: each a pass of its own, as the record's encoding

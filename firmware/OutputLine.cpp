@@ -19,8 +19,10 @@ bool due() {
     return tick.output;
 }
 
-// True when it worked out the angles in hundredths (c).
-static bool emit(uint32_t now_ms, pipeline::AnglesCentideg& c) {
+// True when it worked out the angles in hundredths (c). Never inline: its line buffer and
+// ATTITUDE's frame (~330 B) would join the loop's frame (main, with the estimator step
+// inlined), beyond the 63 bytes ldd/std reach, and slow every access to it.
+__attribute__((noinline)) static bool emit(uint32_t now_ms, pipeline::AnglesCentideg& c) {
     const fmt::OutputMode mode = port::output_mode();
     if (mode == fmt::OutputMode::Quiet) return false;
     // ATTITUDE at SR0_EXTRA1's rate (or its own interval), on the output lines it falls on

@@ -60,6 +60,8 @@ AVR_CFLAGS   := $(AVR_DEFS) $(AVR_OPT) -std=gnu11
 AVR_CXXFLAGS := $(AVR_DEFS) $(AVR_OPT) -std=gnu++11 $(AVR_SHARED_CXX) -DDECIMAL_DIG=__DECIMAL_DIG__
 # The project's own files: every warning is an error.
 PROJECT_WARN := $(AVR_SHARED_WARN) -Werror
+# ... and their own optimisation flags (mk/avr-flags.mk).
+PROJECT_OPT  := $(AVR_SHARED_PROJECT_OPT)
 AVR_LDFLAGS  := -mmcu=$(MCU) $(filter -O% -flto,$(AVR_SHARED_OPT)) $(AVR_SHARED_LINK) \
                 $(filter -m%,$(AVR_SHARED_OPT))
 
@@ -105,11 +107,11 @@ $(SKETCH_CPP): $(SKETCH_INO)
 	$(Q){ echo '#include <Arduino.h>'; for f in $^; do echo "#line 1 \"$$f\""; cat "$$f"; done; } > $@
 $(SKETCH_CPP).o: $(SKETCH_CPP) $(FW_HDR)
 	$(call say,AVR-CXX,$(SKETCH_INO))
-	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(FW_DEFS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
+	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(PROJECT_OPT) $(FW_DEFS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
 $(FW_BUILD)/avr/%.cpp.o: %.cpp $(FW_HDR)
 	$(call say,AVR-CXX,$<)
 	@mkdir -p $(dir $@)
-	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(FW_DEFS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
+	$(Q)$(AVR_CXX) $(AVR_CXXFLAGS) $(PROJECT_OPT) $(FW_DEFS) $(PROJECT_WARN) $(AVR_INC) -c $< -o $@
 
 # The commit's hash for AUTOPILOT_VERSION (firmware/Version.h: git_version.h when the build
 # has one), rewritten only when HEAD moves, so that only GcsLink is compiled again.

@@ -40,7 +40,7 @@ def read_flags(path=FLAGS_FILE):
 
 
 def platformio_flags(flags):
-    opt = flags["AVR_SHARED_OPT"]
+    opt = flags["AVR_SHARED_OPT"] + flags.get("AVR_SHARED_PROJECT_OPT", [])
     link = [f for f in flags["AVR_SHARED_LINK"] if f.startswith("-Wl,")]
     if "-mrelax" in opt:
         link.append("-Wl,--relax")
