@@ -172,14 +172,16 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Flight mode channel", "",
                "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
                "ArduPlane's six bands. 0: no switch, the console's `flight` command only.")},
-    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 5.0f, 0.0f,
+    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 12.0f, 0.0f,
      PARAM_DOC("Flight mode 1", "",
-               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 2 STABILIZE, 5 FBWA (ArduPlane's "
-               "numbers; FBWA flies as STABILIZE does). Any other number is refused.")},
-    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 5.0f, 2.0f,
+               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 1 CIRCLE, 2 STABILIZE, 5 FBWA, 6 "
+               "FBWB, 7 CRUISE, 10 AUTO, 11 RTL, 12 LOITER (ArduPlane's numbers; FBWA flies as STABILIZE does). Any "
+               "other number is refused. A mode that cannot run when the switch picks it (no 3D fix, no home, no "
+               "mission) is refused with its reason and the mode before flies on.")},
+    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 12.0f, 2.0f,
      PARAM_DOC("Flight mode n", "",
                "The mode of the switch's position n (2: 1231 to 1360 us, 3: to 1490, 4: to 1620, 5: to 1749, 6: "
-               "above): 0 MANUAL, 2 STABILIZE, 5 FBWA; any other number is refused.")},
+               "above), numbered as FLTMODE1's; any other number is refused.")},
     {"RCMAP_ROLL", Type::UInt8, 0, 1, 0, AT(flight.rcmap[0]), 1.0f, 8.0f, 1.0f,
      PARAM_DOC("Roll channel", "", "The receiver channel of the roll (aileron) stick.")},
     {"RCMAP_PITCH", Type::UInt8, 0, 1, 0, AT(flight.rcmap[1]), 1.0f, 8.0f, 2.0f,
