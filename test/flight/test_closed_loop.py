@@ -70,6 +70,13 @@ GROUP is one of:
                   nose right (> 2 deg/s on average, the heading > 5 deg right), 10 deg of
                   pitch held within 3 deg from 5 s into it, the bank within 15 deg, level
                   again within 5 deg of pitch, above 80 m
+  rtl             the navigation's RTL (docs/navigation.md "The modes"): on the default settings
+                  but the Rascal's cruise (TRIM_THROTTLE 11, TRIM_ARSPD_CM 1800), ALT_HOLD_RTL
+                  3000 and FLTMODE5 RTL, no gusts: the switch's RTL before the first fix is
+                  refused ("no 3D GPS fix") and STABILIZE flies on; from 25 s out (~400 m)
+                  RTL turns back, and from 15 s after it first comes within 80 m of home the
+                  circle holds WP_LOITER_RAD (60 m) +- 5 m and the height home's + 30 m
+                  +- 3 m, for at least 25 s
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
 import argparse
@@ -730,7 +737,78 @@ def fly_stabilized(f, name, t_turn, t_out, seconds, worst_us, bank):
     soft_assert(lost < 20.0, "%s: lost %.1f m of height (less than 20)" % (name, lost))
 
 
-GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+# The simulator's GPS origin (apm25sim --home's default) and its flat map (sim/models/Geodesy.h),
+# to put the home the board says on the backend's north-east metres.
+SIM_HOME = (7.135045, -73.119421, 1028.0)
+
+
+def sim_ned(lat_deg, lon_deg):
+    a, e2 = 6378137.0, 6.69437999014e-3
+    s = math.sin(math.radians(SIM_HOME[0]))
+    r_m = a * (1 - e2) / (1 - e2 * s * s) ** 1.5
+    r_n = a / math.sqrt(1 - e2 * s * s)
+    return (math.radians(lat_deg - SIM_HOME[0]) * (r_m + SIM_HOME[2]),
+            math.radians(lon_deg - SIM_HOME[1]) * (r_n + SIM_HOME[2]) * math.cos(math.radians(SIM_HOME[0])))
+
+
+def said_home(f):
+    """Home as the board said it: (north m, east m, height above the backend's ground m)."""
+    h = f.said("# home: set at ")
+    if h is None:
+        return None
+    lat, lon = (float(x) for x in h[1].split("set at ")[1].split(",")[0].split())
+    alt = float(h[1].split(", ")[1].split(" m")[0])
+    return sim_ned(lat, lon) + (alt - SIM_HOME[2],)
+
+
+RTL_ALT_CM, LOITER_RAD_M = 3000, 60.0
+RTL_SWITCH = 1700  # channel 8's fifth band: FLTMODE5
+
+
+def check_rtl(args):
+    t_rtl, seconds = HOLD_S + 25.0, 100.0
+    rows = [row(0.0), row(HOLD_S + 1.0, mode=RTL_SWITCH), row(HOLD_S + 2.0), row(t_rtl, mode=RTL_SWITCH)]
+    f = Flight(args.work, "rtl", rows, seconds, tools=args.tools, gps="ublox",
+               console=["set FLTMODE5 11", "set ALT_HOLD_RTL %d" % RTL_ALT_CM, "set TRIM_THROTTLE 11",
+                        "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    refused = f.said("# Mode change refused (switch): RTL")
+    print("rtl: before the fix the board said %r" % (refused,))
+    soft_assert(refused is not None and "no 3D GPS fix" in refused[1] and refused[0] < HOLD_S + 2.0,
+                "rtl: RTL before the first fix not refused with its reason: %r" % (refused,))
+    soft_assert(f.said("# flight RTL", after=HOLD_S + 1.0) is not None and f.said("# flight RTL")[0] >= t_rtl,
+                "rtl: RTL entered before the switch asked for it after the fix: %r" % (f.said("# flight RTL"),))
+    home = said_home(f)
+    soft_assert(home is not None, "rtl: no home said")
+    if home is None:
+        return
+    want_h = home[2] + RTL_ALT_CM / 100.0
+
+    def dist(r):
+        return math.hypot(r["north_m"] - home[0], r["east_m"] - home[1])
+    out = dist(f.truth_at(t_rtl))
+    near = next((r["t"] for r in f.truth_between(t_rtl, seconds) if dist(r) < 80.0), None)
+    soft_assert(near is not None, "rtl: never within 80 m of home")
+    if near is None:
+        return
+    circle = f.truth_between(near + 15.0, seconds)
+    radii = [dist(r) for r in circle]
+    heights = [-r["down_m"] - want_h for r in circle]
+    turned = sum(abs(angle_diff(b["yaw_deg"], a["yaw_deg"])) for a, b in zip(circle, circle[1:]))
+    print("rtl: %.0f m out at %.1f s; within 80 m of home %.1f s later; on the circle from %.1f s for %.0f s (%.0f deg "
+          "turned): radius %.1f-%.1f m (mean %.1f, WP_LOITER_RAD %g), height %+.1f to %+.1f m of home + %g m "
+          "(mean %+.2f)" % (out, t_rtl, near - t_rtl, near + 15.0, seconds - near - 15.0, turned, min(radii),
+                            max(radii), sum(radii) / len(radii), LOITER_RAD_M, min(heights), max(heights),
+                            RTL_ALT_CM / 100.0, sum(heights) / len(heights)))
+    soft_assert(out > 350.0, "rtl: only %.0f m out when RTL began" % out)
+    soft_assert(seconds - near - 15.0 >= 25.0, "rtl: %.1f s to come home" % (near - t_rtl))
+    soft_assert(turned > 300.0, "rtl: the circle turned only %.0f deg" % turned)
+    soft_assert(max(abs(r - LOITER_RAD_M) for r in radii) <= 5.0, "rtl: the radius left %g +- 5 m: %.1f-%.1f"
+                % (LOITER_RAD_M, min(radii), max(radii)))
+    soft_assert(max(abs(h) for h in heights) <= 3.0, "rtl: the height left ALT_HOLD_RTL +- 3 m: %+.1f to %+.1f"
+                % (min(heights), max(heights)))
+
+
+GROUPS = {"rtl": check_rtl, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
