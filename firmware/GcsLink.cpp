@@ -10,6 +10,7 @@
 #include "Console.h"
 #include "ConsoleLink.h"
 #include "GpsPort.h"
+#include "NavModes.h"
 #include "LoopLoad.h"
 #include "MagCalLink.h"
 #include "ParamLink.h"
@@ -447,9 +448,10 @@ void send_heartbeat_and_status() {
 }
 
 // The position messages: each round (kPositionPeriodMs) GLOBAL_POSITION_INT and VFR_HUD,
-// every other round GPS_RAW_INT first; HOME_POSITION before them when due. One frame a run.
+// then NAV_CONTROLLER_OUTPUT while a navigation mode flies, every other round GPS_RAW_INT
+// first; HOME_POSITION before them when due. One frame a run.
 constexpr uint16_t kPositionPeriodMs = 250;
-enum PositionFrame : uint8_t { kGpsRaw, kGlobalPosition, kVfrHud, kRoundDone };
+enum PositionFrame : uint8_t { kGpsRaw, kGlobalPosition, kVfrHud, kNavOutput, kRoundDone };
 static uint8_t next_position_frame = kRoundDone;
 static uint8_t position_rounds = 0;
 static uint32_t position_round_ms = 0;
@@ -491,10 +493,15 @@ void send_position() {
                 position::report(r);
                 n = port::mavlink.global_position_int(frame, r);
                 break;
-            default:
+            case kVfrHud:
                 position::report(r);
                 n = port::mavlink.vfr_hud(frame, r);
                 break;
+            default: {
+                mav::NavOutput nav;
+                if (nav_modes::report(nav)) n = port::mavlink.nav_controller_output(frame, nav);
+                break;
+            }
         }
     }
     if (n > 0) port::send_frame(frame, n);

@@ -56,7 +56,7 @@ nav::NorthEast cruise_end_m = {0.0f, 0.0f};
 bool cruise_locked = false;
 float height_dem_m = 0.0f;                    // CIRCLE, LOITER, FBWB, CRUISE: the height held
 bool have_report = false;
-Report last_report;
+mav::NavOutput last_report;
 
 const settings::Settings& cfg() { return pipe.settings(); }
 
@@ -214,7 +214,7 @@ void run() {
     flight_io.set_nav_demands(roll_cd, tecs.pitch_dem_cd(), (int16_t)(tecs.throttle_pct() * 10u));
 
     // NAV_CONTROLLER_OUTPUT's fields (ArduPlane's: bearings in degrees, 0..360 as int16).
-    Report& rep = last_report;
+    mav::NavOutput& rep = last_report;
     rep.nav_roll_deg = (float)roll_cd * 0.01f;
     rep.nav_pitch_deg = (float)tecs.pitch_dem_cd() * 0.01f;
     if (guided) {
@@ -235,7 +235,7 @@ void run() {
     have_report = true;
 }
 
-bool report(Report& r) {
+bool report(mav::NavOutput& r) {
     if (!have_report) return false;
     r = last_report;
     return true;
@@ -269,7 +269,7 @@ void filters_run() {}
 void configure() {}
 bool refused(flight::Mode, text::Flash&) { return false; }
 uint16_t unavailable_rows() { return 0; }
-bool report(Report&) { return false; }
+bool report(mav::NavOutput&) { return false; }
 }  // namespace nav_modes
 
 #endif

@@ -49,13 +49,7 @@ bool refused(flight::Mode m, text::Flash& reason);
 uint16_t unavailable_rows();
 
 // NAV_CONTROLLER_OUTPUT's fields, while a navigation mode flies (false: none).
-struct Report {
-    float nav_roll_deg, nav_pitch_deg;
-    int16_t nav_bearing_deg, target_bearing_deg;
-    uint16_t wp_dist_m;
-    float alt_error_m, xtrack_error_m;
-};
-bool report(Report& r);
+bool report(mav::NavOutput& r);
 
 #if APM25_FLIGHT
 // The stored mission AUTO flies: the one place that reads it (MissionLink's accessor
