@@ -56,6 +56,16 @@ nav::NorthEast cruise_end_m = {0.0f, 0.0f};
 bool cruise_locked = false;
 float height_dem_m = 0.0f;                    // CIRCLE, LOITER, FBWB, CRUISE: the height held
 bool have_report = false;
+// The step's first half (the guidance) for its second (TECS), on the next loop pass.
+struct Pending {
+    nav::TecsInput in;
+    float dt_s;
+    int16_t roll_cd;
+    int16_t heading_deg;
+    bool guided;
+};
+Pending pending;
+bool tecs_pending = false;
 mav::NavOutput last_report;
 
 const settings::Settings& cfg() { return pipe.settings(); }
@@ -123,10 +133,13 @@ uint16_t unavailable_rows() {
 
 bool due() {
     // At once when the mode changed, so that its first demands are its own.
-    return millis() - last_run_ms >= kPeriodMs || flight_io.nav_mode() != flying;
+    return tecs_pending || millis() - last_run_ms >= kPeriodMs || flight_io.nav_mode() != flying;
 }
 
+static void run_tecs();
+
 void run() {
+    if (tecs_pending) return run_tecs();
     const uint32_t now_ms = millis();
     const float dt_s = (float)(now_ms - last_run_ms) * 0.001f;
     last_run_ms = now_ms;
@@ -148,7 +161,8 @@ void run() {
     const float pitch_rad = (float)att.pitch_centideg * (1.0f / kCdPerRad);
     const float cos_pitch = 1.0f - 0.5f * pitch_rad * pitch_rad;  // within 0.5 % to 25 degrees
     int16_t roll_cd = 0;
-    nav::TecsInput in{};
+    nav::TecsInput& in = pending.in;
+    in = nav::TecsInput{};
     in.eas_dem_m_s = fs.trim_arspd_cm != 0u ? (float)fs.trim_arspd_cm * 0.01f
                                             : 0.5f * (float)(fs.arspd_min_m_s + fs.arspd_max_m_s);
     bool guided = true;  // L1 gives the bank
@@ -202,15 +216,29 @@ void run() {
         }
     }
     if (guided) roll_cd = l1.nav_roll_cd(fs.lim_roll_cd, cos_pitch);
-    // TECS: the height and speed; the bank's cos^2 from the DCM's rows (a.y^2 + b.y^2).
-    const linalg::Matrix3f r = pipe.estimator().matrix();
     in.height_dem_m = height_dem_m;
+    in.pitch_rad = pitch_rad;
+    pending.roll_cd = roll_cd;
+    pending.guided = guided;
+    pending.dt_s = dt_s;
+    pending.heading_deg = (int16_t)(att.heading_centideg / 100);
+    tecs_pending = true;
+}
+
+// The step's second half, on the next loop pass: TECS and the demands (the two halves
+// together took up to 5 ms, past what fits between two samples).
+static void run_tecs() {
+    tecs_pending = false;
+    nav::TecsInput& in = pending.in;
+    // The bank's cos^2 from the DCM's rows (a.y^2 + b.y^2).
+    const linalg::Matrix3f r = pipe.estimator().matrix();
     in.have_airspeed = airspeed_input::state() == airspeed_input::State::kSensor;
     in.eas_m_s = pipe.airspeed_m_s();
     in.eas2tas = 1.0f;
     in.cos_bank_sq = r.a.y * r.a.y + r.b.y * r.b.y;
-    in.pitch_rad = pitch_rad;
-    tecs.update_pitch_throttle(in, dt_s);
+    tecs.update_pitch_throttle(in, pending.dt_s);
+    const int16_t roll_cd = pending.roll_cd;
+    const bool guided = pending.guided;
     flight_io.set_nav_demands(roll_cd, tecs.pitch_dem_cd(), (int16_t)(tecs.throttle_pct() * 10u));
 
     // NAV_CONTROLLER_OUTPUT's fields (ArduPlane's: bearings in degrees, 0..360 as int16).
@@ -227,7 +255,7 @@ void run() {
         rep.wp_dist_m = d < 65535.0f ? (uint16_t)d : 65535u;
         rep.xtrack_error_m = l1.crosstrack_error_m();
     } else {
-        rep.nav_bearing_deg = rep.target_bearing_deg = (int16_t)(att.heading_centideg / 100);
+        rep.nav_bearing_deg = rep.target_bearing_deg = pending.heading_deg;
         rep.wp_dist_m = 0;
         rep.xtrack_error_m = 0.0f;
     }

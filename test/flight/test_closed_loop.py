@@ -77,6 +77,12 @@ GROUP is one of:
                   RTL turns back, and from 15 s after it first comes within 80 m of home the
                   circle holds WP_LOITER_RAD (60 m) +- 5 m and the height home's + 30 m
                   +- 3 m, for at least 25 s
+  auto            a rectangle mission in AUTO (apm25sim --mission: 500 m x 300 m at home + 10 m,
+                  DO_JUMP for ever), no gusts, from 10 s for 140 s (1.6 laps): every waypoint
+                  passed within WP_RADIUS (30 m), the cross-track RMS on the legs after capture
+                  (within 3 m of the line and 10 deg of its course, until the turn) <= 2 m,
+                  the height RMS on them <= 3 m; AUTO before the first fix refused ("no 3D GPS
+                  fix"), no sample missed
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
 import argparse
@@ -142,7 +148,7 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True):
+                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True, mission=None):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
         board (apm25sim --input: from its first angle line); airframe: how the backend reads
         the outputs (closed_loop.py --airframe: plain, elevons, vtail); gps: apm25sim --gps
@@ -166,6 +172,8 @@ class Flight:
             cmd += ["--gps", gps]
         if arm:
             cmd.append("--arm")
+        if mission:
+            cmd += ["--mission", mission]
         if console:
             with open(base + "_console.txt", "w") as f:
                 f.write("".join(line + "\n" for line in console))
@@ -808,7 +816,106 @@ def check_rtl(args):
                 % (min(heights), max(heights)))
 
 
-GROUPS = {"rtl": check_rtl, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+def sim_latlon(north_m, east_m):
+    """The inverse of sim_ned: degrees."""
+    a, e2 = 6378137.0, 6.69437999014e-3
+    s = math.sin(math.radians(SIM_HOME[0]))
+    r_m = a * (1 - e2) / (1 - e2 * s * s) ** 1.5
+    r_n = a / math.sqrt(1 - e2 * s * s)
+    return (SIM_HOME[0] + math.degrees(north_m / (r_m + SIM_HOME[2])),
+            SIM_HOME[1] + math.degrees(east_m / ((r_n + SIM_HOME[2]) * math.cos(math.radians(SIM_HOME[0])))))
+
+
+# The rectangle: north-east metres from the backend's start (the launch point, heading north),
+# at home + RECT_ALT_M; the aeroplane flies up its west side when AUTO starts.
+RECT = [(400.0, 0.0), (400.0, 300.0), (-100.0, 300.0), (-100.0, 0.0)]
+RECT_ALT_M = 10.0
+WP_RADIUS_M = 30.0
+
+
+def write_rectangle(path):
+    lines = ["QGC WPL 110", "0\t1\t0\t16\t0\t0\t0\t0\t%.7f\t%.7f\t%.2f\t1" % (SIM_HOME[0], SIM_HOME[1], SIM_HOME[2])]
+    for i, (n, e) in enumerate(RECT):
+        lat, lon = sim_latlon(n, e)
+        lines.append("%d\t0\t3\t16\t0\t0\t0\t0\t%.7f\t%.7f\t%.2f\t1" % (i + 1, lat, lon, RECT_ALT_M))
+    lines.append("%d\t0\t0\t177\t1\t-1\t0\t0\t0\t0\t0\t1" % (len(RECT) + 1))  # DO_JUMP 1, for ever
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return path
+
+
+def leg_figures(samples, legs, want_h, turn_m=WP_RADIUS_M):
+    """Cross-track and height errors on the legs after capture, as the host route test takes
+    them: on a pass along a leg, from the first sample within 3 m of its line and 10 deg of
+    its course until turn_m before its end. ([cross-track m], [height error m], passes)."""
+    xt, dh, passes = [], [], 0
+    for (a, b) in legs:
+        dn, de = b[0] - a[0], b[1] - a[1]
+        length = math.hypot(dn, de)
+        un, ue = dn / length, de / length
+        captured, last_t = False, None
+        for r in samples:
+            pn, pe = r["north_m"] - a[0], r["east_m"] - a[1]
+            along, cross = pn * un + pe * ue, pe * un - pn * ue
+            course = math.degrees(math.atan2(r["ve_m_s"], r["vn_m_s"]))
+            off = abs(angle_diff(course, math.degrees(math.atan2(ue, un))))
+            on = 0.0 <= along <= length - turn_m and off < 45.0 and abs(cross) < 50.0
+            if not on:
+                captured = False
+                continue
+            if last_t is None or r["t"] - last_t > 1.0:
+                captured = False
+            last_t = r["t"]
+            if not captured and abs(cross) < 3.0 and off < 10.0:
+                captured = True
+                passes += 1
+            if captured:
+                xt.append(cross)
+                dh.append(-r["down_m"] - want_h)
+    return xt, dh, passes
+
+
+def rms(v):
+    return math.sqrt(sum(x * x for x in v) / len(v)) if v else float("nan")
+
+
+def check_auto(args):
+    t_auto, seconds = 10.0, 150.0
+    mission = write_rectangle(os.path.join(args.work, "rectangle.waypoints"))
+    rows = [row(0.0), row(HOLD_S + 1.0, mode=RTL_SWITCH), row(HOLD_S + 2.0), row(t_auto, mode=RTL_SWITCH)]
+    f = Flight(args.work, "auto", rows, seconds, tools=args.tools, gps="ublox", mission=mission,
+               console=["set FLTMODE5 10", "set TRIM_THROTTLE 11", "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    refused = f.said("# Mode change refused (switch): AUTO")
+    print("auto: before the fix the board said %r" % (refused,))
+    soft_assert(refused is not None and "no 3D GPS fix" in refused[1], "auto: AUTO before the fix not refused: %r"
+                % (refused,))
+    entered = f.said("# flight AUTO")
+    soft_assert(entered is not None and entered[0] >= t_auto, "auto: AUTO not entered at %g s: %r" % (t_auto, entered))
+    overrun = f.said("# warn: loop overrun")
+    soft_assert(overrun is None, "auto: %r" % (overrun,))
+    home = said_home(f)
+    soft_assert(home is not None, "auto: no home said")
+    if home is None:
+        return
+    flown = f.truth_between(t_auto, seconds)
+    closest = []
+    for w in RECT:
+        d, t = min((math.hypot(r["north_m"] - w[0], r["east_m"] - w[1]), r["t"]) for r in flown)
+        closest.append((d, t))
+    legs = [(RECT[i], RECT[(i + 1) % len(RECT)]) for i in range(len(RECT))]
+    xt, dh, passes = leg_figures(flown, legs, home[2] + RECT_ALT_M)
+    print("auto: closest to each waypoint %s m; %d leg passes after capture, %.0f s of them: cross-track RMS %.2f m "
+          "(worst %.1f), height RMS %.2f m (mean %+.2f) of home + %g m"
+          % (", ".join("%.1f (%.0f s)" % c for c in closest), passes, len(xt) / 1000.0, rms(xt),
+             max((abs(x) for x in xt), default=float("nan")), rms(dh), sum(dh) / max(len(dh), 1), RECT_ALT_M))
+    soft_assert(all(d <= WP_RADIUS_M for d, _ in closest), "auto: a waypoint missed by more than WP_RADIUS: %s"
+                % closest)
+    soft_assert(passes >= 4 and len(xt) > 40000, "auto: only %d passes, %d samples on the legs" % (passes, len(xt)))
+    soft_assert(rms(xt) <= 2.0, "auto: cross-track RMS %.2f m (at most 2)" % rms(xt))
+    soft_assert(rms(dh) <= 3.0, "auto: height RMS %.2f m (at most 3)" % rms(dh))
+
+
+GROUPS = {"rtl": check_rtl, "auto": check_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
