@@ -113,6 +113,7 @@ def parse_args(argv):
     p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
     p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
+    p.add_argument("--wind", help="the backend's --wind N,E: a steady wind, m/s")
     p.add_argument("--mission", help="apm25sim --mission: a QGC WPL 110 file into the EEPROM before the run")
     p.add_argument("--profile", help="apm25sim --profile: the sections' cycle counts")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
@@ -178,6 +179,8 @@ def run(args):
         backend_cmd += ["--trajectory", args.trajectory]
     if args.no_airspeed:
         backend_cmd.append("--no-airspeed")
+    if args.wind:
+        backend_cmd += ["--wind", args.wind]
     if args.airframe != "plain":
         backend_cmd += ["--airframe", args.airframe]
     deadline = time.monotonic() + args.timeout
