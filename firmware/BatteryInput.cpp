@@ -26,7 +26,7 @@ bool due() { return (uint16_t)(now16() - last_update_ms) >= battery::kUpdatePeri
 
 // The low-battery failsafe's action: ArduPlane's (low_battery_event), RTL; without a 3D
 // fix or home the mode is kept, and said so (FlightIo::failsafe_rtl).
-static void failsafe_action() { vehicle::flight_io.failsafe_rtl(); }
+static void failsafe_action() { vehicle::flight_io.failsafe_rtl(TXT("low battery")); }
 
 static void say_failsafe() {
     // ArduPlane's words: "Low battery %.2fV used %.0f mAh" (a WARNING).

@@ -286,7 +286,7 @@ void FlightIo::long_failsafe(uint32_t now_ms) {
         control_.choose(flight::Mode::FlyByWireA);
     } else if (ns.fs_long_actn == settings::kFsLongRtl ||
                (m != flight::Mode::Auto && m != flight::Mode::Loiter)) {
-        failsafe_rtl();
+        failsafe_rtl(TXT("long (FS_LONG_TIMEOUT)"));
         return;
     } else {
         return;
@@ -311,15 +311,17 @@ void FlightIo::set_nav_demands(int16_t roll_cd, int16_t pitch_cd, int16_t thrott
 
 void FlightIo::set_unavailable(uint16_t rows) { control_.set_unavailable(rows); }
 
-void FlightIo::failsafe_rtl() {
+void FlightIo::failsafe_rtl(text::Flash which) {
     if (control_.chosen() == flight::Mode::Rtl) return;
+    Writer w(out_);
+    w.str(TXT("# failsafe: ")).str(which);
     text::Flash why;
     if (nav_modes::refused(flight::Mode::Rtl, why)) {
-        Writer(out_).str(TXT("# failsafe: no RTL (")).str(why).str(TXT("): mode kept")).end();
+        w.str(TXT(": no RTL (")).str(why).str(TXT("), mode kept")).end();
         return;
     }
     control_.choose(flight::Mode::Rtl);
-    print_flight_line(TXT("# failsafe: RTL, flight "));
+    w.str(TXT(": RTL")).end();
 }
 
 void FlightIo::rc_override(const uint16_t width_us[8]) { control_.on_override(width_us, millis()); }
@@ -464,7 +466,7 @@ flight::Mode FlightIo::nav_mode() const { return flight::Mode::Manual; }
 int16_t FlightIo::stick(uint8_t) const { return 0; }
 void FlightIo::set_nav_demands(int16_t, int16_t, int16_t) {}
 void FlightIo::set_unavailable(uint16_t) {}
-void FlightIo::failsafe_rtl() {}
+void FlightIo::failsafe_rtl(text::Flash) {}
 void FlightIo::rc_override(const uint16_t*) {}
 bool FlightIo::prearm_due() const { return false; }
 uint16_t FlightIo::prearm_failures() const { return 0; }

@@ -78,9 +78,10 @@ public:
     int16_t stick(uint8_t role) const;
     void set_nav_demands(int16_t roll_cd, int16_t pitch_cd, int16_t throttle);
     void set_unavailable(uint16_t rows);
-    // A failsafe's RTL (the battery's, ArduPlane's low_battery_event): RTL chosen and said,
-    // or, when it cannot run, the mode kept and the reason said.
-    void failsafe_rtl();
+    // A failsafe's RTL (`which`: the battery's, ArduPlane's low_battery_event; the long
+    // one): RTL chosen and said ("# failsafe: <which>: RTL"), or, when it cannot run, the
+    // mode kept and the reason said.
+    void failsafe_rtl(text::Flash which);
     // RC_CHANNELS_OVERRIDE's channels 1-8 (FlightControl::on_override).
     void rc_override(const uint16_t width_us[8]);
     // The pre-arm checks' failures now (lib/Flight/Arming.h's PreArm bits; 0: may arm):

@@ -141,7 +141,10 @@ static void run_tecs();
 void run() {
     if (tecs_pending) return run_tecs();
     const uint32_t now_ms = millis();
-    const float dt_s = (float)(now_ms - last_run_ms) * 0.001f;
+    // At most 0.5 s: FBWB's stick moves the height by it (the task runs every 100 ms in any
+    // mode, so only a stalled loop comes near).
+    const uint32_t since_ms = now_ms - last_run_ms;
+    const float dt_s = (float)(since_ms < 500u ? since_ms : 500u) * 0.001f;
     last_run_ms = now_ms;
     flight_io.set_unavailable(unavailable_rows());
     const flight::Mode m = flight_io.nav_mode();

@@ -84,6 +84,10 @@ GROUP is one of:
                   (within 3 m of the line and 10 deg of its course, until the turn) <= 2 m,
                   the height RMS on them <= 3 m; AUTO before the first fix refused ("no 3D GPS
                   fix"), no sample missed
+  rc_loss_auto    the rectangle in AUTO with FS_LONG_ACTN 1, the receiver lost from 35 s: the
+                  short failsafe said ("the mode goes on") and the mission flown on (within
+                  10 m of the legs, HEARTBEAT's mode AUTO in the line), then after
+                  FS_LONG_TIMEOUT (20 s) RTL said and flown: closer to home 15 s later
   auto_wind       the same in a 5 m/s wind from the west (the backend's --wind 0,5) with light
                   gusts (seed 47001): the cross-track RMS <= 5 m, the rest as `auto`
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
@@ -935,12 +939,54 @@ def check_auto(args):
     fly_auto(args, "auto", 2.0)
 
 
+def check_rc_loss_auto(args):
+    t_auto, t_lost, seconds = 10.0, 35.0, 80.0
+    mission = write_rectangle(os.path.join(args.work, "rc_loss_auto.waypoints"))
+    rows = [row(0.0), row(t_auto, mode=RTL_SWITCH), (t_lost, None)]
+    f = Flight(args.work, "rc_loss_auto", rows, seconds, tools=args.tools, gps="ublox", mission=mission,
+               console=["set FLTMODE5 10", "set FS_LONG_ACTN 1", "set TRIM_THROTTLE 11",
+                        "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    short = f.said("# failsafe: receiver lost", after=t_lost)
+    long_fs = f.said("# failsafe: long (FS_LONG_TIMEOUT): RTL", after=t_lost)
+    print("rc_loss_auto: said %r, then %r" % (short, long_fs))
+    soft_assert(short is not None and "the mode goes on" in short[1] and short[0] < t_lost + 1.0,
+                "rc_loss_auto: the short failsafe not said as AUTO flying on: %r" % (short,))
+    soft_assert(long_fs is not None and 19.0 <= long_fs[0] - t_lost <= 21.5,
+                "rc_loss_auto: RTL not entered FS_LONG_TIMEOUT after the loss: %r" % (long_fs,))
+    home = said_home(f)
+    if home is None or long_fs is None:
+        soft_assert(False, "rc_loss_auto: no home or no RTL")
+        return
+    legs = [(RECT[i], RECT[(i + 1) % len(RECT)]) for i in range(len(RECT))]
+
+    def off_route(r):
+        best = float("inf")
+        for a, b in legs:
+            dn, de = b[0] - a[0], b[1] - a[1]
+            length = math.hypot(dn, de)
+            along = ((r["north_m"] - a[0]) * dn + (r["east_m"] - a[1]) * de) / length
+            along = min(max(along, 0.0), length)
+            best = min(best, math.hypot(r["north_m"] - a[0] - along * dn / length,
+                                        r["east_m"] - a[1] - along * de / length))
+        return best
+    # The turns cut inside or overshoot the corners: the worst within 40 m of the route.
+    worst = max(off_route(r) for r in f.truth_between(t_lost, long_fs[0]))
+    d_rtl = math.hypot(f.truth_at(long_fs[0])["north_m"] - home[0], f.truth_at(long_fs[0])["east_m"] - home[1])
+    d_later = math.hypot(f.truth_at(long_fs[0] + 15.0)["north_m"] - home[0],
+                         f.truth_at(long_fs[0] + 15.0)["east_m"] - home[1])
+    print("rc_loss_auto: without the receiver AUTO flew on within %.1f m of the route for %.1f s; RTL at %.0f m from "
+          "home, %.0f m 15 s later" % (worst, long_fs[0] - t_lost, d_rtl, d_later))
+    soft_assert(worst <= 40.0, "rc_loss_auto: %.1f m off the route without the receiver" % worst)
+    soft_assert(d_later < d_rtl - 150.0 or d_later < 120.0, "rc_loss_auto: RTL did not come home: %.0f m -> %.0f m"
+                % (d_rtl, d_later))
+
+
 def check_auto_wind(args):
     """5 m/s from the west (across the long legs) with light gusts, a fresh seed."""
     fly_auto(args, "auto_wind", 5.0, gust=1, seed=47001, wind="0,5")
 
 
-GROUPS = {"rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+GROUPS = {"rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "rc_loss_auto": check_rc_loss_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
