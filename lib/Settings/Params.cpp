@@ -13,11 +13,13 @@
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)pgm_read_byte(&kRows[(r)].member))
 #define ROW_WORD(r, member) ((uint16_t)pgm_read_word(&kRows[(r)].member))
+#define ROW_FLOAT(dst, r, member) memcpy_P((dst), &kRows[(r)].member, sizeof(float))
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)kRows[(r)].member)
 #define ROW_WORD(r, member) ((uint16_t)kRows[(r)].member)
+#define ROW_FLOAT(dst, r, member) memcpy((dst), &kRows[(r)].member, sizeof(float))
 #endif
 
 // What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
@@ -539,7 +541,9 @@ float read(const Settings& s, const Row& row, uint8_t instance) {
 // Stores a value already checked against the row's range.
 void write(Settings& s, const Row& row, uint8_t instance, float value) {
     uint8_t* p = where(s, row, instance);
-    const int32_t whole = (int32_t)(value >= 0.0f ? value + 0.5f : value - 0.5f);
+    // Rounded for the integer types only (two float operations a value: the defaults'
+    // walk writes every one between samples).
+    const int32_t whole = is_integer(row.type) ? (int32_t)(value >= 0.0f ? value + 0.5f : value - 0.5f) : 0;
     switch (row.type) {
         case Type::Float: memcpy(p, &value, sizeof value); break;
         case Type::Int16: { const int16_t v = (int16_t)whole; memcpy(p, &v, sizeof v); break; }
@@ -673,7 +677,13 @@ bool set(Settings& s, uint16_t index, float value) {
 void apply_defaults(Settings& s) {
     Row row;
     for (uint8_t r = 0; r < kRowCount; ++r) {
-        COPY_ROW(&row, &kRows[r]);
+        // The fields write() needs, not the whole row (its name is half of it): the walk
+        // runs between samples (PREFLIGHT_STORAGE's defaults).
+        row.type = (Type)ROW_BYTE(r, type);
+        row.count = ROW_BYTE(r, count);
+        row.stride = ROW_BYTE(r, stride);
+        row.offset = ROW_WORD(r, offset);
+        ROW_FLOAT(&row.def, r, def);
         for (uint8_t i = 0; i < row.count; ++i) write(s, row, i, row.def);
     }
 }
