@@ -66,7 +66,6 @@ struct Pending {
 };
 Pending pending;
 bool tecs_pending = false;
-bool params_stale = true;  // configure() asked for the parameters again
 mav::NavOutput last_report;
 
 const settings::Settings& cfg() { return pipe.settings(); }
@@ -105,12 +104,7 @@ const mission::MissionStore& mission_store() {
     return store;
 }
 
-// On the guide task's next pass, a pass of its own: TECS's coefficients (divides) on top of
-// a caller's work (PREFLIGHT_STORAGE's defaults, a save's configure) took it past its budget.
-void configure() { params_stale = true; }
-
-static void apply_params() {
-    params_stale = false;
+void configure() {
     settings::nav_params(cfg().vehicle.nav, cfg().flight, l1_params, tecs_params, ex_params);
     tecs.set_params();
 }
@@ -139,13 +133,12 @@ uint16_t unavailable_rows() {
 
 bool due() {
     // At once when the mode changed, so that its first demands are its own.
-    return params_stale || tecs_pending || millis() - last_run_ms >= kPeriodMs || flight_io.nav_mode() != flying;
+    return tecs_pending || millis() - last_run_ms >= kPeriodMs || flight_io.nav_mode() != flying;
 }
 
 static void run_tecs();
 
 void run() {
-    if (params_stale) return apply_params();
     if (tecs_pending) return run_tecs();
     const uint32_t now_ms = millis();
     // At most 0.5 s: FBWB's stick moves the height by it (the task runs every 100 ms in any
