@@ -66,6 +66,8 @@ SECTIONS = [
     (46, "barocomp", "the MS5611 compensation: a D2's temperature terms or a D1's pressure", ()),
     (47, "baroheight", "the barometer's height and climb (10 Hz)", ()),
     (53, "battery", "the battery monitor's 10 Hz update (and its failsafe line)", ()),
+    (57, "guide", "the navigation modes' 10 Hz step: executor, L1, TECS (in a navigation mode)", ()),
+    (58, "tecsfilter", "TECS's 50 Hz height and acceleration filters", ()),
     (17, "gcsreply", "one PARAM_VALUE, or RC_CHANNELS + SERVO_OUTPUT_RAW, packed", ()),
 ]
 

@@ -23,10 +23,9 @@ static uint16_t now16() { return (uint16_t)millis(); }
 
 bool due() { return (uint16_t)(now16() - last_update_ms) >= battery::kUpdatePeriodMs; }
 
-// The low-battery failsafe's action. ArduPlane's (low_battery_event) is RTL; the board has
-// no navigation yet, so it keeps flying the mode it is in and says so. When RTL
-// exists, this is where it is asked for.
-static void failsafe_action() {}
+// The low-battery failsafe's action: ArduPlane's (low_battery_event), RTL; without a 3D
+// fix or home the mode is kept, and said so (FlightIo::failsafe_rtl).
+static void failsafe_action() { vehicle::flight_io.failsafe_rtl(TXT("low battery")); }
 
 static void say_failsafe() {
     // ArduPlane's words: "Low battery %.2fV used %.0f mAh" (a WARNING).
@@ -37,7 +36,6 @@ static void say_failsafe() {
         .str(TXT("V used "))
         .u32(used > 0.0f ? (uint32_t)(used + 0.5f) : 0u)
         .str(monitor.failsafe() == battery::Failsafe::kCapacity ? TXT(" mAh (FS_BATT_MAH)") : TXT(" mAh"))
-        .str(TXT("; no RTL yet: mode kept"))
         .end();
 }
 

@@ -75,6 +75,8 @@ enum Section : uint8_t {
     kSecGcsBattery = 54,   // BATTERY_STATUS packed and queued
     kSecGcsCommand = 55,   // a ground station's COMMAND_LONG run and ACKed
     kSecGcsAnswer = 56,    // TIMESYNC, AUTOPILOT_VERSION, a mission reply or SYSTEM_TIME packed and queued
+    kSecGuide = 57,        // the navigation modes' 10 Hz step: the executor, L1, TECS (NavModes)
+    kSecTecsFilter = 58,   // TECS's 50 Hz height and acceleration filters (NavModes)
 };
 inline void mark_begin(uint8_t id) { GPIOR0 = id; }
 inline void mark_end(uint8_t id) { GPIOR1 = id; }

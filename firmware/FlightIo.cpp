@@ -12,6 +12,7 @@
 #include "Baro.h"
 #include "GcsLink.h"
 #include "GpsPort.h"
+#include "NavModes.h"
 #include "RcInput.h"
 #include "SerialText.h"
 #include "ServoOutputs.h"
@@ -56,6 +57,7 @@ FlightIo::FlightIo(const text::Sink* out)
 void FlightIo::begin() {
     uint16_t widths[flight::kChannels];
     configure();  // the loaded settings
+    nav_modes::mission_store();  // the mission's areas checked now, not in a loop pass
     // Disarmed at power-up: with ARMING_REQUIRE 1 the throttle at its minimum from the first pulse.
     control_.set_throttle_live(arming_.throttle_live(pipe.settings().vehicle.arming_require));
     control_.step(0, flight::Attitude{0, 0, 0, 0, false, 0}, widths);
@@ -67,6 +69,7 @@ void FlightIo::loop_starts(uint32_t now_us) { last_control_us_ = now_us; }
 
 void FlightIo::configure() {
     control_.configure();
+    nav_modes::configure();
     control_.set_override_timeout(override_timeout_8ms(pipe.settings().vehicle.rc_override_time_s));
 }
 
@@ -121,6 +124,7 @@ void FlightIo::control_step(uint32_t now_us, uint32_t now_ms, const mpu6000::Sam
         }
     }
     arming_step(now_ms);
+    long_failsafe(now_ms);
     uint16_t widths[flight::kChannels];
     control_.step(now_ms, att, widths);
     servo_outputs::set(widths);
@@ -242,9 +246,82 @@ bool FlightIo::set_mode(uint32_t number) {
         Writer(out_).str(TXT("# Mode change refused: no mode ")).u32(number).str(TXT(" on this board")).end();
         return false;
     }
-    control_.choose((flight::Mode)number);
+    return choose_checked((flight::Mode)number);
+}
+
+static void write_mode_name(Writer& w, flight::Mode m);
+
+// A mode chosen by the ground station or the console: refused with its reason when it
+// cannot run now (NavModes), the mode before flying on.
+bool FlightIo::choose_checked(flight::Mode m) {
+    text::Flash why;
+    if (nav_modes::refused(m, why)) {
+        Writer w(out_);
+        w.str(TXT("# Mode change refused: "));
+        write_mode_name(w, m);
+        w.str(TXT(": ")).str(why).end();
+        return false;
+    }
+    control_.choose(m);
     print_flight_line(TXT("# flight "));
     return true;
+}
+
+// ArduPlane 3.x's long failsafe (failsafe_long_on_event): FS_LONG_TIMEOUT after the
+// receiver was lost, RTL (FS_LONG_ACTN 0 or 1; AUTO and LOITER go on with 0, RTL goes on),
+// or the failsafe glide (2: FBWA chosen, which glides until the receiver is back).
+void FlightIo::long_failsafe(uint32_t now_ms) {
+    const bool fs = control_.state() == flight::State::Failsafe;
+    if (fs != in_failsafe_) {
+        in_failsafe_ = fs;
+        failsafe_since_ms_ = now_ms;
+        long_failsafe_done_ = false;
+    }
+    const settings::NavSettings& ns = pipe.settings().vehicle.nav;
+    if (!fs || long_failsafe_done_ || now_ms - failsafe_since_ms_ < (uint32_t)ns.fs_long_timeout_s * 1000u) return;
+    long_failsafe_done_ = true;
+    const flight::Mode m = control_.chosen();
+    if (m == flight::Mode::Rtl) return;
+    if (ns.fs_long_actn == settings::kFsLongGlide) {
+        control_.choose(flight::Mode::FlyByWireA);
+    } else if (ns.fs_long_actn == settings::kFsLongRtl ||
+               (m != flight::Mode::Auto && m != flight::Mode::Loiter)) {
+        failsafe_rtl(TXT("long (FS_LONG_TIMEOUT)"));
+        return;
+    } else {
+        return;
+    }
+    print_flight_line(TXT("# failsafe: long (FS_LONG_TIMEOUT), flight "));
+}
+
+flight::Mode FlightIo::nav_mode() const {
+    const flight::State st = control_.state();
+    if ((st == flight::State::Navigate && !control_.without_attitude()) || control_.navigating_in_failsafe())
+        return control_.chosen();
+    return flight::Mode::Manual;
+}
+
+int16_t FlightIo::stick(uint8_t role) const {
+    return control_.state() == flight::State::Failsafe ? (int16_t)0 : control_.stick(role, millis());
+}
+
+void FlightIo::set_nav_demands(int16_t roll_cd, int16_t pitch_cd, int16_t throttle) {
+    control_.set_nav_demands(roll_cd, pitch_cd, throttle);
+}
+
+void FlightIo::set_unavailable(uint16_t rows) { control_.set_unavailable(rows); }
+
+void FlightIo::failsafe_rtl(text::Flash which) {
+    if (control_.chosen() == flight::Mode::Rtl) return;
+    Writer w(out_);
+    w.str(TXT("# failsafe: ")).str(which);
+    text::Flash why;
+    if (nav_modes::refused(flight::Mode::Rtl, why)) {
+        w.str(TXT(": no RTL (")).str(why).str(TXT("), mode kept")).end();
+        return;
+    }
+    control_.choose(flight::Mode::Rtl);
+    w.str(TXT(": RTL")).end();
 }
 
 void FlightIo::rc_override(const uint16_t width_us[8]) { control_.on_override(width_us, millis()); }
@@ -265,7 +342,8 @@ uint8_t FlightIo::throttle_percent() const {
 // The failsafe's wings-level glide is ArduPlane's FBWA glide (MavLink.h), an attitude
 // mode without an attitude flies as MANUAL.
 mav::PlaneMode FlightIo::plane_mode() const {
-    if (control_.state() == flight::State::Failsafe) return mav::PlaneMode::FlyByWireA;
+    if (control_.state() == flight::State::Failsafe && !control_.navigating_in_failsafe())
+        return mav::PlaneMode::FlyByWireA;
     if (control_.without_attitude()) return mav::PlaneMode::Manual;
     return (mav::PlaneMode)(uint8_t)control_.chosen();
 }
@@ -308,7 +386,9 @@ void FlightIo::print_widths(Flash prefix, const uint16_t* widths) {
 void FlightIo::say_events() {
     const uint8_t e = control_.take_events();
     if (e == 0) return;
-    if (e & flight::kEvFailsafeLost)
+    if ((e & flight::kEvFailsafeLost) && control_.navigating_in_failsafe())
+        Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): the mode goes on")).end();
+    else if (e & flight::kEvFailsafeLost)
         Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT")).end();
     if (e & flight::kEvFailsafeEncoder)
         Writer(out_).str(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding")).end();
@@ -317,6 +397,14 @@ void FlightIo::say_events() {
         Writer(out_).str(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): MANUAL until it returns")).end();
     if (e & flight::kEvAttitudeBack) Writer(out_).str(TXT("# attitude back: flight STABILIZE")).end();
     if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
+    if (e & flight::kEvModeRefused) {
+        text::Flash why;
+        if (!nav_modes::refused(control_.refused_mode(), why)) why = TXT("not available");
+        Writer w(out_);
+        w.str(TXT("# Mode change refused (switch): "));
+        write_mode_name(w, control_.refused_mode());
+        w.str(TXT(": ")).str(why).end();
+    }
 }
 
 bool FlightIo::print_status_line() {
@@ -331,8 +419,7 @@ void FlightIo::answer(const console::Command& c) {
         if (arm_disarm(arm, false) == mav::Result::Accepted && was == arm)
             Writer(out_).str(arm ? TXT("# Throttle already armed") : TXT("# Throttle already disarmed")).end();
     } else if (c.id == console::CommandId::Flight) {
-        control_.choose((flight::Mode)flight::mode_number(c.arg));
-        print_flight_line(TXT("# flight "));
+        choose_checked((flight::Mode)flight::mode_number(c.arg));
     } else if (c.arg == console::kShowRc) {
         uint16_t widths[flight::kChannels];
         const uint32_t now_ms = millis();
@@ -375,6 +462,11 @@ bool FlightIo::failsafe() const { return false; }
 bool FlightIo::armed() const { return true; }
 mav::Result FlightIo::arm_disarm(bool, bool) { return mav::Result::Unsupported; }
 bool FlightIo::set_mode(uint32_t) { return false; }
+flight::Mode FlightIo::nav_mode() const { return flight::Mode::Manual; }
+int16_t FlightIo::stick(uint8_t) const { return 0; }
+void FlightIo::set_nav_demands(int16_t, int16_t, int16_t) {}
+void FlightIo::set_unavailable(uint16_t) {}
+void FlightIo::failsafe_rtl(text::Flash) {}
 void FlightIo::rc_override(const uint16_t*) {}
 bool FlightIo::prearm_due() const { return false; }
 uint16_t FlightIo::prearm_failures() const { return 0; }

@@ -15,6 +15,7 @@
 
 #include "Console.h"
 #include "Features.h"
+#include "FlightSettings.h"
 #include "Imu.h"
 #include "MavLink.h"
 #include "Mpu6000.h"
@@ -71,6 +72,16 @@ public:
     // number, held until the mode switch next moves; false (and a line saying so) for a
     // number the board does not have.
     bool set_mode(uint32_t number);
+    // The navigation modes (NavModes.h): the navigation mode flying now (its bank, pitch and
+    // throttle are set_nav_demands'), or Mode::Manual when none is; a stick by role.
+    flight::Mode nav_mode() const;
+    int16_t stick(uint8_t role) const;
+    void set_nav_demands(int16_t roll_cd, int16_t pitch_cd, int16_t throttle);
+    void set_unavailable(uint16_t rows);
+    // A failsafe's RTL (`which`: the battery's, ArduPlane's low_battery_event; the long
+    // one): RTL chosen and said ("# failsafe: <which>: RTL"), or, when it cannot run, the
+    // mode kept and the reason said.
+    void failsafe_rtl(text::Flash which);
     // RC_CHANNELS_OVERRIDE's channels 1-8 (FlightControl::on_override).
     void rc_override(const uint16_t width_us[8]);
     // The pre-arm checks' failures now (lib/Flight/Arming.h's PreArm bits; 0: may arm):
@@ -101,11 +112,16 @@ private:
     void arming_step(uint32_t now_ms);
     mav::Result arm_now(bool force);
     bool flying() const;
+    bool choose_checked(flight::Mode m);
+    void long_failsafe(uint32_t now_ms);
 
     flight::PpmDecoder ppm_;
     flight::FlightControl control_;
     flight::Arming arming_;
     uint16_t prearm_unsaid_ = 0;  // PreArm bits still to say
+    uint32_t failsafe_since_ms_ = 0;
+    bool in_failsafe_ = false;
+    bool long_failsafe_done_ = false;  // FS_LONG_ACTN acted on in this failsafe
     bool compass_found_ = false;  // the HMC5883L answered since power-up: its heading is used
     uint8_t control_count_ = 0;
     uint32_t last_control_us_ = 0;

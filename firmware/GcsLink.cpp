@@ -13,6 +13,7 @@
 #include "Console.h"
 #include "ConsoleLink.h"
 #include "GpsPort.h"
+#include "NavModes.h"
 #include "LoopLoad.h"
 #include "MagCalLink.h"
 #include "MissionLink.h"
@@ -536,8 +537,8 @@ void send_heartbeat_and_status() {
 }
 
 // The position messages, each at its stream's interval: GPS_RAW_INT (SR0_EXT_STAT),
-// GLOBAL_POSITION_INT (SR0_POSITION), VFR_HUD (SR0_EXTRA2); HOME_POSITION before them when
-// due. One frame a run.
+// GLOBAL_POSITION_INT (SR0_POSITION), VFR_HUD (SR0_EXTRA2), NAV_CONTROLLER_OUTPUT (SR0_EXT_STAT) while a navigation mode
+// flies; HOME_POSITION before them when due. One frame a run.
 static uint8_t home_changes_sent = 0;
 
 static bool home_due() {
@@ -552,7 +553,7 @@ bool position_due() {
     if (mag_cal_link::due() || home_due()) return true;
     const uint32_t now_ms = millis();
     return streams.due(mav::kStreamGpsRawInt, now_ms) || streams.due(mav::kStreamGlobalPositionInt, now_ms) ||
-           streams.due(mav::kStreamVfrHud, now_ms);
+           streams.due(mav::kStreamVfrHud, now_ms) || streams.due(mav::kStreamNavControllerOutput, now_ms);
 }
 
 void send_position() {
@@ -578,6 +579,9 @@ void send_position() {
         } else if (streams.take(mav::kStreamVfrHud, now_ms)) {
             position::report(r);
             n = port::mavlink.vfr_hud(frame, r);
+        } else if (streams.take(mav::kStreamNavControllerOutput, now_ms)) {
+            mav::NavOutput nav;  // none but while a navigation mode flies
+            if (nav_modes::report(nav)) n = port::mavlink.nav_controller_output(frame, nav);
         }
     }
     if (n > 0) port::send_frame(frame, n);

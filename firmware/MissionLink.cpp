@@ -41,7 +41,7 @@ static void queue_byte(void*, uint16_t address, uint8_t value) {
 
 static uint8_t read_byte(void*, uint16_t address) { return eeprom_read_byte((const uint8_t*)address); }
 
-static mission::MissionStore store(mission::Eeprom{nullptr, read_byte, queue_byte});
+mission::MissionStore store(mission::Eeprom{nullptr, read_byte, queue_byte});
 static mission::MissionProtocol protocol(store);
 
 // The reply waiting: MissionProtocol's, or kAnswer, a download's request answered when

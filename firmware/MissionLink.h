@@ -25,6 +25,8 @@
 
 #include <stdint.h>
 
+#include "MissionStore.h"
+
 #include "MavLink.h"
 #include "MissionCommand.h"
 #include "Text.h"
@@ -46,6 +48,9 @@ void service();
 bool reply_due();
 void send_reply();
 
+// The store, for the navigation's executor (AUTO): loaded by begin(); it reads only the
+// area in use, which an upload never writes (it writes the other, then switches).
+extern mission::MissionStore store;
 // For the navigation (AUTO): the stored commands, read when the EEPROM is ready
 // (eeprom_is_ready(): a read waits for a write's end, up to 3.4 ms). index 0 is seq 1.
 uint8_t count();

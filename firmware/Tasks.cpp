@@ -26,6 +26,7 @@
 #include "GpsPort.h"
 #include "LoopLoad.h"
 #include "MissionLink.h"
+#include "NavModes.h"
 #include "OutputLine.h"
 #include "Position.h"
 #include "Scheduler.h"
@@ -117,6 +118,8 @@ static void once_a_second() {
     X(gcs_position, gcs_link::position_due,          gcs_link::send_position,          2000, kSecGcsPosition,  0)       \
     X(gcs_battery,  battery_input::status_due,       battery_input::send_status,       1000, kSecGcsBattery,   0)       \
     X(nav,          position::due,                   position::run,                    3600, kSecNav,          0)       \
+    X(guide,        nav_modes::due,                  nav_modes::run,                   4000, kSecGuide,        0)       \
+    X(tecs,         nav_modes::filters_due,          nav_modes::filters_run,            700, kSecTecsFilter,   0)       \
     X(store,        nullptr,                         store_service,                    1800, kSecStore,        0)       \
     X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
     X(adc,          adc::battery_conversion_due,     adc::take_battery_conversion,      100, kSecAdc,          kAlways) \

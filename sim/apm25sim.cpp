@@ -30,7 +30,7 @@ const char* const kUsage =
     "usage: apm25sim --elf FILE.elf (--trajectory FILE.csv[.gz] | --physics json[:HOST[:PORT]])\n"
     "                [--seconds S] [--stamp]\n"
     "                [--fault SPEC ...] [--input FILE] [--input-at S] [--eeprom FILE]\n"
-    "                [--eeprom-cuts T1:T2:STEP] [--profile FILE]\n"
+    "                [--eeprom-cuts T1:T2:STEP] [--mission FILE.waypoints] [--profile FILE]\n"
     "                [--rc FILE] [--servo-log FILE] [--serial tcp:PORT] [--speed X]\n"
     "                [--physics-rate HZ] [--physics-timeout S] [--physics-log FILE]\n"
     "                [--earth-field N,E,D] [--verbose]\n"
@@ -62,6 +62,11 @@ const char* const kUsage =
     "  --eeprom-cuts T1:T2:STEP  with --eeprom FILE: also write the chip as a power cut at\n"
     "                   T1, T1+STEP, ... (<= T2, simulated seconds) leaves it (what --seconds\n"
     "                   at that time writes) to FILE.cut0, FILE.cut1, ...: one run for many cuts\n"
+    "  --mission FILE   a mission (QGC WPL 110: Mission Planner's .waypoints, seq 0 home and not\n"
+    "                   stored) written into the EEPROM's mission area before the run, on top of\n"
+    "                   --eeprom's bytes or an erased chip, as the MAVLink upload would (lib/Mission's\n"
+    "                   from_item and MissionStore): AUTO flies it. A command or frame the firmware\n"
+    "                   refuses, or a line that does not parse, is an error naming its line\n"
     "  --profile FILE   cycle counts of the sections the firmware marks: section id 1..63 written\n"
     "                   to GPIOR0 at its start and to GPIOR1 at its end. CSV\n"
     "                   section,count,avg_cycles,min_cycles,max_cycles,total_cycles and a last row\n"
@@ -271,6 +276,8 @@ int main(int argc, char** argv) {
         } else if (arg == "--input-at") {
             options.input_start_s = std::atof(value("--input-at"));
             options.input_start_fixed = true;
+        } else if (arg == "--mission") {
+            options.mission_path = value("--mission");
         } else if (arg == "--eeprom") {
             options.eeprom_path = value("--eeprom");
         } else if (arg == "--eeprom-cuts") {

@@ -254,7 +254,9 @@ namespace {
 // The law of a mode the board has; any other number flies MANUAL.
 State state_of(Mode m) {
     const int8_t i = mode_index((uint8_t)m);
-    return i >= 0 && mode_law((uint8_t)i) == Law::Attitude ? State::Stabilize : State::Manual;
+    if (i < 0) return State::Manual;
+    const Law law = mode_law((uint8_t)i);
+    return law == Law::Attitude ? State::Stabilize : navigates(law) ? State::Navigate : State::Manual;
 }
 
 }  // namespace
@@ -268,7 +270,7 @@ void FlightControl::choose(Mode m) {
     if (!mode_known((uint8_t)m)) m = Mode::Manual;
     const State before = state_of(chosen_);
     chosen_ = m;
-    if (state_ == State::Manual || state_ == State::Stabilize) {
+    if (state_ == State::Manual || state_ == State::Stabilize || state_ == State::Navigate) {
         if (before != state_of(m)) {
             roll_.reset();
             pitch_.reset();
@@ -303,7 +305,14 @@ void FlightControl::read_switch(uint32_t now_ms) {
     if (pos != switch_pos_) {
         switch_pos_ = pos;
         const Mode before = chosen_;
-        choose((Mode)s_.fltmode[pos - 1u]);
+        const Mode want = (Mode)s_.fltmode[pos - 1u];
+        const int8_t row = mode_index((uint8_t)want);
+        if (row >= 0 && ((unavailable_ >> row) & 1u) != 0u) {  // kept until the switch moves again (ArduPlane's)
+            refused_ = want;
+            events_ |= kEvModeRefused;
+            return;
+        }
+        choose(want);
         if (chosen_ != before) events_ |= kEvModeChanged;
     }
 }
@@ -376,6 +385,11 @@ Surfaces FlightControl::stabilize(const Attitude& att, int32_t roll_demand_cd, i
     return out;
 }
 
+bool FlightControl::navigating_in_failsafe() const {
+    const int8_t i = mode_index((uint8_t)chosen_);
+    return state_ == State::Failsafe && i >= 0 && mode_law((uint8_t)i) == Law::NavigateOn;
+}
+
 void FlightControl::configure() {
     scales_ = scales_of(s_);
     roll_terms_ = axis_terms(s_.roll, kControlDt_s);
@@ -393,7 +407,7 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
     // STABILIZE without an attitude (the estimator starting, the IMU failed) flies as
     // MANUAL, and STABILIZE resumes when the attitude does (the estimator restarts from
     // gravity): said both ways.
-    const bool fallback = state_ == State::Stabilize && !att.valid;
+    const bool fallback = (state_ == State::Stabilize || state_ == State::Navigate) && !att.valid;
     if (fallback != no_attitude_) {
         events_ |= fallback ? kEvSensorFallback : kEvAttitudeBack;
         no_attitude_ = fallback;
@@ -401,6 +415,17 @@ void FlightControl::step(uint32_t now_ms, const Attitude& att, uint16_t out_us[k
         pitch_.reset();
     }
     const int16_t fs_throttle = throttle_live_ ? (int16_t)(s_.thr_fs_pct * 10u) : (int16_t)0;
+    const int16_t nav_throttle = throttle_live_ ? nav_throttle_ : (int16_t)0;
+    if ((state_ == State::Navigate && !fallback) || (navigating_in_failsafe() && att.valid)) {
+        // The rudder stays the pilot's (none in the failsafe), as ArduPlane's without a yaw damper.
+        Surfaces sf = stabilize(att, nav_roll_cd_, (int32_t)s_.trim_pitch_cd + nav_pitch_cd_);
+        sf.throttle = nav_throttle;
+        sf.rudder_cd = state_ == State::Navigate ? stick(kYaw, now_ms) : (int16_t)0;
+        uint16_t aux_us[4];
+        for (uint8_t i = 0; i < 4; ++i) aux_us[i] = input_us((uint8_t)(i + 4u), now_ms);
+        mix(s_, scales_, sf, state_ == State::Navigate ? aux_us : nullptr, out_us);
+        return;
+    }
     if (state_ == State::Failsafe) {
         Surfaces sf{0, 0, fs_throttle, 0};
         if (att.valid) sf = stabilize(att, 0, (int32_t)s_.trim_pitch_cd + s_.fs_pitch_cd);

@@ -146,6 +146,7 @@ enum class State : uint8_t {
     Manual,
     Stabilize,
     Failsafe,
+    Navigate,   // a navigation mode (Law::Navigate, NavigateOn): set_nav_demands' bank, pitch, throttle
 };
 
 // The attitude the controller sees (the estimator's), and whether it is to be trusted.
@@ -171,6 +172,7 @@ enum Event : uint8_t {
     kEvSensorFallback = 0x08,   // STABILIZE without an attitude: the sticks pass through (MANUAL) until it returns
     kEvAttitudeBack = 0x20,     // ... it returned: STABILIZE again
     kEvModeChanged = 0x10,      // the mode switch chose another mode
+    kEvModeRefused = 0x40,      // the mode switch chose a mode that cannot run now (refused_mode())
 };
 
 enum class FailsafeCause : uint8_t { None, Lost, Encoder };
@@ -209,6 +211,19 @@ public:
     // The console's or a ground station's choice; the mode switch's next move overrides
     // it. A number the board does not have (Modes.h) flies MANUAL: the caller refuses it.
     void choose(Mode m);
+    // The navigation modes' demands (the firmware's 10 Hz navigation step): the bank and
+    // the pitch (centi-degrees, within LIM_ROLL_CD and LIM_PITCH_*; TRIM_PITCH_CD is added
+    // as to every pitch, ArduPlane's stabilize_pitch) and the throttle (0..1000).
+    void set_nav_demands(int16_t roll_cd, int16_t pitch_cd, int16_t throttle) {
+        nav_roll_cd_ = roll_cd;
+        nav_pitch_cd_ = pitch_cd;
+        nav_throttle_ = throttle;
+    }
+    // The modes (bit i: Modes.h's row i) that cannot run now (no GPS fix, no home, no
+    // mission): the mode switch does not choose them, it keeps the mode flying and says so
+    // (kEvModeRefused, refused_mode()). The caller refuses its own choices before choose().
+    void set_unavailable(uint16_t rows) { unavailable_ = rows; }
+    Mode refused_mode() const { return refused_; }
     // false: the throttle output holds its minimum in every state (disarmed: Arming.h).
     void set_throttle_live(bool live) { throttle_live_ = live; }
     // One control step, every kControlDt_s: the eight output widths, within their limits.
@@ -219,7 +234,11 @@ public:
     void update_signal(uint32_t now_ms);
     // Whether the next step uses the attitude (STABILIZE, FAILSAFE; after update_signal):
     // else the caller need not work it out.
-    bool wants_attitude() const { return state_ == State::Stabilize || state_ == State::Failsafe; }
+    bool wants_attitude() const {
+        return state_ == State::Stabilize || state_ == State::Failsafe || state_ == State::Navigate;
+    }
+    // FAILSAFE in a mode that flies on through it (Law::NavigateOn: AUTO, RTL, LOITER, CIRCLE).
+    bool navigating_in_failsafe() const;
     // An attitude mode chosen (STABILIZE, FBWA), but flying as MANUAL for want of an attitude.
     bool without_attitude() const { return no_attitude_; }
     Mode chosen() const { return chosen_; }
@@ -241,6 +260,11 @@ private:
     AxisTerms roll_terms_;
     AxisTerms pitch_terms_;
     int16_t turn_gain_cds_ = 0;
+    int16_t nav_roll_cd_ = 0;
+    int16_t nav_pitch_cd_ = 0;
+    int16_t nav_throttle_ = 0;
+    uint16_t unavailable_ = 0;
+    Mode refused_ = Mode::Manual;
     uint16_t turn_airspeed_cm_s_ = 0;  // the airspeed turn_gain_cds_ is for
     AxisController roll_;
     AxisController pitch_;

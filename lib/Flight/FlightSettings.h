@@ -33,7 +33,17 @@ struct EndPoints {
 };
 
 // ArduPlane's flight mode numbers (FLTMODEn values) of the modes the board has (Modes.h).
-enum class Mode : uint8_t { Manual = 0, Stabilize = 2, FlyByWireA = 5 };
+enum class Mode : uint8_t {
+    Manual = 0,
+    Circle = 1,
+    Stabilize = 2,
+    FlyByWireA = 5,
+    FlyByWireB = 6,
+    Cruise = 7,
+    Auto = 10,
+    Rtl = 11,
+    Loiter = 12,
+};
 
 struct FlightSettings {
     AxisGains roll;             // RLL2SRV_*

@@ -29,6 +29,13 @@ const Row kModes[kModeCount] MODE_TABLE = {
     {(uint8_t)Mode::Manual, Law::PassThrough, "MANUAL"},
     {(uint8_t)Mode::Stabilize, Law::Attitude, "STABILIZE"},
     {(uint8_t)Mode::FlyByWireA, Law::Attitude, "FBWA"},
+    // The navigation's modes (the firmware's NavModes composes lib/Nav and lib/Mission).
+    {(uint8_t)Mode::Circle, Law::NavigateOn, "CIRCLE"},
+    {(uint8_t)Mode::FlyByWireB, Law::Navigate, "FBWB"},
+    {(uint8_t)Mode::Cruise, Law::Navigate, "CRUISE"},
+    {(uint8_t)Mode::Auto, Law::NavigateOn, "AUTO"},
+    {(uint8_t)Mode::Rtl, Law::NavigateOn, "RTL"},
+    {(uint8_t)Mode::Loiter, Law::NavigateOn, "LOITER"},
 };
 
 char upper(char c) { return (c >= 'a' && c <= 'z') ? (char)(c - 'a' + 'A') : c; }

@@ -17,14 +17,21 @@ namespace flight {
 enum class Law : uint8_t {
     PassThrough,  // MANUAL: the sticks are the surfaces
     Attitude,     // the sticks demand a bank and a pitch (LIM_ROLL_CD, LIM_PITCH_*): STABILIZE, FBWA
+    // The navigation demands the bank, the pitch and the throttle (FlightControl::set_nav_demands):
+    // FBWB and CRUISE (the receiver's failsafe glides, as from FBWA) ...
+    Navigate,
+    // ... and CIRCLE, AUTO, RTL, LOITER, which fly on through the receiver's short failsafe
+    // (ArduPlane 3.x's failsafe_short_on_event with FS_SHORT_ACTN 0).
+    NavigateOn,
 };
 
 constexpr uint8_t kModeNameMax = 9;  // "STABILIZE"
-constexpr uint8_t kModeCount = 3;
+constexpr uint8_t kModeCount = 9;
 
 // Index of ArduPlane mode number `number` in the table, or -1 (not a mode the board has).
 int8_t mode_index(uint8_t number);
 inline bool mode_known(uint8_t number) { return mode_index(number) >= 0; }
+inline bool navigates(Law l) { return l == Law::Navigate || l == Law::NavigateOn; }
 // Row `index` (0 .. kModeCount-1): its number, its law, its name (upper case, NUL-ended).
 uint8_t mode_number(uint8_t index);
 Law mode_law(uint8_t index);

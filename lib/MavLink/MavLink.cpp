@@ -413,6 +413,14 @@ uint8_t Packer::vfr_hud(uint8_t out[kMaxFrame], const PositionReport& p) {
     return f.finish(out, seq_);
 }
 
+uint8_t Packer::nav_controller_output(uint8_t out[kMaxFrame], const NavOutput& n) {
+    Frame f(seq_);
+    mavlink_msg_nav_controller_output_pack_status(kSystemId, kComponentId, &f.status, &f.msg, n.nav_roll_deg,
+                                                  n.nav_pitch_deg, n.nav_bearing_deg, n.target_bearing_deg,
+                                                  n.wp_dist_m, n.alt_error_m, 0.0f, n.xtrack_error_m);
+    return f.finish(out, seq_);
+}
+
 uint8_t Packer::home_position(uint8_t out[kMaxFrame], int32_t lat_e7, int32_t lon_e7, int32_t alt_msl_mm) {
     Frame f(seq_);
     const float q[4] = {1.0f, 0.0f, 0.0f, 0.0f};

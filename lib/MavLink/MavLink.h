@@ -185,6 +185,17 @@ struct PositionReport {
     uint8_t throttle_pct;
 };
 
+// NAV_CONTROLLER_OUTPUT's fields (ArduPlane's: degrees, metres; the firmware's NavModes fills
+// them while a navigation mode flies). aspd_error is not sent (0), as ArduPlane without a pitot.
+struct NavOutput {
+    float nav_roll_deg, nav_pitch_deg;        // the demands
+    int16_t nav_bearing_deg;                  // to the L1 point, 0..359
+    int16_t target_bearing_deg;               // to the waypoint or the loiter's centre, 0..359
+    uint16_t wp_dist_m;
+    float alt_error_m;                        // the height demand less the height (positive: low)
+    float xtrack_error_m;                     // left of the track positive (ArduPilot's)
+};
+
 // MISSION_ACK's type (MAV_MISSION_RESULT; mission::Result has them all).
 enum class MissionResult : uint8_t { Accepted = 0, Unsupported = 3 };
 
@@ -243,6 +254,7 @@ public:
     uint8_t gps_raw_int(uint8_t out[kMaxFrame], const gps::Fix& fix);
     uint8_t global_position_int(uint8_t out[kMaxFrame], const PositionReport& p);
     uint8_t vfr_hud(uint8_t out[kMaxFrame], const PositionReport& p);
+    uint8_t nav_controller_output(uint8_t out[kMaxFrame], const NavOutput& n);
     // HOME_POSITION: home (alt above mean sea level, mm); its local position x, y, z 0
     // (there is no local frame but home's), q level, no approach vector: as ArduPilot.
     uint8_t home_position(uint8_t out[kMaxFrame], int32_t lat_e7, int32_t lon_e7, int32_t alt_msl_mm);

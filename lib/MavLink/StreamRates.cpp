@@ -32,6 +32,7 @@ const Entry kTable[kStreamMsgs] STREAM_TABLE = {
     {74, kGroupExtra2, kFrameOverhead + 20},            // VFR_HUD
     {2, kGroupExtra3, kFrameOverhead + 12},             // SYSTEM_TIME
     {147, kGroupExtra3, kBatteryStatusFrame},           // BATTERY_STATUS
+    {62, kGroupExtStat, kFrameOverhead + 26},           // NAV_CONTROLLER_OUTPUT (while a navigation mode flies)
 };
 
 uint8_t group_of(uint8_t m) { return TABLE_BYTE(kTable[m].group); }

@@ -46,7 +46,7 @@ enum StreamGroup : uint8_t {
 enum StreamMsg : uint8_t {
     kStreamScaledPressure, kStreamSysStatus, kStreamGpsRawInt, kStreamRcChannels, kStreamServoOutputRaw,
     kStreamGlobalPositionInt, kStreamAttitude, kStreamVfrHud, kStreamSystemTime, kStreamBatteryStatus,
-    kStreamMsgs
+    kStreamNavControllerOutput, kStreamMsgs
 };
 
 // MESSAGE_INTERVAL (244) and the commands that ask for it.

@@ -13,11 +13,13 @@
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)pgm_read_byte(&kRows[(r)].member))
 #define ROW_WORD(r, member) ((uint16_t)pgm_read_word(&kRows[(r)].member))
+#define ROW_FLOAT(dst, r, member) memcpy_P((dst), &kRows[(r)].member, sizeof(float))
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)kRows[(r)].member)
 #define ROW_WORD(r, member) ((uint16_t)kRows[(r)].member)
+#define ROW_FLOAT(dst, r, member) memcpy((dst), &kRows[(r)].member, sizeof(float))
 #endif
 
 // What a row means, beside it (ArduPilot's @DisplayName, @Units and @Description): the
@@ -172,14 +174,16 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Flight mode channel", "",
                "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
                "ArduPlane's six bands. 0: no switch, the console's `flight` command only.")},
-    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 5.0f, 0.0f,
+    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 12.0f, 0.0f,
      PARAM_DOC("Flight mode 1", "",
-               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 2 STABILIZE, 5 FBWA (ArduPlane's "
-               "numbers; FBWA flies as STABILIZE does). Any other number is refused.")},
-    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 5.0f, 2.0f,
+               "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 1 CIRCLE, 2 STABILIZE, 5 FBWA, 6 "
+               "FBWB, 7 CRUISE, 10 AUTO, 11 RTL, 12 LOITER (ArduPlane's numbers; FBWA flies as STABILIZE does). Any "
+               "other number is refused. A mode that cannot run when the switch picks it (no 3D fix, no home, no "
+               "mission) is refused with its reason and the mode before flies on.")},
+    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 12.0f, 2.0f,
      PARAM_DOC("Flight mode n", "",
                "The mode of the switch's position n (2: 1231 to 1360 us, 3: to 1490, 4: to 1620, 5: to 1749, 6: "
-               "above): 0 MANUAL, 2 STABILIZE, 5 FBWA; any other number is refused.")},
+               "above), numbered as FLTMODE1's; any other number is refused.")},
     {"RCMAP_ROLL", Type::UInt8, 0, 1, 0, AT(flight.rcmap[0]), 1.0f, 8.0f, 1.0f,
      PARAM_DOC("Roll channel", "", "The receiver channel of the roll (aileron) stick.")},
     {"RCMAP_PITCH", Type::UInt8, 0, 1, 0, AT(flight.rcmap[1]), 1.0f, 8.0f, 2.0f,
@@ -434,6 +438,93 @@ const Row kRows[] PARAM_TABLE = {
                "power-up, so a ground station that only listens hears the board (the frames are MAVLink 2 "
                "for either). Three returns in a row in MAVLink give the text console until the next start.")},
 
+    // Navigation (settings::NavSettings): AP_L1_Control's, AP_TECS's, the mission's, the
+    // throttle's and the long failsafe's, ArduPlane 3.x's names, ranges and defaults
+    // (docs/navigation.md). The Scaled8 rows keep ArduPlane's step in a byte: their stride
+    // is the steps per unit.
+    {"NAVL1_PERIOD", Type::UInt8, 0, 1, 0, AT(vehicle.nav.navl1_period_s), 1.0f, 60.0f, 20.0f,
+     PARAM_DOC("L1 control period", "s",
+               "The period of the oscillation the lateral guidance (L1) flies back to the track with in AUTO, RTL, "
+               "LOITER and CRUISE: shorter follows the track more tightly and turns harder; too short weaves. "
+               "ArduPlane 3.x's 20; lower it a step at a time.")},
+    {"NAVL1_DAMPING", Type::Scaled8, 0, 1, 100, AT(vehicle.nav.navl1_damping_c), 0.6f, 1.0f, 0.75f,
+     PARAM_DOC("L1 control damping ratio", "",
+               "The damping of that oscillation: higher overshoots the track less. Kept in hundredths.")},
+    {"TECS_CLMB_MAX", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_clmb_max_d), 0.1f, 20.0f, 5.0f,
+     PARAM_DOC("Maximum climb rate", "m/s",
+               "The climb the aeroplane makes at THR_MAX and its cruise speed: TECS asks for no faster climb. Too "
+               "high a value slows the aeroplane in climbs. Kept in tenths.")},
+    {"TECS_SINK_MIN", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_sink_min_d), 0.1f, 10.0f, 2.0f,
+     PARAM_DOC("Minimum sink rate", "m/s",
+               "The sink at THR_MIN and the cruise speed (the throttle's feed-forward range). Kept in tenths.")},
+    {"TECS_TIME_CONST", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_time_const_d), 3.0f, 10.0f, 5.0f,
+     PARAM_DOC("Controller time constant", "s",
+               "How fast TECS corrects the height and speed: smaller is tighter, too small oscillates. Kept in "
+               "tenths.")},
+    {"TECS_THR_DAMP", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_thr_damp_d), 0.1f, 1.0f, 0.5f,
+     PARAM_DOC("Throttle damping", "", "Damps the throttle's answer to the total energy's rate error.")},
+    {"TECS_INTEG_GAIN", Type::Scaled8, 0, 1, 100, AT(vehicle.nav.tecs_integ_gain_c), 0.0f, 0.5f, 0.1f,
+     PARAM_DOC("Integrator gain", "",
+               "The throttle's and pitch's integrators: they take out a wrong TRIM_THROTTLE or a steady error. Kept "
+               "in hundredths.")},
+    {"TECS_VERT_ACC", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_vert_acc_d), 1.0f, 10.0f, 7.0f,
+     PARAM_DOC("Vertical acceleration limit", "m/s/s", "Limits how fast the pitch demand may change.")},
+    {"TECS_HGT_OMEGA", Type::Scaled8, 0, 1, 20, AT(vehicle.nav.tecs_hgt_omega_t), 1.0f, 5.0f, 3.0f,
+     PARAM_DOC("Height complementary filter frequency", "rad/s",
+               "The crossover of the filter that takes the height from the barometer and the vertical "
+               "acceleration. Kept in twentieths.")},
+    {"TECS_SPD_OMEGA", Type::Scaled8, 0, 1, 100, AT(vehicle.nav.tecs_spd_omega_c), 0.5f, 2.0f, 2.0f,
+     PARAM_DOC("Speed complementary filter frequency", "rad/s",
+               "The crossover of the airspeed filter (with the pitot). Kept in hundredths.")},
+    {"TECS_RLL2THR", Type::UInt8, 0, 1, 0, AT(vehicle.nav.tecs_rll2thr), 5.0f, 30.0f, 10.0f,
+     PARAM_DOC("Bank angle compensation gain", "",
+               "The extra throttle a turn's induced drag needs: the energy rate a 60-degree bank costs, m^2/s^3.")},
+    {"TECS_SPDWEIGHT", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_spdweight_d), 0.0f, 2.0f, 1.0f,
+     PARAM_DOC("Weighting applied to speed control", "",
+               "The pitch loop's balance: 0 the height first, 2 the speed first, 1 both. Without an airspeed sensor "
+               "0 is taken whatever is set.")},
+    {"TECS_PTCH_DAMP", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_ptch_damp_d), 0.0f, 1.0f, 0.0f,
+     PARAM_DOC("Controller pitch damping", "", "Damps the pitch loop's answer to the energy balance's rate.")},
+    {"TECS_SINK_MAX", Type::Scaled8, 0, 1, 10, AT(vehicle.nav.tecs_sink_max_d), 0.0f, 20.0f, 5.0f,
+     PARAM_DOC("Maximum descent rate", "m/s", "The steepest sink TECS asks for. Kept in tenths.")},
+    {"WP_RADIUS", Type::Int16, 0, 1, 0, AT(vehicle.nav.wp_radius_m), 1.0f, 32767.0f, 30.0f,
+     PARAM_DOC("Waypoint radius", "m",
+               "A waypoint is reached within this distance, or earlier for a gentle turn (the L1 turn distance), or "
+               "once passed; also RTL's radius at home.")},
+    {"WP_LOITER_RAD", Type::Int16, 0, 1, 0, AT(vehicle.nav.wp_loiter_rad_m), -32767.0f, 32767.0f, 60.0f,
+     PARAM_DOC("Waypoint loiter radius", "m",
+               "The circle of LOITER, RTL at home and the mission's loiters: positive clockwise, negative "
+               "counter-clockwise.")},
+    {"ALT_HOLD_RTL", Type::Int16, 0, 1, 0, AT(vehicle.nav.alt_hold_rtl_cm), -1.0f, 32767.0f, 10000.0f,
+     PARAM_DOC("RTL altitude", "cm",
+               "The height above home RTL returns and circles at; -1: the height RTL starts at. At most 327 m here "
+               "(ArduPlane's is wider).")},
+    {"GLIDE_SLOPE_MIN", Type::UInt16, 0, 1, 0, AT(vehicle.nav.glide_slope_min_m), 0.0f, 1000.0f, 15.0f,
+     PARAM_DOC("Glide slope minimum", "m",
+               "A change of height to the next waypoint of this or more is spread along the leg (a slope); a "
+               "smaller one is asked for at once. 0: every change spread.")},
+    {"THR_MIN", Type::UInt8, 0, 1, 0, AT(vehicle.nav.thr_min_pct), 0.0f, 100.0f, 0.0f,
+     PARAM_DOC("Minimum throttle", "%",
+               "The least throttle the navigation modes (FBWB, CRUISE, AUTO, RTL, LOITER, CIRCLE) ask for. "
+               "ArduPlane's negative values (reverse thrust) are not taken.")},
+    {"THR_MAX", Type::UInt8, 0, 1, 0, AT(vehicle.nav.thr_max_pct), 0.0f, 100.0f, 75.0f,
+     PARAM_DOC("Maximum throttle", "%", "The most throttle the navigation modes ask for.")},
+    {"TRIM_THROTTLE", Type::UInt8, 0, 1, 0, AT(vehicle.nav.trim_throttle_pct), 0.0f, 100.0f, 45.0f,
+     PARAM_DOC("Throttle cruise", "%",
+               "The throttle of level flight at the cruise speed: the navigation modes' throttle starts from it "
+               "(without an airspeed sensor it is the throttle held on the level).")},
+    {"FBWB_CLIMB_RATE", Type::UInt8, 0, 1, 0, AT(vehicle.nav.fbwb_climb_rate_m_s), 1.0f, 10.0f, 2.0f,
+     PARAM_DOC("Fly by wire B altitude change rate", "m/s",
+               "In FBWB and CRUISE, full pitch stick moves the height held by this much a second.")},
+    {"FS_LONG_ACTN", Type::UInt8, 0, 1, 0, AT(vehicle.nav.fs_long_actn), 0.0f, 2.0f, 0.0f,
+     PARAM_DOC("Long failsafe action", "",
+               "What the board does FS_LONG_TIMEOUT after the receiver is lost: 0 RTL, but AUTO, RTL and LOITER "
+               "go on; 1 RTL in every mode; 2 the failsafe glide (wings level, FS_GLIDE_PITCH). RTL needs home and "
+               "a 3D fix, else the glide goes on.")},
+    {"FS_LONG_TIMEOUT", Type::UInt16, 0, 1, 0, AT(vehicle.nav.fs_long_timeout_s), 1.0f, 300.0f, 20.0f,
+     PARAM_DOC("Long failsafe timeout", "s",
+               "How long the receiver must be lost for FS_LONG_ACTN. Whole seconds here.")},
+
 };
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
@@ -468,6 +559,7 @@ float read(const Settings& s, const Row& row, uint8_t instance) {
         case Type::Bit: return (float)((*p >> instance) & 1u);
         case Type::DeclRad: { float v; memcpy(&v, p, sizeof v); return v; }
         case Type::MagOfs: { float v; memcpy(&v, p, sizeof v); return compass_ofs_mgauss(v); }
+        case Type::Scaled8: return (float)*p / (float)row.stride;
     }
     return 0.0f;
 }
@@ -475,7 +567,9 @@ float read(const Settings& s, const Row& row, uint8_t instance) {
 // Stores a value already checked against the row's range.
 void write(Settings& s, const Row& row, uint8_t instance, float value) {
     uint8_t* p = where(s, row, instance);
-    const int32_t whole = (int32_t)(value >= 0.0f ? value + 0.5f : value - 0.5f);
+    // Rounded for the integer types only (two float operations a value: the defaults'
+    // walk writes every one between samples).
+    const int32_t whole = is_integer(row.type) ? (int32_t)(value >= 0.0f ? value + 0.5f : value - 0.5f) : 0;
     switch (row.type) {
         case Type::Float: memcpy(p, &value, sizeof value); break;
         case Type::Int16: { const int16_t v = (int16_t)whole; memcpy(p, &v, sizeof v); break; }
@@ -490,6 +584,7 @@ void write(Settings& s, const Row& row, uint8_t instance, float value) {
             memcpy(p, &uT, sizeof uT);
             break;
         }
+        case Type::Scaled8: *p = (uint8_t)(value * (float)row.stride + 0.5f); break;  // in range: >= 0
     }
 }
 
@@ -515,7 +610,9 @@ float compass_ofs_mgauss(float offset_uT) {
     return (float)(int32_t)(centi >= 0.0f ? centi + 0.5f : centi - 0.5f) / 100.0f;
 }
 
-bool is_integer(Type t) { return t != Type::Float && t != Type::DeclRad && t != Type::MagOfs; }
+bool is_integer(Type t) {
+    return t != Type::Float && t != Type::DeclRad && t != Type::MagOfs && t != Type::Scaled8;
+}
 
 bool is_compass_calibration(uint16_t index) {
     return rows_within(offsetof(Settings, cal.mag_offset_uT), offsetof(Settings, cal.mag_learned_uT)).holds(index);
@@ -623,15 +720,13 @@ bool set(Settings& s, uint16_t index, float value) {
 void apply_defaults(Settings& s) {
     Row row;
     for (uint8_t r = 0; r < kRowCount; ++r) {
+        // The fields write() needs, not the whole row (its name is half of it): the walk
+        // runs between samples (PREFLIGHT_STORAGE's defaults).
         row.type = (Type)ROW_BYTE(r, type);
         row.count = ROW_BYTE(r, count);
         row.stride = ROW_BYTE(r, stride);
         row.offset = ROW_WORD(r, offset);
-#ifdef __AVR__
-        memcpy_P(&row.def, &kRows[r].def, sizeof row.def);
-#else
-        row.def = kRows[r].def;
-#endif
+        ROW_FLOAT(&row.def, r, def);
         for (uint8_t i = 0; i < row.count; ++i) write(s, row, i, row.def);
     }
 }
@@ -666,7 +761,7 @@ uint8_t stored_bytes(Type t) {
         case Type::MagOfs: return 4;
         case Type::Int16:
         case Type::UInt16: return 2;
-        default: return 1;
+        default: return 1;  // UInt8, Bit, Scaled8
     }
 }
 

@@ -31,6 +31,11 @@ enum class Type : uint8_t {
     // milligauss: its negation times 10 (1 uT = 10 mGauss), rounded to 0.01 mGauss so that
     // a value sent comes back as sent.
     MagOfs,
+    // A uint8_t holding the value times the row's `stride` (10: tenths, 20: twentieths, 100:
+    // hundredths; a single row's stride is otherwise unused): ArduPlane's float parameters
+    // of a small range and a coarse step (NAVL1_DAMPING, TECS_*) in a byte. A value set is
+    // rounded to the nearest step; shown as byte / stride, the nearest float to the decimal.
+    Scaled8,
 };
 
 constexpr uint8_t kNameMax = 16;  // MAVLink's param_id length

@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "BatterySettings.h"
+#include "NavSettings.h"
 
 namespace settings {
 
@@ -45,6 +46,12 @@ struct VehicleSettings {
 
     // Serial port (AP_SerialManager's SERIALn_*).
     uint8_t serial0_protocol;   // SERIAL0_PROTOCOL: kSerialConsole, or 1/2 MAVLink from power-up
+
+    // Navigation (AP_L1_Control, AP_TECS, ArduPlane's mission, throttle and failsafe names).
+    // Each in the least bytes its ArduPlane range and step allow: the Scaled8 rows
+    // (Params.h) keep tenths, twentieths or hundredths in a byte; nav_params() turns them
+    // into lib/Nav's and lib/Mission's float parameters.
+    NavSettings nav;
 };
 
 // SERIAL0_PROTOCOL's values: ArduPilot's SerialProtocol_Console (0), _MAVLink (1), _MAVLink2 (2).

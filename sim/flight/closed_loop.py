@@ -113,6 +113,9 @@ def parse_args(argv):
     p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
     p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
+    p.add_argument("--wind", help="the backend's --wind N,E: a steady wind, m/s")
+    p.add_argument("--mission", help="apm25sim --mission: a QGC WPL 110 file into the EEPROM before the run")
+    p.add_argument("--profile", help="apm25sim --profile: the sections' cycle counts")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
     p.add_argument("--serial", metavar="tcp:PORT",
@@ -176,6 +179,8 @@ def run(args):
         backend_cmd += ["--trajectory", args.trajectory]
     if args.no_airspeed:
         backend_cmd.append("--no-airspeed")
+    if args.wind:
+        backend_cmd += ["--wind", args.wind]
     if args.airframe != "plain":
         backend_cmd += ["--airframe", args.airframe]
     deadline = time.monotonic() + args.timeout
@@ -210,6 +215,10 @@ def run(args):
             sim_cmd += ["--speed", "%g" % args.speed]
         if args.gps:
             sim_cmd += ["--gps", args.gps]
+        if args.mission:
+            sim_cmd += ["--mission", args.mission]
+        if args.profile:
+            sim_cmd += ["--profile", args.profile]
         sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)
 
         def watchdog():

@@ -154,13 +154,17 @@ class Trim:
 
 class FlightModel:
     def __init__(self, airspeed_m_s=18.0, altitude_m=100.0, heading_deg=0.0, gust=0, seed=1,
-                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0, hold_s=0.0):
+                 latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0, hold_s=0.0,
+                 wind_ne_m_s=(0.0, 0.0)):
         """upsets: (start_s, duration_s, roll_moment_Nm) tuples, a roll moment applied from
         start_s for duration_s (positive rolls right). vibration_m_s2: the amplitude of the
         propeller's vibration at the IMU at the trim's propeller speed (see vibration()).
         hold_s: the aeroplane is held still at its start attitude for so long (on a launch
         stand: the board powers up and calibrates its gyro at rest, as on the ground), then
-        released into the trimmed flight (a catapult launch at the trim's speed)."""
+        released into the trimmed flight (a catapult launch at the trim's speed).
+        wind_ne_m_s: a steady wind, the air's velocity north and east (m/s; (0, 5) blows from
+        the west), from the release on (the trim is in still air: the aeroplane meets it as a
+        gust at the start)."""
         if gust not in GUST_LEVELS:
             raise ValueError("gust level %r: 0 (none), 1 (light) or 2 (moderate)" % (gust,))
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
@@ -169,6 +173,7 @@ class FlightModel:
         self.upsets = [tuple(float(v) for v in u) for u in upsets]
         self.vibration_m_s2 = float(vibration_m_s2)
         self.hold_s = max(0.0, float(hold_s))
+        self.wind_ne_m_s = (float(wind_ne_m_s[0]), float(wind_ne_m_s[1]))
         self.crashed_at = None  # time of the crash (the ground), None while flying
         jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
@@ -263,6 +268,7 @@ class FlightModel:
         self.surfaces = [t.aileron, t.elevator, t.throttle, t.rudder]
         self.dryden = Dryden(self.gust_level, self.seed)
         self.gust_body = np.zeros(3)
+        self.wind_on = False
         self.trim_rpm = self.fdm["propulsion/engine/propeller-rpm"]
         self.prop_angle_rad = 0.0
 
@@ -294,6 +300,10 @@ class FlightModel:
         n = max(1, int(math.ceil(dt_s / MAX_STEP_S - 1e-9)))
         h = dt_s / n
         f = self.fdm
+        if not self.wind_on:
+            self.wind_on = True
+            f["atmosphere/wind-north-fps"] = self.wind_ne_m_s[0] / FT
+            f["atmosphere/wind-east-fps"] = self.wind_ne_m_s[1] / FT
         if abs(f.get_delta_t() - h) > 1e-15:
             f.set_dt(h)
         for i in range(n):

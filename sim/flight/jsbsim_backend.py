@@ -26,6 +26,7 @@ autopilot may run a frame longer) and exits once no packet came for --linger s (
 --idle-timeout s without a packet before that stops it too.
 """
 import argparse
+import math
 import select
 import socket
 import sys
@@ -44,6 +45,8 @@ def parse_args(argv):
     p.add_argument("--gust", type=int, default=0, choices=sorted(flightmodel.GUST_LEVELS),
                    help="Dryden turbulence: 0 none, 1 light, 2 moderate")
     p.add_argument("--seed", type=int, default=1, help="seed of the turbulence")
+    p.add_argument("--wind", default="0,0", metavar="N,E",
+                   help="a steady wind from the release on: the air's velocity north and east, m/s (0,5: from the west)")
     p.add_argument("--airspeed", type=float, default=18.0, help="trim airspeed, m/s")
     p.add_argument("--altitude", type=float, default=100.0, help="start height above ground, m")
     p.add_argument("--heading", type=float, default=0.0, help="start heading, deg")
@@ -84,7 +87,8 @@ class Backend:
                 raise ValueError("--upset %r: want T,SECONDS,NM (three numbers)" % spec)
             upsets.append((start, length, moment))
         self.model = flightmodel.FlightModel(args.airspeed, args.altitude, args.heading, args.gust, args.seed,
-                                             upsets=upsets, vibration_m_s2=args.vibration, hold_s=args.hold)
+                                             upsets=upsets, vibration_m_s2=args.vibration, hold_s=args.hold,
+                                             wind_ne_m_s=wind_arg(args.wind))
         trim = self.model.trim
         widths = trim.widths_us()
         if args.rc == "none":
@@ -185,6 +189,16 @@ class Backend:
         self.say("# %d frames, %.3f s simulated; %d missed, %d repeated, %d resets; end at %.1f m, %.1f m/s"
                  % (self.frames, s["t"], self.tracker.missed, self.tracker.repeats, self.tracker.resets,
                     -s["position"][2], s["airspeed"]))
+
+
+def wind_arg(spec):
+    try:
+        north, east = (float(v) for v in spec.split(","))
+    except ValueError:
+        raise ValueError("--wind %r: want N,E (two numbers, m/s)" % spec)
+    if not (math.isfinite(north) and math.isfinite(east)) or math.hypot(north, east) > 30.0:
+        raise ValueError("--wind %r: at most 30 m/s" % spec)
+    return north, east
 
 
 def main(argv=None):

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Board.h"
+#include "MissionFile.h"
 
 #include "Hmc5883Registers.h"
 #include "Profile.h"
@@ -962,9 +963,9 @@ uint8_t* Board::eeprom_bytes() const {
 // erased (0xFF), as a new chip. The file is the chip: any byte pattern is accepted,
 // a file longer than the chip is refused.
 bool Board::load_eeprom() {
-    if (options_.eeprom_path.empty()) return true;
+    if (options_.eeprom_path.empty() && options_.mission_path.empty()) return true;
     std::vector<uint8_t> bytes(kEepromSize, 0xFF);
-    FILE* f = std::fopen(options_.eeprom_path.c_str(), "rb");
+    FILE* f = options_.eeprom_path.empty() ? nullptr : std::fopen(options_.eeprom_path.c_str(), "rb");
     if (f) {
         const size_t n = std::fread(bytes.data(), 1, kEepromSize, f);
         const bool longer = std::fgetc(f) != EOF;
@@ -974,6 +975,10 @@ bool Board::load_eeprom() {
             error_ = "the EEPROM file '" + options_.eeprom_path + "' is longer than the chip's 4096 bytes";
             return false;
         }
+    }
+    if (!options_.mission_path.empty() && !sim::write_mission_file(options_.mission_path, bytes, error_)) {
+        error_ = "--mission: " + error_;
+        return false;
     }
     uint8_t* chip = eeprom_bytes();
     if (!chip) {

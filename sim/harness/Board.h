@@ -64,6 +64,9 @@ struct BoardOptions {
     // --eeprom-cuts T1:T2:STEP: the EEPROM as a power cut at T1, T1+STEP, ... <= T2 leaves
     // it, written to eeprom_path.cut0, .cut1, ... (cuts_step_s 0: none)
     double eeprom_cuts_from_s = 0.0, eeprom_cuts_to_s = 0.0, eeprom_cuts_step_s = 0.0;
+    // --mission: a QGC WPL 110 file written into the EEPROM's mission area before the run
+    // (sim/models/MissionFile.h), on top of --eeprom's bytes or an erased chip.
+    std::string mission_path;
     // --gps: the GPS module on UART1 (false: --gps none, nothing on the GPS port).
     bool gps_attached = true;
     UbloxOptions gps;

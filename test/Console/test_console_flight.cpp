@@ -32,7 +32,7 @@ TEST(FlightConsole, SetGetFlightShowParse) {
     EXPECT_EQ(c.arg, console::kArm);
     EXPECT_EQ(console::parse_line("DISARM").arg, console::kDisarm);
     EXPECT_EQ(console::parse_line("arm now").error, console::Error::ExtraArgument);
-    c = console::parse_line("set FLTMODE3 1");
+    c = console::parse_line("set FLTMODE3 4");
     EXPECT_EQ(c.error, console::Error::NoSuchMode);
     EXPECT_EQ(c.arg, params::find("FLTMODE3"));
     EXPECT_EQ(console::parse_line("set FLTMODE3 5").id, console::CommandId::Set);
@@ -86,9 +86,11 @@ TEST(FlightConsole, SetAndGetReplies) {
     console::print_error(console::parse_line("set RLL2SRV_P 9"), &sink);
     EXPECT_EQ(out, "# error: RLL2SRV_P must be 0.1000..4.0000; nothing changed\n");
     out.clear();
-    console::print_error(console::parse_line("set FLTMODE2 1"), &sink);
-    EXPECT_EQ(out, "# error: FLTMODE2 must be a mode of this board: 0 manual, 2 stabilize, 5 fbwa; nothing changed\n");
+    console::print_error(console::parse_line("set FLTMODE2 4"), &sink);
+    EXPECT_EQ(out, "# error: FLTMODE2 must be a mode of this board: 0 manual, 2 stabilize, 5 fbwa, 1 circle, 6 fbwb, "
+                   "7 cruise, 10 auto, 11 rtl, 12 loiter; nothing changed\n");
     out.clear();
-    console::print_error(console::parse_line("flight circle"), &sink);
-    EXPECT_EQ(out, "# error: flight manual or stabilize or fbwa; nothing changed\n");
+    console::print_error(console::parse_line("flight acro"), &sink);
+    EXPECT_EQ(out, "# error: flight manual or stabilize or fbwa or circle or fbwb or cruise or auto or rtl or loiter; "
+                   "nothing changed\n");
 }

@@ -256,8 +256,8 @@ TEST(FlightControl, NoSignalHoldsEveryOutputAtTrimAndTheThrottleAtItsFailsafeVal
 
 TEST(FlightControl, EachSwitchPositionIsItsFltmode) {
     Rig r;
-    // FLTMODE1..6: STABILIZE, MANUAL, 1 (not a mode here: MANUAL), STABILIZE, MANUAL, STABILIZE.
-    const uint8_t modes[6] = {2, 0, 1, 2, 0, 2};
+    // FLTMODE1..6: STABILIZE, MANUAL, 4 (ACRO, not a mode here: MANUAL), STABILIZE, MANUAL, STABILIZE.
+    const uint8_t modes[6] = {2, 0, 4, 2, 0, 2};
     for (uint8_t i = 0; i < 6; ++i) r.s.flight.fltmode[i] = modes[i];
     const uint16_t middle[6] = {1100, 1300, 1420, 1560, 1700, 1900};
     r.rc[7] = middle[0];
@@ -313,10 +313,10 @@ TEST(FlightControl, AChoiceInFailsafeWaitsForTheSignal) {
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     r.run(0.1f);  // the switch has not moved: the console's choice holds
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
-    r.fc.choose((flight::Mode)1);  // not a mode here
+    r.fc.choose((flight::Mode)4);  // ACRO: not a mode here
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     r.fc.choose(flight::Mode::Stabilize);
-    r.fc.choose((flight::Mode)10);  // ArduPlane's AUTO: not one here either
+    r.fc.choose((flight::Mode)15);  // ArduPlane's GUIDED: not one here either
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
     r.fc.choose(flight::Mode::FlyByWireA);  // FBWA flies STABILIZE's law
@@ -762,5 +762,80 @@ TEST(FlightControl, ACoordinatedTurnsBodyPitchRateIsFlownNotFought) {
         // Back to STABILIZE afresh for the other side (the integrator emptied).
         r.fc.choose(flight::Mode::Manual);
         r.fc.choose(flight::Mode::Stabilize);
+    }
+}
+
+// The navigation's modes: the bank, pitch and throttle from set_nav_demands, through the
+// same controllers; disarmed, the throttle at its minimum.
+TEST(FlightControl, NavigationModesFlyTheNavigationsDemands) {
+    Rig r;
+    r.s.flight.fltmode[5] = (uint8_t)flight::Mode::Rtl;  // switch high
+    r.rc[7] = 2000;
+    r.fc.set_nav_demands(2000, 500, 600);  // bank right 20 deg, pitch up 5, throttle 60 %
+    r.run(0.1f);
+    ASSERT_EQ(r.fc.state(), flight::State::Navigate);
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::Rtl);
+    EXPECT_GT(r.out[0], 1500) << "aileron right: the bank asked for";
+    EXPECT_GT(r.out[1], 1500) << "elevator up: the pitch asked for";
+    EXPECT_EQ(r.out[2], 1600) << "the navigation's throttle, not the stick's (1100)";
+    r.fc.set_throttle_live(false);
+    r.run(0.05f);
+    EXPECT_EQ(r.out[2], 1000) << "disarmed: the throttle at its minimum";
+    r.fc.set_throttle_live(true);
+    // The demands, not the sticks: a full left stick changes nothing.
+    r.rc[0] = 1000;
+    r.att.roll_cd = 2000;
+    r.att.pitch_cd = 500;
+    r.fc.set_nav_demands(2000, 500, 600);
+    r.run(0.5f);
+    EXPECT_NEAR(r.out[0], 1500, 15) << "on the demanded bank: about trim";
+}
+
+TEST(FlightControl, TheSwitchKeepsTheModeWhenTheOneItPicksCannotRun) {
+    Rig r;
+    r.s.flight.fltmode[5] = (uint8_t)flight::Mode::Auto;
+    r.rc[7] = 1500;  // STABILIZE
+    r.run(0.1f);
+    ASSERT_EQ(r.fc.state(), flight::State::Stabilize);
+    r.fc.take_events();
+    r.fc.set_unavailable(1u << flight::mode_index((uint8_t)flight::Mode::Auto));
+    r.rc[7] = 2000;
+    r.run(0.2f);
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::Stabilize);
+    EXPECT_EQ(r.fc.state(), flight::State::Stabilize);
+    EXPECT_EQ(r.fc.refused_mode(), flight::Mode::Auto);
+    EXPECT_EQ(r.fc.take_events(), flight::kEvModeRefused);
+    // Available later: the switch must move again (ArduPlane's).
+    r.fc.set_unavailable(0);
+    r.run(0.2f);
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::Stabilize);
+    r.rc[7] = 1500;
+    r.run(0.1f);
+    r.rc[7] = 2000;
+    r.run(0.1f);
+    EXPECT_EQ(r.fc.chosen(), flight::Mode::Auto);
+}
+
+// ArduPlane's short failsafe: AUTO, RTL, LOITER and CIRCLE fly on; FBWB and CRUISE glide.
+TEST(FlightControl, TheShortFailsafeLetsAutoGoOnButFbwbGlides) {
+    for (flight::Mode m : {flight::Mode::Auto, flight::Mode::FlyByWireB}) {
+        Rig r;
+        r.run(0.1f);  // the first frame reads the switch (MANUAL)
+        r.fc.choose(m);
+        r.fc.set_nav_demands(-1500, 300, 700);
+        r.run(0.2f);
+        ASSERT_EQ(r.fc.state(), flight::State::Navigate);
+        r.run(1.0f, false);
+        ASSERT_EQ(r.fc.state(), flight::State::Failsafe);
+        if (m == flight::Mode::Auto) {
+            EXPECT_TRUE(r.fc.navigating_in_failsafe());
+            EXPECT_LT(r.out[0], 1500) << "the navigation's bank left, not wings level";
+            EXPECT_EQ(r.out[2], 1700) << "the navigation's throttle";
+        } else {
+            EXPECT_FALSE(r.fc.navigating_in_failsafe());
+            EXPECT_EQ(r.out[2], 1000) << "THR_FS_OUT 0: the glide";
+        }
+        r.run(0.2f);
+        EXPECT_EQ(r.fc.state(), flight::State::Navigate) << "the receiver back: the mode again";
     }
 }

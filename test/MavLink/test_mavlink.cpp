@@ -1487,3 +1487,26 @@ TEST(MavLinkMission, SetCurrentAndAnOldItemFromAGroundStation) {
     EXPECT_EQ(it.mission_type, 0u);
     EXPECT_FALSE(it.int_form);
 }
+
+namespace {
+
+// NAV_CONTROLLER_OUTPUT (62, CRC_EXTRA 183): the fields where common.xml puts them.
+TEST(MavLink, NavControllerOutputCarriesTheNavigationsFigures) {
+    mav::Packer p;
+    uint8_t buf[mav::kMaxFrame];
+    const mav::NavOutput n{12.5f, -3.25f, 271, 90, 1234, -2.5f, 1.75f};
+    const uint8_t len = p.nav_controller_output(buf, n);
+    const Frame f = parse(buf, len, 183);
+    EXPECT_TRUE(f.crc_ok);
+    EXPECT_EQ(f.msgid, 62u);
+    EXPECT_EQ(f32(f.payload, 0), 12.5f);    // nav_roll
+    EXPECT_EQ(f32(f.payload, 4), -3.25f);   // nav_pitch
+    EXPECT_EQ(f32(f.payload, 8), -2.5f);    // alt_error
+    EXPECT_EQ(f32(f.payload, 12), 0.0f);    // aspd_error: not sent
+    EXPECT_EQ(f32(f.payload, 16), 1.75f);   // xtrack_error
+    EXPECT_EQ((int16_t)u16(f.payload, 20), 271);  // nav_bearing
+    EXPECT_EQ((int16_t)u16(f.payload, 22), 90);   // target_bearing
+    EXPECT_EQ(u16(f.payload, 24), 1234u);         // wp_dist
+}
+
+}  // namespace

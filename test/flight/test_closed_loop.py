@@ -70,6 +70,26 @@ GROUP is one of:
                   nose right (> 2 deg/s on average, the heading > 5 deg right), 10 deg of
                   pitch held within 3 deg from 5 s into it, the bank within 15 deg, level
                   again within 5 deg of pitch, above 80 m
+  rtl             the navigation's RTL (docs/navigation.md "The modes"): on the default settings
+                  but the Rascal's cruise (TRIM_THROTTLE 11, TRIM_ARSPD_CM 1800), ALT_HOLD_RTL
+                  3000 and FLTMODE5 RTL, no gusts: the switch's RTL before the first fix is
+                  refused ("no 3D GPS fix") and STABILIZE flies on; from 25 s out (~400 m)
+                  RTL turns back, and from 15 s after it first comes within 80 m of home the
+                  circle holds WP_LOITER_RAD (60 m) +- 5 m and the height home's + 30 m
+                  +- 3 m, for at least 25 s
+  auto            a rectangle mission in AUTO (apm25sim --mission: 500 m x 300 m at home + 10 m,
+                  DO_JUMP for ever), no gusts, from 10 s for 140 s (1.6 laps): every waypoint
+                  passed within WP_RADIUS (30 m); from 15 s into AUTO (the climb done), the
+                  cross-track RMS on the legs after capture
+                  (within 3 m of the line and 10 deg of its course, until the turn) <= 2 m,
+                  the height RMS on them <= 3 m; AUTO before the first fix refused ("no 3D GPS
+                  fix"), no sample missed
+  rc_loss_auto    the rectangle in AUTO with FS_LONG_ACTN 1, the receiver lost from 35 s: the
+                  short failsafe said ("the mode goes on") and the mission flown on (within
+                  10 m of the legs, HEARTBEAT's mode AUTO in the line), then after
+                  FS_LONG_TIMEOUT (20 s) RTL said and flown: closer to home 15 s later
+  auto_wind       the same in a 5 m/s wind from the west (the backend's --wind 0,5) with light
+                  gusts (seed 47001): the cross-track RMS <= 5 m, the rest as `auto`
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
 import argparse
@@ -135,7 +155,7 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True):
+                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True, mission=None, wind=None):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
         board (apm25sim --input: from its first angle line); airframe: how the backend reads
         the outputs (closed_loop.py --airframe: plain, elevons, vtail); gps: apm25sim --gps
@@ -159,6 +179,10 @@ class Flight:
             cmd += ["--gps", gps]
         if arm:
             cmd.append("--arm")
+        if mission:
+            cmd += ["--mission", mission]
+        if wind:
+            cmd += ["--wind", wind]
         if console:
             with open(base + "_console.txt", "w") as f:
                 f.write("".join(line + "\n" for line in console))
@@ -737,7 +761,239 @@ def fly_stabilized(f, name, t_turn, t_out, seconds, worst_us, bank):
     soft_assert(lost < 20.0, "%s: lost %.1f m of height (less than 20)" % (name, lost))
 
 
-GROUPS = {"manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+# The simulator's GPS origin (apm25sim --home's default) and its flat map (sim/models/Geodesy.h),
+# to put the home the board says on the backend's north-east metres.
+SIM_HOME = (7.135045, -73.119421, 1028.0)
+
+
+def sim_ned(lat_deg, lon_deg):
+    a, e2 = 6378137.0, 6.69437999014e-3
+    s = math.sin(math.radians(SIM_HOME[0]))
+    r_m = a * (1 - e2) / (1 - e2 * s * s) ** 1.5
+    r_n = a / math.sqrt(1 - e2 * s * s)
+    return (math.radians(lat_deg - SIM_HOME[0]) * (r_m + SIM_HOME[2]),
+            math.radians(lon_deg - SIM_HOME[1]) * (r_n + SIM_HOME[2]) * math.cos(math.radians(SIM_HOME[0])))
+
+
+GPS_LATENCY_S = 0.2  # apm25sim --gps-latency's default
+
+
+def said_home(f):
+    """Home as the board said it: (north m, east m, the height its heights are above, m above
+    the backend's ground). The board's height above home is the barometer's change since the
+    home fix (docs/position.md), so the height is the truth's at the fix (said less the GPS's
+    latency), not the GPS's (its ~1 m of vertical error left out)."""
+    h = f.said("# home: set at ")
+    if h is None:
+        return None
+    lat, lon = (float(x) for x in h[1].split("set at ")[1].split(",")[0].split())
+    at = f.truth_at(h[0] - GPS_LATENCY_S)
+    return sim_ned(lat, lon) + (-at["down_m"],)
+
+
+RTL_ALT_CM, LOITER_RAD_M = 3000, 60.0
+RTL_SWITCH = 1700  # channel 8's fifth band: FLTMODE5
+
+
+def check_rtl(args):
+    t_rtl, seconds = HOLD_S + 25.0, 100.0
+    rows = [row(0.0), row(HOLD_S + 1.0, mode=RTL_SWITCH), row(HOLD_S + 2.0), row(t_rtl, mode=RTL_SWITCH)]
+    f = Flight(args.work, "rtl", rows, seconds, tools=args.tools, gps="ublox",
+               console=["set FLTMODE5 11", "set ALT_HOLD_RTL %d" % RTL_ALT_CM, "set TRIM_THROTTLE 11",
+                        "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    refused = f.said("# Mode change refused (switch): RTL")
+    print("rtl: before the fix the board said %r" % (refused,))
+    soft_assert(refused is not None and "no 3D GPS fix" in refused[1] and refused[0] < HOLD_S + 2.0,
+                "rtl: RTL before the first fix not refused with its reason: %r" % (refused,))
+    soft_assert(f.said("# flight RTL", after=HOLD_S + 1.0) is not None and f.said("# flight RTL")[0] >= t_rtl,
+                "rtl: RTL entered before the switch asked for it after the fix: %r" % (f.said("# flight RTL"),))
+    home = said_home(f)
+    soft_assert(home is not None, "rtl: no home said")
+    if home is None:
+        return
+    want_h = home[2] + RTL_ALT_CM / 100.0
+
+    def dist(r):
+        return math.hypot(r["north_m"] - home[0], r["east_m"] - home[1])
+    out = dist(f.truth_at(t_rtl))
+    near = next((r["t"] for r in f.truth_between(t_rtl, seconds) if dist(r) < 80.0), None)
+    soft_assert(near is not None, "rtl: never within 80 m of home")
+    if near is None:
+        return
+    circle = f.truth_between(near + 15.0, seconds)
+    radii = [dist(r) for r in circle]
+    heights = [-r["down_m"] - want_h for r in circle]
+    turned = sum(abs(angle_diff(b["yaw_deg"], a["yaw_deg"])) for a, b in zip(circle, circle[1:]))
+    print("rtl: %.0f m out at %.1f s; within 80 m of home %.1f s later; on the circle from %.1f s for %.0f s (%.0f deg "
+          "turned): radius %.1f-%.1f m (mean %.1f, WP_LOITER_RAD %g), height %+.1f to %+.1f m of home + %g m "
+          "(mean %+.2f)" % (out, t_rtl, near - t_rtl, near + 15.0, seconds - near - 15.0, turned, min(radii),
+                            max(radii), sum(radii) / len(radii), LOITER_RAD_M, min(heights), max(heights),
+                            RTL_ALT_CM / 100.0, sum(heights) / len(heights)))
+    soft_assert(out > 350.0, "rtl: only %.0f m out when RTL began" % out)
+    soft_assert(seconds - near - 15.0 >= 25.0, "rtl: %.1f s to come home" % (near - t_rtl))
+    soft_assert(turned > 300.0, "rtl: the circle turned only %.0f deg" % turned)
+    soft_assert(max(abs(r - LOITER_RAD_M) for r in radii) <= 5.0, "rtl: the radius left %g +- 5 m: %.1f-%.1f"
+                % (LOITER_RAD_M, min(radii), max(radii)))
+    soft_assert(max(abs(h) for h in heights) <= 3.0, "rtl: the height left ALT_HOLD_RTL +- 3 m: %+.1f to %+.1f"
+                % (min(heights), max(heights)))
+
+
+def sim_latlon(north_m, east_m):
+    """The inverse of sim_ned: degrees."""
+    a, e2 = 6378137.0, 6.69437999014e-3
+    s = math.sin(math.radians(SIM_HOME[0]))
+    r_m = a * (1 - e2) / (1 - e2 * s * s) ** 1.5
+    r_n = a / math.sqrt(1 - e2 * s * s)
+    return (SIM_HOME[0] + math.degrees(north_m / (r_m + SIM_HOME[2])),
+            SIM_HOME[1] + math.degrees(east_m / ((r_n + SIM_HOME[2]) * math.cos(math.radians(SIM_HOME[0])))))
+
+
+# The rectangle: north-east metres from the backend's start (the launch point, heading north),
+# at home + RECT_ALT_M; the aeroplane flies up its west side when AUTO starts.
+RECT = [(400.0, 0.0), (400.0, 300.0), (-100.0, 300.0), (-100.0, 0.0)]
+RECT_ALT_M = 10.0
+WP_RADIUS_M = 30.0
+
+
+def write_rectangle(path):
+    lines = ["QGC WPL 110", "0\t1\t0\t16\t0\t0\t0\t0\t%.7f\t%.7f\t%.2f\t1" % (SIM_HOME[0], SIM_HOME[1], SIM_HOME[2])]
+    for i, (n, e) in enumerate(RECT):
+        lat, lon = sim_latlon(n, e)
+        lines.append("%d\t0\t3\t16\t0\t0\t0\t0\t%.7f\t%.7f\t%.2f\t1" % (i + 1, lat, lon, RECT_ALT_M))
+    lines.append("%d\t0\t0\t177\t1\t-1\t0\t0\t0\t0\t0\t1" % (len(RECT) + 1))  # DO_JUMP 1, for ever
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return path
+
+
+def leg_figures(samples, legs, want_h, turn_m=WP_RADIUS_M):
+    """Cross-track and height errors on the legs after capture, as the host route test takes
+    them: on a pass along a leg, from the first sample within 3 m of its line and 10 deg of
+    its course until turn_m before its end. ([cross-track m], [height error m], passes)."""
+    xt, dh, passes = [], [], 0
+    for (a, b) in legs:
+        dn, de = b[0] - a[0], b[1] - a[1]
+        length = math.hypot(dn, de)
+        un, ue = dn / length, de / length
+        captured, last_t = False, None
+        for r in samples:
+            pn, pe = r["north_m"] - a[0], r["east_m"] - a[1]
+            along, cross = pn * un + pe * ue, pe * un - pn * ue
+            course = math.degrees(math.atan2(r["ve_m_s"], r["vn_m_s"]))
+            off = abs(angle_diff(course, math.degrees(math.atan2(ue, un))))
+            on = 0.0 <= along <= length - turn_m and off < 45.0 and abs(cross) < 50.0
+            if not on:
+                captured = False
+                continue
+            if last_t is None or r["t"] - last_t > 1.0:
+                captured = False
+            last_t = r["t"]
+            if not captured and abs(cross) < 3.0 and off < 10.0:
+                captured = True
+                passes += 1
+            if captured:
+                xt.append(cross)
+                dh.append(-r["down_m"] - want_h)
+    return xt, dh, passes
+
+
+def rms(v):
+    return math.sqrt(sum(x * x for x in v) / len(v)) if v else float("nan")
+
+
+def fly_auto(args, name, xt_max, gust=0, seed=1, wind=None):
+    """The rectangle in AUTO from 10 s to 150 s; the checks of the `auto` group, the
+    cross-track RMS within xt_max."""
+    t_auto, seconds = 10.0, 150.0
+    mission = write_rectangle(os.path.join(args.work, name + ".waypoints"))
+    rows = [row(0.0), row(HOLD_S + 1.0, mode=RTL_SWITCH), row(HOLD_S + 2.0), row(t_auto, mode=RTL_SWITCH)]
+    f = Flight(args.work, name, rows, seconds, tools=args.tools, gps="ublox", mission=mission, gust=gust, seed=seed,
+               wind=wind, console=["set FLTMODE5 10", "set TRIM_THROTTLE 11", "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    refused = f.said("# Mode change refused (switch): AUTO")
+    print("%s: before the fix the board said %r" % (name, refused))
+    soft_assert(refused is not None and "no 3D GPS fix" in refused[1],
+                "%s: AUTO before the fix not refused: %r" % (name, refused))
+    entered = f.said("# flight AUTO")
+    soft_assert(entered is not None and entered[0] >= t_auto,
+                "%s: AUTO not entered at %g s: %r" % (name, t_auto, entered))
+    overrun = f.said("# warn: loop overrun")
+    soft_assert(overrun is None, "%s: %r" % (name, overrun))
+    home = said_home(f)
+    soft_assert(home is not None, "%s: no home said" % name)
+    if home is None:
+        return
+    flown = f.truth_between(t_auto, seconds)
+    closest = []
+    for w in RECT:
+        d, t = min((math.hypot(r["north_m"] - w[0], r["east_m"] - w[1]), r["t"]) for r in flown)
+        closest.append((d, t))
+    legs = [(RECT[i], RECT[(i + 1) % len(RECT)]) for i in range(len(RECT))]
+    # The legs from 15 s into AUTO: the climb from the launch height to the mission's is done.
+    xt, dh, passes = leg_figures(f.truth_between(t_auto + 15.0, seconds), legs, home[2] + RECT_ALT_M)
+    print("%s: closest to each waypoint %s m; %d leg passes after capture, %.0f s of them: cross-track RMS %.2f m "
+          "(worst %.1f), height RMS %.2f m (mean %+.2f) of home + %g m"
+          % (name, ", ".join("%.1f (%.0f s)" % c for c in closest), passes, len(xt) / 1000.0, rms(xt),
+             max((abs(x) for x in xt), default=float("nan")), rms(dh), sum(dh) / max(len(dh), 1), RECT_ALT_M))
+    soft_assert(all(d <= WP_RADIUS_M for d, _ in closest),
+                "%s: a waypoint missed by more than WP_RADIUS: %s" % (name, closest))
+    soft_assert(passes >= 4 and len(xt) > 35000,
+                "%s: only %d passes, %d samples on the legs" % (name, passes, len(xt)))
+    soft_assert(rms(xt) <= xt_max, "%s: cross-track RMS %.2f m (at most %g)" % (name, rms(xt), xt_max))
+    soft_assert(rms(dh) <= 3.0, "%s: height RMS %.2f m (at most 3)" % (name, rms(dh)))
+
+
+def check_auto(args):
+    fly_auto(args, "auto", 2.0)
+
+
+def check_rc_loss_auto(args):
+    t_auto, t_lost, seconds = 10.0, 35.0, 80.0
+    mission = write_rectangle(os.path.join(args.work, "rc_loss_auto.waypoints"))
+    rows = [row(0.0), row(t_auto, mode=RTL_SWITCH), (t_lost, None)]
+    f = Flight(args.work, "rc_loss_auto", rows, seconds, tools=args.tools, gps="ublox", mission=mission,
+               console=["set FLTMODE5 10", "set FS_LONG_ACTN 1", "set TRIM_THROTTLE 11",
+                        "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    short = f.said("# failsafe: receiver lost", after=t_lost)
+    long_fs = f.said("# failsafe: long (FS_LONG_TIMEOUT): RTL", after=t_lost)
+    print("rc_loss_auto: said %r, then %r" % (short, long_fs))
+    soft_assert(short is not None and "the mode goes on" in short[1] and short[0] < t_lost + 1.0,
+                "rc_loss_auto: the short failsafe not said as AUTO flying on: %r" % (short,))
+    soft_assert(long_fs is not None and 19.0 <= long_fs[0] - t_lost <= 21.5,
+                "rc_loss_auto: RTL not entered FS_LONG_TIMEOUT after the loss: %r" % (long_fs,))
+    home = said_home(f)
+    if home is None or long_fs is None:
+        soft_assert(False, "rc_loss_auto: no home or no RTL")
+        return
+    legs = [(RECT[i], RECT[(i + 1) % len(RECT)]) for i in range(len(RECT))]
+
+    def off_route(r):
+        best = float("inf")
+        for a, b in legs:
+            dn, de = b[0] - a[0], b[1] - a[1]
+            length = math.hypot(dn, de)
+            along = ((r["north_m"] - a[0]) * dn + (r["east_m"] - a[1]) * de) / length
+            along = min(max(along, 0.0), length)
+            best = min(best, math.hypot(r["north_m"] - a[0] - along * dn / length,
+                                        r["east_m"] - a[1] - along * de / length))
+        return best
+    # The turns cut inside or overshoot the corners: the worst within 40 m of the route.
+    worst = max(off_route(r) for r in f.truth_between(t_lost, long_fs[0]))
+    d_rtl = math.hypot(f.truth_at(long_fs[0])["north_m"] - home[0], f.truth_at(long_fs[0])["east_m"] - home[1])
+    d_later = math.hypot(f.truth_at(long_fs[0] + 15.0)["north_m"] - home[0],
+                         f.truth_at(long_fs[0] + 15.0)["east_m"] - home[1])
+    print("rc_loss_auto: without the receiver AUTO flew on within %.1f m of the route for %.1f s; RTL at %.0f m from "
+          "home, %.0f m 15 s later" % (worst, long_fs[0] - t_lost, d_rtl, d_later))
+    soft_assert(worst <= 40.0, "rc_loss_auto: %.1f m off the route without the receiver" % worst)
+    soft_assert(d_later < d_rtl - 150.0 or d_later < 120.0, "rc_loss_auto: RTL did not come home: %.0f m -> %.0f m"
+                % (d_rtl, d_later))
+
+
+def check_auto_wind(args):
+    """5 m/s from the west (across the long legs) with light gusts, a fresh seed."""
+    fly_auto(args, "auto_wind", 5.0, gust=1, seed=47001, wind="0,5")
+
+
+GROUPS = {"rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "rc_loss_auto": check_rc_loss_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,

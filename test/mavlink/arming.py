@@ -19,8 +19,9 @@ barometer taken away for a while (--fault), and talks to it as a ground station:
   - the throttle pin (OUT3) at 1000 us from the first pulse whenever disarmed, the stick's
     width while armed;
   - SET_MODE (ACK command 11), DO_SET_MODE in COMMAND_LONG and COMMAND_INT for MANUAL,
-    STABILIZE and FBWA, each ACCEPTED and in HEARTBEAT's custom_mode; 10 (AUTO) refused with
-    FAILED and a reason; the mode switch moving takes over; PARAM_SET FLTMODE1 1 refused;
+    STABILIZE and FBWA, each ACCEPTED and in HEARTBEAT's custom_mode; 15 (GUIDED) and 4 (ACRO)
+    refused with FAILED and "no mode", 10 (AUTO, no mission) with FAILED and its reason; the
+    mode switch moving takes over; PARAM_SET FLTMODE1 4 refused;
   - RC_CHANNELS_OVERRIDE of channel 1 on the pin (OUT1) and RC_CHANNELS, back to the
     receiver's RC_OVERRIDE_TIME (set to 1.5 s by PARAM_SET: in force at once) after the last
     message.
@@ -117,24 +118,34 @@ def set_mode_checks(b):
         soft_assert(hb is not None and hb.custom_mode == number, "%s %s: HEARTBEAT custom_mode %r"
                     % (how, name, hb and hb.custom_mode))
     print("# modes: SET_MODE, DO_SET_MODE (COMMAND_LONG, COMMAND_INT) for MANUAL, STABILIZE, FBWA accepted and flown")
-    # Refused: a mode the board does not have, in both messages, with its reason.
+    # Refused: a mode the board does not have, in both messages, with its reason; AUTO
+    # (a mode it has) for want of a fix, home or a mission, with that reason.
+    command(b, mavlink2.MAV_CMD_DO_SET_MODE, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 15)
+    ack = b.ack(mavlink2.MAV_CMD_DO_SET_MODE, "COMMAND_ACK to DO_SET_MODE 15")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "DO_SET_MODE 15 (GUIDED): %r" % ack)
+    b.conn.mav.set_mode_send(1, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 4)
+    ack = b.ack(11, "COMMAND_ACK to SET_MODE 4")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "SET_MODE 4 (ACRO): %r" % ack)
     command(b, mavlink2.MAV_CMD_DO_SET_MODE, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 10)
     ack = b.ack(mavlink2.MAV_CMD_DO_SET_MODE, "COMMAND_ACK to DO_SET_MODE 10")
-    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "DO_SET_MODE 10 (AUTO): %r" % ack)
-    b.conn.mav.set_mode_send(1, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 1)
-    ack = b.ack(11, "COMMAND_ACK to SET_MODE 1")
-    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "SET_MODE 1 (CIRCLE): %r" % ack)
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "DO_SET_MODE 10 (AUTO, no mission): %r"
+                % ack)
     t = b.t_s
     b.pump(lambda m, t=t: b.t_s > t + 0.3, "the reasons")
-    for n in (10, 1):
+    for n in (15, 4):
         soft_assert(text_at(b.msgs, "Mode change refused: no mode %d on this board" % n, t - 1.0) is not None,
                     "no reason said for mode %d" % n)
+    auto = [m.text for tm, m in b.msgs if tm >= t - 1.0 and m.get_type() == "STATUSTEXT"
+            and m.text.startswith("Mode change refused: AUTO: ")]
+    print("# AUTO refused: %r" % auto)
+    soft_assert(auto and auto[0].split(": ")[-1] in ("no 3D GPS fix", "no home", "no mission"),
+                "no reason said for AUTO: %r" % auto)
     hb = b.pump(lambda m: m.get_type() == "HEARTBEAT", "HEARTBEAT after the refusals")
     soft_assert(hb is not None and hb.custom_mode == 5, "a refused mode changed the mode: %r" % (hb and hb.custom_mode))
-    # FLTMODE1 1 (CIRCLE) refused: the old value back.
-    b.conn.mav.param_set_send(1, 1, b"FLTMODE1", 1, mavlink2.MAV_PARAM_TYPE_INT8)
-    pv = b.param("FLTMODE1", "PARAM_VALUE for FLTMODE1 1")
-    soft_assert(pv is not None and pv.param_value == 0, "FLTMODE1 1 (not a mode here) -> %r" % pv)
+    # FLTMODE1 4 (ACRO) refused: the old value back.
+    b.conn.mav.param_set_send(1, 1, b"FLTMODE1", 4, mavlink2.MAV_PARAM_TYPE_INT8)
+    pv = b.param("FLTMODE1", "PARAM_VALUE for FLTMODE1 4")
+    soft_assert(pv is not None and pv.param_value == 0, "FLTMODE1 4 (not a mode here) -> %r" % pv)
 
 
 def main():

@@ -20,7 +20,9 @@ stick), BATT_MONITOR 4, BATT_CAPACITY 2200, FS_BATT_VOLTAGE 11.5 V; at 28 s FS_B
   - SYS_STATUS's battery bit present, enabled and healthy before the failsafe;
   - the 3 s sag below 11.5 V enters no failsafe;
   - "Low battery ...V used ... mAh" (STATUSTEXT, WARNING) 10 to 11.5 s after FS_BATT_VOLTAGE
-    went above the pack, once; then the bit unhealthy and BATTERY_STATUS charge_state LOW.
+    went above the pack, once; then the bit unhealthy and BATTERY_STATUS charge_state LOW,
+    and "failsafe: low battery: RTL" (or its reason for none) once; the readings compared
+    until the failsafe (RTL then flies TECS's throttle, not the stick's).
 Run 2, a fixed 20 A: with the default BATT_MONITOR 0 SYS_STATUS says "not measured"
 (voltage UINT16_MAX, current and remaining -1, no battery bit) and no BATTERY_STATUS comes;
 then BATT_MONITOR 4, BATT_CAPACITY 1000, FS_BATT_MAH 995: the failsafe once more than 5 mAh
@@ -134,7 +136,9 @@ def first_run(args, trajectory):
     # Voltage and current at steady throttle, both messages.
     n_sys = n_bat = 0
     for t, m in msgs:
-        if t < t_on + 1.5 or not steady(t):
+        # Until the failsafe: its RTL flies TECS's throttle, not the stick's (with the
+        # simulated GPS's fix and home at rest).
+        if t < t_on + 1.5 or not steady(t) or t >= t_fs - 0.5:
             continue
         volts, amps = truth.at(t, "volts"), truth.at(t, "amps")
         if m.get_type() == "SYS_STATUS":
@@ -191,6 +195,11 @@ def first_run(args, trajectory):
     after = [m for t, m in msgs if m.get_type() == "BATTERY_STATUS" and t > t_fs + 1.5]
     soft_assert(after and all(m.charge_state == mavlink2.MAV_BATTERY_CHARGE_STATE_LOW for m in after),
                 "BATTERY_STATUS charge_state after the failsafe: %s" % [m.charge_state for m in after])
+    # ArduPlane's action: RTL (the board at rest has a fix and home), or the reason it cannot.
+    rtl = [m.text for t, m in msgs if m.get_type() == "STATUSTEXT" and m.text.startswith("failsafe: low battery: ")]
+    print("run 1: the failsafe's action: %r" % rtl)
+    soft_assert(len(rtl) == 1 and (rtl[0].endswith(": RTL") or "no RTL (" in rtl[0]),
+                "the battery failsafe's RTL not said once: %r" % rtl)
     no_overrun(msgs, "run 1")
     print("run 1: %d SYS_STATUS and %d BATTERY_STATUS at steady throttle compared" % (n_sys, n_bat))
 
