@@ -20,7 +20,7 @@ Q := @
 say = @printf '  %-8s %s\n' '$(1)' '$(2)'
 endif
 
-.PHONY: all firmware tools unit sim fly test bench tune upload size attitude-only big docs startup-variants
+.PHONY: all firmware tools unit sim fly test bench tune upload size attitude-only big progmem-control docs startup-variants
 all: firmware tools
 
 # ---------------------------------------------------------------------------
@@ -168,11 +168,15 @@ $(STARTUP_BUILD)/%.elf: $(STARTUP_BUILD)/%.S.o $(FW_OBJ) $(BUILD)/avr/core.a
 # every function pointer (the flash bytes are the same with or without it).
 # Beside it, two controls that the test must see fail: the image linked without trampolines
 # (--no-stubs: a word address of code above 128 KB wraps round), and padding before the
-# PROGMEM data that lifts its end past LPM's 64 KB.
+# PROGMEM data that lifts its end past LPM's 64 KB (that one from the attitude-only build).
 FLASH_BUDGET := 204800
 BIG_BUILD    := $(FW_BUILD)/big
 BIG_LINK      = $(AVR_CXX) $(AVR_LDFLAGS) -Wl,-q $(BIG_LDFLAGS) $< $(FW_OBJ) $(BUILD)/avr/core.a -lm -o $@
-big: $(BIG_BUILD)/firmware.elf $(BIG_BUILD)/no-trampolines.elf $(BIG_BUILD)/progmem-high.elf
+big: $(BIG_BUILD)/firmware.elf $(BIG_BUILD)/no-trampolines.elf
+	@$(MAKE) --no-print-directory -f mk/build.mk APM25_FLIGHT=0 progmem-control
+# The PROGMEM control from the attitude-only objects (build/attitude-only/big): the full
+# firmware and 51 KB of padding no longer fit the 2560's 256 KB.
+progmem-control: $(BIG_BUILD)/progmem-high.elf
 $(BIG_BUILD)/firmware.elf: BIG_LDFLAGS := -Wl,-Map,$(BIG_BUILD)/firmware.map
 $(BIG_BUILD)/no-trampolines.elf: BIG_LDFLAGS := -Wl,--no-stubs
 $(BIG_BUILD)/padding.S.o: test/sketch/padding.S $(FW_BUILD)/firmware.elf

@@ -630,8 +630,9 @@ def cmd_run(args):
                       "the flight run has ATTITUDE, RC_CHANNELS and SERVO_OUTPUT_RAW frames")
 
     # The controls (make big links them beside the image): what the checks above must catch.
-    for control, key, what in ([] if args.no_controls else CONTROLS):
-        path = os.path.join(os.path.dirname(big), control + ".elf")
+    for control, key, what, build in ([] if args.no_controls else CONTROLS):
+        path = os.path.join(os.path.dirname(big) if build is None else os.path.join(args.tools, build, "big"),
+                            control + ".elf")
         if not os.path.exists(path):
             checks.ok(False, "the control %s exists" % path, "build it: make big")
             continue
@@ -639,7 +640,11 @@ def cmd_run(args):
         check_placement(Elf(path), c)
         code, err, data, _, _ = run_sim(args.tools, path, args.work, "console." + control, args.seconds, None,
                                         RUNS[0][3])
-        diffs = compare_outputs(base_output["console"], data)
+        reference = base_output["console"]
+        if build is not None:  # against that build's own image, unpadded
+            _, _, reference, _, _ = run_sim(args.tools, os.path.join(args.tools, build, "firmware.elf"), args.work,
+                                            "console." + build, args.seconds, None, RUNS[0][3])
+        diffs = compare_outputs(reference, data)
         checks.ok(key in c.failed_keys and diffs, "the control %s (%s) is caught: by the check of %s and "
                   "by the console run (%s)" % (control, what, key, diffs[0][:90] + "..." if diffs else "no difference"),
                   "failed checks: %s" % (", ".join(sorted(c.failed_keys)) or "none"))
@@ -647,9 +652,11 @@ def cmd_run(args):
 
 
 # Broken images the test must catch: (the ELF beside the padded one, the check that must
-# fail, what is wrong with it).
-CONTROLS = [("no-trampolines", "words", "linked with --no-stubs: code addresses above 128 KB wrap round"),
-            ("progmem-high", "progmem", "padding before the PROGMEM data, whose end lies above 64 KB")]
+# fail, what is wrong with it, the build it comes from: None the firmware's, else the build
+# folder whose firmware.elf its console run is compared with).
+CONTROLS = [("no-trampolines", "words", "linked with --no-stubs: code addresses above 128 KB wrap round", None),
+            ("progmem-high", "progmem", "padding before the PROGMEM data, whose end lies above 64 KB (the "
+             "attitude-only build: the firmware and the padding overflow the 2560)", "attitude-only")]
 
 
 def main():
