@@ -6,10 +6,11 @@
 //
 // Units as the datasheet: D1 and D2 the 24-bit ADC codes, TEMP in 0.01 degC, P in Pa
 // (0.01 mbar), PROM words C1..C6 at prom[1..6], word 7's low 4 bits the CRC.
-// Integer arithmetic exactly as printed: the intermediate OFF, SENS and D1 * SENS need
-// 64 bits (the datasheet's own variable sizes), every division truncates toward zero as
-// C's does. The temperature terms change slowly: they are worked out once per D2, and
-// each D1 then costs one 64-bit product (terms() and pressure_pa() below).
+// Integer results exactly as printed: OFF, SENS and D1 * SENS need 64 bits (the
+// datasheet's own variable sizes), every division truncates toward zero as C's does;
+// the .cpp keeps to 32 bits what fits (test/MS5611/test_ms5611_exact.cpp holds it to an
+// int64_t transcription). The temperature terms change slowly: they are worked out once
+// per D2, and each D1 then costs one 32 x 32 -> 64 product (terms() and pressure_pa()).
 #pragma once
 
 #include <stdint.h>
@@ -34,6 +35,9 @@ struct Terms {
     int64_t off;        // OFF - OFF2: offset at that temperature
     int64_t sens;       // SENS - SENS2: sensitivity at that temperature
 };
+// Exact (the datasheet's integers) for D2 < 2^24 and TEMP (first order) within the
+// datasheet's -4000..8500; below -4000 temp_c100 stays exact (so the sequencer rejects
+// it) and off, sens take the -40 degC second-order terms.
 Terms terms(const uint16_t prom[kPromWords], uint32_t d2);
 
 // P = (D1 * SENS / 2^21 - OFF) / 2^15, Pa.

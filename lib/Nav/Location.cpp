@@ -47,21 +47,35 @@ int32_t round_to_int32(float x) {
     return (int32_t)(x < 0.0f ? x - 0.5f : x + 0.5f);
 }
 
-Location LocalMap::moved(const Location& loc, float north_m, float east_m) const {
+Location moved_e7(const Location& loc, int32_t north_e7, int32_t east_e7) {
+    // A move near the antimeridian or a pole may leave int32's range before it is wrapped
+    // (longitude) or held (latitude) back into it. Not in int64_t (avr-gcc expands each
+    // 64-bit addition and comparison inline: ~860 bytes here): the 32-bit sum's overflow
+    // says where the true sum is, beyond +-2^31 and so beyond +-90 and +-180 deg.
+    constexpr int32_t kHalfTurn = 1800000000;
+    constexpr int32_t kPole = 900000000;
+    constexpr int32_t kTurnPast32 = 694967296;  // 2^32 - 3.6e9: a turn, less the wrap
     Location out = loc;
-    // In 64 bits: a move near the antimeridian or a pole may leave int32's range before
-    // it is wrapped (longitude) or held (latitude) back into it.
-    constexpr int64_t kHalfTurn = 1800000000;
-    constexpr int64_t kPole = 900000000;
-    int64_t lat = (int64_t)loc.lat_e7 + round_to_int32(north_m * e7_per_north_m_);
-    int64_t lon = (int64_t)loc.lon_e7 + round_to_int32(east_m * e7_per_east_m_);
-    if (lat > kPole) lat = kPole;
+    int32_t lat;
+    if (__builtin_add_overflow(loc.lat_e7, north_e7, &lat)) lat = north_e7 > 0 ? kPole : -kPole;
+    else if (lat > kPole) lat = kPole;
     else if (lat < -kPole) lat = -kPole;
-    if (lon > kHalfTurn) lon -= 2 * kHalfTurn;
-    else if (lon < -kHalfTurn) lon += 2 * kHalfTurn;
-    out.lat_e7 = (int32_t)lat;
-    out.lon_e7 = (int32_t)lon;
+    int32_t lon;
+    if (__builtin_add_overflow(loc.lon_e7, east_e7, &lon)) {
+        // The true sum is lon +- 2^32; less (more) a turn it is lon +- (2^32 - 3.6e9).
+        lon = east_e7 > 0 ? lon + kTurnPast32 : lon - kTurnPast32;
+    } else if (lon > kHalfTurn) {
+        lon = (lon - kHalfTurn) - kHalfTurn;  // each step within int32
+    } else if (lon < -kHalfTurn) {
+        lon = (lon + kHalfTurn) + kHalfTurn;
+    }
+    out.lat_e7 = lat;
+    out.lon_e7 = lon;
     return out;
+}
+
+Location LocalMap::moved(const Location& loc, float north_m, float east_m) const {
+    return moved_e7(loc, round_to_int32(north_m * e7_per_north_m_), round_to_int32(east_m * e7_per_east_m_));
 }
 
 }  // namespace nav

@@ -56,4 +56,8 @@ private:
 // Rounds to the nearest integer (half away from zero), held within +-2e9; NaN gives 0.
 int32_t round_to_int32(float x);
 
+// `loc` moved by north_e7, east_e7 (|each| <= 2e9, round_to_int32's): the latitude held
+// within +-90 deg, the longitude wrapped once by a turn beyond +-180 deg (LocalMap::moved).
+Location moved_e7(const Location& loc, int32_t north_e7, int32_t east_e7);
+
 }  // namespace nav

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <random>
 
 #include "Geodesy.h"
 #include "Location.h"
@@ -102,6 +104,53 @@ TEST(Location, RoundingHoldsItsRange) {
     EXPECT_EQ(nav::round_to_int32(1e12f), 2000000000);
     EXPECT_EQ(nav::round_to_int32(-1e12f), -2000000000);
     EXPECT_EQ(nav::round_to_int32(NAN), 0);
+}
+
+}  // namespace
+
+// moved_e7's 32-bit sums against the int64_t arithmetic it replaced (LocalMap::moved's
+// before): every latitude and longitude, every step round_to_int32 can give.
+namespace {
+
+nav::Location reference_moved_e7(const nav::Location& loc, int32_t north_e7, int32_t east_e7) {
+    constexpr int64_t kHalfTurn = 1800000000;
+    constexpr int64_t kPole = 900000000;
+    nav::Location out = loc;
+    int64_t lat = (int64_t)loc.lat_e7 + north_e7;
+    int64_t lon = (int64_t)loc.lon_e7 + east_e7;
+    if (lat > kPole) lat = kPole;
+    else if (lat < -kPole) lat = -kPole;
+    if (lon > kHalfTurn) lon -= 2 * kHalfTurn;
+    else if (lon < -kHalfTurn) lon += 2 * kHalfTurn;
+    out.lat_e7 = (int32_t)lat;
+    out.lon_e7 = (int32_t)lon;
+    return out;
+}
+
+TEST(Location, MovedE7IsTheInt64Sum) {
+    const int32_t edges[] = {INT32_MIN, INT32_MIN + 1, -2000000000, -1800000001, -1800000000, -900000001,
+                             -900000000, -1, 0, 1, 900000000, 900000001, 1800000000, 1800000001,
+                             2000000000, INT32_MAX - 1, INT32_MAX};
+    const int32_t steps[] = {-2000000000, -1800000000, -900000000, -1, 0, 1, 900000000, 1800000000, 2000000000};
+    std::mt19937 rng(47u);
+    auto check = [](int32_t lat, int32_t lon, int32_t n, int32_t e) {
+        const nav::Location loc{lat, lon, 12345};
+        const nav::Location got = nav::moved_e7(loc, n, e), want = reference_moved_e7(loc, n, e);
+        ASSERT_EQ(got.lat_e7, want.lat_e7) << lat << " + " << n;
+        ASSERT_EQ(got.lon_e7, want.lon_e7) << lon << " + " << e;
+        ASSERT_EQ(got.alt_cm, 12345);
+    };
+    for (int32_t p : edges)
+        for (int32_t s : steps) {
+            check(p, p, s, s);
+            check(p, -p - 1, s, -s);
+        }
+    for (int i = 0; i < 200000; ++i) {
+        const int32_t n = (int32_t)((int64_t)(rng() % 4000000001u) - 2000000000);
+        const int32_t e = (int32_t)((int64_t)(rng() % 4000000001u) - 2000000000);
+        check((int32_t)rng(), (int32_t)rng(), n, e);
+        check((int32_t)(rng() % 1800000001u) - 900000000, (int32_t)((int64_t)(rng() % 3600000001u) - 1800000000), n, e);
+    }
 }
 
 }  // namespace
