@@ -95,7 +95,7 @@ void StreamRates::plan(const uint8_t sr0_hz[kStreamGroups], uint8_t output_rate_
         if (ms == kFollowGroup) {
             uint8_t hz = sr0_hz[group_of(m)];
             if (hz > kStreamRateMaxHz) hz = kStreamRateMaxHz;
-            ms = hz == 0u ? 0u : (uint16_t)(1000u / hz);
+            ms = hz == 0u ? (uint16_t)0u : (uint16_t)(1000u / hz);
         } else if (ms == kStopped) {
             ms = 0;
         }
