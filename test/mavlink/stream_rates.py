@@ -44,8 +44,10 @@ COUNTED = GROUPS + ("ATTITUDE", "HEARTBEAT")
 
 # The link's cap (StreamRates.h): 75 % of 11520 B/s less HEARTBEAT's 21; the frames at their
 # longest, in the table's order: SCALED_PRESSURE, SYS_STATUS, GPS_RAW_INT, RC_CHANNELS,
-# SERVO_OUTPUT_RAW, GLOBAL_POSITION_INT, ATTITUDE, VFR_HUD, SYSTEM_TIME, BATTERY_STATUS.
-FRAME_BYTES = (28, 66, 64, 54, 33, 40, 40, 32, 24, 53)
+# SERVO_OUTPUT_RAW, GLOBAL_POSITION_INT, ATTITUDE, VFR_HUD, SYSTEM_TIME, BATTERY_STATUS,
+# NAV_CONTROLLER_OUTPUT (planned for whether or not a navigation mode flies: its bytes are
+# there when one starts).
+FRAME_BYTES = (28, 66, 64, 54, 33, 40, 40, 32, 24, 53, 38)
 BUDGET = 8640 - 21
 
 
