@@ -12,7 +12,7 @@
 #include "MissionLink.h"
 #include "Modes.h"
 #include "NeVector.h"
-#include "NavSettings.h"
+#include "NavParams.h"
 #include "Position.h"
 #include "Tecs.h"
 #include "Vehicle.h"
@@ -99,7 +99,7 @@ void enter(flight::Mode m, const mission::NavState& st) {
 const mission::MissionStore& mission_store() { return mission_link::store; }
 
 void configure() {
-    settings::nav_params(cfg().vehicle.nav, cfg().flight, l1_params, tecs_params, ex_params);
+    mission::nav_params(cfg().vehicle.nav, cfg().flight, l1_params, tecs_params, ex_params);
     tecs.set_params();
 }
 

@@ -1,17 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The navigation's settings as the second EEPROM record keeps them (VehicleSettings::nav):
 // ArduPlane's names, each in the smallest type its range and step allow (29 bytes), and
-// nav_params(), which turns them into the float parameters lib/Nav's L1Control and Tecs
-// and lib/Mission's MissionExecutor hold references to (those live in RAM beside the
-// objects; a change of a row calls nav_params() again, then Tecs::set_params()).
+// lib/Mission's nav_params() (NavParams.h) turns them into the float parameters lib/Nav's
+// L1Control and Tecs and lib/Mission's MissionExecutor hold references to.
 #pragma once
 
 #include <stdint.h>
 
-#include "FlightSettings.h"
-#include "L1Control.h"
-#include "MissionExecutor.h"
-#include "Tecs.h"
 
 namespace settings {
 
@@ -47,9 +42,5 @@ constexpr uint8_t kFsLongContinue = 0;
 constexpr uint8_t kFsLongRtl = 1;
 constexpr uint8_t kFsLongGlide = 2;
 
-// The float parameters of L1, TECS (with LIM_PITCH_*, ARSPD_FBW_* from the flight
-// settings) and the executor, from the stored ones.
-void nav_params(const NavSettings& n, const flight::FlightSettings& f, nav::L1Params& l1, nav::TecsParams& tecs,
-                mission::ExecutorParams& ex);
 
 }  // namespace settings

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "NavSettings.h"
+#include "NavParams.h"
 
-namespace settings {
+namespace mission {
 
 namespace {
 // Divided, not multiplied by 0.1f: the nearest float to the decimal, as PARAM_VALUE shows it.
@@ -9,8 +9,8 @@ float tenths(uint8_t v) { return (float)v / 10.0f; }
 float hundredths(uint8_t v) { return (float)v / 100.0f; }
 }  // namespace
 
-void nav_params(const NavSettings& n, const flight::FlightSettings& f, nav::L1Params& l1, nav::TecsParams& tecs,
-                mission::ExecutorParams& ex) {
+void nav_params(const settings::NavSettings& n, const flight::FlightSettings& f, nav::L1Params& l1,
+                nav::TecsParams& tecs, ExecutorParams& ex) {
     l1.period_s = (float)n.navl1_period_s;
     l1.damping = hundredths(n.navl1_damping_c);
     tecs.time_const_s = tenths(n.tecs_time_const_d);
@@ -39,4 +39,4 @@ void nav_params(const NavSettings& n, const flight::FlightSettings& f, nav::L1Pa
     ex.glide_slope_min_m = (float)n.glide_slope_min_m;
 }
 
-}  // namespace settings
+}  // namespace mission

@@ -4,7 +4,7 @@
 // lib/Mission's float parameters the defaults docs/navigation.md lists (their own kDefaults).
 #include <gtest/gtest.h>
 
-#include "NavSettings.h"
+#include "NavParams.h"
 #include "Params.h"
 #include "Settings.h"
 
@@ -28,7 +28,7 @@ TEST(NavParams, DefaultsAreLibNavsAndLibMissions) {
     nav::L1Params l1{};
     nav::TecsParams t{};
     mission::ExecutorParams ex{};
-    settings::nav_params(s.vehicle.nav, s.flight, l1, t, ex);
+    mission::nav_params(s.vehicle.nav, s.flight, l1, t, ex);
     EXPECT_EQ(l1.period_s, nav::kL1Defaults.period_s);
     EXPECT_EQ(l1.damping, nav::kL1Defaults.damping);
     const nav::TecsParams& d = nav::kTecsDefaults;
@@ -108,7 +108,7 @@ TEST(NavParams, ThrottleMinimumAboveMaximumIsHeldToIt) {
     nav::L1Params l1{};
     nav::TecsParams t{};
     mission::ExecutorParams ex{};
-    settings::nav_params(s.vehicle.nav, s.flight, l1, t, ex);
+    mission::nav_params(s.vehicle.nav, s.flight, l1, t, ex);
     EXPECT_EQ(t.thr_min_pct, 75u);
     EXPECT_EQ(t.thr_max_pct, 75u);
 }
