@@ -55,15 +55,6 @@ enum ReplyFlag : uint8_t {
 };
 static uint8_t replies = 0;
 static int64_t timesync_ts1 = 0;
-
-// COMPASS_OFS/DIA/ODI_*: their indices, found once (the table walked at the first use).
-static params::Rows compass_rows() {
-    static params::Rows rows{0, 0};
-    if (rows.count == 0u)
-        rows = params::rows_within(offsetof(settings::Settings, cal.mag_offset_uT),
-                                   offsetof(settings::Settings, cal.mag_learned_uT));
-    return rows;
-}
 // The messages on a timer (mav::StreamRates): their intervals planned from the SR0_ rates,
 // a ground station's SET_MESSAGE_INTERVAL and the console's `rate`, again whenever one of
 // them differs from what the plan was made with (a PARAM_SET, the console's `set`, the
@@ -313,9 +304,9 @@ TASK_OWN_FRAME void take_request() {
         // settings before it whole until the new ones are), in a pass of its own.
         if (changed) {
             save_pending = configure_pending = true;
-            // The calibration's rows, known once (a table walk per frame would keep a
-            // burst's frames waiting in the receive ring).
-            if (compass_rows().holds((uint16_t)index)) mag_cal_link::parameter_changed((uint16_t)index);
+            // A compass calibration row is a new calibration (its rows' range is found once:
+            // a table walk per frame would keep a burst's frames waiting in the receive ring).
+            mag_cal_link::parameter_changed((uint16_t)index);
         }
     } else if (rx.msgid == mav::kMsgCommandAck) {
         // MAVProxy's accelcal: COMMAND_ACK with command = the position it confirms.
@@ -379,7 +370,7 @@ static params::Rows calibration_rows(Calibrated what) {
         case Calibrated::kAccel:
             return params::rows_within(offsetof(Settings, vehicle.ins_accoffs_m_s2),
                                        offsetof(Settings, vehicle.ins_accscal) + sizeof(float[3]));
-        case Calibrated::kCompass: return compass_rows();
+        case Calibrated::kCompass: return params::compass_calibration_rows();
         default:
             return params::rows_within(offsetof(Settings, gnd_abs_press_pa),
                                        offsetof(Settings, gnd_abs_press_pa) + sizeof(float));

@@ -614,9 +614,14 @@ bool is_integer(Type t) {
     return t != Type::Float && t != Type::DeclRad && t != Type::MagOfs && t != Type::Scaled8;
 }
 
-bool is_compass_calibration(uint16_t index) {
-    return rows_within(offsetof(Settings, cal.mag_offset_uT), offsetof(Settings, cal.mag_learned_uT)).holds(index);
+Rows compass_calibration_rows() {
+    static Rows rows{0, 0};  // the table is constant: walked once
+    if (rows.count == 0u)
+        rows = rows_within(offsetof(Settings, cal.mag_offset_uT), offsetof(Settings, cal.mag_learned_uT));
+    return rows;
 }
+
+bool is_compass_calibration(uint16_t index) { return compass_calibration_rows().holds(index); }
 
 Rows rows_within(uint16_t from, uint16_t to) {
     Rows rows{0, 0};

@@ -80,6 +80,8 @@ struct Rows {
     bool holds(uint16_t index) const { return (uint16_t)(index - first) < count; }
 };
 Rows rows_within(uint16_t from, uint16_t to);
+// COMPASS_OFS/DIA/ODI_*: rows_within of the compass calibration, found once.
+Rows compass_calibration_rows();
 // Every parameter to its default.
 void apply_defaults(settings::Settings& s);
 // The flight settings in the EEPROM record (settings::encode): the rows that live in
