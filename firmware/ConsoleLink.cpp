@@ -40,10 +40,16 @@ void forget_partial_line() { reader = console::LineReader(); }
 // Received bytes -> parsed commands, while the command queue has room (when it has none,
 // the bytes wait in Serial's ring). In a step (in_step) a line's end waits in the ring
 // for the loop: its parse (a `set`) on top of a long step would be the loop's longest
-// iteration; the step only keeps the ring from filling.
+// iteration; the step only keeps the ring from filling, and takes at most kStepBytesMax
+// (~380 cycles a byte with a frame's end: a step's worst was 16 245, over its 1 ms). The
+// loop's `input` task takes the rest on every pass; the 128-byte ring holds the ~70 bytes
+// that arrive at 115200 baud over the longest pass and a step.
+constexpr uint8_t kStepBytesMax = 32;
 static void take(bool in_step) {
     mav::Parser& frames = gcs_link::parser();
+    uint8_t step_bytes = 0;
     while (!commands.full() && !frames.ready()) {
+        if (in_step && (++step_bytes > kStepBytesMax)) return;
         if (in_step && !port::mavlink_mode()) {
             const int next = Serial.peek();
             if (next == '\r' || next == '\n') return;
