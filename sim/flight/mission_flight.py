@@ -309,7 +309,8 @@ class Flight:
         m["launch_dip_m"] = LAUNCH[1] - min(-r["down_m"] for r in climb)
         m["climb_s"] = None if climb_end is None else climb_end - HOLD_S
         m["climb_bank_deg"] = max(abs(r["roll_deg"]) for r in climb)
-        m["climb_pitch_deg"] = (min(r["pitch_deg"] for r in climb[50:]), max(r["pitch_deg"] for r in climb))
+        # The pitch from 0.5 s after the throw (the throw's own nose-down first).
+        m["climb_pitch_deg"] = (min(r["pitch_deg"] for r in (climb[50:] or climb)), max(r["pitch_deg"] for r in climb))
         # The waypoints in the order flown: each pass is the closest point of the first
         # stretch within 100 m of the waypoint after the pass before.
         passes, i = [], 0
