@@ -357,10 +357,17 @@ class Flight:
                 radii = [dist_home(r) for r in circle]
                 hs = [self.height(r) - RTL_ALT_M for r in circle]
                 turned = sum(abs(angle_diff(b["yaw_deg"], a["yaw_deg"])) for a, b in zip(circle, circle[1:]))
+                # Each whole turn's mean radius and height (a turn by the heading: ~21 s).
+                turns, acc, start = [], 0.0, 0
+                for k in range(1, len(circle)):
+                    acc += abs(angle_diff(circle[k]["yaw_deg"], circle[k - 1]["yaw_deg"]))
+                    if acc >= 360.0:
+                        turns.append((sum(radii[start:k]) / (k - start), sum(hs[start:k]) / (k - start)))
+                        acc, start = acc - 360.0, k
                 m["circle"] = {"from_s": near + CIRCLE_AFTER_S, "s": circle[-1]["t"] - near - CIRCLE_AFTER_S,
                                "turned_deg": turned,
                                "radius": (min(radii), max(radii), sum(radii) / len(radii)),
-                               "height": (min(hs), max(hs), sum(hs) / len(hs))}
+                               "height": (min(hs), max(hs), sum(hs) / len(hs)), "turns": turns}
         return m
 
     def leg_errors(self, samples, a, b, h0, h1):
@@ -424,9 +431,10 @@ def report(m, route):
     c = m.get("circle")
     if c:
         out.append("home circled from %.0f s for %.0f s (%.0f deg): radius %.1f-%.1f m (mean %.1f, WP_LOITER_RAD %g), "
-                   "height %+.1f to %+.1f m of home + %g m (mean %+.2f)"
+                   "height %+.1f to %+.1f m of home + %g m (mean %+.2f); each whole turn's mean radius, height: %s"
                    % (c["from_s"], c["s"], c["turned_deg"], c["radius"][0], c["radius"][1], c["radius"][2],
-                      LOITER_RAD_M, c["height"][0], c["height"][1], RTL_ALT_M, c["height"][2]))
+                      LOITER_RAD_M, c["height"][0], c["height"][1], RTL_ALT_M, c["height"][2],
+                      ", ".join("%.1f m %+.1f m" % t for t in c["turns"]) or "none"))
     else:
         out.append("home never circled")
     return out
