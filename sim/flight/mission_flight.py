@@ -63,7 +63,7 @@ WP_RADIUS_M, LOITER_RAD_M, RTL_ALT_M = 30.0, 60.0, 100.0  # the parameters' defa
 # in the thesis' mission: TECS_CLMB_MAX 5 m/s and the transient after it).
 CIRCLE_AFTER_S = 25.0
 
-NAV_WAYPOINT, NAV_RTL, NAV_TAKEOFF, DO_JUMP = 16, 20, 22, 177
+NAV_WAYPOINT, NAV_RTL, NAV_TAKEOFF, DO_JUMP, DO_CHANGE_SPEED = 16, 20, 22, 177, 178
 
 
 # ---- the mission file ---------------------------------------------------------------------
@@ -158,8 +158,10 @@ class Route:
             elif it["command"] == NAV_RTL:
                 self.rtl = True
                 break
-            elif it["command"] != NAV_TAKEOFF:
-                raise ValueError("item %d: command %d is not flown by this script" % (it["seq"], it["command"]))
+            elif it["command"] not in (NAV_TAKEOFF, DO_CHANGE_SPEED):
+                raise ValueError("item %d: command %d: this script measures NAV_WAYPOINT, DO_JUMP, DO_CHANGE_SPEED "
+                                 "and RETURN_TO_LAUNCH after the takeoff (the board flies more)"
+                                 % (it["seq"], it["command"]))
             i += 1
         if not self.visits:
             raise ValueError("no NAV_WAYPOINT after the takeoff")
@@ -182,7 +184,7 @@ class Route:
 
 # ---- the flight ---------------------------------------------------------------------------
 
-def write_rc(path, seconds):
+def write_rc(path):
     rows = [(0.0, STABILIZE_SWITCH), (AUTO_S, AUTO_SWITCH)]
     with open(path, "w") as f:
         f.write("t,ch1,ch2,ch3,ch4,ch5,ch6,ch7,ch8\n")
@@ -212,7 +214,7 @@ def fly(mission, work, seconds=None, gust=1, seed=1, sim=None, elf=None, serial=
     console = base + "_console.txt"
     with open(console, "w") as f:
         f.write("".join(line + "\n" for line in CONSOLE))
-    cmd = [sys.executable, CLOSED_LOOP, "--rc", write_rc(base + "_rc.csv", seconds), "--seconds", "%g" % seconds,
+    cmd = [sys.executable, CLOSED_LOOP, "--rc", write_rc(base + "_rc.csv"), "--seconds", "%g" % seconds,
            "--gust", str(gust), "--seed", str(seed), "--stamp", "--out", base + "_serial.txt",
            "--log", base + "_log.csv", "--hold", "%g" % HOLD_S, "--launch", "%g,%g,%g" % LAUNCH,
            "--gps", "ublox", "--mission", mission, "--input", console, "--arm", "--timeout", "%g" % timeout]

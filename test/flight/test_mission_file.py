@@ -83,6 +83,15 @@ def check_route():
                 "thesis: NAV_TAKEOFF to %g m at %g deg" % (route.takeoff_m, route.takeoff_pitch_deg))
     heights = sorted(set(h for _, _, h in route.visits))
     soft_assert(heights == [60.0, 90.0], "thesis: heights %r (60 and 90 m)" % heights)
+    items = mf.read_waypoints(os.path.join(MISSIONS, "thesis.waypoints"))
+    speed = dict(items[3], command=mf.DO_CHANGE_SPEED, p=[0.0, 20.0, -1.0, 0.0])
+    with_speed = mf.Route(items[:3] + [speed] + items[3:])
+    soft_assert(len(with_speed.visits) == 10, "DO_CHANGE_SPEED changed the route: %d passes" % len(with_speed.visits))
+    try:
+        mf.Route(items[:3] + [dict(items[3], command=18)] + items[4:])
+        soft_assert(False, "a LOITER_TURNS in the route not refused (the figures would not know it)")
+    except ValueError as e:
+        soft_assert("command 18" in str(e), "LOITER_TURNS refused for another reason: %s" % e)
     north, east = route.places[2][0]
     soft_assert(abs(north - 320.0) < 0.05 and abs(east) < 0.05, "waypoint 2 at %.2f N %.2f E (320, 0)" % (north, east))
 
