@@ -94,6 +94,15 @@ void enter(flight::Mode m, const mission::NavState& st) {
     if (m == flight::Mode::Rtl) executor.return_home(st);
 }
 
+// NAV_TAKEOFF, a hand launch (ArduPlane's takeoff_calc_roll and _pitch before the course is
+// locked): wings level, TECS's takeoff stage (full throttle, at least the item's pitch) up to
+// the item's height. L1 is not stepped: the takeoff has no leg. Returns "L1 banks": false.
+bool takeoff(const mission::NavTarget& t, nav::TecsInput& in) {
+    in.stage = nav::TecsStage::kTakeoff;
+    in.takeoff_pitch_cd = t.takeoff_pitch_cd;
+    return false;
+}
+
 }  // namespace
 
 const mission::MissionStore& mission_store() { return mission_link::store; }
@@ -179,16 +188,15 @@ void run() {
         case flight::Mode::Auto:
         case flight::Mode::Rtl: {
             const mission::NavTarget& t = executor.target();
-            if (t.kind == mission::TargetKind::kWaypoint || t.kind == mission::TargetKind::kTakeoff)
+            if (t.kind == mission::TargetKind::kTakeoff) {
+                guided = takeoff(t, in);
+            } else if (t.kind == mission::TargetKind::kWaypoint) {
                 l1.update_waypoint(st.pos_m, vel, t.prev_m, t.next_m);
-            else
+            } else {
                 l1.update_loiter(st.pos_m, vel, t.next_m, t.radius_m, t.direction);
+            }
             executor.update(st, l1);
             height_dem_m = executor.height_demand_m(st);
-            if (t.kind == mission::TargetKind::kTakeoff) {
-                in.stage = nav::TecsStage::kTakeoff;
-                in.takeoff_pitch_cd = t.takeoff_pitch_cd;
-            }
             if (executor.airspeed_cm_s() != 0u) in.eas_dem_m_s = (float)executor.airspeed_cm_s() * 0.01f;
             break;
         }

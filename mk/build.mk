@@ -274,7 +274,7 @@ sim: firmware tools
 	  $(if $(SECONDS),--seconds $(SECONDS)) $(if $(SERIAL),--serial $(SERIAL)) \
 	  $(if $(MODE),--input $(BUILD)/scenarios/sim-input.txt)
 
-# make fly [FLIGHT=cruise|gusty|upset|turn|figure8|climb] [GUST=0|1|2] [SECONDS=s] [STAMP=1]
+# make fly [FLIGHT=cruise|gusty|upset|turn|figure8|climb|mission] [GUST=0|1|2] [SECONDS=s] [STAMP=1]
 # [VIEW=1] [SERIAL=tcp:5760] [SPEED=x]: the firmware flies the JSBSim Rascal
 # (sim/flight/closed_loop.py: the backend with the flight's stick script, apm25sim
 # --physics json in lock-step), the board's serial output shown as a serial monitor would
@@ -286,9 +286,21 @@ sim: firmware tools
 # on, a ground station that only listens hears it. The board is armed on the stand
 # (closed_loop.py --arm: `arm` typed, the throttle at zero meanwhile). Both processes end by themselves, or
 # after FLY_TIMEOUT wall seconds.
+# FLIGHT=mission flies a mission in AUTO from a hand launch (sim/flight/mission_flight.py;
+# MISSION=FILE.waypoints or FILE.plan, default sim/flight/missions/thesis.waypoints; light
+# gusts unless GUST=), prints its figures and draws it into PLOT (build/flight/mission.png;
+# docs/mission.png is this picture).
 FLY_TIMEOUT ?= 1800
 FLY_SERIAL = $(or $(GCS),$(SERIAL))
+MISSION ?= sim/flight/missions/thesis.waypoints
+PLOT ?= $(BUILD)/flight/mission.png
 fly: firmware tools venv
+ifeq ($(FLIGHT),mission)
+	@echo "# flight 'mission': build/firmware.elf flies $(MISSION) in AUTO from a hand launch (MISSION=file.waypoints|.plan, GUST=0-2, SECONDS=s, SERIAL=tcp:5760)"
+	@$(VENV_PY) sim/flight/mission_flight.py --mission $(MISSION) --plot $(PLOT) $(if $(GUST),--gust $(GUST)) \
+	  $(if $(SECONDS),--seconds $(SECONDS)) --sim $(BUILD)/apm25sim --elf $(BUILD)/firmware.elf \
+	  --timeout $(FLY_TIMEOUT) $(if $(FLY_SERIAL),--serial $(FLY_SERIAL)) $(if $(SPEED),--speed $(SPEED))
+else
 	@echo "# flight '$(or $(FLIGHT),cruise)': build/firmware.elf in simavr flies the JSBSim Rascal 110 (FLIGHT=name, GUST=0-2, SECONDS=s, SERIAL=tcp:5760 for a ground station; flights: fly.py --list)"
 	$(if $(MODE),@mkdir -p $(BUILD)/flight && printf 'mode $(MODE)\n' > $(BUILD)/flight/fly-input.txt)
 	@$(VENV_PY) sim/flight/closed_loop.py --flight $(or $(FLIGHT),cruise) $(if $(GUST),--gust $(GUST)) \
@@ -297,6 +309,7 @@ fly: firmware tools venv
 	  $(if $(FLY_SERIAL),--serial $(FLY_SERIAL)) $(if $(SPEED),--speed $(SPEED)) \
 	  $(if $(MODE),--input $(BUILD)/flight/fly-input.txt) \
 	  $(if $(VIEW),| $(VENV_PY) tools/view.py --file /dev/stdin $(VIEW_FLAGS))
+endif
 
 test: firmware attitude-only big startup-variants tools venv
 	@cd $(HOST_BUILD) && ctest --output-on-failure -j$(NPROC)

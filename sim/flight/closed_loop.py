@@ -8,7 +8,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
-        [--gps ublox|nmea|none] [--arm]
+        [--gps ublox|nmea|none] [--arm] [--launch V,H,PITCH]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -27,7 +27,8 @@ KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: 
 --arm arms the board on the launch stand as a pilot would (ARMING_REQUIRE 1 holds the
 throttle at its minimum until armed): the stick script's throttle at zero until ARM_S
 (2 s) and `arm` typed into the board (apm25sim --input: at its first angle line, ~1.4 s,
-after any --input lines).
+after any --input lines). --launch V,H,PITCH is the backend's hand launch: held --hold s at H m,
+PITCH deg nose up, then thrown at V m/s.
 Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
@@ -114,6 +115,8 @@ def parse_args(argv):
     p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
     p.add_argument("--wind", help="the backend's --wind N,E: a steady wind, m/s")
+    p.add_argument("--launch", metavar="V,H,PITCH",
+                   help="the backend's hand launch: held at H m, PITCH deg nose up, thrown at V m/s after --hold")
     p.add_argument("--mission", help="apm25sim --mission: a QGC WPL 110 file into the EEPROM before the run")
     p.add_argument("--profile", help="apm25sim --profile: the sections' cycle counts")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
@@ -181,6 +184,8 @@ def run(args):
         backend_cmd.append("--no-airspeed")
     if args.wind:
         backend_cmd += ["--wind", args.wind]
+    if args.launch:
+        backend_cmd += ["--launch", args.launch]
     if args.airframe != "plain":
         backend_cmd += ["--airframe", args.airframe]
     deadline = time.monotonic() + args.timeout

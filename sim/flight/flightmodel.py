@@ -33,6 +33,13 @@ CRASH_HEIGHT_M = 0.25
 GUST_LEVELS = {0: None, 1: (1.06, 0.7), 2: (2.12, 1.4)}
 GUST_NAMES = {0: "none", 1: "light", 2: "moderate"}
 GUST_SCALE_UV_M, GUST_SCALE_W_M = 200.0, 50.0
+# The lift of rascal110.xml's linear range (Beard & McLain's C_L0, C_La), for the hand
+# launch's angle of attack.
+LIFT_AT_ZERO_ALPHA, LIFT_SLOPE_PER_RAD = 0.23, 5.61
+
+
+def lift_coefficient(alpha_rad):
+    return LIFT_AT_ZERO_ALPHA + LIFT_SLOPE_PER_RAD * alpha_rad
 
 
 def quat_from_euler(roll, pitch, yaw):
@@ -155,7 +162,7 @@ class Trim:
 class FlightModel:
     def __init__(self, airspeed_m_s=18.0, altitude_m=100.0, heading_deg=0.0, gust=0, seed=1,
                  latitude_deg=52.5, longitude_deg=13.4, upsets=(), vibration_m_s2=0.0, hold_s=0.0,
-                 wind_ne_m_s=(0.0, 0.0)):
+                 wind_ne_m_s=(0.0, 0.0), launch=None):
         """upsets: (start_s, duration_s, roll_moment_Nm) tuples, a roll moment applied from
         start_s for duration_s (positive rolls right). vibration_m_s2: the amplitude of the
         propeller's vibration at the IMU at the trim's propeller speed (see vibration()).
@@ -164,7 +171,12 @@ class FlightModel:
         released into the trimmed flight (a catapult launch at the trim's speed).
         wind_ne_m_s: a steady wind, the air's velocity north and east (m/s; (0, 5) blows from
         the west), from the release on (the trim is in still air: the aeroplane meets it as a
-        gust at the start)."""
+        gust at the start).
+        launch: (speed m/s, height m, pitch deg), a hand launch instead of the trimmed start:
+        the aeroplane held at that height and pitch, wings level, then thrown at that speed
+        along the pitch less the angle of attack whose lift carries its weight at that speed
+        (launch_alpha), its motor turning at the trim's throttle until the autopilot's
+        throttle takes over. The trim (self.trim) is still the cruise's."""
         if gust not in GUST_LEVELS:
             raise ValueError("gust level %r: 0 (none), 1 (light) or 2 (moderate)" % (gust,))
         self.airspeed0, self.altitude0, self.heading0 = airspeed_m_s, altitude_m, math.radians(heading_deg)
@@ -174,6 +186,7 @@ class FlightModel:
         self.vibration_m_s2 = float(vibration_m_s2)
         self.hold_s = max(0.0, float(hold_s))
         self.wind_ne_m_s = (float(wind_ne_m_s[0]), float(wind_ne_m_s[1]))
+        self.launch = None if launch is None else tuple(float(v) for v in launch)
         self.crashed_at = None  # time of the crash (the ground), None while flying
         jsbsim.FGJSBBase().debug_lvl = 0  # no banner on stdout
         self.fdm = jsbsim.FGFDMExec(HERE, None)
@@ -187,16 +200,19 @@ class FlightModel:
         self.reset()
 
     # ---- trim ---------------------------------------------------------------------------
-    def _set_ic(self, alpha, beta):
+    def _set_ic(self, alpha, beta, ic=None):
+        """ic: (speed m/s, height m, flight path angle rad) instead of the trim's (level at
+        airspeed0 and altitude0)."""
+        speed, height, gamma = ic or (self.airspeed0, self.altitude0, 0.0)
         f = self.fdm
         f["ic/lat-geod-rad"] = self.lat0
         f["ic/long-gc-rad"] = self.lon0
         f["ic/terrain-elevation-ft"] = 0.0
-        f["ic/h-agl-ft"] = self.altitude0 / FT
-        f["ic/vt-fps"] = self.airspeed0 / FT
+        f["ic/h-agl-ft"] = height / FT
+        f["ic/vt-fps"] = speed / FT
         f["ic/alpha-rad"] = alpha
         f["ic/beta-rad"] = beta
-        f["ic/gamma-rad"] = 0.0
+        f["ic/gamma-rad"] = gamma
         f["ic/phi-rad"] = 0.0
         f["ic/psi-true-rad"] = self.heading0
         f["ic/p-rad_sec"] = 0.0
@@ -213,7 +229,7 @@ class FlightModel:
         f["fcs/aileron-cmd-norm"] = aileron
         f["fcs/rudder-cmd-norm"] = rudder
 
-    def _residual(self, x):
+    def _residual(self, x, ic=None):
         """Body accelerations (u, v, w dot in m/s^2; p, q, r dot in rad/s^2) at the state and
         controls x = (throttle, elevator, aileron, rudder, alpha, beta), the propeller spun up
         to its steady speed there (JSBSim's own steady-state search divides by the propeller's
@@ -222,7 +238,7 @@ class FlightModel:
         throttle, elevator, aileron, rudder, alpha, beta = x
         f = self.fdm
         self._set_controls(throttle, elevator, aileron, rudder)
-        self._set_ic(alpha, beta)
+        self._set_ic(alpha, beta, ic)
         f["propulsion/set-running"] = -1
         for i in range(600):
             f.set_dt(MAX_STEP_S if i < 200 else 0.01)
@@ -256,11 +272,26 @@ class FlightModel:
             raise RuntimeError("trim did not converge: residual %s" % r)
         return Trim(*[float(v) for v in x], residual=float(np.max(np.abs(r))))
 
+    def launch_alpha(self):
+        """The hand launch's angle of attack: the lift's share of the weight grows as the trim's
+        over (trim speed / launch speed)^2, at the lift slope C_La 5.61 / rad of the XML's
+        linear range (8 deg at 11 m/s; the stall is at 27)."""
+        speed = self.launch[0]
+        cl_share = (self.airspeed0 / speed) ** 2 - 1.0
+        return self.trim.alpha_rad + cl_share * lift_coefficient(self.trim.alpha_rad) / LIFT_SLOPE_PER_RAD
+
     # ---- flight -------------------------------------------------------------------------
     def reset(self):
-        """Back to the trimmed start: time 0, at altitude, trimmed, the gust sequence restarted."""
+        """Back to the start: time 0, at altitude, trimmed (or at the hand launch), the gust
+        sequence restarted."""
         t = self.trim
-        self._residual((t.throttle, t.elevator, t.aileron, t.rudder, t.alpha_rad, t.beta_rad))
+        if self.launch is None:
+            self._residual((t.throttle, t.elevator, t.aileron, t.rudder, t.alpha_rad, t.beta_rad))
+        else:
+            speed, height, pitch_deg = self.launch
+            alpha = self.launch_alpha()
+            self._residual((t.throttle, t.elevator, t.aileron, t.rudder, alpha, 0.0),
+                           (speed, height, math.radians(pitch_deg) - alpha))
         self.time_s = 0.0
         self.crashed_at = None
         self.crash_euler = None

@@ -7,7 +7,7 @@ autopilot speaks the protocol (build/apm25sim --physics json, ArduPilot SITL wit
     build/venv/bin/python sim/flight/jsbsim_backend.py [--port 9002] [--rc FILE|none]
         [--gust 0|1|2] [--seed N] [--trajectory FILE.csv[.gz]] [--log FILE.csv[.gz]]
         [--seconds S] [--airspeed 18] [--altitude 100] [--heading 0] [--upset T,SECONDS,NM ...]
-        [--vibration M_S2] [--no-airspeed] [--airframe plain|elevons|vtail]
+        [--vibration M_S2] [--no-airspeed] [--airframe plain|elevons|vtail] [--launch V,H,PITCH]
 
 Lock-step: one physics frame (1 / frame_rate of the packet, in JSBSim steps of at most
 2.5 ms) per servo packet received, no wall clock, so a flight is the same every time.
@@ -21,6 +21,8 @@ sensor). --airframe elevons or vtail reads OUT1-OUT4 as an autopilot's ELEVON_OU
 VTAIL_OUTPUT mixes them (elevons on OUT1 left and OUT2 right; ruddervators on OUT2 left and
 OUT4 right; above 1500 us trailing edge up) and flies the plain-tailed model with the
 aileron, elevator and rudder those surfaces make (flightmodel.unmix).
+--launch V,H,PITCH starts from a hand launch instead: held (--hold) at H m above the ground,
+PITCH deg nose up, wings level, then thrown at V m/s (flightmodel.FlightModel's launch).
 The files hold --seconds of simulated time; after it the backend still answers (an
 autopilot may run a frame longer) and exits once no packet came for --linger s (default 1);
 --idle-timeout s without a packet before that stops it too.
@@ -58,6 +60,8 @@ def parse_args(argv):
     p.add_argument("--hold", type=float, default=0.0, metavar="S",
                    help="hold the aeroplane still at its start attitude for S s (a launch stand: the "
                         "board starts at rest), then release it into the trimmed flight")
+    p.add_argument("--launch", metavar="V,H,PITCH",
+                   help="a hand launch: held at H m, PITCH deg nose up, then thrown at V m/s (e.g. 11,1.8,10)")
     p.add_argument("--no-airspeed", action="store_true",
                    help="send no airspeed in the replies (no pitot on the aeroplane; the log keeps the truth)")
     p.add_argument("--airframe", default="plain", choices=flightmodel.AIRFRAMES,
@@ -88,7 +92,7 @@ class Backend:
             upsets.append((start, length, moment))
         self.model = flightmodel.FlightModel(args.airspeed, args.altitude, args.heading, args.gust, args.seed,
                                              upsets=upsets, vibration_m_s2=args.vibration, hold_s=args.hold,
-                                             wind_ne_m_s=wind_arg(args.wind))
+                                             wind_ne_m_s=wind_arg(args.wind), launch=launch_arg(args.launch))
         trim = self.model.trim
         widths = trim.widths_us()
         if args.rc == "none":
@@ -199,6 +203,18 @@ def wind_arg(spec):
     if not (math.isfinite(north) and math.isfinite(east)) or math.hypot(north, east) > 30.0:
         raise ValueError("--wind %r: at most 30 m/s" % spec)
     return north, east
+
+
+def launch_arg(spec):
+    if not spec:
+        return None
+    try:
+        speed, height, pitch = (float(v) for v in spec.split(","))
+    except ValueError:
+        raise ValueError("--launch %r: want V,H,PITCH (three numbers: m/s, m, deg)" % spec)
+    if not (5.0 <= speed <= 30.0 and 0.5 <= height <= 500.0 and -10.0 <= pitch <= 30.0):
+        raise ValueError("--launch %r: a speed of 5-30 m/s, a height of 0.5-500 m, a pitch of -10..30 deg" % spec)
+    return speed, height, pitch
 
 
 def main(argv=None):

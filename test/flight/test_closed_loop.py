@@ -90,6 +90,18 @@ GROUP is one of:
                   FS_LONG_TIMEOUT (20 s) RTL said and flown: closer to home 15 s later
   auto_wind       the same in a 5 m/s wind from the west (the backend's --wind 0,5) with light
                   gusts (seed 47001): the cross-track RMS <= 5 m, the rest as `auto`
+  mission         the thesis' flight test (sim/flight/mission_flight.py on
+                  sim/flight/missions/thesis.waypoints), light gusts, a seed of its own: a hand
+                  launch (held at 1.8 m, thrown at 11 m/s) into AUTO's NAV_TAKEOFF: no ground
+                  contact (the C.G. never below the launch height less 1 m), the wings within
+                  10 deg of level up to the takeoff's height; the five waypoints (60/90/60 m)
+                  each passed within WP_RADIUS on both laps, the DO_JUMP's one repeat flown
+                  (two laps, not three); then RTL: from 25 s after it first comes within 80 m
+                  of home (its climb from 60 m done), at least two whole turns about home,
+                  each turn's mean radius within WP_LOITER_RAD (60 m) +- 5 m and its mean
+                  height within ALT_HOLD_RTL (100 m) +- 3 m; the gusts' spread about them
+                  (seeds 1 and 47047: 59.5-65.1 m, -5.1..+3.1 m) within +- 8 m and +- 6 m;
+                  AUTO said after home, before the throw; no sample missed
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
 import argparse
@@ -993,7 +1005,50 @@ def check_auto_wind(args):
     fly_auto(args, "auto_wind", 5.0, gust=1, seed=47001, wind="0,5")
 
 
-GROUPS = {"rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "rc_loss_auto": check_rc_loss_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+def check_mission(args):
+    """The mission flight of `make fly FLIGHT=mission`, asserted."""
+    sys.path.insert(0, os.path.join(ROOT, "sim", "flight"))
+    import mission_flight as mf
+    tools = args.tools or os.path.join(ROOT, "build")
+    f = mf.fly(mf.DEFAULT_MISSION, args.work, gust=1, seed=47047, sim=os.path.join(tools, "apm25sim"),
+               elf=os.path.join(tools, "firmware.elf"), quiet=True)
+    m = f.measure()
+    for line in mf.report(m, f.route):
+        print("mission: " + line)
+    soft_assert(f.status == 0, "mission: mission_flight ended with status %d" % f.status)
+    home, auto = m.get("home"), m.get("auto")
+    soft_assert(home is not None and auto is not None and f.said("# home: set at ")[0] < auto[0] < mf.HOLD_S,
+                "mission: AUTO not entered after home, before the throw: %r %r" % (f.said("# home: set at "), auto))
+    overrun = f.said("# warn: loop overrun")
+    soft_assert(overrun is None, "mission: %r" % (overrun,))
+    if "passes" not in m:
+        soft_assert(False, "mission: no figures: %r" % m)
+        return
+    soft_assert(m["launch_min_m"] > mf.LAUNCH[1] - 1.0, "mission: the launch sank to %.2f m above the ground "
+                "(launched at %g m)" % (m["launch_min_m"], mf.LAUNCH[1]))
+    soft_assert(m["climb_s"] is not None and m["climb_bank_deg"] <= 10.0,
+                "mission: the climb to %g m: %s s, bank up to %.1f deg (at most 10)"
+                % (f.route.takeoff_m, m["climb_s"], m["climb_bank_deg"]))
+    missed = [(seq, p) for seq, p in m["passes"] if p is None or p[0] > mf.WP_RADIUS_M]
+    soft_assert(len(m["passes"]) == 10 and not missed, "mission: waypoints missed (WP_RADIUS %g m): %s"
+                % (mf.WP_RADIUS_M, missed))
+    soft_assert(f.route.jumps == 1 and m["laps"] == 2, "mission: %d laps flown (the DO_JUMP repeats once: 2)"
+                % m["laps"])
+    c = m.get("circle")
+    soft_assert(c is not None and len(c["turns"]) >= 2, "mission: home not circled twice: %r" % (c,))
+    if c:
+        # Each whole turn's mean: where the circle is; every sample: the light gusts' spread.
+        far = [t for t in c["turns"] if abs(t[0] - mf.LOITER_RAD_M) > 5.0 or abs(t[1]) > 3.0]
+        soft_assert(not far, "mission: turns off WP_LOITER_RAD %g +- 5 m or ALT_HOLD_RTL +- 3 m (mean radius, "
+                    "height): %r" % (mf.LOITER_RAD_M, far))
+        soft_assert(max(abs(c["radius"][0] - mf.LOITER_RAD_M), abs(c["radius"][1] - mf.LOITER_RAD_M)) <= 8.0,
+                    "mission: the circle's radius %.1f-%.1f m (WP_LOITER_RAD %g +- 8 in gusts)"
+                    % (c["radius"][0], c["radius"][1], mf.LOITER_RAD_M))
+        soft_assert(max(abs(c["height"][0]), abs(c["height"][1])) <= 6.0,
+                    "mission: the circle's height %+.1f to %+.1f m of ALT_HOLD_RTL (+- 6 in gusts)" % c["height"][:2])
+
+
+GROUPS = {"mission": check_mission, "rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "rc_loss_auto": check_rc_loss_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
