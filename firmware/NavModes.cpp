@@ -68,7 +68,8 @@ mav::NavOutput last_report;
 const settings::Settings& cfg() { return pipe.settings(); }
 
 bool gps_mode(flight::Mode m) {
-    return m == flight::Mode::Cruise || m == flight::Mode::Auto || m == flight::Mode::Rtl || m == flight::Mode::Loiter;
+    return m == flight::Mode::Cruise || m == flight::Mode::Auto || m == flight::Mode::Rtl ||
+           m == flight::Mode::Loiter || m == flight::Mode::Guided;
 }
 
 // The stick's share of a limit (the sticks are -4500..4500).
@@ -92,11 +93,21 @@ void enter(flight::Mode m, const mission::NavState& st) {
         executor.start(st);
     }
     if (m == flight::Mode::Rtl) executor.return_home(st);
+    if (m == flight::Mode::Guided) executor.guide_to(nullptr, st);  // by its number alone: here
 }
 
 }  // namespace
 
 const mission::MissionStore& mission_store() { return mission_link::store; }
+
+bool fly_to(const mission::Command& to) {
+    if (!flight_io.set_mode((uint8_t)flight::Mode::Guided)) return false;
+    const mission::NavState st = state_now(millis());
+    if (flying != flight::Mode::Guided) enter(flight::Mode::Guided, st);
+    flying = flight::Mode::Guided;  // entered: the next step flies the place given
+    executor.guide_to(&to, st);
+    return true;
+}
 
 void configure() {
     mission::nav_params(cfg().vehicle.nav, cfg().flight, l1_params, tecs_params, ex_params);
@@ -177,7 +188,8 @@ void run() {
             break;
         }
         case flight::Mode::Auto:
-        case flight::Mode::Rtl: {
+        case flight::Mode::Rtl:
+        case flight::Mode::Guided: {
             const mission::NavTarget& t = executor.target();
             if (t.kind == mission::TargetKind::kWaypoint || t.kind == mission::TargetKind::kTakeoff)
                 l1.update_waypoint(st.pos_m, vel, t.prev_m, t.next_m);
@@ -297,6 +309,7 @@ void configure() {}
 bool refused(flight::Mode, text::Flash&) { return false; }
 uint16_t unavailable_rows() { return 0; }
 bool report(mav::NavOutput&) { return false; }
+bool fly_to(const mission::Command&) { return false; }
 }  // namespace nav_modes
 
 #endif
