@@ -424,7 +424,7 @@ def check_modes_flown(work, tools):
     soft_assert(abs(sum(banks) / len(banks) - 15.0) <= 5.0, "CIRCLE: mean bank %.1f deg, not 15 +- 5"
                 % (sum(banks) / len(banks)))
     soft_assert(turned_deg(circle) > 180.0, "CIRCLE: only %.0f deg turned" % turned_deg(circle))
-    soft_assert(max(abs(x) for x in dh) <= 5.0, "CIRCLE: the height left its entry's +- 5 m")
+    soft_assert(max(abs(x) for x in dh) <= 3.0, "CIRCLE: the height left its entry's +- 3 m")
 
     # FBWB: the height held with the sticks centred, FBWB_CLIMB_RATE with the stick up.
     h1 = height(at(T_FBWB))

@@ -100,7 +100,7 @@ GROUP is one of:
                   AUTO after it without a mission ("no mission"; then one uploaded); the ground
                   station's LOITER held until the switch moves
   modes_flown     the same attachment, the fix at 40 s, each mode flown against the truth:
-                  CIRCLE before the fix (a mean bank of 15 +- 5 deg, the height within 5 m of its
+                  CIRCLE before the fix (a mean bank of 15 +- 5 deg, the height within 3 m of its
                   entry, > 180 deg turned), FBWB (sticks centred: the height within 3 m; full
                   pitch stick: FBWB_CLIMB_RATE 2 +- 0.5 m/s), CRUISE (40 s: the course within 5
                   deg of its entry's, within 5 m of a straight line, the height within 3 m),
