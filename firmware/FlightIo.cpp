@@ -268,7 +268,7 @@ bool FlightIo::choose_checked(flight::Mode m) {
 }
 
 // ArduPlane 3.x's long failsafe (failsafe_long_on_event): FS_LONG_TIMEOUT after the
-// receiver was lost, RTL (FS_LONG_ACTN 0 or 1; AUTO and LOITER go on with 0, RTL goes on),
+// receiver was lost, RTL (FS_LONG_ACTN 0 or 1; AUTO, LOITER and GUIDED go on with 0, RTL goes on),
 // or the failsafe glide (2: FBWA chosen, which glides until the receiver is back).
 void FlightIo::long_failsafe(uint32_t now_ms) {
     const bool fs = control_.state() == flight::State::Failsafe;
@@ -285,7 +285,7 @@ void FlightIo::long_failsafe(uint32_t now_ms) {
     if (ns.fs_long_actn == settings::kFsLongGlide) {
         control_.choose(flight::Mode::FlyByWireA);
     } else if (ns.fs_long_actn == settings::kFsLongRtl ||
-               (m != flight::Mode::Auto && m != flight::Mode::Loiter)) {
+               (m != flight::Mode::Auto && m != flight::Mode::Loiter && m != flight::Mode::Guided)) {
         failsafe_rtl(TXT("long (FS_LONG_TIMEOUT)"));
         return;
     } else {

@@ -5,6 +5,7 @@
 
 #include "ArduinoCore.h"
 #include "MissionProtocol.h"
+#include "NavModes.h"
 #include "Port.h"
 #include "Position.h"
 #include "Vehicle.h"
@@ -92,9 +93,20 @@ void take(const mav::Received& rx) {
     mission::Reply r = {};
     pending.refused = 0;
     if (mav::decode_mission_item(rx, item)) {
-        r = protocol.on_item(item, now_ms);
-        if (r.kind == mission::Reply::kAck && r.result != mission::Result::kAccepted && item.mission_type == 0)
-            pending.refused = item.command;
+        if (mission::is_guided_request(item)) {
+            // "Fly to here": GUIDED, the stored mission and an upload untouched; refused:
+            // ERROR (FlightIo says why).
+            mission::Command c;
+            mission::Result why = mission::Result::kError;
+            if (mission::guided_command(item, c, why))
+                why = nav_modes::fly_to(c) ? mission::Result::kAccepted : mission::Result::kError;
+            r.kind = mission::Reply::kAck;
+            r.result = why;
+        } else {
+            r = protocol.on_item(item, now_ms);
+            if (r.kind == mission::Reply::kAck && r.result != mission::Result::kAccepted && item.mission_type == 0)
+                pending.refused = item.command;
+        }
     } else if (mav::decode_mission_count(rx, n, type)) {
         // Fence and rally: an empty upload accepted (ArduPilot's answer for an empty list).
         r = protocol.on_count(n, type, now_ms);

@@ -6,6 +6,7 @@
 
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
+#include "Baro.h"
 #include "GpsPort.h"
 #include "L1Control.h"
 #include "MissionExecutor.h"
@@ -48,6 +49,7 @@ flight::Mode flying = flight::Mode::Manual;  // the navigation mode last stepped
 uint32_t last_run_ms = 0;
 uint32_t last_filter_ms = 0;
 bool filters_started = false;
+bool had_home = false;  // home when the mode was entered: its arrival changes the heights' datum
 nav::NorthEast centre_m = {0.0f, 0.0f};      // LOITER's circle; CRUISE's locked track's start
 nav::NorthEast cruise_end_m = {0.0f, 0.0f};
 bool cruise_locked = false;
@@ -68,7 +70,8 @@ mav::NavOutput last_report;
 const settings::Settings& cfg() { return pipe.settings(); }
 
 bool gps_mode(flight::Mode m) {
-    return m == flight::Mode::Cruise || m == flight::Mode::Auto || m == flight::Mode::Rtl || m == flight::Mode::Loiter;
+    return m == flight::Mode::Cruise || m == flight::Mode::Auto || m == flight::Mode::Rtl ||
+           m == flight::Mode::Loiter || m == flight::Mode::Guided;
 }
 
 // The stick's share of a limit (the sticks are -4500..4500).
@@ -76,13 +79,20 @@ int16_t stick_share(int16_t stick_cd, int16_t limit) {
     return (int16_t)((int32_t)stick_cd * limit / flight::kFullThrow_cd);
 }
 
-mission::NavState state_now(uint32_t now_ms) {
+// The height TECS flies: above home; before home (CIRCLE, FBWB without a fix) the
+// barometer's since power-up, not a constant 0 (which let them sink unseen).
+float height_m() {
     const nav::Navigator& n = position::navigator();
-    return mission::NavState{n.from_home_m(), n.height_above_home_m(), now_ms};
+    return n.home_set() ? n.height_above_home_m() : baro::height_m();
+}
+
+mission::NavState state_now(uint32_t now_ms) {
+    return mission::NavState{position::navigator().from_home_m(), height_m(), now_ms};
 }
 
 // A mode entered: its target, and TECS from the aircraft's state (ArduPlane's set_mode).
 void enter(flight::Mode m, const mission::NavState& st) {
+    had_home = position::navigator().home_set();
     tecs.reset();
     height_dem_m = st.height_m;
     centre_m = st.pos_m;
@@ -92,6 +102,7 @@ void enter(flight::Mode m, const mission::NavState& st) {
         executor.start(st);
     }
     if (m == flight::Mode::Rtl) executor.return_home(st);
+    if (m == flight::Mode::Guided) executor.guide_to(nullptr, st);  // by its number alone: here
 }
 
 // NAV_TAKEOFF, a hand launch (ArduPlane's takeoff_calc_roll and _pitch before the course is
@@ -106,6 +117,15 @@ bool takeoff(const mission::NavTarget& t, nav::TecsInput& in) {
 }  // namespace
 
 const mission::MissionStore& mission_store() { return mission_link::store; }
+
+bool fly_to(const mission::Command& to) {
+    if (!flight_io.set_mode((uint8_t)flight::Mode::Guided)) return false;
+    const mission::NavState st = state_now(millis());
+    if (flying != flight::Mode::Guided) enter(flight::Mode::Guided, st);
+    flying = flight::Mode::Guided;  // entered: the next step flies the place given
+    executor.guide_to(&to, st);
+    return true;
+}
 
 void configure() {
     mission::nav_params(cfg().vehicle.nav, cfg().flight, l1_params, tecs_params, ex_params);
@@ -160,7 +180,11 @@ void run() {
     const mission::NavState st = state_now(now_ms);
     // A mission uploaded while AUTO flies: flown from its start (the commands the executor
     // holds may be gone).
-    if (m != flying || (m == flight::Mode::Auto && mission_changes != mission_link::changes())) enter(m, st);
+    // Home's arrival under CIRCLE or FBWB moves the heights' datum: the mode entered again
+    // holds the height flown.
+    if (m != flying || (m == flight::Mode::Auto && mission_changes != mission_link::changes()) ||
+        had_home != n.home_set())
+        enter(m, st);
     flying = m;
     const flight::FlightSettings& fs = cfg().flight;
     const settings::NavSettings& ns = cfg().vehicle.nav;
@@ -186,7 +210,8 @@ void run() {
             break;
         }
         case flight::Mode::Auto:
-        case flight::Mode::Rtl: {
+        case flight::Mode::Rtl:
+        case flight::Mode::Guided: {
             const mission::NavTarget& t = executor.target();
             if (t.kind == mission::TargetKind::kTakeoff) {
                 guided = takeoff(t, in);
@@ -288,7 +313,7 @@ void filters_run() {
     const linalg::Matrix3f r = pipe.estimator().matrix();
     const linalg::Vector3f a = pipe.accel_m_s2();
     const float accel_down = r.c.x * a.x + r.c.y * a.y + r.c.z * a.z;  // specific force: -g at rest
-    tecs.update_50hz(position::navigator().height_above_home_m(), -(accel_down + kGravity_m_s2),
+    tecs.update_50hz(height_m(), -(accel_down + kGravity_m_s2),
                      a.x + kGravity_m_s2 * r.c.x, dt_s);
 }
 
@@ -305,6 +330,7 @@ void configure() {}
 bool refused(flight::Mode, text::Flash&) { return false; }
 uint16_t unavailable_rows() { return 0; }
 bool report(mav::NavOutput&) { return false; }
+bool fly_to(const mission::Command&) { return false; }
 }  // namespace nav_modes
 
 #endif

@@ -9,6 +9,8 @@
 //   AUTO 10    the stored mission (MissionStore, read through mission_store())
 //   RTL 11     home at ALT_HOLD_RTL, then its circle of WP_LOITER_RAD
 //   LOITER 12  a circle of WP_LOITER_RAD where the mode was entered, at that height
+//   GUIDED 15  a circle of WP_LOITER_RAD about a ground station's "fly to here" (fly_to()) at
+//              its height; entered by its number alone, LOITER's circle where it is
 //
 // Two loop tasks: the navigation step at 10 Hz (the target into L1 and TECS; their bank,
 // pitch and throttle to FlightIo's controllers) and TECS's filters at 50 Hz. A mode that
@@ -22,6 +24,7 @@
 #include "Features.h"
 #include "FlightSettings.h"
 #include "MavLink.h"
+#include "MissionCommand.h"
 #include "Text.h"
 
 #if APM25_FLIGHT
@@ -50,6 +53,11 @@ uint16_t unavailable_rows();
 
 // NAV_CONTROLLER_OUTPUT's fields, while a navigation mode flies (false: none).
 bool report(mav::NavOutput& r);
+
+// A ground station's "fly to here" (MISSION_ITEM(_INT) with current 2): GUIDED entered (or
+// its circle moved) about the command's place at its height; false when GUIDED is refused
+// (its reason said).
+bool fly_to(const mission::Command& to);
 
 #if APM25_FLIGHT
 // The stored mission AUTO flies: the one place that reads it (MissionLink's accessor

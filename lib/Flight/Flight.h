@@ -237,7 +237,7 @@ public:
     bool wants_attitude() const {
         return state_ == State::Stabilize || state_ == State::Failsafe || state_ == State::Navigate;
     }
-    // FAILSAFE in a mode that flies on through it (Law::NavigateOn: AUTO, RTL, LOITER, CIRCLE).
+    // FAILSAFE in a mode that flies on through it (Law::NavigateOn: AUTO, RTL, LOITER, CIRCLE, GUIDED).
     bool navigating_in_failsafe() const;
     // An attitude mode chosen (STABILIZE, FBWA), but flying as MANUAL for want of an attitude.
     bool without_attitude() const { return no_attitude_; }

@@ -43,6 +43,7 @@ enum class Mode : uint8_t {
     Auto = 10,
     Rtl = 11,
     Loiter = 12,
+    Guided = 15,
 };
 
 struct FlightSettings {

@@ -36,6 +36,7 @@ const Row kModes[kModeCount] MODE_TABLE = {
     {(uint8_t)Mode::Auto, Law::NavigateOn, "AUTO"},
     {(uint8_t)Mode::Rtl, Law::NavigateOn, "RTL"},
     {(uint8_t)Mode::Loiter, Law::NavigateOn, "LOITER"},
+    {(uint8_t)Mode::Guided, Law::NavigateOn, "GUIDED"},
 };
 
 char upper(char c) { return (c >= 'a' && c <= 'z') ? (char)(c - 'a' + 'A') : c; }

@@ -20,13 +20,13 @@ enum class Law : uint8_t {
     // The navigation demands the bank, the pitch and the throttle (FlightControl::set_nav_demands):
     // FBWB and CRUISE (the receiver's failsafe glides, as from FBWA) ...
     Navigate,
-    // ... and CIRCLE, AUTO, RTL, LOITER, which fly on through the receiver's short failsafe
+    // ... and CIRCLE, AUTO, RTL, LOITER, GUIDED, which fly on through the receiver's short failsafe
     // (ArduPlane 3.x's failsafe_short_on_event with FS_SHORT_ACTN 0).
     NavigateOn,
 };
 
 constexpr uint8_t kModeNameMax = 9;  // "STABILIZE"
-constexpr uint8_t kModeCount = 9;
+constexpr uint8_t kModeCount = 10;
 
 // Index of ArduPlane mode number `number` in the table, or -1 (not a mode the board has).
 int8_t mode_index(uint8_t number);

@@ -149,10 +149,19 @@ void MissionExecutor::loiter_at(const nav::NorthEast& centre, float height_m, fl
     loiter_sum_rad_ = 0.0f;
 }
 
-void MissionExecutor::return_home(const NavState& s) {
+void MissionExecutor::return_home(const NavState& s) { loiter_default(nav::ne(0.0f, 0.0f), rtl_height_m(s), s); }
+
+void MissionExecutor::guide_to(const Command* to, const NavState& s) {
+    if (to != nullptr && to->has_place())
+        loiter_default(place_m(*to, s), height_of(*to), s);
+    else
+        loiter_default(s.pos_m, s.height_m, s);
+}
+
+void MissionExecutor::loiter_default(const nav::NorthEast& centre, float height_m, const NavState& s) {
     if (!complete_) index_ = kNone;
     const int16_t r = params_.loiter_radius_m;
-    loiter_at(nav::ne(0.0f, 0.0f), rtl_height_m(s), (float)(r < 0 ? -r : r), r < 0 ? (int8_t)-1 : (int8_t)1, s);
+    loiter_at(centre, height_m, (float)(r < 0 ? -r : r), r < 0 ? (int8_t)-1 : (int8_t)1, s);
     setup_slope(s, false);
     leg_started();
 }

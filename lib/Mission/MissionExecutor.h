@@ -79,6 +79,10 @@ public:
     bool set_current(uint16_t seq, const NavState& s);
     // RTL mode: loiter at home at ALT_HOLD_RTL.
     void return_home(const NavState& s);
+    // GUIDED mode (ArduPlane's set_guided_WP): loiter on WP_LOITER_RAD about the place of
+    // `to` at its height (a ground station's "fly to here"); nullptr, or a command without a
+    // place: where the aircraft is, at its height now.
+    void guide_to(const Command* to, const NavState& s);
     // Each navigation step, after the guidance's: done yet, and on to the next command (on a
     // loiter, the radial is L1's: its update_loiter on target() comes first).
     void update(const NavState& s, const nav::L1Control& l1);
@@ -115,6 +119,8 @@ private:
     uint8_t start_nav(uint8_t index, const Command& c, const NavState& s);
     void loiter_at(const nav::NorthEast& centre, float height_m, float radius_m, int8_t direction,
                    const NavState& s);
+    // RTL's and GUIDED's circle: WP_LOITER_RAD about centre, out of the mission.
+    void loiter_default(const nav::NorthEast& centre, float height_m, const NavState& s);
     void setup_slope(const NavState& s, bool auto_mode);
     // The leg's constants, once per command started (target_'s prev and next set).
     void leg_started();

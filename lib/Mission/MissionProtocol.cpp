@@ -36,6 +36,12 @@ __attribute__((noinline)) uint16_t clamp_u16(float x, float hi) {
 int32_t e7_from_degrees(float degrees) { return nav::round_to_int32(degrees * 1e7f); }
 float degrees_from_e7(int32_t e7) { return (float)e7 * 1e-7f; }
 
+bool guided_command(const Item& item, Command& c, Result& why) {
+    if (!from_item(item, c, why)) return false;
+    why = Result::kUnsupported;
+    return is_nav(c.id) && c.has_place();
+}
+
 bool from_item(const Item& item, Command& c, Result& why) {
     c = Command();
     c.id = item.command;

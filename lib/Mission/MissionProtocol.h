@@ -76,6 +76,12 @@ float degrees_from_e7(int32_t e7);
 
 // An item as a command (false: the result to refuse it with, set in `why`).
 bool from_item(const Item& item, Command& c, Result& why);
+// A ground station's "fly to here" (MAVProxy's `guided`, Mission Planner's "Fly to here"):
+// MISSION_ITEM(_INT) with current 2, for GUIDED and not for the stored mission (ArduPilot's
+// guided request). Its place and height as a command; false: `why`, a command without a
+// place (the item is then refused, the mission untouched).
+inline bool is_guided_request(const Item& item) { return item.current == 2u && item.mission_type == 0u; }
+bool guided_command(const Item& item, Command& c, Result& why);
 // A command as the item of `seq` (int_form: MISSION_ITEM_INT's frames).
 Item to_item(const Command& c, uint16_t seq, bool int_form);
 // Home as seq 0: a waypoint at home, height above mean sea level.

@@ -174,13 +174,13 @@ const Row kRows[] PARAM_TABLE = {
      PARAM_DOC("Flight mode channel", "",
                "The receiver channel of the mode switch; its width picks one of FLTMODE1 to FLTMODE6 by "
                "ArduPlane's six bands. 0: no switch, the console's `flight` command only.")},
-    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 12.0f, 0.0f,
+    {"FLTMODE1", Type::UInt8, 0, 1, 0, AT(flight.fltmode[0]), 0.0f, 15.0f, 0.0f,
      PARAM_DOC("Flight mode 1", "",
                "The mode of the switch's position 1 (up to 1230 us): 0 MANUAL, 1 CIRCLE, 2 STABILIZE, 5 FBWA, 6 "
-               "FBWB, 7 CRUISE, 10 AUTO, 11 RTL, 12 LOITER (ArduPlane's numbers; FBWA flies as STABILIZE does). Any "
-               "other number is refused. A mode that cannot run when the switch picks it (no 3D fix, no home, no "
+               "FBWB, 7 CRUISE, 10 AUTO, 11 RTL, 12 LOITER, 15 GUIDED (ArduPlane's numbers; FBWA flies as "
+               "STABILIZE does). Any other number is refused. A mode that cannot run when the switch picks it (no 3D fix, no home, no "
                "mission) is refused with its reason and the mode before flies on.")},
-    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 12.0f, 2.0f,
+    {"FLTMODE#", Type::UInt8, 2, 5, 1, AT(flight.fltmode[1]), 0.0f, 15.0f, 2.0f,
      PARAM_DOC("Flight mode n", "",
                "The mode of the switch's position n (2: 1231 to 1360 us, 3: to 1490, 4: to 1620, 5: to 1749, 6: "
                "above), numbered as FLTMODE1's; any other number is refused.")},
@@ -518,9 +518,9 @@ const Row kRows[] PARAM_TABLE = {
                "In FBWB and CRUISE, full pitch stick moves the height held by this much a second.")},
     {"FS_LONG_ACTN", Type::UInt8, 0, 1, 0, AT(vehicle.nav.fs_long_actn), 0.0f, 2.0f, 0.0f,
      PARAM_DOC("Long failsafe action", "",
-               "What the board does FS_LONG_TIMEOUT after the receiver is lost: 0 RTL, but AUTO, RTL and LOITER "
-               "go on; 1 RTL in every mode; 2 the failsafe glide (wings level, FS_GLIDE_PITCH). RTL needs home and "
-               "a 3D fix, else the glide goes on.")},
+               "What the board does FS_LONG_TIMEOUT after the receiver is lost: 0 RTL, but AUTO, RTL, LOITER and "
+               "GUIDED go on; 1 RTL in every mode; 2 the failsafe glide (wings level, FS_GLIDE_PITCH). RTL needs "
+               "home and a 3D fix, else the glide goes on.")},
     {"FS_LONG_TIMEOUT", Type::UInt16, 0, 1, 0, AT(vehicle.nav.fs_long_timeout_s), 1.0f, 300.0f, 20.0f,
      PARAM_DOC("Long failsafe timeout", "s",
                "How long the receiver must be lost for FS_LONG_ACTN. Whole seconds here.")},

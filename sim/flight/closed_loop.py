@@ -8,7 +8,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
-        [--gps ublox|nmea|none] [--arm] [--launch V,H,PITCH]
+        [--gps ublox|nmea|none] [--gps-fix-after S] [--arm] [--launch V,H,PITCH]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -23,7 +23,8 @@ elevons or vtail flies the outputs as an elevon or V-tail aeroplane's (the backe
 tcp:PORT attaches a ground station: apm25sim also serves the board's UART0 on TCP
 127.0.0.1:PORT (MAVProxy, QGroundControl, Mission Planner connect as to SITL's 5760) and
 flies in real time (--speed X for X times real time; 0 as fast as the host goes). --gps
-KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS).
+KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: no GPS);
+--gps-fix-after S its first 3D fix at S simulated seconds (apm25sim's; default 3).
 --arm arms the board on the launch stand as a pilot would (ARMING_REQUIRE 1 holds the
 throttle at its minimum until armed): the stick script's throttle at zero until ARM_S
 (2 s) and `arm` typed into the board (apm25sim --input: at its first angle line, ~1.4 s,
@@ -113,6 +114,7 @@ def parse_args(argv):
                    help="the backend reads the outputs as this airframe's surfaces (default plain)")
     p.add_argument("--trajectory", help="the backend's trajectory file (ideal sensors, truth)")
     p.add_argument("--gps", choices=("ublox", "nmea", "none"), help="apm25sim --gps (default: apm25sim's)")
+    p.add_argument("--gps-fix-after", type=float, metavar="S", help="apm25sim --gps-fix-after: the first 3D fix")
     p.add_argument("--out", help="the serial output into this file instead of stdout")
     p.add_argument("--wind", help="the backend's --wind N,E: a steady wind, m/s")
     p.add_argument("--launch", metavar="V,H,PITCH",
@@ -220,6 +222,8 @@ def run(args):
             sim_cmd += ["--speed", "%g" % args.speed]
         if args.gps:
             sim_cmd += ["--gps", args.gps]
+        if args.gps_fix_after is not None:
+            sim_cmd += ["--gps-fix-after", "%g" % args.gps_fix_after]
         if args.mission:
             sim_cmd += ["--mission", args.mission]
         if args.profile:

@@ -88,9 +88,9 @@ TEST(FlightConsole, SetAndGetReplies) {
     out.clear();
     console::print_error(console::parse_line("set FLTMODE2 4"), &sink);
     EXPECT_EQ(out, "# error: FLTMODE2 must be a mode of this board: 0 manual, 2 stabilize, 5 fbwa, 1 circle, 6 fbwb, "
-                   "7 cruise, 10 auto, 11 rtl, 12 loiter; nothing changed\n");
+                   "7 cruise, 10 auto, 11 rtl, 12 loiter, 15 guided; nothing changed\n");
     out.clear();
     console::print_error(console::parse_line("flight acro"), &sink);
-    EXPECT_EQ(out, "# error: flight manual or stabilize or fbwa or circle or fbwb or cruise or auto or rtl or loiter; "
-                   "nothing changed\n");
+    EXPECT_EQ(out, "# error: flight manual or stabilize or fbwa or circle or fbwb or cruise or auto or rtl or loiter "
+                   "or guided; nothing changed\n");
 }

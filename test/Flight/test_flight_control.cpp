@@ -316,7 +316,7 @@ TEST(FlightControl, AChoiceInFailsafeWaitsForTheSignal) {
     r.fc.choose((flight::Mode)4);  // ACRO: not a mode here
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     r.fc.choose(flight::Mode::Stabilize);
-    r.fc.choose((flight::Mode)15);  // ArduPlane's GUIDED: not one here either
+    r.fc.choose((flight::Mode)8);  // ArduPlane's AUTOTUNE: not one here either
     EXPECT_EQ(r.fc.chosen(), flight::Mode::Manual);
     EXPECT_EQ(r.fc.state(), flight::State::Manual);
     r.fc.choose(flight::Mode::FlyByWireA);  // FBWA flies STABILIZE's law

@@ -19,8 +19,8 @@ TEST(Modes, ArduPlanesNumbersAndNames) {
                 {5, "FBWA", flight::Law::Attitude},        {1, "CIRCLE", flight::Law::NavigateOn},
                 {6, "FBWB", flight::Law::Navigate},        {7, "CRUISE", flight::Law::Navigate},
                 {10, "AUTO", flight::Law::NavigateOn},     {11, "RTL", flight::Law::NavigateOn},
-                {12, "LOITER", flight::Law::NavigateOn}};
-    ASSERT_EQ(flight::kModeCount, 9u);
+                {12, "LOITER", flight::Law::NavigateOn},   {15, "GUIDED", flight::Law::NavigateOn}};
+    ASSERT_EQ(flight::kModeCount, 10u);
     for (uint8_t i = 0; i < flight::kModeCount; ++i) {
         char name[flight::kModeNameMax + 1];
         flight::mode_name(i, name);
@@ -33,7 +33,7 @@ TEST(Modes, ArduPlanesNumbersAndNames) {
         EXPECT_EQ(flight::mode_by_name(lower.c_str()), (int8_t)i);
         EXPECT_EQ(flight::mode_by_name(want[i].name), (int8_t)i);
     }
-    for (uint8_t n : {3, 4, 8, 9, 13, 15, 255}) EXPECT_FALSE(flight::mode_known(n)) << (int)n;
+    for (uint8_t n : {3, 4, 8, 9, 13, 14, 16, 255}) EXPECT_FALSE(flight::mode_known(n)) << (int)n;
     EXPECT_EQ(flight::mode_by_name("fbw"), -1);
     EXPECT_EQ(flight::mode_by_name("fbwab"), -1);
     EXPECT_EQ(flight::mode_by_name("stabilizer"), -1);
@@ -49,7 +49,8 @@ TEST(Modes, FltmodeTakesOnlyTheBoardsModes) {
         EXPECT_TRUE(params::set(s, (uint16_t)i, 5.0f)) << name;
         EXPECT_EQ(params::get(s, (uint16_t)i), 5.0f);
         EXPECT_FALSE(params::set(s, (uint16_t)i, 4.0f)) << name << ": ACRO is not on this board";
-        EXPECT_FALSE(params::set(s, (uint16_t)i, 15.0f)) << name << ": GUIDED is not on this board";
+        EXPECT_FALSE(params::set(s, (uint16_t)i, 8.0f)) << name << ": AUTOTUNE is not on this board";
+        EXPECT_TRUE(params::set(s, (uint16_t)i, 15.0f)) << name << ": GUIDED";
         EXPECT_TRUE(params::set(s, (uint16_t)i, 11.0f)) << name;
         EXPECT_TRUE(params::set(s, (uint16_t)i, 5.0f)) << name;
         EXPECT_FALSE(params::set(s, (uint16_t)i, 3.0f)) << name;

@@ -2,7 +2,7 @@
 // lib/Mission/MissionExecutor: waypoints reached within the turn distance or once past
 // them, DO_JUMP's counts (and for ever), the loiters' ends, the takeoff, RTL, the end of
 // the mission (a loiter at home at ALT_HOLD_RTL), DO_CHANGE_SPEED, the glide slope,
-// MISSION_SET_CURRENT.
+// MISSION_SET_CURRENT, GUIDED's circle (a ground station's "fly to here").
 #include <gtest/gtest.h>
 
 #include <math.h>
@@ -278,6 +278,59 @@ TEST(MissionExecutor, SetCurrentAndAnEmptyMission) {
     EXPECT_EQ(rtl.exec.target().direction, -1);
     EXPECT_FLOAT_EQ(rtl.exec.target().radius_m, 80.0f);
     EXPECT_FLOAT_EQ(rtl.exec.target().height_m, 50.0f);
+}
+
+// GUIDED (ArduPlane's set_guided_WP): WP_LOITER_RAD about the place given, at its height
+// (above home or above mean sea level), the mission left; without a place, where it is.
+TEST(MissionExecutor, GuidedCirclesThePlaceGivenAtItsHeight) {
+    Flight r;
+    r.f.upload({r.f.wp(500.0f, 0.0f, 60.0f), r.f.wp(500.0f, 300.0f, 60.0f)});
+    r.exec.start(r.s);
+    ASSERT_EQ(r.exec.current_seq(), 1u);
+    const mission::Command to = r.f.wp(300.0f, -200.0f, 80.0f);
+    r.exec.guide_to(&to, r.s);
+    EXPECT_EQ(r.exec.target().kind, mission::TargetKind::kLoiter);
+    EXPECT_NEAR(r.exec.target().next_m.north_m, 300.0f, 0.02f);
+    EXPECT_NEAR(r.exec.target().next_m.east_m, -200.0f, 0.02f);
+    EXPECT_FLOAT_EQ(r.exec.target().radius_m, 60.0f);
+    EXPECT_EQ(r.exec.target().direction, 1);
+    EXPECT_FLOAT_EQ(r.exec.target().height_m, 80.0f);
+    EXPECT_FLOAT_EQ(r.exec.height_demand_m(r.s), 80.0f);  // a climb: no slope (ArduPlane's)
+    EXPECT_EQ(r.exec.current_seq(), 0u);                  // out of the mission
+    // The steps after fly the circle: the mission's waypoint reached is not flown on to.
+    EXPECT_EQ(r.at(500.0f, 0.0f), 0u);
+    EXPECT_EQ(r.exec.target().kind, mission::TargetKind::kLoiter);
+    EXPECT_NEAR(r.exec.target().next_m.north_m, 300.0f, 0.02f);
+
+    // Above mean sea level (MAVProxy's AMSL frame): home's 1028 m + 40 m is 40 m above home;
+    // a negative WP_LOITER_RAD circles counter-clockwise.
+    Flight amsl;
+    amsl.params.loiter_radius_m = -45;
+    amsl.s.height_m = 80.0f;
+    mission::Command high = amsl.f.wp(-100.0f, 50.0f, 0.0f);
+    high.relative_alt = false;
+    high.alt_cm = amsl.f.home.alt_cm + 4000;
+    amsl.exec.guide_to(&high, amsl.s);
+    EXPECT_FLOAT_EQ(amsl.exec.target().height_m, 40.0f);
+    EXPECT_FLOAT_EQ(amsl.exec.target().radius_m, 45.0f);
+    EXPECT_EQ(amsl.exec.target().direction, -1);
+    EXPECT_NEAR(amsl.exec.target().next_m.east_m, 50.0f, 0.02f);
+    // 40 m below the aircraft: the glide slope spreads the descent from where it is.
+    EXPECT_NEAR(amsl.exec.height_demand_m(amsl.s), 80.0f, 0.01f);
+
+    // GUIDED from SET_MODE alone: around the aircraft's position, at its height.
+    Flight here;
+    here.s.pos_m = ne(120.0f, 80.0f);
+    here.s.height_m = 35.0f;
+    here.exec.guide_to(nullptr, here.s);
+    EXPECT_FLOAT_EQ(here.exec.target().next_m.north_m, 120.0f);
+    EXPECT_FLOAT_EQ(here.exec.target().next_m.east_m, 80.0f);
+    EXPECT_FLOAT_EQ(here.exec.target().height_m, 35.0f);
+    EXPECT_EQ(here.exec.target().kind, mission::TargetKind::kLoiter);
+    // AUTO again: the mission from its start.
+    r.exec.start(r.s);
+    EXPECT_EQ(r.exec.current_seq(), 1u);
+    EXPECT_EQ(r.exec.target().kind, mission::TargetKind::kWaypoint);
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 // downloaded back equal; a ground station that stops half way (re-requests, then
 // cancelled, the old mission whole), refused commands and frames (the old mission
 // whole), items out of order, too many, a lost final ACK, clear, set current, fence
-// and rally lists.
+// and rally lists; a ground station's "fly to here" (current 2) taken apart from them.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -261,6 +261,39 @@ TEST(MissionProtocol, ClearSetCurrentFenceAndRally) {
     r = p.on_count(4, 2, now);
     EXPECT_EQ(r.result, Result::kUnsupported);
     EXPECT_EQ(r.mission_type, 2u);
+}
+
+// MAVProxy's `guided LAT LON ALT`: MISSION_ITEM_INT seq 0, NAV_WAYPOINT, current 2, its
+// frame (above home by default, AMSL when set). A place and a height; nothing else flies.
+TEST(MissionProtocol, GuidedRequestIsAPlaceAndAHeight) {
+    mission::Item g = item(0, 16, 71370450, -731170000, 45.0f);
+    EXPECT_FALSE(mission::is_guided_request(g));  // an upload's item
+    g.current = 2;
+    EXPECT_TRUE(mission::is_guided_request(g));
+    mission::Command c;
+    Result why = Result::kAccepted;
+    ASSERT_TRUE(mission::guided_command(g, c, why));
+    EXPECT_EQ(c.lat_e7, 71370450);
+    EXPECT_EQ(c.lon_e7, -731170000);
+    EXPECT_EQ(c.alt_cm, 4500);
+    EXPECT_TRUE(c.relative_alt);
+    mission::Item amsl = item(0, 16, 71370450, -731170000, 1100.0f, false, mission::kFrameGlobal);
+    amsl.current = 2;
+    ASSERT_TRUE(mission::guided_command(amsl, c, why));
+    EXPECT_FALSE(c.relative_alt);
+    EXPECT_EQ(c.alt_cm, 110000);
+    mission::Item fence = g;
+    fence.mission_type = 1;
+    EXPECT_FALSE(mission::is_guided_request(fence));
+    // Refused: no place, a DO command, a frame the board does not take.
+    mission::Item none = item(0, 16, 0, 0, 45.0f);
+    EXPECT_FALSE(mission::guided_command(none, c, why));
+    EXPECT_EQ(why, Result::kUnsupported);
+    mission::Item jump = item(0, 177, 0, 0, 0.0f, true, mission::kFrameMission);
+    EXPECT_FALSE(mission::guided_command(jump, c, why));
+    mission::Item body = item(0, 16, 71370450, -731170000, 45.0f, true, 11);  // TERRAIN_ALT_INT: AGL
+    EXPECT_FALSE(mission::guided_command(body, c, why));
+    EXPECT_EQ(why, Result::kUnsupportedFrame);
 }
 
 }  // namespace

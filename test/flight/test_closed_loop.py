@@ -88,6 +88,26 @@ GROUP is one of:
                   short failsafe said ("the mode goes on") and the mission flown on (within
                   10 m of the legs, HEARTBEAT's mode AUTO in the line), then after
                   FS_LONG_TIMEOUT (20 s) RTL said and flown: closer to home 15 s later
+  modes_from_switch  a ground station attached (pymavlink over closed_loop.py --serial tcp:0,
+                  test/flight/closed_loop_modes.py), the first fix at 32 s: every mode (MANUAL,
+                  CIRCLE, STABILIZE, FBWA, FBWB, CRUISE, AUTO, RTL, LOITER, GUIDED) from the mode
+                  switch (FLTMODE1..6 set by PARAM_SET, twice, to cover them) and from the ground
+                  station by SET_MODE and by COMMAND_LONG DO_SET_MODE: ACCEPTED, and every
+                  HEARTBEAT's custom_mode the mode's until the next change; refused with FAILED
+                  (a "fly to here" with MISSION_ACK ERROR), the reason in a STATUSTEXT and
+                  STABILIZE flying on: the switch's AUTO and the ground station's LOITER,
+                  GUIDED, CRUISE, RTL, AUTO and "fly to here" before the fix ("no 3D GPS fix"),
+                  AUTO after it without a mission ("no mission"; then one uploaded); the ground
+                  station's LOITER held until the switch moves
+  modes_flown     the same attachment, the fix at 40 s, each mode flown against the truth:
+                  CIRCLE before the fix (a mean bank of 15 +- 5 deg, the height within 3 m of its
+                  entry, > 180 deg turned), FBWB (sticks centred: the height within 3 m; full
+                  pitch stick: FBWB_CLIMB_RATE 2 +- 0.5 m/s), CRUISE (40 s: the course within 5
+                  deg of its entry's, within 5 m of a straight line, the height within 3 m),
+                  LOITER (from 25 s in: WP_LOITER_RAD 60 +- 5 m about a centre within 15 m of
+                  the entry, the height within 5 m), GUIDED from MAVProxy's `guided` item
+                  ~300 m away (ACCEPTED; from 35 s in, 60 +- 8 m from the place given at home
+                  + 40 +- 5 m); never below 40 m
   auto_wind       the same in a 5 m/s wind from the west (the backend's --wind 0,5) with light
                   gusts (seed 47001): the cross-track RMS <= 5 m, the rest as `auto`
   mission         the thesis' flight test (sim/flight/mission_flight.py on
@@ -1053,7 +1073,16 @@ GROUPS = {"mission": check_mission, "rtl": check_rtl, "auto": check_auto, "auto_
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
           "restart_air": check_restart_air, "elevons": check_elevons, "vtail": check_vtail,
-          "turn_gps": check_turn_gps}
+          "turn_gps": check_turn_gps,
+          "modes_from_switch": lambda args: modes_group("check_modes_from_switch", args),
+          "modes_flown": lambda args: modes_group("check_modes_flown", args)}
+
+
+def modes_group(name, args):
+    """The ground station's flights (closed_loop_modes.py: pymavlink, imported only for them)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import closed_loop_modes
+    getattr(closed_loop_modes, name)(args.work, args.tools or os.path.join(ROOT, "build"))
 
 
 def main():

@@ -19,7 +19,7 @@ barometer taken away for a while (--fault), and talks to it as a ground station:
   - the throttle pin (OUT3) at 1000 us from the first pulse whenever disarmed, the stick's
     width while armed;
   - SET_MODE (ACK command 11), DO_SET_MODE in COMMAND_LONG and COMMAND_INT for MANUAL,
-    STABILIZE and FBWA, each ACCEPTED and in HEARTBEAT's custom_mode; 15 (GUIDED) and 4 (ACRO)
+    STABILIZE and FBWA, each ACCEPTED and in HEARTBEAT's custom_mode; 8 (AUTOTUNE) and 4 (ACRO)
     refused with FAILED and "no mode", 10 (AUTO, no mission) with FAILED and its reason; the
     mode switch moving takes over; PARAM_SET FLTMODE1 4 refused;
   - RC_CHANNELS_OVERRIDE of channel 1 on the pin (OUT1) and RC_CHANNELS, back to the
@@ -120,9 +120,9 @@ def set_mode_checks(b):
     print("# modes: SET_MODE, DO_SET_MODE (COMMAND_LONG, COMMAND_INT) for MANUAL, STABILIZE, FBWA accepted and flown")
     # Refused: a mode the board does not have, in both messages, with its reason; AUTO
     # (a mode it has) for want of a fix, home or a mission, with that reason.
-    command(b, mavlink2.MAV_CMD_DO_SET_MODE, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 15)
-    ack = b.ack(mavlink2.MAV_CMD_DO_SET_MODE, "COMMAND_ACK to DO_SET_MODE 15")
-    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "DO_SET_MODE 15 (GUIDED): %r" % ack)
+    command(b, mavlink2.MAV_CMD_DO_SET_MODE, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 8)
+    ack = b.ack(mavlink2.MAV_CMD_DO_SET_MODE, "COMMAND_ACK to DO_SET_MODE 8")
+    soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "DO_SET_MODE 8 (AUTOTUNE): %r" % ack)
     b.conn.mav.set_mode_send(1, mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 4)
     ack = b.ack(11, "COMMAND_ACK to SET_MODE 4")
     soft_assert(ack is not None and ack.result == mavlink2.MAV_RESULT_FAILED, "SET_MODE 4 (ACRO): %r" % ack)
@@ -132,7 +132,7 @@ def set_mode_checks(b):
                 % ack)
     t = b.t_s
     b.pump(lambda m, t=t: b.t_s > t + 0.3, "the reasons")
-    for n in (15, 4):
+    for n in (8, 4):
         soft_assert(text_at(b.msgs, "Mode change refused: no mode %d on this board" % n, t - 1.0) is not None,
                     "no reason said for mode %d" % n)
     auto = [m.text for tm, m in b.msgs if tm >= t - 1.0 and m.get_type() == "STATUSTEXT"
