@@ -9,7 +9,7 @@
 //   MISSION_ITEM_REACHED  once for each command the executor reaches (its reached_count())
 //
 // The executor is the caller's (firmware/NavModes), passed to start() and follow().
-// Plain C++, host-tested; 7 bytes.
+// Plain C++, host-tested; 8 bytes.
 #pragma once
 
 #include <stdint.h>
