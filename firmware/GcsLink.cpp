@@ -185,6 +185,9 @@ static mav::Result run_command(const mav::CommandLong& c) {
         return mav::Result::Accepted;
     }
     if (c.command == mav::kCmdDoSetHome) return set_home(p);
+    if (c.command == mav::kCmdDoSetMissionCurrent)  // as MISSION_SET_CURRENT (ArduPilot's reset: not here)
+        return p[1] == 0.0f && p[0] >= 0.0f && p[0] < 65536.0f && mission_link::set_current((uint16_t)p[0])
+                   ? mav::Result::Accepted : mav::Result::Failed;
     if (mag_cal_link::handles(c.command)) return mag_cal_link::command(c);
     if (c.command == mav::kCmdPreflightRebootShutdown) {
         // param1 1: the autopilot (ArduPilot's 2 shutdown, 3 the bootloader: not here);
@@ -470,7 +473,7 @@ bool streams_due() {
     const uint32_t now_ms = millis();
     return (streams.due(mav::kStreamSysStatus, now_ms) || streams.due(mav::kStreamRcChannels, now_ms) ||
             streams.due(mav::kStreamServoOutputRaw, now_ms) || streams.due(mav::kStreamScaledPressure, now_ms) ||
-            streams.due(mav::kStreamSystemTime, now_ms)) &&
+            streams.due(mav::kStreamSystemTime, now_ms) || streams.due(mav::kStreamMissionCurrent, now_ms)) &&
            room_for(mav::kMaxFrame);
 }
 void send_streams() {
@@ -489,6 +492,8 @@ void send_streams() {
             n = port::mavlink.scaled_pressure(frame, now_ms, baro::pressure_pa(), baro::temperature_c());
     } else if (streams.take(mav::kStreamSystemTime, now_ms)) {
         n = port::mavlink.system_time(frame, gps::unix_time_us(gps_port::fix(), now_ms), now_ms);
+    } else if (streams.take(mav::kStreamMissionCurrent, now_ms)) {
+        n = port::mavlink.mission_current(frame, mission_link::current_seq(), mission_link::count());
     }
     if (n > 0) port::send_frame(frame, n);
 }

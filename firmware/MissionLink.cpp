@@ -59,7 +59,7 @@ static struct {
 } pending;
 static bool check_commit = false;  // an ACK ACCEPTED of a commit: ERROR if it did not verify
 static uint16_t sequence_before = 0;
-static uint16_t current = 0;
+mission::MissionReporter reporter;
 
 void begin() {
     store.set_stepped(true);
@@ -124,8 +124,7 @@ void take(const mav::Received& rx) {
         r = protocol.on_clear_all(type);
         if (type != 0) r.result = mission::Result::kAccepted;
     } else if (mav::decode_mission_set_current(rx, n)) {
-        r = protocol.on_set_current(n);
-        if (r.kind == mission::Reply::kCurrent) current = n;
+        set_current(n);  // MISSION_CURRENT is the reporter's news
     } else {
         return;
     }
@@ -146,7 +145,22 @@ void service() {
     }
 }
 
-bool reply_due() { return pending.kind != mission::Reply::kNone && !writing() && eeprom_is_ready(); }
+static bool protocol_reply_due() { return pending.kind != mission::Reply::kNone && !writing() && eeprom_is_ready(); }
+bool reply_due() { return protocol_reply_due() || reporter.news(); }
+
+// The executor's news: MISSION_ITEM_REACHED first (MISSION_CURRENT is on a stream too).
+static void send_news() {
+    uint8_t frame[mav::kMaxFrame];
+    uint16_t seq;
+    uint8_t n;
+    if (reporter.take_reached(seq)) {
+        n = port::mavlink.mission_item_reached(frame, seq);
+    } else {
+        reporter.take_current();
+        n = port::mavlink.mission_current(frame, reporter.current_seq(), store.count());
+    }
+    port::send_frame(frame, n);
+}
 
 static nav::Location home() {
     const nav::Navigator& nav = position::navigator();
@@ -154,6 +168,7 @@ static nav::Location home() {
 }
 
 void send_reply() {
+    if (!protocol_reply_due()) return send_news();
     uint8_t frame[mav::kMaxFrame];
     uint8_t n;
     const uint8_t sys = pending.sysid, comp = pending.compid;
@@ -173,10 +188,10 @@ void send_reply() {
     switch (kind) {
         case mission::Reply::kItem: n = port::mavlink.mission_item(frame, sys, comp, r.item); break;
         case mission::Reply::kCount: n = port::mavlink.mission_count(frame, sys, comp, pending.seq, pending.type); break;
-        case mission::Reply::kCurrent: n = port::mavlink.mission_current(frame, pending.seq, store.count()); break;
         case mission::Reply::kAck:
             // Committed but not read back whole: the mission before stays, said so.
             if (check_commit && store.sequence() == sequence_before) pending.result = (uint8_t)mission::Result::kError;
+            if (store.sequence() != sequence_before) reporter.forget();  // a seq asked of the mission before
             n = port::mavlink.mission_ack(frame, sys, comp, (mav::MissionResult)pending.result, pending.type);
             break;
         default:
@@ -191,13 +206,13 @@ void send_reply() {
 uint8_t count() { return store.count(); }
 bool read(uint8_t index, mission::Command& c) { return store.read(index, c); }
 uint16_t changes() { return store.sequence(); }
-uint16_t current_seq() { return current; }
-void set_current_seq(uint16_t seq) { current = seq; }
+uint16_t current_seq() { return reporter.current_seq(); }
+bool set_current(uint16_t seq) { return reporter.request(seq, store.count()); }
 
 bool print(uint8_t part, const text::Sink* out) {
     text::Writer w(out);
     if (part == 0) {
-        w.str(TXT("# mission: ")).u32(store.count()).str(TXT(" commands, current ")).u32(current);
+        w.str(TXT("# mission: ")).u32(store.count()).str(TXT(" commands, current ")).u32(reporter.current_seq());
         if (writing()) w.str(TXT(" (being written)"));
         w.end();
         return true;

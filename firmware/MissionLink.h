@@ -5,7 +5,8 @@
 //   upload    MISSION_COUNT -> MISSION_REQUEST_INT 0 <- MISSION_ITEM_INT 0 ... -> MISSION_ACK
 //             (MISSION_REQUEST / MISSION_ITEM for old ground stations; retries, time-outs)
 //   download  MISSION_REQUEST_LIST -> MISSION_COUNT; MISSION_REQUEST(_INT) -> MISSION_ITEM(_INT)
-//   MISSION_CLEAR_ALL -> MISSION_ACK; MISSION_SET_CURRENT -> MISSION_CURRENT
+//   MISSION_CLEAR_ALL -> MISSION_ACK; MISSION_SET_CURRENT -> MISSION_CURRENT, the executor moved
+//   MISSION_CURRENT when the current command changes, MISSION_ITEM_REACHED when one is reached
 //   fence, rally: empty lists; a clear or an empty upload accepted, an upload refused
 //
 // Seq 0 is home (ArduPilot's): Position's home, zeros before one; an upload's item 0 is
@@ -25,6 +26,7 @@
 
 #include <stdint.h>
 
+#include "MissionReporter.h"
 #include "MissionStore.h"
 
 #include "MavLink.h"
@@ -44,7 +46,8 @@ void take(const mav::Received& rx);
 // The store task, each loop pass: a queued byte written or a commit step (when the EEPROM
 // is ready), the upload's time-outs.
 void service();
-// A reply to send (its room is the caller's to check: two frames, a STATUSTEXT after an ACK).
+// A reply to send (its room is the caller's to check: two frames, a STATUSTEXT after an ACK),
+// or the executor's news (MISSION_ITEM_REACHED, MISSION_CURRENT).
 bool reply_due();
 void send_reply();
 
@@ -57,9 +60,14 @@ uint8_t count();
 bool read(uint8_t index, mission::Command& c);
 // Moves with each mission committed (restart the executor when it does).
 uint16_t changes();
-// The current command's seq: MISSION_SET_CURRENT's, or the executor's.
+// The current command's seq (MISSION_CURRENT's): the executor's, or MISSION_SET_CURRENT's.
 uint16_t current_seq();
-void set_current_seq(uint16_t seq);
+// MAV_CMD_DO_SET_MISSION_CURRENT's seq (MAVProxy's `wp set`): as MISSION_SET_CURRENT; false
+// but for 1..count.
+bool set_current(uint16_t seq);
+// Between MISSION_SET_CURRENT and the executor (NavModes): its start() when AUTO is entered,
+// its follow() each step of AUTO.
+extern mission::MissionReporter reporter;
 
 // `mission`: part 0 the count, then a command a part ("# seq: id p1 lat lon alt").
 bool print(uint8_t part, const text::Sink* out);

@@ -99,7 +99,7 @@ void enter(flight::Mode m, const mission::NavState& st) {
     cruise_locked = false;
     if (m == flight::Mode::Auto) {
         mission_changes = mission_link::changes();
-        executor.start(st);
+        mission_link::reporter.start(executor, st);  // from MISSION_SET_CURRENT's seq, if one came
     }
     if (m == flight::Mode::Rtl) executor.return_home(st);
     if (m == flight::Mode::Guided) executor.guide_to(nullptr, st);  // by its number alone: here
@@ -221,6 +221,7 @@ void run() {
                 l1.update_loiter(st.pos_m, vel, t.next_m, t.radius_m, t.direction);
             }
             executor.update(st, l1);
+            if (m == flight::Mode::Auto) mission_link::reporter.follow(executor, st);  // MISSION_SET_CURRENT, the news
             height_dem_m = executor.height_demand_m(st);
             if (executor.airspeed_cm_s() != 0u) in.eas_dem_m_s = (float)executor.airspeed_cm_s() * 0.01f;
             break;

@@ -493,6 +493,7 @@ constexpr uint16_t kCmdRequestAutopilotCapabilities = 520;  // answered with AUT
 constexpr uint16_t kCmdPreflightRebootShutdown = 246;       // param1 1: reboot (a watchdog reset)
 constexpr uint8_t kMsgAutopilotVersion = 148;               // ... and REQUEST_MESSAGE 148
 constexpr uint16_t kCmdComponentArmDisarm = 400;  // param1 1 arm, 0 disarm; param2 kForceMagic: without the checks
+constexpr uint16_t kCmdDoSetMissionCurrent = 224;  // param1 the seq (MAVProxy's `wp set`), param2 1 reset: FAILED
 constexpr uint16_t kCmdDoSetMode = 176;           // param1 base_mode (CUSTOM_MODE_ENABLED), param2 the custom mode
 constexpr uint16_t kSetModeAck = 11;               // ArduPilot answers SET_MODE with a COMMAND_ACK of "command" 11
 constexpr float kForceMagic = 21196.0f;     // MAVLink's: arm or disarm without the checks

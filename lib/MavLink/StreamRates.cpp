@@ -33,6 +33,7 @@ const Entry kTable[kStreamMsgs] STREAM_TABLE = {
     {2, kGroupExtra3, kFrameOverhead + 12},             // SYSTEM_TIME
     {147, kGroupExtra3, kBatteryStatusFrame},           // BATTERY_STATUS
     {62, kGroupExtStat, kFrameOverhead + 26},           // NAV_CONTROLLER_OUTPUT (while a navigation mode flies)
+    {42, kGroupExtStat, kFrameOverhead + 6},            // MISSION_CURRENT (seq, total)
 };
 
 uint8_t group_of(uint8_t m) { return TABLE_BYTE(kTable[m].group); }

@@ -8,7 +8,8 @@
 //
 //   group (SR0_)  MAV_DATA_STREAM     messages the board sends          frame bytes (longest)
 //   RAW_SENS      1 RAW_SENSORS       SCALED_PRESSURE                   28
-//   EXT_STAT      2 EXTENDED_STATUS   SYS_STATUS, GPS_RAW_INT           66, 64
+//   EXT_STAT      2 EXTENDED_STATUS   SYS_STATUS, GPS_RAW_INT,          66, 64,
+//                                     NAV_CONTROLLER_OUTPUT, MISSION_CURRENT  38, 18
 //   RC_CHAN       3 RC_CHANNELS       RC_CHANNELS, SERVO_OUTPUT_RAW     54, 33
 //   POSITION      6 POSITION          GLOBAL_POSITION_INT               40
 //   EXTRA1       10 EXTRA1            ATTITUDE (at most one an output line: the console's `rate`)  40
@@ -46,7 +47,7 @@ enum StreamGroup : uint8_t {
 enum StreamMsg : uint8_t {
     kStreamScaledPressure, kStreamSysStatus, kStreamGpsRawInt, kStreamRcChannels, kStreamServoOutputRaw,
     kStreamGlobalPositionInt, kStreamAttitude, kStreamVfrHud, kStreamSystemTime, kStreamBatteryStatus,
-    kStreamNavControllerOutput, kStreamMsgs
+    kStreamNavControllerOutput, kStreamMissionCurrent, kStreamMsgs
 };
 
 // MESSAGE_INTERVAL (244) and the commands that ask for it.

@@ -60,16 +60,18 @@ uint8_t MissionExecutor::walk(uint8_t from, Walk mode, Command& c) {
     return kNone;
 }
 
-void MissionExecutor::start(const NavState& s) {
+void MissionExecutor::start(const NavState& s, uint16_t seq) {
     for (Jump& j : jumps_) j.index = kNone;
     complete_ = false;
     target_.kind = TargetKind::kNone;
-    advance(0, s);
+    index_ = kNone;
+    advance(seq != 0 && seq <= store_.count() ? (uint8_t)(seq - 1u) : (uint8_t)0u, s);
 }
 
 bool MissionExecutor::set_current(uint16_t seq, const NavState& s) {
     if (seq == 0 || seq > store_.count()) return false;
     complete_ = false;
+    index_ = kNone;  // the leg from here, not from the waypoint flown to
     advance((uint8_t)(seq - 1u), s);
     return true;
 }

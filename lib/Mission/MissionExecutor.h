@@ -73,9 +73,11 @@ public:
                     const ExecutorParams& params)
         : store_(store), map_(map), home_(home), params_(params) {}
 
-    // From the first command, DO_JUMP counts reset (AUTO entered).
-    void start(const NavState& s);
-    // MISSION_SET_CURRENT: on from seq (1..count); false for another seq.
+    // AUTO entered: DO_JUMP counts reset, on from seq (MISSION_SET_CURRENT's out of AUTO),
+    // from the first command when seq is not 1..count.
+    void start(const NavState& s, uint16_t seq = 1);
+    // MISSION_SET_CURRENT: on from seq (1..count), its leg from here (the plane turns to it,
+    // as ArduPlane's next_wp_crosstrack = false); false for another seq.
     bool set_current(uint16_t seq, const NavState& s);
     // RTL mode: loiter at home at ALT_HOLD_RTL.
     void return_home(const NavState& s);

@@ -43,6 +43,7 @@ TEST(StreamRates, GroupsAreArduPlanes) {
     EXPECT_EQ(mav::stream_msg_of(74), mav::kStreamVfrHud);
     EXPECT_EQ(mav::stream_msg_of(2), mav::kStreamSystemTime);
     EXPECT_EQ(mav::stream_msg_of(147), mav::kStreamBatteryStatus);
+    EXPECT_EQ(mav::stream_msg_of(42), mav::kStreamMissionCurrent);
     EXPECT_EQ(mav::stream_msg_of(0), mav::kStreamMsgs);    // HEARTBEAT: 1 Hz, not a stream
     EXPECT_EQ(mav::stream_msg_of(27), mav::kStreamMsgs);   // RAW_IMU: not sent by the board
     EXPECT_EQ(mav::stream_msg_of(65536u + 30u), mav::kStreamMsgs);
@@ -62,6 +63,7 @@ TEST(StreamRates, DefaultsPlanTheRatesTheBoardSent) {
     EXPECT_EQ(ms(r, mav::kStreamVfrHud), 250u);
     EXPECT_EQ(ms(r, mav::kStreamSystemTime), 1000u);
     EXPECT_EQ(ms(r, mav::kStreamBatteryStatus), 1000u);
+    EXPECT_EQ(ms(r, mav::kStreamMissionCurrent), 1000u);  // SR0_EXT_STAT's, as ArduPlane's
     EXPECT_LT(r.bytes_per_s(), mav::kLinkBudgetBytesPerS);
 }
 

@@ -258,9 +258,19 @@ TEST(MissionExecutor, SetCurrentAndAnEmptyMission) {
     Flight r;
     r.f.upload({r.f.wp(300.0f, 0.0f, 50.0f), r.f.wp(300.0f, 300.0f, 50.0f), r.f.wp(0.0f, 300.0f, 50.0f)});
     r.exec.start(r.s);
+    r.s.pos_m = ne(100.0f, 20.0f);
     EXPECT_TRUE(r.exec.set_current(3, r.s));
     EXPECT_EQ(r.exec.current_seq(), 3u);
     EXPECT_NEAR(r.exec.target().next_m.east_m, 300.0f, 0.02f);
+    // The leg from here (the plane turns to it), not from waypoint 1 it was flying to.
+    EXPECT_FLOAT_EQ(r.exec.target().prev_m.north_m, 100.0f);
+    EXPECT_FLOAT_EQ(r.exec.target().prev_m.east_m, 20.0f);
+    // AUTO entered with a seq: from it; another seq: from the first.
+    r.exec.start(r.s, 2);
+    EXPECT_EQ(r.exec.current_seq(), 2u);
+    r.exec.start(r.s, 9);
+    EXPECT_EQ(r.exec.current_seq(), 1u);
+    r.exec.set_current(3, r.s);
     EXPECT_FALSE(r.exec.set_current(0, r.s));
     EXPECT_FALSE(r.exec.set_current(4, r.s));
     EXPECT_EQ(r.exec.current_seq(), 3u);

@@ -8,7 +8,8 @@ Runs build/firmware.elf in `apm25sim --serial tcp:0 --speed 1 --eeprom FILE` on 
 scenario and counts messages by the board's own clock (their time_boot_ms) over WINDOW_S
 seconds after each request has settled:
   - before any request, the SR0_ defaults: RC_CHANNELS, SERVO_OUTPUT_RAW, SCALED_PRESSURE
-    5 Hz, SYS_STATUS 1 Hz, VFR_HUD 4 Hz, SYSTEM_TIME and HEARTBEAT 1 Hz, ATTITUDE 50 Hz;
+    5 Hz, SYS_STATUS 1 Hz, VFR_HUD 4 Hz, SYSTEM_TIME, MISSION_CURRENT and HEARTBEAT 1 Hz,
+    ATTITUDE 50 Hz;
   - PARAM_SET SR0_RAW_SENS 2: SCALED_PRESSURE at 2 Hz, answered by its PARAM_VALUE;
   - REQUEST_DATA_STREAM RC_CHANNELS (3) at 2 Hz: RC_CHANNELS and SERVO_OUTPUT_RAW at 2 Hz,
     SCALED_PRESSURE still 2; SR0_RC_CHAN read back 2; start_stop 0: neither sent;
@@ -39,15 +40,16 @@ from soft_assert import finish, soft_assert  # noqa: E402
 
 WINDOW_S = 4.0
 SETTLE_S = 1.0
-GROUPS = ("RC_CHANNELS", "SERVO_OUTPUT_RAW", "SCALED_PRESSURE", "SYS_STATUS", "VFR_HUD", "SYSTEM_TIME")
+GROUPS = ("RC_CHANNELS", "SERVO_OUTPUT_RAW", "SCALED_PRESSURE", "SYS_STATUS", "VFR_HUD", "SYSTEM_TIME",
+          "MISSION_CURRENT")
 COUNTED = GROUPS + ("ATTITUDE", "HEARTBEAT")
 
 # The link's cap (StreamRates.h): 75 % of 11520 B/s less HEARTBEAT's 21; the frames at their
 # longest, in the table's order: SCALED_PRESSURE, SYS_STATUS, GPS_RAW_INT, RC_CHANNELS,
 # SERVO_OUTPUT_RAW, GLOBAL_POSITION_INT, ATTITUDE, VFR_HUD, SYSTEM_TIME, BATTERY_STATUS,
 # NAV_CONTROLLER_OUTPUT (planned for whether or not a navigation mode flies: its bytes are
-# there when one starts).
-FRAME_BYTES = (28, 66, 64, 54, 33, 40, 40, 32, 24, 53, 38)
+# there when one starts), MISSION_CURRENT.
+FRAME_BYTES = (28, 66, 64, 54, 33, 40, 40, 32, 24, 53, 38, 18)
 BUDGET = 8640 - 21
 
 
@@ -146,7 +148,8 @@ def first_session(args, trajectory, eeprom):
         b.pump(lambda m: b.t_s > 2.0, "the estimator to start")
         r = rates(b, "the SR0_ defaults")
         for name, hz in (("RC_CHANNELS", 5), ("SERVO_OUTPUT_RAW", 5), ("SCALED_PRESSURE", 5), ("SYS_STATUS", 1),
-                         ("VFR_HUD", 4), ("SYSTEM_TIME", 1), ("HEARTBEAT", 1), ("ATTITUDE", 50)):
+                         ("VFR_HUD", 4), ("SYSTEM_TIME", 1), ("HEARTBEAT", 1), ("ATTITUDE", 50),
+                         ("MISSION_CURRENT", 1)):
             near(r[name], hz, "%s at the defaults" % name)
 
         b.conn.mav.param_set_send(1, 1, b"SR0_RAW_SENS", 2, mavlink2.MAV_PARAM_TYPE_UINT8)
