@@ -93,7 +93,7 @@ GROUP is one of:
   gps_loss_auto   the rectangle in AUTO, the GPS fix lost for 30 s (apm25sim --fault
                   gps:no-fix@45-75): the loss said once within 1.5 s ("# warn: GPS lost"), the
                   mode kept (no "# flight" line), from 3 s after the dead reckoning's 10 s to
-                  the return the TRUE bank within 5 deg of level, through the loss the height
+                  the fix's return the TRUE bank within 3 deg of level, through the loss the height
                   within 10 m of the route's (home + 10 m), every servo pulse within SERVO_MIN
                   .. SERVO_MAX; the return said once within 3 s of the fix's ("# GPS back"),
                   then a waypoint of the route passed within WP_RADIUS; no sample missed
@@ -1032,8 +1032,8 @@ def check_gps_loss_auto(args):
     t_said, t_again = lost[0][0], back[0][0]
     want_h = home[2] + RECT_ALT_M
     # Wings level from the dead reckoning's end (its 10 s from the loss's step, the roll-out
-    # from L1's bank given 3 s) to the return.
-    level = f.truth_between(t_said + GPS_DEAD_RECKONING_S + 3.0, t_again)
+    # from L1's bank given 3 s) to the fix's return (the route's bank comes with the line).
+    level = f.truth_between(t_said + GPS_DEAD_RECKONING_S + 3.0, t_back)
     bank = max((abs(r["roll_deg"]) for r in level), default=float("nan"))
     during = f.truth_between(t_lost, t_again + 5.0)
     heights = [-r["down_m"] - want_h for r in during]
@@ -1054,16 +1054,16 @@ def check_gps_loss_auto(args):
         if near:
             reached = (r["t"], near[0] + 1)
             break
-    print("gps_loss_auto: wings level from %.1f s to %.1f s: |true bank| <= %.1f deg; the height %+.1f to %+.1f m of "
+    print("gps_loss_auto: wings level from %.1f s to %.1f s: |true bank| <= %.2f deg; the height %+.1f to %+.1f m of "
           "home + %g m from the loss to 5 s after the return; the board's roll within %.1f deg of the truth through "
           "the loss; OUT1-4 %.0f-%.0f us; %.0f m flown from where the fix went (%.0f, %.0f) to where it came back "
-          "(%.0f, %.0f); then waypoint %s" % (t_said + GPS_DEAD_RECKONING_S + 3.0, t_again, bank, min(heights),
+          "(%.0f, %.0f); then waypoint %s" % (t_said + GPS_DEAD_RECKONING_S + 3.0, t_back, bank, min(heights),
                                                max(heights), RECT_ALT_M, roll_err, worst_pulse[0], worst_pulse[1],
                                                drift, r_lost["north_m"], r_lost["east_m"], r_again["north_m"],
                                                r_again["east_m"],
                                                "none" if reached is None else "%d passed within %g m %.1f s after "
                                                "the return" % (reached[1], WP_RADIUS_M, reached[0] - t_again)))
-    soft_assert(len(level) > 100 and bank <= 5.0, "gps_loss_auto: the true bank reached %.1f deg wings level" % bank)
+    soft_assert(len(level) > 100 and bank <= 3.0, "gps_loss_auto: the true bank reached %.1f deg wings level" % bank)
     soft_assert(heights and max(abs(h) for h in heights) <= 10.0,
                 "gps_loss_auto: the height left home + %g +- 10 m: %+.1f to %+.1f" % (RECT_ALT_M, min(heights),
                                                                                      max(heights)))
