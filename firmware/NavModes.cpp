@@ -7,6 +7,8 @@
 #include "AirspeedInput.h"
 #include "ArduinoCore.h"
 #include "Baro.h"
+#include "GcsLink.h"
+#include "GpsLoss.h"
 #include "GpsPort.h"
 #include "L1Control.h"
 #include "MissionExecutor.h"
@@ -15,6 +17,7 @@
 #include "NeVector.h"
 #include "NavParams.h"
 #include "Position.h"
+#include "SerialText.h"
 #include "Tecs.h"
 #include "Vehicle.h"
 
@@ -66,6 +69,8 @@ struct Pending {
 Pending pending;
 bool tecs_pending = false;
 mav::NavOutput last_report;
+nav::GpsLoss gps_loss;
+uint8_t gps_unsaid = 0;  // GpsLoss's events not said yet (waiting for room)
 
 const settings::Settings& cfg() { return pipe.settings(); }
 
@@ -112,6 +117,34 @@ bool takeoff(const mission::NavTarget& t, nav::TecsInput& in) {
     in.stage = nav::TecsStage::kTakeoff;
     in.takeoff_pitch_cd = t.takeoff_pitch_cd;
     return false;
+}
+
+// GPS loss in a GPS mode (docs/navigation.md "GPS loss"): pos_m and vel, the navigator's,
+// become what to fly (dead reckoning); true when there is none left (wings level).
+__attribute__((noinline)) bool gps_loss_step(nav::NorthEast& pos_m, nav::NorthEast& vel,
+                                             const pipeline::AnglesCentideg& att, float dt_s, uint32_t now_ms) {
+    const gps::Fix& f = gps_port::fix();
+    // Fresh: the navigator moves a fix on for at most as long.
+    const bool fix_ok = f.fix == gps::FixType::k3D && now_ms - f.received_ms <= nav::Navigator::kMaxExtrapolation_ms;
+    const nav::WindEstimator& w = position::wind();  // learnt with the pitot only
+    gps_unsaid = (uint8_t)(gps_unsaid | gps_loss.step(fix_ok, pos_m, vel, (uint16_t)att.heading_centideg,
+                                                      w.valid() ? &w.wind_m_s() : nullptr, dt_s, (uint16_t)now_ms));
+    return gps_loss.wings_level();
+}
+
+// Its lines, once each, in a loop pass of their own when the output has room (two
+// STATUSTEXT frames and an output line: a write into a full queue would wait for the UART).
+bool say_gps_loss() {
+    if (gps_unsaid == 0u || serial_text::room() < 2u * mav::kMaxFrame + gcs_link::output_line_bytes()) return false;
+    text::Writer w(vehicle::out);
+    if (gps_unsaid & nav::GpsLoss::kLost) {
+        gps_unsaid = (uint8_t)(gps_unsaid & ~nav::GpsLoss::kLost);
+        w.str(TXT(TXT_WARN "GPS lost: dead reckoning, then wings level")).end();
+    } else {
+        gps_unsaid = 0;
+        w.str(TXT("# GPS back: on the route again")).end();
+    }
+    return true;
 }
 
 }  // namespace
@@ -163,6 +196,7 @@ static void run_tecs();
 
 void run() {
     if (tecs_pending) return run_tecs();
+    if (say_gps_loss()) return;  // the step on the next pass
     const uint32_t now_ms = millis();
     // At most 0.5 s: FBWB's stick moves the height by it (the task runs every 100 ms in any
     // mode, so only a stalled loop comes near).
@@ -177,7 +211,15 @@ void run() {
         return;
     }
     const nav::Navigator& n = position::navigator();
-    const mission::NavState st = state_now(now_ms);
+    mission::NavState st = state_now(now_ms);
+    nav::NorthEast vel = n.ground_velocity_m_s();
+    const pipeline::AnglesCentideg att = pipe.angles_centideg();
+    const float pitch_rad = (float)att.pitch_centideg * (1.0f / kCdPerRad);
+    const float cos_pitch = 1.0f - 0.5f * pitch_rad * pitch_rad;  // within 0.5 % to 25 degrees
+    // The GPS lost: the dead reckoning's position, or none (wings level).
+    bool no_position = false;
+    if (gps_mode(m)) no_position = gps_loss_step(st.pos_m, vel, att, dt_s, now_ms);
+    else gps_loss.reset();
     // A mission uploaded while AUTO flies: flown from its start (the commands the executor
     // holds may be gone).
     // Home's arrival under CIRCLE or FBWB moves the heights' datum: the mode entered again
@@ -188,17 +230,16 @@ void run() {
     flying = m;
     const flight::FlightSettings& fs = cfg().flight;
     const settings::NavSettings& ns = cfg().vehicle.nav;
-    const nav::NorthEast vel = n.ground_velocity_m_s();
-    const pipeline::AnglesCentideg att = pipe.angles_centideg();
-    const float pitch_rad = (float)att.pitch_centideg * (1.0f / kCdPerRad);
-    const float cos_pitch = 1.0f - 0.5f * pitch_rad * pitch_rad;  // within 0.5 % to 25 degrees
     int16_t roll_cd = 0;
     nav::TecsInput& in = pending.in;
     in = nav::TecsInput{};
     in.eas_dem_m_s = fs.trim_arspd_cm != 0u ? (float)fs.trim_arspd_cm * 0.01f
                                             : 0.5f * (float)(fs.arspd_min_m_s + fs.arspd_max_m_s);
-    bool guided = true;  // L1 gives the bank
-    switch (m) {
+    // No position (the GPS lost past its dead reckoning): the wings level and the height
+    // held, the mode kept; CRUISE flies as FBWB.
+    const bool wings_level = no_position && m != flight::Mode::Cruise;
+    bool guided = !wings_level;  // L1 gives the bank
+    if (!wings_level) switch (m) {
         case flight::Mode::Circle:
             // ArduPlane's CIRCLE: a third of the bank limit, the height held.
             roll_cd = (int16_t)(fs.lim_roll_cd / 3);
@@ -234,7 +275,7 @@ void run() {
             // CRUISE: the roll stick centred locks the track along the course flown
             // (ArduPlane's update_cruise, from 0.5 m/s ground speed); moved, it banks.
             const float speed_sq = nav::length_squared(vel);
-            if (m == flight::Mode::Cruise && roll_stick == 0 && (cruise_locked || speed_sq > 0.25f)) {
+            if (m == flight::Mode::Cruise && roll_stick == 0 && !no_position && (cruise_locked || speed_sq > 0.25f)) {
                 if (!cruise_locked) {
                     centre_m = st.pos_m;
                     cruise_end_m = st.pos_m + vel * (kCruiseAhead_m / sqrtf(speed_sq));

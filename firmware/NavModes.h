@@ -15,8 +15,9 @@
 // Two loop tasks: the navigation step at 10 Hz (the target into L1 and TECS; their bank,
 // pitch and throttle to FlightIo's controllers) and TECS's filters at 50 Hz. A mode that
 // cannot run (a GPS mode without a 3D fix or home, AUTO without a mission) is refused
-// with its reason, from the switch, the ground station and the console. The attitude-only
-// build has none of it.
+// with its reason, from the switch, the ground station and the console; a GPS mode that
+// loses its fix dead-reckons for 10 s, then holds the wings level until it returns, the
+// mode kept (lib/Nav/GpsLoss). The attitude-only build has none of it.
 #pragma once
 
 #include <stdint.h>

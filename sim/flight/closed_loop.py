@@ -8,7 +8,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
-        [--gps ublox|nmea|none] [--gps-fix-after S] [--arm] [--launch V,H,PITCH]
+        [--gps ublox|nmea|none] [--gps-fix-after S] [--arm] [--launch V,H,PITCH] [--fault SPEC ...]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -30,6 +30,8 @@ throttle at its minimum until armed): the stick script's throttle at zero until 
 (2 s) and `arm` typed into the board (apm25sim --input: at its first angle line, ~1.4 s,
 after any --input lines). --launch V,H,PITCH is the backend's hand launch: held --hold s at H m,
 PITCH deg nose up, then thrown at V m/s.
+--fault SPEC goes to apm25sim as it is (its --help lists the
+faults: gps:no-fix@45-75 loses the fix for 30 s).
 Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
@@ -121,6 +123,7 @@ def parse_args(argv):
                    help="the backend's hand launch: held at H m, PITCH deg nose up, thrown at V m/s after --hold")
     p.add_argument("--mission", help="apm25sim --mission: a QGC WPL 110 file into the EEPROM before the run")
     p.add_argument("--profile", help="apm25sim --profile: the sections' cycle counts")
+    p.add_argument("--fault", action="append", default=[], metavar="SPEC", help="apm25sim --fault SPEC (repeatable)")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
     p.add_argument("--serial", metavar="tcp:PORT",
@@ -228,6 +231,8 @@ def run(args):
             sim_cmd += ["--mission", args.mission]
         if args.profile:
             sim_cmd += ["--profile", args.profile]
+        for spec in args.fault:
+            sim_cmd += ["--fault", spec]
         sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)
 
         def watchdog():

@@ -122,9 +122,17 @@ GROUP is one of:
                   height within ALT_HOLD_RTL (100 m) +- 3 m; the gusts' spread about them
                   (seeds 1 and 47047: 59.5-65.1 m, -5.1..+3.1 m) within +- 8 m and +- 6 m;
                   AUTO said after home, before the throw; no sample missed
+  gps_loss_auto   the rectangle in AUTO, the GPS fix lost for 30 s (apm25sim --fault
+                  gps:no-fix@45-75): the loss said once within 1.5 s ("# warn: GPS lost"), the
+                  mode kept (no "# flight" line), from 3 s after the dead reckoning's 10 s to
+                  the fix's return the TRUE bank within 3 deg of level, through the loss the height
+                  within 10 m of the route's (home + 10 m), every servo pulse within SERVO_MIN
+                  .. SERVO_MAX; the return said once within 3 s of the fix's ("# GPS back"),
+                  then a waypoint of the route passed within WP_RADIUS; no sample missed
 Exit 1 with the reasons on any failure. The figures are printed on stdout.
 """
 import argparse
+import bisect
 import csv
 import math
 import os
@@ -187,11 +195,13 @@ class Flight:
     """One closed-loop flight's files, read back."""
 
     def __init__(self, work, name, rows, seconds, gust=0, upsets=(), tools=None, seed=1, airspeed=True,
-                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True, mission=None, wind=None):
+                 console=(), hold=HOLD_S, airframe="plain", gps=None, arm=True, mission=None, wind=None,
+                 faults=()):
         """airspeed False: the backend sends none (no pitot); console: lines typed into the
         board (apm25sim --input: from its first angle line); airframe: how the backend reads
         the outputs (closed_loop.py --airframe: plain, elevons, vtail); gps: apm25sim --gps
-        (None: its default); arm: closed_loop.py --arm (armed on the stand)."""
+        (None: its default); arm: closed_loop.py --arm (armed on the stand); faults: apm25sim
+        --fault SPECs."""
         self.name, self.seconds = name, seconds
         base = os.path.join(work, name)
         self.rc = write_rc(base + "_rc.csv", rows)
@@ -215,6 +225,8 @@ class Flight:
             cmd += ["--mission", mission]
         if wind:
             cmd += ["--wind", wind]
+        for spec in faults:
+            cmd += ["--fault", spec]
         if console:
             with open(base + "_console.txt", "w") as f:
                 f.write("".join(line + "\n" for line in console))
@@ -1020,6 +1032,79 @@ def check_rc_loss_auto(args):
                 % (d_rtl, d_later))
 
 
+GPS_DEAD_RECKONING_S = 10.0  # lib/Nav/GpsLoss.h kDeadReckoning_ms
+SERVO_MIN_US, SERVO_MAX_US = 1000, 2000  # SERVOn_MIN / _MAX's defaults
+
+
+def check_gps_loss_auto(args):
+    t_auto, t_lost, t_back, seconds = 10.0, 45.0, 75.0, 140.0
+    mission = write_rectangle(os.path.join(args.work, "gps_loss_auto.waypoints"))
+    rows = [row(0.0), row(t_auto, mode=RTL_SWITCH)]
+    f = Flight(args.work, "gps_loss_auto", rows, seconds, tools=args.tools, gps="ublox", mission=mission,
+               faults=["gps:no-fix@%g-%g" % (t_lost, t_back)],
+               console=["set FLTMODE5 10", "set TRIM_THROTTLE 11", "set TRIM_ARSPD_CM %d" % TRIM_ARSPD_CM])
+    entered = f.said("# flight AUTO")
+    lost = [(t, x) for t, x in f.lines if x.startswith("# warn: GPS lost")]
+    back = [(t, x) for t, x in f.lines if x.startswith("# GPS back")]
+    changed = f.said("# flight ", after=(entered[0] + 0.1) if entered else t_auto)
+    print("gps_loss_auto: AUTO %r; the fix lost at %g s: said %r; back at %g s: said %r; a mode change after: %r"
+          % (entered, t_lost, lost, t_back, back, changed))
+    soft_assert(entered is not None and entered[0] < t_lost, "gps_loss_auto: AUTO not flown: %r" % (entered,))
+    soft_assert(len(lost) == 1 and t_lost <= lost[0][0] <= t_lost + 1.5,
+                "gps_loss_auto: the loss not said once within 1.5 s: %r" % lost)
+    soft_assert(len(back) == 1 and t_back <= back[0][0] <= t_back + 3.0,
+                "gps_loss_auto: the return not said once within 3 s: %r" % back)
+    soft_assert(changed is None, "gps_loss_auto: the mode changed: %r" % (changed,))
+    overrun = f.said("# warn: loop overrun")
+    soft_assert(overrun is None, "gps_loss_auto: %r" % (overrun,))
+    home = said_home(f)
+    if home is None or len(lost) != 1 or len(back) != 1:
+        soft_assert(False, "gps_loss_auto: no home, or the loss and return not said")
+        return
+    t_said, t_again = lost[0][0], back[0][0]
+    want_h = home[2] + RECT_ALT_M
+    # Wings level from the dead reckoning's end (its 10 s from the loss's step, the roll-out
+    # from L1's bank given 3 s) to the fix's return (the route's bank comes with the line).
+    level = f.truth_between(t_said + GPS_DEAD_RECKONING_S + 3.0, t_back)
+    bank = max((abs(r["roll_deg"]) for r in level), default=float("nan"))
+    during = f.truth_between(t_lost, t_again + 5.0)
+    heights = [-r["down_m"] - want_h for r in during]
+    # The board's roll against the truth through the loss (the estimator without the GPS's
+    # acceleration after its time-out: docs/position.md).
+    times = [r["t"] for r in f.truth]
+    roll_err = max((abs(angle_diff(roll, f.truth[max(bisect.bisect_right(times, t) - 1, 0)]["roll_deg"]))
+                    for t, roll, _, _ in f.estimates() if t_lost <= t < t_again), default=float("nan"))
+    pulses = [(t, out, w) for t, out, w in f.pulses if out <= 4 and t >= t_auto]
+    worst_pulse = (min(w for _, _, w in pulses), max(w for _, _, w in pulses)) if pulses else (float("nan"),) * 2
+    r_lost, r_again = f.truth_at(t_said), f.truth_at(t_again)
+    drift = math.hypot(r_again["north_m"] - r_lost["north_m"], r_again["east_m"] - r_lost["east_m"])
+    # The route again: the first waypoint passed within WP_RADIUS after the return.
+    after = f.truth_between(t_again, seconds)
+    reached = None
+    for r in after:
+        near = [i for i, w in enumerate(RECT) if math.hypot(r["north_m"] - w[0], r["east_m"] - w[1]) <= WP_RADIUS_M]
+        if near:
+            reached = (r["t"], near[0] + 1)
+            break
+    print("gps_loss_auto: wings level from %.1f s to %.1f s: |true bank| <= %.2f deg; the height %+.1f to %+.1f m of "
+          "home + %g m from the loss to 5 s after the return; the board's roll within %.1f deg of the truth through "
+          "the loss; OUT1-4 %.0f-%.0f us; %.0f m flown from where the fix went (%.0f, %.0f) to where it came back "
+          "(%.0f, %.0f); then waypoint %s" % (t_said + GPS_DEAD_RECKONING_S + 3.0, t_back, bank, min(heights),
+                                               max(heights), RECT_ALT_M, roll_err, worst_pulse[0], worst_pulse[1],
+                                               drift, r_lost["north_m"], r_lost["east_m"], r_again["north_m"],
+                                               r_again["east_m"],
+                                               "none" if reached is None else "%d passed within %g m %.1f s after "
+                                               "the return" % (reached[1], WP_RADIUS_M, reached[0] - t_again)))
+    soft_assert(len(level) > 100 and bank <= 3.0, "gps_loss_auto: the true bank reached %.1f deg wings level" % bank)
+    soft_assert(heights and max(abs(h) for h in heights) <= 10.0,
+                "gps_loss_auto: the height left home + %g +- 10 m: %+.1f to %+.1f" % (RECT_ALT_M, min(heights),
+                                                                                     max(heights)))
+    soft_assert(pulses and SERVO_MIN_US - FOLLOW_US <= worst_pulse[0] and worst_pulse[1] <= SERVO_MAX_US + FOLLOW_US,
+                "gps_loss_auto: a pulse out of %d-%d us: %.1f-%.1f" % (SERVO_MIN_US, SERVO_MAX_US, worst_pulse[0],
+                                                                        worst_pulse[1]))
+    soft_assert(reached is not None, "gps_loss_auto: no waypoint reached after the return")
+
+
 def check_auto_wind(args):
     """5 m/s from the west (across the long legs) with light gusts, a fresh seed."""
     fly_auto(args, "auto_wind", 5.0, gust=1, seed=47001, wind="0,5")
@@ -1068,7 +1153,8 @@ def check_mission(args):
                     "mission: the circle's height %+.1f to %+.1f m of ALT_HOLD_RTL (+- 6 in gusts)" % c["height"][:2])
 
 
-GROUPS = {"mission": check_mission, "rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "rc_loss_auto": check_rc_loss_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
+GROUPS = {"mission": check_mission, "rtl": check_rtl, "auto": check_auto, "auto_wind": check_auto_wind, "rc_loss_auto": check_rc_loss_auto,
+          "gps_loss_auto": check_gps_loss_auto, "manual_circuit": check_manual_circuit, "manual_upset": check_manual_upset, "stabilize": check_stabilize,
           "rc_loss": check_rc_loss, "turn": check_turn, "turn_cruise": check_turn_cruise,
           "determinism": check_determinism, "turn45_default": check_turn45_default,
           "rc_loss_turn": check_rc_loss_turn, "pitch_trim": check_pitch_trim, "climb_pitch": check_climb_pitch,
