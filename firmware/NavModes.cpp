@@ -68,7 +68,9 @@ struct Pending {
 };
 Pending pending;
 bool tecs_pending = false;
-mav::NavOutput last_report;
+mav::NavOutput last_report;      // NAV_CONTROLLER_OUTPUT's fields but L1's (report())
+bool report_guided = false;      // ... L1 gave the bank: its fields; else the heading's
+int16_t report_heading_deg = 0;
 nav::GpsLoss gps_loss;
 uint8_t gps_unsaid = 0;  // GpsLoss's events not said yet (waiting for room)
 
@@ -315,31 +317,35 @@ static void run_tecs() {
     const bool guided = pending.guided;
     flight_io.set_nav_demands(roll_cd, tecs.pitch_dem_cd(), (int16_t)(tecs.throttle_pct() * 10u));
 
-    // NAV_CONTROLLER_OUTPUT's fields (ArduPlane's: bearings in degrees, 0..360 as int16).
+    // NAV_CONTROLLER_OUTPUT's fields; L1's when the report is asked for (report()).
     mav::NavOutput& rep = last_report;
     rep.nav_roll_deg = (float)roll_cd * 0.01f;
     rep.nav_pitch_deg = (float)tecs.pitch_dem_cd() * 0.01f;
-    if (guided) {
-        const float to_deg = 57.29578f;
-        int16_t nb = (int16_t)(l1.nav_bearing_rad() * to_deg);
-        int16_t tb = (int16_t)(l1.target_bearing_rad() * to_deg);
-        rep.nav_bearing_deg = nb < 0 ? (int16_t)(nb + 360) : nb;
-        rep.target_bearing_deg = tb < 0 ? (int16_t)(tb + 360) : tb;
-        const float d = nav::length(l1.to_target_m());
-        rep.wp_dist_m = d < 65535.0f ? (uint16_t)d : 65535u;
-        rep.xtrack_error_m = l1.crosstrack_error_m();
-    } else {
-        rep.nav_bearing_deg = rep.target_bearing_deg = pending.heading_deg;
-        rep.wp_dist_m = 0;
-        rep.xtrack_error_m = 0.0f;
-    }
     rep.alt_error_m = tecs.height_dem_adj_m() - tecs.height_m();
+    report_guided = guided;
+    report_heading_deg = pending.heading_deg;
     have_report = true;
 }
 
 bool report(mav::NavOutput& r) {
     if (!have_report) return false;
     r = last_report;
+    // ArduPlane's: bearings in degrees, 0..360 as int16; from L1's last step, worked out at
+    // the report's rate (1 Hz), not at each 10 Hz step: two atan2 and a square root.
+    if (report_guided) {
+        const float to_deg = 57.29578f;
+        int16_t nb = (int16_t)(l1.nav_bearing_rad() * to_deg);
+        int16_t tb = (int16_t)(l1.target_bearing_rad() * to_deg);
+        r.nav_bearing_deg = nb < 0 ? (int16_t)(nb + 360) : nb;
+        r.target_bearing_deg = tb < 0 ? (int16_t)(tb + 360) : tb;
+        const float d = nav::length(l1.to_target_m());
+        r.wp_dist_m = d < 65535.0f ? (uint16_t)d : 65535u;
+        r.xtrack_error_m = l1.crosstrack_error_m();
+    } else {
+        r.nav_bearing_deg = r.target_bearing_deg = report_heading_deg;
+        r.wp_dist_m = 0;
+        r.xtrack_error_m = 0.0f;
+    }
     return true;
 }
 

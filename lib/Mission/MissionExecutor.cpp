@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MissionExecutor.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "Constants.h"
 #include "LinAlg.h"
 #include "NeVector.h"
@@ -26,12 +29,32 @@ int16_t* MissionExecutor::jump_runs(uint8_t index) {
     return &free_slot->runs;
 }
 
+bool MissionExecutor::read(uint8_t index, Command& c) {
+    if (store_.sequence() != cache_sequence_ || store_.current_area() != cache_area_) {
+        cache_[0].index = cache_[1].index = kNone;  // another mission: nothing kept holds
+        cache_sequence_ = store_.sequence();
+        cache_area_ = store_.current_area();
+    }
+    for (const Cached& e : cache_) {
+        if (e.index == index) {
+            c = e.command;
+            return true;
+        }
+    }
+    if (!store_.read(index, c)) return false;
+    Cached& e = cache_[cache_next_];
+    e.index = index;
+    e.command = c;
+    cache_next_ ^= 1u;
+    return true;
+}
+
 uint8_t MissionExecutor::walk(uint8_t from, Walk mode, Command& c) {
     uint8_t i = from;
     // Each command is passed at most twice without a navigation command between: a loop
     // of DO_JUMPs only is the end (AP_Mission's endless-loop check).
     for (uint16_t guard = 0; guard < 2u * kMaxCommands + 2u; ++guard) {
-        if (!store_.read(i, c)) return kNone;
+        if (!read(i, c)) return kNone;
         if (is_nav(c.id)) return i;
         if (c.id == kDoJump) {
             const uint16_t target_seq = c.p1;
@@ -84,14 +107,12 @@ void MissionExecutor::advance(uint8_t from, const NavState& s) {
         return_home(s);
         return;
     }
-    const uint8_t after = start_nav(next, nav, s);
+    start_nav(next, nav, s);
     // The DO_ commands after it act now (AP_Mission's do commands of this leg), up to the
-    // next navigation command or DO_JUMP: none when the next command is the navigation
-    // command start_nav found.
-    if (after == (uint8_t)(next + 1u)) return;
+    // next navigation command or DO_JUMP (the first read the last look-ahead's, cached).
     for (uint8_t i = (uint8_t)(next + 1u); i < store_.count(); ++i) {
         Command c;
-        if (!store_.read(i, c) || is_nav(c.id) || c.id == kDoJump) break;
+        if (!read(i, c) || is_nav(c.id) || c.id == kDoJump) break;
         apply_do(c);
     }
 }
@@ -104,12 +125,24 @@ void MissionExecutor::apply_do(const Command& c) {
     if (c.lon_e7 > 0 && c.lon_e7 <= 100) throttle_pct_ = (int8_t)c.lon_e7;
 }
 
-nav::NorthEast MissionExecutor::place_m(const Command& c, const NavState& s) const {
+nav::NorthEast MissionExecutor::place_m(const Command& c, const NavState& s) {
     if (!c.has_place()) return s.pos_m;
+    const float north = map_.north_m_per_e7();
+    const float east = map_.east_m_per_e7();
+    Placed key;
+    key.lat_e7 = c.lat_e7;
+    key.lon_e7 = c.lon_e7;
+    key.home_lat_e7 = home_.lat_e7;
+    key.home_lon_e7 = home_.lon_e7;
+    memcpy(&key.north_bits, &north, sizeof north);
+    memcpy(&key.east_bits, &east, sizeof east);
+    if (memcmp(&key, &placed_, offsetof(Placed, m)) == 0) return placed_.m;
     nav::Location l;
     l.lat_e7 = c.lat_e7;
     l.lon_e7 = c.lon_e7;
-    return map_.offset_m(home_, l);
+    key.m = map_.offset_m(home_, l);
+    placed_ = key;
+    return key.m;
 }
 
 float MissionExecutor::height_of(const Command& c) const {
@@ -162,18 +195,26 @@ void MissionExecutor::guide_to(const Command* to, const NavState& s) {
 
 void MissionExecutor::loiter_default(const nav::NorthEast& centre, float height_m, const NavState& s) {
     if (!complete_) index_ = kNone;
+    ahead_ = kAheadDone;
+    ahead_index_ = kNone;
     const int16_t r = params_.loiter_radius_m;
     loiter_at(centre, height_m, (float)(r < 0 ? -r : r), r < 0 ? (int8_t)-1 : (int8_t)1, s);
     setup_slope(s, false);
     leg_started();
 }
 
-uint8_t MissionExecutor::start_nav(uint8_t index, const Command& c, const NavState& s) {
-    uint8_t after = kNone;
+void MissionExecutor::start_nav(uint8_t index, const Command& c, const NavState& s) {
     const bool after_waypoint = target_.kind == TargetKind::kWaypoint && index_ != kNone;
     const nav::NorthEast last_next = target_.next_m;
     index_ = index;
     command_ = c;
+    // The turn at a waypoint, for the turn distance, is the look-ahead's (to the next
+    // navigation command's place; beyond 90 degrees the turn distance is whole: 90 until
+    // then).
+    turn_angle_deg_ = 90.0f;
+    turn_pending_ = false;
+    ahead_ = kAheadTurn;
+    ahead_index_ = kNone;
     const int16_t wp_loiter = params_.loiter_radius_m;
     const float default_radius = (float)(wp_loiter < 0 ? -wp_loiter : wp_loiter);
     const int8_t dir = c.loiter_ccw ? (int8_t)-1 : (int8_t)1;
@@ -183,22 +224,6 @@ uint8_t MissionExecutor::start_nav(uint8_t index, const Command& c, const NavSta
         target_.prev_m = after_waypoint ? last_next : s.pos_m;
         target_.next_m = place_m(c, s);
         target_.height_m = height_of(c);
-        // The turn at its end, for the turn distance: to the next navigation command's place.
-        // Beyond 90 degrees it leaves the turn distance whole: no angle needed.
-        turn_angle_deg_ = 90.0f;
-        turn_pending_ = false;
-        Command n;
-        after = walk((uint8_t)(index + 1u), kPeek, n);
-        if (after != kNone && n.has_place() && n.id != kNavTakeoff) {
-            const nav::NorthEast leg = target_.next_m - target_.prev_m;
-            nav::Location l;
-            l.lat_e7 = n.lat_e7;
-            l.lon_e7 = n.lon_e7;
-            const nav::NorthEast next_leg = map_.offset_m(home_, l) - target_.next_m;
-            turn_cross_ = nav::cross(leg, next_leg);
-            turn_dot_ = nav::dot(leg, next_leg);
-            turn_pending_ = turn_dot_ >= 0.0f;
-        }
         break;
     }
     case kNavLoiterUnlim:
@@ -233,7 +258,37 @@ uint8_t MissionExecutor::start_nav(uint8_t index, const Command& c, const NavSta
         setup_slope(s, true);
     }
     leg_started();
-    return after;
+}
+
+void MissionExecutor::look_at_turn() {
+    Command n;
+    ahead_index_ = walk((uint8_t)(index_ + 1u), kPeek, n);
+    ahead_ = kAheadFollower;
+    if (command_.id != kNavWaypoint || ahead_index_ == kNone || !n.has_place() || n.id == kNavTakeoff) return;
+    // The turn's sine and cosine times the two legs' lengths; its angle once within the
+    // whole turn distance (verify), and only for a turn under 90 degrees.
+    const nav::NorthEast next_leg = place_m(n, NavState()) - target_.next_m;
+    turn_cross_ = nav::cross(leg_m_, next_leg);
+    turn_dot_ = nav::dot(leg_m_, next_leg);
+    turn_pending_ = turn_dot_ >= 0.0f;
+}
+
+void MissionExecutor::look_ahead() {
+    switch (ahead_) {
+    case kAheadTurn:
+        look_at_turn();
+        break;
+    case kAheadFollower: {
+        // The command after the next navigation command: the first the DO_ loop reads when
+        // that one starts (advance), and the next look-ahead's.
+        Command c;
+        if (ahead_index_ != kNone) read((uint8_t)(ahead_index_ + 1u), c);
+        ahead_ = kAheadDone;
+        break;
+    }
+    default:
+        break;
+    }
 }
 
 float MissionExecutor::height_demand_m(const NavState& s) const {
@@ -270,6 +325,7 @@ bool MissionExecutor::verify(const NavState& s, const nav::L1Control& l1) {
         // turn's angle is needed only within it, and taken there once.
         const float whole = l1.turn_distance_m(params_.wp_radius_m);
         if (dist2 <= whole * whole) {
+            if (ahead_ < kAheadFollower) look_at_turn();  // a leg too short for the look-ahead
             if (turn_pending_) {
                 const float cr = turn_cross_ < 0.0f ? -turn_cross_ : turn_cross_;
                 turn_angle_deg_ = linalg::fast_atan2(cr, turn_dot_) * linalg::kDegPerRad;
@@ -298,7 +354,11 @@ bool MissionExecutor::verify(const NavState& s, const nav::L1Control& l1) {
 
 void MissionExecutor::update(const NavState& s, const nav::L1Control& l1) {
     if (complete_ || index_ == kNone) return;
-    if (!verify(s, l1)) return;
+    const uint8_t ahead = ahead_;
+    if (!verify(s, l1)) {
+        if (ahead_ == ahead) look_ahead();  // one piece a step: none when verify looked
+        return;
+    }
     reached_seq_ = current_seq();
     ++reached_count_;
     advance((uint8_t)(index_ + 1u), s);

@@ -21,6 +21,10 @@
 // - The end of the mission (no navigation command left): loiter at home at ALT_HOLD_RTL,
 //   as ArduPlane 3.x's exit_mission_callback (a LOITER_UNLIM at home; later ArduPlanes
 //   switch to RTL, which flies the same); complete() says so. return_home() is RTL mode's.
+// - The look-ahead: what the step that reaches a waypoint needs (the next navigation
+//   command, its place, the turn to it, the command after it) is found a piece a step
+//   before (look_ahead()) and kept (the last two commands read, the last place worked
+//   out), so that step reads no EEPROM and maps no place.
 // - The height: ArduPlane's glide slope. When a command starts, a change of height of
 //   GLIDE_SLOPE_MIN or more is spread along the leg (in AUTO above 20 m or descending; in
 //   RTL descending only); a smaller one is asked for at once (TECS limits its rate).
@@ -114,11 +118,18 @@ private:
     // The index of the navigation command reached from `from` (kNone: the end), and the
     // command itself in `nav` (read once: a read is 14 EEPROM bytes unpacked).
     uint8_t walk(uint8_t from, Walk mode, Command& nav);
+    // store_.read through the cache of the last two commands read (a read is 14 EEPROM
+    // bytes unpacked): the look-ahead reads the commands a leg's end needs, so that the
+    // step that reaches the waypoint finds them here.
+    bool read(uint8_t index, Command& c);
     void advance(uint8_t from, const NavState& s);
     void apply_do(const Command& c);
-    // Returns the index of the navigation command after it when it looked (a waypoint's
-    // turn), else kNone.
-    uint8_t start_nav(uint8_t index, const Command& c, const NavState& s);
+    void start_nav(uint8_t index, const Command& c, const NavState& s);
+    // The look-ahead, a piece a step from the step after the one that started the command:
+    // the navigation command after this one and the turn to it, then the command after
+    // that into the cache (the DO_ commands' first read when it starts).
+    void look_ahead();
+    void look_at_turn();
     void loiter_at(const nav::NorthEast& centre, float height_m, float radius_m, int8_t direction,
                    const NavState& s);
     // RTL's and GUIDED's circle: WP_LOITER_RAD about centre, out of the mission.
@@ -129,7 +140,7 @@ private:
     bool verify(const NavState& s, const nav::L1Control& l1);
     bool loiter_progress(const NavState& s, const nav::L1Control& l1);
     int16_t* jump_runs(uint8_t index);
-    nav::NorthEast place_m(const Command& c, const NavState& s) const;
+    nav::NorthEast place_m(const Command& c, const NavState& s);
     float height_of(const Command& c) const;
     float rtl_height_m(const NavState& s) const;
 
@@ -155,6 +166,30 @@ private:
     float turn_cross_ = 0.0f;
     float turn_dot_ = 0.0f;
     bool turn_pending_ = false;
+    // The look-ahead's progress for the command flying (Ahead), and what it found: the
+    // index of the navigation command after it (kNone: the end, or not looked yet).
+    enum Ahead : uint8_t { kAheadTurn, kAheadFollower, kAheadDone };
+    uint8_t ahead_ = kAheadDone;
+    uint8_t ahead_index_ = kNone;
+    // The commands cache: the last two read, of the store's mission cache_sequence_ in
+    // cache_area_ (a commit changes both); cache_next_ the one to replace.
+    struct Cached {
+        uint8_t index;
+        Command command;
+    };
+    Cached cache_[2] = {{kNone, Command()}, {kNone, Command()}};
+    uint16_t cache_sequence_ = 0;
+    uint8_t cache_area_ = 0xFF;
+    uint8_t cache_next_ = 0;
+    // The last place worked out (a command's latitude and longitude to metres: ~1 000
+    // cycles), with what it came from: the look-ahead's, used again when that command
+    // starts. The map's scales as bits (a float's == is a call).
+    struct Placed {
+        int32_t lat_e7, lon_e7, home_lat_e7, home_lon_e7;
+        uint32_t north_bits, east_bits;
+        nav::NorthEast m;
+    };
+    Placed placed_ = {0, 0, 0, 0, 0u, 0u, {0.0f, 0.0f}};
     uint32_t loiter_start_ms_ = 0;
     uint16_t airspeed_cm_s_ = 0;
     uint16_t reached_seq_ = 0;

@@ -93,9 +93,10 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
         if (to_next_len > 1e-3f) {
             ab_unit = to_target_m_ * (1.0f / to_next_len);
         } else {
-            ab_unit = vg > kMinGroundSpeed_m_s ? vel_m_s * (1.0f / vg) : nav_dir_;
+            ab_unit = vg > kMinGroundSpeed_m_s ? vel_m_s * (1.0f / vg) : nav_direction();
         }
     }
+    nav_turned_ = false;
     // Below 0.1 m/s the velocity's direction means nothing: the track's at 0.1 m/s
     // (ArduPilot takes the compass heading there).
     NorthEast vel = vel_m_s;
@@ -138,7 +139,11 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
         const float cos1 = linalg::safe_sqrt(1.0f - sin1 * sin1);
         sin_eta = sin1 * cos2 + cos1 * sin2;
         cos_eta = cos1 * cos2 - sin1 * sin2;
-        nav_dir_ = rotated(ab_unit, cos1, sin1);
+        // Towards the L1 point: the track turned by eta1 (for telemetry: when asked for).
+        nav_dir_ = ab_unit;
+        nav_cos1_ = cos1;
+        nav_sin1_ = sin1;
+        nav_turned_ = true;
     }
     // Beyond 90 deg eta has eta2's sign (|eta1| <= 45 deg), the sign of the cross product.
     const float s = limited_sin_eta(sin_eta, cos_eta, xvel >= 0.0f, vel, vg);
@@ -148,6 +153,7 @@ void L1Control::update_waypoint(const NorthEast& pos_m, const NorthEast& vel_m_s
 void L1Control::update_loiter(const NorthEast& pos_m, const NorthEast& vel_m_s, const NorthEast& centre_m,
                               float radius_m, int8_t direction) {
     refresh_coefficients();
+    nav_turned_ = false;
     const float dir = direction < 0 ? -1.0f : 1.0f;
 
     const float speed = length(vel_m_s);
@@ -203,7 +209,11 @@ int16_t L1Control::nav_roll_cd(int16_t lim_roll_cd, float cos_pitch) const {
     return (int16_t)linalg::constrain(bank_cd, -lim, lim);
 }
 
-float L1Control::nav_bearing_rad() const { return bearing_rad(nav_dir_); }
+NorthEast L1Control::nav_direction() const {
+    return nav_turned_ ? rotated(nav_dir_, nav_cos1_, nav_sin1_) : nav_dir_;
+}
+
+float L1Control::nav_bearing_rad() const { return bearing_rad(nav_direction()); }
 float L1Control::target_bearing_rad() const { return bearing_rad(to_target_m_); }
 
 float L1Control::turn_distance_m(float wp_radius_m) const { return wp_radius_m < l1_m_ ? wp_radius_m : l1_m_; }

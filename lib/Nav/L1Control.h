@@ -71,9 +71,10 @@ public:
     int16_t nav_roll_cd(int16_t lim_roll_cd, float cos_pitch = 1.0f) const;
     // Metres off the track (positive left of it); on a loiter, the distance outside the circle.
     float crosstrack_error_m() const { return crosstrack_m_; }
-    // Towards the L1 point (nav_bearing; a unit vector), and the metres to the waypoint or
-    // the loiter's centre (target_bearing).
-    const NorthEast& nav_direction() const { return nav_dir_; }
+    // Towards the L1 point (nav_bearing; a unit vector: on a leg the track's turned by
+    // eta1, worked out when asked for), and the metres to the waypoint or the loiter's
+    // centre (target_bearing).
+    NorthEast nav_direction() const;
     const NorthEast& to_target_m() const { return to_target_m_; }
     float nav_bearing_rad() const;
     float target_bearing_rad() const;
@@ -106,7 +107,12 @@ private:
     float lat_acc_m_s2_ = 0.0f;
     float crosstrack_m_ = 0.0f;
     float l1_m_ = 0.0f;
+    // nav_direction(): nav_dir_, turned by the angle of cosine nav_cos1_ and sine nav_sin1_
+    // when nav_turned_ (on a leg: the track's direction and eta1).
     NorthEast nav_dir_ = {1.0f, 0.0f};
+    float nav_cos1_ = 1.0f;
+    float nav_sin1_ = 0.0f;
+    bool nav_turned_ = false;
     NorthEast to_target_m_ = {1.0f, 0.0f};
     int8_t behind_side_ = 0;  // the sign of eta when it was beyond 162 deg last step, else 0
     bool circling_ = false;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "Tecs.h"
 
+#include <string.h>
+
 #include "Constants.h"
 #include "LinAlg.h"
 
@@ -15,6 +17,8 @@ constexpr float kInvStep = 10.0f;
 constexpr float kPitchMargin_rad = 0.0783f;  // the pitch integrator may saturate by 4.5 deg
 constexpr float kMinTas_m_s = 3.0f;
 constexpr float kRadPerCd = linalg::kRadPerDeg * 0.01f;
+constexpr uint32_t kOneBits = 0x3F800000u;  // 1.0f
+constexpr uint32_t kNoBits = 0xFFFFFFFFu;   // a NaN: no EAS2TAS yet
 
 float min_of(float a, float b) { return a < b ? a : b; }
 float max_of(float a, float b) { return a > b ? a : b; }
@@ -58,6 +62,26 @@ void Tecs::set_params() {
     k_.tc_g = p.time_const_s * kG;
     k_.pitch_max_margin = k_.pitch_max_rad + kPitchMargin_rad;
     k_.pitch_min_margin = k_.pitch_min_rad - kPitchMargin_rad;
+    k_.thr_underspeed = k_.thr_max * 0.95f;
+    k_.pitch_damped = p.ptch_damp != 0.0f;
+    k_.unit_weights = k_.spe_w == 1.0f && k_.ske_w == 1.0f;
+    range_.eas2tas_bits = kNoBits;  // the speed range again at the next step
+}
+
+void Tecs::refresh_speed_range(float eas2tas) {
+    uint32_t bits;
+    memcpy(&bits, &eas2tas, sizeof bits);
+    if (bits == range_.eas2tas_bits) return;
+    range_.eas2tas_bits = bits;
+    range_.tas_max = k_.arspd_max * eas2tas;
+    range_.tas_min = k_.arspd_min * eas2tas;
+    range_.ske_min = 0.5f * range_.tas_min * range_.tas_min;
+    range_.ske_max = 0.5f * range_.tas_max * range_.tas_max;
+    range_.underspeed_tas = range_.tas_min * 0.9f;
+}
+
+float Tecs::tas_of(float eas_m_s, float eas2tas) const {
+    return range_.eas2tas_bits == kOneBits ? eas_m_s : eas_m_s * eas2tas;
 }
 
 void Tecs::update_50hz(float height_m, float accel_up_m_s2, float accel_fwd_m_s2, float dt_s) {
@@ -90,7 +114,7 @@ void Tecs::initialise(const TecsInput& in, float tas_m_s) {
     hgt_dem_adj_ = height_m_;
     hgt_dem_prev_ = height_m_;
     hgt_dem_in_old_ = height_m_;
-    tas_dem_last_ = in.eas_dem_m_s * in.eas2tas;
+    tas_dem_last_ = tas_of(in.eas_dem_m_s, in.eas2tas);
     tas_dem_adj_ = tas_dem_last_;
     ste_dot_err_last_ = 0.0f;
     underspeed_ = false;
@@ -100,7 +124,7 @@ void Tecs::initialise(const TecsInput& in, float tas_m_s) {
 
 void Tecs::update_speed(const TecsInput& in, float eas_m_s, float dt_s) {
     // Second-order complementary filter: the airspeed with the along-track acceleration.
-    const float err = eas_m_s * in.eas2tas - tas_m_s_;
+    const float err = tas_of(eas_m_s, in.eas2tas) - tas_m_s_;
     float integ_in = err * k_.spd_kx;
     if (tas_m_s_ < 3.1f) integ_in = max_of(integ_in, 0.0f);  // no wind-up at standstill
     tas_integ_ += integ_in * dt_s;
@@ -112,11 +136,9 @@ Tecs::Demands Tecs::update_demands(const TecsInput& in, float inv_tas) {
     Demands d;
     // Speed: within ARSPD_FBW_MIN..MAX (the least when underspeed or descending badly),
     // changing no faster than half the energy rate the aircraft has.
-    d.tas_max = k_.arspd_max * in.eas2tas;
-    d.tas_min = k_.arspd_min * in.eas2tas;
-    float tas_dem = in.eas_dem_m_s * in.eas2tas;
-    if (bad_descent_ || underspeed_) tas_dem = d.tas_min;
-    tas_dem = constrain(tas_dem, d.tas_min, d.tas_max);
+    const float tas_min = range_.tas_min, tas_max = range_.tas_max;
+    float tas_dem = bad_descent_ || underspeed_ ? tas_min : tas_of(in.eas_dem_m_s, in.eas2tas);
+    tas_dem = constrain(tas_dem, tas_min, tas_max);
     const float up_step = k_.tas_step_up * inv_tas;
     const float down_step = k_.tas_step_down * inv_tas;
     const float change = tas_dem - tas_dem_adj_;
@@ -130,7 +152,7 @@ Tecs::Demands Tecs::update_demands(const TecsInput& in, float inv_tas) {
         tas_dem_adj_ = tas_dem;
         d.tas_rate = (tas_dem - tas_dem_last_) * kInvStep;
     }
-    tas_dem_adj_ = constrain(tas_dem_adj_, d.tas_min, d.tas_max);
+    tas_dem_adj_ = constrain(tas_dem_adj_, tas_min, tas_max);
     tas_dem_last_ = tas_dem;
 
     // Height: a 2-point average, the climb within TECS_CLMB_MAX and the sink within
@@ -149,8 +171,9 @@ Tecs::Demands Tecs::update_demands(const TecsInput& in, float inv_tas) {
 void Tecs::update_pitch_throttle(const TecsInput& in, float dt_s) {
     const float eas = in.have_airspeed ? in.eas_m_s
                                        : 0.5f * (float)(params_.arspd_min_m_s + params_.arspd_max_m_s);
+    refresh_speed_range(in.eas2tas);
     if (need_reset_ || dt_s > 1.0f) {
-        initialise(in, eas * in.eas2tas);
+        initialise(in, tas_of(eas, in.eas2tas));
         dt_s = kStep_s;
     }
     update_speed(in, eas, dt_s);
@@ -165,7 +188,7 @@ void Tecs::update_pitch_throttle(const TecsInput& in, float dt_s) {
         thr_min = k_.thr_max - 0.01f;
         hgt_dem_adj_ = height_m_;
         hgt_dem_prev_ = height_m_;
-        tas_dem_last_ = in.eas_dem_m_s * in.eas2tas;
+        tas_dem_last_ = tas_of(in.eas_dem_m_s, in.eas2tas);
         tas_dem_adj_ = tas_dem_last_;
         underspeed_ = false;
         bad_descent_ = false;
@@ -174,7 +197,7 @@ void Tecs::update_pitch_throttle(const TecsInput& in, float dt_s) {
 
     // Underspeed: slow at full throttle; held while below the height demand.
     underspeed_ = in.have_airspeed && !takeoff &&
-                  ((tas_m_s_ < d.tas_min * 0.9f && throttle_dem_ >= k_.thr_max * 0.95f) ||
+                  ((tas_m_s_ < range_.underspeed_tas && throttle_dem_ >= k_.thr_underspeed) ||
                    (height_m_ < hgt_dem_adj_ && underspeed_));
 
     // Specific energies (m^2/s^2) and their rates as errors: potential g h, kinetic V^2 / 2.
@@ -194,8 +217,7 @@ void Tecs::update_pitch_throttle(const TecsInput& in, float dt_s) {
     const float ste_dot = spe_dot + ske_dot;
 
     // Total energy error, its potential part limited to what the speed range can hold.
-    const float ste_error = constrain(spe_err, 0.5f * d.tas_min * d.tas_min - ske_dem,
-                                      0.5f * d.tas_max * d.tas_max - ske_dem) + ske_err;
+    const float ste_error = constrain(spe_err, range_.ske_min - ske_dem, range_.ske_max - ske_dem) + ske_err;
     update_throttle(in, thr_min, ste_error, ste_dot, spe_dot_dem + ske_dot_dem, dt_s);
     // Bad descent: a speed demand it cannot reach, sinking at full throttle.
     bad_descent_ = !underspeed_ && ((ste_error > 200.0f && ste_dot < 0.0f && throttle_dem_ >= k_.thr_max * 0.9f) ||
@@ -204,6 +226,11 @@ void Tecs::update_pitch_throttle(const TecsInput& in, float dt_s) {
     // Pitch: the energy balance, speed weighted by TECS_SPDWEIGHT (all speed when
     // underspeed or taking off).
     const bool speed_first = underspeed_ || takeoff;
+    if (!speed_first && k_.unit_weights) {  // x 1: the same sums without the products
+        update_pitch(in, pitch_min, spe_err - ske_err, spe_dot_dem - ske_dot_dem,
+                     (spe_dot_dem - spe_dot) - (ske_dot_dem - ske_dot), inv_tas, dt_s);
+        return;
+    }
     const float spe_w = speed_first ? 0.0f : k_.spe_w;
     const float ske_w = speed_first ? 1.0f : k_.ske_w;
     const float seb_err = spe_err * spe_w - ske_err * ske_w;
@@ -269,7 +296,8 @@ void Tecs::update_pitch(const TecsInput& in, float pitch_min, float seb_err, flo
     integ_pitch_ += integ_in * dt_s;
     // Energy balance per radian of pitch: V TECS_TIME_CONST g.
     const float gain_inv = tas_m_s_ * k_.tc_g;
-    float temp = seb_err + seb_dot_dem * params_.time_const_s + seb_dot_err * params_.ptch_damp;
+    float temp = seb_err + seb_dot_dem * params_.time_const_s;
+    if (k_.pitch_damped) temp += seb_dot_err * params_.ptch_damp;
     if (in.stage == TecsStage::kTakeoff) temp += pitch_min * gain_inv;
     const float pitch_min_margin = in.stage == TecsStage::kTakeoff ? pitch_min - kPitchMargin_rad : k_.pitch_min_margin;
     integ_pitch_ = constrain(integ_pitch_, gain_inv * pitch_min_margin - temp, gain_inv * k_.pitch_max_margin - temp);

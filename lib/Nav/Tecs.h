@@ -77,6 +77,9 @@ struct TecsCoefficients {
     float integ_thr_k;             // TECS_INTEG_GAIN k_ste_to_thr
     float tc_g;                    // TECS_TIME_CONST g: times V, the energy balance per radian
     float pitch_max_margin, pitch_min_margin;  // the pitch integrator's reach, 4.5 deg beyond
+    float thr_underspeed;          // THR_MAX 0.95: at or above it, slow is underspeed
+    bool pitch_damped;             // TECS_PTCH_DAMP not 0 (its term is skipped at 0)
+    bool unit_weights;             // both weights 1 (TECS_SPDWEIGHT 1): their products skipped
 };
 
 enum class TecsStage : uint8_t {
@@ -129,8 +132,18 @@ public:
 
 private:
     struct Demands {
-        float tas_max, tas_min, hgt_rate, tas_rate;  // this step's limits and rates
+        float hgt_rate, tas_rate;  // this step's rates
     };
+    // The speed range in true airspeed for an EAS2TAS (its bits: a float's == is a call),
+    // kept until EAS2TAS or a parameter changes: ARSPD_FBW_MIN and _MAX x EAS2TAS, their
+    // kinetic energies V^2 / 2, and underspeed's 0.9 of the least.
+    struct SpeedRange {
+        uint32_t eas2tas_bits;
+        float tas_min, tas_max, ske_min, ske_max, underspeed_tas;
+    };
+    void refresh_speed_range(float eas2tas);
+    // An equivalent airspeed in true airspeed (no multiply at EAS2TAS 1).
+    float tas_of(float eas_m_s, float eas2tas) const;
     void initialise(const TecsInput& in, float tas_m_s);
     void update_speed(const TecsInput& in, float eas_m_s, float dt_s);
     Demands update_demands(const TecsInput& in, float inv_tas);
@@ -144,6 +157,7 @@ private:
 
     const TecsParams& params_;
     TecsCoefficients k_ = {};
+    SpeedRange range_ = {};
     // 50 Hz filters
     float height_m_ = 0.0f;        // the complementary filter's height, m
     float climb_m_s_ = 0.0f;       // ... its climb rate

@@ -254,6 +254,35 @@ TEST(MissionExecutor, GlideSlopeSpreadsBigChangesOnly) {
     EXPECT_FLOAT_EQ(down.exec.target().slope_m, -40.0f);
 }
 
+// The look-ahead keeps the commands it read and the place it mapped: a new mission, or
+// home moved (DO_SET_HOME), is read and mapped afresh, not taken from what it kept.
+TEST(MissionExecutor, TheLookAheadKeepsNothingStale) {
+    Flight r;
+    r.f.upload({r.f.wp(500.0f, 0.0f, 60.0f), r.f.wp(500.0f, 300.0f, 60.0f)});
+    r.exec.start(r.s);
+    r.at(0.0f, 0.0f);  // the next command read and mapped, the turn to it
+    r.at(0.0f, 0.0f);  // the one after it (none here)
+    r.f.upload({r.f.wp(200.0f, 0.0f, 60.0f), r.f.wp(200.0f, -300.0f, 60.0f)});
+    r.exec.start(r.s);  // the new mission: its commands at the indices the old one's were read
+    EXPECT_NEAR(r.exec.target().next_m.north_m, 200.0f, 0.02f);
+    r.at(0.0f, 0.0f);
+    r.at(0.0f, 0.0f);
+    EXPECT_EQ(r.arrive(), 2u);
+    EXPECT_NEAR(r.exec.target().next_m.east_m, -300.0f, 0.02f);
+
+    Flight moved;
+    moved.f.upload({moved.f.wp(500.0f, 0.0f, 60.0f), moved.f.wp(500.0f, 300.0f, 60.0f)});
+    moved.exec.start(moved.s);
+    moved.at(0.0f, 0.0f);
+    moved.at(0.0f, 0.0f);
+    // Home 100 m east: the next waypoint is 200 m east of it when its leg starts.
+    moved.f.home = moved.f.map.moved(moved.f.home, 0.0f, 100.0f);
+    moved.f.map.set_origin(moved.f.home);
+    EXPECT_EQ(moved.arrive(), 2u);
+    EXPECT_NEAR(moved.exec.target().next_m.north_m, 500.0f, 0.05f);
+    EXPECT_NEAR(moved.exec.target().next_m.east_m, 200.0f, 0.05f);
+}
+
 TEST(MissionExecutor, SetCurrentAndAnEmptyMission) {
     Flight r;
     r.f.upload({r.f.wp(300.0f, 0.0f, 50.0f), r.f.wp(300.0f, 300.0f, 50.0f), r.f.wp(0.0f, 300.0f, 50.0f)});
