@@ -123,7 +123,7 @@ static void once_a_second() {
     X(guide,        nav_modes::due,                  nav_modes::run,                   4000, kSecGuide,        0)       \
     X(tecs,         nav_modes::filters_due,          nav_modes::filters_run,            700, kSecTecsFilter,   0)       \
     X(store,        nullptr,                         store_service,                    1800, kSecStore,        0)       \
-    X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
+    X(baro,         baro::due,                       baro::service,                    2600, kSecBaro,         0)       \
     X(adc,          adc::battery_conversion_due,     adc::take_battery_conversion,      100, kSecAdc,          kAlways) \
     X(battery,      battery_input::due,              battery_input::update,            2800, kSecBattery,      0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
