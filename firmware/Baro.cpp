@@ -42,6 +42,7 @@ static float mean_pa = 0.0f;
 static float ground_sum_pa = 0.0f;
 static float ground_pa = 0.0f, ground_c = 0.0f;  // as set in `height`
 static float ground_chip_c = 0.0f;  // the chip's temperature when the ground was taken
+static bool ground_unsaid = false;  // the ground taken, its line not said yet
 static uint32_t period_start_us = 0, last_pressure_ms = 0, last_reject_said_ms = 0;
 static uint8_t periods = 0;  // 10 Hz periods since found (saturates)
 static bool found = false, lost = false, absent = false;
@@ -55,7 +56,7 @@ bool healthy() {
     return chip.converting() && !chip.stuck() && height.have_ground() && millis() - last_pressure_ms < kStaleMs;
 }
 
-bool due() { return chip.due(micros()); }
+bool due() { return ground_unsaid || chip.due(micros()); }
 
 static void say(ms5611::Event e) {
     Writer w(vehicle::out);
@@ -112,8 +113,7 @@ static void new_period(uint32_t now_us) {
         // The ground air's temperature is the chip's now: later it warms in the fuselage
         // and cools aloft, neither of which is the ground air's.
         ground_chip_c = temperature_c();
-        Writer(vehicle::out).str(TXT("# baro: MS5611, ground ")).u32((uint32_t)(s.gnd_abs_press_pa + 0.5f))
-            .str(TXT(" Pa (GND_ABS_PRESS), ")).fixed2(ground_chip_c).str(TXT(" C")).end();
+        ground_unsaid = true;
         gcs_link::announce_calibration(gcs_link::Calibrated::kBaroGround);
     }
     const float t_c = s.flight.gnd_temp_c != 0.0f ? s.flight.gnd_temp_c : ground_chip_c;
@@ -128,7 +128,19 @@ static void new_period(uint32_t now_us) {
     board::mark_end(board::kSecBaroHeight);
 }
 
+// The ground's line in a run of its own: with the ground's maths and a conversion it
+// would take more than the task's budget in MAVLink (two STATUSTEXT frames packed).
+static void say_ground() {
+    ground_unsaid = false;
+    Writer(vehicle::out).str(TXT("# baro: MS5611, ground ")).u32((uint32_t)(vehicle::pipe.settings().gnd_abs_press_pa + 0.5f))
+        .str(TXT(" Pa (GND_ABS_PRESS), ")).fixed2(ground_chip_c).str(TXT(" C")).end();
+}
+
 void service() {
+    if (ground_unsaid) {
+        say_ground();  // the conversion waits for the next pass (due() still true)
+        return;
+    }
     const uint32_t now_us = micros();
     const ms5611::Event e = chip.service(now_us);
     if (e == ms5611::Event::Found || e == ms5611::Event::Back) {

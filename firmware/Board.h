@@ -52,6 +52,7 @@ enum Section : uint8_t {
     kSecOutput = 22,       // the output line task: Euler (2), formatting (3), queueing
     kSecLeds = 23,
     kSecPump = 24,         // queued text handed to Serial
+    kSecHeldBack = 62,     // "# N line(s) held back" packed and queued (Port)
     kSecInput = 25,        // the console's received bytes, between samples
     kSecGcsStreams = 26,   // RC_CHANNELS + SERVO_OUTPUT_RAW packed and queued
     kSecGcsSave = 27,      // a save started after a PARAM_SET

@@ -432,7 +432,9 @@ void save_soon() { save_pending = true; }
 
 bool param_value_due() {
     uint16_t index;
-    return param_replies.peek(index) && room_for(mav::kParamValueFrame);
+    // Room left for a "# " line (two STATUSTEXT frames) beside it: a list asked for at
+    // start-up does not crowd out the start-up's messages (Port holds back what has none).
+    return param_replies.peek(index) && room_for(mav::kParamValueFrame + 2u * mav::kMaxFrame);
 }
 void send_param_value() {
     uint16_t index;

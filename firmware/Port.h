@@ -26,8 +26,15 @@ void set_gcs_link(bool on);
 // Three returns in a row in MAVLink: the text console.
 void escape_to_text();
 
-// text::Sink's write for every "# " message: text, or STATUSTEXT frames in MAVLink.
+// text::Sink's write for every "# " message: text, or STATUSTEXT frames in MAVLink. Each
+// line goes out whole or, when the output has no room for it now, not at all: never a
+// wait for the UART in the loop (serial_text::line_part). The lines dropped are counted...
 void write_message(void*, const char* data, uint8_t len);
+// ... and told by the loop task `held_back` once the output has room again:
+// "# N line(s) held back: output full", or, when warnings (warn, error, PreArm) were among
+// them, "# warn: N line(s) held back, W warning(s)" (a STATUSTEXT warning).
+bool held_back_due();
+void say_held_back();
 // A frame (a reply: never dropped; waits for room).
 void send_frame(const uint8_t* frame, uint8_t len);
 

@@ -5,19 +5,25 @@
 
 namespace serial_text {
 
+static_assert(kCapacity <= 256u, "the ring's indices are bytes");
 static char ring[kCapacity];
-static uint16_t head = 0, tail = 0;  // head: next write, tail: next byte for Serial
+// head: next write; tail: next byte for Serial; done: the end of what may go (the start of
+// an open line's bytes, head when none is open).
+static uint8_t head = 0, tail = 0, done = 0;
+enum : uint8_t { kDropped = 1, kInLoop = 2 };
+static uint8_t flags = 0;
 
-static uint16_t next(uint16_t i) { return i + 1u == kCapacity ? 0u : (uint16_t)(i + 1u); }
+static uint8_t next(uint8_t i) { return i + 1u == kCapacity ? 0u : (uint8_t)(i + 1u); }
 uint16_t queued() { return head >= tail ? (uint16_t)(head - tail) : (uint16_t)(head + kCapacity - tail); }
 static uint16_t ring_room() { return (uint16_t)(kCapacity - 1u - queued()); }
 uint16_t room() { return (uint16_t)(ring_room() + (uint16_t)Serial.availableForWrite()); }
 
 void begin() { Serial.begin(kBaud); }
+void loop_starts() { flags = (uint8_t)(flags | kInLoop); }
 
 void pump() {
     int free_bytes = Serial.availableForWrite();
-    while (free_bytes-- > 0 && tail != head) {
+    while (free_bytes-- > 0 && tail != done) {
         Serial.write((uint8_t)ring[tail]);
         tail = next(tail);
     }
@@ -27,9 +33,11 @@ static void put(char c) {
     while (ring_room() == 0) pump();
     ring[head] = c;
     head = next(head);
+    done = head;
 }
 
 void write(const char* data, uint8_t len) {
+    done = head;  // an open line goes as it is: its bytes stay before these
     for (uint8_t i = 0; i < len; ++i) put(data[i]);
 }
 
@@ -39,7 +47,33 @@ bool write_line_if_room(const char* line, uint8_t len) {
     return true;
 }
 
+void line_part(const char* data, uint8_t len) {
+    if (flags & kDropped) return;
+    for (uint8_t i = 0; i < len; ++i) {
+        if (ring_room() == 0) pump();  // the bytes before the line, as Serial has room now
+        while (ring_room() == 0) {
+            if (flags & kInLoop) {
+                head = done;  // the line taken back, whole
+                flags = (uint8_t)(flags | kDropped);
+                return;
+            }
+            if (tail == done) done = head;  // setup(): a line longer than the ring goes as it is
+            pump();
+        }
+        ring[head] = data[i];
+        head = next(head);
+    }
+}
+
+bool end_line() {
+    const bool said = !(flags & kDropped);
+    flags = (uint8_t)(flags & ~kDropped);
+    done = head;
+    return said;
+}
+
 void flush() {
+    done = head;
     while (tail != head) pump();
     Serial.flush();
 }

@@ -28,6 +28,7 @@
 #include "MissionLink.h"
 #include "NavModes.h"
 #include "OutputLine.h"
+#include "Port.h"
 #include "Position.h"
 #include "Scheduler.h"
 #include "SerialText.h"
@@ -102,6 +103,7 @@ static void once_a_second() {
 //     name         due test                         run                             budget_us section         flags
 #define LOOP_TASKS(X)                                                                                            \
     X(pump,         nullptr,                         serial_text::pump,                 800, kSecPump,         kAlways) \
+    X(held_back,    port::held_back_due,             port::say_held_back,              2000, kSecHeldBack,     0)       \
     X(input,        nullptr,                         console_link::take_input,         2000, kSecInput,        kAlways) \
     X(command,      console_link::command_due,       console_link::reply,              5800, kSecCommand,      0)       \
     X(reply,        console_link::reply_due_text,    console_link::reply,              3200, kSecConsoleReply, 0)       \
@@ -121,7 +123,7 @@ static void once_a_second() {
     X(guide,        nav_modes::due,                  nav_modes::run,                   4000, kSecGuide,        0)       \
     X(tecs,         nav_modes::filters_due,          nav_modes::filters_run,            700, kSecTecsFilter,   0)       \
     X(store,        nullptr,                         store_service,                    1800, kSecStore,        0)       \
-    X(baro,         baro::due,                       baro::service,                    2000, kSecBaro,         0)       \
+    X(baro,         baro::due,                       baro::service,                    2600, kSecBaro,         0)       \
     X(adc,          adc::battery_conversion_due,     adc::take_battery_conversion,      100, kSecAdc,          kAlways) \
     X(battery,      battery_input::due,              battery_input::update,            2800, kSecBattery,      0)       \
     X(retries,      nullptr,                         sensor_retries,                 150000, kSecRetry,        kAlways) \
@@ -185,6 +187,7 @@ static void run_loop_tasks() {
 void loop_starts() {
     const uint32_t now_us = micros();
     loop_load::start(now_us);
+    serial_text::loop_starts();  // a message that does not fit now is held back, never waited for
     vehicle::flight_io.loop_starts(now_us);
     vehicle::update_leds();
 }
