@@ -66,7 +66,9 @@ bool due() {
     return link.start_pending || !running || (uint16_t)((uint16_t)millis() - progress_ms) >= kProgressPeriodMs;
 }
 
-void send() {
+// Never inline (cold, between samples): inlined into its callers with the rest, it took
+// 508 B more flash together with six others of the kind (docs/performance.md, "Size").
+__attribute__((noinline)) void send() {
     if (link.start_pending) {
         link.start_pending = false;
         pipe.start_mag_calibration(!link.autosave);

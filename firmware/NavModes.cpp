@@ -194,9 +194,12 @@ bool due() {
     return tecs_pending || millis() - last_run_ms >= kPeriodMs || flight_io.nav_mode() != flying;
 }
 
-static void run_tecs();
+// Neither half inlined (into each other, or run into the loop tasks' function): together
+// their locals took the frame past the 63 bytes ldd/std reach from Y (a subi/sbci pair
+// each side of every access beyond: 1.8 KB of them in run alone).
+__attribute__((noinline)) static void run_tecs();
 
-void run() {
+__attribute__((noinline)) void run() {
     if (tecs_pending) return run_tecs();
     if (say_gps_loss()) return;  // the step on the next pass
     const uint32_t now_ms = millis();

@@ -19,6 +19,29 @@ bool due() {
     return tick.output;
 }
 
+// The float modes' lines, each in a function of its own (never inline): inlined, their
+// float temporaries joined emit's frame beyond the 63 bytes ldd/std reach, and every
+// access to it took a subi/sbci pair each side, in every mode (plot's too).
+__attribute__((noinline)) static uint8_t quat_line(char* line) {
+    return fmt::format_quat_line(line, pipe.quaternion());
+}
+__attribute__((noinline)) static uint8_t raw_line(char* line) {
+    const float inv_g = 1.0f / dcm::kGravity_m_s2;
+    return fmt::format_raw_line(line, pipe.gyro_rad_s() * linalg::kDegPerRad, pipe.accel_m_s2() * inv_g,
+                                pipe.field_uT());
+}
+// MAVLink's ATTITUDE carries floats: the Euler extraction's float form, then the frame.
+__attribute__((noinline)) static uint8_t attitude_frame(char* line, uint32_t now_ms) {
+    board::mark_begin(board::kSecEuler);
+    const pipeline::Angles a = pipe.angles();
+    board::mark_end(board::kSecEuler);
+    board::mark_begin(board::kSecFormat);
+    const uint8_t n = port::mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg,
+                                             a.heading_deg, pipe.body_rate_rad_s());
+    board::mark_end(board::kSecFormat);
+    return n;
+}
+
 // True when it worked out the angles in hundredths (c). Never inline: its line buffer and
 // ATTITUDE's frame (~330 B) would join the loop's frame (main, with the estimator step
 // inlined), beyond the 63 bytes ldd/std reach, and slow every access to it.
@@ -31,39 +54,33 @@ __attribute__((noinline)) static bool emit(uint32_t now_ms, pipeline::AnglesCent
     constexpr uint16_t kStepMs = 1000u / pipeline::kRateHz;
     if (mode == fmt::OutputMode::Mavlink && !gcs_link::take_stream(mav::kStreamAttitude, now_ms + kStepMs))
         return false;
-    // Plot and csv lines print hundredths, which the integer path gives without a float;
-    // MAVLink's ATTITUDE carries floats.
-    pipeline::Angles a{};
-    if (mode == fmt::OutputMode::Mavlink) {
-        board::mark_begin(board::kSecEuler);
-        a = pipe.angles();
-        board::mark_end(board::kSecEuler);
-    } else if (mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv) {
+    // Plot and csv lines print hundredths, which the integer path gives without a float.
+    const bool centideg = mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv;
+    if (centideg) {
         board::mark_begin(board::kSecEuler);
         c = pipe.angles_centideg();
         board::mark_end(board::kSecEuler);
     }
     char line[fmt::kRawLineMax];
     uint8_t n;
-    board::mark_begin(board::kSecFormat);
-    if (mode == fmt::OutputMode::Quat) {
-        n = fmt::format_quat_line(line, pipe.quaternion());
-    } else if (mode == fmt::OutputMode::Raw) {
-        const float inv_g = 1.0f / dcm::kGravity_m_s2;
-        n = fmt::format_raw_line(line, pipe.gyro_rad_s() * linalg::kDegPerRad, pipe.accel_m_s2() * inv_g,
-                                 pipe.field_uT());
-    } else if (mode == fmt::OutputMode::Mavlink) {
-        n = port::mavlink.attitude(reinterpret_cast<uint8_t*>(line), now_ms, a.roll_deg, a.pitch_deg, a.heading_deg,
-                                   pipe.body_rate_rad_s());
-    } else if (mode == fmt::OutputMode::Csv) {
-        n = fmt::format_csv_line_centideg(line, now_ms, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
+    if (mode == fmt::OutputMode::Mavlink) {
+        n = attitude_frame(line, now_ms);
     } else {
-        n = fmt::format_plot_line_centideg(line, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
+        board::mark_begin(board::kSecFormat);
+        if (mode == fmt::OutputMode::Quat) {
+            n = quat_line(line);
+        } else if (mode == fmt::OutputMode::Raw) {
+            n = raw_line(line);
+        } else if (mode == fmt::OutputMode::Csv) {
+            n = fmt::format_csv_line_centideg(line, now_ms, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
+        } else {
+            n = fmt::format_plot_line_centideg(line, c.roll_centideg, c.pitch_centideg, c.heading_centideg);
+        }
+        board::mark_end(board::kSecFormat);
     }
-    board::mark_end(board::kSecFormat);
     if (n > 0) serial_text::write_line_if_room(line, n);
     else if (warn_angle.allow(now_ms, 2000)) vehicle::say(TXT(TXT_WARN "output not finite: line skipped"));
-    return mode == fmt::OutputMode::Plot || mode == fmt::OutputMode::Csv;
+    return centideg;
 }
 
 void run() { tick.have_angles = emit(tick.now_ms, tick.angles); }

@@ -74,7 +74,9 @@ static void learn_wind(const gps::Fix& fix) {
                  (float)a.pitch_centideg * kRadPerCentideg, (float)dt_ms * 0.001f);
 }
 
-void run() {
+// Never inline (cold, between samples): inlined into its callers with the rest, it took
+// 508 B more flash together with six others of the kind (docs/performance.md, "Size").
+__attribute__((noinline)) void run() {
     const uint32_t now_ms = millis();
     last_run_ms = now_ms;
     const nav::BaroReading baro = baro_now();

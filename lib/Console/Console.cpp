@@ -112,7 +112,9 @@ bool parse_fixed(const char* s, uint8_t decimals, uint8_t max_int_digits, int32_
     return true;
 }
 
-Command parse_line(const char* line) {
+// Never inline (cold, between samples): inlined into its callers with the rest, it took
+// 508 B more flash together with six others of the kind (docs/performance.md, "Size").
+__attribute__((noinline)) Command parse_line(const char* line) {
     char copy[kLineCapacity + 1];
     const char* w[3] = {nullptr, nullptr, nullptr};
     const uint8_t n = split(line, copy, w);

@@ -199,7 +199,9 @@ void NmeaParser::field_end() {
     }
 }
 
-NmeaParser::Message NmeaParser::sentence_end() {
+// Never inline (cold, between samples): inlined into its callers with the rest, it took
+// 508 B more flash together with six others of the kind (docs/performance.md, "Size").
+__attribute__((noinline)) NmeaParser::Message NmeaParser::sentence_end() {
     switch (kind_) {
         case kGga:
             if (!v_.have_time) return Message::kOther;

@@ -86,7 +86,9 @@ Event Sequencer::reject() {
     return spike_run_++ == 0 ? Event::Rejected : Event::None;
 }
 
-Event Sequencer::take_d2(uint32_t d2) {
+// Never inline (cold, between samples): inlined into its callers with the rest, it took
+// 508 B more flash together with six others of the kind (docs/performance.md, "Size").
+__attribute__((noinline)) Event Sequencer::take_d2(uint32_t d2) {
     profile::begin(profile::kBaroCompensation);
     const Terms t = terms(prom_, d2);
     profile::end(profile::kBaroCompensation);

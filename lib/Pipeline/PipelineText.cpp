@@ -9,7 +9,9 @@ using text::Writer;
 namespace {
 
 // The `cal mag` verdict (kMagCalDone).
-void write_cal_mag_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
+// Never inline (cold, between samples): inlined into its callers with the rest, it took
+// 508 B more flash together with six others of the kind (docs/performance.md, "Size").
+__attribute__((noinline)) void write_cal_mag_verdict(Writer& w, const pipeline::AttitudePipeline& pipe, const pipeline::Event& e) {
     using Quality = calib::MagCalibrator::Quality;
     const Quality q = (Quality)e.code;
     if (q == Quality::Ok) {
