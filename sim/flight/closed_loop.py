@@ -8,7 +8,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--sim build/apm25sim] [--elf build/firmware.elf] [--stamp] [--input FILE]
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
-        [--gps ublox|nmea|none] [--arm]
+        [--gps ublox|nmea|none] [--arm] [--eeprom FILE]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -27,7 +27,8 @@ KIND is apm25sim's module on the GPS port (default: apm25sim's, a u-blox; none: 
 --arm arms the board on the launch stand as a pilot would (ARMING_REQUIRE 1 holds the
 throttle at its minimum until armed): the stick script's throttle at zero until ARM_S
 (2 s) and `arm` typed into the board (apm25sim --input: at its first angle line, ~1.4 s,
-after any --input lines).
+after any --input lines). --eeprom FILE is apm25sim's: the board's EEPROM from FILE and back
+into it at the end (what an earlier run saved, as across a power cycle).
 Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
@@ -115,6 +116,7 @@ def parse_args(argv):
     p.add_argument("--out", help="the serial output into this file instead of stdout")
     p.add_argument("--wind", help="the backend's --wind N,E: a steady wind, m/s")
     p.add_argument("--mission", help="apm25sim --mission: a QGC WPL 110 file into the EEPROM before the run")
+    p.add_argument("--eeprom", help="apm25sim --eeprom: the EEPROM from this file, written back at the end")
     p.add_argument("--profile", help="apm25sim --profile: the sections' cycle counts")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
     p.add_argument("--timeout", type=float, default=900.0, help="wall seconds before both are stopped")
@@ -217,6 +219,8 @@ def run(args):
             sim_cmd += ["--gps", args.gps]
         if args.mission:
             sim_cmd += ["--mission", args.mission]
+        if args.eeprom:
+            sim_cmd += ["--eeprom", args.eeprom]
         if args.profile:
             sim_cmd += ["--profile", args.profile]
         sim = subprocess.Popen(sim_cmd, stdout=subprocess.PIPE)
