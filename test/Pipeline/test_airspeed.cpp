@@ -57,8 +57,8 @@ TEST(AirspeedSensor, TheZeroInArduPilotsUnitKeepsQuarterCounts) {
 // sensor could have read it and the reading is not below it, else the cruise speed.
 TEST(AirspeedSensor, AStartInMotionUsesTheSavedZeroAndAStillOneSavesOnlyAMovedOne) {
     using airspeed::StartZero;
-    const uint16_t zero = 4u * counts_at(0.0f);
-    const uint16_t cruise = 4u * counts_at(18.0f);  // 41 counts above the zero
+    const uint16_t zero = (uint16_t)(4u * counts_at(0.0f));
+    const uint16_t cruise = (uint16_t)(4u * counts_at(18.0f));  // 41 counts above the zero
     const uint16_t noise = airspeed::kOffsetNoise;
     EXPECT_EQ(noise, 8u);  // 2 counts
     // Still: none saved, or one beyond the noise either way, is saved; within it, kept.
@@ -80,7 +80,7 @@ TEST(AirspeedSensor, AStartInMotionUsesTheSavedZeroAndAStillOneSavesOnlyAMovedOn
     // In motion but slow or still in fact (a reading within the noise of the saved zero): saved.
     EXPECT_EQ(airspeed::start_zero((uint16_t)(zero - noise), false, zero), StartZero::kSaved);
     // Fast, past 3.0 V (~31 m/s) but within the sensor's 4.5 V: the saved zero still.
-    EXPECT_EQ(airspeed::start_zero(4u * counts_at(35.0f), false, zero), StartZero::kSaved);
+    EXPECT_EQ(airspeed::start_zero((uint16_t)(4u * counts_at(35.0f)), false, zero), StartZero::kSaved);
     // A saved zero refused: one no still MPXV7002DP reads (out of 2.0-3.0 V) ...
     EXPECT_EQ(airspeed::start_zero(cruise, false, 4u * 300u), StartZero::kCruise);
     EXPECT_EQ(airspeed::start_zero(cruise, false, 4u * 700u), StartZero::kCruise);
@@ -115,7 +115,7 @@ TEST(AirspeedSensor, ArspdOffsetIsASavedParameterAbsentFromOlderRecords) {
     params::vehicle_part(settings::defaults(), 0, n, def);
     uint8_t at = 0;
     while (at < n && bytes[at] == def[at]) ++at;
-    ASSERT_LE(at + 2u, n);
+    ASSERT_LE(at + 2u, (unsigned)n);
     EXPECT_EQ(bytes[at] | bytes[at + 1u] << 8, 2049);
     settings::Settings older = settings::defaults();
     params::decode_vehicle(bytes, at, older);
