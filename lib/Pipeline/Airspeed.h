@@ -34,7 +34,8 @@ constexpr uint16_t kOffsetPerCount = 4;
 inline bool offset_present(uint16_t offset) { return present((uint16_t)(offset / kOffsetPerCount)); }
 // The mean of n readings (their sum) in ARSPD_OFFSET's unit, rounded.
 inline uint16_t offset_of(uint32_t sum_counts, uint16_t n) {
-    return n == 0u ? 0u : (uint16_t)((sum_counts * kOffsetPerCount + n / 2u) / n);
+    if (n == 0u) return 0;
+    return (uint16_t)((sum_counts * kOffsetPerCount + n / 2u) / n);
 }
 
 // Airspeed (m/s) from a sum of n ADC readings and the zero (ARSPD_OFFSET's unit, measured at
