@@ -13,24 +13,33 @@ using vehicle::pipe;
 constexpr uint8_t kReadings = 8;
 static State state_ = State::kZero;
 static bool started = false;
-static uint16_t zero = 0;
 static uint16_t n = 0;
 static uint32_t sum = 0;
 
 State state() { return state_; }
 
-// What a board without the pitot flies on: the cruise speed, or no turn correction.
-static void say_no_sensor(bool moving) {
+// What the start made of the pitot (but a zero kept as saved: nothing to say).
+static void say_start(airspeed::StartZero z, uint16_t offset) {
+    using airspeed::StartZero;
     const uint16_t trim_cm_s = pipe.settings().flight.trim_arspd_cm;
     text::Writer w(vehicle::out);
-    if (moving)
-        w.str(TXT("# airspeed: the board was moving at start (a restart in flight?): no pitot zero taken, "));
-    else
-        w.str(TXT("# airspeed: no sensor on A0: "));
-    if (trim_cm_s == 0u)
+    w.str(TXT("# airspeed: "));
+    if (z == StartZero::kSave) {
+        w.str(TXT("new zero "));
+    } else if (z == StartZero::kNone) {
+        w.str(TXT("no sensor on A0: "));
+    } else {
+        w.str(TXT("the board was moving at start (a restart in flight?): "));
+        w.str(z == StartZero::kSaved ? TXT("the saved zero ") : TXT("no pitot zero taken, "));
+    }
+    if (z == StartZero::kSave || z == StartZero::kSaved) {
+        w.str(TXT("ARSPD_OFFSET ")).u32(offset);
+        if (z == StartZero::kSaved) w.str(TXT(" used"));
+    } else if (trim_cm_s == 0u) {
         w.str(TXT("TRIM_ARSPD_CM 0, no turn correction (sustained turns spiral down)"));
-    else
+    } else {
         w.str(TXT("cruise speed TRIM_ARSPD_CM ")).fixed2((float)trim_cm_s * 0.01f).str(TXT(" m/s assumed"));
+    }
     w.end();
 }
 
@@ -56,17 +65,24 @@ void step() {
     }
     sum += counts;
     ++n;
+    // The zero in use is ARSPD_OFFSET (the settings: no copy in RAM).
+    uint16_t& zero = pipe.settings().vehicle.arspd_offset;
     if (state_ == State::kZero) {
         if (pipe.phase() != pipeline::Phase::Running || n < kReadings) return;
-        zero = (uint16_t)(sum / n);
         // A zero is what the pitot reads in still air, so only a board the start's gyro
-        // calibration found still gives one: one that never was (it starts measuring on,
-        // pipe.gyro_calibrating()) may be flying, and its zero would be the flight's dynamic
-        // pressure, within the sensor's offset tolerance at cruise (0.2 kPa at 18 m/s) and
-        // reading every airspeed as none. It flies on the cruise speed instead, as without one.
-        const bool moving = pipe.gyro_calibrating();
-        state_ = airspeed::present(zero) && !moving ? State::kSensor : State::kNone;
-        if (state_ == State::kNone) say_no_sensor(moving && airspeed::present(zero));
+        // calibration found still measures one: one that never was (it starts measuring on,
+        // pipe.gyro_calibrating()) may be flying, and takes the zero an earlier still start
+        // saved, or flies on the cruise speed (airspeed::start_zero).
+        const uint16_t measured = airspeed::offset_of(sum, n);
+        const airspeed::StartZero z = airspeed::start_zero(measured, !pipe.gyro_calibrating(), zero);
+        state_ = z <= airspeed::StartZero::kSaved ? State::kSensor : State::kNone;
+        if (z == airspeed::StartZero::kSave) {
+            zero = measured;
+            // Saved as `save` does (a save under way takes it in), unless the settings are a
+            // bad record's defaults: those are not to replace the user's record.
+            if (vehicle::store.settings_loaded() && !vehicle::store.busy()) vehicle::store.start_save(pipe.settings());
+        }
+        if (z != airspeed::StartZero::kKeep) say_start(z, zero);
     } else if (n >= kReadings) {
         pipe.set_airspeed_m_s(airspeed::airspeed_m_s(sum, (uint8_t)n, zero));
     } else {

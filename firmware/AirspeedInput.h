@@ -3,10 +3,11 @@
 // the estimator's centripetal correction. Never blocking: each sample reads the
 // conversion of A0 started after the previous one (13 ADC clocks at 125 kHz, long done
 // 5 ms later) and starts the next (the ADC is shared with the battery's pins: Adc.h). While the gyro calibrates (the board still) the readings are the
-// sensor's zero; a zero far from 2.5 V is no sensor, and the configured cruise speed
-// (TRIM_ARSPD_CM) is used instead, as it is when the start's gyro calibration never found
-// the board still (it may be flying: no still-air zero to take). Then the mean of each
-// kReadings readings is the airspeed.
+// sensor's zero, kept as ARSPD_OFFSET (saved when it moved); a zero far from 2.5 V is no
+// sensor, and the configured cruise speed (TRIM_ARSPD_CM) is used instead. A start the gyro
+// calibration never found still (it may be flying: no still-air zero to take) uses the
+// saved ARSPD_OFFSET, or the cruise speed without one (airspeed::start_zero). Then the mean
+// of each kReadings readings is the airspeed.
 #pragma once
 
 #include <stdint.h>

@@ -524,6 +524,13 @@ const Row kRows[] PARAM_TABLE = {
     {"FS_LONG_TIMEOUT", Type::UInt16, 0, 1, 0, AT(vehicle.nav.fs_long_timeout_s), 1.0f, 300.0f, 20.0f,
      PARAM_DOC("Long failsafe timeout", "s",
                "How long the receiver must be lost for FS_LONG_ACTN. Whole seconds here.")},
+    {"ARSPD_OFFSET", Type::UInt16, 0, 1, 0, AT(vehicle.arspd_offset), 0.0f, 4095.0f, 0.0f,
+     PARAM_DOC("Airspeed offset", "",
+               "The airspeed sensor's zero, the reading of the pitot in still air, in ArduPilot's unit: 4096ths of "
+               "the 5 V supply (A0's 10-bit reading times 4; 2048 at the nominal 2.5 V). Measured at every start "
+               "the board is still and saved when it moved by more than 8 (2 counts: the reading's noise); a start "
+               "in motion (a restart in flight) uses it instead of measuring, when a still sensor reads it "
+               "(2.0 to 3.0 V). While the sensor is in use, setting it moves its zero at once. 0: none measured yet.")},
 
 };
 #undef AT

@@ -52,6 +52,9 @@ struct VehicleSettings {
     // (Params.h) keep tenths, twentieths or hundredths in a byte; nav_params() turns them
     // into lib/Nav's and lib/Mission's float parameters.
     NavSettings nav;
+
+    // Airspeed (AP_Airspeed).
+    uint16_t arspd_offset;      // ARSPD_OFFSET: the pitot's zero in use, 4096ths of 5 V (lib/Pipeline/Airspeed.h; 0: none)
 };
 
 // SERIAL0_PROTOCOL's values: ArduPilot's SerialProtocol_Console (0), _MAVLink (1), _MAVLink2 (2).

@@ -9,6 +9,7 @@ with the firmware's ELF, in lock-step, the board's serial output on stdout.
         [--servo-log FILE] [--log TRUTH.csv] [--trajectory FLIGHT.csv.gz] [--timeout S]
         [--no-airspeed] [--airframe plain|elevons|vtail] [--serial tcp:PORT] [--speed X]
         [--gps ublox|nmea|none] [--gps-fix-after S] [--arm] [--launch V,H,PITCH] [--fault SPEC ...]
+        [--eeprom FILE]
 
 --flight NAME takes the named flight of fly.py (its stick script in sim/flight/pilots/, its
 length, gusts and upsets); --rc FILE any stick script in the simulator's --rc format
@@ -32,6 +33,8 @@ after any --input lines). --launch V,H,PITCH is the backend's hand launch: held 
 PITCH deg nose up, then thrown at V m/s.
 --fault SPEC goes to apm25sim as it is (its --help lists the
 faults: gps:no-fix@45-75 loses the fix for 30 s).
+--eeprom FILE is apm25sim's: the board's EEPROM from FILE and back
+into it at the end (what an earlier run saved, as across a power cycle).
 Exit status: apm25sim's, or 4 when the backend failed, 5 on the timeout.
 """
 import argparse
@@ -122,6 +125,7 @@ def parse_args(argv):
     p.add_argument("--launch", metavar="V,H,PITCH",
                    help="the backend's hand launch: held at H m, PITCH deg nose up, thrown at V m/s after --hold")
     p.add_argument("--mission", help="apm25sim --mission: a QGC WPL 110 file into the EEPROM before the run")
+    p.add_argument("--eeprom", help="apm25sim --eeprom: the EEPROM from this file, written back at the end")
     p.add_argument("--profile", help="apm25sim --profile: the sections' cycle counts")
     p.add_argument("--fault", action="append", default=[], metavar="SPEC", help="apm25sim --fault SPEC (repeatable)")
     p.add_argument("--physics-rate", type=int, default=1000, help="frames per simulated second (default 1000)")
@@ -229,6 +233,8 @@ def run(args):
             sim_cmd += ["--gps-fix-after", "%g" % args.gps_fix_after]
         if args.mission:
             sim_cmd += ["--mission", args.mission]
+        if args.eeprom:
+            sim_cmd += ["--eeprom", args.eeprom]
         if args.profile:
             sim_cmd += ["--profile", args.profile]
         for spec in args.fault:

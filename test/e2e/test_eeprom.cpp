@@ -501,8 +501,8 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfASettingsSave) {
 // `cal mag` on a tumble, then `save`: the calibration's floats all change. The console
 // waits through the 30 s of turning on empty lines (ignored) before the declination and
 // the save (the characters come a little slower than the baud rate: the save starts near
-// 36.15 s and ends near 36.69 s: the cuts go on to 36.75 s, past its end whatever a pass more
-// or less on the way there).
+// 36.15 s and ends near 36.69 s, the second record's 102 bytes: the cuts go on to 36.77 s,
+// past its end whatever a pass more or less on the way there).
 TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
     E2E_REQUIRE_TOOLS("firmware.elf", "apm25sim", "scenario");
     const double input_at_s = 5.5, char_s = 10.0 / 115200.0;
@@ -514,7 +514,7 @@ TEST(Eeprom, PowerCutAtEveryMillisecondOfACompassCalibrationSave) {
                                  {record2::slot_address(1), slot2_of(numbered_settings(3, true), 3)},
                                  {slots::slot_address(0), slot_of(encoded(numbered_settings(4, false)), 2)},
                                  {record2::slot_address(0), slot2_of(numbered_settings(4, false), 2)}},
-                                35.8, 36.75);
+                                35.8, 36.77);
     // The save is the new calibration's: the fit's verdict came before it.
     const e2e::Line* fit = find_line(r.lines, "# cal mag: offset");
     ASSERT_TRUE(fit) << "no cal mag result";
