@@ -860,17 +860,9 @@ def fly_stabilized(f, name, t_turn, t_out, seconds, worst_us, bank):
 
 
 # The simulator's GPS origin (apm25sim --home's default) and its flat map (sim/models/Geodesy.h),
-# to put the home the board says on the backend's north-east metres.
-SIM_HOME = (7.135045, -73.119421, 1028.0)
-
-
-def sim_ned(lat_deg, lon_deg):
-    a, e2 = 6378137.0, 6.69437999014e-3
-    s = math.sin(math.radians(SIM_HOME[0]))
-    r_m = a * (1 - e2) / (1 - e2 * s * s) ** 1.5
-    r_n = a / math.sqrt(1 - e2 * s * s)
-    return (math.radians(lat_deg - SIM_HOME[0]) * (r_m + SIM_HOME[2]),
-            math.radians(lon_deg - SIM_HOME[1]) * (r_n + SIM_HOME[2]) * math.cos(math.radians(SIM_HOME[0])))
+# to put the home the board says on the backend's north-east metres: mission_flight's.
+sys.path.insert(0, os.path.join(ROOT, "sim", "flight"))
+from mission_flight import SIM_HOME, sim_ned  # noqa: E402,F401
 
 
 GPS_LATENCY_S = 0.2  # apm25sim --gps-latency's default
