@@ -87,7 +87,7 @@ def main():
     types = [m.get_type() for m in msgs]
     soft_assert(set(types) <= {"HEARTBEAT", "ATTITUDE", "SYS_STATUS", "STATUSTEXT", "RC_CHANNELS", "SERVO_OUTPUT_RAW",
                                "SCALED_PRESSURE", "GPS_RAW_INT", "GLOBAL_POSITION_INT", "VFR_HUD", "HOME_POSITION",
-                               "SYSTEM_TIME"},
+                               "SYSTEM_TIME", "MISSION_CURRENT"},
                 "unexpected: %r" % set(types))
     soft_assert(msgs and msgs[0].get_type() == "STATUSTEXT" and msgs[0].text == "mode mavlink",
           "first frame: the reply to the command, got %r" % (msgs[:1],))
