@@ -48,9 +48,10 @@ constexpr uint8_t kStepBytesMax = 32;
 static void take(bool in_step) {
     mav::Parser& frames = gcs_link::parser();
     uint8_t step_bytes = 0;
+    bool mavlink = port::mavlink_mode();  // changes only with a frame's end or the escape
     while (!commands.full() && !frames.ready()) {
         if (in_step && (++step_bytes > kStepBytesMax)) return;
-        if (in_step && !port::mavlink_mode()) {
+        if (in_step && !mavlink) {
             const int next = Serial.peek();
             if (next == '\r' || next == '\n') return;
         }
@@ -59,11 +60,14 @@ static void take(bool in_step) {
         // In MAVLink a ground station's frames are set aside (not garbage to answer). In
         // a text mode every byte is the console's too (0xFD/0xFE in garbage would hide the
         // next ~260 bytes), and the parser only looks for a ground station's HEARTBEAT.
-        const bool was_mavlink = port::mavlink_mode();
+        const bool was_mavlink = mavlink;
         if (frames.consume((uint8_t)b)) {
             returns = 0;
-            gcs_link::take_heartbeat();
-            if (was_mavlink || port::mavlink_mode()) continue;
+            if (frames.ready()) {
+                gcs_link::take_heartbeat();
+                mavlink = port::mavlink_mode();
+            }
+            if (was_mavlink || mavlink) continue;
         }
         if (was_mavlink) {
             // In MAVLink only frames act: no text line is a command (a ground station's
@@ -73,6 +77,7 @@ static void take(bool in_step) {
             if (returns == kEscapeReturns) {
                 returns = 0;
                 port::escape_to_text();
+                mavlink = port::mavlink_mode();
                 forget_partial_line();
                 console::Command help{};
                 help.id = console::CommandId::Help;  // the console's first words: what it takes

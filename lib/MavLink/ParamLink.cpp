@@ -30,8 +30,7 @@ int16_t apply_param_set(settings::Settings& s, const ParamSet& p, bool& changed)
     changed = false;
     const int16_t index = params::find(p.name);
     if (index < 0) return -1;
-    const float before = params::get(s, (uint16_t)index);
-    if (params::set(s, (uint16_t)index, p.value)) changed = params::get(s, (uint16_t)index) != before;
+    params::set(s, (uint16_t)index, p.value, &changed);
     return index;
 }
 

@@ -12,12 +12,14 @@
 #define PARAM_TABLE PROGMEM
 #define COPY_ROW(dst, src) memcpy_P((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)pgm_read_byte(&kRows[(r)].member))
+#define AT_BYTE(row_ptr, member) ((uint8_t)pgm_read_byte(&(row_ptr)->member))
 #define ROW_WORD(r, member) ((uint16_t)pgm_read_word(&kRows[(r)].member))
 #define ROW_FLOAT(dst, r, member) memcpy_P((dst), &kRows[(r)].member, sizeof(float))
 #else
 #define PARAM_TABLE
 #define COPY_ROW(dst, src) memcpy((dst), (src), sizeof(Row))
 #define ROW_BYTE(r, member) ((uint8_t)kRows[(r)].member)
+#define AT_BYTE(row_ptr, member) ((uint8_t)(row_ptr)->member)
 #define ROW_WORD(r, member) ((uint16_t)kRows[(r)].member)
 #define ROW_FLOAT(dst, r, member) memcpy((dst), &kRows[(r)].member, sizeof(float))
 #endif
@@ -75,7 +77,7 @@ constexpr uint8_t kLetterX = (uint8_t)('X' - '0');
 // TCONST 0.5 s is slower than a trainer's roll and pitch response (a few tenths of a
 // second), so the demanded rates are ones it can fly; P 1 and D 0.08 (roll), 0.04 (pitch)
 // and IMAX 3000 (two thirds of the throw) are ArduPlane's, for models of this size.
-const Row kRows[] PARAM_TABLE = {
+constexpr Row kRows[] PARAM_TABLE = {
     {"RLL2SRV_TCONST", Type::Float, 0, 1, 0, AT(flight.roll.tconst_s), 0.4f, 1.0f, 0.5f,
      PARAM_DOC("Roll time constant", "s",
                "How fast STABILIZE brings the bank to the one asked for: the roll error over this time is the "
@@ -535,15 +537,21 @@ const Row kRows[] PARAM_TABLE = {
 };
 #undef AT
 constexpr uint8_t kRowCount = (uint8_t)(sizeof kRows / sizeof kRows[0]);
+// The parameters' count, summed when compiled (a walk over the rows' counts in flash took
+// ~2 000 cycles, and a PARAM_SET asked for it twice).
+constexpr uint16_t counts_from(uint8_t r) {
+    return r == kRowCount ? (uint16_t)0 : (uint16_t)(kRows[r].count + counts_from((uint8_t)(r + 1u)));
+}
+constexpr uint16_t kParamCount = counts_from(0);
 
 // The row holding index, and the instance within it; false past the end. Only the counts
 // are read on the way and the one row copied: a walk copying every row (35 bytes from
 // flash each) took a PARAM_SET of a row near the table's end past its task's budget.
 bool locate(uint16_t index, Row& row, uint8_t& instance) {
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        const uint8_t n = ROW_BYTE(r, count);
+    for (const Row* r = kRows; r != kRows + kRowCount; ++r) {  // a pointer: no multiply a row
+        const uint8_t n = AT_BYTE(r, count);
         if (index < n) {
-            COPY_ROW(&row, &kRows[r]);
+            COPY_ROW(&row, r);
             instance = (uint8_t)index;
             return true;
         }
@@ -647,11 +655,7 @@ Rows rows_within(uint16_t from, uint16_t to) {
     return rows;
 }
 
-uint16_t count() {
-    uint16_t n = 0;
-    for (uint8_t r = 0; r < kRowCount; ++r) n = (uint16_t)(n + ROW_BYTE(r, count));
-    return n;
-}
+uint16_t count() { return kParamCount; }
 
 bool info(uint16_t index, Info& out) {
     Row row;
@@ -672,23 +676,27 @@ bool info(uint16_t index, Info& out) {
 // not info() for every index: MAVLink's PARAM_SET and PARAM_REQUEST_READ look names up
 // between samples.
 int16_t find(const char* name) {
+    const char first = upper(name[0]);
     uint16_t index = 0;
-    for (uint8_t r = 0; r < kRowCount; ++r) {
-        const uint8_t count = ROW_BYTE(r, count);
-        uint8_t i = 0, j = 0;  // the row's name (read from flash a character at a time), name
-        int16_t instance = 0;
-        bool match = true;
-        for (char rc = (char)ROW_BYTE(r, name[0]); match && rc != '\0'; rc = (char)ROW_BYTE(r, name[++i])) {
-            if (rc == '#') {
-                // A digit, or a letter (X, Y, Z): '0' + first + instance, whatever its case.
-                const char c = upper(name[j++]);
-                instance = (int16_t)(c - '0' - (char)ROW_BYTE(r, first));
-                match = instance >= 0 && instance < count;
-            } else {
-                match = upper(name[j++]) == rc;
+    for (const Row* r = kRows; r != kRows + kRowCount; ++r) {  // a pointer: no multiply a row
+        const uint8_t count = AT_BYTE(r, count);
+        // The first character rules out all rows but a few (a name never starts with '#').
+        if (AT_BYTE(r, name[0]) == (uint8_t)first) {
+            uint8_t i = 1, j = 1;  // the row's name (read from flash a character at a time), name
+            int16_t instance = 0;
+            bool match = true;
+            for (char rc = (char)AT_BYTE(r, name[1]); match && rc != '\0'; rc = (char)AT_BYTE(r, name[++i])) {
+                if (rc == '#') {
+                    // A digit, or a letter (X, Y, Z): '0' + first + instance, whatever its case.
+                    const char c = upper(name[j++]);
+                    instance = (int16_t)(c - '0' - (char)AT_BYTE(r, first));
+                    match = instance >= 0 && instance < count;
+                } else {
+                    match = upper(name[j++]) == rc;
+                }
             }
+            if (match && name[j] == '\0') return (int16_t)(index + instance);
         }
-        if (match && name[j] == '\0') return (int16_t)(index + instance);
         index = (uint16_t)(index + count);
     }
     return -1;
@@ -713,7 +721,8 @@ bool is_flight_mode(uint16_t index) {
     return locate(index, row, instance) && holds_flight_mode(row);
 }
 
-bool set(Settings& s, uint16_t index, float value) {
+bool set(Settings& s, uint16_t index, float value, bool* changed) {
+    if (changed != nullptr) *changed = false;
     Row row;
     uint8_t instance;
     if (!locate(index, row, instance) || !in_range(row, value)) return false;
@@ -721,7 +730,10 @@ bool set(Settings& s, uint16_t index, float value) {
     if (holds_flight_mode(row) && !flight::mode_known((uint8_t)value)) return false;
     const float before = read(s, row, instance);
     write(s, row, instance, value);
-    if (ends_in_order(s.flight.rc) && ends_in_order(s.flight.servo)) return true;
+    if (ends_in_order(s.flight.rc) && ends_in_order(s.flight.servo)) {
+        if (changed != nullptr) *changed = read(s, row, instance) != before;
+        return true;
+    }
     write(s, row, instance, before);
     return false;
 }

@@ -58,8 +58,9 @@ float get(const settings::Settings& s, uint16_t index);
 // Sets a value: false (nothing changed) when index is past the end, the value is NaN,
 // out of range, not whole for an integer type, not a mode the board has (FLTMODEn), or
 // leaves an end point pair out of order
-// (RCn/SERVOn: MIN <= TRIM <= MAX).
-bool set(settings::Settings& s, uint16_t index, float value);
+// (RCn/SERVOn: MIN <= TRIM <= MAX). *changed (when given): the value stored now differs
+// from the one before (one walk to the row for MAVLink's PARAM_SET, not three).
+bool set(settings::Settings& s, uint16_t index, float value, bool* changed = nullptr);
 // ArduPilot's COMPASS_OFS (mGauss, added to the field) of a `cal mag` offset (uT, subtracted
 // from the field): 1 uT = 10 mGauss, rounded to 0.01 mGauss (the nearest float to that
 // decimal, so that the value a ground station sets comes back as sent).
