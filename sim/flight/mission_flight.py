@@ -127,6 +127,34 @@ def sim_ned(lat_deg, lon_deg):
             math.radians(lon_deg - SIM_HOME[1]) * (r_n + SIM_HOME[2]) * math.cos(math.radians(SIM_HOME[0])))
 
 
+def captured_on_leg(samples, a, b, end_margin_m):
+    """The samples of the passes along the leg a -> b (north, east m) after capture, as the
+    host route test takes them: on a pass (within 45 deg of the leg's course and 50 m of its
+    line, before end_margin_m of its end; a gap over 1 s ends one), from the first sample
+    within 3 m of the line and 10 deg of its course. Yields (sample, along m, cross-track m,
+    whether it is a pass's first)."""
+    dn, de = b[0] - a[0], b[1] - a[1]
+    length = math.hypot(dn, de)
+    un, ue = dn / length, de / length
+    course_leg = math.degrees(math.atan2(ue, un))
+    captured, last_t = False, None
+    for r in samples:
+        pn, pe = r["north_m"] - a[0], r["east_m"] - a[1]
+        along, cross = pn * un + pe * ue, pe * un - pn * ue
+        off = abs(angle_diff(math.degrees(math.atan2(r["ve_m_s"], r["vn_m_s"])), course_leg))
+        if not (0.0 <= along <= length - end_margin_m and off < 45.0 and abs(cross) < 50.0):
+            captured = False
+            continue
+        if last_t is None or r["t"] - last_t > 1.0:
+            captured = False
+        last_t = r["t"]
+        first = False
+        if not captured and abs(cross) < 3.0 and off < 10.0:
+            captured = first = True
+        if captured:
+            yield r, along, cross, first
+
+
 class Route:
     """What the mission asks, walked as lib/Mission's executor walks it: the takeoff's
     height, then the waypoints in the order flown (DO_JUMPs taken while their count lasts),
@@ -374,26 +402,11 @@ class Flight:
 
     def leg_errors(self, samples, a, b, h0, h1):
         """Cross-track and height errors on passes along a -> b after capture."""
-        dn, de = b[0] - a[0], b[1] - a[1]
-        length = math.hypot(dn, de)
-        un, ue = dn / length, de / length
-        course_leg = math.degrees(math.atan2(ue, un))
-        xt, dh, captured, last_t = [], [], False, None
-        for r in samples:
-            pn, pe = r["north_m"] - a[0], r["east_m"] - a[1]
-            along, cross = pn * un + pe * ue, pe * un - pn * ue
-            off = abs(angle_diff(math.degrees(math.atan2(r["ve_m_s"], r["vn_m_s"])), course_leg))
-            if not (0.0 <= along <= length - WP_RADIUS_M and off < 45.0 and abs(cross) < 50.0):
-                captured = False
-                continue
-            if last_t is None or r["t"] - last_t > 1.0:
-                captured = False
-            last_t = r["t"]
-            if not captured and abs(cross) < 3.0 and off < 10.0:
-                captured = True
-            if captured:
-                xt.append(cross)
-                dh.append(self.height(r) - (h0 + (h1 - h0) * along / length))
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        xt, dh = [], []
+        for r, along, cross, _ in captured_on_leg(samples, a, b, WP_RADIUS_M):
+            xt.append(cross)
+            dh.append(self.height(r) - (h0 + (h1 - h0) * along / length))
         return xt, dh
 
     def route_height(self, passes):

@@ -862,7 +862,7 @@ def fly_stabilized(f, name, t_turn, t_out, seconds, worst_us, bank):
 # The simulator's GPS origin (apm25sim --home's default) and its flat map (sim/models/Geodesy.h),
 # to put the home the board says on the backend's north-east metres: mission_flight's.
 sys.path.insert(0, os.path.join(ROOT, "sim", "flight"))
-from mission_flight import SIM_HOME, sim_ned  # noqa: E402,F401
+from mission_flight import SIM_HOME, captured_on_leg, sim_ned  # noqa: E402,F401
 
 
 GPS_LATENCY_S = 0.2  # apm25sim --gps-latency's default
@@ -957,33 +957,14 @@ def write_rectangle(path):
 
 
 def leg_figures(samples, legs, want_h, turn_m=WP_RADIUS_M):
-    """Cross-track and height errors on the legs after capture, as the host route test takes
-    them: on a pass along a leg, from the first sample within 3 m of its line and 10 deg of
-    its course until turn_m before its end. ([cross-track m], [height error m], passes)."""
+    """Cross-track and height errors on the legs after capture (mission_flight's
+    captured_on_leg, turn_m before each leg's end). ([cross-track m], [height error m], passes)."""
     xt, dh, passes = [], [], 0
     for (a, b) in legs:
-        dn, de = b[0] - a[0], b[1] - a[1]
-        length = math.hypot(dn, de)
-        un, ue = dn / length, de / length
-        captured, last_t = False, None
-        for r in samples:
-            pn, pe = r["north_m"] - a[0], r["east_m"] - a[1]
-            along, cross = pn * un + pe * ue, pe * un - pn * ue
-            course = math.degrees(math.atan2(r["ve_m_s"], r["vn_m_s"]))
-            off = abs(angle_diff(course, math.degrees(math.atan2(ue, un))))
-            on = 0.0 <= along <= length - turn_m and off < 45.0 and abs(cross) < 50.0
-            if not on:
-                captured = False
-                continue
-            if last_t is None or r["t"] - last_t > 1.0:
-                captured = False
-            last_t = r["t"]
-            if not captured and abs(cross) < 3.0 and off < 10.0:
-                captured = True
-                passes += 1
-            if captured:
-                xt.append(cross)
-                dh.append(-r["down_m"] - want_h)
+        for r, _, cross, first in captured_on_leg(samples, a, b, turn_m):
+            passes += first
+            xt.append(cross)
+            dh.append(-r["down_m"] - want_h)
     return xt, dh, passes
 
 
