@@ -55,7 +55,7 @@ void set_leds(bool calibrating, bool running, bool fault) {
 // library computes the clock divider at compile time.
 void spi_begin() { SPI.begin(); }
 
-static void spi_select(void*, bool on, uint32_t clock_hz) {
+void seam::spi_select(void*, bool on, uint32_t clock_hz) {
     if (on) {
         if (clock_hz >= mpu6000::kReadClockHz)
             SPI.beginTransaction(SPISettings(mpu6000::kReadClockHz, MSBFIRST, SPI_MODE0));
@@ -69,10 +69,8 @@ static void spi_select(void*, bool on, uint32_t clock_hz) {
         SPI.endTransaction();
     }
 }
-static uint8_t spi_transfer(void*, uint8_t out) { return SPI.transfer(out); }
-static void wait_ms(void*, uint16_t ms) { delay(ms); }
-
-const mpu6000::SpiDevice kSpi = {nullptr, spi_select, spi_transfer, wait_ms};
+uint8_t seam::spi_transfer(void*, uint8_t out) { return SPI.transfer(out); }
+void seam::wait_ms(void*, uint16_t ms) { delay(ms); }
 
 // ---------------------------------------------------------------------------
 // I2C on Wire. Register writes are one transmission; reads set the register pointer,
@@ -90,14 +88,14 @@ bool i2c_timed_out() {
     return t;
 }
 
-static bool i2c_write_reg(void*, uint8_t addr7, uint8_t reg, uint8_t value) {
+bool seam::i2c_write_reg(void*, uint8_t addr7, uint8_t reg, uint8_t value) {
     Wire.beginTransmission(addr7);
     Wire.write(reg);
     Wire.write(value);
     return Wire.endTransmission() == 0;
 }
 
-static bool i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t len) {
+bool seam::i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t len) {
     Wire.beginTransmission(addr7);
     Wire.write(reg);
     if (Wire.endTransmission() != 0) return false;
@@ -105,8 +103,6 @@ static bool i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint
     for (uint8_t i = 0; i < len; ++i) data[i] = (uint8_t)Wire.read();
     return true;
 }
-
-const hmc5883::I2cBus kI2c = {nullptr, i2c_write_reg, i2c_read_regs, wait_ms};
 
 // Open drain by hand: a line is driven low as an output, released as an input with
 // its pull-up.

@@ -113,8 +113,16 @@ void i2c_recover();
 // True (and clears it) if a Wire call timed out since the last call.
 bool i2c_timed_out();
 
-// The drivers' bus seams, filled with SPI and Wire.
-extern const mpu6000::SpiDevice kSpi;
-extern const hmc5883::I2cBus kI2c;
+// The drivers' bus seams, filled with SPI and Wire (Board.cpp's functions), as constant
+// expressions: the sensors' static objects (Vehicle.cpp) copy them with no start-up code.
+namespace seam {
+void spi_select(void*, bool on, uint32_t clock_hz);
+uint8_t spi_transfer(void*, uint8_t out);
+void wait_ms(void*, uint16_t ms);
+bool i2c_write_reg(void*, uint8_t addr7, uint8_t reg, uint8_t value);
+bool i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t len);
+}  // namespace seam
+constexpr mpu6000::SpiDevice kSpi = {nullptr, seam::spi_select, seam::spi_transfer, seam::wait_ms};
+constexpr hmc5883::I2cBus kI2c = {nullptr, seam::i2c_write_reg, seam::i2c_read_regs, seam::wait_ms};
 
 }  // namespace board

@@ -14,7 +14,8 @@
 
 class Compass {
 public:
-    Compass(const hmc5883::I2cBus& bus, const text::Sink* out, pipeline::AttitudePipeline& pipe)
+    // constexpr: the static object needs no start-up code.
+    constexpr Compass(const hmc5883::I2cBus& bus, const text::Sink* out, pipeline::AttitudePipeline& pipe)
         : chip_(bus), out_(out), pipe_(pipe) {}
 
     // Bring-up; with self_test the datasheet's positive-bias test sets the per-axis

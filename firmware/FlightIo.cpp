@@ -51,9 +51,6 @@ static uint16_t override_timeout_8ms(float s) {
     return t >= 65534.0f ? (uint16_t)65534u : (uint16_t)t;
 }
 
-FlightIo::FlightIo(const text::Sink* out)
-    : out_(out), control_(pipe.settings().flight, flight::FlightControl::ConfiguredLater{}) {}
-
 void FlightIo::begin() {
     uint16_t widths[flight::kChannels];
     configure();  // the loaded settings
@@ -448,7 +445,6 @@ uint8_t FlightIo::servo_output_raw(mav::Packer& mavlink, uint8_t* frame, uint32_
 
 #else  // the attitude-only build: nothing to fly
 
-FlightIo::FlightIo(const text::Sink* out) : out_(out) {}
 void FlightIo::begin() {}
 void FlightIo::loop_starts(uint32_t) {}
 void FlightIo::configure() {}

@@ -31,7 +31,14 @@ class FlightIo {
 public:
     static constexpr bool kEnabled = APM25_FLIGHT != 0;
 
-    explicit FlightIo(const text::Sink* out);
+    // constexpr: the static object needs no start-up code. `settings`: the pipeline's
+    // (its flight part), kept by reference; configure() works them out after setup()'s load.
+#if APM25_FLIGHT
+    constexpr FlightIo(const text::Sink* out, const flight::FlightSettings& settings)
+        : out_(out), control_(settings, flight::FlightControl::ConfiguredLater{}) {}
+#else
+    constexpr FlightIo(const text::Sink* out, const flight::FlightSettings&) : out_(out) {}
+#endif
 
     // In setup(), once the settings are loaded: the outputs at trim and the throttle at
     // its failsafe value until the receiver's first frame, then the receiver.

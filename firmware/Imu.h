@@ -14,7 +14,8 @@ class Imu {
 public:
     static constexpr uint16_t kPeriodUs = 1000000u / mpu6000::kRateHz;  // 5 000
 
-    Imu(const mpu6000::SpiDevice& spi, const text::Sink* out) : chip_(spi), out_(out) {}
+    // constexpr: the static object needs no start-up code.
+    constexpr Imu(const mpu6000::SpiDevice& spi, const text::Sink* out) : chip_(spi), out_(out) {}
 
     // Bring-up (~110 ms); a failure is reported once. True when the chip is configured.
     bool start(uint32_t now_ms);

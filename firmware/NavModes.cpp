@@ -40,8 +40,8 @@ nav::L1Params l1_params = nav::kL1Defaults;
 nav::TecsParams tecs_params = nav::kTecsDefaults;
 mission::ExecutorParams ex_params = mission::kExecutorDefaults;
 
-nav::L1Control l1(l1_params);
-nav::Tecs tecs(tecs_params);
+nav::L1Control l1(l1_params, nav::L1Control::CoefficientsSetLater{});  // configure() sets them
+nav::Tecs tecs(tecs_params, nav::Tecs::ParamsSetLater{});  // configure() sets them
 
 // The mission is MissionLink's (the upload's, or the simulator's --mission in the EEPROM).
 mission::MissionExecutor executor(mission_link::store, position::navigator().map(), position::navigator().home(),
@@ -164,6 +164,7 @@ bool fly_to(const mission::Command& to) {
 
 void configure() {
     mission::nav_params(cfg().vehicle.nav, cfg().flight, l1_params, tecs_params, ex_params);
+    l1.set_coefficients();
     tecs.set_params();
 }
 

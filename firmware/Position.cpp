@@ -15,7 +15,7 @@ namespace position {
 using text::Writer;
 using vehicle::pipe;
 
-static nav::Navigator nav_;
+nav::Navigator nav_;
 static nav::WindEstimator wind_;
 static uint16_t last_fix_count = 0;
 static uint32_t last_run_ms = 0;
@@ -27,7 +27,6 @@ static bool home_from_gps = false;
 static uint8_t home_sats = 0;
 static uint16_t home_hdop_cm = 0;
 
-const nav::Navigator& navigator() { return nav_; }
 const nav::WindEstimator& wind() { return wind_; }
 uint8_t home_changes() { return nav_.home_changes(); }
 

@@ -25,7 +25,10 @@ constexpr uint16_t kPeriodMs = 100;
 bool due();
 void run();
 
-const nav::Navigator& navigator();
+// Position.cpp's, named here so that navigator() is a constant expression: NavModes'
+// mission executor keeps its map and home with no start-up code.
+extern nav::Navigator nav_;
+constexpr const nav::Navigator& navigator() { return nav_; }
 const nav::WindEstimator& wind();
 
 // MAV_CMD_DO_SET_HOME (the ground station's home, said on the console): false when

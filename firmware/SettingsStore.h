@@ -29,7 +29,7 @@
 
 class SettingsStore {
 public:
-    explicit SettingsStore(const text::Sink* out) : out_(out) {}
+    explicit constexpr SettingsStore(const text::Sink* out) : out_(out), part_{} {}  // no start-up code
 
     // Reads the newer valid slot (or, with none, an earlier firmware's single record) and
     // the second record paired with it into `s` (defaults when blank, corrupted, or from

@@ -21,8 +21,8 @@ pipeline::AttitudePipeline pipe(&pipeline_events, pipeline::AttitudePipeline::Se
 Imu imu(board::kSpi, out);
 Compass compass(board::kI2c, out, pipe);
 SettingsStore store(out);
-FlightIo flight_io(out);
-Tick tick;
+FlightIo flight_io(out, pipeline::AttitudePipeline::settings_of(pipe).flight);
+Tick tick = {};  // zeros at compile time (default-initialised, its vectors' constructors ran at start-up)
 
 void say(text::Flash text) { text::Writer(out).str(text).end(); }
 

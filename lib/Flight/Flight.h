@@ -183,7 +183,9 @@ public:
     // The firmware's static object (no work before init(): AttitudePipeline's
     // SettingsLoadedLater): setup() calls configure() once the settings are loaded.
     struct ConfiguredLater {};
-    FlightControl(const FlightSettings& s, ConfiguredLater) : s_(s) {}
+    // constexpr: the static object needs no start-up code (its terms zeroed until then).
+    constexpr FlightControl(const FlightSettings& s, ConfiguredLater)
+        : s_(s), scales_{}, roll_terms_{}, pitch_terms_{} {}
 
     // The end points' factors and the gains' terms again: call after any change of the
     // settings.

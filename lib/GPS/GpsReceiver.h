@@ -89,7 +89,8 @@ public:
     static uint32_t baud_at(uint8_t index);  // kBauds[index]: 38400, 57600, 9600, 115200, 4800
 
     // The port is kept by reference: it outlives the receiver.
-    explicit Receiver(const Port& port) : port_(&port), ubx_(work_), nmea_(work_) {}
+    // constexpr: a static receiver needs no start-up code.
+    explicit constexpr Receiver(const Port& port) : port_(&port), ubx_(work_), nmea_(work_) {}
 
     // Starts (or restarts with new settings) detection; Type::kNone: stays silent.
     void begin(const Config& config, uint32_t now_ms);

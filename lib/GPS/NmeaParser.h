@@ -40,7 +40,8 @@ public:
         uint16_t malformed = 0;     // too long, a field too long, no "*hh"
     };
 
-    explicit NmeaParser(Fix& work) : fix_(work) {}  // the working solution (see UbxParser)
+    // The working solution (see UbxParser); constexpr as UbxParser's.
+    explicit constexpr NmeaParser(Fix& work) : field_{}, v_{}, fix_(work) {}
 
     Message feed(uint8_t byte);
     const Fix& fix() const { return fix_; }

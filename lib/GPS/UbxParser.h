@@ -27,7 +27,9 @@ class UbxParser {
 public:
     // The working solution is the caller's (the NMEA parser may share it: only one of
     // them runs once a receiver is found).
-    explicit UbxParser(Fix& work) : fix_(work) {}
+    // constexpr (the payload zeroed, as a static object's is anyway): the firmware's
+    // receiver is then set up at compile time, with no start-up code.
+    explicit constexpr UbxParser(Fix& work) : payload_{}, fix_(work) {}
 
     static constexpr uint8_t kMaxPayload = ubx::kLenNavSol;
     static constexpr uint16_t kMaxSkip = 512;  // u-blox 6's longest output (NAV-SVINFO, 16 channels) fits

@@ -60,7 +60,7 @@ enum class ReadStatus : uint8_t {
 
 class Hmc5883 {
 public:
-    explicit Hmc5883(const I2cBus& bus) : bus_(bus) {}
+    explicit constexpr Hmc5883(const I2cBus& bus) : bus_(bus) {}  // constexpr: no start-up code
 
     // ID check, then (if run_self_test) the self-test (~100 ms), then continuous mode,
     // with read back. Without self-test the previous scale is kept (a quick re-init).

@@ -75,7 +75,8 @@ enum class Event : uint8_t {
 
 class Sequencer {
 public:
-    explicit Sequencer(const SpiDevice& spi) : spi_(spi) {}
+    // constexpr: a static sequencer needs no start-up code.
+    explicit constexpr Sequencer(const SpiDevice& spi) : spi_(spi) {}
 
     // True when service() has work at now_us (a conversion ended, the reset's wait is
     // over, a retry is due); call service() then, and only then has the bus been used.

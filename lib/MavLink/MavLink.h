@@ -315,7 +315,7 @@ struct FrameSink {
 // line buffer beyond one chunk.
 class StatusText {
 public:
-    StatusText(Packer& packer, FrameSink out) : packer_(packer), out_(out) {}
+    constexpr StatusText(Packer& packer, FrameSink out) : packer_(packer), out_(out) {}  // no start-up code
     void write(const char* data, uint8_t len);
     // For text::Sink{&status_text, &StatusText::write_text}.
     static void write_text(void* ctx, const char* data, uint8_t len) {

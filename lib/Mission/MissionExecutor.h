@@ -73,8 +73,9 @@ public:
     static constexpr uint8_t kMaxJumps = 6;
     static constexpr uint8_t kNone = 0xFF;
 
-    MissionExecutor(const MissionStore& store, const nav::LocalMap& map, const nav::Location& home,
-                    const ExecutorParams& params)
+    // constexpr: a static executor needs no start-up code.
+    constexpr MissionExecutor(const MissionStore& store, const nav::LocalMap& map, const nav::Location& home,
+                              const ExecutorParams& params)
         : store_(store), map_(map), home_(home), params_(params) {}
 
     // AUTO entered: DO_JUMP counts reset, on from seq (MISSION_SET_CURRENT's out of AUTO),

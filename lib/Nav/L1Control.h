@@ -53,6 +53,13 @@ struct L1Coefficients {
 class L1Control {
 public:
     explicit L1Control(const L1Params& params) : params_(params) { set_coefficients(); }
+    // A static object's (constexpr: no start-up code): set_coefficients() before the first
+    // update (the firmware's configure(), once the settings are loaded; not in a step).
+    struct CoefficientsSetLater {};
+    constexpr L1Control(const L1Params& params, CoefficientsSetLater) : params_(params) {}
+    // The coefficients from the parameters (the updates do it again when a parameter's
+    // bits changed).
+    void set_coefficients();
 
     // Track the line from prev to next (metres from home), at position pos_m with the GPS
     // ground velocity vel_m_s. Behind prev by more than L1 (beyond +-135 deg of the
@@ -91,8 +98,7 @@ private:
     // beyond 90 deg; holds the last side when the target is behind (ArduPilot's
     // _prevent_indecision).
     float limited_sin_eta(float sin_eta, float cos_eta, bool eta_positive, const NorthEast& vel, float speed);
-    // The coefficients from the parameters; again when a parameter's bits changed.
-    void set_coefficients();
+    // set_coefficients() again when a parameter's bits changed.
     void refresh_coefficients();
     // The leg's length and unit vector again when prev or next moved (a new leg).
     void refresh_leg(const NorthEast& prev_m, const NorthEast& next_m);

@@ -57,7 +57,7 @@ public:
 
     bool home_set() const { return home_source_ != HomeSource::kNone; }
     HomeSource home_source() const { return home_source_; }
-    const Location& home() const { return home_; }
+    constexpr const Location& home() const { return home_; }
     // Counts every change of home (the ground station is told each, HOME_POSITION).
     uint8_t home_changes() const { return home_changes_; }
 
@@ -79,7 +79,7 @@ public:
 
     // Fixes dead-reckoned over (the driver said they glitched), since power-up.
     uint16_t glitched_fixes() const { return glitched_fixes_; }
-    const LocalMap& map() const { return map_; }
+    constexpr const LocalMap& map() const { return map_; }
 
 private:
     void take_home(const Location& home, const BaroReading& baro, HomeSource source);

@@ -103,6 +103,10 @@ struct TecsInput {
 class Tecs {
 public:
     explicit Tecs(const TecsParams& params) : params_(params) { set_params(); }
+    // A static object's (constexpr: no start-up code): set_params() before the first step
+    // (the firmware's configure(), once the settings are loaded).
+    struct ParamsSetLater {};
+    constexpr Tecs(const TecsParams& params, ParamsSetLater) : params_(params) {}
     // After a change of the parameters.
     void set_params();
     // Starts over at the next steps (a mode entered): filters and demands from the aircraft.

@@ -264,6 +264,9 @@ public:
     // Rate, declination, mode and calibration; change them freely (console commands).
     settings::Settings& settings() { return settings_; }
     const settings::Settings& settings() const { return settings_; }
+    // The same as a constant expression (static: the class is not a literal type), for a
+    // static object that keeps a reference to them with no start-up code (FlightIo).
+    static constexpr settings::Settings& settings_of(AttitudePipeline& p) { return p.settings_; }
 
     // Whether a magnetometer is delivering. false: yaw is gyro-only, heading not corrected.
     void set_mag_present(bool present);
