@@ -380,28 +380,48 @@ void FlightIo::print_widths(Flash prefix, const uint16_t* widths) {
 }
 
 // The flight control's events, said as "# " lines (STATUSTEXT in `mode mavlink`).
+// One line a call (a control step, 50 Hz), the events in this order; the others wait. Two
+// lines in one step (the STABILIZE warning's two STATUSTEXT frames and the mode's line at
+// start-up) outgrew the room a parameter list leaves for a line, and the second was held
+// back; one line's frames are also all a step packs (~7 700 cycles a frame).
 void FlightIo::say_events() {
-    const uint8_t e = control_.take_events();
+    unsaid_events_ = (uint8_t)(unsaid_events_ | control_.take_events());
+    const uint8_t e = unsaid_events_;
     if (e == 0) return;
-    if ((e & flight::kEvFailsafeLost) && control_.navigating_in_failsafe())
-        Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): the mode goes on")).end();
-    else if (e & flight::kEvFailsafeLost)
-        Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT")).end();
-    if (e & flight::kEvFailsafeEncoder)
+    uint8_t said;
+    if (e & flight::kEvFailsafeLost) {
+        said = flight::kEvFailsafeLost;
+        if (control_.navigating_in_failsafe())
+            Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): the mode goes on")).end();
+        else
+            Writer(out_).str(TXT("# failsafe: receiver lost (no PPM frame for 0.5 s): wings level, gliding, throttle THR_FS_OUT")).end();
+    } else if (e & flight::kEvFailsafeEncoder) {
+        said = flight::kEvFailsafeEncoder;
         Writer(out_).str(TXT("# failsafe: receiver's encoder failsafe (throttle below THR_FS_VALUE): wings level, gliding")).end();
-    if (e & flight::kEvFailsafeEnd) print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
-    if (e & flight::kEvSensorFallback)
+    } else if (e & flight::kEvFailsafeEnd) {
+        said = flight::kEvFailsafeEnd;
+        print_flight_line(TXT("# failsafe cleared: receiver back, flight "));
+    } else if (e & flight::kEvSensorFallback) {
+        said = flight::kEvSensorFallback;
         Writer(out_).str(TXT(TXT_WARN "STABILIZE without an attitude (" TXT_MPU " or estimator): MANUAL until it returns")).end();
-    if (e & flight::kEvAttitudeBack) Writer(out_).str(TXT("# attitude back: flight STABILIZE")).end();
-    if (e & flight::kEvModeChanged) print_flight_line(TXT("# flight "));
-    if (e & flight::kEvModeRefused) {
+    } else if (e & flight::kEvAttitudeBack) {
+        said = flight::kEvAttitudeBack;
+        Writer(out_).str(TXT("# attitude back: flight STABILIZE")).end();
+    } else if (e & flight::kEvModeChanged) {
+        said = flight::kEvModeChanged;
+        print_flight_line(TXT("# flight "));
+    } else if (e & flight::kEvModeRefused) {
+        said = flight::kEvModeRefused;
         text::Flash why;
         if (!nav_modes::refused(control_.refused_mode(), why)) why = TXT("not available");
         Writer w(out_);
         w.str(TXT("# Mode change refused (switch): "));
         write_mode_name(w, control_.refused_mode());
         w.str(TXT(": ")).str(why).end();
+    } else {
+        said = e;  // no line of its own
     }
+    unsaid_events_ = (uint8_t)(unsaid_events_ & ~said);
 }
 
 bool FlightIo::print_status_line() {

@@ -126,6 +126,7 @@ private:
     flight::FlightControl control_;
     flight::Arming arming_;
     uint16_t prearm_unsaid_ = 0;  // PreArm bits still to say
+    uint8_t unsaid_events_ = 0;   // flight::Event bits taken, still to say (say_events: a line a step)
     uint32_t failsafe_since_ms_ = 0;
     bool in_failsafe_ = false;
     bool long_failsafe_done_ = false;  // FS_LONG_ACTN acted on in this failsafe
