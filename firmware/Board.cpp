@@ -11,6 +11,9 @@ extern "C" {
 #include <utility/twi.h>
 }
 
+// MPU6000 INT (wake_on_data_ready): a bare RETI.
+EMPTY_INTERRUPT(INT6_vect)
+
 namespace board {
 
 // Written high before it is an output: no low glitch on a chip select.
@@ -31,8 +34,13 @@ void init_pins() {
 }
 
 // Nothing to do in the handler: waking the core is the point; the loop reads the pin.
-static void on_data_ready() {}
-void wake_on_data_ready() { attachInterrupt(6, on_data_ready, RISING); }  // INT6 on the 2560's core
+// The registers attachInterrupt(6, f, RISING) sets (INT6 on the 2560's core), with an
+// empty vector of our own: attachInterrupt's table of eight handlers was 16 bytes of RAM
+// (and its eight vectors flash) for this one, whose handler did nothing.
+void wake_on_data_ready() {
+    EICRB = (uint8_t)((EICRB & ~(_BV(ISC60) | _BV(ISC61))) | (RISING << ISC60));
+    EIMSK |= _BV(INT6);
+}
 
 void idle_until_interrupt() {
     set_sleep_mode(SLEEP_MODE_IDLE);
