@@ -5,7 +5,14 @@
 #include <avr/wdt.h>
 
 #include <SPI.h>
-#include <Wire.h>
+// Wire's TWI driver under it, called directly (see "I2C" below); firmware.ino still
+// includes <Wire.h>, which makes the Arduino IDE and PlatformIO build the library.
+extern "C" {
+#include <utility/twi.h>
+}
+
+// MPU6000 INT (wake_on_data_ready): a bare RETI.
+EMPTY_INTERRUPT(INT6_vect)
 
 namespace board {
 
@@ -27,8 +34,13 @@ void init_pins() {
 }
 
 // Nothing to do in the handler: waking the core is the point; the loop reads the pin.
-static void on_data_ready() {}
-void wake_on_data_ready() { attachInterrupt(6, on_data_ready, RISING); }  // INT6 on the 2560's core
+// The registers attachInterrupt(6, f, RISING) sets (INT6 on the 2560's core), with an
+// empty vector of our own: attachInterrupt's table of eight handlers was 16 bytes of RAM
+// (and its eight vectors flash) for this one, whose handler did nothing.
+void wake_on_data_ready() {
+    EICRB = (uint8_t)((EICRB & ~(_BV(ISC60) | _BV(ISC61))) | (RISING << ISC60));
+    EIMSK |= _BV(INT6);
+}
 
 void idle_until_interrupt() {
     set_sleep_mode(SLEEP_MODE_IDLE);
@@ -73,34 +85,45 @@ uint8_t seam::spi_transfer(void*, uint8_t out) { return SPI.transfer(out); }
 void seam::wait_ms(void*, uint16_t ms) { delay(ms); }
 
 // ---------------------------------------------------------------------------
-// I2C on Wire. Register writes are one transmission; reads set the register pointer,
-// then read with a STOP in between (the HMC5883L's protocol, datasheet "I2C
-// Communication Protocol").
+// I2C on Wire's TWI driver (utility/twi.c), the calls Wire's own methods make, without
+// Wire: its TwoWire object (a Stream, with its vtable) and its two 32-byte buffers, which
+// <Wire.h> fixes at 32, were 94 bytes of RAM for transfers of at most 7 bytes (twi.c's
+// own buffers, TWI_BUFFER_LENGTH, hold them). The Makefile links the core as an archive:
+// with no reference left, Wire.cpp's object stays out. Register writes are one
+// transmission; reads set the register pointer, then read with a STOP in between (the
+// HMC5883L's protocol, datasheet "I2C Communication Protocol").
+
+// The slave events Wire.begin() attaches (twi.c's interrupt calls them unchecked if the
+// TWI is ever addressed as a slave): without a user callback Wire's do nothing.
+static void on_slave_receive(uint8_t*, int) {}
+static void on_slave_transmit() {}
+
 void wire_begin() {
-    Wire.begin();  // pull-ups on
-    Wire.setClock(kI2cClockHz);
-    Wire.setWireTimeout(kI2cTimeoutUs, true);
+    twi_init();  // pull-ups on
+    twi_attachSlaveTxEvent(on_slave_transmit);
+    twi_attachSlaveRxEvent(on_slave_receive);
+    twi_setFrequency(kI2cClockHz);
+    twi_setTimeoutInMicros(kI2cTimeoutUs, true);
 }
 
 bool i2c_timed_out() {
-    const bool t = Wire.getWireTimeoutFlag();
-    Wire.clearWireTimeoutFlag();
+    const bool t = twi_manageTimeoutFlag(false);
+    twi_manageTimeoutFlag(true);  // clear it
     return t;
 }
 
 bool seam::i2c_write_reg(void*, uint8_t addr7, uint8_t reg, uint8_t value) {
-    Wire.beginTransmission(addr7);
-    Wire.write(reg);
-    Wire.write(value);
-    return Wire.endTransmission() == 0;
+    uint8_t bytes[2] = {reg, value};
+    return twi_writeTo(addr7, bytes, 2, 1, 1) == 0;  // wait, STOP
 }
 
 bool seam::i2c_read_regs(void*, uint8_t addr7, uint8_t reg, uint8_t* data, uint8_t len) {
-    Wire.beginTransmission(addr7);
-    Wire.write(reg);
-    if (Wire.endTransmission() != 0) return false;
-    if (Wire.requestFrom(addr7, len) != len) return false;
-    for (uint8_t i = 0; i < len; ++i) data[i] = (uint8_t)Wire.read();
+    if (twi_writeTo(addr7, &reg, 1, 1, 1) != 0) return false;
+    // Read into a buffer of its own as Wire did: data is left alone by a short read.
+    // Longer than TWI_BUFFER_LENGTH: twi_readFrom reads nothing (so did Wire).
+    uint8_t got[TWI_BUFFER_LENGTH];
+    if (len > TWI_BUFFER_LENGTH || twi_readFrom(addr7, got, len, 1) != len) return false;
+    for (uint8_t i = 0; i < len; ++i) data[i] = got[i];
     return true;
 }
 
@@ -117,7 +140,7 @@ static void line_release(uint8_t pin) {
 }
 
 void i2c_recover() {
-    Wire.end();  // the pins back to the port
+    twi_disable();  // the pins back to the port (Wire.end())
     line_release(kPinSda);
     line_release(kPinScl);
     for (uint8_t i = 0; i < 16 && sda_low(); ++i) {

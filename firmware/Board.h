@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The APM 2.5 board as the sketch sees it: its pins, the two sensor buses on the
-// Arduino core's SPI and Wire libraries, the LEDs and the benchmark markers.
+// Arduino core's SPI library and Wire's TWI driver (twi.c), the LEDs and the benchmark markers.
 // Everything here is a small named piece; the sketch (firmware.ino) composes them.
 //
 // Pins (../shared/APM25.md): MPU6000 CS = pin 53 (PB0, also the AVR's SS: an output keeps
@@ -26,7 +26,7 @@ constexpr uint8_t kPinLedC = 25;  // a sensor fault
 constexpr uint8_t kPinSda = 20;
 constexpr uint8_t kPinScl = 21;
 constexpr uint32_t kI2cClockHz = 400000;
-// Any Wire call returns within this bound (Wire's own timeout, the bus reset with it):
+// Any I2C call returns within this bound (twi.c's timeout, the bus reset with it):
 // a compass read is ~250 us at 400 kHz, so 3 ms is ten reads' worth.
 constexpr uint32_t kI2cTimeoutUs = 3000;
 
@@ -105,15 +105,15 @@ void set_leds(bool calibrating, bool running, bool fault);
 // SPI.begin() (after init_pins). Transactions: 1 MHz for the MPU6000's register
 // writes (datasheet limit), 8 MHz (the AVR's fastest) for sensor reads.
 void spi_begin();
-// Wire at 400 kHz with a bounded timeout that resets the TWI.
+// The TWI at 400 kHz with a bounded timeout that resets it (as Wire.begin() would).
 void wire_begin();
 // Frees the I2C bus when a slave holds SDA low: up to 16 SCL pulses until SDA is
-// released (>= 9 clocks finish any byte), then a STOP, then Wire again.
+// released (>= 9 clocks finish any byte), then a STOP, then wire_begin() again.
 void i2c_recover();
-// True (and clears it) if a Wire call timed out since the last call.
+// True (and clears it) if an I2C call timed out since the last call.
 bool i2c_timed_out();
 
-// The drivers' bus seams, filled with SPI and Wire (Board.cpp's functions), as constant
+// The drivers' bus seams, filled with SPI and twi.c (Board.cpp's functions), as constant
 // expressions: the sensors' static objects (Vehicle.cpp) copy them with no start-up code.
 namespace seam {
 void spi_select(void*, bool on, uint32_t clock_hz);

@@ -13,7 +13,7 @@
 // LoopLoad. The estimator is lib/Pipeline and lib/DCM, which the host replay tool runs
 // too. Your own code goes in user.ino.
 #include <SPI.h>
-#include <Wire.h>
+#include <Wire.h>  // unused itself: makes the IDE and PlatformIO build Wire's twi.c (Board.cpp)
 
 #include "AirspeedInput.h"
 #include "Board.h"

@@ -45,17 +45,25 @@ constexpr uint16_t kMaxIntervalMs = 60000;  // ArduPilot's longest
 
 }  // namespace
 
+// MAV_DATA_STREAM id -> group, in flash: the switch it was became a lookup table the
+// compiler put in the AVR's RAM (12 bytes of .data).
+const uint8_t kGroupOfDataStream[] STREAM_TABLE = {
+    kStreamGroups,   // 0 ALL: not a group
+    kGroupRawSens,   // 1 MAV_DATA_STREAM_RAW_SENSORS
+    kGroupExtStat,   // 2 _EXTENDED_STATUS
+    kGroupRcChan,    // 3 _RC_CHANNELS
+    kStreamGroups,   // 4 _RAW_CONTROLLER: nothing sent
+    kStreamGroups,   // 5 unknown
+    kGroupPosition,  // 6 _POSITION
+    kStreamGroups, kStreamGroups, kStreamGroups,  // 7..9 unknown
+    kGroupExtra1,    // 10
+    kGroupExtra2,    // 11
+    kGroupExtra3,    // 12
+};
+
 StreamGroup group_of_data_stream(uint8_t stream_id) {
-    switch (stream_id) {
-        case 1: return kGroupRawSens;   // MAV_DATA_STREAM_RAW_SENSORS
-        case 2: return kGroupExtStat;   // _EXTENDED_STATUS
-        case 3: return kGroupRcChan;    // _RC_CHANNELS
-        case 6: return kGroupPosition;  // _POSITION
-        case 10: return kGroupExtra1;
-        case 11: return kGroupExtra2;
-        case 12: return kGroupExtra3;
-        default: return kStreamGroups;  // ALL (0), RAW_CONTROLLER (4: nothing sent), unknown
-    }
+    if (stream_id >= sizeof kGroupOfDataStream) return kStreamGroups;  // unknown
+    return (StreamGroup)TABLE_BYTE(kGroupOfDataStream[stream_id]);
 }
 
 StreamMsg stream_msg_of(uint32_t msgid) {

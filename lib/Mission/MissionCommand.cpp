@@ -1,21 +1,31 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MissionCommand.h"
 
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define CODE_TABLE PROGMEM
+#define CODE_BYTE(p) ((uint8_t)pgm_read_byte(&(p)))
+#else
+#define CODE_TABLE
+#define CODE_BYTE(p) ((uint8_t)(p))
+#endif
+
 namespace mission {
 
 namespace {
 
-// The code in byte 0 of each supported id (its index here). Bytes: every id is below 256,
-// and the table is in the AVR's RAM (8 bytes, not 16).
-constexpr uint8_t kCodes[] = {kNavWaypoint,       kNavLoiterUnlim, kNavLoiterTurns, kNavLoiterTime,
-                               kNavReturnToLaunch, kNavTakeoff,     kDoJump,         kDoChangeSpeed};
+// The code in byte 0 of each supported id (its index here). Bytes: every id is below 256
+// (8 bytes, not 16). In flash on the AVR (CODE_BYTE reads it): only read, by index, and a
+// constexpr array indexed at run time is otherwise copied into RAM at start-up.
+const uint8_t kCodes[] CODE_TABLE = {kNavWaypoint,       kNavLoiterUnlim, kNavLoiterTurns, kNavLoiterTime,
+                                   kNavReturnToLaunch, kNavTakeoff,     kDoJump,         kDoChangeSpeed};
 constexpr uint8_t kCodeCount = sizeof kCodes / sizeof kCodes[0];
 constexpr uint8_t kRelativeBit = 0x10u;
 constexpr uint8_t kCcwBit = 0x20u;
 
 int8_t code_of(uint16_t id) {
     for (uint8_t i = 0; i < kCodeCount; ++i)
-        if (kCodes[i] == id) return (int8_t)i;
+        if (CODE_BYTE(kCodes[i]) == id) return (int8_t)i;
     return -1;
 }
 
@@ -50,7 +60,7 @@ void pack(const Command& c, uint8_t out[kCommandBytes]) {
 bool unpack(const uint8_t in[kCommandBytes], Command& c) {
     const uint8_t code = in[0] & 0x0Fu;
     if (code >= kCodeCount || (in[0] & 0xC0u) != 0) return false;
-    c.id = kCodes[code];
+    c.id = CODE_BYTE(kCodes[code]);
     c.relative_alt = (in[0] & kRelativeBit) != 0;
     c.loiter_ccw = (in[0] & kCcwBit) != 0;
     c.p1 = (uint16_t)get_le(in + 1, 2);

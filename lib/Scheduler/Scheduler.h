@@ -40,10 +40,14 @@ namespace sched {
 constexpr uint8_t kAlways = 1;  // a loop task not held back for the next sample
 
 // A task's record since start-up.
+// overruns is a byte: the only reader is `status`'s tasks line (firmware/Tasks.cpp;
+// `make bench` times the tasks from the simulator's profile, not from these), where 255
+// says "often" as well as 65535 would; 37 rows x 1 B of the 8 KB RAM saved.
 struct TaskStats {
-    uint16_t overruns;   // runs longer than the budget (saturates)
+    uint8_t overruns;    // runs longer than the budget (saturates at 255)
     uint16_t max_ticks;  // the longest run
 };
+constexpr uint8_t kMaxOverruns = 0xFFu;  // TaskStats::overruns saturates here
 
 // A row's test: none (due by its period alone), or the row's function.
 inline bool is_due(decltype(nullptr)) { return true; }
@@ -74,7 +78,7 @@ struct Timing {
     __attribute__((always_inline)) static uint16_t record(TaskStats& s, uint16_t start, uint16_t budget_ticks) {
         const uint16_t end = Clock::ticks();
         const uint16_t took = (uint16_t)(end - start);
-        if (took > budget_ticks && s.overruns != 0xFFFFu) ++s.overruns;
+        if (took > budget_ticks && s.overruns != kMaxOverruns) ++s.overruns;
         if (took > s.max_ticks) s.max_ticks = took;
         return end;
     }

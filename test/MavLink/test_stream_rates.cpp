@@ -32,6 +32,7 @@ TEST(StreamRates, GroupsAreArduPlanes) {
     EXPECT_EQ(mav::group_of_data_stream(0), mav::kStreamGroups);   // ALL: not one group
     EXPECT_EQ(mav::group_of_data_stream(4), mav::kStreamGroups);   // RAW_CONTROLLER: nothing sent
     EXPECT_EQ(mav::group_of_data_stream(13), mav::kStreamGroups);
+    for (uint8_t unknown : {5, 7, 8, 9, 255}) EXPECT_EQ(mav::group_of_data_stream(unknown), mav::kStreamGroups);
     // Each message the board sends on a timer, by its MAVLink id.
     EXPECT_EQ(mav::stream_msg_of(29), mav::kStreamScaledPressure);
     EXPECT_EQ(mav::stream_msg_of(1), mav::kStreamSysStatus);

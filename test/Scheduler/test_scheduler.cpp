@@ -136,10 +136,10 @@ TEST_F(Scheduler, ALoopTasksTimeCountsAgainstTheOnesAfterIt) {
 
 TEST_F(Scheduler, TheOverrunCountSaturates) {
     Table t;
-    t.stats[kTask_a].overruns = 0xFFFFu;
+    t.stats[kTask_a].overruns = sched::kMaxOverruns;
     cost_us[0] = 1000;
     t.run_sample_tasks();
-    EXPECT_EQ(t.stats[kTask_a].overruns, 0xFFFFu);
+    EXPECT_EQ(t.stats[kTask_a].overruns, sched::kMaxOverruns);
 }
 
 TEST_F(Scheduler, BudgetsRoundUpToWholeTicks) {
