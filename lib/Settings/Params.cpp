@@ -543,6 +543,11 @@ constexpr uint16_t counts_from(uint8_t r) {
     return r == kRowCount ? (uint16_t)0 : (uint16_t)(kRows[r].count + counts_from((uint8_t)(r + 1u)));
 }
 constexpr uint16_t kParamCount = counts_from(0);
+// find() matches a name's first character before the rest: no row may start with its number.
+constexpr bool no_name_starts_numbered(uint8_t r) {
+    return r == kRowCount || (kRows[r].name[0] != '#' && no_name_starts_numbered((uint8_t)(r + 1u)));
+}
+static_assert(no_name_starts_numbered(0), "a row's name starts with '#': find() would miss it");
 
 // The row holding index, and the instance within it; false past the end. Only the counts
 // are read on the way and the one row copied: a walk copying every row (35 bytes from
@@ -680,7 +685,7 @@ int16_t find(const char* name) {
     uint16_t index = 0;
     for (const Row* r = kRows; r != kRows + kRowCount; ++r) {  // a pointer: no multiply a row
         const uint8_t count = AT_BYTE(r, count);
-        // The first character rules out all rows but a few (a name never starts with '#').
+        // The first character rules out all rows but a few (none starts with '#': static_assert).
         if (AT_BYTE(r, name[0]) == (uint8_t)first) {
             uint8_t i = 1, j = 1;  // the row's name (read from flash a character at a time), name
             int16_t instance = 0;
